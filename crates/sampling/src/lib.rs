@@ -1,0 +1,35 @@
+//! Sampling building blocks for the `restir` renderer.
+//!
+//! - [`Pcg32`]: a small PCG random number generator whose whole state can be stored and restored
+//!   (ReSTIR PT replays paths from stored states), with [`Pcg32::for_pixel_sample`] deriving
+//!   independent streams from `(seed, pixel, sample index)`.
+//! - [`sequences`]: low-discrepancy sequences (Halton, R2).
+//! - [`warp`]: warps from the unit square with their pdfs, in triples (`sample_*`, `*_pdf`, and the
+//!   inverse where it exists).
+//! - [`Distribution1D`], [`Distribution2D`]: piecewise-constant distributions; [`AliasTable`]: O(1)
+//!   discrete sampling.
+//!
+//! Conventions: random numbers are arguments (`u: f32`, `u: Vec2`) in `[0, 1)`; a pdf over
+//! directions is per unit solid angle and its name says so (`*_pdf` functions in [`warp`] document
+//! their measure); discrete probabilities are called `pmf`.
+//!
+//! ```
+//! use restir_sampling::{Pcg32, warp};
+//! use glam::Vec2;
+//! let mut rng = Pcg32::for_pixel_sample(7, 1234, 0);
+//! let u = Vec2::new(rng.next_f32(), rng.next_f32());
+//! let wi = warp::sample_cosine_hemisphere(u);
+//! let pdf_sa = warp::cosine_hemisphere_pdf(wi.z);
+//! assert!(wi.z >= 0.0 && pdf_sa >= 0.0);
+//! ```
+
+mod distribution;
+mod rng;
+pub mod sequences;
+pub mod warp;
+
+pub use distribution::{AliasTable, Distribution1D, Distribution2D};
+pub use rng::{Pcg32, mix64};
+
+/// The largest `f32` strictly below one: random numbers are clamped to it so that `u < 1` holds.
+pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;

@@ -1,0 +1,253 @@
+//! Warps from the unit square to common domains, each with its pdf and, where it exists, its
+//! inverse. Directions are in a local frame with `z` up; pdfs over directions are per unit solid
+//! angle, pdfs over points per unit area.
+
+use core::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
+use glam::{Vec2, Vec3};
+
+const INV_4PI: f32 = 0.25 * FRAC_1_PI;
+const INV_2PI: f32 = 0.5 * FRAC_1_PI;
+
+/// Shirley–Chiu concentric map from the square to the unit disk (area-preserving up to a constant).
+#[inline]
+pub fn sample_concentric_disk(u: Vec2) -> Vec2 {
+    let o = 2.0 * u - Vec2::ONE;
+    if o.x == 0.0 && o.y == 0.0 {
+        return Vec2::ZERO;
+    }
+    let (r, theta) = if o.x.abs() > o.y.abs() {
+        (o.x, FRAC_PI_4 * (o.y / o.x))
+    } else {
+        (o.y, FRAC_PI_2 - FRAC_PI_4 * (o.x / o.y))
+    };
+    let (s, c) = theta.sin_cos();
+    r * Vec2::new(c, s)
+}
+
+/// The inverse of [`sample_concentric_disk`].
+pub fn invert_concentric_disk(p: Vec2) -> Vec2 {
+    let r = p.length();
+    if r == 0.0 {
+        return Vec2::splat(0.5);
+    }
+    let mut phi = p.y.atan2(p.x);
+    if phi < -FRAC_PI_4 {
+        phi += 2.0 * PI;
+    }
+    let (a, b) = if phi < FRAC_PI_4 {
+        (r, phi * r / FRAC_PI_4)
+    } else if phi < 3.0 * FRAC_PI_4 {
+        (-(phi - FRAC_PI_2) * r / FRAC_PI_4, r)
+    } else if phi < 5.0 * FRAC_PI_4 {
+        (-r, -(phi - PI) * r / FRAC_PI_4)
+    } else {
+        ((phi - 3.0 * FRAC_PI_2) * r / FRAC_PI_4, -r)
+    };
+    (Vec2::new(a, b) + Vec2::ONE) * 0.5
+}
+
+/// Uniform density on the unit disk, per unit area.
+pub const UNIT_DISK_PDF: f32 = FRAC_1_PI;
+
+/// Cosine-weighted direction on the upper hemisphere (Malley's method over the concentric disk).
+#[inline]
+pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
+    let d = sample_concentric_disk(u);
+    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
+    Vec3::new(d.x, d.y, z)
+}
+
+/// Solid-angle pdf of [`sample_cosine_hemisphere`]: `cos θ / π` for `cos θ > 0`, else 0.
+#[inline]
+pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
+    if cos_theta > 0.0 {
+        cos_theta * FRAC_1_PI
+    } else {
+        0.0
+    }
+}
+
+/// The inverse of [`sample_cosine_hemisphere`].
+pub fn invert_cosine_hemisphere(w: Vec3) -> Vec2 {
+    invert_concentric_disk(Vec2::new(w.x, w.y))
+}
+
+/// Uniform direction on the upper hemisphere.
+pub fn sample_uniform_hemisphere(u: Vec2) -> Vec3 {
+    let z = u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let (s, c) = (2.0 * PI * u.y).sin_cos();
+    Vec3::new(r * c, r * s, z)
+}
+
+/// Solid-angle pdf of [`sample_uniform_hemisphere`]: `1 / (2π)`.
+pub const UNIFORM_HEMISPHERE_PDF: f32 = INV_2PI;
+
+/// Uniform direction on the unit sphere.
+#[inline]
+pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let (s, c) = (2.0 * PI * u.y).sin_cos();
+    Vec3::new(r * c, r * s, z)
+}
+
+/// Solid-angle pdf of [`sample_uniform_sphere`]: `1 / (4π)`.
+pub const UNIFORM_SPHERE_PDF: f32 = INV_4PI;
+
+/// The inverse of [`sample_uniform_sphere`].
+pub fn invert_uniform_sphere(w: Vec3) -> Vec2 {
+    let mut phi = w.y.atan2(w.x);
+    if phi < 0.0 {
+        phi += 2.0 * PI;
+    }
+    Vec2::new((1.0 - w.z) * 0.5, phi * INV_2PI)
+}
+
+/// Uniform direction inside the cone around `+z` with half-angle `acos(cos_theta_max)`.
+#[inline]
+pub fn sample_uniform_cone(u: Vec2, cos_theta_max: f32) -> Vec3 {
+    let cos_theta = (1.0 - u.x) + u.x * cos_theta_max;
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let (s, c) = (2.0 * PI * u.y).sin_cos();
+    Vec3::new(sin_theta * c, sin_theta * s, cos_theta)
+}
+
+/// Solid-angle pdf of [`sample_uniform_cone`]: `1 / (2π (1 − cos θmax))` inside the cone.
+#[inline]
+pub fn uniform_cone_pdf(cos_theta_max: f32) -> f32 {
+    let solid_angle = 2.0 * PI * (1.0 - cos_theta_max);
+    if solid_angle > 0.0 {
+        1.0 / solid_angle
+    } else {
+        0.0
+    }
+}
+
+/// The inverse of [`sample_uniform_cone`].
+pub fn invert_uniform_cone(w: Vec3, cos_theta_max: f32) -> Vec2 {
+    let mut phi = w.y.atan2(w.x);
+    if phi < 0.0 {
+        phi += 2.0 * PI;
+    }
+    let denom = 1.0 - cos_theta_max;
+    let ux = if denom > 0.0 {
+        (1.0 - w.z) / denom
+    } else {
+        0.0
+    };
+    Vec2::new(ux.clamp(0.0, crate::ONE_MINUS_EPSILON), phi * INV_2PI)
+}
+
+/// Uniform barycentrics `(b1, b2)` on a triangle (the point is `(1−b1−b2)·p0 + b1·p1 + b2·p2`),
+/// by the square-root parameterisation. The area pdf is `1 / area`.
+#[inline]
+pub fn sample_uniform_triangle(u: Vec2) -> Vec2 {
+    let su0 = u.x.sqrt();
+    Vec2::new(1.0 - su0, u.y * su0)
+}
+
+/// The inverse of [`sample_uniform_triangle`].
+pub fn invert_uniform_triangle(b: Vec2) -> Vec2 {
+    let su0 = 1.0 - b.x;
+    let ux = su0 * su0;
+    let uy = if su0 > 0.0 { b.y / su0 } else { 0.0 };
+    Vec2::new(ux, uy)
+}
+
+/// Tent on `[-radius, radius]` with density `(radius − |x|) / radius²`.
+#[inline]
+pub fn sample_tent(u: f32, radius: f32) -> f32 {
+    if u < 0.5 {
+        let v = 2.0 * u;
+        radius * ((v.sqrt()) - 1.0)
+    } else {
+        let v = 2.0 * (1.0 - u);
+        radius * (1.0 - v.sqrt())
+    }
+}
+
+/// Density of [`sample_tent`].
+#[inline]
+pub fn tent_pdf(x: f32, radius: f32) -> f32 {
+    if x.abs() >= radius {
+        0.0
+    } else {
+        (radius - x.abs()) / (radius * radius)
+    }
+}
+
+/// The power heuristic with exponent 2 (Veach 1997, eq. 9.13) for one sample of strategy `a`:
+/// `pdf_a² / (pdf_a² + pdf_b²)`. Infinite `pdf_a` (a delta strategy) gives 1; non-finite results 0.
+#[inline]
+pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
+    if pdf_a.is_infinite() {
+        return 1.0;
+    }
+    let a2 = pdf_a * pdf_a;
+    let b2 = pdf_b * pdf_b;
+    let w = a2 / (a2 + b2);
+    if w.is_finite() { w } else { 0.0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #[test]
+        fn concentric_roundtrip(x in 0.0f32..1.0, y in 0.0f32..1.0) {
+            let u = Vec2::new(x, y);
+            let back = invert_concentric_disk(sample_concentric_disk(u));
+            prop_assert!((back - u).abs().max_element() < 1e-4, "{u} -> {back}");
+        }
+
+        #[test]
+        fn sphere_roundtrip(x in 0.001f32..0.999, y in 0.0f32..0.999) {
+            let u = Vec2::new(x, y);
+            let w = sample_uniform_sphere(u);
+            prop_assert!((w.length() - 1.0).abs() < 1e-5);
+            let back = invert_uniform_sphere(w);
+            prop_assert!((back - u).abs().max_element() < 1e-3, "{u} -> {back}");
+        }
+
+        #[test]
+        fn cone_roundtrip(x in 0.0f32..1.0, y in 0.0f32..0.999, c in -0.9f32..0.99) {
+            let u = Vec2::new(x, y);
+            let w = sample_uniform_cone(u, c);
+            prop_assert!(w.z >= c - 1e-5);
+            let back = invert_uniform_cone(w, c);
+            prop_assert!((back - u).abs().max_element() < 2e-3, "{u} -> {back}");
+        }
+
+        #[test]
+        fn triangle_roundtrip(x in 0.0f32..1.0, y in 0.0f32..1.0) {
+            let u = Vec2::new(x, y);
+            let b = sample_uniform_triangle(u);
+            prop_assert!(b.x >= 0.0 && b.y >= 0.0 && b.x + b.y <= 1.0 + 1e-6);
+            let back = invert_uniform_triangle(b);
+            prop_assert!((back - u).abs().max_element() < 1e-4);
+        }
+
+        #[test]
+        fn cosine_hemisphere_is_upper(x in 0.0f32..1.0, y in 0.0f32..1.0) {
+            let w = sample_cosine_hemisphere(Vec2::new(x, y));
+            prop_assert!(w.z >= 0.0 && (w.length() - 1.0).abs() < 1e-4);
+        }
+
+        #[test]
+        fn tent_within_radius(u in 0.0f32..1.0, r in 0.1f32..4.0) {
+            let x = sample_tent(u, r);
+            prop_assert!(x.abs() <= r);
+        }
+    }
+
+    #[test]
+    fn power_heuristic_edges() {
+        assert_eq!(power_heuristic(f32::INFINITY, 3.0), 1.0);
+        assert_eq!(power_heuristic(0.0, 0.0), 0.0);
+        assert!((power_heuristic(1.0, 1.0) - 0.5).abs() < 1e-7);
+        assert!((power_heuristic(2.0, 1.0) + power_heuristic(1.0, 2.0) - 1.0).abs() < 1e-6);
+    }
+}
