@@ -33,3 +33,11 @@ pub use rng::{Pcg32, mix64};
 
 /// The largest `f32` strictly below one: random numbers are clamped to it so that `u < 1` holds.
 pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// Relative luminance of a linear RGB value with Mitsuba 3's coefficients (sRGB primaries, D65),
+/// the one scalarisation used across the workspace: light powers, envmap importance, ReSTIR target
+/// functions and Russian roulette all use it.
+#[inline]
+pub fn luminance(rgb: glam::Vec3) -> f32 {
+    0.212_671 * rgb.x + 0.715_160 * rgb.y + 0.072_169 * rgb.z
+}

@@ -1,0 +1,196 @@
+use glam::{Mat4, Vec2, Vec3};
+
+use crate::Ray;
+
+/// Which image axis the field of view spans (Mitsuba's `fov_axis`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum FovAxis {
+    /// Horizontal.
+    #[default]
+    X,
+    /// Vertical.
+    Y,
+    /// The image diagonal.
+    Diagonal,
+    /// The smaller of the two image axes.
+    Smaller,
+    /// The larger of the two image axes.
+    Larger,
+}
+
+/// Why a camera cannot be built.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CameraError {
+    /// The field of view is not in (0, 180) degrees.
+    Fov(f32),
+    /// The film has a zero dimension.
+    Resolution(u32, u32),
+    /// The transform is not invertible or not finite.
+    Transform,
+    /// Aperture radius or focus distance is negative, zero where it must not be, or not finite.
+    Lens,
+}
+
+impl core::fmt::Display for CameraError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            CameraError::Fov(v) => write!(f, "field of view {v}° is not between 0 and 180"),
+            CameraError::Resolution(w, h) => write!(f, "film resolution {w}×{h} has a zero side"),
+            CameraError::Transform => write!(f, "camera transform is degenerate or not finite"),
+            CameraError::Lens => write!(f, "aperture radius and focus distance must be positive"),
+        }
+    }
+}
+
+impl std::error::Error for CameraError {}
+
+/// A perspective camera (pinhole or thin lens) with Mitsuba's conventions: in camera space the
+/// camera looks along `+z`, `+y` is up and `+x` is left (Mitsuba's `lookat` builds
+/// `left = up × dir`); film position `(0, 0)` is the top-left corner.
+#[derive(Clone, Copy, Debug)]
+pub struct Camera {
+    to_world: Mat4,
+    origin: Vec3,
+    tan_half: Vec2,
+    resolution: (u32, u32),
+    aperture_radius: f32,
+    focus_distance: f32,
+}
+
+impl Camera {
+    /// A camera with `fov_degrees` along `fov_axis`, placed by `to_world`.
+    pub fn perspective(
+        to_world: Mat4,
+        fov_degrees: f32,
+        fov_axis: FovAxis,
+        resolution: (u32, u32),
+    ) -> Result<Self, CameraError> {
+        Self::thin_lens(to_world, fov_degrees, fov_axis, resolution, 0.0, 1.0)
+    }
+
+    /// A thin-lens camera; `aperture_radius = 0` is a pinhole.
+    pub fn thin_lens(
+        to_world: Mat4,
+        fov_degrees: f32,
+        fov_axis: FovAxis,
+        resolution: (u32, u32),
+        aperture_radius: f32,
+        focus_distance: f32,
+    ) -> Result<Self, CameraError> {
+        if !(fov_degrees > 0.0 && fov_degrees < 180.0) {
+            return Err(CameraError::Fov(fov_degrees));
+        }
+        let (w, h) = resolution;
+        if w == 0 || h == 0 {
+            return Err(CameraError::Resolution(w, h));
+        }
+        if !to_world.is_finite() || to_world.determinant().abs() < 1e-20 {
+            return Err(CameraError::Transform);
+        }
+        if !(aperture_radius >= 0.0 && aperture_radius.is_finite())
+            || !(focus_distance > 0.0 && focus_distance.is_finite())
+        {
+            return Err(CameraError::Lens);
+        }
+        let aspect = w as f32 / h as f32;
+        let t = (fov_degrees.to_radians() * 0.5).tan();
+        let axis = match fov_axis {
+            FovAxis::Smaller if aspect > 1.0 => FovAxis::Y,
+            FovAxis::Smaller => FovAxis::X,
+            FovAxis::Larger if aspect > 1.0 => FovAxis::X,
+            FovAxis::Larger => FovAxis::Y,
+            a => a,
+        };
+        let tan_half = match axis {
+            FovAxis::X => Vec2::new(t, t / aspect),
+            FovAxis::Y => Vec2::new(t * aspect, t),
+            _ => {
+                let diag = (aspect * aspect + 1.0).sqrt();
+                Vec2::new(t * aspect / diag, t / diag)
+            }
+        };
+        Ok(Self {
+            to_world,
+            origin: to_world.transform_point3(Vec3::ZERO),
+            tan_half,
+            resolution,
+            aperture_radius,
+            focus_distance,
+        })
+    }
+
+    /// Film resolution `(width, height)`.
+    pub fn resolution(&self) -> (u32, u32) {
+        self.resolution
+    }
+
+    /// The camera position.
+    pub fn origin(&self) -> Vec3 {
+        self.origin
+    }
+
+    /// The camera-to-world matrix.
+    pub fn to_world(&self) -> Mat4 {
+        self.to_world
+    }
+
+    /// The primary ray through film position `film` (in pixels, `(0, 0)` at the top-left corner),
+    /// with `u_lens` choosing the point on the aperture. The direction is unit length.
+    #[inline]
+    pub fn generate_ray(&self, film: Vec2, u_lens: Vec2) -> Ray {
+        let (w, h) = self.resolution;
+        let s = Vec2::new(film.x / w as f32, film.y / h as f32);
+        let local = Vec3::new(
+            (1.0 - 2.0 * s.x) * self.tan_half.x,
+            (1.0 - 2.0 * s.y) * self.tan_half.y,
+            1.0,
+        );
+        if self.aperture_radius > 0.0 {
+            let lens = self.aperture_radius * restir_sampling::warp::sample_concentric_disk(u_lens);
+            let focus = local * self.focus_distance;
+            let o_local = Vec3::new(lens.x, lens.y, 0.0);
+            let o = self.to_world.transform_point3(o_local);
+            let d = self.to_world.transform_vector3(focus - o_local).normalize();
+            return Ray::new(o, d);
+        }
+        let d = self.to_world.transform_vector3(local).normalize();
+        Ray::new(self.origin, d)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lookat_conventions() {
+        // Mitsuba's lookat from +z looking at the origin with +y up.
+        let origin = Vec3::new(0.0, 0.0, 5.0);
+        let dir = (Vec3::ZERO - origin).normalize();
+        let left = Vec3::Y.cross(dir).normalize();
+        let up = dir.cross(left);
+        let m = Mat4::from_cols(
+            left.extend(0.0),
+            up.extend(0.0),
+            dir.extend(0.0),
+            origin.extend(1.0),
+        );
+        let cam = Camera::perspective(m, 90.0, FovAxis::X, (100, 50)).unwrap();
+        let centre = cam.generate_ray(Vec2::new(50.0, 25.0), Vec2::ZERO);
+        assert!((centre.d - dir).length() < 1e-6);
+        // Left edge of the image looks towards -x in world space (camera +x is world -x here).
+        let l = cam.generate_ray(Vec2::new(0.0, 25.0), Vec2::ZERO);
+        assert!(l.d.x < 0.0 && (l.d.x / l.d.z - 1.0).abs() < 1e-5);
+        // Top edge looks up; vertical half-extent is tan(45°)/aspect.
+        let t = cam.generate_ray(Vec2::new(50.0, 0.0), Vec2::ZERO);
+        assert!(t.d.y > 0.0 && (t.d.y / -t.d.z - 0.5).abs() < 1e-5);
+    }
+
+    #[test]
+    fn rejects_bad_parameters() {
+        assert!(Camera::perspective(Mat4::IDENTITY, 0.0, FovAxis::X, (1, 1)).is_err());
+        assert!(Camera::perspective(Mat4::IDENTITY, 180.0, FovAxis::X, (1, 1)).is_err());
+        assert!(Camera::perspective(Mat4::IDENTITY, 45.0, FovAxis::X, (0, 1)).is_err());
+        assert!(Camera::perspective(Mat4::ZERO, 45.0, FovAxis::X, (1, 1)).is_err());
+    }
+}

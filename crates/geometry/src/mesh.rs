@@ -1,0 +1,289 @@
+use glam::{Affine3A, Vec2, Vec3};
+use restir_sampling::Distribution1D;
+
+/// Why a mesh is unusable.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MeshError {
+    /// A face refers to a vertex that does not exist.
+    IndexOutOfRange {
+        /// The face.
+        face: usize,
+        /// The index it holds.
+        index: u32,
+        /// How many vertices there are.
+        vertex_count: usize,
+    },
+    /// A position, normal or uv is NaN or infinite.
+    NonFinite {
+        /// Which attribute.
+        attribute: &'static str,
+        /// Its index.
+        index: usize,
+    },
+    /// Normals or uvs are given but not one per vertex.
+    AttributeCount {
+        /// Which attribute.
+        attribute: &'static str,
+        /// How many there are.
+        count: usize,
+        /// How many vertices there are.
+        vertex_count: usize,
+    },
+    /// The mesh has no triangles.
+    Empty,
+}
+
+impl core::fmt::Display for MeshError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            MeshError::IndexOutOfRange {
+                face,
+                index,
+                vertex_count,
+            } => write!(
+                f,
+                "face {face} refers to vertex {index}, but the mesh has {vertex_count} vertices"
+            ),
+            MeshError::NonFinite { attribute, index } => {
+                write!(f, "{attribute} {index} is not a finite number")
+            }
+            MeshError::AttributeCount {
+                attribute,
+                count,
+                vertex_count,
+            } => write!(
+                f,
+                "the mesh has {count} {attribute} for {vertex_count} vertices"
+            ),
+            MeshError::Empty => write!(f, "the mesh has no triangles"),
+        }
+    }
+}
+
+impl std::error::Error for MeshError {}
+
+/// An indexed triangle mesh in world space, with an area table for uniform point sampling.
+#[derive(Clone, Debug)]
+pub struct TriangleMesh {
+    positions: Vec<Vec3>,
+    normals: Option<Vec<Vec3>>,
+    uvs: Option<Vec<Vec2>>,
+    indices: Vec<[u32; 3]>,
+    flip_normals: bool,
+    area: f32,
+    area_distribution: Option<Distribution1D>,
+}
+
+impl TriangleMesh {
+    /// Validates and builds a mesh. Degenerate (zero-area) triangles are kept for intersection but
+    /// never sampled. With `flip_normals`, geometric and shading normals point the other way.
+    pub fn new(
+        positions: Vec<Vec3>,
+        normals: Option<Vec<Vec3>>,
+        uvs: Option<Vec<Vec2>>,
+        indices: Vec<[u32; 3]>,
+        flip_normals: bool,
+    ) -> Result<Self, MeshError> {
+        if indices.is_empty() {
+            return Err(MeshError::Empty);
+        }
+        let n = positions.len();
+        for (i, p) in positions.iter().enumerate() {
+            if !p.is_finite() {
+                return Err(MeshError::NonFinite {
+                    attribute: "position",
+                    index: i,
+                });
+            }
+        }
+        if let Some(ns) = &normals {
+            if ns.len() != n {
+                return Err(MeshError::AttributeCount {
+                    attribute: "normals",
+                    count: ns.len(),
+                    vertex_count: n,
+                });
+            }
+            if let Some(i) = ns.iter().position(|v| !v.is_finite()) {
+                return Err(MeshError::NonFinite {
+                    attribute: "normal",
+                    index: i,
+                });
+            }
+        }
+        if let Some(uv) = &uvs {
+            if uv.len() != n {
+                return Err(MeshError::AttributeCount {
+                    attribute: "uvs",
+                    count: uv.len(),
+                    vertex_count: n,
+                });
+            }
+            if let Some(i) = uv.iter().position(|v| !v.is_finite()) {
+                return Err(MeshError::NonFinite {
+                    attribute: "uv",
+                    index: i,
+                });
+            }
+        }
+        for (f, tri) in indices.iter().enumerate() {
+            for &index in tri {
+                if index as usize >= n {
+                    return Err(MeshError::IndexOutOfRange {
+                        face: f,
+                        index,
+                        vertex_count: n,
+                    });
+                }
+            }
+        }
+        // Normalise vertex normals; a zero normal falls back to the face normal at lookup time.
+        let normals = normals.map(|ns| ns.into_iter().map(|v| v.normalize_or_zero()).collect());
+        let mut mesh = Self {
+            positions,
+            normals,
+            uvs,
+            indices,
+            flip_normals,
+            area: 0.0,
+            area_distribution: None,
+        };
+        mesh.update_areas();
+        Ok(mesh)
+    }
+
+    fn update_areas(&mut self) {
+        let areas: Vec<f32> = (0..self.indices.len())
+            .map(|i| self.triangle_area(i))
+            .map(|a| if a.is_finite() { a } else { 0.0 })
+            .collect();
+        self.area = areas.iter().map(|&a| a as f64).sum::<f64>() as f32;
+        self.area_distribution = Distribution1D::new(&areas);
+    }
+
+    /// Applies an affine transform to positions (and the inverse transpose to normals).
+    pub fn transform(&mut self, m: &Affine3A) {
+        for p in &mut self.positions {
+            *p = m.transform_point3(*p);
+        }
+        if let Some(ns) = &mut self.normals {
+            let nm = glam::Mat3::from(m.matrix3).inverse().transpose();
+            for n in ns {
+                *n = (nm * *n).normalize_or_zero();
+            }
+        }
+        // A mirroring transform turns the winding inside out; keep normals pointing the way the
+        // transformed shape's outside points, as Mitsuba does.
+        if m.matrix3.determinant() < 0.0 {
+            for tri in &mut self.indices {
+                tri.swap(1, 2);
+            }
+        }
+        self.update_areas();
+    }
+
+    /// Vertex positions.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+    /// Per-vertex shading normals, if any.
+    pub fn normals(&self) -> Option<&[Vec3]> {
+        self.normals.as_deref()
+    }
+    /// Per-vertex texture coordinates, if any.
+    pub fn uvs(&self) -> Option<&[Vec2]> {
+        self.uvs.as_deref()
+    }
+    /// Triangles as vertex index triples.
+    pub fn indices(&self) -> &[[u32; 3]] {
+        &self.indices
+    }
+    /// Whether normals are flipped.
+    pub fn flip_normals(&self) -> bool {
+        self.flip_normals
+    }
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len()
+    }
+    /// Total surface area.
+    pub fn area(&self) -> f32 {
+        self.area
+    }
+
+    /// The three corners of triangle `i`.
+    #[inline]
+    pub fn triangle(&self, i: usize) -> [Vec3; 3] {
+        let [a, b, c] = self.indices[i];
+        [
+            self.positions[a as usize],
+            self.positions[b as usize],
+            self.positions[c as usize],
+        ]
+    }
+
+    /// Area of triangle `i`.
+    pub fn triangle_area(&self, i: usize) -> f32 {
+        let [p0, p1, p2] = self.triangle(i);
+        0.5 * (p1 - p0).cross(p2 - p0).length()
+    }
+
+    /// The unit geometric normal of triangle `i` (zero for a degenerate triangle).
+    #[inline]
+    pub fn face_normal(&self, i: usize) -> Vec3 {
+        let [p0, p1, p2] = self.triangle(i);
+        let n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+        if self.flip_normals { -n } else { n }
+    }
+
+    /// Point, geometric normal, shading normal, uv and `dp/du` at barycentrics `b = (b1, b2)` of
+    /// triangle `i`.
+    #[inline]
+    pub fn surface_at(&self, i: usize, b: Vec2) -> (Vec3, Vec3, Vec3, Vec2, Vec3) {
+        let [ia, ib, ic] = self.indices[i];
+        let [p0, p1, p2] = self.triangle(i);
+        let b0 = 1.0 - b.x - b.y;
+        let p = b0 * p0 + b.x * p1 + b.y * p2;
+        let ng = self.face_normal(i);
+        let ns = match &self.normals {
+            Some(ns) => {
+                let n = (b0 * ns[ia as usize] + b.x * ns[ib as usize] + b.y * ns[ic as usize])
+                    .normalize_or_zero();
+                if n == Vec3::ZERO {
+                    ng
+                } else if self.flip_normals {
+                    -n
+                } else {
+                    n
+                }
+            }
+            None => ng,
+        };
+        let (uv, dpdu) = match &self.uvs {
+            Some(uvs) => {
+                let (t0, t1, t2) = (uvs[ia as usize], uvs[ib as usize], uvs[ic as usize]);
+                let uv = b0 * t0 + b.x * t1 + b.y * t2;
+                let (d1, d2) = (t1 - t0, t2 - t0);
+                let det = d1.x * d2.y - d1.y * d2.x;
+                let dpdu = if det.abs() > 1e-12 {
+                    ((p1 - p0) * d2.y - (p2 - p0) * d1.y) / det
+                } else {
+                    p1 - p0
+                };
+                (uv, dpdu)
+            }
+            None => (b, p1 - p0),
+        };
+        (p, ng, ns, uv, dpdu)
+    }
+
+    /// Picks a triangle proportionally to area and a uniform point on it. Returns the triangle,
+    /// its barycentrics and the area pdf `1 / total area`. `None` if the mesh has no area.
+    #[inline]
+    pub fn sample_point(&self, u: Vec2) -> Option<(usize, Vec2, f32)> {
+        let dist = self.area_distribution.as_ref()?;
+        let (tri, _pmf, ux) = dist.sample_discrete(u.x);
+        let b = restir_sampling::warp::sample_uniform_triangle(Vec2::new(ux, u.y));
+        Some((tri, b, 1.0 / self.area))
+    }
+}

@@ -1,0 +1,341 @@
+use core::f32::consts::PI;
+use glam::{Vec2, Vec3};
+use restir_sampling::warp;
+
+use crate::{Frame, MeshError, TriangleMesh};
+
+/// An analytic sphere. Its normals point outwards unless `flip_normals`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Centre.
+    pub center: Vec3,
+    /// Radius (> 0).
+    pub radius: f32,
+    /// Whether normals point inwards.
+    pub flip_normals: bool,
+}
+
+impl Sphere {
+    /// A sphere.
+    pub fn new(center: Vec3, radius: f32, flip_normals: bool) -> Self {
+        Self {
+            center,
+            radius,
+            flip_normals,
+        }
+    }
+
+    /// The surface point for spherical parameters `uv = (φ/2π, θ/π)` (θ from `+z`).
+    #[inline]
+    pub fn point_at(&self, uv: Vec2) -> (Vec3, Vec3) {
+        let phi = uv.x * 2.0 * PI;
+        let theta = uv.y * PI;
+        let (st, ct) = theta.sin_cos();
+        let (sp, cp) = phi.sin_cos();
+        let n = Vec3::new(st * cp, st * sp, ct);
+        (self.center + self.radius * n, n)
+    }
+
+    /// Spherical parameters of direction `n` from the centre.
+    #[inline]
+    pub fn uv_of(n: Vec3) -> Vec2 {
+        let mut phi = n.y.atan2(n.x);
+        if phi < 0.0 {
+            phi += 2.0 * PI;
+        }
+        Vec2::new(phi / (2.0 * PI), n.z.clamp(-1.0, 1.0).acos() / PI)
+    }
+}
+
+/// A point sampled on a shape.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PositionSample {
+    /// The point.
+    pub p: Vec3,
+    /// Shading normal at the point (the normal emission is measured against).
+    pub n: Vec3,
+    /// Geometric normal at the point.
+    pub ng: Vec3,
+    /// Primitive (triangle) index within the shape; 0 for a sphere.
+    pub prim: u32,
+    /// Barycentrics (mesh) or spherical parameters (sphere) locating the point on the primitive.
+    pub param: Vec2,
+    /// Texture coordinates.
+    pub uv: Vec2,
+}
+
+/// A geometric shape.
+#[derive(Clone, Debug)]
+pub enum Shape {
+    /// A triangle mesh.
+    Mesh(TriangleMesh),
+    /// An analytic sphere.
+    Sphere(Sphere),
+}
+
+impl Shape {
+    /// Surface area.
+    pub fn area(&self) -> f32 {
+        match self {
+            Shape::Mesh(m) => m.area(),
+            Shape::Sphere(s) => 4.0 * PI * s.radius * s.radius,
+        }
+    }
+
+    /// The surface point at primitive `prim` and parameters `param` (barycentrics for meshes,
+    /// spherical `(φ/2π, θ/π)` for spheres).
+    #[inline]
+    pub fn position_at(&self, prim: u32, param: Vec2) -> PositionSample {
+        match self {
+            Shape::Mesh(m) => {
+                let (p, ng, ns, uv, _) = m.surface_at(prim as usize, param);
+                PositionSample {
+                    p,
+                    n: ns,
+                    ng,
+                    prim,
+                    param,
+                    uv,
+                }
+            }
+            Shape::Sphere(s) => {
+                let (p, n) = s.point_at(param);
+                let n = if s.flip_normals { -n } else { n };
+                PositionSample {
+                    p,
+                    n,
+                    ng: n,
+                    prim: 0,
+                    param,
+                    uv: param,
+                }
+            }
+        }
+    }
+
+    /// A uniformly distributed point on the surface; the area pdf is `1 / area()`.
+    #[inline]
+    pub fn sample_uniform_area(&self, u: Vec2) -> Option<PositionSample> {
+        match self {
+            Shape::Mesh(m) => {
+                let (tri, b, _) = m.sample_point(u)?;
+                Some(self.position_at(tri as u32, b))
+            }
+            Shape::Sphere(s) => {
+                let n = warp::sample_uniform_sphere(u);
+                let uv = Sphere::uv_of(n);
+                let n = if s.flip_normals { -n } else { n };
+                Some(PositionSample {
+                    p: s.center + s.radius * (if s.flip_normals { -n } else { n }),
+                    n,
+                    ng: n,
+                    prim: 0,
+                    param: uv,
+                    uv,
+                })
+            }
+        }
+    }
+
+    /// Samples a point on the shape as seen from `ref_p`, with a solid-angle pdf at `ref_p`.
+    /// Meshes sample uniformly by area; spheres seen from outside sample the cone of directions
+    /// they subtend, from inside uniformly by area. [`Shape::pdf_sa_from`] returns the same pdf.
+    #[inline]
+    pub fn sample_from(&self, ref_p: Vec3, u: Vec2) -> Option<(PositionSample, f32)> {
+        match self {
+            Shape::Sphere(s) => {
+                let to_c = s.center - ref_p;
+                let d2 = to_c.length_squared();
+                let r2 = s.radius * s.radius;
+                if d2 <= r2 * (1.0 + 1e-4) {
+                    let ps = self.sample_uniform_area(u)?;
+                    let pdf = area_to_solid_angle(1.0 / self.area(), ref_p, ps.p, ps.n)?;
+                    return Some((ps, pdf));
+                }
+                let dist = d2.sqrt();
+                let sin2_max = r2 / d2;
+                let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+                let frame = Frame::from_normal(to_c / dist);
+                let local = warp::sample_uniform_cone(u, cos_max);
+                let dir = frame.to_world(local);
+                // Intersect the ray with the sphere; clamp tangential misses to the silhouette.
+                let b = dir.dot(to_c);
+                let disc = (r2 - (d2 - b * b)).max(0.0);
+                let t = b - disc.sqrt();
+                let p = ref_p + dir * t;
+                let n = ((p - s.center) / s.radius).normalize();
+                let uv = Sphere::uv_of(n);
+                let n = if s.flip_normals { -n } else { n };
+                let pdf = warp::uniform_cone_pdf(cos_max);
+                if pdf <= 0.0 || !pdf.is_finite() {
+                    return None;
+                }
+                Some((
+                    PositionSample {
+                        p,
+                        n,
+                        ng: n,
+                        prim: 0,
+                        param: uv,
+                        uv,
+                    },
+                    pdf,
+                ))
+            }
+            Shape::Mesh(_) => {
+                let ps = self.sample_uniform_area(u)?;
+                let pdf = area_to_solid_angle(1.0 / self.area(), ref_p, ps.p, ps.n)?;
+                Some((ps, pdf))
+            }
+        }
+    }
+
+    /// The solid-angle pdf at `ref_p` with which [`Shape::sample_from`] returns point `p` with
+    /// normal `n`.
+    #[inline]
+    pub fn pdf_sa_from(&self, ref_p: Vec3, p: Vec3, n: Vec3) -> f32 {
+        match self {
+            Shape::Sphere(s) => {
+                let d2 = (s.center - ref_p).length_squared();
+                let r2 = s.radius * s.radius;
+                if d2 <= r2 * (1.0 + 1e-4) {
+                    return area_to_solid_angle(1.0 / self.area(), ref_p, p, n).unwrap_or(0.0);
+                }
+                let cos_max = (1.0 - r2 / d2).max(0.0).sqrt();
+                warp::uniform_cone_pdf(cos_max)
+            }
+            Shape::Mesh(_) => area_to_solid_angle(1.0 / self.area(), ref_p, p, n).unwrap_or(0.0),
+        }
+    }
+
+    /// Mitsuba's `rectangle`: `[-1, 1]²` in the `z = 0` plane, normal `+z`, uv over `[0, 1]²`.
+    pub fn rectangle() -> TriangleMesh {
+        let positions = vec![
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(-1.0, 1.0, 0.0),
+        ];
+        let normals = vec![Vec3::Z; 4];
+        let uvs = vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(0.0, 1.0),
+        ];
+        TriangleMesh::new(
+            positions,
+            Some(normals),
+            Some(uvs),
+            vec![[0, 1, 2], [2, 3, 0]],
+            false,
+        )
+        .expect("the unit rectangle is a valid mesh")
+    }
+
+    /// Mitsuba's `cube`: `[-1, 1]³` with outward normals, four vertices per face.
+    pub fn cube() -> TriangleMesh {
+        let mut positions = Vec::with_capacity(24);
+        let mut normals = Vec::with_capacity(24);
+        let mut uvs = Vec::with_capacity(24);
+        let mut indices = Vec::with_capacity(12);
+        for axis in 0..3 {
+            for sign in [-1.0f32, 1.0] {
+                let mut n = Vec3::ZERO;
+                n[axis] = sign;
+                // Two tangents with (t1 × t2) = n so that the winding faces outwards.
+                let a = Vec3::from_array({
+                    let mut v = [0.0; 3];
+                    v[(axis + 1) % 3] = 1.0;
+                    v
+                });
+                let b = n.cross(a);
+                let base = positions.len() as u32;
+                for (i, (sa, sb)) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                    .into_iter()
+                    .enumerate()
+                {
+                    positions.push(n + sa * a + sb * b);
+                    normals.push(n);
+                    uvs.push(Vec2::new([0.0, 1.0, 1.0, 0.0][i], [0.0, 0.0, 1.0, 1.0][i]));
+                }
+                indices.push([base, base + 1, base + 2]);
+                indices.push([base + 2, base + 3, base]);
+            }
+        }
+        TriangleMesh::new(positions, Some(normals), Some(uvs), indices, false)
+            .expect("the unit cube is a valid mesh")
+    }
+
+    /// A disk of radius 1 in the `z = 0` plane, normal `+z`, as a fan of `segments` triangles.
+    pub fn disk(segments: u32) -> Result<TriangleMesh, MeshError> {
+        let segments = segments.max(3);
+        let mut positions = vec![Vec3::ZERO];
+        let mut uvs = vec![Vec2::new(0.0, 0.0)];
+        for i in 0..segments {
+            let phi = 2.0 * PI * i as f32 / segments as f32;
+            positions.push(Vec3::new(phi.cos(), phi.sin(), 0.0));
+            uvs.push(Vec2::new(1.0, i as f32 / segments as f32));
+        }
+        let normals = vec![Vec3::Z; positions.len()];
+        let indices = (0..segments)
+            .map(|i| [0, 1 + i, 1 + (i + 1) % segments])
+            .collect();
+        TriangleMesh::new(positions, Some(normals), Some(uvs), indices, false)
+    }
+}
+
+/// Converts an area pdf at `p` (normal `n`) to a solid-angle pdf at `ref_p`:
+/// `pdf_area · d² / |cos θ|`. `None` when the conversion is degenerate (grazing or coincident).
+#[inline]
+pub fn area_to_solid_angle(pdf_area: f32, ref_p: Vec3, p: Vec3, n: Vec3) -> Option<f32> {
+    let d = p - ref_p;
+    let d2 = d.length_squared();
+    if d2 <= 0.0 {
+        return None;
+    }
+    let cos = (n.dot(d) / d2.sqrt()).abs();
+    let pdf = pdf_area * d2 / cos;
+    (pdf.is_finite() && pdf > 0.0).then_some(pdf)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cube_normals_face_out() {
+        let cube = Shape::cube();
+        for i in 0..cube.triangle_count() {
+            let [a, b, c] = cube.triangle(i);
+            let centroid = (a + b + c) / 3.0;
+            assert!(cube.face_normal(i).dot(centroid) > 0.0, "face {i}");
+        }
+        assert!((cube.area() - 24.0).abs() < 1e-4);
+    }
+
+    #[test]
+    fn rectangle_area_and_normal() {
+        let r = Shape::rectangle();
+        assert!((r.area() - 4.0).abs() < 1e-6);
+        assert!((r.face_normal(0) - Vec3::Z).length() < 1e-6);
+        assert!((r.face_normal(1) - Vec3::Z).length() < 1e-6);
+    }
+
+    /// The solid-angle pdf `sample_from` returns equals `pdf_sa_from`, and its reciprocal averages
+    /// to the solid angle the shape subtends (for a sphere: 2π(1 − cos θmax)).
+    #[test]
+    fn sphere_cone_sampling_consistent() {
+        let shape = Shape::Sphere(Sphere::new(Vec3::new(0.0, 0.0, 3.0), 1.0, false));
+        let ref_p = Vec3::ZERO;
+        let cos_max = (1.0f32 - 1.0 / 9.0).sqrt();
+        let mut rng = restir_sampling::Pcg32::new(1, 1);
+        for _ in 0..1000 {
+            let (ps, pdf) = shape.sample_from(ref_p, rng.next_2d()).unwrap();
+            assert!(((ps.p - Vec3::new(0.0, 0.0, 3.0)).length() - 1.0).abs() < 1e-4);
+            assert!(ps.n.dot(ref_p - ps.p) >= -1e-3, "visible side");
+            assert!((pdf - shape.pdf_sa_from(ref_p, ps.p, ps.n)).abs() < 1e-4 * pdf);
+            assert!((1.0 / pdf - 2.0 * PI * (1.0 - cos_max)).abs() < 1e-4);
+        }
+    }
+}
