@@ -236,15 +236,20 @@ impl TriangleMesh {
         if self.flip_normals { -n } else { n }
     }
 
-    /// Point, geometric normal, shading normal, uv and `dp/du` at barycentrics `b = (b1, b2)` of
-    /// triangle `i`.
+    /// Point, geometric normal and shading normal at barycentrics `b = (b1, b2)` of triangle `i`
+    /// (the cheaper part of [`TriangleMesh::surface_at`], for light sampling).
     #[inline]
-    pub fn surface_at(&self, i: usize, b: Vec2) -> (Vec3, Vec3, Vec3, Vec2, Vec3) {
+    pub fn point_at(&self, i: usize, b: Vec2) -> (Vec3, Vec3, Vec3) {
         let [ia, ib, ic] = self.indices[i];
-        let [p0, p1, p2] = self.triangle(i);
+        let (p0, p1, p2) = (
+            self.positions[ia as usize],
+            self.positions[ib as usize],
+            self.positions[ic as usize],
+        );
         let b0 = 1.0 - b.x - b.y;
         let p = b0 * p0 + b.x * p1 + b.y * p2;
-        let ng = self.face_normal(i);
+        let n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+        let ng = if self.flip_normals { -n } else { n };
         let ns = match &self.normals {
             Some(ns) => {
                 let n = (b0 * ns[ia as usize] + b.x * ns[ib as usize] + b.y * ns[ic as usize])
@@ -259,6 +264,17 @@ impl TriangleMesh {
             }
             None => ng,
         };
+        (p, ng, ns)
+    }
+
+    /// Point, geometric normal, shading normal, uv and `dp/du` at barycentrics `b = (b1, b2)` of
+    /// triangle `i`.
+    #[inline]
+    pub fn surface_at(&self, i: usize, b: Vec2) -> (Vec3, Vec3, Vec3, Vec2, Vec3) {
+        let [ia, ib, ic] = self.indices[i];
+        let [p0, p1, p2] = self.triangle(i);
+        let b0 = 1.0 - b.x - b.y;
+        let (p, ng, ns) = self.point_at(i, b);
         let (uv, dpdu) = match &self.uvs {
             Some(uvs) => {
                 let (t0, t1, t2) = (uvs[ia as usize], uvs[ib as usize], uvs[ic as usize]);

@@ -60,8 +60,6 @@ pub struct PositionSample {
     pub prim: u32,
     /// Barycentrics (mesh) or spherical parameters (sphere) locating the point on the primitive.
     pub param: Vec2,
-    /// Texture coordinates.
-    pub uv: Vec2,
 }
 
 /// A geometric shape.
@@ -88,14 +86,13 @@ impl Shape {
     pub fn position_at(&self, prim: u32, param: Vec2) -> PositionSample {
         match self {
             Shape::Mesh(m) => {
-                let (p, ng, ns, uv, _) = m.surface_at(prim as usize, param);
+                let (p, ng, ns) = m.point_at(prim as usize, param);
                 PositionSample {
                     p,
                     n: ns,
                     ng,
                     prim,
                     param,
-                    uv,
                 }
             }
             Shape::Sphere(s) => {
@@ -107,7 +104,6 @@ impl Shape {
                     ng: n,
                     prim: 0,
                     param,
-                    uv: param,
                 }
             }
         }
@@ -119,7 +115,14 @@ impl Shape {
         match self {
             Shape::Mesh(m) => {
                 let (tri, b, _) = m.sample_point(u)?;
-                Some(self.position_at(tri as u32, b))
+                let (p, ng, n) = m.point_at(tri, b);
+                Some(PositionSample {
+                    p,
+                    n,
+                    ng,
+                    prim: tri as u32,
+                    param: b,
+                })
             }
             Shape::Sphere(s) => {
                 let n = warp::sample_uniform_sphere(u);
@@ -131,7 +134,6 @@ impl Shape {
                     ng: n,
                     prim: 0,
                     param: uv,
-                    uv,
                 })
             }
         }
@@ -177,7 +179,6 @@ impl Shape {
                         ng: n,
                         prim: 0,
                         param: uv,
-                        uv,
                     },
                     pdf,
                 ))

@@ -1,1 +1,311 @@
-fn main() {}
+//! `restir`: the command-line front end. Parsing arguments, a progress bar and writing files;
+//! everything else lives in the library crates.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use clap::{Parser, Subcommand};
+use restir_integrators::{Image, RenderSettings, compare, make_integrator, render};
+use restir_scene::{Scene, load_desc};
+
+#[derive(Parser, Debug)]
+#[command(name = "restir", version, about = "Path tracing, ReSTIR DI and ReSTIR PT on the CPU")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Render a scene (.xml in Mitsuba format, or .ron) to an image.
+    Render(RenderArgs),
+    /// Compare a rendered EXR with a reference EXR: relMSE, MSE, mean ratio, non-finite pixels.
+    Compare {
+        /// The image to judge.
+        test: PathBuf,
+        /// The reference.
+        reference: PathBuf,
+    },
+}
+
+#[derive(clap::Args, Debug)]
+struct RenderArgs {
+    /// Scene file.
+    scene: PathBuf,
+    /// Output image: .exr (linear float32 RGB) or .png (8-bit sRGB). Default: the film's
+    /// filename from the scene, else <scene name>.exr.
+    #[arg(short = 'o', long = "output")]
+    output: Option<PathBuf>,
+    /// Estimator.
+    #[arg(long, default_value = "path")]
+    integrator: String,
+    /// Passes (samples per pixel); overrides the scene.
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Render whole passes until this many seconds have passed (at least one pass).
+    #[arg(long, value_name = "SECONDS")]
+    time_limit: Option<f64>,
+    /// Longest path in segments from the camera (1 = emitters only, 2 = direct light, -1 = no limit).
+    #[arg(long, allow_negative_numbers = true)]
+    max_depth: Option<i32>,
+    /// Random seed.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Image width; overrides the scene.
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height; overrides the scene.
+    #[arg(long)]
+    height: Option<u32>,
+    /// Set a scene <default> variable (XML scenes).
+    #[arg(short = 'D', value_name = "NAME=VALUE")]
+    defines: Vec<String>,
+    /// Write render statistics as JSON.
+    #[arg(long, value_name = "FILE.json")]
+    stats: Option<PathBuf>,
+    /// No progress bar, no warnings, no summary.
+    #[arg(long)]
+    quiet: bool,
+}
+
+#[derive(serde::Serialize)]
+struct Stats<'a> {
+    scene: String,
+    integrator: &'a str,
+    seconds: f64,
+    load_seconds: f64,
+    spp: u32,
+    width: u32,
+    height: u32,
+    rays: u64,
+    mrays_per_second: f64,
+    nonfinite_pixels: usize,
+    seed: u64,
+    threads: usize,
+}
+
+fn run_render(args: RenderArgs) -> Result<(), String> {
+    let load_start = Instant::now();
+    let mut defines = Vec::new();
+    for d in &args.defines {
+        let (k, v) = d
+            .split_once('=')
+            .ok_or_else(|| format!("-D {d}: expected NAME=VALUE"))?;
+        defines.push((k.trim().to_string(), v.trim().to_string()));
+    }
+    let (mut desc, warnings) = load_desc(&args.scene, &defines).map_err(|e| e.to_string())?;
+    if !args.quiet {
+        for w in &warnings {
+            eprintln!("{w}");
+        }
+    }
+    if let Some(w) = args.width {
+        desc.film.width = w;
+    }
+    if let Some(h) = args.height {
+        desc.film.height = h;
+    }
+    let base = args.scene.parent().map(Path::to_path_buf).unwrap_or_default();
+    let scene = Scene::build(&desc, &base, &args.scene).map_err(|e| e.to_string())?;
+    let load_seconds = load_start.elapsed().as_secs_f64();
+
+    let integrator = make_integrator(&args.integrator, &scene, args.max_depth)?;
+    let spp = args.spp.unwrap_or(scene.spp);
+    if spp == 0 {
+        return Err("--spp must be at least 1".into());
+    }
+    let time_limit = match args.time_limit {
+        Some(t) if t.is_finite() && t > 0.0 => Some(Duration::from_secs_f64(t)),
+        Some(t) => return Err(format!("--time-limit {t}: expected a positive number of seconds")),
+        None => None,
+    };
+    // With only a time limit, keep rendering until it runs out.
+    let spp = if args.time_limit.is_some() && args.spp.is_none() {
+        u32::MAX
+    } else {
+        spp
+    };
+    let output = match &args.output {
+        Some(o) => o.clone(),
+        None => match &scene.output {
+            Some(f) => PathBuf::from(f),
+            None => PathBuf::from(format!(
+                "{}.exr",
+                args.scene.file_stem().and_then(|s| s.to_str()).unwrap_or("render")
+            )),
+        },
+    };
+    match output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("exr") | Some("png") => {}
+        _ => return Err(format!("{}: output must end in .exr or .png", output.display())),
+    }
+
+    let threads = args.threads.unwrap_or(0);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| format!("cannot start {threads} threads: {e}"))?;
+    let threads = pool.current_num_threads();
+
+    let cancel = Arc::new(AtomicBool::new(false));
+    {
+        let cancel = cancel.clone();
+        // Ctrl-C finishes the current pass and still writes the image.
+        let _ = ctrlc::set_handler(move || cancel.store(true, Ordering::Relaxed));
+    }
+
+    let show_bar = !args.quiet && std::io::stderr().is_terminal();
+    let bar = if show_bar {
+        let bar = match time_limit {
+            Some(t) if spp == u32::MAX => {
+                let b = indicatif::ProgressBar::new(t.as_millis() as u64);
+                b.set_style(
+                    indicatif::ProgressStyle::with_template(
+                        "{bar:40} {elapsed_precise} / time limit, {msg}",
+                    )
+                    .expect("valid template"),
+                );
+                b
+            }
+            _ => {
+                let b = indicatif::ProgressBar::new(spp as u64);
+                b.set_style(
+                    indicatif::ProgressStyle::with_template(
+                        "{bar:40} {pos}/{len} passes, {elapsed_precise} elapsed, ETA {eta_precise}",
+                    )
+                    .expect("valid template"),
+                );
+                b
+            }
+        };
+        Some(bar)
+    } else {
+        None
+    };
+
+    let settings = RenderSettings {
+        spp,
+        time_limit,
+        seed: args.seed,
+    };
+    let out = pool.install(|| {
+        render(&scene, integrator.as_ref(), &settings, &cancel, &mut |passes, elapsed| {
+            if let Some(b) = &bar {
+                if spp == u32::MAX {
+                    b.set_position(elapsed.as_millis() as u64);
+                    b.set_message(format!("{passes} passes"));
+                } else {
+                    b.set_position(passes as u64);
+                }
+            }
+        })
+    });
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+
+    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    out.image.write(&output).map_err(|e| e.to_string())?;
+
+    let mrays = out.rays as f64 / out.seconds.max(1e-9) / 1e6;
+    if let Some(path) = &args.stats {
+        let stats = Stats {
+            scene: args.scene.display().to_string(),
+            integrator: integrator.name(),
+            seconds: out.seconds,
+            load_seconds,
+            spp: out.passes,
+            width: out.image.width,
+            height: out.image.height,
+            rays: out.rays,
+            mrays_per_second: mrays,
+            nonfinite_pixels: out.nonfinite_pixels,
+            seed: args.seed,
+            threads,
+        };
+        let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
+        std::fs::write(path, json + "\n").map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    if !args.quiet {
+        let stopped = if cancel.load(Ordering::Relaxed) {
+            " (interrupted)"
+        } else {
+            ""
+        };
+        println!(
+            "{}: {} passes in {:.2} s{stopped}, {:.1} Mrays/s, {} threads, loaded in {:.2} s -> {}",
+            integrator.name(),
+            out.passes,
+            out.seconds,
+            mrays,
+            threads,
+            load_seconds,
+            output.display()
+        );
+        if out.nonfinite_pixels > 0 {
+            eprintln!("warning: {} pixels are NaN or infinite", out.nonfinite_pixels);
+        }
+    }
+    Ok(())
+}
+
+fn run_compare(test: &Path, reference: &Path) -> Result<(), String> {
+    let t = Image::read_exr(test).map_err(|e| e.to_string())?;
+    let r = Image::read_exr(reference).map_err(|e| e.to_string())?;
+    let m = compare(&t, &r).ok_or_else(|| {
+        format!(
+            "{}: size {}×{} differs from the reference's {}×{}",
+            test.display(),
+            t.width,
+            t.height,
+            r.width,
+            r.height
+        )
+    })?;
+    println!(
+        "relmse={:.6e} mse={:.6e} mean_ratio={:.6} nonfinite={}",
+        m.relmse, m.mse, m.mean_ratio, m.nonfinite
+    );
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand) {
+                let _ = e.print();
+                return if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+                    ExitCode::FAILURE
+                } else {
+                    ExitCode::SUCCESS
+                };
+            }
+            let text = e.render().to_string();
+            let first = text.lines().next().unwrap_or("invalid arguments");
+            eprintln!("{} (see restir --help)", first.trim());
+            return ExitCode::FAILURE;
+        }
+    };
+    let result = match cli.command {
+        Command::Render(args) => run_render(args),
+        Command::Compare { test, reference } => run_compare(&test, &reference),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,192 @@
+//! The reference estimator: unidirectional path tracing with next-event estimation and BSDF
+//! sampling combined by multiple importance sampling (power heuristic, Veach 1997 §9.2), and
+//! Russian roulette. Depth semantics follow Mitsuba 3's `path` integrator: `max_depth` counts
+//! path segments from the camera (1 = directly visible emitters, 2 = direct lighting, -1 =
+//! unbounded); Russian roulette starts once `depth ≥ rr_depth` with survival probability
+//! `min(max(β)·η², 0.95)`.
+
+use glam::{Vec2, Vec3};
+use restir_geometry::{Ray, offset_ray_origin, shadow_ray_between, shadow_ray_towards};
+use restir_sampling::{Pcg32, warp::power_heuristic};
+use restir_scene::Scene;
+
+/// Path tracer settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathSettings {
+    /// Longest path in segments; -1 is unbounded.
+    pub max_depth: i32,
+    /// Depth at which Russian roulette starts.
+    pub rr_depth: u32,
+    /// Hide directly visible emitters.
+    pub hide_emitters: bool,
+}
+
+impl PathSettings {
+    /// Settings from the scene's integrator description.
+    pub fn from_scene(scene: &Scene) -> Self {
+        Self {
+            max_depth: scene.integrator.max_depth,
+            rr_depth: scene.integrator.rr_depth.max(1),
+            hide_emitters: scene.integrator.hide_emitters,
+        }
+    }
+}
+
+/// Random numbers each bounce consumes, whatever happens at it: light selection (1), point on the
+/// light (2), BSDF lobe (1), BSDF direction (2), Russian roulette (1). A fixed budget keeps the
+/// numbers of bounce `k` at a known offset in the stream, so paths can be replayed.
+pub const RANDOMS_PER_BOUNCE: usize = 7;
+
+/// The state a path carries from a surface to the next one, enough to weight an emitter the
+/// continuation ray hits by MIS.
+#[derive(Clone, Copy, Debug)]
+pub struct PrevVertex {
+    /// Position of the scattering vertex.
+    pub p: Vec3,
+    /// Solid-angle pdf of the sampled direction.
+    pub pdf_sa: f32,
+    /// Whether the sampled lobe was a delta lobe (no light sampling could have produced it).
+    pub delta: bool,
+}
+
+/// Radiance arriving along `ray` (a camera ray, or a continuation from `prev`), estimated with one
+/// path. `depth` is the number of segments already traced before `ray`. Returns the estimate and
+/// the number of rays traced.
+pub fn trace_path(
+    scene: &Scene,
+    settings: &PathSettings,
+    mut ray: Ray,
+    mut depth: u32,
+    mut beta: Vec3,
+    mut prev: Option<PrevVertex>,
+    rng: &mut Pcg32,
+) -> (Vec3, u64) {
+    let mut radiance = Vec3::ZERO;
+    let mut rays = 0u64;
+    let max_depth = if settings.max_depth < 0 {
+        u32::MAX
+    } else {
+        settings.max_depth as u32
+    };
+    if depth >= max_depth {
+        return (radiance, rays);
+    }
+    let lights = &scene.lights;
+    let has_env = scene.features.has_environment;
+    let mut eta_scale = 1.0f32;
+    loop {
+        let hit = scene.intersect(&ray);
+        rays += 1;
+        let Some(si) = hit else {
+            if has_env && !(depth == 0 && settings.hide_emitters) {
+                let le = lights.environment_radiance(ray.d);
+                let w = match prev {
+                    Some(pv) if !pv.delta => {
+                        let env = lights.environment().expect("feature summary says there is one");
+                        let em_pdf = lights.pdf_sa(&scene.shapes, env, pv.p, pv.p + ray.d, -ray.d);
+                        power_heuristic(pv.pdf_sa, em_pdf)
+                    }
+                    _ => 1.0,
+                };
+                radiance += beta * le * w;
+            }
+            break;
+        };
+
+        // Emission from the surface the ray hit.
+        if let Some(light) = lights.light_on_shape(si.shape)
+            && !(depth == 0 && settings.hide_emitters)
+        {
+            let le = lights.area_radiance(light, si.shading.n, -ray.d);
+            if le != Vec3::ZERO {
+                let w = match prev {
+                    Some(pv) if !pv.delta => {
+                        let em_pdf = lights.pdf_sa(&scene.shapes, light, pv.p, si.p, si.shading.n);
+                        power_heuristic(pv.pdf_sa, em_pdf)
+                    }
+                    _ => 1.0,
+                };
+                radiance += beta * le * w;
+            }
+        }
+
+        if depth + 1 >= max_depth {
+            break;
+        }
+
+        // The fixed per-bounce budget of random numbers.
+        let u_select = rng.next_f32();
+        let u_light = rng.next_2d();
+        let u_lobe = rng.next_f32();
+        let u_bsdf = rng.next_2d();
+        let u_rr = rng.next_f32();
+
+        let bsdf = scene.bsdf(&si);
+        let wo = si.shading.to_local(-ray.d);
+
+        // Next-event estimation.
+        if bsdf.has_smooth_lobe()
+            && let Some(ls) = lights.sample(&scene.shapes, si.p, u_select, u_light)
+        {
+            let wi = si.shading.to_local(ls.wi);
+            let f = bsdf.eval(wo, wi);
+            if f != Vec3::ZERO {
+                let (shadow, t_max) = if ls.dist.is_finite() {
+                    shadow_ray_between(si.p, si.ng, ls.p)
+                } else {
+                    shadow_ray_towards(si.p, si.ng, ls.wi, f32::INFINITY)
+                };
+                rays += 1;
+                if !scene.occluded(&shadow, t_max) {
+                    let w = if ls.delta {
+                        1.0
+                    } else {
+                        power_heuristic(ls.pdf_sa, bsdf.pdf_sa(wo, wi))
+                    };
+                    radiance += beta * f * ls.le * (w / ls.pdf_sa);
+                }
+            }
+        }
+
+        // BSDF sampling.
+        let Some(bs) = bsdf.sample(wo, u_lobe, u_bsdf) else {
+            break;
+        };
+        beta *= bs.f / bs.pdf_sa;
+        eta_scale *= bs.eta;
+        let d = si.shading.to_world(bs.wi);
+        prev = Some(PrevVertex {
+            p: si.p,
+            pdf_sa: bs.pdf_sa,
+            delta: bs.lobe.is_delta(),
+        });
+        ray = Ray::new(offset_ray_origin(si.p, si.ng, d), d);
+        depth += 1;
+
+        let bmax = beta.max_element();
+        if !(bmax > 0.0) || !beta.is_finite() {
+            break;
+        }
+        if depth >= settings.rr_depth {
+            let q = (bmax * eta_scale * eta_scale).min(0.95);
+            if u_rr >= q {
+                break;
+            }
+            beta /= q;
+        }
+    }
+    (radiance, rays)
+}
+
+/// One path-traced estimate for the camera ray through `film` (pixel coordinates).
+#[inline]
+pub fn trace_camera_path(
+    scene: &Scene,
+    settings: &PathSettings,
+    film: Vec2,
+    rng: &mut Pcg32,
+) -> (Vec3, u64) {
+    let u_lens = rng.next_2d();
+    let ray = scene.camera.generate_ray(film, u_lens);
+    trace_path(scene, settings, ray, 0, Vec3::ONE, None, rng)
+}

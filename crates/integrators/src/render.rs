@@ -1,0 +1,162 @@
+//! The render driver: passes over the image until the sample count, the time limit or a
+//! cancellation ends it. A pass is one sample per pixel of an integrator's final estimator.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use glam::{DVec3, Vec2, Vec3};
+use rayon::prelude::*;
+use restir_sampling::Pcg32;
+use restir_scene::Scene;
+
+use crate::film::Filter;
+use crate::path::{PathSettings, trace_camera_path};
+use crate::Image;
+
+/// Rows per parallel work item.
+const BAND_ROWS: usize = 2;
+
+/// What an integrator needs to know about the current pass.
+#[derive(Debug)]
+pub struct PassContext<'a> {
+    /// The render's seed.
+    pub seed: u64,
+    /// Index of this pass (0-based).
+    pub pass: u32,
+    /// The pixel filter, for jittering camera rays.
+    pub filter: &'a Filter,
+}
+
+impl PassContext<'_> {
+    /// The random stream of pixel `index` in this pass, the same whatever thread renders it.
+    #[inline]
+    pub fn pixel_rng(&self, index: usize) -> Pcg32 {
+        Pcg32::for_pixel_sample(self.seed, index as u64, self.pass as u64)
+    }
+
+    /// The film position (pixel units) of a filter-jittered camera ray through pixel `(x, y)`.
+    #[inline]
+    pub fn film_position(&self, x: u32, y: u32, rng: &mut Pcg32) -> Vec2 {
+        Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + self.filter.sample(rng.next_2d())
+    }
+}
+
+/// An estimator that renders whole passes.
+pub trait Integrator: Sync + Send + std::fmt::Debug {
+    /// Name as given on the command line.
+    fn name(&self) -> &'static str;
+    /// Renders one pass, adding one estimate per pixel to `accum` (row-major). Returns the number
+    /// of rays traced.
+    fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64;
+}
+
+/// The path tracer as an [`Integrator`].
+#[derive(Clone, Debug)]
+pub struct PathIntegrator {
+    /// Settings.
+    pub settings: PathSettings,
+}
+
+impl Integrator for PathIntegrator {
+    fn name(&self) -> &'static str {
+        "path"
+    }
+
+    fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
+        let (w, _) = scene.camera.resolution();
+        let w = w as usize;
+        accum
+            .par_chunks_mut(w * BAND_ROWS)
+            .enumerate()
+            .map(|(band, chunk)| {
+                let mut rays = 0;
+                for (i, px) in chunk.iter_mut().enumerate() {
+                    let index = band * w * BAND_ROWS + i;
+                    let (x, y) = ((index % w) as u32, (index / w) as u32);
+                    let mut rng = ctx.pixel_rng(index);
+                    let film = ctx.film_position(x, y, &mut rng);
+                    let (l, r) = trace_camera_path(scene, &self.settings, film, &mut rng);
+                    *px += l.as_dvec3();
+                    rays += r;
+                }
+                rays
+            })
+            .sum()
+    }
+}
+
+/// How long and how much to render.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderSettings {
+    /// Passes to render (at least one is always rendered).
+    pub spp: u32,
+    /// Stop starting new passes once this much time has passed.
+    pub time_limit: Option<Duration>,
+    /// Seed of every random stream.
+    pub seed: u64,
+}
+
+/// The result of a render.
+#[derive(Clone, Debug)]
+pub struct RenderOutput {
+    /// The average of the passes.
+    pub image: Image,
+    /// Passes made.
+    pub passes: u32,
+    /// Render time in seconds (excluding scene loading).
+    pub seconds: f64,
+    /// Rays traced: camera, continuation and shadow rays.
+    pub rays: u64,
+    /// Pixels with a NaN or infinite value.
+    pub nonfinite_pixels: usize,
+}
+
+/// Renders `scene` with `integrator` in the current rayon pool. `cancel` stops the render after
+/// the current pass; `progress` is called after each pass with `(passes done, elapsed)`.
+pub fn render(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    settings: &RenderSettings,
+    cancel: &AtomicBool,
+    progress: &mut dyn FnMut(u32, Duration),
+) -> RenderOutput {
+    let (w, h) = scene.camera.resolution();
+    let filter = Filter::new(scene.filter);
+    let mut accum = vec![DVec3::ZERO; w as usize * h as usize];
+    let start = Instant::now();
+    let mut passes = 0u32;
+    let mut rays = 0u64;
+    let spp = settings.spp.max(1);
+    while passes < spp {
+        let ctx = PassContext {
+            seed: settings.seed,
+            pass: passes,
+            filter: &filter,
+        };
+        rays += integrator.render_pass(scene, &ctx, &mut accum);
+        passes += 1;
+        let elapsed = start.elapsed();
+        progress(passes, elapsed);
+        if cancel.load(Ordering::Relaxed) {
+            break;
+        }
+        if settings.time_limit.is_some_and(|t| elapsed >= t) {
+            break;
+        }
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    let inv = 1.0 / passes as f64;
+    let image = Image {
+        width: w,
+        height: h,
+        pixels: accum.iter().map(|s| (*s * inv).as_vec3()).collect::<Vec<Vec3>>(),
+    };
+    let nonfinite_pixels = image.nonfinite_count();
+    RenderOutput {
+        image,
+        passes,
+        seconds,
+        rays,
+        nonfinite_pixels,
+    }
+}

@@ -1,0 +1,171 @@
+//! Scenes for the `restir` renderer.
+//!
+//! A scene is first a *description* ([`SceneDesc`]): plain data that the project's RON format
+//! deserialises into (strictly: unknown fields are errors) and that the Mitsuba-style XML importer
+//! ([`xml`]) produces. [`Scene::build`] turns a description into the runtime [`Scene`] once:
+//! meshes loaded and transformed to world space, one BVH, light tables, and a [`SceneFeatures`]
+//! summary from which integrators choose cheaper code paths.
+//!
+//! ```
+//! let ron = r#"(
+//!     camera: (fov: 40, to_world: [LookAt(origin: (0, 0, 4), target: (0, 0, 0), up: (0, 1, 0))]),
+//!     film: (width: 32, height: 32, filter: Box),
+//!     shapes: [
+//!         (geometry: Rectangle, material: Some(Inline(Diffuse(reflectance: (0.5, 0.5, 0.5))))),
+//!         (geometry: Sphere(center: (0, 0, 2), radius: 0.1), emission: Some((10, 10, 10)), flip_normals: true),
+//!     ],
+//! )"#;
+//! let desc = restir_scene::parse_ron(ron, "inline.ron".as_ref()).unwrap();
+//! let scene = restir_scene::Scene::build(&desc, ".".as_ref(), "inline.ron".as_ref()).unwrap();
+//! assert_eq!(scene.lights.len(), 1);
+//! assert_eq!(scene.camera.resolution(), (32, 32));
+//! ```
+
+mod build;
+pub mod desc;
+mod error;
+pub mod xml;
+
+use std::path::{Path, PathBuf};
+
+pub use build::transform_matrix;
+pub use desc::*;
+pub use error::{SceneError, SceneWarning};
+
+use restir_geometry::{Accel, Camera, Hit, Ray, Shape, SurfaceInteraction};
+use restir_lights::LightSet;
+use restir_materials::Bsdf;
+
+/// What a scene contains, decided once at build time so that integrators can pick cheaper code
+/// paths instead of testing inside their loops.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SceneFeatures {
+    /// Some material has a delta lobe (mirror, smooth glass).
+    pub has_delta_lobes: bool,
+    /// Some material has a glossy (microfacet) lobe.
+    pub has_glossy_lobes: bool,
+    /// Some material parameter is a texture.
+    pub has_textures: bool,
+    /// There is an environment light (rays that escape gather radiance).
+    pub has_environment: bool,
+    /// There is a point or directional light.
+    pub has_delta_lights: bool,
+    /// Number of lights.
+    pub light_count: usize,
+}
+
+/// The runtime scene.
+#[derive(Debug)]
+pub struct Scene {
+    /// World-space shapes.
+    pub shapes: Vec<Shape>,
+    /// For each shape, the index of its BSDF in `bsdfs`.
+    pub shape_bsdf: Vec<u32>,
+    /// The materials.
+    pub bsdfs: Vec<Bsdf>,
+    /// The BVH over `shapes`.
+    pub accel: Accel,
+    /// Lights and light selection.
+    pub lights: LightSet,
+    /// The camera (its resolution is the film's).
+    pub camera: Camera,
+    /// Reconstruction filter.
+    pub filter: FilterDesc,
+    /// Samples per pixel the scene asks for.
+    pub spp: u32,
+    /// The scene's integrator settings.
+    pub integrator: IntegratorDesc,
+    /// Output file name the scene asks for.
+    pub output: Option<String>,
+    /// What the scene contains.
+    pub features: SceneFeatures,
+}
+
+impl Scene {
+    /// The closest surface hit by `ray`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
+        let hit: Hit = self.accel.intersect(ray, f32::INFINITY)?;
+        Some(self.accel.surface_interaction(&self.shapes, &hit, ray))
+    }
+
+    /// Whether the segment `ray` up to `t_max` is blocked.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        self.accel.occluded(ray, t_max)
+    }
+
+    /// The BSDF of a surface point.
+    #[inline]
+    pub fn bsdf(&self, si: &SurfaceInteraction) -> &Bsdf {
+        &self.bsdfs[self.shape_bsdf[si.shape as usize] as usize]
+    }
+}
+
+/// A loaded scene and what the loader noticed.
+#[derive(Debug)]
+pub struct LoadedScene {
+    /// The built scene.
+    pub scene: Scene,
+    /// Warnings (ignored properties, fallbacks), each with `file:line`.
+    pub warnings: Vec<SceneWarning>,
+    /// The description it was built from.
+    pub desc: SceneDesc,
+}
+
+/// Parses the project's RON scene format.
+pub fn parse_ron(text: &str, file: &Path) -> Result<SceneDesc, SceneError> {
+    ron::Options::default()
+        .from_str::<SceneDesc>(text)
+        .map_err(|e| {
+            SceneError::new(
+                Location {
+                    file: file.to_path_buf(),
+                    line: e.span.start.line as u32,
+                },
+                e.code.to_string(),
+            )
+        })
+}
+
+/// Reads a scene description from a `.ron` or `.xml` file. `defines` set XML `<default>` values
+/// (`-D name=value` on the command line); they are an error for RON files, which have none.
+pub fn load_desc(
+    path: &Path,
+    defines: &[(String, String)],
+) -> Result<(SceneDesc, Vec<SceneWarning>), SceneError> {
+    let whole = |msg: String| {
+        SceneError::new(
+            Location {
+                file: path.to_path_buf(),
+                line: 0,
+            },
+            msg,
+        )
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| whole(format!("cannot read scene: {e}")))?;
+    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("ron") => {
+            if let Some((name, _)) = defines.first() {
+                return Err(whole(format!(
+                    "-D {name}=…: RON scenes have no <default> variables to set"
+                )));
+            }
+            Ok((parse_ron(&text, path)?, Vec::new()))
+        }
+        Some("xml") => xml::parse_xml(&text, path, defines),
+        _ => Err(whole("unknown scene format: expected a .ron or .xml file".into())),
+    }
+}
+
+/// Loads and builds a scene file.
+pub fn load_scene(path: &Path, defines: &[(String, String)]) -> Result<LoadedScene, SceneError> {
+    let (desc, warnings) = load_desc(path, defines)?;
+    let base: PathBuf = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let scene = Scene::build(&desc, &base, path)?;
+    Ok(LoadedScene {
+        scene,
+        warnings,
+        desc,
+    })
+}
