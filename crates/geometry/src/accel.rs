@@ -145,7 +145,10 @@ impl Accel {
                     });
                     ids.push((si as u32, 0));
                     let r = Vec3A::splat(s.radius);
-                    aabbs.push(Aabb::new(Vec3A::from(s.center) - r, Vec3A::from(s.center) + r));
+                    aabbs.push(Aabb::new(
+                        Vec3A::from(s.center) - r,
+                        Vec3A::from(s.center) + r,
+                    ));
                 }
             }
         }
@@ -162,7 +165,11 @@ impl Accel {
                 bounds: (Vec3::ZERO, Vec3::ZERO),
             };
         }
-        let bvh = build_cwbvh(&aabbs, BvhBuildParams::medium_build(), &mut Duration::default());
+        let bvh = build_cwbvh(
+            &aabbs,
+            BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
         // Lay primitives out in BVH order so the traversal indexes them directly.
         let prims = bvh
             .primitive_indices
@@ -243,7 +250,12 @@ impl Accel {
 
     /// Surface details of a hit returned by [`Accel::intersect`] for the same `ray`.
     #[inline]
-    pub fn surface_interaction(&self, shapes: &[Shape], hit: &Hit, ray: &Ray) -> SurfaceInteraction {
+    pub fn surface_interaction(
+        &self,
+        shapes: &[Shape],
+        hit: &Hit,
+        ray: &Ray,
+    ) -> SurfaceInteraction {
         let shape = &shapes[hit.shape as usize];
         let param = match shape {
             Shape::Mesh(m) => {
@@ -375,7 +387,9 @@ mod tests {
             let si = accel.surface_interaction(&shapes, &hit, &ray);
             // Reflect off the surface into the hemisphere the ray came from.
             let frame = Frame::from_normal(si.ng * -si.ng.dot(ray.d).signum());
-            let d = frame.to_world(restir_sampling::warp::sample_cosine_hemisphere(rng.next_2d()));
+            let d = frame.to_world(restir_sampling::warp::sample_cosine_hemisphere(
+                rng.next_2d(),
+            ));
             let o2 = offset_ray_origin(si.p, si.ng, d);
             if let Some(h2) = accel.intersect(&Ray::new(o2, d), f32::INFINITY) {
                 assert!(
@@ -393,7 +407,9 @@ mod tests {
     fn sphere_hit_from_inside() {
         let shapes = vec![Shape::Sphere(Sphere::new(Vec3::ZERO, 2.0, false))];
         let accel = Accel::build(&shapes);
-        let h = accel.intersect(&Ray::new(Vec3::ZERO, Vec3::X), f32::INFINITY).unwrap();
+        let h = accel
+            .intersect(&Ray::new(Vec3::ZERO, Vec3::X), f32::INFINITY)
+            .unwrap();
         assert!((h.t - 2.0).abs() < 1e-5);
     }
 }

@@ -87,9 +87,11 @@ impl Camera {
         if !to_world.is_finite() || to_world.determinant().abs() < 1e-20 {
             return Err(CameraError::Transform);
         }
-        if !(aperture_radius >= 0.0 && aperture_radius.is_finite())
-            || !(focus_distance > 0.0 && focus_distance.is_finite())
-        {
+        let lens_ok = aperture_radius >= 0.0
+            && aperture_radius.is_finite()
+            && focus_distance > 0.0
+            && focus_distance.is_finite();
+        if !lens_ok {
             return Err(CameraError::Lens);
         }
         let aspect = w as f32 / h as f32;

@@ -185,14 +185,15 @@ impl Shape {
             }
             Shape::Mesh(_) => {
                 let ps = self.sample_uniform_area(u)?;
-                let pdf = area_to_solid_angle(1.0 / self.area(), ref_p, ps.p, ps.n)?;
+                // Uniform by area: the solid-angle density uses the geometric normal.
+                let pdf = area_to_solid_angle(1.0 / self.area(), ref_p, ps.p, ps.ng)?;
                 Some((ps, pdf))
             }
         }
     }
 
     /// The solid-angle pdf at `ref_p` with which [`Shape::sample_from`] returns point `p` with
-    /// normal `n`.
+    /// *geometric* normal `n`.
     #[inline]
     pub fn pdf_sa_from(&self, ref_p: Vec3, p: Vec3, n: Vec3) -> f32 {
         match self {

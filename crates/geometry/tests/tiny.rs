@@ -14,7 +14,10 @@ fn axis_aligned_rays_hit() {
             for d in [axis, -axis] {
                 let ray = Ray::new(-5.0 * d, d);
                 let hit = accel.intersect(&ray, f32::INFINITY);
-                assert!(hit.is_some_and(|h| (h.t - 4.0).abs() < 1e-4), "{n} prims, d = {d:?}");
+                assert!(
+                    hit.is_some_and(|h| (h.t - 4.0).abs() < 1e-4),
+                    "{n} prims, d = {d:?}"
+                );
                 assert!(accel.occluded(&ray, f32::INFINITY));
                 assert!(!accel.occluded(&ray, 3.9));
             }

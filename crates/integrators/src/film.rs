@@ -56,9 +56,10 @@ impl Filter {
     pub fn sample(&self, u: Vec2) -> Vec2 {
         match self {
             Filter::Box => u - Vec2::splat(0.5),
-            Filter::Tent { radius } => {
-                Vec2::new(warp::sample_tent(u.x, *radius), warp::sample_tent(u.y, *radius))
-            }
+            Filter::Tent { radius } => Vec2::new(
+                warp::sample_tent(u.x, *radius),
+                warp::sample_tent(u.y, *radius),
+            ),
             Filter::Tabulated { radius, table } => {
                 let x = table.sample_continuous(u.x).0;
                 let y = table.sample_continuous(u.y).0;
@@ -96,7 +97,10 @@ mod tests {
             let se_mean = (var / n as f64).sqrt();
             assert!(mean.abs() < 4.0 * se_mean, "{desc:?}: mean {mean}");
             // Fourth moment ≤ 3σ⁴ for these profiles: SE of the variance ≤ sqrt(2/n)·σ².
-            assert!((v - var).abs() < 4.0 * (2.0 / n as f64).sqrt() * var + 1e-3 * var, "{desc:?}: var {v} vs {var}");
+            assert!(
+                (v - var).abs() < 4.0 * (2.0 / n as f64).sqrt() * var + 1e-3 * var,
+                "{desc:?}: var {v} vs {var}"
+            );
         }
     }
 }

@@ -33,7 +33,11 @@ impl core::fmt::Display for ImageError {
 impl std::error::Error for ImageError {}
 
 fn srgb_encode(c: f32) -> u8 {
-    let c = if c.is_finite() { c.clamp(0.0, 1.0) } else { 0.0 };
+    let c = if c.is_finite() {
+        c.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     let v = if c <= 0.003_130_8 {
         12.92 * c
     } else {
@@ -108,7 +112,7 @@ impl Image {
                 .map_err(|e| err(format!("cannot write PNG: {e}")))
             }
             _ => Err(err(
-                "unknown image format: use a .exr or .png file name".into(),
+                "unknown image format: use a .exr or .png file name".into()
             )),
         }
     }

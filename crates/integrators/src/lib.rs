@@ -25,9 +25,7 @@ mod render;
 
 pub use image_io::{Image, ImageError};
 pub use metrics::{ErrorMetrics, compare};
-pub use render::{
-    Integrator, PassContext, PathIntegrator, RenderOutput, RenderSettings, render,
-};
+pub use render::{Integrator, PassContext, PathIntegrator, RenderOutput, RenderSettings, render};
 
 use restir_scene::Scene;
 
@@ -43,7 +41,9 @@ pub fn make_integrator(
     let mut settings = path::PathSettings::from_scene(scene);
     if let Some(d) = max_depth {
         if d < -1 {
-            return Err(format!("max depth {d} must be -1 (unbounded) or non-negative"));
+            return Err(format!(
+                "max depth {d} must be -1 (unbounded) or non-negative"
+            ));
         }
         settings.max_depth = d;
     }

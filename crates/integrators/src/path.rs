@@ -82,7 +82,9 @@ pub fn trace_path(
                 let le = lights.environment_radiance(ray.d);
                 let w = match prev {
                     Some(pv) if !pv.delta => {
-                        let env = lights.environment().expect("feature summary says there is one");
+                        let env = lights
+                            .environment()
+                            .expect("feature summary says there is one");
                         let em_pdf = lights.pdf_sa(&scene.shapes, env, pv.p, pv.p + ray.d, -ray.d);
                         power_heuristic(pv.pdf_sa, em_pdf)
                     }
@@ -101,7 +103,7 @@ pub fn trace_path(
             if le != Vec3::ZERO {
                 let w = match prev {
                     Some(pv) if !pv.delta => {
-                        let em_pdf = lights.pdf_sa(&scene.shapes, light, pv.p, si.p, si.shading.n);
+                        let em_pdf = lights.pdf_sa(&scene.shapes, light, pv.p, si.p, si.ng);
                         power_heuristic(pv.pdf_sa, em_pdf)
                     }
                     _ => 1.0,

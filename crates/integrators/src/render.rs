@@ -9,9 +9,9 @@ use rayon::prelude::*;
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
+use crate::Image;
 use crate::film::Filter;
 use crate::path::{PathSettings, trace_camera_path};
-use crate::Image;
 
 /// Rows per parallel work item.
 const BAND_ROWS: usize = 2;
@@ -149,7 +149,10 @@ pub fn render(
     let image = Image {
         width: w,
         height: h,
-        pixels: accum.iter().map(|s| (*s * inv).as_vec3()).collect::<Vec<Vec3>>(),
+        pixels: accum
+            .iter()
+            .map(|s| (*s * inv).as_vec3())
+            .collect::<Vec<Vec3>>(),
     };
     let nonfinite_pixels = image.nonfinite_count();
     RenderOutput {

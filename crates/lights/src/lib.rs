@@ -53,8 +53,11 @@ pub struct LightSample {
     pub light: u32,
     /// The point on the light (for lights at infinity, a far point along `wi`).
     pub p: Vec3,
-    /// The light's normal at `p` (zero for point lights, `-wi` for lights at infinity).
+    /// The light's shading normal at `p` (zero for point lights, `-wi` for lights at infinity);
+    /// one-sided emission is judged against it.
     pub n: Vec3,
+    /// The light's geometric normal at `p` (the one [`LightSet::pdf_sa`] takes).
+    pub ng: Vec3,
     /// Unit direction from the receiver to the light.
     pub wi: Vec3,
     /// Distance to `p`; infinite for lights at infinity.
@@ -138,7 +141,10 @@ impl LightSet {
                     shape_light[shape as usize] = Some(i as u32);
                     PI * s.area() * luminance(radiance)
                 }
-                Light::Point { position, intensity } => {
+                Light::Point {
+                    position,
+                    intensity,
+                } => {
                     if !valid(intensity) || !position.is_finite() {
                         return Err(LightError::BadParameter(i, "intensity"));
                     }
@@ -283,6 +289,7 @@ impl LightSet {
                     light,
                     p: ps.p,
                     n: ps.n,
+                    ng: ps.ng,
                     wi,
                     dist,
                     le: radiance,
@@ -306,6 +313,7 @@ impl LightSet {
                     light,
                     p: position,
                     n: Vec3::ZERO,
+                    ng: Vec3::ZERO,
                     wi: to / dist,
                     dist,
                     le: intensity / d2,
@@ -322,6 +330,7 @@ impl LightSet {
                 light,
                 p: ref_p - direction * (2.0 * self.scene_radius),
                 n: direction,
+                ng: direction,
                 wi: -direction,
                 dist: f32::INFINITY,
                 le: irradiance,
@@ -336,6 +345,7 @@ impl LightSet {
                     light,
                     p: ref_p + wi * (2.0 * self.scene_radius),
                     n: -wi,
+                    ng: -wi,
                     wi,
                     dist: f32::INFINITY,
                     le: radiance,
@@ -349,7 +359,7 @@ impl LightSet {
     }
 
     /// The solid-angle density, including the selection probability, with which
-    /// [`LightSet::sample`] would return point `p` (normal `n`) on light `light` from `ref_p`; for
+    /// [`LightSet::sample`] would return point `p` (geometric normal `n`) on light `light` from `ref_p`; for
     /// the environment `p` is ignored and `n` is unused. Zero for delta lights.
     #[inline]
     pub fn pdf_sa(&self, shapes: &[Shape], light: u32, ref_p: Vec3, p: Vec3, n: Vec3) -> f32 {
@@ -418,8 +428,12 @@ mod tests {
                 if s.delta {
                     assert!((s.pdf_sa - set.pmf(s.light)).abs() < 1e-6);
                 } else {
-                    let pdf = set.pdf_sa(&shapes, s.light, Vec3::ZERO, s.p, s.n);
-                    assert!((pdf - s.pdf_sa).abs() <= 1e-3 * pdf, "{pdf} vs {}", s.pdf_sa);
+                    let pdf = set.pdf_sa(&shapes, s.light, Vec3::ZERO, s.p, s.ng);
+                    assert!(
+                        (pdf - s.pdf_sa).abs() <= 1e-3 * pdf,
+                        "{pdf} vs {}",
+                        s.pdf_sa
+                    );
                 }
             }
         }
@@ -457,6 +471,9 @@ mod tests {
                 + y / (y * y + h * h).sqrt() * (x / (y * y + h * h).sqrt()).atan()
         };
         let exact = 2.0 * fa(a, a);
-        assert!((mean - exact).abs() < 4.0 * se, "{mean} vs {exact} (se {se})");
+        assert!(
+            (mean - exact).abs() < 4.0 * se,
+            "{mean} vs {exact} (se {se})"
+        );
     }
 }

@@ -60,7 +60,10 @@ impl Pcg32 {
 
     /// Rebuilds a generator from [`Pcg32::to_raw`]; the increment is forced odd.
     pub fn from_raw(state: u64, inc: u64) -> Self {
-        Self { state, inc: inc | 1 }
+        Self {
+            state,
+            inc: inc | 1,
+        }
     }
 
     /// The next 32 random bits.
@@ -138,7 +141,14 @@ mod tests {
         // The first outputs of pcg32 with the demo seed (42, 54) from the PCG reference
         // implementation (pcg32-demo).
         let mut rng = Pcg32::new(42, 54);
-        let expected = [0xa15c02b7u32, 0x7b47f409, 0xba1d3330, 0x83d2f293, 0xbfa4784b, 0xcbed606e];
+        let expected = [
+            0xa15c02b7u32,
+            0x7b47f409,
+            0xba1d3330,
+            0x83d2f293,
+            0xbfa4784b,
+            0xcbed606e,
+        ];
         for e in expected {
             assert_eq!(rng.next_u32(), e);
         }

@@ -55,7 +55,11 @@ pub fn transform_matrix(ops: &[TransformOp]) -> Result<Mat4, String> {
 
 fn affine(m: Mat4) -> Result<Affine3A, String> {
     let row3 = m.row(3);
-    if (row3 - glam::Vec4::new(0.0, 0.0, 0.0, 1.0)).abs().max_element() > 1e-6 {
+    if (row3 - glam::Vec4::new(0.0, 0.0, 0.0, 1.0))
+        .abs()
+        .max_element()
+        > 1e-6
+    {
         return Err("projective transforms are not supported on shapes".into());
     }
     let a = Affine3A::from_mat4(m);
@@ -82,7 +86,17 @@ fn material_bsdf(m: &MaterialDesc) -> Result<Bsdf, String> {
     })
 }
 
-fn load_obj(path: &Path) -> Result<(Vec<Vec3>, Option<Vec<Vec3>>, Option<Vec<Vec2>>, Vec<[u32; 3]>), String> {
+fn load_obj(
+    path: &Path,
+) -> Result<
+    (
+        Vec<Vec3>,
+        Option<Vec<Vec3>>,
+        Option<Vec<Vec2>>,
+        Vec<[u32; 3]>,
+    ),
+    String,
+> {
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -107,12 +121,24 @@ fn load_obj(path: &Path) -> Result<(Vec<Vec3>, Option<Vec<Vec3>>, Option<Vec<Vec
         if mesh.positions.len() % 3 != 0 || mesh.indices.len() % 3 != 0 {
             return Err(format!("mesh '{}' is truncated", path.display()));
         }
-        positions.extend(mesh.positions.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
+        positions.extend(
+            mesh.positions
+                .chunks_exact(3)
+                .map(|c| Vec3::new(c[0], c[1], c[2])),
+        );
         if all_normals {
-            normals.extend(mesh.normals.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
+            normals.extend(
+                mesh.normals
+                    .chunks_exact(3)
+                    .map(|c| Vec3::new(c[0], c[1], c[2])),
+            );
         }
         if all_uvs {
-            uvs.extend(mesh.texcoords.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])));
+            uvs.extend(
+                mesh.texcoords
+                    .chunks_exact(2)
+                    .map(|c| Vec2::new(c[0], c[1])),
+            );
         }
         for t in mesh.indices.chunks_exact(3) {
             indices.push([base + t[0], base + t[1], base + t[2]]);
@@ -156,9 +182,10 @@ fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<Shape, String> {
             let path = base_dir.join(filename);
             let (p, n, uv, idx) = load_obj(&path)?;
             let n = if desc.face_normals { None } else { n };
-            mesh(TriangleMesh::new(p, n, uv, idx, desc.flip_normals).map_err(|e| {
-                format!("mesh '{}': {e}", path.display())
-            })?)?
+            mesh(
+                TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
+                    .map_err(|e| format!("mesh '{}': {e}", path.display()))?,
+            )?
         }
         GeometryDesc::Mesh {
             positions,
@@ -184,7 +211,11 @@ fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<Shape, String> {
         if !m.flip_normals() {
             let rebuilt = TriangleMesh::new(
                 m.positions().to_vec(),
-                if desc.face_normals { None } else { m.normals().map(<[Vec3]>::to_vec) },
+                if desc.face_normals {
+                    None
+                } else {
+                    m.normals().map(<[Vec3]>::to_vec)
+                },
                 m.uvs().map(<[Vec2]>::to_vec),
                 m.indices().to_vec(),
                 true,
@@ -235,7 +266,8 @@ impl Scene {
                 "film resolution {w}×{h} is out of range (each side 1..=32768, at most 2^28 pixels)"
             )));
         }
-        let cam_m = transform_matrix(&desc.camera.to_world).map_err(|e| whole(format!("camera: {e}")))?;
+        let cam_m =
+            transform_matrix(&desc.camera.to_world).map_err(|e| whole(format!("camera: {e}")))?;
         let fov_axis = match desc.camera.fov_axis {
             FovAxis::X => GeoFovAxis::X,
             FovAxis::Y => GeoFovAxis::Y,
@@ -272,7 +304,8 @@ impl Scene {
         let mut bsdfs = vec![Bsdf::diffuse(Vec3::splat(0.5)), Bsdf::black()];
         let mut names = std::collections::HashMap::new();
         for nm in &desc.materials {
-            let b = material_bsdf(&nm.material).map_err(|e| whole(format!("material '{}': {e}", nm.name)))?;
+            let b = material_bsdf(&nm.material)
+                .map_err(|e| whole(format!("material '{}': {e}", nm.name)))?;
             names.insert(nm.name.clone(), bsdfs.len() as u32);
             bsdfs.push(b);
         }
@@ -282,13 +315,18 @@ impl Scene {
         let mut shape_bsdf = Vec::with_capacity(desc.shapes.len());
         let mut lights = Vec::new();
         for (i, sd) in desc.shapes.iter().enumerate() {
-            let shape = build_shape(sd, base_dir).map_err(|e| at(&sd.location, format!("shape {i}: {e}")))?;
+            let shape = build_shape(sd, base_dir)
+                .map_err(|e| at(&sd.location, format!("shape {i}: {e}")))?;
             let bsdf = match &sd.material {
-                Some(MaterialRef::Ref(name)) => *names
-                    .get(name)
-                    .ok_or_else(|| at(&sd.location, format!("shape {i}: no material named '{name}'")))?,
+                Some(MaterialRef::Ref(name)) => *names.get(name).ok_or_else(|| {
+                    at(
+                        &sd.location,
+                        format!("shape {i}: no material named '{name}'"),
+                    )
+                })?,
                 Some(MaterialRef::Inline(m)) => {
-                    let b = material_bsdf(m).map_err(|e| at(&sd.location, format!("shape {i}: {e}")))?;
+                    let b = material_bsdf(m)
+                        .map_err(|e| at(&sd.location, format!("shape {i}: {e}")))?;
                     bsdfs.push(b);
                     bsdfs.len() as u32 - 1
                 }
@@ -298,7 +336,12 @@ impl Scene {
             if let Some(e) = &sd.emission {
                 let radiance = v3(e);
                 if !radiance.is_finite() || radiance.min_element() < 0.0 {
-                    return Err(at(&sd.location, format!("shape {i}: emitted radiance {e:?} must be finite and non-negative")));
+                    return Err(at(
+                        &sd.location,
+                        format!(
+                            "shape {i}: emitted radiance {e:?} must be finite and non-negative"
+                        ),
+                    ));
                 }
                 if radiance.max_element() > 0.0 && shape.area() > 0.0 {
                     lights.push(Light::Area {
@@ -312,21 +355,30 @@ impl Scene {
         }
         for l in &desc.lights {
             let light = match l {
-                LightDesc::Point { position, intensity } => Light::Point {
+                LightDesc::Point {
+                    position,
+                    intensity,
+                } => Light::Point {
                     position: v3(position),
                     intensity: v3(intensity),
                 },
-                LightDesc::Directional { direction, irradiance } => Light::Directional {
+                LightDesc::Directional {
+                    direction,
+                    irradiance,
+                } => Light::Directional {
                     direction: v3(direction),
                     irradiance: v3(irradiance),
                 },
-                LightDesc::Constant { radiance } => Light::Constant { radiance: v3(radiance) },
+                LightDesc::Constant { radiance } => Light::Constant {
+                    radiance: v3(radiance),
+                },
             };
             lights.push(light);
         }
 
         let accel = Accel::build(&shapes);
-        let light_set = LightSet::new(lights, &shapes, accel.bounds()).map_err(|e| whole(e.to_string()))?;
+        let light_set =
+            LightSet::new(lights, &shapes, accel.bounds()).map_err(|e| whole(e.to_string()))?;
 
         // Feature summary, decided once.
         let used: Vec<&Bsdf> = shape_bsdf.iter().map(|&b| &bsdfs[b as usize]).collect();

@@ -143,8 +143,14 @@ pub fn load_desc(
             msg,
         )
     };
-    let text = std::fs::read_to_string(path).map_err(|e| whole(format!("cannot read scene: {e}")))?;
-    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+    let text =
+        std::fs::read_to_string(path).map_err(|e| whole(format!("cannot read scene: {e}")))?;
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
         Some("ron") => {
             if let Some((name, _)) = defines.first() {
                 return Err(whole(format!(
@@ -154,7 +160,9 @@ pub fn load_desc(
             Ok((parse_ron(&text, path)?, Vec::new()))
         }
         Some("xml") => xml::parse_xml(&text, path, defines),
-        _ => Err(whole("unknown scene format: expected a .ron or .xml file".into())),
+        _ => Err(whole(
+            "unknown scene format: expected a .ron or .xml file".into(),
+        )),
     }
 }
 

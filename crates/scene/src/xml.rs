@@ -194,7 +194,10 @@ impl<'a, 'i> Importer<'a, 'i> {
         match v.len() {
             1 => Ok([v[0] as f32; 3]),
             3 => Ok([v[0] as f32, v[1] as f32, v[2] as f32]),
-            n => Err(self.err(node, format!("expected 1 or 3 numbers, found {n} in \"{s}\""))),
+            n => Err(self.err(
+                node,
+                format!("expected 1 or 3 numbers, found {n} in \"{s}\""),
+            )),
         }
     }
 
@@ -281,7 +284,10 @@ impl<'a, 'i> Importer<'a, 'i> {
     fn srgb_hex(&self, node: Node, s: &str) -> Result<[f32; 3]> {
         let h = s.trim().trim_start_matches('#');
         if h.len() != 6 || !h.chars().all(|c| c.is_ascii_hexdigit()) {
-            return Err(self.err(node, format!("cannot parse sRGB colour \"{s}\" (expected #rrggbb)")));
+            return Err(self.err(
+                node,
+                format!("cannot parse sRGB colour \"{s}\" (expected #rrggbb)"),
+            ));
         }
         let byte = |i: usize| u8::from_str_radix(&h[i..i + 2], 16).unwrap_or(0) as f32 / 255.0;
         let lin = |c: f32| {
@@ -303,9 +309,10 @@ impl<'a, 'i> Importer<'a, 'i> {
                 "float" => Value::Float(self.parse_float(c, &self.req_attr(c, "value")?)?),
                 "integer" => {
                     let s = self.req_attr(c, "value")?;
-                    let v = s.trim().parse::<i64>().map_err(|_| {
-                        self.err(c, format!("cannot parse \"{s}\" as an integer"))
-                    })?;
+                    let v = s
+                        .trim()
+                        .parse::<i64>()
+                        .map_err(|_| self.err(c, format!("cannot parse \"{s}\" as an integer")))?;
                     Value::Int(v)
                 }
                 "boolean" => {
@@ -342,10 +349,7 @@ impl<'a, 'i> Importer<'a, 'i> {
                 used: Cell::new(false),
             });
         }
-        Ok(Props {
-            what,
-            items,
-        })
+        Ok(Props { what, items })
     }
 
     /// Warns about properties nobody read.
@@ -460,7 +464,10 @@ impl Props<'_, '_> {
         if usage == ColorUse::Reflectance && c.iter().any(|&x| !(0.0..=1.0).contains(&x)) {
             return Err(imp.err(
                 p.node,
-                format!("{}: reflectance '{}' = {c:?} must lie in [0, 1]", self.what, p.name),
+                format!(
+                    "{}: reflectance '{}' = {c:?} must lie in [0, 1]",
+                    self.what, p.name
+                ),
             ));
         }
         if usage == ColorUse::Emission && c.iter().any(|&x| x < 0.0) {
@@ -478,8 +485,17 @@ fn elements<'a, 'i>(node: Node<'a, 'i>) -> impl Iterator<Item = Node<'a, 'i>> {
 }
 
 const PROPERTY_TAGS: &[&str] = &[
-    "float", "integer", "boolean", "string", "rgb", "color", "srgb", "spectrum", "point",
-    "vector", "transform",
+    "float",
+    "integer",
+    "boolean",
+    "string",
+    "rgb",
+    "color",
+    "srgb",
+    "spectrum",
+    "point",
+    "vector",
+    "transform",
 ];
 
 impl<'a, 'i> Importer<'a, 'i> {
@@ -490,7 +506,9 @@ impl<'a, 'i> Importer<'a, 'i> {
     fn bsdf(&mut self, node: Node<'a, 'i>) -> Result<MaterialDesc> {
         let ty = self.plugin_type(node)?;
         let props = self.props(node, format!("bsdf '{ty}'"))?;
-        let nested: Vec<Node> = elements(node).filter(|c| c.tag_name().name() == "bsdf").collect();
+        let nested: Vec<Node> = elements(node)
+            .filter(|c| c.tag_name().name() == "bsdf")
+            .collect();
         let m = match ty.as_str() {
             "diffuse" => {
                 let r = props
@@ -502,8 +520,13 @@ impl<'a, 'i> Importer<'a, 'i> {
                 let inner = match nested.first() {
                     Some(n) => self.bsdf(*n)?,
                     None => {
-                        self.warn(node, "empty twosided bsdf wraps a default diffuse (reflectance 0.5)");
-                        MaterialDesc::Diffuse { reflectance: [0.5; 3] }
+                        self.warn(
+                            node,
+                            "empty twosided bsdf wraps a default diffuse (reflectance 0.5)",
+                        );
+                        MaterialDesc::Diffuse {
+                            reflectance: [0.5; 3],
+                        }
                     }
                 };
                 if nested.len() > 1 {
@@ -572,10 +595,14 @@ impl<'a, 'i> Importer<'a, 'i> {
                 "emitter" => {
                     let ety = self.plugin_type(c)?;
                     if ety != "area" {
-                        return Err(self.err(c, format!("shapes carry only 'area' emitters, not '{ety}'")));
+                        return Err(
+                            self.err(c, format!("shapes carry only 'area' emitters, not '{ety}'"))
+                        );
                     }
                     let ep = self.props(c, "emitter 'area'".into())?;
-                    let r = ep.color(self, "radiance", ColorUse::Emission)?.unwrap_or([1.0; 3]);
+                    let r = ep
+                        .color(self, "radiance", ColorUse::Emission)?
+                        .unwrap_or([1.0; 3]);
                     self.finish(ep);
                     emission = Some(r);
                 }
@@ -614,7 +641,10 @@ impl<'a, 'i> Importer<'a, 'i> {
                 "smaller" => FovAxis::Smaller,
                 "larger" => FovAxis::Larger,
                 other => {
-                    return Err(self.err(node, format!("unknown fov_axis '{other}' (x, y, diagonal, smaller, larger)")));
+                    return Err(self.err(
+                        node,
+                        format!("unknown fov_axis '{other}' (x, y, diagonal, smaller, larger)"),
+                    ));
                 }
             };
         }
@@ -635,7 +665,10 @@ impl<'a, 'i> Importer<'a, 'i> {
                         desc.spp = n as u32;
                     }
                     if sty != "independent" {
-                        self.warn(c, format!("sampler '{sty}' is replaced by this renderer's own sampler"));
+                        self.warn(
+                            c,
+                            format!("sampler '{sty}' is replaced by this renderer's own sampler"),
+                        );
                     }
                     self.finish(sp);
                 }
@@ -655,7 +688,9 @@ impl<'a, 'i> Importer<'a, 'i> {
             match v {
                 None => Ok(d),
                 Some(n) if (1..=32768).contains(&n) => Ok(n as u32),
-                Some(n) => Err(self.err(node, format!("film {what} {n} is out of range (1..=32768)"))),
+                Some(n) => {
+                    Err(self.err(node, format!("film {what} {n} is out of range (1..=32768)")))
+                }
             }
         };
         film.width = dim(props.int(self, "width")?, "width", 768)?;
@@ -670,9 +705,15 @@ impl<'a, 'i> Importer<'a, 'i> {
                     film.filter = match fty.as_str() {
                         "box" => {
                             // Lajolla's box filter `width`; Mitsuba's box is one pixel.
-                            if let Some(w) = fp.float(self, "width")?.or(fp.float(self, "radius")?.map(|r| 2.0 * r)) {
+                            if let Some(w) = fp
+                                .float(self, "width")?
+                                .or(fp.float(self, "radius")?.map(|r| 2.0 * r))
+                            {
                                 if (w - 1.0).abs() > 1e-6 {
-                                    self.warn(c, format!("box filter width {w} is treated as 1 pixel"));
+                                    self.warn(
+                                        c,
+                                        format!("box filter width {w} is treated as 1 pixel"),
+                                    );
                                 }
                             }
                             FilterDesc::Box
@@ -717,7 +758,10 @@ impl<'a, 'i> Importer<'a, 'i> {
                 integ.max_depth = 2;
             }
             other => {
-                self.warn(node, format!("unknown integrator type '{other}': using the path tracer"));
+                self.warn(
+                    node,
+                    format!("unknown integrator type '{other}': using the path tracer"),
+                );
                 integ.kind = "path".into();
                 // Keep every parameter for estimators that understand them.
                 for p in &props.items {
@@ -735,7 +779,10 @@ impl<'a, 'i> Importer<'a, 'i> {
         }
         if let Some(d) = props.int(self, "max_depth")? {
             if d < -1 {
-                return Err(self.err(node, format!("max_depth {d} must be -1 (unbounded) or non-negative")));
+                return Err(self.err(
+                    node,
+                    format!("max_depth {d} must be -1 (unbounded) or non-negative"),
+                ));
             }
             integ.max_depth = d.min(i32::MAX as i64) as i32;
         }
@@ -758,7 +805,9 @@ impl<'a, 'i> Importer<'a, 'i> {
         let props = self.props(node, format!("emitter '{ty}'"))?;
         let light = match ty.as_str() {
             "point" => {
-                let intensity = props.color(self, "intensity", ColorUse::Emission)?.unwrap_or([1.0; 3]);
+                let intensity = props
+                    .color(self, "intensity", ColorUse::Emission)?
+                    .unwrap_or([1.0; 3]);
                 let position = match props.point(self, "position")? {
                     Some(p) => p,
                     None => {
@@ -767,10 +816,15 @@ impl<'a, 'i> Importer<'a, 'i> {
                         m.transform_point3(glam::Vec3::ZERO).to_array()
                     }
                 };
-                LightDesc::Point { position, intensity }
+                LightDesc::Point {
+                    position,
+                    intensity,
+                }
             }
             "directional" => {
-                let irradiance = props.color(self, "irradiance", ColorUse::Emission)?.unwrap_or([1.0; 3]);
+                let irradiance = props
+                    .color(self, "irradiance", ColorUse::Emission)?
+                    .unwrap_or([1.0; 3]);
                 let direction = match props.point(self, "direction")? {
                     Some(d) => d,
                     None => {
@@ -782,10 +836,15 @@ impl<'a, 'i> Importer<'a, 'i> {
                 if direction == [0.0; 3] {
                     return Err(self.err(node, "directional emitter direction is zero"));
                 }
-                LightDesc::Directional { direction, irradiance }
+                LightDesc::Directional {
+                    direction,
+                    irradiance,
+                }
             }
             "constant" => {
-                let radiance = props.color(self, "radiance", ColorUse::Emission)?.unwrap_or([1.0; 3]);
+                let radiance = props
+                    .color(self, "radiance", ColorUse::Emission)?
+                    .unwrap_or([1.0; 3]);
                 LightDesc::Constant { radiance }
             }
             "area" => return Err(self.err(node, "an area emitter must be inside a <shape>")),
@@ -821,7 +880,13 @@ pub fn parse_xml(
         bsdf_anon: 0,
     };
     if root.tag_name().name() != "scene" {
-        return Err(imp.err(root, format!("expected a <scene> root element, found <{}>", root.tag_name().name())));
+        return Err(imp.err(
+            root,
+            format!(
+                "expected a <scene> root element, found <{}>",
+                root.tag_name().name()
+            ),
+        ));
     }
     // Defaults first (the command line wins), so that `$name` works anywhere.
     for c in elements(root).filter(|c| c.tag_name().name() == "default") {
@@ -883,7 +948,9 @@ pub fn parse_xml(
                 let l = imp.emitter(c)?;
                 desc.lights.push(l);
             }
-            t if PROPERTY_TAGS.contains(&t) => imp.warn(c, format!("ignored <{t}> directly inside <scene>")),
+            t if PROPERTY_TAGS.contains(&t) => {
+                imp.warn(c, format!("ignored <{t}> directly inside <scene>"))
+            }
             t => return Err(imp.err(c, format!("unsupported element <{t}>"))),
         }
     }

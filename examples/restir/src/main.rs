@@ -13,7 +13,11 @@ use restir_integrators::{Image, RenderSettings, compare, make_integrator, render
 use restir_scene::{Scene, load_desc};
 
 #[derive(Parser, Debug)]
-#[command(name = "restir", version, about = "Path tracing, ReSTIR DI and ReSTIR PT on the CPU")]
+#[command(
+    name = "restir",
+    version,
+    about = "Path tracing, ReSTIR DI and ReSTIR PT on the CPU"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -112,7 +116,11 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
     if let Some(h) = args.height {
         desc.film.height = h;
     }
-    let base = args.scene.parent().map(Path::to_path_buf).unwrap_or_default();
+    let base = args
+        .scene
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default();
     let scene = Scene::build(&desc, &base, &args.scene).map_err(|e| e.to_string())?;
     let load_seconds = load_start.elapsed().as_secs_f64();
 
@@ -123,7 +131,11 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
     }
     let time_limit = match args.time_limit {
         Some(t) if t.is_finite() && t > 0.0 => Some(Duration::from_secs_f64(t)),
-        Some(t) => return Err(format!("--time-limit {t}: expected a positive number of seconds")),
+        Some(t) => {
+            return Err(format!(
+                "--time-limit {t}: expected a positive number of seconds"
+            ));
+        }
         None => None,
     };
     // With only a time limit, keep rendering until it runs out.
@@ -138,13 +150,26 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
             Some(f) => PathBuf::from(f),
             None => PathBuf::from(format!(
                 "{}.exr",
-                args.scene.file_stem().and_then(|s| s.to_str()).unwrap_or("render")
+                args.scene
+                    .file_stem()
+                    .and_then(|s| s.to_str())
+                    .unwrap_or("render")
             )),
         },
     };
-    match output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+    match output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
         Some("exr") | Some("png") => {}
-        _ => return Err(format!("{}: output must end in .exr or .png", output.display())),
+        _ => {
+            return Err(format!(
+                "{}: output must end in .exr or .png",
+                output.display()
+            ));
+        }
     }
 
     let threads = args.threads.unwrap_or(0);
@@ -196,16 +221,22 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         seed: args.seed,
     };
     let out = pool.install(|| {
-        render(&scene, integrator.as_ref(), &settings, &cancel, &mut |passes, elapsed| {
-            if let Some(b) = &bar {
-                if spp == u32::MAX {
-                    b.set_position(elapsed.as_millis() as u64);
-                    b.set_message(format!("{passes} passes"));
-                } else {
-                    b.set_position(passes as u64);
+        render(
+            &scene,
+            integrator.as_ref(),
+            &settings,
+            &cancel,
+            &mut |passes, elapsed| {
+                if let Some(b) = &bar {
+                    if spp == u32::MAX {
+                        b.set_position(elapsed.as_millis() as u64);
+                        b.set_message(format!("{passes} passes"));
+                    } else {
+                        b.set_position(passes as u64);
+                    }
                 }
-            }
-        })
+            },
+        )
     });
     if let Some(b) = bar {
         b.finish_and_clear();
@@ -252,7 +283,10 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
             output.display()
         );
         if out.nonfinite_pixels > 0 {
-            eprintln!("warning: {} pixels are NaN or infinite", out.nonfinite_pixels);
+            eprintln!(
+                "warning: {} pixels are NaN or infinite",
+                out.nonfinite_pixels
+            );
         }
     }
     Ok(())
@@ -283,7 +317,12 @@ fn main() -> ExitCode {
         Ok(c) => c,
         Err(e) => {
             use clap::error::ErrorKind;
-            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand) {
+            if matches!(
+                e.kind(),
+                ErrorKind::DisplayHelp
+                    | ErrorKind::DisplayVersion
+                    | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+            ) {
                 let _ = e.print();
                 return if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
                     ExitCode::FAILURE
