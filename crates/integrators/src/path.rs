@@ -166,7 +166,7 @@ pub fn trace_path(
         depth += 1;
 
         let bmax = beta.max_element();
-        if !(bmax > 0.0) || !beta.is_finite() {
+        if bmax <= 0.0 || !beta.is_finite() {
             break;
         }
         if depth >= settings.rr_depth {

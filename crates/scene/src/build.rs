@@ -86,17 +86,15 @@ fn material_bsdf(m: &MaterialDesc) -> Result<Bsdf, String> {
     })
 }
 
-fn load_obj(
-    path: &Path,
-) -> Result<
-    (
-        Vec<Vec3>,
-        Option<Vec<Vec3>>,
-        Option<Vec<Vec2>>,
-        Vec<[u32; 3]>,
-    ),
-    String,
-> {
+/// Positions, optional normals, optional uvs and triangles of a mesh file.
+type MeshData = (
+    Vec<Vec3>,
+    Option<Vec<Vec3>>,
+    Option<Vec<Vec2>>,
+    Vec<[u32; 3]>,
+);
+
+fn load_obj(path: &Path) -> Result<MeshData, String> {
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,

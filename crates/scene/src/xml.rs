@@ -80,7 +80,7 @@ enum ColorUse {
 
 /// XYZ → linear sRGB of an equal-energy (constant 1) emission spectrum, as Mitsuba 3's RGB mode
 /// computes it (`xyz_to_srgb(1, 1, 1)`).
-const EQUAL_ENERGY_RGB: [f32; 3] = [1.204_790, 0.948_291, 0.908_916];
+const EQUAL_ENERGY_RGB: [f32; 3] = [1.204_79, 0.948_291, 0.908_916];
 
 struct Props<'a, 'i> {
     what: String,
