@@ -125,15 +125,14 @@ impl Shape {
                 })
             }
             Shape::Sphere(s) => {
-                let n = warp::sample_uniform_sphere(u);
-                let uv = Sphere::uv_of(n);
-                let n = if s.flip_normals { -n } else { n };
+                let dir = warp::sample_uniform_sphere(u);
+                let n = if s.flip_normals { -dir } else { dir };
                 Some(PositionSample {
-                    p: s.center + s.radius * (if s.flip_normals { -n } else { n }),
+                    p: s.center + s.radius * dir,
                     n,
                     ng: n,
                     prim: 0,
-                    param: uv,
+                    param: Sphere::uv_of(dir),
                 })
             }
         }
