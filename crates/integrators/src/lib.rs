@@ -9,37 +9,60 @@
 //!
 //! ```no_run
 //! use std::sync::atomic::AtomicBool;
-//! use restir_integrators::{make_integrator, render, RenderSettings};
+//! use restir_integrators::{make_integrator, render, IntegratorOptions, RenderSettings};
 //! let loaded = restir_scene::load_scene("scenes/cornell-box.xml".as_ref(), &[]).unwrap();
-//! let integrator = make_integrator("path", &loaded.scene, None).unwrap();
+//! let options = IntegratorOptions { name: Some("restir-di".into()), ..Default::default() };
+//! let made = make_integrator(&loaded.scene, &options).unwrap();
 //! let settings = RenderSettings { spp: 16, time_limit: None, seed: 0 };
-//! let out = render(&loaded.scene, integrator.as_ref(), &settings, &AtomicBool::new(false), &mut |_, _| {});
+//! let out = render(&loaded.scene, made.integrator.as_ref(), &settings, &AtomicBool::new(false), &mut |_, _| {});
 //! out.image.write("cbox.exr".as_ref()).unwrap();
 //! ```
 
 pub mod film;
+pub mod gbuffer;
 mod image_io;
 pub mod metrics;
 pub mod path;
 mod render;
+pub mod restir_di;
 
 pub use image_io::{Image, ImageError};
 pub use metrics::{ErrorMetrics, compare};
 pub use render::{Integrator, PassContext, PathIntegrator, RenderOutput, RenderSettings, render};
+pub use restir_di::{RestirDiIntegrator, RestirDiSettings};
 
 use restir_scene::Scene;
 
 /// The integrators this crate provides, by command-line name.
-pub const INTEGRATORS: &[&str] = &["path"];
+pub const INTEGRATORS: &[&str] = &["path", "restir-di"];
 
-/// Builds the integrator called `name` for `scene`; `max_depth` overrides the scene's.
+/// Command-line choices that override the scene's integrator settings.
+#[derive(Clone, Debug, Default)]
+pub struct IntegratorOptions {
+    /// Estimator name; `None` takes the scene's.
+    pub name: Option<String>,
+    /// Longest path; `None` takes the scene's.
+    pub max_depth: Option<i32>,
+    /// Estimator parameters as `name = value`, applied after the scene's.
+    pub params: Vec<(String, String)>,
+}
+
+/// A built integrator and the scene parameters it did not recognise.
+#[derive(Debug)]
+pub struct MadeIntegrator {
+    /// The estimator.
+    pub integrator: Box<dyn Integrator>,
+    /// Names of scene or command-line parameters the estimator does not use.
+    pub unused_params: Vec<String>,
+}
+
+/// Builds the integrator for `scene`: the scene's choice and parameters, overridden by `options`.
 pub fn make_integrator(
-    name: &str,
     scene: &Scene,
-    max_depth: Option<i32>,
-) -> Result<Box<dyn Integrator>, String> {
+    options: &IntegratorOptions,
+) -> Result<MadeIntegrator, String> {
     let mut settings = path::PathSettings::from_scene(scene);
-    if let Some(d) = max_depth {
+    if let Some(d) = options.max_depth {
         if d < -1 {
             return Err(format!(
                 "max depth {d} must be -1 (unbounded) or non-negative"
@@ -47,11 +70,41 @@ pub fn make_integrator(
         }
         settings.max_depth = d;
     }
+    let scene_kind = canonical_name(&scene.integrator.kind);
+    let name = options
+        .name
+        .as_deref()
+        .map_or(scene_kind, canonical_name);
+    // The scene's parameters belong to the scene's estimator.
+    let mut params = Vec::new();
+    if name == scene_kind {
+        params.extend(scene.integrator.params.iter().cloned());
+    }
+    params.extend(options.params.iter().cloned());
     match name {
-        "path" => Ok(Box::new(PathIntegrator { settings })),
+        "path" => Ok(MadeIntegrator {
+            integrator: Box::new(PathIntegrator { settings }),
+            unused_params: params.into_iter().map(|(k, _)| k).collect(),
+        }),
+        "restir-di" => {
+            let mut s = RestirDiSettings::new(settings);
+            let unused_params = s.apply(&params)?;
+            Ok(MadeIntegrator {
+                integrator: Box::new(RestirDiIntegrator::new(s)),
+                unused_params,
+            })
+        }
         other => Err(format!(
             "unknown integrator '{other}' (available: {})",
             INTEGRATORS.join(", ")
         )),
+    }
+}
+
+/// The command-line name for the names scene files use (`restir` is ReSTIR DI, as in Lajolla).
+fn canonical_name(name: &str) -> &str {
+    match name {
+        "restir" | "restir_di" | "restirdi" => "restir-di",
+        other => other,
     }
 }

@@ -47,6 +47,55 @@ pub struct PrevVertex {
     pub pdf_sa: f32,
     /// Whether the sampled lobe was a delta lobe (no light sampling could have produced it).
     pub delta: bool,
+    /// How the direct light at this vertex was split between light and BSDF sampling.
+    pub mis: EmissionMis,
+}
+
+/// The MIS weight an emitter reached by BSDF sampling gets, against the light-sampling strategy
+/// that also covered it at the previous vertex.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EmissionMis {
+    /// One light sample and one BSDF sample, power heuristic (the path tracer).
+    Power,
+    /// `light_samples` light-strategy samples and `bsdf_samples` BSDF samples combined by the
+    /// balance heuristic; this continuation is one of the BSDF samples (or, with
+    /// `bsdf_samples = 0`, an indirect-only continuation whose direct emission counts zero).
+    /// ReSTIR DI uses it: its reservoirs cover the light strategy's share.
+    Balance {
+        /// Light-strategy sample count `N_L`.
+        light_samples: f32,
+        /// BSDF sample count `N_B`.
+        bsdf_samples: f32,
+    },
+}
+
+impl PrevVertex {
+    /// The weight of emission reached from this vertex, whose light-sampling density (solid
+    /// angle, selection included) is `light_pdf_sa`. Emission behind a delta lobe gets 1.
+    #[inline]
+    pub fn emission_weight(&self, light_pdf_sa: f32) -> f32 {
+        if self.delta {
+            return 1.0;
+        }
+        match self.mis {
+            EmissionMis::Power => power_heuristic(self.pdf_sa, light_pdf_sa),
+            EmissionMis::Balance {
+                light_samples,
+                bsdf_samples,
+            } => balance_share(self.pdf_sa, bsdf_samples, light_pdf_sa, light_samples),
+        }
+    }
+}
+
+/// The share `p_b / (N_l·p_l + N_b·p_b)` of one of `N_b` BSDF samples of density `p_b` against
+/// `N_l` light samples of density `p_l` (0 when there are no BSDF samples).
+#[inline]
+pub fn balance_share(bsdf_pdf: f32, bsdf_samples: f32, light_pdf: f32, light_samples: f32) -> f32 {
+    if !(bsdf_samples > 0.0 && bsdf_pdf > 0.0) {
+        return 0.0;
+    }
+    let w = bsdf_pdf / (light_samples * light_pdf + bsdf_samples * bsdf_pdf);
+    if w.is_finite() { w } else { 0.0 }
 }
 
 /// Radiance arriving along `ray` (a camera ray, or a continuation from `prev`), estimated with one
@@ -86,7 +135,7 @@ pub fn trace_path(
                             .environment()
                             .expect("feature summary says there is one");
                         let em_pdf = lights.pdf_sa(&scene.shapes, env, pv.p, pv.p + ray.d, -ray.d);
-                        power_heuristic(pv.pdf_sa, em_pdf)
+                        pv.emission_weight(em_pdf)
                     }
                     _ => 1.0,
                 };
@@ -104,7 +153,7 @@ pub fn trace_path(
                 let w = match prev {
                     Some(pv) if !pv.delta => {
                         let em_pdf = lights.pdf_sa(&scene.shapes, light, pv.p, si.p, si.ng);
-                        power_heuristic(pv.pdf_sa, em_pdf)
+                        pv.emission_weight(em_pdf)
                     }
                     _ => 1.0,
                 };
@@ -161,6 +210,7 @@ pub fn trace_path(
             p: si.p,
             pdf_sa: bs.pdf_sa,
             delta: bs.lobe.is_delta(),
+            mis: EmissionMis::Power,
         });
         ray = Ray::new(offset_ray_origin(si.p, si.ng, d), d);
         depth += 1;

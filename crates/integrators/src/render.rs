@@ -14,7 +14,7 @@ use crate::film::Filter;
 use crate::path::{PathSettings, trace_camera_path};
 
 /// Rows per parallel work item.
-const BAND_ROWS: usize = 2;
+pub(crate) const BAND_ROWS: usize = 2;
 
 /// What an integrator needs to know about the current pass.
 #[derive(Debug)]
@@ -32,6 +32,18 @@ impl PassContext<'_> {
     #[inline]
     pub fn pixel_rng(&self, index: usize) -> Pcg32 {
         Pcg32::for_pixel_sample(self.seed, index as u64, self.pass as u64)
+    }
+
+    /// A second, independent stream of pixel `index` in this pass, for estimator stage `stage`
+    /// (stage 0 is [`PassContext::pixel_rng`]'s stream).
+    #[inline]
+    pub fn stage_rng(&self, index: usize, stage: u64) -> Pcg32 {
+        let seed = if stage == 0 {
+            self.seed
+        } else {
+            restir_sampling::mix64(self.seed ^ stage.wrapping_mul(0xa076_1d64_78bd_642f))
+        };
+        Pcg32::for_pixel_sample(seed, index as u64, self.pass as u64)
     }
 
     /// The film position (pixel units) of a filter-jittered camera ray through pixel `(x, y)`.

@@ -751,11 +751,16 @@ impl<'a, 'i> Importer<'a, 'i> {
         let ty = self.plugin_type(node)?;
         let props = self.props(node, format!("integrator '{ty}'"))?;
         let mut integ = IntegratorDesc::default();
+        let mut keep_params = false;
         match ty.as_str() {
             "path" | "volpath" => integ.kind = "path".into(),
             "direct" => {
                 integ.kind = "path".into();
                 integ.max_depth = 2;
+            }
+            "restir" | "restir_di" | "restir-di" => {
+                integ.kind = "restir-di".into();
+                keep_params = true;
             }
             other => {
                 self.warn(
@@ -763,18 +768,23 @@ impl<'a, 'i> Importer<'a, 'i> {
                     format!("unknown integrator type '{other}': using the path tracer"),
                 );
                 integ.kind = "path".into();
-                // Keep every parameter for estimators that understand them.
-                for p in &props.items {
-                    p.used.set(true);
-                    let v = match &p.value {
-                        Value::Float(v) => v.to_string(),
-                        Value::Int(v) => v.to_string(),
-                        Value::Bool(v) => v.to_string(),
-                        Value::Str(v) => v.clone(),
-                        _ => continue,
-                    };
-                    integ.params.push((p.name.clone(), v));
+            }
+        }
+        if keep_params {
+            // Keep every parameter but the common ones for estimators that understand them.
+            for p in &props.items {
+                if matches!(p.name.as_str(), "max_depth" | "rr_depth" | "hide_emitters") {
+                    continue;
                 }
+                let v = match &p.value {
+                    Value::Float(v) => v.to_string(),
+                    Value::Int(v) => v.to_string(),
+                    Value::Bool(v) => v.to_string(),
+                    Value::Str(v) => v.clone(),
+                    _ => continue,
+                };
+                p.used.set(true);
+                integ.params.push((p.name.clone(), v));
             }
         }
         if let Some(d) = props.int(self, "max_depth")? {

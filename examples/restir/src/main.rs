@@ -9,7 +9,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use clap::{Parser, Subcommand};
-use restir_integrators::{Image, RenderSettings, compare, make_integrator, render};
+use restir_integrators::{
+    Image, IntegratorOptions, RenderSettings, compare, make_integrator, render,
+};
 use restir_scene::{Scene, load_desc};
 
 #[derive(Parser, Debug)]
@@ -44,9 +46,9 @@ struct RenderArgs {
     /// filename from the scene, else <scene name>.exr.
     #[arg(short = 'o', long = "output")]
     output: Option<PathBuf>,
-    /// Estimator.
-    #[arg(long, default_value = "path")]
-    integrator: String,
+    /// Estimator: path or restir-di (default: the scene's, else path).
+    #[arg(long)]
+    integrator: Option<String>,
     /// Passes (samples per pixel); overrides the scene.
     #[arg(long)]
     spp: Option<u32>,
@@ -77,6 +79,63 @@ struct RenderArgs {
     /// No progress bar, no warnings, no summary.
     #[arg(long)]
     quiet: bool,
+    #[command(flatten)]
+    restir: RestirArgs,
+}
+
+/// ReSTIR settings; each overrides the scene's `<integrator>` parameter of the same name.
+#[derive(clap::Args, Debug)]
+#[command(next_help_heading = "ReSTIR")]
+struct RestirArgs {
+    /// Light candidates per pixel in initial resampling [default: 32].
+    #[arg(long)]
+    candidates: Option<u32>,
+    /// BSDF samples per pixel, MIS-combined with the reservoirs [default: 1].
+    #[arg(long)]
+    bsdf_candidates: Option<u32>,
+    /// Spatial neighbours per round [default: 3].
+    #[arg(long, alias = "neighbours")]
+    neighbors: Option<u32>,
+    /// Spatial reuse radius in pixels [default: 30].
+    #[arg(long)]
+    radius: Option<f32>,
+    /// Spatial reuse rounds [default: 1].
+    #[arg(long)]
+    spatial_rounds: Option<u32>,
+    /// Reuse MIS: defensive-pairwise, pairwise, confidence-pairwise, balance, contribution,
+    /// one-over-z, or uniform (biased) [default: defensive-pairwise].
+    #[arg(long)]
+    mis: Option<String>,
+    /// Confidence cap after every reuse step [default: 20].
+    #[arg(long)]
+    mcap: Option<f32>,
+    /// Reuse the previous pass's reservoirs.
+    #[arg(long)]
+    temporal: bool,
+    /// Drop occluded initial candidates (biased at shadow edges).
+    #[arg(long)]
+    visibility_reuse: bool,
+}
+
+impl RestirArgs {
+    fn params(&self) -> Vec<(String, String)> {
+        let mut p = Vec::new();
+        let mut put = |k: &str, v: Option<String>| {
+            if let Some(v) = v {
+                p.push((k.to_string(), v));
+            }
+        };
+        put("candidates", self.candidates.map(|v| v.to_string()));
+        put("bsdf_candidates", self.bsdf_candidates.map(|v| v.to_string()));
+        put("neighbors", self.neighbors.map(|v| v.to_string()));
+        put("radius", self.radius.map(|v| v.to_string()));
+        put("spatial_rounds", self.spatial_rounds.map(|v| v.to_string()));
+        put("mis", self.mis.clone());
+        put("mcap", self.mcap.map(|v| v.to_string()));
+        put("temporal", self.temporal.then(|| "true".into()));
+        put("visibility_reuse", self.visibility_reuse.then(|| "true".into()));
+        p
+    }
 }
 
 #[derive(serde::Serialize)]
@@ -124,7 +183,21 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
     let scene = Scene::build(&desc, &base, &args.scene).map_err(|e| e.to_string())?;
     let load_seconds = load_start.elapsed().as_secs_f64();
 
-    let integrator = make_integrator(&args.integrator, &scene, args.max_depth)?;
+    let options = IntegratorOptions {
+        name: args.integrator.clone(),
+        max_depth: args.max_depth,
+        params: args.restir.params(),
+    };
+    let made = make_integrator(&scene, &options)?;
+    if !args.quiet {
+        for p in &made.unused_params {
+            eprintln!(
+                "warning: integrator '{}' does not use the parameter '{p}'",
+                made.integrator.name()
+            );
+        }
+    }
+    let integrator = made.integrator;
     let spp = args.spp.unwrap_or(scene.spp);
     if spp == 0 {
         return Err("--spp must be at least 1".into());

@@ -1,0 +1,435 @@
+//! ReSTIR DI (Bitterli et al. 2020): reservoir-based direct lighting with spatial (and optional
+//! temporal) reuse, combined unbiasedly with the MIS schemes of `restir-gris`.
+//!
+//! One pass, for every pixel at once (ALGORITHMS.md §2):
+//!
+//! 1. **Primary hits** ([`GBuffer`]), adding what the camera sees directly.
+//! 2. **Initial resampling**: `N_L` light candidates from the power-based light sampler
+//!    (stratified selection), streamed into a reservoir with weights `p̂/(N_L·p_L)`; the result
+//!    counts as confidence 1. Optional visibility reuse drops an occluded selection (biased).
+//! 3. **Temporal reuse** (optional): the same pixel's reservoir from the previous pass.
+//! 4. **Spatial reuse**: `R` rounds of `k` neighbours from a low-discrepancy disk pattern with a
+//!    per-pixel random start, rejected by normal and depth similarity, resampled with the chosen
+//!    MIS scheme ([`restir_gris::resample`]; the shift is the identity, see [`light_point`]).
+//!    Each round reads the previous round's buffer and writes a new one, so the result does not
+//!    depend on scheduling. Confidence is capped at `mcap` after every step.
+//! 5. **Shading**: the selected sample with a shadow ray, times its `W`; plus `N_B` BSDF samples
+//!    weighted by the balance heuristic against the light strategy (the exact split is explained
+//!    in [`light_point`]); the first BSDF sample continues as a path-traced path when
+//!    `max_depth > 2` (indirect light) or when it followed a delta lobe.
+
+pub mod light_point;
+mod settings;
+
+use std::sync::Mutex;
+
+use glam::{DVec3, Vec2, Vec3};
+use rayon::prelude::*;
+use restir_geometry::{Ray, offset_ray_origin, shadow_ray_between, shadow_ray_towards};
+use restir_gris::{Reservoir, ShiftMap, Shifted, StreamingReservoir, resample};
+use restir_sampling::{Pcg32, sequences::r2};
+use restir_scene::Scene;
+
+pub use settings::{MIS_NAMES, RestirDiSettings, mis_name};
+
+use crate::gbuffer::{GBuffer, Receiver};
+use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
+use crate::render::{BAND_ROWS, Integrator, PassContext};
+use light_point::{Contact, LightPoint, StrategyCounts, contact, evaluate, target};
+
+/// Random-stream stages (see [`PassContext::stage_rng`]).
+const STAGE_INITIAL: u64 = 1;
+const STAGE_TEMPORAL: u64 = 2;
+const STAGE_SHADE: u64 = 3;
+const STAGE_SPATIAL: u64 = 16;
+
+/// Points of the neighbour pattern (R2 sequence inside the unit disk).
+const OFFSET_COUNT: usize = 8192;
+
+/// The reservoir type: 16-byte sample, `W`, `M`, `p̂`.
+pub type DiReservoir = Reservoir<LightPoint>;
+
+/// What temporal reuse keeps from the previous pass.
+#[derive(Debug)]
+struct History {
+    gbuffer: GBuffer,
+    reservoirs: Vec<DiReservoir>,
+}
+
+/// The ReSTIR DI estimator (`--integrator restir-di`).
+#[derive(Debug)]
+pub struct RestirDiIntegrator {
+    settings: RestirDiSettings,
+    counts: StrategyCounts,
+    offsets: Vec<Vec2>,
+    history: Mutex<Option<History>>,
+}
+
+/// The identity shift between pixels: the sample stays on the light, `J = 1`; only the target
+/// changes.
+struct DiShift<'a> {
+    scene: &'a Scene,
+    counts: StrategyCounts,
+}
+
+impl ShiftMap<LightPoint> for DiShift<'_> {
+    type Domain = Receiver;
+
+    #[inline]
+    fn shift(&self, _from: &Receiver, to: &Receiver, x: &LightPoint) -> Option<Shifted<LightPoint>> {
+        Some(Shifted::identity(*x, target(self.scene, to, x, self.counts)))
+    }
+}
+
+impl RestirDiIntegrator {
+    /// An integrator with `settings`.
+    pub fn new(settings: RestirDiSettings) -> Self {
+        let mut offsets = Vec::with_capacity(OFFSET_COUNT);
+        let mut i = 0u64;
+        while offsets.len() < OFFSET_COUNT {
+            let [u, v] = r2(i, [0.5, 0.5]);
+            i += 1;
+            let p = Vec2::new(2.0 * u - 1.0, 2.0 * v - 1.0);
+            if p.length_squared() <= 1.0 {
+                offsets.push(p);
+            }
+        }
+        Self {
+            counts: StrategyCounts {
+                light: settings.candidates as f32,
+                bsdf: settings.bsdf_candidates as f32,
+            },
+            settings,
+            offsets,
+            history: Mutex::new(None),
+        }
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &RestirDiSettings {
+        &self.settings
+    }
+
+    /// Bytes per pixel of one reservoir buffer.
+    pub const RESERVOIR_BYTES: usize = std::mem::size_of::<DiReservoir>();
+
+    /// Initial resampling at receiver `r`. Returns the reservoir and the rays traced.
+    fn initial(&self, scene: &Scene, r: &Receiver, rng: &mut Pcg32) -> (DiReservoir, u64) {
+        let bsdf = &scene.bsdfs[r.bsdf as usize];
+        if !bsdf.has_smooth_lobe() || scene.lights.is_empty() {
+            return (
+                Reservoir {
+                    confidence: 1.0,
+                    ..Reservoir::empty()
+                },
+                0,
+            );
+        }
+        let n = self.settings.candidates;
+        let nf = n as f32;
+        let mut stream = StreamingReservoir::new();
+        let u0 = rng.next_f32();
+        for i in 0..n {
+            let u_select = ((i as f32 + u0) / nf).min(restir_sampling::ONE_MINUS_EPSILON);
+            let u_light = rng.next_2d();
+            let u_pick = rng.next_f32();
+            let Some(ls) = scene.lights.sample(&scene.shapes, r.p, u_select, u_light) else {
+                continue;
+            };
+            let sample = LightPoint::from_light_sample(&ls);
+            let measure = if ls.delta || !ls.dist.is_finite() {
+                1.0
+            } else {
+                ls.ng.dot(ls.wi).abs() / (ls.dist * ls.dist)
+            };
+            let c = Contact {
+                wi: ls.wi,
+                p: ls.p,
+                dist: ls.dist,
+                le: ls.le,
+                measure,
+                delta: ls.delta,
+                ng: ls.ng,
+            };
+            let e = evaluate(scene, r, &sample, &c, Some(ls.pdf_sa), self.counts);
+            let w = e.target / (nf * e.light_pdf);
+            stream.add_candidate(sample, e.target, w, 0.0, u_pick);
+        }
+        let mut res = stream.finalize_recorded();
+        res.confidence = 1.0;
+        let mut rays = 0;
+        if self.settings.visibility_reuse
+            && let Some(y) = res.sample
+        {
+            let visible = contact(scene, &y, r.p).is_some_and(|c| {
+                rays += 1;
+                visible(scene, r, &c)
+            });
+            if !visible {
+                res.sample = None;
+                res.ucw = 0.0;
+                res.target_pdf = 0.0;
+            }
+        }
+        (res, rays)
+    }
+
+    /// One spatial round at pixel `index`: resamples the pixel's reservoir from `input` with up to
+    /// `k` similar neighbours.
+    #[allow(clippy::too_many_arguments)]
+    fn spatial(
+        &self,
+        shift: &DiShift,
+        gbuf: &GBuffer,
+        input: &[DiReservoir],
+        index: usize,
+        rng: &mut Pcg32,
+        neighbors: &mut Vec<(usize, DiReservoir)>,
+    ) -> DiReservoir {
+        let canonical = &input[index];
+        let Some(r) = &gbuf.receivers[index] else {
+            return *canonical;
+        };
+        let (w, h) = (gbuf.width as i64, gbuf.height as i64);
+        let (x, y) = ((index as i64) % w, (index as i64) / w);
+        let k = self.settings.neighbors as usize;
+        neighbors.clear();
+        let start = rng.next_bounded(self.offsets.len() as u32) as usize;
+        let radius = self.settings.radius;
+        for attempt in 0..2 * k {
+            if neighbors.len() == k {
+                break;
+            }
+            let o = self.offsets[(start + attempt) % self.offsets.len()] * radius;
+            let (nx, ny) = (x + o.x.round() as i64, y + o.y.round() as i64);
+            if nx < 0 || ny < 0 || nx >= w || ny >= h || (nx == x && ny == y) {
+                continue;
+            }
+            let q = (ny * w + nx) as usize;
+            if let Some(rq) = &gbuf.receivers[q]
+                && r.is_similar(rq, self.settings.normal_cos, self.settings.depth_tolerance)
+            {
+                neighbors.push((q, input[q]));
+            }
+        }
+        let domains: Vec<(&Receiver, &DiReservoir)> = neighbors
+            .iter()
+            .map(|(q, res)| (gbuf.receivers[*q].as_ref().expect("checked above"), res))
+            .collect();
+        resample(shift, self.settings.mis, r, canonical, &domains, || rng.next_f32())
+            .with_confidence_cap(self.settings.mcap)
+    }
+
+    /// Shading at receiver `r` with its final reservoir: the reservoir's sample with a shadow
+    /// ray, the BSDF samples, and the continuation. Returns radiance and rays.
+    fn shade(&self, scene: &Scene, r: &Receiver, res: &DiReservoir, rng: &mut Pcg32) -> (Vec3, u64) {
+        let mut l = Vec3::ZERO;
+        let mut rays = 0;
+        if let Some(y) = &res.sample
+            && let Some(c) = contact(scene, y, r.p)
+        {
+            let e = evaluate(scene, r, y, &c, None, self.counts);
+            if e.target > 0.0 {
+                rays += 1;
+                if visible(scene, r, &c) {
+                    l += e.contribution * res.ucw;
+                }
+            }
+        }
+
+        // BSDF samples; the first continues the path when indirect light or delta lobes need it.
+        let settings = &self.settings.path;
+        let max_depth = if settings.max_depth < 0 {
+            u32::MAX
+        } else {
+            settings.max_depth as u32
+        };
+        let continues = max_depth > 2 || scene.features.has_delta_lobes;
+        let samples = self.settings.bsdf_candidates.max(u32::from(continues));
+        let bsdf = &scene.bsdfs[r.bsdf as usize];
+        // BSDF samples after the first only look for emitters at their first hit.
+        let direct_only = PathSettings {
+            max_depth: 2,
+            ..*settings
+        };
+        for b in 0..samples {
+            let u_lobe = rng.next_f32();
+            let u_dir = rng.next_2d();
+            let u_rr = rng.next_f32();
+            let Some(bs) = bsdf.sample(r.wo, u_lobe, u_dir) else {
+                continue;
+            };
+            let delta = bs.lobe.is_delta();
+            let cont = b == 0 && continues;
+            if !cont && self.settings.bsdf_candidates == 0 {
+                continue;
+            }
+            if cont && !delta && max_depth <= 2 && self.settings.bsdf_candidates == 0 {
+                continue; // nothing this ray could add
+            }
+            let mut beta = bs.f / bs.pdf_sa;
+            let d = r.frame.to_world(bs.wi);
+            let ray = Ray::new(offset_ray_origin(r.p, r.ng, d), d);
+            let prev = PrevVertex {
+                p: r.p,
+                pdf_sa: bs.pdf_sa,
+                delta,
+                mis: EmissionMis::Balance {
+                    light_samples: self.counts.light,
+                    bsdf_samples: self.counts.bsdf,
+                },
+            };
+            let path = if cont { settings } else { &direct_only };
+            if cont && settings.rr_depth <= 1 {
+                let q = (beta.max_element() * bs.eta * bs.eta).min(0.95);
+                if u_rr >= q {
+                    continue;
+                }
+                beta /= q;
+            }
+            if !beta.is_finite() || beta.max_element() <= 0.0 {
+                continue;
+            }
+            let (li, n) = trace_path(scene, path, ray, 1, beta, Some(prev), rng);
+            l += li;
+            rays += n;
+        }
+        (l, rays)
+    }
+}
+
+/// Whether the light point `c` is visible from receiver `r` (one shadow ray).
+#[inline]
+fn visible(scene: &Scene, r: &Receiver, c: &Contact) -> bool {
+    let (ray, t_max) = if c.dist.is_finite() {
+        shadow_ray_between(r.p, r.ng, c.p)
+    } else {
+        shadow_ray_towards(r.p, r.ng, c.wi, f32::INFINITY)
+    };
+    !scene.occluded(&ray, t_max)
+}
+
+impl Integrator for RestirDiIntegrator {
+    fn name(&self) -> &'static str {
+        "restir-di"
+    }
+
+    fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
+        let s = &self.settings;
+        let n = accum.len();
+        let mut radiance = vec![Vec3::ZERO; n];
+        let keep = s.path.max_depth < 0 || s.path.max_depth >= 2;
+        let (gbuf, mut rays) = GBuffer::trace(scene, ctx, s.path.hide_emitters, keep, &mut radiance);
+        let w = gbuf.width;
+        if keep {
+            let shift = DiShift {
+                scene,
+                counts: self.counts,
+            };
+            // Initial resampling.
+            let mut current = vec![DiReservoir::empty(); n];
+            rays += current
+                .par_chunks_mut(w * BAND_ROWS)
+                .enumerate()
+                .map(|(band, out)| {
+                    let mut rays = 0;
+                    for (i, res) in out.iter_mut().enumerate() {
+                        let index = band * w * BAND_ROWS + i;
+                        if let Some(r) = &gbuf.receivers[index] {
+                            let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
+                            let (init, nr) = self.initial(scene, r, &mut rng);
+                            *res = init;
+                            rays += nr;
+                        }
+                    }
+                    rays
+                })
+                .sum::<u64>();
+
+            // Temporal reuse.
+            let history = if s.temporal {
+                self.history.lock().map(|mut h| h.take()).unwrap_or(None)
+            } else {
+                None
+            };
+            if let Some(hist) = history.as_ref().filter(|h| h.reservoirs.len() == n) {
+                current
+                    .par_chunks_mut(w * BAND_ROWS)
+                    .enumerate()
+                    .for_each(|(band, out)| {
+                        for (i, res) in out.iter_mut().enumerate() {
+                            let index = band * w * BAND_ROWS + i;
+                            let (Some(r), Some(prev_r)) =
+                                (&gbuf.receivers[index], &hist.gbuffer.receivers[index])
+                            else {
+                                continue;
+                            };
+                            if !r.is_similar(prev_r, s.normal_cos, s.depth_tolerance) {
+                                continue;
+                            }
+                            let prev = hist.reservoirs[index].with_confidence_cap(s.mcap);
+                            let mut rng = ctx.stage_rng(index, STAGE_TEMPORAL);
+                            *res = resample(&shift, s.mis, r, res, &[(prev_r, &prev)], || {
+                                rng.next_f32()
+                            })
+                            .with_confidence_cap(s.mcap);
+                        }
+                    });
+            }
+
+            // Spatial reuse, ping-ponging two buffers.
+            if s.neighbors > 0 {
+                let mut next = vec![DiReservoir::empty(); n];
+                for round in 0..s.spatial_rounds {
+                    let input = &current;
+                    next.par_chunks_mut(w * BAND_ROWS)
+                        .enumerate()
+                        .for_each(|(band, out)| {
+                            let mut scratch = Vec::with_capacity(s.neighbors as usize);
+                            for (i, res) in out.iter_mut().enumerate() {
+                                let index = band * w * BAND_ROWS + i;
+                                let mut rng =
+                                    ctx.stage_rng(index, STAGE_SPATIAL + u64::from(round));
+                                *res =
+                                    self.spatial(&shift, &gbuf, input, index, &mut rng, &mut scratch);
+                            }
+                        });
+                    std::mem::swap(&mut current, &mut next);
+                }
+            }
+
+            // Shading.
+            rays += radiance
+                .par_chunks_mut(w * BAND_ROWS)
+                .enumerate()
+                .map(|(band, out)| {
+                    let mut rays = 0;
+                    for (i, l) in out.iter_mut().enumerate() {
+                        let index = band * w * BAND_ROWS + i;
+                        if let Some(r) = &gbuf.receivers[index] {
+                            let mut rng = ctx.stage_rng(index, STAGE_SHADE);
+                            let (li, nr) = self.shade(scene, r, &current[index], &mut rng);
+                            *l += li;
+                            rays += nr;
+                        }
+                    }
+                    rays
+                })
+                .sum::<u64>();
+
+            if s.temporal
+                && let Ok(mut h) = self.history.lock()
+            {
+                *h = Some(History {
+                    gbuffer: gbuf,
+                    reservoirs: current,
+                });
+            }
+        }
+        accum
+            .par_iter_mut()
+            .zip(radiance.par_iter())
+            .for_each(|(a, l)| *a += l.as_dvec3());
+        rays
+    }
+}
