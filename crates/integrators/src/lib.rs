@@ -71,10 +71,7 @@ pub fn make_integrator(
         settings.max_depth = d;
     }
     let scene_kind = canonical_name(&scene.integrator.kind);
-    let name = options
-        .name
-        .as_deref()
-        .map_or(scene_kind, canonical_name);
+    let name = options.name.as_deref().map_or(scene_kind, canonical_name);
     // The scene's parameters belong to the scene's estimator.
     let mut params = Vec::new();
     if name == scene_kind {

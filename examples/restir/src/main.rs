@@ -126,14 +126,20 @@ impl RestirArgs {
             }
         };
         put("candidates", self.candidates.map(|v| v.to_string()));
-        put("bsdf_candidates", self.bsdf_candidates.map(|v| v.to_string()));
+        put(
+            "bsdf_candidates",
+            self.bsdf_candidates.map(|v| v.to_string()),
+        );
         put("neighbors", self.neighbors.map(|v| v.to_string()));
         put("radius", self.radius.map(|v| v.to_string()));
         put("spatial_rounds", self.spatial_rounds.map(|v| v.to_string()));
         put("mis", self.mis.clone());
         put("mcap", self.mcap.map(|v| v.to_string()));
         put("temporal", self.temporal.then(|| "true".into()));
-        put("visibility_reuse", self.visibility_reuse.then(|| "true".into()));
+        put(
+            "visibility_reuse",
+            self.visibility_reuse.then(|| "true".into()),
+        );
         p
     }
 }

@@ -49,6 +49,9 @@ impl LightPoint {
     /// The sample a light-sampling record names.
     #[inline]
     pub fn from_light_sample(ls: &LightSample) -> Self {
+        if !ls.delta && !ls.dist.is_finite() {
+            return Self::environment(ls.light, ls.wi);
+        }
         Self {
             light: ls.light,
             prim: ls.prim,

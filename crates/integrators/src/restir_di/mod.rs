@@ -76,8 +76,16 @@ impl ShiftMap<LightPoint> for DiShift<'_> {
     type Domain = Receiver;
 
     #[inline]
-    fn shift(&self, _from: &Receiver, to: &Receiver, x: &LightPoint) -> Option<Shifted<LightPoint>> {
-        Some(Shifted::identity(*x, target(self.scene, to, x, self.counts)))
+    fn shift(
+        &self,
+        _from: &Receiver,
+        to: &Receiver,
+        x: &LightPoint,
+    ) -> Option<Shifted<LightPoint>> {
+        Some(Shifted::identity(
+            *x,
+            target(self.scene, to, x, self.counts),
+        ))
     }
 }
 
@@ -216,13 +224,21 @@ impl RestirDiIntegrator {
             .iter()
             .map(|(q, res)| (gbuf.receivers[*q].as_ref().expect("checked above"), res))
             .collect();
-        resample(shift, self.settings.mis, r, canonical, &domains, || rng.next_f32())
-            .with_confidence_cap(self.settings.mcap)
+        resample(shift, self.settings.mis, r, canonical, &domains, || {
+            rng.next_f32()
+        })
+        .with_confidence_cap(self.settings.mcap)
     }
 
     /// Shading at receiver `r` with its final reservoir: the reservoir's sample with a shadow
     /// ray, the BSDF samples, and the continuation. Returns radiance and rays.
-    fn shade(&self, scene: &Scene, r: &Receiver, res: &DiReservoir, rng: &mut Pcg32) -> (Vec3, u64) {
+    fn shade(
+        &self,
+        scene: &Scene,
+        r: &Receiver,
+        res: &DiReservoir,
+        rng: &mut Pcg32,
+    ) -> (Vec3, u64) {
         let mut l = Vec3::ZERO;
         let mut rays = 0;
         if let Some(y) = &res.sample
@@ -319,7 +335,8 @@ impl Integrator for RestirDiIntegrator {
         let n = accum.len();
         let mut radiance = vec![Vec3::ZERO; n];
         let keep = s.path.max_depth < 0 || s.path.max_depth >= 2;
-        let (gbuf, mut rays) = GBuffer::trace(scene, ctx, s.path.hide_emitters, keep, &mut radiance);
+        let (gbuf, mut rays) =
+            GBuffer::trace(scene, ctx, s.path.hide_emitters, keep, &mut radiance);
         let w = gbuf.width;
         if keep {
             let shift = DiShift {
@@ -390,8 +407,14 @@ impl Integrator for RestirDiIntegrator {
                                 let index = band * w * BAND_ROWS + i;
                                 let mut rng =
                                     ctx.stage_rng(index, STAGE_SPATIAL + u64::from(round));
-                                *res =
-                                    self.spatial(&shift, &gbuf, input, index, &mut rng, &mut scratch);
+                                *res = self.spatial(
+                                    &shift,
+                                    &gbuf,
+                                    input,
+                                    index,
+                                    &mut rng,
+                                    &mut scratch,
+                                );
                             }
                         });
                     std::mem::swap(&mut current, &mut next);

@@ -93,25 +93,38 @@ impl RestirDiSettings {
                 "bsdf_candidates" | "brdf_candidates" => {
                     self.bsdf_candidates = parse_count(name, v, 0)?;
                 }
-                "neighbors" | "neighbours" | "neighbors_per_pixel" | "neighbours_per_pixel"
-                | "neighbor_select" | "neighbour_select" | "num_neighbors" | "spatial_neighbors" => {
+                "neighbors"
+                | "neighbours"
+                | "neighbors_per_pixel"
+                | "neighbours_per_pixel"
+                | "neighbor_select"
+                | "neighbour_select"
+                | "num_neighbors"
+                | "spatial_neighbors" => {
                     self.neighbors = parse_count(name, v, 0)?;
                 }
                 "radius" | "max_radius" | "spatial_radius" => {
                     self.radius = parse_positive(name, v)?;
                 }
-                "spatial_rounds" | "spatial_iteration" | "spatial_iterations" | "spatial_passes" => {
+                "spatial_rounds" | "spatial_iteration" | "spatial_iterations"
+                | "spatial_passes" => {
                     self.spatial_rounds = parse_count(name, v, 0)?;
                 }
                 "mis" | "bias_correction" => {
                     self.mis = MIS_NAMES
                         .iter()
-                        .find(|(n, _)| n.replace('-', "_") == v.to_ascii_lowercase().replace('-', "_"))
+                        .find(|(n, _)| {
+                            n.replace('-', "_") == v.to_ascii_lowercase().replace('-', "_")
+                        })
                         .map(|(_, s)| *s)
                         .ok_or_else(|| {
                             format!(
                                 "{name} = '{v}': expected one of {}",
-                                MIS_NAMES.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
+                                MIS_NAMES
+                                    .iter()
+                                    .map(|(n, _)| *n)
+                                    .collect::<Vec<_>>()
+                                    .join(", ")
                             )
                         })?;
                 }
@@ -123,7 +136,9 @@ impl RestirDiSettings {
                 "normal_threshold" => {
                     let deg = parse_positive(name, v)?;
                     if deg > 180.0 {
-                        return Err(format!("{name} = {v}: expected an angle in degrees up to 180"));
+                        return Err(format!(
+                            "{name} = {v}: expected an angle in degrees up to 180"
+                        ));
                     }
                     self.normal_cos = deg.to_radians().cos();
                 }
@@ -140,7 +155,10 @@ fn parse_count(name: &str, v: &str, min: u32) -> Result<u32, String> {
         .parse()
         .map_err(|_| format!("{name} = '{v}': expected a whole number"))?;
     if n < min || n > 1 << 20 {
-        return Err(format!("{name} = {n}: expected a number from {min} to {}", 1 << 20));
+        return Err(format!(
+            "{name} = {n}: expected a number from {min} to {}",
+            1 << 20
+        ));
     }
     Ok(n)
 }
@@ -194,7 +212,11 @@ mod tests {
         assert_eq!((s.mcap, s.mis), (8.0, MisScheme::OneOverZ));
         assert!(s.apply(&[p("candidates", "0")]).is_err());
         assert!(s.apply(&[p("radius", "NaN")]).is_err());
-        assert!(s.apply(&[p("mis", "magic")]).unwrap_err().contains("defensive-pairwise"));
+        assert!(
+            s.apply(&[p("mis", "magic")])
+                .unwrap_err()
+                .contains("defensive-pairwise")
+        );
         assert!(s.apply(&[p("temporal", "maybe")]).is_err());
     }
 }
