@@ -46,7 +46,7 @@ pub struct SurfaceInteraction {
     pub shape: u32,
     /// Primitive within the shape.
     pub prim: u32,
-    /// Barycentrics (meshes) or spherical parameters (spheres) of the point on its primitive;
+    /// Barycentrics (meshes) or [`crate::Sphere::param_of`] parameters (spheres) of the point on its primitive;
     /// with `shape` and `prim` this names the point without storing it.
     pub param: Vec2,
     /// Distance from the ray origin.
@@ -273,7 +273,7 @@ impl Accel {
             }
             Shape::Sphere(s) => {
                 let n = (ray.at(hit.t) - s.center).normalize();
-                crate::Sphere::uv_of(n)
+                crate::Sphere::param_of(n)
             }
         };
         let mut si = surface_at(shapes, hit.shape, hit.prim, param);
@@ -314,7 +314,7 @@ pub fn surface_at(shapes: &[Shape], shape: u32, prim: u32, param: Vec2) -> Surfa
                 p,
                 ng: n,
                 shading: Frame::from_normal_tangent(n, dpdu),
-                uv: param,
+                uv: crate::Sphere::uv_of(if s.flip_normals { -n } else { n }),
                 shape,
                 prim,
                 param,

@@ -71,7 +71,7 @@ pub struct LightSample {
     pub delta: bool,
     /// The primitive on the light's shape (area lights).
     pub prim: u32,
-    /// Barycentrics or spherical parameters of `p` on the primitive (area lights).
+    /// Barycentrics or sphere parameters of `p` on the primitive (area lights).
     pub param: Vec2,
 }
 

@@ -40,7 +40,7 @@ pub struct LightPoint {
     pub light: u32,
     /// Primitive on an area light's shape (0 otherwise).
     pub prim: u32,
-    /// Barycentrics or spherical parameters on an area light; spherical parameters of the
+    /// Barycentrics or sphere parameters on an area light; the octahedral encoding of the
     /// direction towards the environment; unused for point and directional lights.
     pub param: Vec2,
 }
@@ -65,7 +65,7 @@ impl LightPoint {
         Self {
             light,
             prim: 0,
-            param: Sphere::uv_of(d),
+            param: Sphere::param_of(d),
         }
     }
 }
