@@ -60,6 +60,15 @@ pub trait Integrator: Sync + Send + std::fmt::Debug {
     /// Renders one pass, adding one estimate per pixel to `accum` (row-major). Returns the number
     /// of rays traced.
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64;
+    /// The estimator's settings in one line, for logs and statistics.
+    fn describe(&self) -> String {
+        self.name().to_string()
+    }
+    /// Bytes per pixel of the per-pass buffers the estimator keeps besides the image (reservoirs,
+    /// primary hits).
+    fn buffer_bytes_per_pixel(&self) -> usize {
+        0
+    }
 }
 
 /// The path tracer as an [`Integrator`].
@@ -72,6 +81,13 @@ pub struct PathIntegrator {
 impl Integrator for PathIntegrator {
     fn name(&self) -> &'static str {
         "path"
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "path max_depth={} rr_depth={}",
+            self.settings.max_depth, self.settings.rr_depth
+        )
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {

@@ -25,6 +25,8 @@ fn scene() -> Scene {
              material: Some(Inline(Diffuse(reflectance: (0.6, 0.5, 0.4))))),
             (geometry: Rectangle, to_world: [Scale((0.25, 3, 1)), Rotate(axis: (1, 0, 0), angle: -90),
              Translate((-0.9, 0.002, 0))], material: Some(Inline(Black))),
+            (geometry: Rectangle, to_world: [Scale((3, 1.5, 1)), Rotate(axis: (0, 1, 0), angle: -90),
+             Translate((1.8, 1.5, 0))], material: Some(Inline(Diffuse(reflectance: (0.9, 0.9, 0.9))))),
             (geometry: Cube, to_world: [Scale((0.35, 0.35, 0.35)), Translate((0.4, 0.7, 0.2))],
              material: Some(Inline(Diffuse(reflectance: (0.3, 0.6, 0.3))))),
             (geometry: Rectangle, to_world: [Scale((0.8, 0.8, 1)), Rotate(axis: (1, 0, 0), angle: 90),
@@ -42,9 +44,15 @@ fn scene() -> Scene {
 }
 
 fn render_image(scene: &Scene, name: &str, params: &[(&str, &str)], spp: u32, seed: u64) -> Image {
+    // "max_depth" is the command line's --max-depth; the rest are estimator parameters.
+    let max_depth = params
+        .iter()
+        .find(|(k, _)| *k == "max_depth")
+        .map(|(_, v)| v.parse().unwrap());
+    let params: Vec<_> = params.iter().filter(|(k, _)| *k != "max_depth").collect();
     let options = IntegratorOptions {
         name: Some(name.into()),
-        max_depth: None,
+        max_depth,
         params: params
             .iter()
             .map(|(k, v)| (k.to_string(), v.to_string()))
@@ -114,8 +122,24 @@ fn max_z(a: &[(f64, f64)], b: &[(f64, f64)]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-fn reference(scene: &Scene) -> Vec<(f64, f64)> {
+fn direct_reference(scene: &Scene) -> Vec<(f64, f64)> {
     statistics(scene, "path", &[], 256, 48)
+}
+
+/// With `max_depth > 2` the first BSDF sample continues as a path: indirect light is added by
+/// the path tracer's estimator and the total stays unbiased.
+#[test]
+fn unbiased_with_indirect_light() {
+    let scene = scene();
+    let reference = statistics(&scene, "path", &[("max_depth", "-1")], 128, 48);
+    let di = statistics(&scene, "restir-di", &[("max_depth", "-1"), ("candidates", "8")], 1, 200);
+    let z = max_z(&di, &reference);
+    eprintln!("max_depth -1: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "max_depth -1: max |z| = {z:.2}");
+    // The direct-only reference differs from it: the comparison can fail.
+    let z = max_z(&di, &direct_reference(&scene));
+    eprintln!("against direct light only: max |z| = {z:.2}");
+    assert!(z > 2.0 * Z_MAX, "indirect light should be detectable, max |z| = {z:.2}");
 }
 
 /// 16 blocks × 6 schemes: a Bonferroni-style bound of 4.5 standard errors.
@@ -124,7 +148,7 @@ const Z_MAX: f64 = 4.5;
 #[test]
 fn unbiased_for_every_unbiased_mis_scheme() {
     let scene = scene();
-    let reference = reference(&scene);
+    let reference = direct_reference(&scene);
     for (mis, scheme) in MIS_NAMES {
         if !scheme.is_unbiased() {
             continue;
@@ -164,7 +188,7 @@ fn unbiased_for_every_unbiased_mis_scheme() {
 #[test]
 fn biased_options_show_their_bias() {
     let scene = scene();
-    let reference = reference(&scene);
+    let reference = direct_reference(&scene);
     let z = max_z(
         &statistics(
             &scene,

@@ -148,6 +148,8 @@ impl RestirArgs {
 struct Stats<'a> {
     scene: String,
     integrator: &'a str,
+    integrator_settings: String,
+    buffer_bytes_per_pixel: usize,
     seconds: f64,
     load_seconds: f64,
     spp: u32,
@@ -331,6 +333,8 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         let stats = Stats {
             scene: args.scene.display().to_string(),
             integrator: integrator.name(),
+            integrator_settings: integrator.describe(),
+            buffer_bytes_per_pixel: integrator.buffer_bytes_per_pixel(),
             seconds: out.seconds,
             load_seconds,
             spp: out.passes,
@@ -353,7 +357,7 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         };
         println!(
             "{}: {} passes in {:.2} s{stopped}, {:.1} Mrays/s, {} threads, loaded in {:.2} s -> {}",
-            integrator.name(),
+            integrator.describe(),
             out.passes,
             out.seconds,
             mrays,

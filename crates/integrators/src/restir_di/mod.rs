@@ -330,6 +330,33 @@ impl Integrator for RestirDiIntegrator {
         "restir-di"
     }
 
+    fn describe(&self) -> String {
+        let s = &self.settings;
+        format!(
+            "restir-di max_depth={} candidates={} bsdf_candidates={} neighbors={} radius={} \
+             spatial_rounds={} mis={} mcap={} temporal={} visibility_reuse={}{}",
+            s.path.max_depth,
+            s.candidates,
+            s.bsdf_candidates,
+            s.neighbors,
+            s.radius,
+            s.spatial_rounds,
+            mis_name(s.mis),
+            s.mcap,
+            s.temporal,
+            s.visibility_reuse,
+            if s.is_unbiased() { "" } else { " (biased)" }
+        )
+    }
+
+    fn buffer_bytes_per_pixel(&self) -> usize {
+        let reservoirs = if self.settings.temporal { 3 } else { 2 };
+        let hits = if self.settings.temporal { 2 } else { 1 };
+        reservoirs * Self::RESERVOIR_BYTES
+            + hits * std::mem::size_of::<Option<Receiver>>()
+            + std::mem::size_of::<Vec3>()
+    }
+
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
         let s = &self.settings;
         let n = accum.len();
