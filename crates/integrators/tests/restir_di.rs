@@ -132,14 +132,23 @@ fn direct_reference(scene: &Scene) -> Vec<(f64, f64)> {
 fn unbiased_with_indirect_light() {
     let scene = scene();
     let reference = statistics(&scene, "path", &[("max_depth", "-1")], 128, 48);
-    let di = statistics(&scene, "restir-di", &[("max_depth", "-1"), ("candidates", "8")], 1, 200);
+    let di = statistics(
+        &scene,
+        "restir-di",
+        &[("max_depth", "-1"), ("candidates", "8")],
+        1,
+        200,
+    );
     let z = max_z(&di, &reference);
     eprintln!("max_depth -1: max |z| = {z:.2}");
     assert!(z < Z_MAX, "max_depth -1: max |z| = {z:.2}");
     // The direct-only reference differs from it: the comparison can fail.
     let z = max_z(&di, &direct_reference(&scene));
     eprintln!("against direct light only: max |z| = {z:.2}");
-    assert!(z > 2.0 * Z_MAX, "indirect light should be detectable, max |z| = {z:.2}");
+    assert!(
+        z > 2.0 * Z_MAX,
+        "indirect light should be detectable, max |z| = {z:.2}"
+    );
 }
 
 /// 16 blocks × 6 schemes: a Bonferroni-style bound of 4.5 standard errors.

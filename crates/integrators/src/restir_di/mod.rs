@@ -26,7 +26,7 @@ use std::sync::Mutex;
 use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
 use restir_geometry::{Ray, offset_ray_origin, shadow_ray_between, shadow_ray_towards};
-use restir_gris::{Reservoir, ShiftMap, Shifted, StreamingReservoir, resample};
+use restir_gris::{MisScheme, Reservoir, ShiftMap, Shifted, StreamingReservoir, resample};
 use restir_sampling::{Pcg32, sequences::r2};
 use restir_scene::Scene;
 
@@ -122,6 +122,7 @@ impl RestirDiIntegrator {
     pub const RESERVOIR_BYTES: usize = std::mem::size_of::<DiReservoir>();
 
     /// Initial resampling at receiver `r`. Returns the reservoir and the rays traced.
+    #[inline(never)]
     fn initial(&self, scene: &Scene, r: &Receiver, rng: &mut Pcg32) -> (DiReservoir, u64) {
         let bsdf = &scene.bsdfs[r.bsdf as usize];
         if !bsdf.has_smooth_lobe() || scene.lights.is_empty() {
@@ -185,6 +186,7 @@ impl RestirDiIntegrator {
     /// One spatial round at pixel `index`: resamples the pixel's reservoir from `input` with up to
     /// `k` similar neighbours.
     #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
     fn spatial(
         &self,
         shift: &DiShift,
@@ -396,6 +398,15 @@ impl Integrator for RestirDiIntegrator {
             } else {
                 None
             };
+            // Two techniques, one of them carrying up to `mcap` passes of history: the generalized
+            // balance heuristic (4 target evaluations) lets the history weigh by its confidence,
+            // where defensive pairwise would keep half the weight on the fresh sample
+            // (ALGORITHMS.md §3.3 (d); ReSTIR PT's temporal reuse does the same).
+            let temporal_mis = if s.mis.is_unbiased() {
+                MisScheme::GeneralizedBalance
+            } else {
+                s.mis
+            };
             if let Some(hist) = history.as_ref().filter(|h| h.reservoirs.len() == n) {
                 current
                     .par_chunks_mut(w * BAND_ROWS)
@@ -413,10 +424,11 @@ impl Integrator for RestirDiIntegrator {
                             }
                             let prev = hist.reservoirs[index].with_confidence_cap(s.mcap);
                             let mut rng = ctx.stage_rng(index, STAGE_TEMPORAL);
-                            *res = resample(&shift, s.mis, r, res, &[(prev_r, &prev)], || {
-                                rng.next_f32()
-                            })
-                            .with_confidence_cap(s.mcap);
+                            *res =
+                                resample(&shift, temporal_mis, r, res, &[(prev_r, &prev)], || {
+                                    rng.next_f32()
+                                })
+                                .with_confidence_cap(s.mcap);
                         }
                     });
             }
