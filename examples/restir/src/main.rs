@@ -12,6 +12,8 @@ use clap::{Parser, Subcommand};
 use restir_integrators::{Image, RenderSettings, compare, make_integrator, render};
 use restir_scene::{Scene, load_desc};
 
+mod generate;
+
 #[derive(Parser, Debug)]
 #[command(
     name = "restir",
@@ -34,6 +36,9 @@ enum Command {
         /// The reference.
         reference: PathBuf,
     },
+    /// Write a procedurally generated scene (RON).
+    #[command(subcommand)]
+    Generate(generate::Generate),
 }
 
 #[derive(clap::Args, Debug)]
@@ -339,6 +344,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => run_render(args),
         Command::Compare { test, reference } => run_compare(&test, &reference),
+        Command::Generate(what) => generate::run(what),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
