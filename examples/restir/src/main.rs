@@ -14,6 +14,8 @@ use restir_integrators::{
 };
 use restir_scene::{Scene, load_desc};
 
+mod generate;
+
 #[derive(Parser, Debug)]
 #[command(
     name = "restir",
@@ -36,6 +38,9 @@ enum Command {
         /// The reference.
         reference: PathBuf,
     },
+    /// Write a procedurally generated scene (RON).
+    #[command(subcommand)]
+    Generate(generate::Generate),
 }
 
 #[derive(clap::Args, Debug)]
@@ -144,6 +149,9 @@ impl RestirArgs {
     }
 }
 
+/// More worker threads than this is a typo, not a machine.
+const MAX_THREADS: usize = 1024;
+
 #[derive(serde::Serialize)]
 struct Stats<'a> {
     scene: String,
@@ -168,6 +176,7 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
     for d in &args.defines {
         let (k, v) = d
             .split_once('=')
+            .filter(|(k, _)| !k.trim().is_empty())
             .ok_or_else(|| format!("-D {d}: expected NAME=VALUE"))?;
         defines.push((k.trim().to_string(), v.trim().to_string()));
     }
@@ -211,7 +220,9 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         return Err("--spp must be at least 1".into());
     }
     let time_limit = match args.time_limit {
-        Some(t) if t.is_finite() && t > 0.0 => Some(Duration::from_secs_f64(t)),
+        Some(t) if t.is_finite() && t > 0.0 => Some(
+            Duration::try_from_secs_f64(t).map_err(|_| format!("--time-limit {t:e}: too large"))?,
+        ),
         Some(t) => {
             return Err(format!(
                 "--time-limit {t}: expected a positive number of seconds"
@@ -253,7 +264,21 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         }
     }
 
+    // Fail before rendering, not after, when the output cannot be written.
+    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("{}: cannot create output directory: {e}", dir.display()))?;
+    }
+    if output.is_dir() {
+        return Err(format!("{}: is a directory", output.display()));
+    }
+
     let threads = args.threads.unwrap_or(0);
+    if threads > MAX_THREADS {
+        return Err(format!(
+            "--threads {threads}: at most {MAX_THREADS} (0 = all cores)"
+        ));
+    }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -323,9 +348,6 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         b.finish_and_clear();
     }
 
-    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    }
     out.image.write(&output).map_err(|e| e.to_string())?;
 
     let mrays = out.rays as f64 / out.seconds.max(1e-9) / 1e6;
@@ -422,6 +444,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => run_render(args),
         Command::Compare { test, reference } => run_compare(&test, &reference),
+        Command::Generate(what) => generate::run(what),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,350 @@
+//! The `restir` command on bad input (exit code 1, a one-line error naming the problem, never a
+//! panic) and on a tiny happy path (images, `--stats` JSON, `compare`).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicU32, Ordering};
+
+const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
+
+fn cornell() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml")
+}
+
+/// A fresh directory under the system temp dir, unique to this process and call, removed when
+/// dropped.
+struct TempDir(PathBuf);
+
+impl std::ops::Deref for TempDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn temp_dir(tag: &str) -> TempDir {
+    static COUNTER: AtomicU32 = AtomicU32::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("restir-cli-{}-{n}-{tag}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    TempDir(dir)
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn restir(args: &[&str]) -> Output {
+    Command::new(RESTIR).args(args).output().unwrap()
+}
+
+/// Runs `restir` with `args`, expects failure with exit code 1 and a single stderr line that
+/// contains every string in `needles`; returns that line.
+fn fails(args: &[&str], needles: &[&str]) -> String {
+    let out = restir(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(!stderr.contains("panicked"), "{args:?}: panicked:\n{stderr}");
+    assert_eq!(out.status.code(), Some(1), "{args:?}: stderr:\n{stderr}");
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(lines.len(), 1, "{args:?}: expected one line, got:\n{stderr}");
+    for n in needles {
+        assert!(lines[0].contains(n), "{args:?}: {:?} lacks {n:?}", lines[0]);
+    }
+    lines[0].to_string()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn missing_scene_file() {
+    let dir = temp_dir("missing");
+    let scene = dir.join("no-such-scene.xml");
+    let out = dir.join("o.png");
+    fails(
+        &["render", s(&scene), "-o", s(&out)],
+        &[s(&scene), "cannot read"],
+    );
+}
+
+#[test]
+fn malformed_xml_names_file_and_line() {
+    let dir = temp_dir("xml");
+    let scene = write(
+        &dir,
+        "bad.xml",
+        "<scene version=\"3.0.0\">\n    <shape type=\"rectangle\">\n        <float name=\"x\" value=\"1\"\n    </shape>\n</scene>\n",
+    );
+    let out = dir.join("o.png");
+    let line = fails(&["render", s(&scene), "-o", s(&out)], &["malformed XML"]);
+    // `file:line:` with a line in the malformed region.
+    let prefix = format!("{}:", s(&scene));
+    let rest = line
+        .split_once(&prefix)
+        .unwrap_or_else(|| panic!("{line:?} does not name the file"))
+        .1;
+    let n: u32 = rest.split(':').next().unwrap().parse().unwrap();
+    assert!((3..=4).contains(&n), "line {n} in {line:?}");
+}
+
+#[test]
+fn malformed_ron_names_file_and_line() {
+    let dir = temp_dir("ron");
+    let scene = write(
+        &dir,
+        "bad.ron",
+        "(\n    camera: (fov: 40),\n    film: (width: 16 height: 16),\n)\n",
+    );
+    let out = dir.join("o.png");
+    fails(
+        &["render", s(&scene), "-o", s(&out)],
+        &[&format!("{}:3:", s(&scene))],
+    );
+}
+
+#[test]
+fn unknown_field_in_ron() {
+    let dir = temp_dir("ronfield");
+    let scene = write(&dir, "typo.ron", "(\n    camera: (fov: 40, fvo: 3),\n)\n");
+    let out = dir.join("o.png");
+    fails(
+        &["render", s(&scene), "-o", s(&out)],
+        &[&format!("{}:2:", s(&scene)), "fvo"],
+    );
+}
+
+#[test]
+fn unknown_plugin_type() {
+    let dir = temp_dir("plugin");
+    let scene = write(
+        &dir,
+        "teapot.xml",
+        "<scene version=\"3.0.0\">\n    <shape type=\"teapot\"/>\n</scene>\n",
+    );
+    let out = dir.join("o.png");
+    fails(
+        &["render", s(&scene), "-o", s(&out)],
+        &[&format!("{}:2:", s(&scene)), "teapot"],
+    );
+}
+
+#[test]
+fn nan_in_a_parameter() {
+    let dir = temp_dir("nan");
+    let text = std::fs::read_to_string(cornell()).unwrap();
+    let needle = "<float name=\"fov\" value=\"40\"/>";
+    assert!(text.contains(needle));
+    let line = text.lines().position(|l| l.contains(needle)).unwrap() + 1;
+    let scene = write(
+        &dir,
+        "nan.xml",
+        &text.replace(needle, "<float name=\"fov\" value=\"nan\"/>"),
+    );
+    let out = dir.join("o.png");
+    fails(
+        &["render", s(&scene), "-o", s(&out)],
+        &[&format!("{}:{line}:", s(&scene)), "nan", "finite"],
+    );
+    // And a NaN in a RON scene, caught when the scene is built.
+    let scene = write(
+        &dir,
+        "nan.ron",
+        "(camera: (fov: 40), shapes: [(geometry: Sphere(center: (0, 0, 0), radius: NaN))])",
+    );
+    fails(
+        &["render", s(&scene), "-o", s(&out)],
+        &[s(&scene), "radius NaN"],
+    );
+}
+
+#[test]
+fn unknown_flag() {
+    fails(
+        &["render", s(&cornell()), "--frobnicate"],
+        &["--frobnicate"],
+    );
+    fails(&["frobnicate"], &["frobnicate"]);
+}
+
+#[test]
+fn unknown_integrator() {
+    let dir = temp_dir("integrator");
+    let out = dir.join("o.png");
+    fails(
+        &[
+            "render",
+            s(&cornell()),
+            "--integrator",
+            "nosuch",
+            "-o",
+            s(&out),
+        ],
+        &["unknown integrator", "nosuch", "path"],
+    );
+}
+
+#[test]
+fn bad_define_syntax() {
+    let dir = temp_dir("define");
+    let out = dir.join("o.png");
+    for bad in ["resx", "=3"] {
+        fails(
+            &["render", s(&cornell()), "-D", bad, "-o", s(&out)],
+            &["-D", bad, "NAME=VALUE"],
+        );
+    }
+    // A well-formed define with a value the scene cannot use: file and line.
+    fails(
+        &["render", s(&cornell()), "-D", "resx=abc", "-o", s(&out)],
+        &["cornell-box.xml:", "\"abc\"", "integer"],
+    );
+}
+
+#[test]
+fn unwritable_output_path() {
+    let dir = temp_dir("unwritable");
+    // A regular file where a directory should be: fails even for root, before rendering.
+    let file = write(&dir, "a-file", "");
+    let out = file.join("o.png");
+    fails(
+        &["render", s(&cornell()), "--spp", "1", "-o", s(&out)],
+        &[s(&file), "cannot create output directory"],
+    );
+    // The output is an existing directory.
+    let out = dir.join("dir.png");
+    std::fs::create_dir_all(&out).unwrap();
+    fails(
+        &["render", s(&cornell()), "--spp", "1", "-o", s(&out)],
+        &[s(&out), "directory"],
+    );
+    // An unsupported extension.
+    let out = dir.join("o.txt");
+    fails(
+        &["render", s(&cornell()), "--spp", "1", "-o", s(&out)],
+        &[s(&out), ".exr or .png"],
+    );
+    // The stats file cannot be written (after a render of 8×8 pixels).
+    let out = dir.join("o.exr");
+    let stats = file.join("stats.json");
+    let common = ["--width", "8", "--height", "8", "--spp", "1", "--quiet"];
+    let c = cornell();
+    let mut args = vec!["render", s(&c), "-o", s(&out), "--stats", s(&stats)];
+    args.extend(common);
+    fails(&args, &[s(&stats)]);
+}
+
+#[test]
+fn bad_numbers_on_the_command_line() {
+    let dir = temp_dir("numbers");
+    let out = dir.join("o.png");
+    let c = cornell();
+    // Each of these fails before rendering.
+    let base = ["render", s(&c), "-o", s(&out)];
+    let cases: [(&[&str], &[&str]); 6] = [
+        (&["--time-limit", "nan"], &["--time-limit"]),
+        (&["--time-limit", "1e300"], &["--time-limit", "too large"]),
+        (&["--threads", "100000"], &["--threads", "100000"]),
+        (&["--spp", "0"], &["--spp"]),
+        (&["--max-depth", "-5"], &["max depth -5"]),
+        (&["--width", "0"], &["0×256", "resolution"]),
+    ];
+    for (extra, needles) in cases {
+        let mut args = base.to_vec();
+        args.extend_from_slice(extra);
+        fails(&args, needles);
+    }
+}
+
+#[test]
+fn compare_bad_inputs() {
+    let dir = temp_dir("compare");
+    let not_exr = write(&dir, "not.exr", "hello");
+    let missing = dir.join("missing.exr");
+    fails(&["compare", s(&not_exr), s(&not_exr)], &[s(&not_exr)]);
+    fails(&["compare", s(&missing), s(&not_exr)], &[s(&missing)]);
+}
+
+#[test]
+fn tiny_render_writes_images_stats_and_compares() {
+    let dir = temp_dir("happy");
+    let exr = dir.join("a.exr");
+    let exr2 = dir.join("b.exr");
+    let png = dir.join("a.png");
+    let stats = dir.join("stats.json");
+    let c = cornell();
+    let tiny = ["--width", "16", "--height", "16", "--spp", "2", "--quiet"];
+    for (out, seed) in [(&exr, "1"), (&exr2, "2"), (&png, "1")] {
+        let mut args = vec!["render", s(&c), "-o", s(out), "--seed", seed];
+        args.extend(tiny);
+        if out == &exr {
+            args.extend(["--stats", s(&stats)]);
+        }
+        let o = restir(&args);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{args:?}: {stderr}");
+        assert!(stderr.is_empty(), "--quiet printed: {stderr}");
+    }
+    let exr_bytes = std::fs::read(&exr).unwrap();
+    assert_eq!(&exr_bytes[..4], &[0x76, 0x2f, 0x31, 0x01], "EXR magic");
+    let png_bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&png_bytes[..8], b"\x89PNG\r\n\x1a\n", "PNG magic");
+
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    for key in [
+        "seconds",
+        "load_seconds",
+        "spp",
+        "width",
+        "height",
+        "integrator",
+        "rays",
+        "nonfinite_pixels",
+    ] {
+        assert!(json.get(key).is_some(), "stats lack {key}: {json}");
+    }
+    assert_eq!(json["spp"], 2);
+    assert_eq!(json["width"], 16);
+    assert_eq!(json["height"], 16);
+    assert_eq!(json["integrator"], "path");
+    assert_eq!(json["nonfinite_pixels"], 0);
+    // At least a camera ray per pixel and pass.
+    assert!(json["rays"].as_u64().unwrap() >= 16 * 16 * 2);
+    assert!(json["seconds"].as_f64().unwrap() >= 0.0);
+
+    // compare: one line `relmse=… mse=… mean_ratio=… nonfinite=…`.
+    let o = restir(&["compare", s(&exr), s(&exr2)]);
+    assert!(o.status.success());
+    let stdout = String::from_utf8(o.stdout).unwrap();
+    let fields: Vec<(&str, &str)> = stdout
+        .trim()
+        .split(' ')
+        .map(|f| f.split_once('=').unwrap())
+        .collect();
+    let names: Vec<&str> = fields.iter().map(|f| f.0).collect();
+    assert_eq!(names, ["relmse", "mse", "mean_ratio", "nonfinite"]);
+    let relmse: f64 = fields[0].1.parse().unwrap();
+    let ratio: f64 = fields[2].1.parse().unwrap();
+    assert!(relmse > 0.0 && relmse.is_finite(), "{stdout}");
+    assert!(ratio > 0.5 && ratio < 2.0, "{stdout}");
+    assert_eq!(fields[3].1, "0");
+    // An image against itself.
+    let o = restir(&["compare", s(&exr), s(&exr)]);
+    let stdout = String::from_utf8(o.stdout).unwrap();
+    assert!(stdout.starts_with("relmse=0.000000e0 mse=0.000000e0 mean_ratio=1.000000"));
+    // Different sizes are an error, not a panic.
+    let small = dir.join("small.exr");
+    let mut args = vec!["render", s(&c), "-o", s(&small), "--width", "8"];
+    args.extend(&tiny[2..]);
+    assert!(restir(&args).status.success());
+    fails(&["compare", s(&small), s(&exr)], &[s(&small), "differs"]);
+}
