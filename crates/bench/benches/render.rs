@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use glam::DVec3;
 use restir_integrators::film::Filter;
-use restir_integrators::{Integrator, PassContext, make_integrator};
+use restir_integrators::{Integrator, IntegratorOptions, PassContext, make_integrator};
 use restir_scene::{Scene, load_desc};
 
 const SIZE: u32 = 128;
@@ -78,16 +78,16 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(3.0);
     let all = rayon::current_num_threads();
-    println!(
-        "path tracer, one pass at {SIZE}×{SIZE}, ~{budget} s per row (RESTIR_BENCH_SECONDS)"
-    );
+    println!("path tracer, one pass at {SIZE}×{SIZE}, ~{budget} s per row (RESTIR_BENCH_SECONDS)");
     println!(
         "{:<18} {:>7} {:>9} {:>10} {:>10} {:>10} {:>8}",
         "scene", "threads", "max_depth", "ms/pass", "passes/s", "Mrays/s", "passes"
     );
     for name in ["cornell-box.xml", "many-lights.ron"] {
         let scene = load(name);
-        let integrator = make_integrator("path", &scene, None).unwrap();
+        let integrator = make_integrator(&scene, &IntegratorOptions::default())
+            .unwrap()
+            .integrator;
         for threads in [all, 1] {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)

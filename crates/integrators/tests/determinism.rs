@@ -5,11 +5,15 @@
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
-use restir_integrators::{Image, RenderOutput, RenderSettings, make_integrator, render};
+use restir_integrators::{
+    Image, IntegratorOptions, RenderOutput, RenderSettings, make_integrator, render,
+};
 use restir_scene::{Scene, load_desc};
 
 fn scene_path(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name)
 }
 
 /// Loads a shipped scene at `size`×`size` pixels.
@@ -27,7 +31,9 @@ fn render_with_threads(scene: &Scene, threads: usize, seed: u64, spp: u32) -> Re
         .build()
         .unwrap();
     assert_eq!(pool.current_num_threads(), threads);
-    let integrator = make_integrator("path", scene, None).unwrap();
+    let integrator = make_integrator(scene, &IntegratorOptions::default())
+        .unwrap()
+        .integrator;
     let settings = RenderSettings {
         spp,
         time_limit: None,

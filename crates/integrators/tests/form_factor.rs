@@ -13,7 +13,7 @@
 
 use std::sync::atomic::AtomicBool;
 
-use restir_integrators::{RenderSettings, make_integrator, render};
+use restir_integrators::{IntegratorOptions, RenderSettings, make_integrator, render};
 use restir_scene::{Scene, parse_ron};
 
 /// Form factor from a differential element at the origin (normal towards the rectangle) to the
@@ -78,7 +78,9 @@ impl Setup {
     /// Per channel: the mean of all pixel estimates over `seeds` renders and its standard error.
     fn estimate(&self, seeds: u64, spp: u32) -> [(f64, f64); 3] {
         let scene = self.scene();
-        let integrator = make_integrator("path", &scene, None).unwrap();
+        let integrator = make_integrator(&scene, &IntegratorOptions::default())
+            .unwrap()
+            .integrator;
         let mut values: [Vec<f64>; 3] = Default::default();
         for seed in 0..seeds {
             let settings = RenderSettings {
