@@ -1,5 +1,7 @@
-//! Path-tracer throughput on the shipped scenes: passes per second and Mrays/s (camera,
-//! continuation and shadow rays) of one pass of the `path` integrator.
+//! Estimator throughput on the shipped scenes: passes per second and Mrays/s (camera,
+//! continuation and shadow rays) of one pass of the `path` and `restir-di` integrators (ReSTIR DI
+//! with its defaults and with the configuration of the equal-time comparison in
+//! docs/BENCHMARKS.md).
 //!
 //! Run with `cargo bench -p restir-bench --bench render`. A small harness rather than divan,
 //! because the two numbers wanted are rates of whole passes: each scene is loaded at 128×128,
@@ -78,25 +80,68 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(3.0);
     let all = rayon::current_num_threads();
-    println!("path tracer, one pass at {SIZE}×{SIZE}, ~{budget} s per row (RESTIR_BENCH_SECONDS)");
+    println!("one pass at {SIZE}×{SIZE}, ~{budget} s per row (RESTIR_BENCH_SECONDS)");
     println!(
-        "{:<18} {:>7} {:>9} {:>10} {:>10} {:>10} {:>8}",
-        "scene", "threads", "max_depth", "ms/pass", "passes/s", "Mrays/s", "passes"
+        "{:<18} {:<22} {:>7} {:>9} {:>10} {:>10} {:>10} {:>8}",
+        "scene", "integrator", "threads", "max_depth", "ms/pass", "passes/s", "Mrays/s", "passes"
     );
+    let configs: [Config; 3] = [
+        ("path", "path", &[]),
+        ("restir-di", "restir-di", &[]),
+        (
+            "restir-di (tuned)",
+            "restir-di",
+            &[
+                ("candidates", "8"),
+                ("neighbors", "5"),
+                ("spatial_rounds", "2"),
+                ("radius", "10"),
+            ],
+        ),
+    ];
     for name in ["cornell-box.xml", "many-lights.ron"] {
         let scene = load(name);
-        let integrator = make_integrator(&scene, &IntegratorOptions::default())
-            .unwrap()
-            .integrator;
+        for (label, kind, params) in configs {
+            let options = IntegratorOptions {
+                name: Some(kind.into()),
+                max_depth: None,
+                params: params
+                    .iter()
+                    .map(|(k, v)| (k.to_string(), v.to_string()))
+                    .collect(),
+            };
+            let integrator = make_integrator(&scene, &options).unwrap().integrator;
+            bench_rows(&scene, name, label, integrator.as_ref(), budget, all);
+        }
+    }
+}
+
+/// A row label, an integrator name and its parameters.
+type Config = (
+    &'static str,
+    &'static str,
+    &'static [(&'static str, &'static str)],
+);
+
+fn bench_rows(
+    scene: &Scene,
+    name: &str,
+    label: &str,
+    integrator: &dyn Integrator,
+    budget: f64,
+    all: usize,
+) {
+    {
         for threads in [all, 1] {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
                 .unwrap();
-            let m = pool.install(|| measure(&scene, integrator.as_ref(), budget));
+            let m = pool.install(|| measure(scene, integrator, budget));
             println!(
-                "{:<18} {:>7} {:>9} {:>10.2} {:>10.2} {:>10.2} {:>8}",
+                "{:<18} {:<22} {:>7} {:>9} {:>10.2} {:>10.2} {:>10.2} {:>8}",
                 name,
+                label,
                 threads,
                 scene.integrator.max_depth,
                 m.median_seconds * 1e3,

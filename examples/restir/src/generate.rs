@@ -2,8 +2,13 @@
 //!
 //! `many-lights` is the direct-lighting test scene for ReSTIR DI: a floor with diffuse boxes and
 //! pillars (for shadow edges), lit only by many small emissive spheres whose radiance is
-//! log-uniform over three orders of magnitude, in varied colours. The same seed always writes the
-//! same file.
+//! log-uniform over three orders of magnitude, tinted warm to cool white like lamps. The same seed
+//! always writes the same file.
+//!
+//! The emitters themselves are hidden from the camera (`hide_emitters`): each bulb covers about a
+//! pixel, and the noise of its silhouette comes from jittering the camera ray, not from light
+//! sampling. Every estimator pays it equally per pass, so leaving it in would measure camera
+//! sampling rather than the direct-lighting estimators this scene compares.
 
 use std::path::PathBuf;
 
@@ -63,7 +68,9 @@ const EXTENT: f32 = 6.0;
 /// Sphere light radii are uniform in this range.
 const RADIUS: (f32, f32) = (0.03, 0.06);
 /// Light centres lie between these heights.
-const HEIGHT: (f32, f32) = (0.1, 1.5);
+const HEIGHT: (f32, f32) = (0.2, 2.0);
+/// Largest saturation of a light's tint (0 is white).
+const TINT: f32 = 0.35;
 /// The dimmest radiance (luminance-ish scale) for the default 400 lights; the brightest is 1000×.
 const BASE_RADIANCE: f32 = 0.1;
 
@@ -77,7 +84,7 @@ fn uniform(rng: &mut Pcg32, lo: f32, hi: f32) -> f32 {
     lo + (hi - lo) * rng.next_f32()
 }
 
-/// A saturated-to-pastel colour with maximum component 1 from a hue in `[0, 1)` and a saturation.
+/// A colour with maximum component 1 from a hue in `[0, 1)` and a saturation (0 is white).
 fn hue_colour(h: f32, s: f32) -> [f32; 3] {
     let channel = |offset: f32| {
         let x = (h + offset).fract() * 6.0;
@@ -214,7 +221,7 @@ pub fn many_lights(lights: u32, seed: u64) -> SceneDesc {
         let z = uniform(&mut rng, -EXTENT, EXTENT);
         let y = uniform(&mut rng, HEIGHT.0, HEIGHT.1);
         let level = 10f32.powf(3.0 * rng.next_f32());
-        let colour = hue_colour(rng.next_f32(), uniform(&mut rng, 0.5, 1.0));
+        let colour = hue_colour(rng.next_f32(), uniform(&mut rng, 0.0, TINT));
         // Keep lights out of the occluders (with a margin of one radius).
         let inside = footprints.iter().any(|f| {
             (x - f.x).abs() < f.half + r && (z - f.z).abs() < f.half + r && y < f.height + r
@@ -257,6 +264,7 @@ pub fn many_lights(lights: u32, seed: u64) -> SceneDesc {
         spp: 64,
         integrator: IntegratorDesc {
             max_depth: 2,
+            hide_emitters: true,
             ..IntegratorDesc::default()
         },
         materials,

@@ -30,7 +30,7 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Render a scene (.xml in Mitsuba format, or .ron) to an image.
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// Compare a rendered EXR with a reference EXR: relMSE, MSE, mean ratio, non-finite pixels.
     Compare {
         /// The image to judge.
@@ -442,7 +442,7 @@ fn main() -> ExitCode {
         }
     };
     let result = match cli.command {
-        Command::Render(args) => run_render(args),
+        Command::Render(args) => run_render(*args),
         Command::Compare { test, reference } => run_compare(&test, &reference),
         Command::Generate(what) => generate::run(what),
     };

@@ -99,7 +99,7 @@ pub fn contact(scene: &Scene, sample: &LightPoint, x: Vec3) -> Option<Contact> {
             let ps = scene.shapes[shape as usize].position_at(sample.prim, sample.param);
             let to = ps.p - x;
             let d2 = to.length_squared();
-            if !(d2 > 0.0) {
+            if d2.is_nan() || d2 <= 0.0 {
                 return None;
             }
             let dist = d2.sqrt();
@@ -123,7 +123,7 @@ pub fn contact(scene: &Scene, sample: &LightPoint, x: Vec3) -> Option<Contact> {
         } => {
             let to = position - x;
             let d2 = to.length_squared();
-            if !(d2 > 0.0) {
+            if d2.is_nan() || d2 <= 0.0 {
                 return None;
             }
             let dist = d2.sqrt();
