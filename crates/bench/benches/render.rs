@@ -78,9 +78,7 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(3.0);
     let all = rayon::current_num_threads();
-    println!(
-        "path tracer, one pass at {SIZE}×{SIZE}, ~{budget} s per row (RESTIR_BENCH_SECONDS)"
-    );
+    println!("path tracer, one pass at {SIZE}×{SIZE}, ~{budget} s per row (RESTIR_BENCH_SECONDS)");
     println!(
         "{:<18} {:>7} {:>9} {:>10} {:>10} {:>10} {:>8}",
         "scene", "threads", "max_depth", "ms/pass", "passes/s", "Mrays/s", "passes"

@@ -9,7 +9,9 @@ use restir_integrators::{Image, RenderOutput, RenderSettings, make_integrator, r
 use restir_scene::{Scene, load_desc};
 
 fn scene_path(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name)
 }
 
 /// Loads a shipped scene at `size`×`size` pixels.

@@ -51,10 +51,17 @@ fn restir(args: &[&str]) -> Output {
 fn fails(args: &[&str], needles: &[&str]) -> String {
     let out = restir(args);
     let stderr = String::from_utf8_lossy(&out.stderr).to_string();
-    assert!(!stderr.contains("panicked"), "{args:?}: panicked:\n{stderr}");
+    assert!(
+        !stderr.contains("panicked"),
+        "{args:?}: panicked:\n{stderr}"
+    );
     assert_eq!(out.status.code(), Some(1), "{args:?}: stderr:\n{stderr}");
     let lines: Vec<&str> = stderr.lines().collect();
-    assert_eq!(lines.len(), 1, "{args:?}: expected one line, got:\n{stderr}");
+    assert_eq!(
+        lines.len(),
+        1,
+        "{args:?}: expected one line, got:\n{stderr}"
+    );
     for n in needles {
         assert!(lines[0].contains(n), "{args:?}: {:?} lacks {n:?}", lines[0]);
     }
