@@ -90,78 +90,139 @@ pub struct Contact {
     pub ng: Vec3,
 }
 
-/// Where `sample` lies as seen from `x`, or `None` if it cannot contribute there (behind a
-/// one-sided emitter, at zero distance).
+/// A sample resolved in world space, independent of any receiver: resolving once and
+/// evaluating at several receivers (as spatial reuse does) saves the surface lookup.
+#[derive(Clone, Copy, Debug)]
+pub enum Resolved {
+    /// A point on an area light.
+    Surface {
+        /// Position.
+        p: Vec3,
+        /// Shading normal (one-sided emission is judged against it).
+        n: Vec3,
+        /// Geometric normal (for the area-measure factor and the light pdf).
+        ng: Vec3,
+        /// Emitted radiance.
+        le: Vec3,
+    },
+    /// A point light.
+    Point {
+        /// Position.
+        p: Vec3,
+        /// Radiant intensity.
+        intensity: Vec3,
+    },
+    /// A light at infinity seen in direction `wi` (towards the light).
+    Direction {
+        /// Unit direction towards the light.
+        wi: Vec3,
+        /// Radiance (environment) or irradiance (directional light).
+        le: Vec3,
+        /// Whether the light is a delta light (directional).
+        delta: bool,
+    },
+}
+
+/// Resolves `sample` in world space.
 #[inline]
-pub fn contact(scene: &Scene, sample: &LightPoint, x: Vec3) -> Option<Contact> {
+pub fn resolve(scene: &Scene, sample: &LightPoint) -> Resolved {
     match scene.lights.lights()[sample.light as usize] {
         Light::Area { shape, radiance } => {
             let ps = scene.shapes[shape as usize].position_at(sample.prim, sample.param);
-            let to = ps.p - x;
-            let d2 = to.length_squared();
-            if d2.is_nan() || d2 <= 0.0 {
-                return None;
-            }
-            let dist = d2.sqrt();
-            let wi = to / dist;
-            if ps.n.dot(wi) >= 0.0 {
-                return None; // the back of a one-sided emitter
-            }
-            Some(Contact {
-                wi,
+            Resolved::Surface {
                 p: ps.p,
-                dist,
-                le: radiance,
-                measure: ps.ng.dot(wi).abs() / d2,
-                delta: false,
+                n: ps.n,
                 ng: ps.ng,
-            })
+                le: radiance,
+            }
         }
         Light::Point {
             position,
             intensity,
-        } => {
-            let to = position - x;
-            let d2 = to.length_squared();
-            if d2.is_nan() || d2 <= 0.0 {
-                return None;
-            }
-            let dist = d2.sqrt();
-            Some(Contact {
-                wi: to / dist,
-                p: position,
-                dist,
-                le: intensity / d2,
-                measure: 1.0,
-                delta: true,
-                ng: Vec3::ZERO,
-            })
-        }
+        } => Resolved::Point {
+            p: position,
+            intensity,
+        },
         Light::Directional {
             direction,
             irradiance,
-        } => Some(Contact {
+        } => Resolved::Direction {
             wi: -direction,
-            p: x - direction,
-            dist: f32::INFINITY,
             le: irradiance,
-            measure: 1.0,
             delta: true,
-            ng: direction,
-        }),
+        },
         Light::Constant { .. } => {
             let (_, wi) = Sphere::new(Vec3::ZERO, 1.0, false).point_at(sample.param);
-            Some(Contact {
+            Resolved::Direction {
+                wi,
+                le: scene.lights.environment_radiance(wi),
+                delta: false,
+            }
+        }
+    }
+}
+
+impl Resolved {
+    /// The sample as seen from `x`, or `None` if it cannot contribute there (behind a one-sided
+    /// emitter, at zero distance).
+    #[inline]
+    pub fn contact(&self, x: Vec3) -> Option<Contact> {
+        match *self {
+            Resolved::Surface { p, n, ng, le } => {
+                let to = p - x;
+                let d2 = to.length_squared();
+                if d2.is_nan() || d2 <= 0.0 {
+                    return None;
+                }
+                let dist = d2.sqrt();
+                let wi = to / dist;
+                if n.dot(wi) >= 0.0 {
+                    return None; // the back of a one-sided emitter
+                }
+                Some(Contact {
+                    wi,
+                    p,
+                    dist,
+                    le,
+                    measure: ng.dot(wi).abs() / d2,
+                    delta: false,
+                    ng,
+                })
+            }
+            Resolved::Point { p, intensity } => {
+                let to = p - x;
+                let d2 = to.length_squared();
+                if d2.is_nan() || d2 <= 0.0 {
+                    return None;
+                }
+                let dist = d2.sqrt();
+                Some(Contact {
+                    wi: to / dist,
+                    p,
+                    dist,
+                    le: intensity / d2,
+                    measure: 1.0,
+                    delta: true,
+                    ng: Vec3::ZERO,
+                })
+            }
+            Resolved::Direction { wi, le, delta } => Some(Contact {
                 wi,
                 p: x + wi,
                 dist: f32::INFINITY,
-                le: scene.lights.environment_radiance(wi),
+                le,
                 measure: 1.0,
-                delta: false,
+                delta,
                 ng: -wi,
-            })
+            }),
         }
     }
+}
+
+/// Where `sample` lies as seen from `x` ([`resolve`] then [`Resolved::contact`]).
+#[inline]
+pub fn contact(scene: &Scene, sample: &LightPoint, x: Vec3) -> Option<Contact> {
+    resolve(scene, sample).contact(x)
 }
 
 /// The two strategy counts of the direct-light split.
@@ -241,8 +302,17 @@ pub fn evaluate(
     }
 }
 
-/// The target `p̂` of receiver `r` at `sample` (0 where it cannot contribute).
+/// The target `p̂` of receiver `r` at `sample`, resolved as `resolved` (0 where it cannot
+/// contribute).
 #[inline]
-pub fn target(scene: &Scene, r: &Receiver, sample: &LightPoint, counts: StrategyCounts) -> f32 {
-    contact(scene, sample, r.p).map_or(0.0, |c| evaluate(scene, r, sample, &c, None, counts).target)
+pub fn target(
+    scene: &Scene,
+    r: &Receiver,
+    sample: &LightPoint,
+    resolved: &Resolved,
+    counts: StrategyCounts,
+) -> f32 {
+    resolved
+        .contact(r.p)
+        .map_or(0.0, |c| evaluate(scene, r, sample, &c, None, counts).target)
 }

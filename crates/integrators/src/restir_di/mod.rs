@@ -35,7 +35,7 @@ pub use settings::{MIS_NAMES, RestirDiSettings, mis_name};
 use crate::gbuffer::{GBuffer, Receiver};
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
 use crate::render::{BAND_ROWS, Integrator, PassContext};
-use light_point::{Contact, LightPoint, StrategyCounts, contact, evaluate, target};
+use light_point::{Contact, LightPoint, Resolved, StrategyCounts, contact, evaluate, resolve, target};
 
 /// Random-stream stages (see [`PassContext::stage_rng`]).
 const STAGE_INITIAL: u64 = 1;
@@ -43,7 +43,8 @@ const STAGE_TEMPORAL: u64 = 2;
 const STAGE_SHADE: u64 = 3;
 const STAGE_SPATIAL: u64 = 16;
 
-/// Points of the neighbour pattern (R2 sequence inside the unit disk).
+/// Points of the neighbour pattern (R2 sequence inside the unit disk); a power of two, so that
+/// indices wrap with a mask.
 const OFFSET_COUNT: usize = 8192;
 
 /// The reservoir type: 16-byte sample, `W`, `M`, `p̂`.
@@ -66,25 +67,41 @@ pub struct RestirDiIntegrator {
 }
 
 /// The identity shift between pixels: the sample stays on the light, `J = 1`; only the target
-/// changes.
+/// changes. It keeps the receiving pixel's own sample resolved, because pairwise MIS evaluates
+/// that sample at every neighbour.
 struct DiShift<'a> {
     scene: &'a Scene,
     counts: StrategyCounts,
+    canonical: Option<(LightPoint, Resolved)>,
+}
+
+impl<'a> DiShift<'a> {
+    fn new(scene: &'a Scene, counts: StrategyCounts, canonical: &DiReservoir) -> Self {
+        Self {
+            scene,
+            counts,
+            canonical: canonical.sample.map(|x| (x, resolve(scene, &x))),
+        }
+    }
+
+    #[inline]
+    fn resolved(&self, x: &LightPoint) -> Resolved {
+        match &self.canonical {
+            Some((y, r)) if y == x => *r,
+            _ => resolve(self.scene, x),
+        }
+    }
 }
 
 impl ShiftMap<LightPoint> for DiShift<'_> {
     type Domain = Receiver;
 
     #[inline]
-    fn shift(
-        &self,
-        _from: &Receiver,
-        to: &Receiver,
-        x: &LightPoint,
-    ) -> Option<Shifted<LightPoint>> {
+    fn shift(&self, _from: &Receiver, to: &Receiver, x: &LightPoint) -> Option<Shifted<LightPoint>> {
+        let resolved = self.resolved(x);
         Some(Shifted::identity(
             *x,
-            target(self.scene, to, x, self.counts),
+            target(self.scene, to, x, &resolved, self.counts),
         ))
     }
 }
@@ -187,14 +204,14 @@ impl RestirDiIntegrator {
     /// `k` similar neighbours.
     #[allow(clippy::too_many_arguments)]
     #[inline(never)]
-    fn spatial(
+    fn spatial<'a>(
         &self,
-        shift: &DiShift,
-        gbuf: &GBuffer,
-        input: &[DiReservoir],
+        scene: &Scene,
+        gbuf: &'a GBuffer,
+        input: &'a [DiReservoir],
         index: usize,
         rng: &mut Pcg32,
-        neighbors: &mut Vec<(usize, DiReservoir)>,
+        neighbors: &mut Vec<(&'a Receiver, &'a DiReservoir)>,
     ) -> DiReservoir {
         let canonical = &input[index];
         let Some(r) = &gbuf.receivers[index] else {
@@ -204,14 +221,15 @@ impl RestirDiIntegrator {
         let (x, y) = ((index as i64) % w, (index as i64) / w);
         let k = self.settings.neighbors as usize;
         neighbors.clear();
-        let start = rng.next_bounded(self.offsets.len() as u32) as usize;
+        let mask = self.offsets.len() - 1; // a power of two
+        let start = rng.next_u32() as usize;
         let radius = self.settings.radius;
         for attempt in 0..2 * k {
             if neighbors.len() == k {
                 break;
             }
-            let o = self.offsets[(start + attempt) % self.offsets.len()] * radius;
-            let (nx, ny) = (x + o.x.round() as i64, y + o.y.round() as i64);
+            let o = self.offsets[(start + attempt) & mask] * radius;
+            let (nx, ny) = (x + round(o.x), y + round(o.y));
             if nx < 0 || ny < 0 || nx >= w || ny >= h || (nx == x && ny == y) {
                 continue;
             }
@@ -219,14 +237,11 @@ impl RestirDiIntegrator {
             if let Some(rq) = &gbuf.receivers[q]
                 && r.is_similar(rq, self.settings.normal_cos, self.settings.depth_tolerance)
             {
-                neighbors.push((q, input[q]));
+                neighbors.push((rq, &input[q]));
             }
         }
-        let domains: Vec<(&Receiver, &DiReservoir)> = neighbors
-            .iter()
-            .map(|(q, res)| (gbuf.receivers[*q].as_ref().expect("checked above"), res))
-            .collect();
-        resample(shift, self.settings.mis, r, canonical, &domains, || {
+        let shift = DiShift::new(scene, self.counts, canonical);
+        resample(&shift, self.settings.mis, r, canonical, neighbors, || {
             rng.next_f32()
         })
         .with_confidence_cap(self.settings.mcap)
@@ -316,6 +331,12 @@ impl RestirDiIntegrator {
     }
 }
 
+/// Nearest integer (half away from zero) without a libm call.
+#[inline]
+fn round(v: f32) -> i64 {
+    (v + 0.5f32.copysign(v)) as i64
+}
+
 /// Whether the light point `c` is visible from receiver `r` (one shadow ray).
 #[inline]
 fn visible(scene: &Scene, r: &Receiver, c: &Contact) -> bool {
@@ -368,10 +389,6 @@ impl Integrator for RestirDiIntegrator {
             GBuffer::trace(scene, ctx, s.path.hide_emitters, keep, &mut radiance);
         let w = gbuf.width;
         if keep {
-            let shift = DiShift {
-                scene,
-                counts: self.counts,
-            };
             // Initial resampling.
             let mut current = vec![DiReservoir::empty(); n];
             rays += current
@@ -424,6 +441,7 @@ impl Integrator for RestirDiIntegrator {
                             }
                             let prev = hist.reservoirs[index].with_confidence_cap(s.mcap);
                             let mut rng = ctx.stage_rng(index, STAGE_TEMPORAL);
+                            let shift = DiShift::new(scene, self.counts, res);
                             *res =
                                 resample(&shift, temporal_mis, r, res, &[(prev_r, &prev)], || {
                                     rng.next_f32()
@@ -447,7 +465,7 @@ impl Integrator for RestirDiIntegrator {
                                 let mut rng =
                                     ctx.stage_rng(index, STAGE_SPATIAL + u64::from(round));
                                 *res = self.spatial(
-                                    &shift,
+                                    scene,
                                     &gbuf,
                                     input,
                                     index,
