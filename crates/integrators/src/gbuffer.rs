@@ -9,53 +9,88 @@ use restir_scene::Scene;
 
 use crate::render::{BAND_ROWS, PassContext};
 
-/// What a reuse pass needs to know about a pixel's primary hit: the shading point, its material,
-/// the direction to the camera, and what the neighbour-similarity tests compare.
+/// What a reuse pass needs to know about a pixel's primary hit to evaluate a target there: the
+/// shading point, its frame, its material and the direction to the camera. 64 bytes, one cache
+/// line: spatial reuse reads it at random neighbours.
 #[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
 pub struct Receiver {
     /// Hit position.
     pub p: Vec3,
-    /// Geometric normal (for ray offsets).
-    pub ng: Vec3,
     /// Shading frame.
     pub frame: Frame,
     /// Direction towards the camera in the shading frame.
     pub wo: Vec3,
-    /// Index of the BSDF in `Scene::bsdfs`.
+    /// Index of the BSDF in `Scene::bsdfs`, or [`Receiver::NO_HIT`].
     pub bsdf: u32,
-    /// Distance from the camera.
-    pub depth: f32,
 }
 
 impl Receiver {
+    /// `bsdf` of a pixel without a primary hit.
+    pub const NO_HIT: u32 = u32::MAX;
+
+    const EMPTY: Self = Self {
+        p: Vec3::ZERO,
+        frame: Frame {
+            s: Vec3::X,
+            t: Vec3::Y,
+            n: Vec3::Z,
+        },
+        wo: Vec3::Z,
+        bsdf: Self::NO_HIT,
+    };
+}
+
+/// What the neighbour-similarity tests compare (16 bytes, kept apart from [`Receiver`] so that
+/// rejecting a neighbour touches little memory).
+#[derive(Clone, Copy, Debug)]
+pub struct SimilarityKey {
+    /// Shading normal.
+    pub n: Vec3,
+    /// Distance from the camera (0 without a hit).
+    pub depth: f32,
+}
+
+impl SimilarityKey {
     /// Whether `other` is similar enough to be a reuse neighbour: shading normals within
     /// `normal_cos` (cosine of the largest angle) and camera distances within a relative
     /// `depth_tolerance` (ALGORITHMS.md §2.4). These tests only pick participating domains;
     /// the estimators stay unbiased whatever they decide.
     #[inline]
-    pub fn is_similar(&self, other: &Receiver, normal_cos: f32, depth_tolerance: f32) -> bool {
-        self.frame.n.dot(other.frame.n) >= normal_cos
+    pub fn is_similar(&self, other: &SimilarityKey, normal_cos: f32, depth_tolerance: f32) -> bool {
+        self.n.dot(other.n) >= normal_cos
             && (self.depth - other.depth).abs() <= depth_tolerance * self.depth.max(other.depth)
     }
 }
 
-/// One pass's primary hits.
+/// One pass's primary hits, one entry per pixel (row-major) in each array.
 #[derive(Clone, Debug, Default)]
 pub struct GBuffer {
     /// Width in pixels.
     pub width: usize,
     /// Height in pixels.
     pub height: usize,
-    /// Per pixel (row-major), the primary hit, or `None` where the camera ray left the scene or
-    /// the path ends there.
-    pub receivers: Vec<Option<Receiver>>,
+    /// The shading data of each primary hit ([`Receiver::NO_HIT`] where the camera ray left the
+    /// scene or the path ends there).
+    pub receivers: Vec<Receiver>,
+    /// The similarity keys.
+    pub keys: Vec<SimilarityKey>,
+    /// Geometric normals (for ray offsets at shading).
+    pub ng: Vec<Vec3>,
 }
 
 impl GBuffer {
+    /// The primary hit of pixel `index`, if there is one.
+    #[inline]
+    pub fn receiver(&self, index: usize) -> Option<&Receiver> {
+        let r = &self.receivers[index];
+        (r.bsdf != Receiver::NO_HIT).then_some(r)
+    }
+
     /// Traces the camera rays of pass `ctx`. Adds what the camera sees directly (emitters and
     /// the environment, unless `hide_emitters`) to `radiance`, which must have one entry per
-    /// pixel. With `keep_hits = false` (`max_depth ≤ 1`) no receivers are stored. Returns the
-    /// buffer and the number of rays traced.
+    /// pixel. With `keep_hits = false` (`max_depth ≤ 1`) no hits are stored. Returns the buffer
+    /// and the number of rays traced.
     pub fn trace(
         scene: &Scene,
         ctx: &PassContext,
@@ -65,14 +100,24 @@ impl GBuffer {
     ) -> (Self, u64) {
         let (w, h) = scene.camera.resolution();
         let (w, h) = (w as usize, h as usize);
-        let mut receivers = vec![None; w * h];
+        let mut receivers = vec![Receiver::EMPTY; w * h];
+        let mut keys = vec![
+            SimilarityKey {
+                n: Vec3::ZERO,
+                depth: 0.0
+            };
+            w * h
+        ];
+        let mut ng = vec![Vec3::ZERO; w * h];
         let lights = &scene.lights;
         let rays = receivers
             .par_chunks_mut(w * BAND_ROWS)
+            .zip(keys.par_chunks_mut(w * BAND_ROWS))
+            .zip(ng.par_chunks_mut(w * BAND_ROWS))
             .zip(radiance.par_chunks_mut(w * BAND_ROWS))
             .enumerate()
-            .map(|(band, (recv, rad))| {
-                for (i, (r, l)) in recv.iter_mut().zip(rad.iter_mut()).enumerate() {
+            .map(|(band, (((recv, key), ngs), rad))| {
+                for (i, l) in rad.iter_mut().enumerate() {
                     let index = band * w * BAND_ROWS + i;
                     let (x, y) = ((index % w) as u32, (index / w) as u32);
                     let mut rng = ctx.pixel_rng(index);
@@ -88,17 +133,20 @@ impl GBuffer {
                         *l += lights.area_radiance(light, si.shading.n, -ray.d);
                     }
                     if keep_hits {
-                        *r = Some(Receiver {
+                        recv[i] = Receiver {
                             p: si.p,
-                            ng: si.ng,
                             frame: si.shading,
                             wo: si.shading.to_local(-ray.d),
                             bsdf: scene.shape_bsdf[si.shape as usize],
+                        };
+                        key[i] = SimilarityKey {
+                            n: si.shading.n,
                             depth: si.t,
-                        });
+                        };
+                        ngs[i] = si.ng;
                     }
                 }
-                recv.len() as u64
+                rad.len() as u64
             })
             .sum();
         (
@@ -106,6 +154,8 @@ impl GBuffer {
                 width: w,
                 height: h,
                 receivers,
+                keys,
+                ng,
             },
             rays,
         )

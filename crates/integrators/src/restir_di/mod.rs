@@ -35,7 +35,9 @@ pub use settings::{MIS_NAMES, RestirDiSettings, mis_name};
 use crate::gbuffer::{GBuffer, Receiver};
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
 use crate::render::{BAND_ROWS, Integrator, PassContext};
-use light_point::{Contact, LightPoint, Resolved, StrategyCounts, contact, evaluate, resolve, target};
+use light_point::{
+    Contact, LightPoint, Resolved, StrategyCounts, contact, evaluate, resolve, target,
+};
 
 /// Random-stream stages (see [`PassContext::stage_rng`]).
 const STAGE_INITIAL: u64 = 1;
@@ -97,7 +99,12 @@ impl ShiftMap<LightPoint> for DiShift<'_> {
     type Domain = Receiver;
 
     #[inline]
-    fn shift(&self, _from: &Receiver, to: &Receiver, x: &LightPoint) -> Option<Shifted<LightPoint>> {
+    fn shift(
+        &self,
+        _from: &Receiver,
+        to: &Receiver,
+        x: &LightPoint,
+    ) -> Option<Shifted<LightPoint>> {
         let resolved = self.resolved(x);
         Some(Shifted::identity(
             *x,
@@ -140,7 +147,13 @@ impl RestirDiIntegrator {
 
     /// Initial resampling at receiver `r`. Returns the reservoir and the rays traced.
     #[inline(never)]
-    fn initial(&self, scene: &Scene, r: &Receiver, rng: &mut Pcg32) -> (DiReservoir, u64) {
+    fn initial(
+        &self,
+        scene: &Scene,
+        r: &Receiver,
+        ng: Vec3,
+        rng: &mut Pcg32,
+    ) -> (DiReservoir, u64) {
         let bsdf = &scene.bsdfs[r.bsdf as usize];
         if !bsdf.has_smooth_lobe() || scene.lights.is_empty() {
             return (
@@ -189,7 +202,7 @@ impl RestirDiIntegrator {
         {
             let visible = contact(scene, &y, r.p).is_some_and(|c| {
                 rays += 1;
-                visible(scene, r, &c)
+                visible(scene, r, ng, &c)
             });
             if !visible {
                 res.sample = None;
@@ -214,9 +227,10 @@ impl RestirDiIntegrator {
         neighbors: &mut Vec<(&'a Receiver, &'a DiReservoir)>,
     ) -> DiReservoir {
         let canonical = &input[index];
-        let Some(r) = &gbuf.receivers[index] else {
+        let Some(r) = gbuf.receiver(index) else {
             return *canonical;
         };
+        let key = &gbuf.keys[index];
         let (w, h) = (gbuf.width as i64, gbuf.height as i64);
         let (x, y) = ((index as i64) % w, (index as i64) / w);
         let k = self.settings.neighbors as usize;
@@ -234,8 +248,11 @@ impl RestirDiIntegrator {
                 continue;
             }
             let q = (ny * w + nx) as usize;
-            if let Some(rq) = &gbuf.receivers[q]
-                && r.is_similar(rq, self.settings.normal_cos, self.settings.depth_tolerance)
+            if key.is_similar(
+                &gbuf.keys[q],
+                self.settings.normal_cos,
+                self.settings.depth_tolerance,
+            ) && let Some(rq) = gbuf.receiver(q)
             {
                 neighbors.push((rq, &input[q]));
             }
@@ -253,6 +270,7 @@ impl RestirDiIntegrator {
         &self,
         scene: &Scene,
         r: &Receiver,
+        ng: Vec3,
         res: &DiReservoir,
         rng: &mut Pcg32,
     ) -> (Vec3, u64) {
@@ -264,7 +282,7 @@ impl RestirDiIntegrator {
             let e = evaluate(scene, r, y, &c, None, self.counts);
             if e.target > 0.0 {
                 rays += 1;
-                if visible(scene, r, &c) {
+                if visible(scene, r, ng, &c) {
                     l += e.contribution * res.ucw;
                 }
             }
@@ -302,7 +320,7 @@ impl RestirDiIntegrator {
             }
             let mut beta = bs.f / bs.pdf_sa;
             let d = r.frame.to_world(bs.wi);
-            let ray = Ray::new(offset_ray_origin(r.p, r.ng, d), d);
+            let ray = Ray::new(offset_ray_origin(r.p, ng, d), d);
             let prev = PrevVertex {
                 p: r.p,
                 pdf_sa: bs.pdf_sa,
@@ -339,11 +357,11 @@ fn round(v: f32) -> i64 {
 
 /// Whether the light point `c` is visible from receiver `r` (one shadow ray).
 #[inline]
-fn visible(scene: &Scene, r: &Receiver, c: &Contact) -> bool {
+fn visible(scene: &Scene, r: &Receiver, ng: Vec3, c: &Contact) -> bool {
     let (ray, t_max) = if c.dist.is_finite() {
-        shadow_ray_between(r.p, r.ng, c.p)
+        shadow_ray_between(r.p, ng, c.p)
     } else {
-        shadow_ray_towards(r.p, r.ng, c.wi, f32::INFINITY)
+        shadow_ray_towards(r.p, ng, c.wi, f32::INFINITY)
     };
     !scene.occluded(&ray, t_max)
 }
@@ -375,9 +393,10 @@ impl Integrator for RestirDiIntegrator {
     fn buffer_bytes_per_pixel(&self) -> usize {
         let reservoirs = if self.settings.temporal { 3 } else { 2 };
         let hits = if self.settings.temporal { 2 } else { 1 };
-        reservoirs * Self::RESERVOIR_BYTES
-            + hits * std::mem::size_of::<Option<Receiver>>()
-            + std::mem::size_of::<Vec3>()
+        let hit_bytes = std::mem::size_of::<Receiver>()
+            + std::mem::size_of::<crate::gbuffer::SimilarityKey>()
+            + std::mem::size_of::<Vec3>();
+        reservoirs * Self::RESERVOIR_BYTES + hits * hit_bytes + std::mem::size_of::<Vec3>()
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
@@ -398,9 +417,9 @@ impl Integrator for RestirDiIntegrator {
                     let mut rays = 0;
                     for (i, res) in out.iter_mut().enumerate() {
                         let index = band * w * BAND_ROWS + i;
-                        if let Some(r) = &gbuf.receivers[index] {
+                        if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
-                            let (init, nr) = self.initial(scene, r, &mut rng);
+                            let (init, nr) = self.initial(scene, r, gbuf.ng[index], &mut rng);
                             *res = init;
                             rays += nr;
                         }
@@ -432,11 +451,15 @@ impl Integrator for RestirDiIntegrator {
                         for (i, res) in out.iter_mut().enumerate() {
                             let index = band * w * BAND_ROWS + i;
                             let (Some(r), Some(prev_r)) =
-                                (&gbuf.receivers[index], &hist.gbuffer.receivers[index])
+                                (gbuf.receiver(index), hist.gbuffer.receiver(index))
                             else {
                                 continue;
                             };
-                            if !r.is_similar(prev_r, s.normal_cos, s.depth_tolerance) {
+                            if !gbuf.keys[index].is_similar(
+                                &hist.gbuffer.keys[index],
+                                s.normal_cos,
+                                s.depth_tolerance,
+                            ) {
                                 continue;
                             }
                             let prev = hist.reservoirs[index].with_confidence_cap(s.mcap);
@@ -486,9 +509,10 @@ impl Integrator for RestirDiIntegrator {
                     let mut rays = 0;
                     for (i, l) in out.iter_mut().enumerate() {
                         let index = band * w * BAND_ROWS + i;
-                        if let Some(r) = &gbuf.receivers[index] {
+                        if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_SHADE);
-                            let (li, nr) = self.shade(scene, r, &current[index], &mut rng);
+                            let ng = gbuf.ng[index];
+                            let (li, nr) = self.shade(scene, r, ng, &current[index], &mut rng);
                             *l += li;
                             rays += nr;
                         }
