@@ -9,20 +9,25 @@ use restir_scene::Scene;
 
 use crate::render::{BAND_ROWS, PassContext};
 
-/// What a reuse pass needs to know about a pixel's primary hit to evaluate a target there: the
-/// shading point, its frame, its material and the direction to the camera. 64 bytes, one cache
-/// line: spatial reuse reads it at random neighbours.
+/// What a reuse pass needs to know about a pixel's primary hit: the shading point, its frame,
+/// its material, the direction to the camera and what the neighbour-similarity tests compare.
+/// One cache line (spatial reuse reads it at random neighbours); the second tangent of the
+/// shading frame is recomputed as `n × s`.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub struct Receiver {
     /// Hit position.
     pub p: Vec3,
-    /// Shading frame.
-    pub frame: Frame,
-    /// Direction towards the camera in the shading frame.
+    /// Shading normal.
+    pub n: Vec3,
+    /// First shading tangent.
+    pub s: Vec3,
+    /// Direction towards the camera in the shading frame [`Receiver::frame`].
     pub wo: Vec3,
     /// Index of the BSDF in `Scene::bsdfs`, or [`Receiver::NO_HIT`].
     pub bsdf: u32,
+    /// Distance from the camera.
+    pub depth: f32,
 }
 
 impl Receiver {
@@ -31,33 +36,44 @@ impl Receiver {
 
     const EMPTY: Self = Self {
         p: Vec3::ZERO,
-        frame: Frame {
-            s: Vec3::X,
-            t: Vec3::Y,
-            n: Vec3::Z,
-        },
+        n: Vec3::Z,
+        s: Vec3::X,
         wo: Vec3::Z,
         bsdf: Self::NO_HIT,
+        depth: 0.0,
     };
-}
 
-/// What the neighbour-similarity tests compare (16 bytes, kept apart from [`Receiver`] so that
-/// rejecting a neighbour touches little memory).
-#[derive(Clone, Copy, Debug)]
-pub struct SimilarityKey {
-    /// Shading normal.
-    pub n: Vec3,
-    /// Distance from the camera (0 without a hit).
-    pub depth: f32,
-}
+    /// A receiver at a surface point with shading frame `(s, ·, n)`, seen from direction
+    /// `to_camera` (world space, unit) at distance `depth`.
+    pub fn new(p: Vec3, frame: &Frame, to_camera: Vec3, bsdf: u32, depth: f32) -> Self {
+        let mut r = Self {
+            p,
+            n: frame.n,
+            s: frame.s,
+            wo: Vec3::Z,
+            bsdf,
+            depth,
+        };
+        r.wo = r.frame().to_local(to_camera);
+        r
+    }
 
-impl SimilarityKey {
+    /// The shading frame.
+    #[inline]
+    pub fn frame(&self) -> Frame {
+        Frame {
+            s: self.s,
+            t: self.n.cross(self.s),
+            n: self.n,
+        }
+    }
+
     /// Whether `other` is similar enough to be a reuse neighbour: shading normals within
     /// `normal_cos` (cosine of the largest angle) and camera distances within a relative
     /// `depth_tolerance` (ALGORITHMS.md §2.4). These tests only pick participating domains;
     /// the estimators stay unbiased whatever they decide.
     #[inline]
-    pub fn is_similar(&self, other: &SimilarityKey, normal_cos: f32, depth_tolerance: f32) -> bool {
+    pub fn is_similar(&self, other: &Receiver, normal_cos: f32, depth_tolerance: f32) -> bool {
         self.n.dot(other.n) >= normal_cos
             && (self.depth - other.depth).abs() <= depth_tolerance * self.depth.max(other.depth)
     }
@@ -73,8 +89,6 @@ pub struct GBuffer {
     /// The shading data of each primary hit ([`Receiver::NO_HIT`] where the camera ray left the
     /// scene or the path ends there).
     pub receivers: Vec<Receiver>,
-    /// The similarity keys.
-    pub keys: Vec<SimilarityKey>,
     /// Geometric normals (for ray offsets at shading).
     pub ng: Vec<Vec3>,
 }
@@ -101,22 +115,14 @@ impl GBuffer {
         let (w, h) = scene.camera.resolution();
         let (w, h) = (w as usize, h as usize);
         let mut receivers = vec![Receiver::EMPTY; w * h];
-        let mut keys = vec![
-            SimilarityKey {
-                n: Vec3::ZERO,
-                depth: 0.0
-            };
-            w * h
-        ];
         let mut ng = vec![Vec3::ZERO; w * h];
         let lights = &scene.lights;
         let rays = receivers
             .par_chunks_mut(w * BAND_ROWS)
-            .zip(keys.par_chunks_mut(w * BAND_ROWS))
             .zip(ng.par_chunks_mut(w * BAND_ROWS))
             .zip(radiance.par_chunks_mut(w * BAND_ROWS))
             .enumerate()
-            .map(|(band, (((recv, key), ngs), rad))| {
+            .map(|(band, ((recv, ngs), rad))| {
                 for (i, l) in rad.iter_mut().enumerate() {
                     let index = band * w * BAND_ROWS + i;
                     let (x, y) = ((index % w) as u32, (index / w) as u32);
@@ -133,16 +139,13 @@ impl GBuffer {
                         *l += lights.area_radiance(light, si.shading.n, -ray.d);
                     }
                     if keep_hits {
-                        recv[i] = Receiver {
-                            p: si.p,
-                            frame: si.shading,
-                            wo: si.shading.to_local(-ray.d),
-                            bsdf: scene.shape_bsdf[si.shape as usize],
-                        };
-                        key[i] = SimilarityKey {
-                            n: si.shading.n,
-                            depth: si.t,
-                        };
+                        recv[i] = Receiver::new(
+                            si.p,
+                            &si.shading,
+                            -ray.d,
+                            scene.shape_bsdf[si.shape as usize],
+                            si.t,
+                        );
                         ngs[i] = si.ng;
                     }
                 }
@@ -154,7 +157,6 @@ impl GBuffer {
                 width: w,
                 height: h,
                 receivers,
-                keys,
                 ng,
             },
             rays,

@@ -241,13 +241,18 @@ pub struct Evaluated {
     pub contribution: Vec3,
     /// `p̂(y) = lum(contribution)`.
     pub target: f32,
-    /// The light-sampling density at the receiver in the sample's measure (selection included).
-    pub light_pdf: f32,
+}
+
+impl Evaluated {
+    const ZERO: Self = Self {
+        contribution: Vec3::ZERO,
+        target: 0.0,
+    };
 }
 
 /// Evaluates `sample` at receiver `r` seen as `c` (from [`contact`]). `known_light_pdf_sa` is
 /// the light-sampling density at `r` if the caller has it (selection included; the pmf for
-/// delta lights); otherwise it is computed.
+/// delta lights); otherwise it is computed when the light/BSDF split needs it (`N_B > 0`).
 #[inline]
 pub fn evaluate(
     scene: &Scene,
@@ -258,30 +263,19 @@ pub fn evaluate(
     counts: StrategyCounts,
 ) -> Evaluated {
     let bsdf = &scene.bsdfs[r.bsdf as usize];
-    let wi = r.frame.to_local(c.wi);
+    let wi = r.frame().to_local(c.wi);
     let f = bsdf.eval(r.wo, wi);
-    let light_pdf_sa = match known_light_pdf_sa {
-        Some(p) => p,
-        None if c.delta => scene.lights.pmf(sample.light),
-        None => scene
-            .lights
-            .pdf_sa(&scene.shapes, sample.light, r.p, c.p, c.ng),
-    };
-    let light_pdf = if c.delta {
-        light_pdf_sa
-    } else {
-        light_pdf_sa * c.measure
-    };
     if f == Vec3::ZERO {
-        return Evaluated {
-            contribution: Vec3::ZERO,
-            target: 0.0,
-            light_pdf,
-        };
+        return Evaluated::ZERO;
     }
     let m_light = if c.delta || counts.bsdf == 0.0 {
         1.0
     } else {
+        let light_pdf_sa = known_light_pdf_sa.unwrap_or_else(|| {
+            scene
+                .lights
+                .pdf_sa(&scene.shapes, sample.light, r.p, c.p, c.ng)
+        });
         let nl = counts.light * light_pdf_sa;
         let nb = counts.bsdf * bsdf.pdf_sa(r.wo, wi);
         if nl > 0.0 { nl / (nl + nb) } else { 0.0 }
@@ -289,16 +283,11 @@ pub fn evaluate(
     let contribution = f * c.le * (c.measure * m_light);
     let target = luminance(contribution);
     if !(target > 0.0 && target.is_finite()) {
-        return Evaluated {
-            contribution: Vec3::ZERO,
-            target: 0.0,
-            light_pdf,
-        };
+        return Evaluated::ZERO;
     }
     Evaluated {
         contribution,
         target,
-        light_pdf,
     }
 }
 

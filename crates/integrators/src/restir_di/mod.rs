@@ -86,7 +86,7 @@ impl<'a> DiShift<'a> {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn resolved(&self, x: &LightPoint) -> Resolved {
         match &self.canonical {
             Some((y, r)) if y == x => *r,
@@ -98,7 +98,7 @@ impl<'a> DiShift<'a> {
 impl ShiftMap<LightPoint> for DiShift<'_> {
     type Domain = Receiver;
 
-    #[inline]
+    #[inline(always)]
     fn shift(
         &self,
         _from: &Receiver,
@@ -191,7 +191,13 @@ impl RestirDiIntegrator {
                 ng: ls.ng,
             };
             let e = evaluate(scene, r, &sample, &c, Some(ls.pdf_sa), self.counts);
-            let w = e.target / (nf * e.light_pdf);
+            // The source density in the sample's measure (the light sampler's is solid angle).
+            let light_pdf = if ls.delta {
+                ls.pdf_sa
+            } else {
+                ls.pdf_sa * measure
+            };
+            let w = e.target / (nf * light_pdf);
             stream.add_candidate(sample, e.target, w, 0.0, u_pick);
         }
         let mut res = stream.finalize_recorded();
@@ -230,7 +236,6 @@ impl RestirDiIntegrator {
         let Some(r) = gbuf.receiver(index) else {
             return *canonical;
         };
-        let key = &gbuf.keys[index];
         let (w, h) = (gbuf.width as i64, gbuf.height as i64);
         let (x, y) = ((index as i64) % w, (index as i64) / w);
         let k = self.settings.neighbors as usize;
@@ -248,11 +253,8 @@ impl RestirDiIntegrator {
                 continue;
             }
             let q = (ny * w + nx) as usize;
-            if key.is_similar(
-                &gbuf.keys[q],
-                self.settings.normal_cos,
-                self.settings.depth_tolerance,
-            ) && let Some(rq) = gbuf.receiver(q)
+            if let Some(rq) = gbuf.receiver(q)
+                && r.is_similar(rq, self.settings.normal_cos, self.settings.depth_tolerance)
             {
                 neighbors.push((rq, &input[q]));
             }
@@ -319,7 +321,7 @@ impl RestirDiIntegrator {
                 continue; // nothing this ray could add
             }
             let mut beta = bs.f / bs.pdf_sa;
-            let d = r.frame.to_world(bs.wi);
+            let d = r.frame().to_world(bs.wi);
             let ray = Ray::new(offset_ray_origin(r.p, ng, d), d);
             let prev = PrevVertex {
                 p: r.p,
@@ -393,9 +395,7 @@ impl Integrator for RestirDiIntegrator {
     fn buffer_bytes_per_pixel(&self) -> usize {
         let reservoirs = if self.settings.temporal { 3 } else { 2 };
         let hits = if self.settings.temporal { 2 } else { 1 };
-        let hit_bytes = std::mem::size_of::<Receiver>()
-            + std::mem::size_of::<crate::gbuffer::SimilarityKey>()
-            + std::mem::size_of::<Vec3>();
+        let hit_bytes = std::mem::size_of::<Receiver>() + std::mem::size_of::<Vec3>();
         reservoirs * Self::RESERVOIR_BYTES + hits * hit_bytes + std::mem::size_of::<Vec3>()
     }
 
@@ -455,11 +455,7 @@ impl Integrator for RestirDiIntegrator {
                             else {
                                 continue;
                             };
-                            if !gbuf.keys[index].is_similar(
-                                &hist.gbuffer.keys[index],
-                                s.normal_cos,
-                                s.depth_tolerance,
-                            ) {
+                            if !r.is_similar(prev_r, s.normal_cos, s.depth_tolerance) {
                                 continue;
                             }
                             let prev = hist.reservoirs[index].with_confidence_cap(s.mcap);
