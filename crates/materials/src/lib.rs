@@ -26,7 +26,12 @@
 //! ```
 
 mod bsdf;
+pub mod fresnel;
+pub mod ior;
 mod lobe;
+pub mod microfacet;
+pub mod plastic;
 
-pub use bsdf::{Bsdf, BsdfKind, BsdfSample};
+pub use bsdf::{Bsdf, BsdfKind, BsdfSample, Plastic, RoughPlastic};
 pub use lobe::LobeFlags;
+pub use microfacet::{Distribution, Microfacet};
