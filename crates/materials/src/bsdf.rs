@@ -632,10 +632,11 @@ fn rough_reflection_pdf(mf: &Microfacet, v: Vec3, l: Vec3) -> f32 {
         return 0.0;
     }
     let h = (v + l).normalize();
-    if v.dot(h) <= 0.0 || l.dot(h) <= 0.0 {
+    let lh = l.dot(h);
+    if v.dot(h) <= 0.0 || lh <= 0.0 {
         return 0.0;
     }
-    mf.d(h) * mf.g1(v, h) / (4.0 * v.z)
+    mf.pdf(v, h) / (4.0 * lh)
 }
 
 /// The generalised half vector of a rough dielectric (Walter et al. 2007), in `+z`; `None` if
