@@ -10,7 +10,7 @@
 //! - a negative control: GGX samples must fail the chi-square test against the Beckmann pdf.
 
 use glam::{Vec2, Vec3};
-use restir_materials::{Bsdf, Distribution, LobeFlags, Microfacet, ior};
+use restir_materials::{Bsdf, Distribution, LobeFlags, Microfacet, fresnel, ior};
 use restir_sampling::stats::{Histogram, Quadrature, SphereGrid};
 use restir_sampling::{Pcg32, warp};
 
@@ -140,7 +140,7 @@ fn reciprocity_of_reflection_models() {
 /// Rough dielectric: reflection is reciprocal; transmission in radiance units obeys
 /// `f(wo, wi) / η_o² = f(wi, wo) / η_i²` with `η` the absolute IOR on each direction's side
 /// (Veach 1997, §5.2: the radiance BTDF is not symmetric, `f/η²` of the receiving side is).
-/// Relative 2e-3: the half vector is rebuilt from either side in `f32`.
+/// Relative 1e-3: the half vector is rebuilt from either side in `f32`.
 #[test]
 fn rough_dielectric_generalised_reciprocity() {
     let eta = 1.5046 / 1.000_277;
@@ -155,11 +155,22 @@ fn rough_dielectric_generalised_reciprocity() {
             if a.z.abs() < 1e-2 || b.z.abs() < 1e-2 {
                 continue;
             }
+            // Skip pairs near the critical angle, where `1 − F` and `cos θt` cancel in `f32`
+            // (measured: 0.5 % between the two evaluation orders at F = 0.975, exactly
+            // reciprocal in f64).
+            if a.z * b.z < 0.0 {
+                let (inside, outside) = if a.z < 0.0 { (a, b) } else { (b, a) };
+                let m = (outside + inside * eta).normalize();
+                let m = if m.z < 0.0 { -m } else { m };
+                if fresnel::fresnel_dielectric(inside.dot(m), eta).r > 0.9 {
+                    continue;
+                }
+            }
             let fab = bsdf.eval(a, b).x / b.z.abs() / side_ior(a).powi(2);
             let fba = bsdf.eval(b, a).x / a.z.abs() / side_ior(b).powi(2);
             let scale = fab.max(fba);
             assert!(
-                (fab - fba).abs() <= 2e-3 * scale + 1e-7,
+                (fab - fba).abs() <= 1e-3 * scale + 1e-7,
                 "{dist:?}: {a} {b}: {fab} vs {fba}"
             );
             checked += (scale > 0.0 && a.z * b.z < 0.0) as u32;
