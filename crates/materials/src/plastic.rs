@@ -138,11 +138,9 @@ pub fn rough_plastic_table(
     }
     // Built outside the lock (it takes a moment); a racing thread may build it twice.
     let table: &'static RoughPlasticTable = Box::leak(Box::new(build(distribution, alpha, eta)));
-    *tables
-        .lock()
-        .unwrap_or_else(|e| e.into_inner())
-        .entry(key)
-        .or_insert(table)
+    let mut guard = tables.lock().unwrap_or_else(|e| e.into_inner());
+    let stored: &&'static RoughPlasticTable = guard.entry(key).or_insert(table);
+    stored
 }
 
 #[cfg(test)]

@@ -738,7 +738,7 @@ impl<'a, 'i> Importer<'a, 'i> {
                 .find(|p| p.name == name)
                 .map(|p| p.node);
             match props.float(self, name)? {
-                Some(a) if !(a >= 0.0) => Err(self.err(
+                Some(a) if a.is_nan() || a < 0.0 => Err(self.err(
                     node_of.unwrap_or(node),
                     format!(
                         "{}: {name} {a} must be a non-negative roughness",
