@@ -11,7 +11,38 @@
 //!   that lobe and its `f` is the lobe's weight times that probability, so `f / pdf_sa` is the
 //!   throughput weight in every case.
 //! - One-sided models (diffuse, conductors, plastics) are black unless both `wo` and `wi` are above
-//!   the surface, as in Mitsuba; [`Bsdf::two_sided`] wraps them.
+//!   the surface, as in Mitsuba; [`Bsdf::two_sided`] wraps them. Transmitting models (dielectric,
+//!   rough dielectric, null) are two-sided by nature: seen from below (`wo.z < 0`) the relative
+//!   IOR is `1/eta`.
+//! - **Radiance across refraction** (Mitsuba 3's radiance mode): transmitted radiance is scaled by
+//!   `1/η'²`, with `η'` the relative IOR `η_t/η_i` seen from `wo`'s side. The smooth dielectric's
+//!   transmission weight is `kt·(η_i/η_t)²`; in the rough dielectric's `eval` the `η'²` of Walter
+//!   et al.'s BTDF and the scale `1/η'²` cancel. The radiance BTDF is therefore not symmetric:
+//!   `f(wo, wi)/η_o² = f(wi, wo)/η_i²` (Veach 1997, §5.2). A transmission sample's `eta` is
+//!   `η'`, so a path's product of `eta²` undoes the scaling where energy is wanted (Russian
+//!   roulette, as Mitsuba: `q = min(max(β)·η², 0.95)`). Reflection samples have `eta = 1`.
+//! - Sample records: `lobe` is the lobe that produced the sample (`DELTA`/`GLOSSY`/`DIFFUSE` with
+//!   `REFLECTION`/`TRANSMISSION`); `roughness` is Mitsuba's α (`√(αu·αv)` when anisotropic), 1
+//!   for diffuse and 0 for delta lobes. For non-delta samples of a model with several lobes
+//!   (rough plastic, rough dielectric), `f` and `pdf_sa` are the whole model's `eval` and `pdf_sa`
+//!   (one-sample MIS over the lobes, as Mitsuba), so `f/pdf_sa` is what `eval/pdf_sa` gives.
+//!
+//! # Models
+//!
+//! [`BsdfKind`] holds Mitsuba 3's `diffuse`, `conductor`, `roughconductor`, `dielectric`,
+//! `roughdielectric`, `plastic`, `roughplastic` and `null` with Mitsuba's parameters, defaults and
+//! formulas (`shared/MATERIALS.md` is the specification, with Mitsuba source paths):
+//! [`microfacet`] (GGX and Beckmann, anisotropic, separable Smith, visible-normal sampling),
+//! [`fresnel`] (exact dielectric and conductor Fresnel, the diffuse Fresnel fit), [`ior`]
+//! (named IORs and metals) and [`plastic`] (the rough plastic's precomputed coating tables).
+//! Deliberate differences from Mitsuba, none of which changes an expected value:
+//! - visible normals are always sampled (Mitsuba's `sample_visible = false` samples `D` instead);
+//! - the VNDF pdf uses the exact Beckmann Smith term (Mitsuba's rational G1 fit stays in `eval`),
+//!   so that the pdf is the density the sampler draws from; Mitsuba's sample weight assumes the
+//!   fit normalises it, which it does to 0.35 %;
+//! - the Beckmann visible-slope sampler inverts the same CDF by safeguarded Newton in `f64`
+//!   instead of Mitsuba's three Newton steps, so the rough plastic tables (integrated through it)
+//!   agree with Mitsuba's to ~1e-4, not 1e-6.
 //!
 //! ```
 //! use restir_materials::{Bsdf, LobeFlags};
@@ -26,7 +57,12 @@
 //! ```
 
 mod bsdf;
+pub mod fresnel;
+pub mod ior;
 mod lobe;
+pub mod microfacet;
+pub mod plastic;
 
-pub use bsdf::{Bsdf, BsdfKind, BsdfSample};
+pub use bsdf::{Bsdf, BsdfKind, BsdfSample, Plastic, RoughPlastic};
 pub use lobe::LobeFlags;
+pub use microfacet::{Distribution, Microfacet};

@@ -16,12 +16,16 @@
 //! - **White furnace**: the albedo `∫ eval(wo, wi) dωi` estimated by uniform sphere sampling
 //!   (independent of `sample`) and by `sample` itself equals the known albedo within 4 standard
 //!   errors where known (1 for a white diffuse surface), and is ≤ 1 + 4 standard errors always.
+//!   Transmitted radiance is scaled by `1/η²` (see the crate docs), so the furnace measures
+//!   *energy*: transmitted values are multiplied back by `η'²`, the relative IOR seen from `wo`.
+//!   The uniform estimate misses delta lobes and is compared with the known albedo only for
+//!   models without them.
 //!
 //! A negative control (diffuse samples against the uniform-hemisphere pdf) must be rejected with
 //! p < 1e-6.
 
 use glam::Vec3;
-use restir_materials::Bsdf;
+use restir_materials::{Bsdf, Distribution, LobeFlags, Microfacet, ior};
 use restir_sampling::stats::{
     Chi2Error, Chi2Outcome, Histogram, Quadrature, SphereGrid, sidak_level,
 };
@@ -33,7 +37,6 @@ enum Mass {
     /// `∫ pdf_sa = 1`: every sample succeeds and no lobe is a delta.
     One,
     /// `∫ pdf_sa ≤ 1`: samples may fail or come from delta lobes.
-    #[allow(dead_code, reason = "for the rough and delta models still to come")]
     AtMostOne,
     /// Nothing is scattered.
     Zero,
@@ -47,9 +50,11 @@ struct Case {
     /// `pdf_sa`'s mass when `wo` is on a side the BSDF scatters from (the front, or either side
     /// when two-sided). From the other side the mass is always zero.
     mass: Mass,
-    /// The albedo `∫ eval dωi` per channel when `wo` is on a scattering side, if known exactly;
-    /// otherwise only `≤ 1` is checked.
+    /// The albedo `∫ eval dωi` (with delta lobes, and in energy: see the file docs) per channel
+    /// when `wo` is on a scattering side, if known exactly; otherwise only `≤ 1` is checked.
     albedo: Option<Vec3>,
+    /// Relative IOR of a transmitting model (1 otherwise), to turn radiance into energy.
+    eta: f32,
 }
 
 /// The BSDFs under test. To test a new model, add a case, e.g.
@@ -59,38 +64,142 @@ struct Case {
 /// the chi-square's remainder cell, and a BSDF with only delta lobes (`pdf_sa` zero everywhere)
 /// has no directions to test, only the checks that every sample is a delta sample.
 fn cases() -> Vec<Case> {
-    vec![
+    let mut v = vec![
         Case {
             name: "diffuse white",
             bsdf: Bsdf::diffuse(Vec3::ONE),
             mass: Mass::One,
             albedo: Some(Vec3::ONE),
+            eta: 1.0,
         },
         Case {
             name: "diffuse coloured",
             bsdf: Bsdf::diffuse(Vec3::new(0.8, 0.5, 0.2)),
             mass: Mass::One,
             albedo: Some(Vec3::new(0.8, 0.5, 0.2)),
+            eta: 1.0,
         },
         Case {
             name: "diffuse white two-sided",
             bsdf: Bsdf::diffuse(Vec3::ONE).two_sided(),
             mass: Mass::One,
             albedo: Some(Vec3::ONE),
+            eta: 1.0,
         },
         Case {
             name: "diffuse coloured two-sided",
             bsdf: Bsdf::diffuse(Vec3::new(0.1, 0.9, 0.4)).two_sided(),
             mass: Mass::One,
             albedo: Some(Vec3::new(0.1, 0.9, 0.4)),
+            eta: 1.0,
         },
         Case {
             name: "black",
             bsdf: Bsdf::black(),
             mass: Mass::Zero,
             albedo: Some(Vec3::ZERO),
+            eta: 1.0,
         },
-    ]
+    ];
+    let mirror = ior::conductor("none").unwrap();
+    let gold = ior::conductor("Au").unwrap();
+    let glass = 1.5046 / 1.000_277;
+    let pp = 1.49 / 1.000_277;
+    // Smooth (delta) models: every sample is a delta sample.
+    v.push(Case {
+        name: "conductor mirror",
+        bsdf: Bsdf::conductor(mirror.0, mirror.1, Vec3::ONE),
+        mass: Mass::AtMostOne,
+        albedo: Some(Vec3::ONE),
+        eta: 1.0,
+    });
+    v.push(Case {
+        name: "dielectric bk7",
+        bsdf: Bsdf::dielectric(glass, Vec3::ONE, Vec3::ONE),
+        mass: Mass::AtMostOne,
+        albedo: Some(Vec3::ONE),
+        eta: glass,
+    });
+    v.push(Case {
+        name: "null",
+        bsdf: Bsdf::null(),
+        mass: Mass::AtMostOne,
+        albedo: Some(Vec3::ONE),
+        eta: 1.0,
+    });
+    v.push(Case {
+        name: "plastic",
+        bsdf: Bsdf::plastic(pp, Vec3::new(0.2, 0.5, 0.8), Vec3::ONE, false),
+        mass: Mass::AtMostOne,
+        albedo: None,
+        eta: 1.0,
+    });
+    v.push(Case {
+        name: "plastic nonlinear two-sided",
+        bsdf: Bsdf::plastic(pp, Vec3::new(0.9, 0.1, 0.5), Vec3::splat(0.7), true).two_sided(),
+        mass: Mass::AtMostOne,
+        albedo: None,
+        eta: 1.0,
+    });
+    for (dist, dname) in [
+        (Distribution::Beckmann, "beckmann"),
+        (Distribution::Ggx, "ggx"),
+    ] {
+        for alpha in [0.05f32, 0.2, 0.6] {
+            let mf = Microfacet::new(dist, alpha);
+            let name = |what: &str| -> &'static str {
+                Box::leak(format!("{what} {dname} α={alpha}").into_boxed_str())
+            };
+            v.push(Case {
+                name: name("rough conductor mirror"),
+                bsdf: Bsdf::rough_conductor(mirror.0, mirror.1, Vec3::ONE, mf),
+                mass: Mass::AtMostOne,
+                albedo: None,
+                eta: 1.0,
+            });
+            v.push(Case {
+                name: name("rough dielectric bk7"),
+                bsdf: Bsdf::rough_dielectric(glass, Vec3::ONE, Vec3::ONE, mf),
+                mass: Mass::AtMostOne,
+                albedo: None,
+                eta: glass,
+            });
+            v.push(Case {
+                name: name("rough plastic"),
+                bsdf: Bsdf::rough_plastic(
+                    pp,
+                    Vec3::new(0.2, 0.5, 0.8),
+                    Vec3::ONE,
+                    false,
+                    dist,
+                    alpha,
+                ),
+                mass: Mass::AtMostOne,
+                albedo: None,
+                eta: 1.0,
+            });
+        }
+        let aniso = Microfacet::anisotropic(dist, 0.05, 0.4);
+        v.push(Case {
+            name: Box::leak(
+                format!("rough conductor gold two-sided {dname} α=(0.05, 0.4)").into_boxed_str(),
+            ),
+            bsdf: Bsdf::rough_conductor(gold.0, gold.1, Vec3::ONE, aniso).two_sided(),
+            mass: Mass::AtMostOne,
+            albedo: None,
+            eta: 1.0,
+        });
+        v.push(Case {
+            name: Box::leak(
+                format!("rough dielectric water {dname} α=(0.05, 0.4)").into_boxed_str(),
+            ),
+            bsdf: Bsdf::rough_dielectric(1.333, Vec3::ONE, Vec3::splat(0.5), aniso),
+            mass: Mass::AtMostOne,
+            albedo: None,
+            eta: 1.333,
+        });
+    }
+    v
 }
 
 /// Outgoing directions: normal, oblique, grazing, and the same below the surface.
@@ -114,7 +223,18 @@ fn wos() -> Vec<Vec3> {
 impl Case {
     /// Whether `wo` sees a scattering side.
     fn lit(&self, wo: Vec3) -> bool {
-        wo.z > 0.0 || (self.bsdf.two_sided && wo.z < 0.0)
+        wo.z > 0.0 || ((self.bsdf.two_sided || self.bsdf.kind.transmits()) && wo.z < 0.0)
+    }
+
+    /// Factor turning a transmitted radiance weight into energy: `η'²`, the relative IOR seen
+    /// from `wo`, when `wi` is on the other side.
+    fn energy(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z * wi.z < 0.0 {
+            let eta = if wo.z > 0.0 { self.eta } else { 1.0 / self.eta };
+            eta * eta
+        } else {
+            1.0
+        }
     }
 
     fn mass(&self, wo: Vec3) -> Mass {
@@ -132,12 +252,22 @@ impl Case {
 
 const SAMPLES: usize = 400_000;
 
+/// Whether the chi-square test runs for `case` at `wo` (see [`MICROFACET_MIN_COS`]).
+fn chi2_runs(case: &Case, wo: Vec3) -> bool {
+    let glossy = case.bsdf.flags().contains(LobeFlags::GLOSSY);
+    !(glossy && wo.z.abs() < MICROFACET_MIN_COS)
+}
+
 /// Every (case, wo) with something to sample is one chi-square test.
 fn chi2_test_count() -> usize {
     let wos = wos();
     cases()
         .iter()
-        .map(|c| wos.iter().filter(|&&wo| c.mass(wo) != Mass::Zero).count())
+        .map(|c| {
+            wos.iter()
+                .filter(|&&wo| c.mass(wo) != Mass::Zero && chi2_runs(c, wo))
+                .count()
+        })
         .sum()
 }
 
@@ -149,6 +279,14 @@ fn seed(case: usize, wo: usize) -> u64 {
 fn pdf_cells(grid: &SphereGrid, bsdf: &Bsdf, wo: Vec3) -> Vec<f64> {
     grid.integrate(|wi| bsdf.pdf_sa(wo, wi) as f64, &Quadrature::default())
 }
+
+/// The chi-square test skips `|cos θo|` below this for microfacet models. Seen from
+/// `cos θo = 10⁻³`, a microfacet reflection lobe is a sliver about 10⁻³ thick in `cos θ` at the
+/// horizon, which the `(cos θ, φ)` quadrature cannot resolve: it loses ~1.6e-4 of the mass
+/// (measured for Beckmann α = 0.05), and the test then fails on its own quadrature. The same
+/// `pdf_sa` integrated in microfacet-normal space (where the lobe is smooth) gives the mass the
+/// sampler produces (0.99991 vs 0.99990); mass, consistency and furnace checks still run there.
+const MICROFACET_MIN_COS: f32 = 5e-3;
 
 /// Bins `n` samples of `bsdf` at `wo`: smooth samples by direction, failed and delta samples in
 /// the remainder.
@@ -171,6 +309,9 @@ fn chi2_sampled_directions() {
     let grid = SphereGrid::default();
     for (ci, case) in cases().iter().enumerate() {
         for (wi_, wo) in wos().into_iter().enumerate() {
+            if !chi2_runs(case, wo) {
+                continue;
+            }
             let what = format!("{} at wo = {wo}", case.name);
             let hist = sample_histogram(&grid, &case.bsdf, wo, seed(ci, wi_), SAMPLES);
             let p = pdf_cells(&grid, &case.bsdf, wo);
@@ -294,7 +435,8 @@ fn white_furnace() {
             let mut uniform = MeanVec3::default();
             for _ in 0..N {
                 let wi = warp::sample_uniform_sphere(rng.next_2d());
-                uniform.push(case.bsdf.eval(wo, wi) / warp::UNIFORM_SPHERE_PDF);
+                uniform
+                    .push(case.bsdf.eval(wo, wi) * case.energy(wo, wi) / warp::UNIFORM_SPHERE_PDF);
             }
             // With the BSDF's own sampling (f/pdf; zero when sampling fails).
             let mut sampled = MeanVec3::default();
@@ -303,7 +445,7 @@ fn white_furnace() {
                 let v = case
                     .bsdf
                     .sample(wo, u_lobe, rng.next_2d())
-                    .map_or(Vec3::ZERO, |s| s.f / s.pdf_sa);
+                    .map_or(Vec3::ZERO, |s| s.f / s.pdf_sa * case.energy(wo, s.wi));
                 sampled.push(v);
             }
             for (name, est) in [("uniform", &uniform), ("sampled", &sampled)] {
@@ -315,7 +457,10 @@ fn white_furnace() {
                         case.name
                     );
                     assert!(m <= 1.0 + tol, "{what} exceeds one");
-                    if let Some(albedo) = case.albedo(wo) {
+                    let has_delta = case.bsdf.flags().contains(LobeFlags::DELTA);
+                    if let Some(albedo) = case.albedo(wo)
+                        && !(name == "uniform" && has_delta && case.lit(wo))
+                    {
                         let want = albedo[k] as f64;
                         assert!((m - want).abs() <= tol, "{what}, want {want}");
                     }

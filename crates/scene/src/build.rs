@@ -6,7 +6,7 @@ use std::path::Path;
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 use restir_geometry::{Accel, Camera, FovAxis as GeoFovAxis, Shape, Sphere, TriangleMesh};
 use restir_lights::{Light, LightSet};
-use restir_materials::{Bsdf, LobeFlags};
+use restir_materials::{Bsdf, Distribution, LobeFlags, Microfacet};
 
 use crate::desc::*;
 use crate::{Scene, SceneError, SceneFeatures};
@@ -70,18 +70,182 @@ fn affine(m: Mat4) -> Result<Affine3A, String> {
     Ok(a)
 }
 
+fn unit_color(what: &str, c: &V3) -> Result<Vec3, String> {
+    let v = Vec3::from(*c);
+    if !v.is_finite() || v.min_element() < 0.0 || v.max_element() > 1.0 {
+        return Err(format!("{what} {c:?} must lie in [0, 1]"));
+    }
+    Ok(v)
+}
+
+fn relative_ior(int_ior: f32, ext_ior: f32) -> Result<f32, String> {
+    for (name, v) in [("int_ior", int_ior), ("ext_ior", ext_ior)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(format!("{name} {v} must be a positive number"));
+        }
+    }
+    Ok(int_ior / ext_ior)
+}
+
+fn conductor_ior(d: &ConductorIorDesc) -> Result<(Vec3, Vec3), String> {
+    if let Some(name) = &d.material {
+        if name != "none" && (d.eta.is_some() || d.k.is_some()) {
+            return Err(format!(
+                "conductor material '{name}' cannot be combined with explicit eta or k"
+            ));
+        }
+        if d.eta.is_none() && d.k.is_none() {
+            return restir_materials::ior::conductor(name).ok_or_else(|| {
+                format!(
+                    "unknown conductor material '{name}' (known: {})",
+                    restir_materials::ior::conductor_names()
+                )
+            });
+        }
+    }
+    let eta = Vec3::from(d.eta.unwrap_or([0.0; 3]));
+    let k = Vec3::from(d.k.unwrap_or([1.0; 3]));
+    for (name, v) in [("eta", eta), ("k", k)] {
+        if !v.is_finite() || v.min_element() < 0.0 {
+            return Err(format!(
+                "conductor {name} {v} must be finite and non-negative"
+            ));
+        }
+    }
+    Ok((eta, k))
+}
+
+fn microfacet(r: &RoughnessDesc, anisotropy_allowed: bool) -> Result<Microfacet, String> {
+    let dist = match r.distribution {
+        MicrofacetDesc::Beckmann => Distribution::Beckmann,
+        MicrofacetDesc::Ggx => Distribution::Ggx,
+    };
+    let check = |name: &str, a: f32| {
+        if a.is_finite() && a >= 0.0 {
+            Ok(a)
+        } else {
+            Err(format!(
+                "{name} {a} must be a finite non-negative roughness"
+            ))
+        }
+    };
+    match (r.alpha_u, r.alpha_v) {
+        (None, None) => Ok(Microfacet::new(dist, check("alpha", r.alpha)?)),
+        (Some(u), Some(v)) => {
+            if !anisotropy_allowed {
+                return Err("this material is isotropic: give alpha, not alpha_u/alpha_v".into());
+            }
+            Ok(Microfacet::anisotropic(
+                dist,
+                check("alpha_u", u)?,
+                check("alpha_v", v)?,
+            ))
+        }
+        _ => Err("alpha_u and alpha_v must be given together".into()),
+    }
+}
+
+/// Checks a material the way [`Scene::build`] would, without keeping the result.
+pub(crate) fn check_material(m: &MaterialDesc) -> Result<(), String> {
+    material_bsdf(m).map(|_| ())
+}
+
 fn material_bsdf(m: &MaterialDesc) -> Result<Bsdf, String> {
     Ok(match m {
         MaterialDesc::Diffuse { reflectance } => {
-            let r = Vec3::from(*reflectance);
-            if !r.is_finite() || r.min_element() < 0.0 || r.max_element() > 1.0 {
-                return Err(format!(
-                    "diffuse reflectance {reflectance:?} must lie in [0, 1]"
-                ));
-            }
-            Bsdf::diffuse(r)
+            Bsdf::diffuse(unit_color("diffuse reflectance", reflectance)?)
         }
-        MaterialDesc::TwoSided(inner) => material_bsdf(inner)?.two_sided(),
+        MaterialDesc::Conductor {
+            ior,
+            specular_reflectance,
+        } => {
+            let (eta, k) = conductor_ior(ior)?;
+            Bsdf::conductor(
+                eta,
+                k,
+                unit_color("specular_reflectance", specular_reflectance)?,
+            )
+        }
+        MaterialDesc::RoughConductor {
+            ior,
+            specular_reflectance,
+            roughness,
+        } => {
+            let (eta, k) = conductor_ior(ior)?;
+            Bsdf::rough_conductor(
+                eta,
+                k,
+                unit_color("specular_reflectance", specular_reflectance)?,
+                microfacet(roughness, true)?,
+            )
+        }
+        MaterialDesc::Dielectric {
+            int_ior,
+            ext_ior,
+            specular_reflectance,
+            specular_transmittance,
+        } => Bsdf::dielectric(
+            relative_ior(*int_ior, *ext_ior)?,
+            unit_color("specular_reflectance", specular_reflectance)?,
+            unit_color("specular_transmittance", specular_transmittance)?,
+        ),
+        MaterialDesc::RoughDielectric {
+            int_ior,
+            ext_ior,
+            specular_reflectance,
+            specular_transmittance,
+            roughness,
+        } => Bsdf::rough_dielectric(
+            relative_ior(*int_ior, *ext_ior)?,
+            unit_color("specular_reflectance", specular_reflectance)?,
+            unit_color("specular_transmittance", specular_transmittance)?,
+            microfacet(roughness, true)?,
+        ),
+        MaterialDesc::Plastic {
+            int_ior,
+            ext_ior,
+            diffuse_reflectance,
+            specular_reflectance,
+            nonlinear,
+        } => Bsdf::plastic(
+            relative_ior(*int_ior, *ext_ior)?,
+            unit_color("diffuse_reflectance", diffuse_reflectance)?,
+            unit_color("specular_reflectance", specular_reflectance)?,
+            *nonlinear,
+        ),
+        MaterialDesc::RoughPlastic {
+            int_ior,
+            ext_ior,
+            diffuse_reflectance,
+            specular_reflectance,
+            nonlinear,
+            roughness,
+        } => {
+            let eta = relative_ior(*int_ior, *ext_ior)?;
+            if eta == 1.0 {
+                return Err("roughplastic: int_ior must differ from ext_ior".into());
+            }
+            let mf = microfacet(roughness, false)?;
+            Bsdf::rough_plastic(
+                eta,
+                unit_color("diffuse_reflectance", diffuse_reflectance)?,
+                unit_color("specular_reflectance", specular_reflectance)?,
+                *nonlinear,
+                mf.distribution,
+                mf.alpha_u,
+            )
+        }
+        MaterialDesc::Null => Bsdf::null(),
+        MaterialDesc::TwoSided(inner) => {
+            let b = material_bsdf(inner)?;
+            if b.kind.transmits() {
+                return Err(
+                    "twosided cannot wrap a transmitting material (dielectric, roughdielectric, null), as in Mitsuba"
+                        .into(),
+                );
+            }
+            b.two_sided()
+        }
         MaterialDesc::Black => Bsdf::black(),
     })
 }

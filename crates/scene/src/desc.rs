@@ -243,7 +243,90 @@ pub struct NamedMaterial {
     pub material: MaterialDesc,
 }
 
-/// A surface material.
+/// A microfacet normal distribution (Mitsuba's `distribution`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MicrofacetDesc {
+    /// Beckmann (Mitsuba's default).
+    #[default]
+    Beckmann,
+    /// GGX / Trowbridge–Reitz.
+    Ggx,
+}
+
+/// Mitsuba's default roughness.
+fn alpha_default() -> f32 {
+    0.1
+}
+fn ones() -> V3 {
+    [1.0; 3]
+}
+fn halves() -> V3 {
+    [0.5; 3]
+}
+/// `air` in Mitsuba's IOR table.
+pub const AIR_IOR: f32 = 1.000_277;
+/// `bk7` in Mitsuba's IOR table (the dielectrics' default `int_ior`).
+pub const BK7_IOR: f32 = 1.5046;
+/// `polypropylene` in Mitsuba's IOR table (the plastics' default `int_ior`).
+pub const POLYPROPYLENE_IOR: f32 = 1.49;
+fn air() -> f32 {
+    AIR_IOR
+}
+fn bk7() -> f32 {
+    BK7_IOR
+}
+fn polypropylene() -> f32 {
+    POLYPROPYLENE_IOR
+}
+
+/// A conductor's complex IOR: Mitsuba's `material` preset or explicit `eta`/`k`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConductorIorDesc {
+    /// A named metal (`Au`, `Ag`, `Cu`, `Al`, `Cr`, …, `none` = perfect mirror); an error when
+    /// combined with `eta` or `k`. Default: `none` unless `eta`/`k` are given.
+    #[serde(default)]
+    pub material: Option<String>,
+    /// Real part of the IOR per channel (default 0).
+    #[serde(default)]
+    pub eta: Option<V3>,
+    /// Imaginary part per channel (default 1).
+    #[serde(default)]
+    pub k: Option<V3>,
+}
+
+/// Microfacet roughness: isotropic `alpha`, or `alpha_u` and `alpha_v` together.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RoughnessDesc {
+    /// Normal distribution (default Beckmann).
+    #[serde(default)]
+    pub distribution: MicrofacetDesc,
+    /// Isotropic roughness (Mitsuba `alpha`, default 0.1; clamped to at least 1e-4).
+    #[serde(default = "alpha_default")]
+    pub alpha: f32,
+    /// Anisotropic roughness along the tangent; needs `alpha_v` and replaces `alpha`.
+    #[serde(default)]
+    pub alpha_u: Option<f32>,
+    /// Anisotropic roughness along the bitangent; needs `alpha_u`.
+    #[serde(default)]
+    pub alpha_v: Option<f32>,
+}
+
+impl Default for RoughnessDesc {
+    fn default() -> Self {
+        Self {
+            distribution: MicrofacetDesc::Beckmann,
+            alpha: alpha_default(),
+            alpha_u: None,
+            alpha_v: None,
+        }
+    }
+}
+
+/// A surface material. Every model and default is Mitsuba 3's plugin of the same name (see
+/// `docs/SCENES.md`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum MaterialDesc {
@@ -252,7 +335,103 @@ pub enum MaterialDesc {
         /// Albedo in `[0, 1]`.
         reflectance: V3,
     },
-    /// The wrapped material on both sides.
+    /// Smooth conductor (a delta mirror with the conductor Fresnel term), black from the back.
+    Conductor {
+        /// Complex IOR (default: `none`, a perfect mirror).
+        #[serde(default)]
+        ior: ConductorIorDesc,
+        /// Multiplier in `[0, 1]` (default 1).
+        #[serde(default = "ones")]
+        specular_reflectance: V3,
+    },
+    /// Rough conductor (microfacet), black from the back.
+    RoughConductor {
+        /// Complex IOR (default: `none`, a perfect mirror).
+        #[serde(default)]
+        ior: ConductorIorDesc,
+        /// Multiplier in `[0, 1]` (default 1).
+        #[serde(default = "ones")]
+        specular_reflectance: V3,
+        /// Distribution and roughness.
+        #[serde(default)]
+        roughness: RoughnessDesc,
+    },
+    /// Smooth dielectric interface (glass): delta reflection and refraction, from both sides.
+    Dielectric {
+        /// IOR inside (default 1.5046, `bk7`).
+        #[serde(default = "bk7")]
+        int_ior: f32,
+        /// IOR outside (default 1.000277, `air`).
+        #[serde(default = "air")]
+        ext_ior: f32,
+        /// Reflection multiplier in `[0, 1]` (default 1).
+        #[serde(default = "ones")]
+        specular_reflectance: V3,
+        /// Transmission multiplier in `[0, 1]` (default 1).
+        #[serde(default = "ones")]
+        specular_transmittance: V3,
+    },
+    /// Rough dielectric interface (microfacet), from both sides.
+    RoughDielectric {
+        /// IOR inside (default 1.5046, `bk7`).
+        #[serde(default = "bk7")]
+        int_ior: f32,
+        /// IOR outside (default 1.000277, `air`).
+        #[serde(default = "air")]
+        ext_ior: f32,
+        /// Reflection multiplier in `[0, 1]` (default 1).
+        #[serde(default = "ones")]
+        specular_reflectance: V3,
+        /// Transmission multiplier in `[0, 1]` (default 1).
+        #[serde(default = "ones")]
+        specular_transmittance: V3,
+        /// Distribution and roughness.
+        #[serde(default)]
+        roughness: RoughnessDesc,
+    },
+    /// Diffuse base under a smooth dielectric coating, black from the back.
+    Plastic {
+        /// IOR of the coating (default 1.49, `polypropylene`).
+        #[serde(default = "polypropylene")]
+        int_ior: f32,
+        /// IOR outside (default 1.000277, `air`).
+        #[serde(default = "air")]
+        ext_ior: f32,
+        /// Base albedo in `[0, 1]` (default 0.5).
+        #[serde(default = "halves")]
+        diffuse_reflectance: V3,
+        /// Specular multiplier in `[0, 1]` (default 1).
+        #[serde(default = "ones")]
+        specular_reflectance: V3,
+        /// Mitsuba's `nonlinear` internal-scattering model (default false).
+        #[serde(default)]
+        nonlinear: bool,
+    },
+    /// Diffuse base under a rough dielectric coating, black from the back. Isotropic only.
+    RoughPlastic {
+        /// IOR of the coating (default 1.49, `polypropylene`); must differ from `ext_ior`.
+        #[serde(default = "polypropylene")]
+        int_ior: f32,
+        /// IOR outside (default 1.000277, `air`).
+        #[serde(default = "air")]
+        ext_ior: f32,
+        /// Base albedo in `[0, 1]` (default 0.5).
+        #[serde(default = "halves")]
+        diffuse_reflectance: V3,
+        /// Specular multiplier in `[0, 1]` (default 1).
+        #[serde(default = "ones")]
+        specular_reflectance: V3,
+        /// Mitsuba's `nonlinear` internal-scattering model (default false).
+        #[serde(default)]
+        nonlinear: bool,
+        /// Distribution and roughness (`alpha_u`/`alpha_v` are an error).
+        #[serde(default)]
+        roughness: RoughnessDesc,
+    },
+    /// A surface light passes through unchanged (Mitsuba `null`).
+    Null,
+    /// The wrapped material on both sides (an error around transmitting materials, as in
+    /// Mitsuba).
     TwoSided(Box<MaterialDesc>),
     /// Absorbs all light.
     Black,

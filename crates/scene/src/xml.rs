@@ -76,6 +76,8 @@ struct Prop<'a, 'i> {
 enum ColorUse {
     Reflectance,
     Emission,
+    /// Unbounded non-negative parameters (conductor `eta`/`k`): taken as given.
+    Unbounded,
 }
 
 /// XYZ → linear sRGB of an equal-energy (constant 1) emission spectrum, as Mitsuba 3's RGB mode
@@ -453,7 +455,7 @@ impl Props<'_, '_> {
             Value::Float(v) => [v as f32; 3],
             Value::Int(v) => [v as f32; 3],
             Value::SpectrumConst(v) => match usage {
-                ColorUse::Reflectance => [v; 3],
+                ColorUse::Reflectance | ColorUse::Unbounded => [v; 3],
                 ColorUse::Emission => EQUAL_ENERGY_RGB.map(|c| c * v),
             },
             _ => return Err(self.type_err(imp, p, "a colour (rgb, spectrum or float)")),
@@ -470,7 +472,7 @@ impl Props<'_, '_> {
                 ),
             ));
         }
-        if usage == ColorUse::Emission && c.iter().any(|&x| x < 0.0) {
+        if usage != ColorUse::Reflectance && c.iter().any(|&x| x < 0.0) {
             return Err(imp.err(
                 p.node,
                 format!("{}: '{}' = {c:?} must not be negative", self.what, p.name),
@@ -534,8 +536,110 @@ impl<'a, 'i> Importer<'a, 'i> {
                 }
                 MaterialDesc::TwoSided(Box::new(inner))
             }
+            "conductor" | "roughconductor" => {
+                let ior = self.conductor_ior(&props)?;
+                let specular_reflectance = props
+                    .color(self, "specular_reflectance", ColorUse::Reflectance)?
+                    .unwrap_or([1.0; 3]);
+                if ty == "conductor" {
+                    MaterialDesc::Conductor {
+                        ior,
+                        specular_reflectance,
+                    }
+                } else {
+                    MaterialDesc::RoughConductor {
+                        ior,
+                        specular_reflectance,
+                        roughness: self.roughness(node, &props, true)?,
+                    }
+                }
+            }
+            "dielectric" | "roughdielectric" => {
+                let int_ior = self.ior(&props, "int_ior", BK7_IOR)?;
+                let ext_ior = self.ior(&props, "ext_ior", AIR_IOR)?;
+                let specular_reflectance = props
+                    .color(self, "specular_reflectance", ColorUse::Reflectance)?
+                    .unwrap_or([1.0; 3]);
+                let specular_transmittance = props
+                    .color(self, "specular_transmittance", ColorUse::Reflectance)?
+                    .unwrap_or([1.0; 3]);
+                if ty == "dielectric" {
+                    MaterialDesc::Dielectric {
+                        int_ior,
+                        ext_ior,
+                        specular_reflectance,
+                        specular_transmittance,
+                    }
+                } else {
+                    MaterialDesc::RoughDielectric {
+                        int_ior,
+                        ext_ior,
+                        specular_reflectance,
+                        specular_transmittance,
+                        roughness: self.roughness(node, &props, true)?,
+                    }
+                }
+            }
+            "plastic" | "roughplastic" => {
+                let int_ior = self.ior(&props, "int_ior", POLYPROPYLENE_IOR)?;
+                let ext_ior = self.ior(&props, "ext_ior", AIR_IOR)?;
+                let diffuse_reflectance = props
+                    .color(self, "diffuse_reflectance", ColorUse::Reflectance)?
+                    .unwrap_or([0.5; 3]);
+                let specular_reflectance = props
+                    .color(self, "specular_reflectance", ColorUse::Reflectance)?
+                    .unwrap_or([1.0; 3]);
+                let nonlinear = props.bool(self, "nonlinear")?.unwrap_or(false);
+                if ty == "plastic" {
+                    MaterialDesc::Plastic {
+                        int_ior,
+                        ext_ior,
+                        diffuse_reflectance,
+                        specular_reflectance,
+                        nonlinear,
+                    }
+                } else {
+                    if int_ior == ext_ior {
+                        return Err(self.err(
+                            node,
+                            format!("bsdf 'roughplastic': int_ior and ext_ior are both {int_ior}; they must differ"),
+                        ));
+                    }
+                    MaterialDesc::RoughPlastic {
+                        int_ior,
+                        ext_ior,
+                        diffuse_reflectance,
+                        specular_reflectance,
+                        nonlinear,
+                        roughness: self.roughness(node, &props, false)?,
+                    }
+                }
+            }
+            "null" => MaterialDesc::Null,
+            "thindielectric" => {
+                return Err(self.err(
+                    node,
+                    "bsdf 'thindielectric' is not supported yet (use 'dielectric' on a closed shape)",
+                ));
+            }
             other => return Err(self.err(node, format!("unknown bsdf type '{other}'"))),
         };
+        if let MaterialDesc::TwoSided(inner) = &m
+            && matches!(
+                **inner,
+                MaterialDesc::Dielectric { .. }
+                    | MaterialDesc::RoughDielectric { .. }
+                    | MaterialDesc::Null
+            )
+        {
+            return Err(self.err(
+                node,
+                "twosided cannot wrap a transmitting bsdf (dielectric, roughdielectric, null), as in Mitsuba",
+            ));
+        }
+        // Everything the builder would reject, reported here with this bsdf's line.
+        crate::build::check_material(&m)
+            .map_err(|e| self.err(node, format!("bsdf '{ty}': {e}")))?;
         for c in elements(node) {
             let tag = c.tag_name().name();
             if !PROPERTY_TAGS.contains(&tag) && tag != "bsdf" {
@@ -544,6 +648,150 @@ impl<'a, 'i> Importer<'a, 'i> {
         }
         self.finish(props);
         Ok(m)
+    }
+
+    /// `int_ior`/`ext_ior`: a number or a name from Mitsuba's IOR table.
+    fn ior(&self, props: &Props, name: &str, default: f32) -> Result<f32> {
+        let Some(p) = props.get(name) else {
+            return Ok(default);
+        };
+        let v = match &p.value {
+            Value::Float(v) => *v as f32,
+            Value::Int(v) => *v as f32,
+            Value::Str(s) => restir_materials::ior::ior(s).ok_or_else(|| {
+                self.err(
+                    p.node,
+                    format!(
+                        "{}: unknown {name} material '{s}' (known: {})",
+                        props.what,
+                        restir_materials::ior::ior_names()
+                    ),
+                )
+            })?,
+            _ => return Err(props.type_err(self, p, "a number or an IOR name")),
+        };
+        if !(v.is_finite() && v > 0.0) {
+            return Err(self.err(
+                p.node,
+                format!("{}: {name} {v} must be positive", props.what),
+            ));
+        }
+        Ok(v)
+    }
+
+    /// Conductor `material` / `eta` / `k` (Mitsuba: `eta` with a named material is an error).
+    fn conductor_ior(&self, props: &Props) -> Result<ConductorIorDesc> {
+        let material_node = props.get("material").map(|p| p.node);
+        let material = props.string(self, "material")?;
+        let eta = props.color(self, "eta", ColorUse::Unbounded)?;
+        let k = props.color(self, "k", ColorUse::Unbounded)?;
+        if let (Some(name), Some(n)) = (&material, material_node) {
+            if restir_materials::ior::conductor(name).is_none() {
+                return Err(self.err(
+                    n,
+                    format!(
+                        "{}: unknown conductor material '{name}' (known: {})",
+                        props.what,
+                        restir_materials::ior::conductor_names()
+                    ),
+                ));
+            }
+            if name != "none" && (eta.is_some() || k.is_some()) {
+                return Err(self.err(
+                    n,
+                    format!(
+                        "{}: give either material '{name}' or eta/k, not both",
+                        props.what
+                    ),
+                ));
+            }
+        }
+        Ok(ConductorIorDesc { material, eta, k })
+    }
+
+    /// `distribution`, `alpha` or `alpha_u`/`alpha_v`, and `sample_visible`.
+    fn roughness(&mut self, node: Node, props: &Props, anisotropic: bool) -> Result<RoughnessDesc> {
+        let mut r = RoughnessDesc::default();
+        if let Some(p) = props.get("distribution") {
+            let Value::Str(d) = &p.value else {
+                return Err(props.type_err(self, p, "a string"));
+            };
+            r.distribution = match d.as_str() {
+                "beckmann" => MicrofacetDesc::Beckmann,
+                "ggx" => MicrofacetDesc::Ggx,
+                other => {
+                    return Err(self.err(
+                        p.node,
+                        format!(
+                            "{}: unknown distribution '{other}' (beckmann, ggx)",
+                            props.what
+                        ),
+                    ));
+                }
+            };
+        }
+        let alpha = |name: &str| -> Result<Option<f32>> {
+            let node_of = props
+                .items
+                .iter()
+                .rev()
+                .find(|p| p.name == name)
+                .map(|p| p.node);
+            match props.float(self, name)? {
+                Some(a) if a.is_nan() || a < 0.0 => Err(self.err(
+                    node_of.unwrap_or(node),
+                    format!(
+                        "{}: {name} {a} must be a non-negative roughness",
+                        props.what
+                    ),
+                )),
+                a => Ok(a),
+            }
+        };
+        let a = alpha("alpha")?;
+        let au = alpha("alpha_u")?;
+        let av = alpha("alpha_v")?;
+        match (au, av) {
+            (None, None) => r.alpha = a.unwrap_or(0.1),
+            (Some(u), Some(v)) => {
+                if !anisotropic {
+                    return Err(self.err(
+                        node,
+                        format!(
+                            "{}: anisotropic roughness is not supported; give 'alpha'",
+                            props.what
+                        ),
+                    ));
+                }
+                if a.is_some() {
+                    return Err(self.err(
+                        node,
+                        format!(
+                            "{}: give either alpha or alpha_u/alpha_v, not both",
+                            props.what
+                        ),
+                    ));
+                }
+                r.alpha_u = Some(u);
+                r.alpha_v = Some(v);
+            }
+            _ => {
+                return Err(self.err(
+                    node,
+                    format!("{}: alpha_u and alpha_v must be given together", props.what),
+                ));
+            }
+        }
+        if props.bool(self, "sample_visible")? == Some(false) {
+            self.warn(
+                node,
+                format!(
+                    "{}: sample_visible=false is ignored; visible normals are always sampled (the same expected image, different noise)",
+                    props.what
+                ),
+            );
+        }
+        Ok(r)
     }
 
     fn shape(&mut self, node: Node<'a, 'i>) -> Result<ShapeDesc> {
