@@ -11,7 +11,7 @@
 
 use std::sync::atomic::AtomicBool;
 
-use restir_integrators::{RenderSettings, make_integrator, render};
+use restir_integrators::{IntegratorOptions, RenderSettings, make_integrator, render};
 use restir_scene::{Scene, parse_ron};
 
 fn furnace(material: &str) -> (f64, f64) {
@@ -26,7 +26,9 @@ fn furnace(material: &str) -> (f64, f64) {
     );
     let desc = parse_ron(&ron, "furnace.ron".as_ref()).unwrap();
     let scene = Scene::build(&desc, ".".as_ref(), "furnace.ron".as_ref()).unwrap();
-    let integrator = make_integrator("path", &scene, None).unwrap();
+    let integrator = make_integrator(&scene, &IntegratorOptions::default())
+        .unwrap()
+        .integrator;
     let settings = RenderSettings {
         spp: 256,
         time_limit: None,
