@@ -185,6 +185,19 @@ fn unbiased_for_every_unbiased_mis_scheme() {
     );
     eprintln!("2 rounds: max |z| = {z:.2}");
     assert!(z < Z_MAX, "2 rounds: max |z| = {z:.2}");
+    // Tile light selection (mixed with the power sampler) and a tiny radius stay unbiased.
+    let params = [
+        ("light_sampler", "tiles"),
+        ("candidates", "4"),
+        ("radius", "3"),
+        ("spatial_rounds", "2"),
+    ];
+    let z = max_z(
+        &statistics(&scene, "restir-di", &params, 1, 200),
+        &reference,
+    );
+    eprintln!("tiles: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "tiles: max |z| = {z:.2}");
     let z = max_z(
         &statistics(&scene, "restir-di", &[("temporal", "true")], 4, 100),
         &reference,

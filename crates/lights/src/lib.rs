@@ -102,6 +102,10 @@ impl std::error::Error for LightError {}
 pub struct LightSet {
     lights: Vec<Light>,
     sampler: Option<AliasTable>,
+    /// Each light's power (the selection weights).
+    powers: Vec<f32>,
+    /// Each light's bounding sphere; `None` for lights at infinity.
+    spheres: Vec<Option<(Vec3, f32)>>,
     /// For each shape, the area light on it.
     shape_light: Vec<Option<u32>>,
     environment: Option<u32>,
@@ -129,7 +133,13 @@ impl LightSet {
         let mut shape_light = vec![None; shapes.len()];
         let mut environment = None;
         let mut powers = Vec::with_capacity(lights.len());
+        let mut spheres = Vec::with_capacity(lights.len());
         for (i, l) in lights.iter().enumerate() {
+            spheres.push(match *l {
+                Light::Area { shape, .. } => shapes.get(shape as usize).map(bounding_sphere),
+                Light::Point { position, .. } => Some((position, 0.0)),
+                Light::Directional { .. } | Light::Constant { .. } => None,
+            });
             let power = match *l {
                 Light::Area { shape, radiance } => {
                     let s = shapes
@@ -185,6 +195,8 @@ impl LightSet {
         Ok(Self {
             lights,
             sampler: AliasTable::new(&powers),
+            powers,
+            spheres,
             shape_light,
             environment,
             scene_radius,
@@ -220,6 +232,25 @@ impl LightSet {
     /// Radius of the scene's bounding sphere.
     pub fn scene_radius(&self) -> f32 {
         self.scene_radius
+    }
+
+    /// Picks a light by power: `(index, probability)`.
+    #[inline]
+    pub fn select(&self, u: f32) -> Option<(u32, f32)> {
+        let (index, pmf, _) = self.sampler.as_ref()?.sample(u);
+        Some((index as u32, pmf))
+    }
+
+    /// The power (selection weight) of light `light`: `π·A·lum(L)` for area lights, `4π·lum(I)`
+    /// for point lights, and the power through the scene's bounding sphere for lights at
+    /// infinity.
+    pub fn power(&self, light: u32) -> f32 {
+        self.powers[light as usize]
+    }
+
+    /// A sphere bounding light `light` (centre, radius); `None` for lights at infinity.
+    pub fn bounding_sphere(&self, light: u32) -> Option<(Vec3, f32)> {
+        self.spheres[light as usize]
     }
 
     /// Probability that [`LightSet::sample`] picks light `light`.
@@ -371,6 +402,27 @@ impl LightSet {
             Light::Area { shape, .. } => pmf * shapes[shape as usize].pdf_sa_from(ref_p, p, n),
             Light::Constant { .. } => pmf * warp::UNIFORM_SPHERE_PDF,
             Light::Point { .. } | Light::Directional { .. } => 0.0,
+        }
+    }
+}
+
+/// A sphere around a shape (for meshes, around its bounding box).
+fn bounding_sphere(shape: &Shape) -> (Vec3, f32) {
+    match shape {
+        Shape::Sphere(s) => (s.center, s.radius),
+        Shape::Mesh(m) => {
+            let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+            for i in 0..m.triangle_count() {
+                for p in m.triangle(i) {
+                    lo = lo.min(p);
+                    hi = hi.max(p);
+                }
+            }
+            if lo.cmple(hi).all() {
+                (0.5 * (lo + hi), 0.5 * (hi - lo).length())
+            } else {
+                (Vec3::ZERO, 0.0)
+            }
         }
     }
 }

@@ -95,6 +95,10 @@ struct RestirArgs {
     /// Light candidates per pixel in initial resampling [default: 32].
     #[arg(long)]
     candidates: Option<u32>,
+    /// Where candidates' lights come from: power (the power-based sampler) or tiles (per
+    /// 16×16-pixel tile, mixed with a distance-aware table) [default: power].
+    #[arg(long)]
+    light_sampler: Option<String>,
     /// BSDF samples per pixel, MIS-combined with the reservoirs [default: 1].
     #[arg(long)]
     bsdf_candidates: Option<u32>,
@@ -131,6 +135,7 @@ impl RestirArgs {
             }
         };
         put("candidates", self.candidates.map(|v| v.to_string()));
+        put("light_sampler", self.light_sampler.clone());
         put(
             "bsdf_candidates",
             self.bsdf_candidates.map(|v| v.to_string()),

@@ -20,6 +20,7 @@
 
 pub mod light_point;
 mod settings;
+pub mod tiles;
 
 use std::sync::Mutex;
 
@@ -30,7 +31,7 @@ use restir_gris::{MisScheme, Reservoir, ShiftMap, Shifted, StreamingReservoir, r
 use restir_sampling::{Pcg32, sequences::r2};
 use restir_scene::Scene;
 
-pub use settings::{MIS_NAMES, RestirDiSettings, mis_name};
+pub use settings::{LightSampler, MIS_NAMES, RestirDiSettings, mis_name};
 
 use crate::gbuffer::{GBuffer, Receiver};
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
@@ -152,6 +153,7 @@ impl RestirDiIntegrator {
         scene: &Scene,
         r: &Receiver,
         ng: Vec3,
+        tile: Option<&restir_sampling::AliasTable>,
         rng: &mut Pcg32,
     ) -> (DiReservoir, u64) {
         let bsdf = &scene.bsdfs[r.bsdf as usize];
@@ -172,8 +174,29 @@ impl RestirDiIntegrator {
             let u_select = ((i as f32 + u0) / nf).min(restir_sampling::ONE_MINUS_EPSILON);
             let u_light = rng.next_2d();
             let u_pick = rng.next_f32();
-            let Some(ls) = scene.lights.sample(&scene.shapes, r.p, u_select, u_light) else {
-                continue;
+            // The candidate, its solid-angle source density (selection included) and the
+            // power sampler's density (which the light/BSDF split uses, whatever picked it).
+            let (ls, source_pdf_sa, power_pdf_sa) = match tile {
+                None => {
+                    let Some(ls) = scene.lights.sample(&scene.shapes, r.p, u_select, u_light)
+                    else {
+                        continue;
+                    };
+                    (ls, ls.pdf_sa, ls.pdf_sa)
+                }
+                Some(table) => {
+                    let Some((light, pmf, power_pmf)) = tiles::select(scene, table, u_select)
+                    else {
+                        continue;
+                    };
+                    let Some(ls) = scene
+                        .lights
+                        .sample_light(&scene.shapes, light, r.p, u_light)
+                    else {
+                        continue;
+                    };
+                    (ls, pmf * ls.pdf_sa, power_pmf * ls.pdf_sa)
+                }
             };
             let sample = LightPoint::from_light_sample(&ls);
             let measure = if ls.delta || !ls.dist.is_finite() {
@@ -190,12 +213,12 @@ impl RestirDiIntegrator {
                 delta: ls.delta,
                 ng: ls.ng,
             };
-            let e = evaluate(scene, r, &sample, &c, Some(ls.pdf_sa), self.counts);
+            let e = evaluate(scene, r, &sample, &c, Some(power_pdf_sa), self.counts);
             // The source density in the sample's measure (the light sampler's is solid angle).
             let light_pdf = if ls.delta {
-                ls.pdf_sa
+                source_pdf_sa
             } else {
-                ls.pdf_sa * measure
+                source_pdf_sa * measure
             };
             let w = e.target / (nf * light_pdf);
             stream.add_candidate(sample, e.target, w, 0.0, u_pick);
@@ -376,10 +399,14 @@ impl Integrator for RestirDiIntegrator {
     fn describe(&self) -> String {
         let s = &self.settings;
         format!(
-            "restir-di max_depth={} candidates={} bsdf_candidates={} neighbors={} radius={} \
-             spatial_rounds={} mis={} mcap={} temporal={} visibility_reuse={}{}",
+            "restir-di max_depth={} candidates={} light_sampler={} bsdf_candidates={} neighbors={} \
+             radius={} spatial_rounds={} mis={} mcap={} temporal={} visibility_reuse={}{}",
             s.path.max_depth,
             s.candidates,
+            match s.light_sampler {
+                LightSampler::Power => "power",
+                LightSampler::Tiles => "tiles",
+            },
             s.bsdf_candidates,
             s.neighbors,
             s.radius,
@@ -409,6 +436,10 @@ impl Integrator for RestirDiIntegrator {
         let w = gbuf.width;
         if keep {
             // Initial resampling.
+            let light_tiles = match s.light_sampler {
+                LightSampler::Power => None,
+                LightSampler::Tiles => tiles::LightTiles::build(scene, &gbuf),
+            };
             let mut current = vec![DiReservoir::empty(); n];
             rays += current
                 .par_chunks_mut(w * BAND_ROWS)
@@ -419,7 +450,10 @@ impl Integrator for RestirDiIntegrator {
                         let index = band * w * BAND_ROWS + i;
                         if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
-                            let (init, nr) = self.initial(scene, r, gbuf.ng[index], &mut rng);
+                            let tile = light_tiles
+                                .as_ref()
+                                .and_then(|t| t.table(index % w, index / w));
+                            let (init, nr) = self.initial(scene, r, gbuf.ng[index], tile, &mut rng);
                             *res = init;
                             rays += nr;
                         }

@@ -24,6 +24,16 @@ pub fn mis_name(scheme: MisScheme) -> &'static str {
         .map_or("?", |(n, _)| n)
 }
 
+/// Where initial candidates' lights come from (`--light-sampler`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightSampler {
+    /// The power-based light sampler (the paper's choice; default).
+    Power,
+    /// Per 16×16-pixel tile, a mixture of a distance-aware table and the power sampler
+    /// (see [`super::tiles`]).
+    Tiles,
+}
+
 /// Everything ReSTIR DI can be told.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RestirDiSettings {
@@ -31,6 +41,8 @@ pub struct RestirDiSettings {
     pub path: PathSettings,
     /// Light candidates per pixel in initial resampling, `N_L` (default 32).
     pub candidates: u32,
+    /// Where candidates' lights come from (default the power sampler).
+    pub light_sampler: LightSampler,
     /// BSDF samples per pixel, `N_B` (default 1), combined with the reservoirs' light strategy
     /// by the balance heuristic.
     pub bsdf_candidates: u32,
@@ -60,6 +72,7 @@ impl RestirDiSettings {
         Self {
             path,
             candidates: 32,
+            light_sampler: LightSampler::Power,
             bsdf_candidates: 1,
             neighbors: 3,
             radius: 30.0,
@@ -89,6 +102,13 @@ impl RestirDiSettings {
                 "candidates" | "light_candidates" | "initial_candidates" | "num_candidates"
                 | "reservoir_size" | "reservior_size" => {
                     self.candidates = parse_count(name, v, 1)?;
+                }
+                "light_sampler" => {
+                    self.light_sampler = match v.to_ascii_lowercase().as_str() {
+                        "power" => LightSampler::Power,
+                        "tiles" => LightSampler::Tiles,
+                        _ => return Err(format!("{name} = '{v}': expected power or tiles")),
+                    };
                 }
                 "bsdf_candidates" | "brdf_candidates" => {
                     self.bsdf_candidates = parse_count(name, v, 0)?;
