@@ -1,19 +1,29 @@
-//! Furnace test: a convex diffuse sphere of albedo ρ under a constant environment of radiance 1
-//! reflects exactly ρ in every direction (no interreflection), whatever the path depth. Every
-//! pixel that sees the sphere must average to ρ within 4 standard errors of the pixel mean.
+//! Furnace tests: a convex object under a constant environment of radiance 1.
+//!
+//! - A diffuse sphere of albedo ρ reflects exactly ρ in every direction (no interreflection),
+//!   whatever the path depth.
+//! - A smooth dielectric sphere conserves energy (R + T = 1 at every interface) and, with the
+//!   radiance scaling by 1/η² on entering and η² on leaving, is invisible: every pixel is 1.
+//! - A null sphere is invisible too.
+//! - A rough dielectric or rough mirror sphere loses some energy (single-scattering microfacets)
+//!   but never gains any.
+//!
+//! Pixel means are compared within 4 standard errors of the mean over the covered pixels.
 
 use std::sync::atomic::AtomicBool;
 
 use restir_integrators::{IntegratorOptions, RenderSettings, make_integrator, render};
 use restir_scene::{Scene, parse_ron};
 
-fn furnace(rho: f32, max_depth: i32) -> (f64, f64) {
+/// Mean and standard error over the pixels covered by a unit sphere of `material` (RON), seen
+/// under a constant environment of radiance 1.
+fn furnace(material: &str, max_depth: i32, seed: u64) -> (f64, f64) {
     let ron = format!(
         r#"(
         camera: (fov: 20, to_world: [LookAt(origin: (0, 0, 5), target: (0, 0, 0), up: (0, 1, 0))]),
         film: (width: 16, height: 16, filter: Box),
         integrator: (max_depth: {max_depth}),
-        shapes: [(geometry: Sphere(center: (0, 0, 0), radius: 1), material: Some(Inline(Diffuse(reflectance: ({rho}, {rho}, {rho})))))],
+        shapes: [(geometry: Sphere(center: (0, 0, 0), radius: 1), material: Some(Inline({material})))],
         lights: [Constant(radiance: (1, 1, 1))],
     )"#
     );
@@ -25,7 +35,7 @@ fn furnace(rho: f32, max_depth: i32) -> (f64, f64) {
     let settings = RenderSettings {
         spp: 256,
         time_limit: None,
-        seed: 1,
+        seed,
     };
     let out = render(
         &scene,
@@ -49,7 +59,11 @@ fn furnace(rho: f32, max_depth: i32) -> (f64, f64) {
 #[test]
 fn white_furnace_sphere() {
     for (rho, depth) in [(0.8, -1), (0.5, 2), (1.0, -1)] {
-        let (mean, se) = furnace(rho, depth);
+        let (mean, se) = furnace(
+            &format!("Diffuse(reflectance: ({rho}, {rho}, {rho}))"),
+            depth,
+            1,
+        );
         assert!(
             (mean - rho as f64).abs() < 4.0 * se.max(1e-4),
             "rho {rho}, depth {depth}: mean {mean} (se {se})"
@@ -60,6 +74,34 @@ fn white_furnace_sphere() {
 /// With max_depth 1 only emitters are visible: the sphere is black.
 #[test]
 fn depth_one_shows_only_emitters() {
-    let (mean, _) = furnace(0.8, 1);
+    let (mean, _) = furnace("Diffuse(reflectance: (0.8, 0.8, 0.8))", 1, 1);
     assert_eq!(mean, 0.0);
+}
+
+#[test]
+fn smooth_dielectric_and_null_spheres_are_invisible() {
+    for m in ["Dielectric()", "Dielectric(int_ior: 2.4)", "Null"] {
+        let (mean, se) = furnace(m, -1, 3);
+        assert!(
+            (mean - 1.0).abs() < 4.0 * se.max(1e-4),
+            "{m}: mean {mean} (se {se})"
+        );
+    }
+}
+
+#[test]
+fn rough_spheres_do_not_gain_energy() {
+    for m in [
+        "RoughDielectric(roughness: (alpha: 0.3))",
+        "RoughDielectric(roughness: (distribution: ggx, alpha: 0.1))",
+        "RoughConductor(roughness: (alpha: 0.3))",
+        "TwoSided(RoughPlastic(diffuse_reflectance: (1, 1, 1)))",
+    ] {
+        let (mean, se) = furnace(m, -1, 3);
+        assert!(
+            mean <= 1.0 + 4.0 * se.max(1e-4),
+            "{m}: mean {mean} (se {se})"
+        );
+        assert!(mean > 0.7, "{m}: mean {mean} (se {se}) lost too much");
+    }
 }
