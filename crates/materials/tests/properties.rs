@@ -284,7 +284,7 @@ fn control_ggx_samples_vs_beckmann_pdf() {
 #[test]
 fn eval_matches_mitsuba() {
     #[allow(clippy::type_complexity)]
-    let table: Vec<(Bsdf, Vec<((f32, f32), (f32, f32), [f32; 3])>)> = vec![
+    let table: Vec<(Bsdf, Vec<((f32, f32), (f32, f32), [f64; 3])>)> = vec![
         // roughdielectric_beckmann_0.3
         (
             Bsdf::rough_dielectric(
@@ -520,7 +520,7 @@ fn eval_matches_mitsuba() {
     for (ci, (bsdf, rows)) in table.iter().enumerate() {
         for (wo, wi, want) in rows {
             let got = bsdf.eval(sph(wo.0, wo.1), sph(wi.0, wi.1));
-            let want = Vec3::from(*want);
+            let want = Vec3::new(want[0] as f32, want[1] as f32, want[2] as f32);
             assert!(
                 (got - want).abs().max_element() <= 2e-3 * want.max_element() + 1e-8,
                 "case {ci}, wo {wo:?}, wi {wi:?}: ours {got}, Mitsuba {want}"
