@@ -765,7 +765,11 @@ mod tests {
     /// The enum stays small (it is copied into path vertices and reservoirs).
     #[test]
     fn bsdf_is_small() {
-        assert!(core::mem::size_of::<Bsdf>() <= 64, "{}", core::mem::size_of::<Bsdf>());
+        assert!(
+            core::mem::size_of::<Bsdf>() <= 64,
+            "{}",
+            core::mem::size_of::<Bsdf>()
+        );
     }
 
     #[test]
