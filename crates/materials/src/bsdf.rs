@@ -762,6 +762,16 @@ mod tests {
         }
     }
 
+    /// The enum stays small (it is copied into path vertices and reservoirs).
+    #[test]
+    fn bsdf_is_small() {
+        assert!(
+            core::mem::size_of::<Bsdf>() <= 64,
+            "{}",
+            core::mem::size_of::<Bsdf>()
+        );
+    }
+
     #[test]
     fn one_sided_is_black_from_behind() {
         let bsdf = Bsdf::diffuse(Vec3::ONE);

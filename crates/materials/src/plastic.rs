@@ -89,13 +89,12 @@ fn build(distribution: Distribution, alpha: f32, eta: f32) -> RoughPlasticTable 
     let order = |e: f32| if e > 1.0 { 32 } else { 128 };
     let nodes_t = gauss_legendre(order(eta));
     let nodes_r = gauss_legendre(order(1.0 / eta));
-    let mut transmittance = [0.0f32; TABLE_RES];
-    let mut r_sum = 0.0f64;
-    for (k, t_k) in transmittance.iter_mut().enumerate() {
+    // Row k: (T(μ_k), R(μ_k)·μ_k).
+    let row = |k: usize| -> (f32, f64) {
         let mu = (k as f32 / (TABLE_RES - 1) as f32).max(1e-6);
         let v = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
         // Transmission through the interface from outside (relative IOR η).
-        *t_k = integrate_vndf(&mf, v, &nodes_t, |m| {
+        let t = integrate_vndf(&mf, v, &nodes_t, |m| {
             let f = fresnel_dielectric(v.dot(m), eta);
             let wt = refract(v, m, f.cos_theta_t, f.eta_ti);
             if wt.z < 0.0 {
@@ -114,8 +113,29 @@ fn build(distribution: Distribution, alpha: f32, eta: f32) -> RoughPlasticTable 
                 0.0
             }
         });
-        r_sum += r * mu as f64;
+        (t, r * mu as f64)
+    };
+    // The rows are independent: spread them over the cores (loading a scene waits for this).
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(TABLE_RES);
+    let mut rows = vec![(0.0f32, 0.0f64); TABLE_RES];
+    std::thread::scope(|s| {
+        let chunk = TABLE_RES.div_ceil(threads);
+        for (c, out) in rows.chunks_mut(chunk).enumerate() {
+            let row = &row;
+            s.spawn(move || {
+                for (i, slot) in out.iter_mut().enumerate() {
+                    *slot = row(c * chunk + i);
+                }
+            });
+        }
+    });
+    let mut transmittance = [0.0f32; TABLE_RES];
+    for (t, r) in transmittance.iter_mut().zip(&rows) {
+        *t = r.0;
     }
+    let r_sum: f64 = rows.iter().map(|r| r.1).sum();
     RoughPlasticTable {
         transmittance,
         internal_reflectance: (2.0 * r_sum / TABLE_RES as f64) as f32,

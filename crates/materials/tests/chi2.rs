@@ -303,11 +303,31 @@ fn sample_histogram(grid: &SphereGrid, bsdf: &Bsdf, wo: Vec3, seed: u64, n: usiz
     hist
 }
 
+/// Runs `f` on every case, spread over the available cores (the cases are independent and each
+/// uses its own fixed seeds, so the outcome does not depend on the scheduling). A panic in any
+/// case fails the test with that case's message.
+fn for_each_case(f: impl Fn(usize, &Case) + Sync) {
+    let cases = cases();
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    std::thread::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|| {
+                loop {
+                    let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    let Some(case) = cases.get(i) else { break };
+                    f(i, case);
+                }
+            });
+        }
+    });
+}
+
 #[test]
 fn chi2_sampled_directions() {
     let level = sidak_level(0.01, chi2_test_count());
     let grid = SphereGrid::default();
-    for (ci, case) in cases().iter().enumerate() {
+    for_each_case(|ci, case| {
         for (wi_, wo) in wos().into_iter().enumerate() {
             if !chi2_runs(case, wo) {
                 continue;
@@ -332,7 +352,7 @@ fn chi2_sampled_directions() {
                 Err(e) => panic!("{what}: {e}"),
             }
         }
-    }
+    });
 }
 
 #[test]
@@ -428,7 +448,7 @@ impl MeanVec3 {
 #[test]
 fn white_furnace() {
     const N: usize = 400_000;
-    for (ci, case) in cases().iter().enumerate() {
+    for_each_case(|ci, case| {
         for (wi_, wo) in wos().into_iter().enumerate() {
             // Independent of `sample`: uniform directions over the sphere.
             let mut rng = Pcg32::new(seed(ci, wi_), 3);
@@ -467,7 +487,7 @@ fn white_furnace() {
                 }
             }
         }
-    }
+    });
 }
 
 // ------------------------------------------------------------------------------------------

@@ -279,12 +279,12 @@ fn control_ggx_samples_vs_beckmann_pdf() {
 /// `eval` against Mitsuba 3.9.1's `eval` (scalar_rgb, values printed by a `/tmp` script) for
 /// rough dielectrics (reflection, transmission from both sides, TIR), anisotropic GGX, rough
 /// conductors with named metals and the nonlinear plastic. Mitsuba's `(wi, wo)` are our
-/// `(wo, wi)`; directions are (θ, φ) in degrees. Relative 2e-3 (f32 evaluation of exponentials
-/// of large tangents) plus 1e-8.
+/// `(wo, wi)`; directions are (θ, φ) in degrees. Relative 1e-4 plus 1e-8 (measured: 2.3e-5 at
+/// worst, for a value of 3e-11 far in the Beckmann tail; 2e-6 elsewhere).
 #[test]
 fn eval_matches_mitsuba() {
     #[allow(clippy::type_complexity)]
-    let table: Vec<(Bsdf, Vec<((f32, f32), (f32, f32), [f32; 3])>)> = vec![
+    let table: Vec<(Bsdf, Vec<((f32, f32), (f32, f32), [f64; 3])>)> = vec![
         // roughdielectric_beckmann_0.3
         (
             Bsdf::rough_dielectric(
@@ -520,9 +520,9 @@ fn eval_matches_mitsuba() {
     for (ci, (bsdf, rows)) in table.iter().enumerate() {
         for (wo, wi, want) in rows {
             let got = bsdf.eval(sph(wo.0, wo.1), sph(wi.0, wi.1));
-            let want = Vec3::from(*want);
+            let want = Vec3::new(want[0] as f32, want[1] as f32, want[2] as f32);
             assert!(
-                (got - want).abs().max_element() <= 2e-3 * want.max_element() + 1e-8,
+                (got - want).abs().max_element() <= 1e-4 * want.max_element() + 1e-8,
                 "case {ci}, wo {wo:?}, wi {wi:?}: ours {got}, Mitsuba {want}"
             );
         }
