@@ -65,7 +65,7 @@ fn white_furnace_sphere() {
             1,
         );
         assert!(
-            (mean - rho as f64).abs() < 4.0 * se.max(1e-4),
+            (mean - rho).abs() < 4.0 * se.max(1e-4),
             "rho {rho}, depth {depth}: mean {mean} (se {se})"
         );
     }

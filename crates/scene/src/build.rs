@@ -385,17 +385,17 @@ fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<Shape, String> {
             .map_err(|e| e.to_string())?;
             *m = rebuilt;
         }
-    } else if let (Shape::Mesh(m), true) = (&mut shape, desc.face_normals) {
-        if m.normals().is_some() {
-            *m = TriangleMesh::new(
-                m.positions().to_vec(),
-                None,
-                m.uvs().map(<[Vec2]>::to_vec),
-                m.indices().to_vec(),
-                m.flip_normals(),
-            )
-            .map_err(|e| e.to_string())?;
-        }
+    } else if let (Shape::Mesh(m), true) = (&mut shape, desc.face_normals)
+        && m.normals().is_some()
+    {
+        *m = TriangleMesh::new(
+            m.positions().to_vec(),
+            None,
+            m.uvs().map(<[Vec2]>::to_vec),
+            m.indices().to_vec(),
+            m.flip_normals(),
+        )
+        .map_err(|e| e.to_string())?;
     }
     Ok(shape)
 }

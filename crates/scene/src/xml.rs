@@ -956,13 +956,9 @@ impl<'a, 'i> Importer<'a, 'i> {
                             if let Some(w) = fp
                                 .float(self, "width")?
                                 .or(fp.float(self, "radius")?.map(|r| 2.0 * r))
+                                && (w - 1.0).abs() > 1e-6
                             {
-                                if (w - 1.0).abs() > 1e-6 {
-                                    self.warn(
-                                        c,
-                                        format!("box filter width {w} is treated as 1 pixel"),
-                                    );
-                                }
+                                self.warn(c, format!("box filter width {w} is treated as 1 pixel"));
                             }
                             FilterDesc::Box
                         }
