@@ -41,7 +41,10 @@ mod plot;
 mod report;
 pub mod suite;
 
-pub use report::{Summary, TimeToError, summarize, time_to_error, update_doc, write_outputs};
+pub use report::{
+    BEGIN_MARKER, END_MARKER, Summary, TimeToError, check_doc, summarize, time_to_error,
+    update_doc, write_outputs,
+};
 pub use suite::{IntegratorConfig, Suite, SuiteScene};
 
 /// Seeds of the two reference halves; benchmark runs use seeds `0..seeds`.
@@ -117,8 +120,7 @@ pub struct Strip {
     pub crop: (u32, u32, u32, u32),
     /// Budget of the cropped renders.
     pub budget: f64,
-    /// Reference crop, then one crop per configuration (`None` if that render failed to
-    /// happen).
+    /// Reference crop, then one crop per configuration.
     pub crops: Vec<Image>,
 }
 
@@ -370,7 +372,9 @@ fn reference_for(
         ));
     }
     let spp = entry.reference_spp.unwrap_or(suite.reference_spp);
-    let depth = entry.max_depth.map_or("scene".to_string(), |d| d.to_string());
+    let depth = entry
+        .max_depth
+        .map_or("scene".to_string(), |d| d.to_string());
     let key = fnv1a(&[
         &loaded.file_bytes,
         format!("{w}x{h} max_depth={depth} spp={spp} path-halves-v1").as_bytes(),
@@ -379,12 +383,17 @@ fn reference_for(
     let stem = format!("{}-{key:016x}", loaded.name);
     let exr = dir.join(format!("{stem}.exr"));
     let noise_file = dir.join(format!("{stem}.noise"));
-    if exr.is_file()
-        && let Ok(text) = std::fs::read_to_string(&noise_file)
-        && let Ok(noise) = text.trim().parse::<f64>()
-        && let Ok(image) = Image::read_exr(&exr)
-        && (image.width, image.height) == (w, h)
-    {
+    // A cached reference needs its EXR (of the right size) and its noise estimate.
+    let cached = || -> Option<(Image, f64)> {
+        let noise = std::fs::read_to_string(&noise_file)
+            .ok()?
+            .trim()
+            .parse::<f64>()
+            .ok()?;
+        let image = Image::read_exr(&exr).ok()?;
+        ((image.width, image.height) == (w, h)).then_some((image, noise))
+    };
+    if let Some((image, noise)) = cached() {
         return Ok((
             image,
             ReferenceInfo {

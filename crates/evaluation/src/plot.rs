@@ -34,16 +34,16 @@ fn usable(v: f64) -> bool {
 fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
         .filter(|v| usable(*v))
-        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
     if !lo.is_finite() {
         return (0.1, 10.0);
     }
-    let (lo, hi) = if hi / lo < 1.5 {
-        (lo / 1.5, hi * 1.5)
-    } else {
-        (lo, hi)
-    };
-    (lo / 1.15, hi * 1.15)
+    // Whole decades, so that the log axes always have labelled ticks.
+    let lo = 10f64.powf(lo.log10().floor());
+    let hi = 10f64.powf(hi.log10().ceil()).max(lo * 10.0);
+    (lo, hi)
 }
 
 /// Writes the plot of `series` to `path` (SVG); `reference_noise` draws a grey horizontal line.
@@ -96,7 +96,9 @@ fn draw(
         chart
             .draw_series(LineSeries::new(line, color.stroke_width(2)))?
             .label(s.label.as_str())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], color.stroke_width(2)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], color.stroke_width(2))
+            });
         // Min–max over seeds as a vertical bar at the median time.
         chart.draw_series(
             s.medians
@@ -119,7 +121,9 @@ fn draw(
                 grey.stroke_width(1),
             ))?
             .label("reference's own relMSE (est.)")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], grey.stroke_width(1)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], grey.stroke_width(1))
+            });
     }
     chart
         .configure_series_labels()

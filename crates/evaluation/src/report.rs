@@ -276,7 +276,12 @@ pub fn report_markdown(results: &BenchResults, h: &str, link: &str) -> String {
          the start and {} at the end (the machine is shared: times include other people's load).\n",
         m.cpu, m.cores, m.threads, m.load_start, m.load_end
     );
-    let budgets: Vec<String> = results.suite.budgets.iter().map(|b| b.to_string()).collect();
+    let budgets: Vec<String> = results
+        .suite
+        .budgets
+        .iter()
+        .map(|b| b.to_string())
+        .collect();
     let _ = writeln!(
         s,
         "Budgets {} s, {} seed(s) each; every render runs whole passes until its budget is spent \
@@ -537,11 +542,8 @@ fn relative(from: &Path, to: &Path) -> PathBuf {
     out
 }
 
-/// Replaces the text between [`BEGIN_MARKER`] and [`END_MARKER`] in the Markdown file `doc` with
-/// the report (links relative to the document); the rest of the file is kept as it is.
-pub fn update_doc(results: &BenchResults, out: &Path, doc: &Path) -> Result<(), String> {
-    let text =
-        std::fs::read_to_string(doc).map_err(|e| format!("{}: cannot read: {e}", doc.display()))?;
+/// Positions just after the begin marker and at the end marker.
+fn find_markers(text: &str, doc: &Path) -> Result<(usize, usize), String> {
     let begin = text.find(BEGIN_MARKER).ok_or_else(|| {
         format!(
             "{}: no '{BEGIN_MARKER}' marker: add the markers where the results belong",
@@ -552,7 +554,28 @@ pub fn update_doc(results: &BenchResults, out: &Path, doc: &Path) -> Result<(), 
     let end = text[after_begin..]
         .find(END_MARKER)
         .map(|i| after_begin + i)
-        .ok_or_else(|| format!("{}: no '{END_MARKER}' after the begin marker", doc.display()))?;
+        .ok_or_else(|| {
+            format!(
+                "{}: no '{END_MARKER}' after the begin marker",
+                doc.display()
+            )
+        })?;
+    Ok((after_begin, end))
+}
+
+/// Checks that `doc` can be read and has both markers (before spending time on a run).
+pub fn check_doc(doc: &Path) -> Result<(), String> {
+    let text =
+        std::fs::read_to_string(doc).map_err(|e| format!("{}: cannot read: {e}", doc.display()))?;
+    find_markers(&text, doc).map(|_| ())
+}
+
+/// Replaces the text between [`BEGIN_MARKER`] and [`END_MARKER`] in the Markdown file `doc` with
+/// the report (links relative to the document); the rest of the file is kept as it is.
+pub fn update_doc(results: &BenchResults, out: &Path, doc: &Path) -> Result<(), String> {
+    let text =
+        std::fs::read_to_string(doc).map_err(|e| format!("{}: cannot read: {e}", doc.display()))?;
+    let (after_begin, end) = find_markers(&text, doc)?;
     let doc_dir = doc
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
@@ -599,8 +622,14 @@ mod tests {
     #[test]
     fn relative_links() {
         let base = std::env::temp_dir();
-        assert_eq!(relative(&base.join("docs"), &base.join("docs/bench")), PathBuf::from("bench"));
-        assert_eq!(relative(&base.join("docs"), &base.join("out")), PathBuf::from("../out"));
+        assert_eq!(
+            relative(&base.join("docs"), &base.join("docs/bench")),
+            PathBuf::from("bench")
+        );
+        assert_eq!(
+            relative(&base.join("docs"), &base.join("out")),
+            PathBuf::from("../out")
+        );
         assert_eq!(csv_field("a,b"), "\"a,b\"");
     }
 }

@@ -150,20 +150,20 @@ impl Suite {
             }
         };
         check_spp(self.reference_spp)?;
-        if let Some(b) = self.strip_budget
-            && !self.budgets.contains(&b)
-        {
+        if let Some(b) = self.strip_budget.filter(|b| !self.budgets.contains(b)) {
             return Err(format!("strip_budget {b} is not one of the budgets"));
         }
         let mut names = Vec::new();
         for s in &self.scenes {
             let name = s.display_name();
             if names.contains(&name) {
-                return Err(format!(
-                    "two scenes are named '{name}': give one a `name`"
-                ));
+                return Err(format!("two scenes are named '{name}': give one a `name`"));
             }
-            if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c)) {
+            if name.is_empty()
+                || !name
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
+            {
                 return Err(format!(
                     "scene name '{name}': use letters, digits, '-', '_' or '.'"
                 ));

@@ -4,7 +4,9 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use restir_evaluation::{Progress, RunOptions, Suite, run_suite, suite, update_doc, write_outputs};
+use restir_evaluation::{
+    Progress, RunOptions, Suite, check_doc, run_suite, suite, update_doc, write_outputs,
+};
 
 /// Options of `restir bench`.
 #[derive(clap::Args, Debug)]
@@ -53,11 +55,11 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
             s.reference_spp = None;
         }
     }
-    suite.validate().map_err(|e| format!("{}: {e}", args.suite.display()))?;
-    if let Some(doc) = &args.update_doc
-        && !doc.is_file()
-    {
-        return Err(format!("--update-doc {}: no such file", doc.display()));
+    suite
+        .validate()
+        .map_err(|e| format!("{}: {e}", args.suite.display()))?;
+    if let Some(doc) = &args.update_doc {
+        check_doc(doc)?;
     }
     let threads = args.threads.unwrap_or(0);
     if threads > 1024 {
@@ -68,13 +70,12 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         .build()
         .map_err(|e| format!("cannot start {threads} threads: {e}"))?;
     let opts = RunOptions {
-        suite_dir: args
-            .suite
-            .parent()
-            .map(PathBuf::from)
-            .unwrap_or_default(),
+        suite_dir: args.suite.parent().map(PathBuf::from).unwrap_or_default(),
         out: args.out.clone(),
-        command_line: std::env::args().collect::<Vec<_>>().join(" "),
+        command_line: std::iter::once("restir".to_string())
+            .chain(std::env::args().skip(1))
+            .collect::<Vec<_>>()
+            .join(" "),
     };
     let bar = (!args.quiet && std::io::stderr().is_terminal()).then(|| {
         let b = indicatif::ProgressBar::new(0);
