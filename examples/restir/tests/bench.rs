@@ -129,7 +129,8 @@ fn smoke_suite_end_to_end() {
 
     let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
     for needle in [
-        "restir bench scenes",
+        "restir bench /",
+        "smoke.ron --out",
         "## cornell-box (24×24)",
         "relmse-many-lights.svg",
         "strip-cornell-box.png",
