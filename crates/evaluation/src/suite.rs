@@ -242,7 +242,7 @@ mod tests {
     fn errors_name_file_and_line() {
         let bad = GOOD.replace("budgets", "\n budgetz");
         let e = Suite::parse(&bad, Path::new("s.ron")).unwrap_err();
-        assert!(e.starts_with("s.ron:5:"), "{e}");
+        assert!(e.starts_with("s.ron:6:2:"), "{e}");
         let e = Suite::parse(&GOOD.replace("0.5", "-1.0"), Path::new("s.ron")).unwrap_err();
         assert!(e.contains("time budget -1"), "{e}");
         let e = Suite::parse(&GOOD.replace("\"di\"", "\"path\""), Path::new("s.ron")).unwrap_err();
