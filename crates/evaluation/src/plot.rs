@@ -46,6 +46,12 @@ fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo, hi)
 }
 
+/// `0.5`, `1`, `10`: a tick value without trailing zeros.
+fn short(x: f64) -> String {
+    let s = format!("{x:.3}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 /// Writes the plot of `series` to `path` (SVG); `reference_noise` draws a grey horizontal line.
 pub(crate) fn relmse_plot(
     path: &Path,
@@ -75,6 +81,7 @@ fn draw(
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 20))
         .margin(12)
+        .margin_right(28)
         .x_label_area_size(45)
         .y_label_area_size(75)
         .build_cartesian_2d((xmin..xmax).log_scale(), (ymin..ymax).log_scale())?;
@@ -82,7 +89,7 @@ fn draw(
         .configure_mesh()
         .x_desc("render time (s)")
         .y_desc("relMSE")
-        .x_label_formatter(&|x| format!("{x:.3}"))
+        .x_label_formatter(&|x| short(*x))
         .y_label_formatter(&|y| format!("{y:.1e}"))
         .draw()?;
     for (i, s) in series.iter().enumerate() {
@@ -127,10 +134,31 @@ fn draw(
     }
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
+        // Error falls with time: the lower left is the emptiest corner.
+        .position(SeriesLabelPosition::LowerLeft)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .draw()?;
     root.present()?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn axes_span_whole_decades() {
+        let close = |(a, b): (f64, f64), (c, d): (f64, f64)| {
+            assert!(
+                (a / c - 1.0).abs() < 1e-9 && (b / d - 1.0).abs() < 1e-9,
+                "{a} {b}"
+            );
+        };
+        close(log_range([0.5, 8.0].into_iter()), (0.1, 10.0));
+        close(log_range([2e-3, 3e-3].into_iter()), (1e-3, 1e-2));
+        close(log_range(std::iter::empty()), (0.1, 10.0));
+        assert_eq!(short(10.0), "10");
+        assert_eq!(short(0.5), "0.5");
+    }
 }
