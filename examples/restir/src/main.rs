@@ -14,6 +14,7 @@ use restir_integrators::{
 };
 use restir_scene::{Scene, load_desc};
 
+mod bench;
 mod generate;
 
 #[derive(Parser, Debug)]
@@ -41,6 +42,9 @@ enum Command {
     /// Write a procedurally generated scene (RON).
     #[command(subcommand)]
     Generate(generate::Generate),
+    /// Equal-time evaluation: render a suite of scenes × integrators × time budgets × seeds,
+    /// compare with references, write a CSV, relMSE-versus-time plots, crops and a report.
+    Bench(Box<bench::BenchArgs>),
 }
 
 #[derive(clap::Args, Debug)]
@@ -450,6 +454,7 @@ fn main() -> ExitCode {
         Command::Render(args) => run_render(*args),
         Command::Compare { test, reference } => run_compare(&test, &reference),
         Command::Generate(what) => generate::run(what),
+        Command::Bench(args) => bench::run(*args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,617 @@
+//! Equal-time evaluation of the restir estimators (`restir bench`).
+//!
+//! A [`Suite`] lists scenes, integrator configurations, time budgets and seeds. [`run_suite`]
+//! renders every combination with the library [`render`] (`spp: u32::MAX`, the budget as time
+//! limit), compares each image with a reference and records time, passes, rays, errors and peak
+//! memory. [`write_outputs`] then writes the CSV, one log-log relMSE-versus-time plot per scene
+//! (SVG), one strip of crops per scene (PNG) and a Markdown report; [`update_doc`] puts the report
+//! into a marked section of another Markdown file.
+//!
+//! **References.** A scene's `reference` EXR is used as given (its noise is unknown). Otherwise
+//! the path tracer renders the scene at the suite's `reference_spp`, as two halves of
+//! `reference_spp / 2` passes with two seeds that no benchmark run uses, and the average is the
+//! reference. It is cached in `<out>/references/` under a key that hashes the scene file's bytes,
+//! the resolution, the max-depth override and the pass count, so changing any of them renders a
+//! new one (files the scene includes, such as meshes, are not hashed). The reference's own error
+//! is estimated from the halves: if `a` and `b` are independent with per-pixel variance `v`, the
+//! reference `(a + b)/2` has variance `v/2` while `E[(a − b)²] = 2v`, so
+//! `relMSE(a, b) / 4` estimates the relMSE the reference itself carries. Since a test image is
+//! independent of the reference, its measured relMSE is, in expectation, its true relMSE plus
+//! this amount: errors within a few times the reference noise are not meaningful.
+//!
+//! **Peak memory.** Before each render the process's peak resident set (`VmHWM` in
+//! `/proc/self/status`) is reset by writing `5` to `/proc/self/clear_refs` (Linux 4.0 and
+//! later), then read before and after the render. `peak_rss_mib` is the peak resident memory of
+//! the whole process during that render: the scene, its BVH, the reference and whatever the
+//! allocator still holds from earlier runs are included; `peak_rss_mib − rss_before_mib`
+//! approximates what the render itself added (accumulation buffer, reservoirs, primary hits).
+//! Where the reset is not allowed, `VmHWM` is the peak since the process started and only grows
+//! from run to run; the report says which case applied.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+use std::time::{Duration, Instant};
+
+use restir_integrators::{
+    Image, IntegratorOptions, RenderSettings, compare, make_integrator, render,
+};
+use restir_scene::{Scene, load_desc};
+
+mod plot;
+mod report;
+pub mod suite;
+
+pub use report::{
+    BEGIN_MARKER, END_MARKER, Summary, TimeToError, check_doc, summarize, time_to_error,
+    update_doc, write_outputs,
+};
+pub use suite::{IntegratorConfig, Suite, SuiteScene};
+
+/// Seeds of the two reference halves; benchmark runs use seeds `0..seeds`.
+pub const REFERENCE_SEEDS: [u64; 2] = [0x5eed_0000_0000_0001, 0x5eed_0000_0000_0002];
+
+/// One render of the suite.
+#[derive(Clone, Debug)]
+pub struct RunRecord {
+    /// Scene name.
+    pub scene: String,
+    /// Integrator configuration label.
+    pub label: String,
+    /// What the integrator reports about its settings (`Integrator::describe`).
+    pub describe: String,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Time budget in seconds.
+    pub budget: f64,
+    /// Seed.
+    pub seed: u64,
+    /// Render time in seconds (whole passes: at least the budget, unless one pass is longer).
+    pub seconds: f64,
+    /// Passes rendered.
+    pub passes: u32,
+    /// Rays traced.
+    pub rays: u64,
+    /// relMSE against the reference.
+    pub relmse: f64,
+    /// MSE against the reference.
+    pub mse: f64,
+    /// Mean of the image over mean of the reference.
+    pub mean_ratio: f64,
+    /// Pixels with NaN or infinite values.
+    pub nonfinite: usize,
+    /// Resident memory just before the render, MiB (`VmHWM` right after the reset).
+    pub rss_before_mib: f64,
+    /// Peak resident memory during the render, MiB (see the crate documentation).
+    pub peak_rss_mib: f64,
+}
+
+impl RunRecord {
+    /// Millions of rays per second.
+    pub fn mrays_per_second(&self) -> f64 {
+        self.rays as f64 / self.seconds.max(1e-9) / 1e6
+    }
+}
+
+/// Where a scene's reference came from and how noisy it is.
+#[derive(Clone, Debug)]
+pub struct ReferenceInfo {
+    /// Scene name.
+    pub scene: String,
+    /// The EXR file.
+    pub path: PathBuf,
+    /// Passes, for a path-traced reference.
+    pub spp: Option<u32>,
+    /// relMSE the reference itself carries (estimated from its halves), when known.
+    pub noise_relmse: Option<f64>,
+    /// Whether it came from the cache (or was given) rather than rendered by this run.
+    pub reused: bool,
+    /// Seconds spent rendering it in this run.
+    pub seconds: f64,
+}
+
+/// A scene's strip of crops: the reference first, then each configuration in suite order.
+#[derive(Clone, Debug)]
+pub struct Strip {
+    /// Scene name.
+    pub scene: String,
+    /// Crop rectangle `(x, y, width, height)`.
+    pub crop: (u32, u32, u32, u32),
+    /// Budget of the cropped renders.
+    pub budget: f64,
+    /// Reference crop, then one crop per configuration.
+    pub crops: Vec<Image>,
+}
+
+/// The machine the suite ran on.
+#[derive(Clone, Debug)]
+pub struct Machine {
+    /// `/proc/cpuinfo` model name.
+    pub cpu: String,
+    /// Logical cores.
+    pub cores: usize,
+    /// Worker threads of the render pool.
+    pub threads: usize,
+    /// `/proc/loadavg` at the start and end of the suite.
+    pub load_start: String,
+    /// See `load_start`.
+    pub load_end: String,
+    /// Whether peak memory could be reset before each render.
+    pub peak_reset: bool,
+}
+
+/// Everything a suite run produced.
+#[derive(Clone, Debug)]
+pub struct BenchResults {
+    /// The suite (with command-line overrides applied).
+    pub suite: Suite,
+    /// Every render.
+    pub records: Vec<RunRecord>,
+    /// One per scene.
+    pub references: Vec<ReferenceInfo>,
+    /// One per scene.
+    pub strips: Vec<Strip>,
+    /// Where it ran.
+    pub machine: Machine,
+    /// The command that ran it.
+    pub command_line: String,
+    /// UTC start time (seconds since the Unix epoch).
+    pub started_unix: u64,
+    /// Wall-clock seconds of the whole suite.
+    pub wall_seconds: f64,
+}
+
+/// What [`run_suite`] reports as it goes.
+#[derive(Clone, Debug)]
+pub struct Progress {
+    /// Steps done (references and renders).
+    pub done: u64,
+    /// All steps.
+    pub total: u64,
+    /// What is being done next.
+    pub message: String,
+}
+
+/// Options of [`run_suite`] beyond the suite itself.
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    /// Directory of the suite file: scene and reference paths are relative to it.
+    pub suite_dir: PathBuf,
+    /// Output directory (references are cached in its `references/`).
+    pub out: PathBuf,
+    /// The command line, for the report.
+    pub command_line: String,
+}
+
+/// Stable 64-bit FNV-1a hash (for cache keys that must not change between Rust versions).
+pub fn fnv1a(chunks: &[&[u8]]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for chunk in chunks {
+        for &b in *chunk {
+            h ^= b as u64;
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        // Separate chunks so that ("ab", "c") and ("a", "bc") differ.
+        h ^= 0xff;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+/// `VmHWM` of this process in KiB, if `/proc` has it.
+fn vm_hwm_kib() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    line.split_whitespace().nth(1)?.parse().ok()
+}
+
+/// Resets `VmHWM` to the current resident set; `false` where the kernel does not allow it.
+fn reset_peak_rss() -> bool {
+    std::fs::write("/proc/self/clear_refs", "5").is_ok()
+}
+
+fn mib(kib: Option<u64>) -> f64 {
+    kib.map_or(f64::NAN, |k| k as f64 / 1024.0)
+}
+
+fn cpu_model() -> (String, usize) {
+    let info = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let model = info
+        .lines()
+        .find(|l| l.starts_with("model name"))
+        .and_then(|l| l.split_once(':'))
+        .map(|(_, v)| v.trim().to_string())
+        .unwrap_or_else(|| "unknown CPU".into());
+    let cores = info
+        .lines()
+        .filter(|l| l.starts_with("processor"))
+        .count()
+        .max(std::thread::available_parallelism().map_or(1, |n| n.get()));
+    (model, cores)
+}
+
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|| "unknown".into())
+}
+
+/// A scene loaded with the suite's overrides.
+struct LoadedSuiteScene {
+    name: String,
+    scene: Scene,
+    file_bytes: Vec<u8>,
+}
+
+fn load_suite_scene(entry: &SuiteScene, suite_dir: &Path) -> Result<LoadedSuiteScene, String> {
+    let path = suite_dir.join(&entry.path);
+    let file_bytes =
+        std::fs::read(&path).map_err(|e| format!("{}: cannot read scene: {e}", path.display()))?;
+    let (mut desc, _warnings) = load_desc(&path, &[]).map_err(|e| e.to_string())?;
+    if let Some(w) = entry.width {
+        desc.film.width = w;
+    }
+    if let Some(h) = entry.height {
+        desc.film.height = h;
+    }
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let scene = Scene::build(&desc, &base, &path).map_err(|e| e.to_string())?;
+    Ok(LoadedSuiteScene {
+        name: entry.display_name(),
+        scene,
+        file_bytes,
+    })
+}
+
+fn options_for(config: &IntegratorConfig, entry: &SuiteScene) -> IntegratorOptions {
+    IntegratorOptions {
+        name: Some(config.integrator.clone()),
+        max_depth: entry.max_depth,
+        params: config.params.clone(),
+    }
+}
+
+/// Builds a configuration's integrator for a scene; parameters it does not use are an error
+/// (a typo would otherwise benchmark the defaults under the wrong label).
+fn build_integrator(
+    scene: &Scene,
+    config: &IntegratorConfig,
+    entry: &SuiteScene,
+) -> Result<Box<dyn restir_integrators::Integrator>, String> {
+    let made = make_integrator(scene, &options_for(config, entry))
+        .map_err(|e| format!("integrator '{}': {e}", config.label))?;
+    if let Some(p) = made
+        .unused_params
+        .iter()
+        .find(|p| config.params.iter().any(|(k, _)| k == *p))
+    {
+        return Err(format!(
+            "integrator '{}': {} does not use the parameter '{p}'",
+            config.label, config.integrator
+        ));
+    }
+    Ok(made.integrator)
+}
+
+fn crop_rect(entry: &SuiteScene, width: u32, height: u32) -> Result<(u32, u32, u32, u32), String> {
+    match entry.crop {
+        Some((x, y, w, h)) => {
+            if x.checked_add(w).is_none_or(|r| r > width)
+                || y.checked_add(h).is_none_or(|b| b > height)
+            {
+                Err(format!(
+                    "{}: crop ({x}, {y}, {w}, {h}) does not fit in {width}×{height}",
+                    entry.path.display()
+                ))
+            } else {
+                Ok((x, y, w, h))
+            }
+        }
+        None => {
+            let (w, h) = ((width / 2).max(1), (height / 2).max(1));
+            Ok(((width - w) / 2, (height - h) / 2, w, h))
+        }
+    }
+}
+
+fn crop(image: &Image, (x0, y0, w, h): (u32, u32, u32, u32)) -> Image {
+    let mut out = Image::new(w, h);
+    for y in 0..h {
+        for x in 0..w {
+            out.pixels[(y * w + x) as usize] = image.get(x0 + x, y0 + y);
+        }
+    }
+    out
+}
+
+fn render_once(
+    scene: &Scene,
+    integrator: &dyn restir_integrators::Integrator,
+    settings: &RenderSettings,
+) -> restir_integrators::RenderOutput {
+    render(
+        scene,
+        integrator,
+        settings,
+        &AtomicBool::new(false),
+        &mut |_, _| {},
+    )
+}
+
+/// Loads, or renders and caches, the reference of one scene.
+fn reference_for(
+    entry: &SuiteScene,
+    loaded: &LoadedSuiteScene,
+    suite: &Suite,
+    opts: &RunOptions,
+) -> Result<(Image, ReferenceInfo), String> {
+    let (w, h) = loaded.scene.camera.resolution();
+    if let Some(given) = &entry.reference {
+        let path = opts.suite_dir.join(given);
+        let image = Image::read_exr(&path).map_err(|e| e.to_string())?;
+        if (image.width, image.height) != (w, h) {
+            return Err(format!(
+                "{}: reference is {}×{} but the scene renders {w}×{h}",
+                path.display(),
+                image.width,
+                image.height
+            ));
+        }
+        return Ok((
+            image,
+            ReferenceInfo {
+                scene: loaded.name.clone(),
+                path,
+                spp: None,
+                noise_relmse: None,
+                reused: true,
+                seconds: 0.0,
+            },
+        ));
+    }
+    let spp = entry.reference_spp.unwrap_or(suite.reference_spp);
+    let depth = entry
+        .max_depth
+        .map_or("scene".to_string(), |d| d.to_string());
+    let key = fnv1a(&[
+        &loaded.file_bytes,
+        format!("{w}x{h} max_depth={depth} spp={spp} path-halves-v1").as_bytes(),
+    ]);
+    let dir = opts.out.join("references");
+    let stem = format!("{}-{key:016x}", loaded.name);
+    let exr = dir.join(format!("{stem}.exr"));
+    let noise_file = dir.join(format!("{stem}.noise"));
+    // A cached reference needs its EXR (of the right size) and its noise estimate.
+    let cached = || -> Option<(Image, f64)> {
+        let noise = std::fs::read_to_string(&noise_file)
+            .ok()?
+            .trim()
+            .parse::<f64>()
+            .ok()?;
+        let image = Image::read_exr(&exr).ok()?;
+        ((image.width, image.height) == (w, h)).then_some((image, noise))
+    };
+    if let Some((image, noise)) = cached() {
+        return Ok((
+            image,
+            ReferenceInfo {
+                scene: loaded.name.clone(),
+                path: exr,
+                spp: Some(spp),
+                noise_relmse: Some(noise),
+                reused: true,
+                seconds: 0.0,
+            },
+        ));
+    }
+    std::fs::create_dir_all(&dir)
+        .map_err(|e| format!("{}: cannot create directory: {e}", dir.display()))?;
+    let path_config = IntegratorConfig {
+        label: "reference".into(),
+        integrator: "path".into(),
+        params: Vec::new(),
+    };
+    let integrator = build_integrator(&loaded.scene, &path_config, entry)?;
+    let start = Instant::now();
+    let halves: Vec<Image> = REFERENCE_SEEDS
+        .iter()
+        .map(|&seed| {
+            let settings = RenderSettings {
+                spp: spp / 2,
+                time_limit: None,
+                seed,
+            };
+            render_once(&loaded.scene, integrator.as_ref(), &settings).image
+        })
+        .collect();
+    let seconds = start.elapsed().as_secs_f64();
+    let mut image = Image::new(w, h);
+    for (i, p) in image.pixels.iter_mut().enumerate() {
+        *p = 0.5 * (halves[0].pixels[i] + halves[1].pixels[i]);
+    }
+    let noise = compare(&halves[0], &halves[1]).map_or(f64::NAN, |m| m.relmse / 4.0);
+    image.write(&exr).map_err(|e| e.to_string())?;
+    std::fs::write(&noise_file, format!("{noise:e}\n"))
+        .map_err(|e| format!("{}: {e}", noise_file.display()))?;
+    Ok((
+        image,
+        ReferenceInfo {
+            scene: loaded.name.clone(),
+            path: exr,
+            spp: Some(spp),
+            noise_relmse: Some(noise),
+            reused: false,
+            seconds,
+        },
+    ))
+}
+
+/// Runs every render of `suite` in the current rayon pool, calling `progress` before each step.
+pub fn run_suite(
+    suite: &Suite,
+    opts: &RunOptions,
+    progress: &mut dyn FnMut(&Progress),
+) -> Result<BenchResults, String> {
+    suite.validate()?;
+    let started_unix = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let wall = Instant::now();
+    let (cpu, cores) = cpu_model();
+    let load_start = load_average();
+    let peak_reset = reset_peak_rss();
+
+    // Load every scene and build every integrator once up front, so that a bad scene or
+    // parameter fails in seconds rather than after an hour of rendering.
+    let mut scenes = Vec::new();
+    for entry in &suite.scenes {
+        let loaded = load_suite_scene(entry, &opts.suite_dir)?;
+        for config in &suite.integrators {
+            build_integrator(&loaded.scene, config, entry)?;
+        }
+        let (w, h) = loaded.scene.camera.resolution();
+        let rect = crop_rect(entry, w, h)?;
+        scenes.push((entry, loaded, rect));
+    }
+
+    let per_scene = (suite.budgets.len() * suite.integrators.len()) as u64 * suite.seeds as u64;
+    let total = scenes.len() as u64 * (1 + per_scene);
+    let mut done = 0u64;
+    let strip_budget = suite
+        .strip_budget
+        .unwrap_or_else(|| suite.budgets.iter().copied().fold(f64::INFINITY, f64::min));
+
+    let mut records = Vec::new();
+    let mut references = Vec::new();
+    let mut strips = Vec::new();
+    for (entry, loaded, rect) in &scenes {
+        let (w, h) = loaded.scene.camera.resolution();
+        progress(&Progress {
+            done,
+            total,
+            message: format!("{}: reference", loaded.name),
+        });
+        let (reference, info) = reference_for(entry, loaded, suite, opts)?;
+        done += 1;
+        references.push(info);
+        let mut strip_crops: Vec<Option<Image>> = vec![None; suite.integrators.len()];
+        let integrators = suite
+            .integrators
+            .iter()
+            .map(|c| build_integrator(&loaded.scene, c, entry))
+            .collect::<Result<Vec<_>, _>>()?;
+        // Seeds outermost, so that a load spike on the shared machine hits every configuration
+        // and budget rather than all seeds of one.
+        for seed in 0..suite.seeds as u64 {
+            for &budget in &suite.budgets {
+                for (ci, config) in suite.integrators.iter().enumerate() {
+                    progress(&Progress {
+                        done,
+                        total,
+                        message: format!(
+                            "{}: {} {budget} s seed {seed}",
+                            loaded.name, config.label
+                        ),
+                    });
+                    let integrator = integrators[ci].as_ref();
+                    let settings = RenderSettings {
+                        spp: u32::MAX,
+                        time_limit: Some(Duration::from_secs_f64(budget)),
+                        seed,
+                    };
+                    reset_peak_rss();
+                    let before = vm_hwm_kib();
+                    let out = render_once(&loaded.scene, integrator, &settings);
+                    let after = vm_hwm_kib();
+                    let m = compare(&out.image, &reference).ok_or("reference size mismatch")?;
+                    if seed == 0 && budget == strip_budget {
+                        strip_crops[ci] = Some(crop(&out.image, *rect));
+                    }
+                    records.push(RunRecord {
+                        scene: loaded.name.clone(),
+                        label: config.label.clone(),
+                        describe: integrator.describe(),
+                        width: w,
+                        height: h,
+                        budget,
+                        seed,
+                        seconds: out.seconds,
+                        passes: out.passes,
+                        rays: out.rays,
+                        relmse: m.relmse,
+                        mse: m.mse,
+                        mean_ratio: m.mean_ratio,
+                        nonfinite: m.nonfinite,
+                        rss_before_mib: mib(before),
+                        peak_rss_mib: mib(after),
+                    });
+                    done += 1;
+                }
+            }
+        }
+        let mut crops = vec![crop(&reference, *rect)];
+        crops.extend(strip_crops.into_iter().flatten());
+        strips.push(Strip {
+            scene: loaded.name.clone(),
+            crop: *rect,
+            budget: strip_budget,
+            crops,
+        });
+    }
+    progress(&Progress {
+        done,
+        total,
+        message: "writing outputs".into(),
+    });
+    Ok(BenchResults {
+        suite: suite.clone(),
+        records,
+        references,
+        strips,
+        machine: Machine {
+            cpu,
+            cores,
+            threads: rayon::current_num_threads(),
+            load_start,
+            load_end: load_average(),
+            peak_reset,
+        },
+        command_line: opts.command_line.clone(),
+        started_unix,
+        wall_seconds: wall.elapsed().as_secs_f64(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fnv_is_stable_and_chunked() {
+        assert_eq!(fnv1a(&[]), 0xcbf2_9ce4_8422_2325);
+        assert_ne!(fnv1a(&[b"ab", b"c"]), fnv1a(&[b"a", b"bc"]));
+        assert_eq!(fnv1a(&[b"scene"]), fnv1a(&[b"scene"]));
+    }
+
+    #[test]
+    fn default_crop_is_central_quarter() {
+        let entry = SuiteScene {
+            path: "a.xml".into(),
+            name: None,
+            width: None,
+            height: None,
+            max_depth: None,
+            reference: None,
+            reference_spp: None,
+            crop: None,
+        };
+        assert_eq!(crop_rect(&entry, 64, 32).unwrap(), (16, 8, 32, 16));
+        let bad = SuiteScene {
+            crop: Some((60, 0, 8, 8)),
+            ..entry
+        };
+        assert!(crop_rect(&bad, 64, 32).is_err());
+    }
+}

@@ -1,0 +1,251 @@
+//! The suite file: scenes × integrator configurations × time budgets × seeds (RON, strict).
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+/// A benchmark suite as written in a `.ron` file. Unknown fields are an error; `Option` fields
+/// may be written bare (`width: 128`) or as `Some(128)`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Suite {
+    /// Scenes to render.
+    pub scenes: Vec<SuiteScene>,
+    /// Integrator configurations; each renders every scene.
+    pub integrators: Vec<IntegratorConfig>,
+    /// Time budgets in seconds (each render stops starting passes once its budget is spent).
+    pub budgets: Vec<f64>,
+    /// Seeds per (scene, configuration, budget): seeds `0..seeds`.
+    #[serde(default = "one")]
+    pub seeds: u32,
+    /// Passes of the path-traced reference (rendered as two halves with different seeds), for
+    /// scenes without a reference EXR.
+    #[serde(default = "default_reference_spp")]
+    pub reference_spp: u32,
+    /// Budget whose first-seed renders go into the crop strips (default: the smallest budget).
+    #[serde(default)]
+    pub strip_budget: Option<f64>,
+}
+
+/// One scene of a suite.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SuiteScene {
+    /// Scene file (`.xml` or `.ron`), relative to the suite file.
+    pub path: PathBuf,
+    /// Name in the outputs (default: the file stem).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Image width; overrides the scene's.
+    #[serde(default)]
+    pub width: Option<u32>,
+    /// Image height; overrides the scene's.
+    #[serde(default)]
+    pub height: Option<u32>,
+    /// Longest path; overrides the scene's (for every configuration and the reference).
+    #[serde(default)]
+    pub max_depth: Option<i32>,
+    /// Reference EXR, relative to the suite file; default: a cached path-traced reference.
+    #[serde(default)]
+    pub reference: Option<PathBuf>,
+    /// Reference passes for this scene; overrides the suite's `reference_spp`.
+    #[serde(default)]
+    pub reference_spp: Option<u32>,
+    /// Crop rectangle `(x, y, width, height)` in pixels for the image strip (default: the
+    /// central quarter of the image).
+    #[serde(default)]
+    pub crop: Option<(u32, u32, u32, u32)>,
+}
+
+/// One integrator configuration: what `IntegratorOptions` takes, plus a label.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IntegratorConfig {
+    /// Name in the outputs (unique within the suite).
+    pub label: String,
+    /// Estimator: `path`, `restir-di`, …
+    pub integrator: String,
+    /// Estimator parameters as `("name", "value")`, as `restir render --NAME VALUE` sets them.
+    #[serde(default)]
+    pub params: Vec<(String, String)>,
+}
+
+fn one() -> u32 {
+    1
+}
+
+fn default_reference_spp() -> u32 {
+    4096
+}
+
+impl IntegratorConfig {
+    /// The parameters as `name=value` joined by spaces (empty for none).
+    pub fn params_string(&self) -> String {
+        self.params
+            .iter()
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+}
+
+impl SuiteScene {
+    /// The scene's name in the outputs.
+    pub fn display_name(&self) -> String {
+        self.name.clone().unwrap_or_else(|| {
+            self.path
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("scene")
+                .to_string()
+        })
+    }
+}
+
+impl Suite {
+    /// Parses a suite; errors read `file:line:column: message`.
+    pub fn parse(text: &str, file: &Path) -> Result<Suite, String> {
+        let suite: Suite = ron::Options::default()
+            .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+            .from_str(text)
+            .map_err(|e| {
+                format!(
+                    "{}:{}:{}: {}",
+                    file.display(),
+                    e.span.start.line,
+                    e.span.start.col,
+                    e.code
+                )
+            })?;
+        suite
+            .validate()
+            .map_err(|m| format!("{}: {m}", file.display()))?;
+        Ok(suite)
+    }
+
+    /// Reads and parses a suite file.
+    pub fn load(file: &Path) -> Result<Suite, String> {
+        let text = std::fs::read_to_string(file)
+            .map_err(|e| format!("{}: cannot read suite: {e}", file.display()))?;
+        Self::parse(&text, file)
+    }
+
+    /// Checks what the format cannot: non-empty lists, positive budgets, unique names.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.scenes.is_empty() {
+            return Err("the suite has no scenes".into());
+        }
+        if self.integrators.is_empty() {
+            return Err("the suite has no integrators".into());
+        }
+        check_budgets(&self.budgets)?;
+        if self.seeds == 0 || self.seeds > 10_000 {
+            return Err(format!("seeds {}: expected 1 to 10000", self.seeds));
+        }
+        let check_spp = |spp: u32| {
+            if (2..=1 << 24).contains(&spp) {
+                Ok(())
+            } else {
+                Err(format!("reference_spp {spp}: expected 2 to 16777216"))
+            }
+        };
+        check_spp(self.reference_spp)?;
+        if let Some(b) = self.strip_budget.filter(|b| !self.budgets.contains(b)) {
+            return Err(format!("strip_budget {b} is not one of the budgets"));
+        }
+        let mut names = Vec::new();
+        for s in &self.scenes {
+            let name = s.display_name();
+            if names.contains(&name) {
+                return Err(format!("two scenes are named '{name}': give one a `name`"));
+            }
+            if name.is_empty()
+                || !name
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
+            {
+                return Err(format!(
+                    "scene name '{name}': use letters, digits, '-', '_' or '.'"
+                ));
+            }
+            names.push(name);
+            for (what, v) in [("width", s.width), ("height", s.height)] {
+                if v.is_some_and(|v| !(1..=16384).contains(&v)) {
+                    return Err(format!("{}: {what} must be 1 to 16384", s.path.display()));
+                }
+            }
+            if let Some(spp) = s.reference_spp {
+                check_spp(spp)?;
+            }
+            if s.crop.is_some_and(|(_, _, w, h)| w == 0 || h == 0) {
+                return Err(format!("{}: empty crop rectangle", s.path.display()));
+            }
+        }
+        let mut labels: Vec<&str> = Vec::new();
+        for c in &self.integrators {
+            if c.label.is_empty() || labels.contains(&c.label.as_str()) {
+                return Err(format!(
+                    "integrator label '{}' is empty or used twice",
+                    c.label
+                ));
+            }
+            if c.label.contains(['\n', '"', '|']) {
+                return Err(format!(
+                    "integrator label '{}': no newlines, quotes or '|'",
+                    c.label
+                ));
+            }
+            labels.push(&c.label);
+        }
+        Ok(())
+    }
+}
+
+/// Budgets must be positive, finite and at most a day.
+pub fn check_budgets(budgets: &[f64]) -> Result<(), String> {
+    if budgets.is_empty() {
+        return Err("no time budgets".into());
+    }
+    for &b in budgets {
+        if !(b.is_finite() && b > 0.0 && b <= 86_400.0) {
+            return Err(format!(
+                "time budget {b}: expected a positive number of seconds (at most 86400)"
+            ));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"(
+        scenes: [(path: "a.xml", width: 32, height: Some(16))],
+        integrators: [(label: "path", integrator: "path"),
+                      (label: "di", integrator: "restir-di", params: [("candidates", "8")])],
+        budgets: [0.5, 1.0],
+    )"#;
+
+    #[test]
+    fn parses_with_defaults() {
+        let s = Suite::parse(GOOD, Path::new("s.ron")).unwrap();
+        assert_eq!(s.seeds, 1);
+        assert_eq!(s.reference_spp, 4096);
+        assert_eq!(s.scenes[0].width, Some(32));
+        assert_eq!(s.scenes[0].height, Some(16));
+        assert_eq!(s.scenes[0].display_name(), "a");
+        assert_eq!(s.integrators[1].params_string(), "candidates=8");
+    }
+
+    #[test]
+    fn errors_name_file_and_line() {
+        let bad = GOOD.replace("budgets", "\n budgetz");
+        let e = Suite::parse(&bad, Path::new("s.ron")).unwrap_err();
+        assert!(e.starts_with("s.ron:6:2:"), "{e}");
+        let e = Suite::parse(&GOOD.replace("0.5", "-1.0"), Path::new("s.ron")).unwrap_err();
+        assert!(e.contains("time budget -1"), "{e}");
+        let e = Suite::parse(&GOOD.replace("\"di\"", "\"path\""), Path::new("s.ron")).unwrap_err();
+        assert!(e.contains("used twice"), "{e}");
+    }
+}

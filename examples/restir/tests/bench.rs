@@ -1,0 +1,220 @@
+//! `restir bench` end to end on the smoke suite (tiny images, 0.2 s budgets, 64-pass references
+//! rendered into a temporary directory), and its errors on bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicU32, Ordering};
+
+const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
+
+fn repo(rel: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(rel)
+}
+
+/// A fresh directory under the system temp dir, removed when dropped.
+struct TempDir(PathBuf);
+
+impl std::ops::Deref for TempDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn temp_dir(tag: &str) -> TempDir {
+    static COUNTER: AtomicU32 = AtomicU32::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("restir-bench-{}-{n}-{tag}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    TempDir(dir)
+}
+
+fn restir(args: &[&str]) -> Output {
+    Command::new(RESTIR).args(args).output().unwrap()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Expects exit code 1 and one stderr line containing every needle.
+fn fails(args: &[&str], needles: &[&str]) -> String {
+    let out = restir(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(
+        !stderr.contains("panicked"),
+        "{args:?}: panicked:\n{stderr}"
+    );
+    assert_eq!(out.status.code(), Some(1), "{args:?}: stderr:\n{stderr}");
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(
+        lines.len(),
+        1,
+        "{args:?}: expected one line, got:\n{stderr}"
+    );
+    for n in needles {
+        assert!(lines[0].contains(n), "{args:?}: {:?} lacks {n:?}", lines[0]);
+    }
+    lines[0].to_string()
+}
+
+/// Splits a CSV line without quoted commas (the smoke suite's labels and settings have none).
+fn fields(line: &str) -> Vec<&str> {
+    line.split(',').collect()
+}
+
+#[test]
+fn smoke_suite_end_to_end() {
+    let dir = temp_dir("smoke");
+    let out_dir = dir.join("out");
+    let doc = dir.join("DOC.md");
+    std::fs::write(
+        &doc,
+        "# Hand-written\n\nKeep me.\n\n<!-- restir bench results begin -->\nold\n\
+         <!-- restir bench results end -->\n\n## After\n\nKeep me too.\n",
+    )
+    .unwrap();
+    let suite = repo("scenes/bench/smoke.ron");
+    let args = [
+        "bench",
+        s(&suite),
+        "--out",
+        s(&out_dir),
+        "--update-doc",
+        s(&doc),
+    ];
+    let out = restir(&args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "stderr:\n{stderr}");
+
+    // CSV: header, one row per scene × configuration × budget × seed, numbers that parse.
+    let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header = fields(lines.next().unwrap());
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<&str>> = lines.map(fields).collect();
+    assert_eq!(rows.len(), 2 * 3, "{csv}");
+    let scenes: Vec<&str> = rows.iter().map(|r| r[col("scene")]).collect();
+    assert!(scenes.contains(&"cornell-box") && scenes.contains(&"many-lights"));
+    for r in &rows {
+        assert_eq!(r.len(), header.len(), "{r:?}");
+        let num = |name: &str| r[col(name)].parse::<f64>().unwrap();
+        assert!(num("relmse") > 0.0 && num("relmse").is_finite(), "{r:?}");
+        assert!(num("seconds") >= 0.2, "{r:?}");
+        assert!(num("passes") >= 1.0 && num("rays") > 0.0, "{r:?}");
+        assert!((num("mean_ratio") - 1.0).abs() < 0.5, "{r:?}");
+        assert!(num("reference_noise_relmse") > 0.0, "{r:?}");
+        assert_eq!(num("nonfinite_pixels"), 0.0);
+        assert_eq!(num("budget_s"), 0.2);
+    }
+
+    for scene in ["cornell-box", "many-lights"] {
+        let svg = std::fs::read_to_string(out_dir.join(format!("relmse-{scene}.svg"))).unwrap();
+        assert!(svg.contains("<svg") && svg.trim_end().ends_with("</svg>"));
+        assert!(
+            svg.contains("restir-di tuned"),
+            "legend lacks a configuration"
+        );
+        let png = std::fs::read(out_dir.join(format!("strip-{scene}.png"))).unwrap();
+        assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"));
+    }
+
+    let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    for needle in [
+        "restir bench /",
+        "smoke.ron --out",
+        "## cornell-box (24×24)",
+        "relmse-many-lights.svg",
+        "strip-cornell-box.png",
+        "| restir-di tuned |",
+        "equal-time ratio",
+        "own relMSE",
+    ] {
+        assert!(
+            report.contains(needle),
+            "report lacks {needle:?}:\n{report}"
+        );
+    }
+
+    // The document keeps its hand-written parts and links into the output directory.
+    let text = std::fs::read_to_string(&doc).unwrap();
+    assert!(text.starts_with("# Hand-written\n\nKeep me.\n"));
+    assert!(text.trim_end().ends_with("## After\n\nKeep me too."));
+    assert!(!text.contains("\nold\n"));
+    assert!(text.contains("](out/relmse-cornell-box.svg)"), "{text}");
+
+    // A second run reuses the cached references.
+    let out = restir(&["bench", s(&suite), "--out", s(&out_dir), "--quiet"]);
+    assert!(out.status.success());
+    let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    assert!(report.contains("64 passes (cached)"), "{report}");
+}
+
+#[test]
+fn bad_suites_fail_with_one_line() {
+    let dir = temp_dir("bad");
+    let bad = dir.join("bad.ron");
+    std::fs::write(
+        &bad,
+        "(\n    scenes: [],\n    integratorz: [],\n    budgets: [1.0],\n)\n",
+    )
+    .unwrap();
+    fails(
+        &["bench", s(&bad), "--out", s(&dir)],
+        &["bad.ron:3:", "integratorz"],
+    );
+
+    let empty = dir.join("empty.ron");
+    std::fs::write(&empty, "(scenes: [], integrators: [], budgets: [1.0])").unwrap();
+    fails(
+        &["bench", s(&empty), "--out", s(&dir)],
+        &["empty.ron", "no scenes"],
+    );
+
+    let suite = repo("scenes/bench/smoke.ron");
+    fails(
+        &["bench", s(&suite), "--out", s(&dir), "--budgets", "0.1,-2"],
+        &["--budgets", "-2"],
+    );
+    fails(
+        &["bench", s(&dir.join("none.ron")), "--out", s(&dir)],
+        &["none.ron", "cannot read"],
+    );
+
+    // A misspelt parameter fails before anything renders.
+    let typo = dir.join("typo.ron");
+    let text = std::fs::read_to_string(&suite)
+        .unwrap()
+        .replace("\"../", &format!("\"{}/", s(&repo("scenes"))))
+        .replace("(\"neighbors\"", "(\"neighbours_x\"");
+    std::fs::write(&typo, text).unwrap();
+    fails(
+        &["bench", s(&typo), "--out", s(&dir.join("typo-out"))],
+        &["restir-di tuned", "neighbours_x"],
+    );
+    assert!(!dir.join("typo-out").exists());
+
+    // --update-doc without markers is an error before anything renders, naming the file.
+    let doc = dir.join("NOMARK.md");
+    std::fs::write(&doc, "# Nothing to replace\n").unwrap();
+    fails(
+        &[
+            "bench",
+            s(&suite),
+            "--out",
+            s(&dir.join("o")),
+            "--update-doc",
+            s(&doc),
+        ],
+        &["NOMARK.md", "marker"],
+    );
+    assert!(!dir.join("o").exists());
+}
