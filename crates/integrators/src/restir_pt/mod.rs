@@ -150,7 +150,13 @@ impl RestirPtIntegrator {
     }
 
     /// Initial sampling at receiver `r`: `N` walks, every light connection a candidate.
-    fn initial(&self, scene: &Scene, r: &Receiver, ng: Vec3, rng: &mut Pcg32) -> (PtReservoir, u64) {
+    fn initial(
+        &self,
+        scene: &Scene,
+        r: &Receiver,
+        ng: Vec3,
+        rng: &mut Pcg32,
+    ) -> (PtReservoir, u64) {
         let bsdf = &scene.bsdfs[r.bsdf as usize];
         let empty = Reservoir {
             confidence: 1.0,
@@ -454,18 +460,19 @@ impl RestirPtIntegrator {
             }
             let q = (ny * w + nx) as usize;
             if let Some(rq) = gbuf.receiver(q)
-                && r.is_similar(
-                    rq,
-                    self.settings.normal_cos,
-                    self.settings.depth_tolerance,
-                )
+                && r.is_similar(rq, self.settings.normal_cos, self.settings.depth_tolerance)
             {
                 neighbors.push((&indices[q], &input[q]));
             }
         }
-        resample(shift, self.settings.mis, &indices[index], canonical, neighbors, || {
-            rng.next_f32()
-        })
+        resample(
+            shift,
+            self.settings.mis,
+            &indices[index],
+            canonical,
+            neighbors,
+            || rng.next_f32(),
+        )
         .with_confidence_cap(self.settings.mcap)
     }
 
@@ -522,10 +529,16 @@ impl RestirPtIntegrator {
 /// tracer does it. Returns whether the path survives (`beta` is divided by the survival
 /// probability).
 #[inline]
-fn russian_roulette(beta: &mut Vec3, eta_scale: f32, depth: u32, rr_depth: u32, rng: &mut Pcg32) -> bool {
+fn russian_roulette(
+    beta: &mut Vec3,
+    eta_scale: f32,
+    depth: u32,
+    rr_depth: u32,
+    rng: &mut Pcg32,
+) -> bool {
     let u = rng.next_f32();
     let bmax = beta.max_element();
-    if !(bmax > 0.0) || !beta.is_finite() {
+    if !(bmax > 0.0 && beta.is_finite()) {
         return false;
     }
     if depth >= rr_depth {

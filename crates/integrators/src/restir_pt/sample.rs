@@ -192,11 +192,7 @@ pub fn evaluate_unshadowed(
             if f == Vec3::ZERO {
                 return (Vec3::ZERO, Target::None);
             }
-            let light_pdf = || {
-                scene
-                    .lights
-                    .pdf_sa(&scene.shapes, s.id, r.p, c.p, c.ng)
-            };
+            let light_pdf = || scene.lights.pdf_sa(&scene.shapes, s.id, r.p, c.p, c.ng);
             let w = match (s.kind, c.delta) {
                 (Kind::DirectNee, true) => 1.0,
                 (Kind::DirectNee, false) => power_heuristic(light_pdf(), bsdf1.pdf_sa(r.wo, wi)),
@@ -213,7 +209,7 @@ pub fn evaluate_unshadowed(
         Vertex::Surface(si) => {
             let to = si.p - r.p;
             let d2 = to.length_squared();
-            if !(d2 > 0.0) {
+            if d2.is_nan() || d2 <= 0.0 {
                 return (Vec3::ZERO, Target::None);
             }
             let w1 = to / d2.sqrt();
@@ -310,13 +306,13 @@ impl PtShift<'_> {
             }
             None => 1.0,
         };
-        if !(jacobian > 0.0) {
+        if jacobian.is_nan() || jacobian <= 0.0 {
             return None;
         }
         let jacobian = if self.unit_jacobian { 1.0 } else { jacobian };
         let (f, target) = evaluate_unshadowed(self.scene, dst, s, &v);
         let mut p = luminance(f);
-        if !(p > 0.0 && p.is_finite()) || !visible(self.scene, dst, self.gbuf.ng[to], target) {
+        if !(p > 0.0 && p.is_finite() && visible(self.scene, dst, self.gbuf.ng[to], target)) {
             p = 0.0;
         }
         Some((p, jacobian, if p > 0.0 { f } else { Vec3::ZERO }))
