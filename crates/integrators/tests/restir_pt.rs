@@ -22,6 +22,21 @@ const SIZE: u32 = 24;
 const BLOCK: u32 = 8;
 
 fn scene() -> Scene {
+    scene_with("")
+}
+
+/// The room with a smooth glass sphere and a smooth plastic sphere: delta lobes at primary hits
+/// (path traced) and at reconnection vertices (paths that cannot be shifted).
+fn glass_scene() -> Scene {
+    scene_with(
+        r#"(geometry: Sphere(center: (-0.6, 0.45, 0.6), radius: 0.4),
+             material: Some(Inline(Dielectric()))),
+            (geometry: Sphere(center: (0.9, 1.2, -0.3), radius: 0.3),
+             material: Some(Inline(Plastic(diffuse_reflectance: (0.3, 0.6, 0.3))))),"#,
+    )
+}
+
+fn scene_with(extra: &str) -> Scene {
     let ron = format!(
         r#"(
         camera: (fov: 55, to_world: [LookAt(origin: (0, 1, 4.5), target: (0, 0.7, 0), up: (0, 1, 0))]),
@@ -49,6 +64,7 @@ fn scene() -> Scene {
              roughness: (alpha: 0.1))))),
             (geometry: Rectangle, to_world: [Scale((0.5, 0.5, 1)), Rotate(axis: (1, 0, 0), angle: -90),
              Translate((0, 0.05, -1.4))], emission: Some((20, 20, 20))),
+            {extra}
         ],
         lights: [
             Constant(radiance: (0.02, 0.03, 0.05)),
@@ -154,7 +170,14 @@ fn integrator(max_depth: i32) -> RestirPtIntegrator {
 /// pixels the forward shift succeeds iff the inverse does and their Jacobians multiply to 1.
 #[test]
 fn shift_identity_and_round_trip_on_scene_paths() {
-    let scene = scene();
+    let kinds = check_shifts(&scene());
+    assert!(kinds[Kind::Continue as usize] > 100 && kinds[Kind::DirectNee as usize] > 0);
+    let kinds = check_shifts(&glass_scene());
+    assert!(kinds[Kind::Frozen as usize] > 0, "{kinds:?}");
+}
+
+/// Runs the shift checks on four passes of `scene`; returns how many reservoirs hold each kind.
+fn check_shifts(scene: &Scene) -> [usize; 6] {
     let pt = integrator(-1);
     let filter = Filter::new(scene.filter);
     let (mut identity, mut kinds, mut pairs, mut both, mut one_way) = (0, [0usize; 6], 0, 0, 0);
@@ -164,8 +187,8 @@ fn shift_identity_and_round_trip_on_scene_paths() {
             pass,
             filter: &filter,
         };
-        let (gbuf, reservoirs, _, _) = pt.initial_reservoirs(&scene, &ctx);
-        let shift = pt.shift_map(&scene, &gbuf);
+        let (gbuf, reservoirs, _, _) = pt.initial_reservoirs(scene, &ctx);
+        let shift = pt.shift_map(scene, &gbuf);
         let n = reservoirs.len();
         let mut rng = Pcg32::new(11, u64::from(pass));
         for (i, res) in reservoirs.iter().enumerate() {
@@ -213,7 +236,7 @@ fn shift_identity_and_round_trip_on_scene_paths() {
     );
     assert!(identity > 500, "too few identity checks: {identity}");
     assert!(both > 500, "too few successful shifts: {both}");
-    assert!(kinds[Kind::Continue as usize] > 100 && kinds[Kind::DirectNee as usize] > 0);
+    kinds
 }
 
 #[test]
@@ -277,6 +300,17 @@ fn unbiased_with_unbounded_depth() {
         z > 2.0 * Z_MAX,
         "indirect light should be detectable: {z:.2}"
     );
+}
+
+/// Delta lobes: glass and smooth plastic at primary hits and at reconnection vertices.
+#[test]
+fn unbiased_with_glass() {
+    let scene = glass_scene();
+    let reference = statistics(&scene, "path", &[("max_depth", "5")], 128, 64);
+    let pt = statistics(&scene, "restir-pt", &[("max_depth", "5")], 1, 400);
+    let z = max_z(&pt, &reference);
+    eprintln!("glass, max_depth 5: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "glass: max |z| = {z:.2}");
 }
 
 #[test]
