@@ -51,7 +51,7 @@ struct RenderArgs {
     /// filename from the scene, else <scene name>.exr.
     #[arg(short = 'o', long = "output")]
     output: Option<PathBuf>,
-    /// Estimator: path or restir-di (default: the scene's, else path).
+    /// Estimator: path, restir-di or restir-pt (default: the scene's, else path).
     #[arg(long)]
     integrator: Option<String>,
     /// Passes (samples per pixel); overrides the scene.
