@@ -92,7 +92,8 @@ struct RenderArgs {
 #[derive(clap::Args, Debug)]
 #[command(next_help_heading = "ReSTIR")]
 struct RestirArgs {
-    /// Light candidates per pixel in initial resampling [default: 32].
+    /// Initial candidates per pixel: light samples for restir-di [default: 32], paths for
+    /// restir-pt [default: 1].
     #[arg(long)]
     candidates: Option<u32>,
     /// BSDF samples per pixel, MIS-combined with the reservoirs [default: 1].
@@ -120,6 +121,9 @@ struct RestirArgs {
     /// Drop occluded initial candidates (biased at shadow edges).
     #[arg(long)]
     visibility_reuse: bool,
+    /// restir-pt shift map: reconnection (the only one implemented).
+    #[arg(long)]
+    shift: Option<String>,
 }
 
 impl RestirArgs {
@@ -145,6 +149,7 @@ impl RestirArgs {
             "visibility_reuse",
             self.visibility_reuse.then(|| "true".into()),
         );
+        put("shift", self.shift.clone());
         p
     }
 }
