@@ -170,15 +170,18 @@ fn integrator(max_depth: i32) -> RestirPtIntegrator {
 /// pixels the forward shift succeeds iff the inverse does and their Jacobians multiply to 1.
 #[test]
 fn shift_identity_and_round_trip_on_scene_paths() {
-    let kinds = check_shifts(&scene());
+    let kinds = check_shifts(&scene(), integrator(-1));
     assert!(kinds[Kind::Continue as usize] > 100 && kinds[Kind::DirectNee as usize] > 0);
-    let kinds = check_shifts(&glass_scene());
+    let kinds = check_shifts(&glass_scene(), integrator(-1));
     assert!(kinds[Kind::Frozen as usize] > 0, "{kinds:?}");
+    // Symmetric Jacobian rejection keeps forward and inverse failures together.
+    let mut settings = *integrator(-1).settings();
+    settings.max_jacobian = 2.0;
+    check_shifts(&scene(), RestirPtIntegrator::new(settings));
 }
 
 /// Runs the shift checks on four passes of `scene`; returns how many reservoirs hold each kind.
-fn check_shifts(scene: &Scene) -> [usize; 6] {
-    let pt = integrator(-1);
+fn check_shifts(scene: &Scene, pt: RestirPtIntegrator) -> [usize; 6] {
     let filter = Filter::new(scene.filter);
     let (mut identity, mut kinds, mut pairs, mut both, mut one_way) = (0, [0usize; 6], 0, 0, 0);
     for pass in 0..4 {
@@ -235,7 +238,7 @@ fn check_shifts(scene: &Scene) -> [usize; 6] {
          visible one way only {one_way}"
     );
     assert!(identity > 500, "too few identity checks: {identity}");
-    assert!(both > 500, "too few successful shifts: {both}");
+    assert!(both > 200, "too few successful shifts: {both}");
     kinds
 }
 

@@ -107,6 +107,7 @@ impl RestirPtIntegrator {
             scene,
             gbuf,
             near_distance2: d * d,
+            max_jacobian: self.settings.max_jacobian,
             unit_jacobian: self.settings.unit_jacobian,
         }
     }
@@ -577,7 +578,7 @@ impl Integrator for RestirPtIntegrator {
         let s = &self.settings;
         format!(
             "restir-pt max_depth={} candidates={} neighbors={} radius={} spatial_rounds={} \
-             mis={} mcap={} shift=reconnection near_distance={}{}",
+             mis={} mcap={} shift=reconnection near_distance={} max_jacobian={}{}",
             s.path.max_depth,
             s.candidates,
             s.neighbors,
@@ -586,6 +587,7 @@ impl Integrator for RestirPtIntegrator {
             mis_name(s.mis),
             s.mcap,
             s.near_distance,
+            s.max_jacobian,
             if s.is_unbiased() { "" } else { " (biased)" }
         )
     }

@@ -30,7 +30,7 @@
 
 use glam::{Vec2, Vec3};
 use restir_geometry::{SurfaceInteraction, shadow_ray_between, shadow_ray_towards, surface_at};
-use restir_gris::jacobian::reconnection_jacobian_from_points;
+use restir_gris::jacobian::{reconnection_jacobian_from_points, reject_jacobian};
 use restir_gris::{ShiftMap, Shifted};
 use restir_materials::{Bsdf, BsdfKind};
 use restir_sampling::{luminance, warp::power_heuristic};
@@ -272,6 +272,8 @@ pub struct PtShift<'a> {
     pub gbuf: &'a GBuffer,
     /// Square of the shortest reconnection segment.
     pub near_distance2: f32,
+    /// Symmetric Jacobian rejection bound (`max(J, 1/J)`); 0 for none.
+    pub max_jacobian: f32,
     /// Negative control: Jacobian 1 (biased).
     pub unit_jacobian: bool,
 }
@@ -307,6 +309,9 @@ impl PtShift<'_> {
             None => 1.0,
         };
         if jacobian.is_nan() || jacobian <= 0.0 {
+            return None;
+        }
+        if self.max_jacobian > 0.0 && reject_jacobian(jacobian, self.max_jacobian) {
             return None;
         }
         let jacobian = if self.unit_jacobian { 1.0 } else { jacobian };

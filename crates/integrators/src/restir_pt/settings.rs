@@ -33,6 +33,9 @@ pub struct RestirPtSettings {
     /// Shortest reconnection segment, as a fraction of the scene's bounding-sphere radius
     /// (default 0.01).
     pub near_distance: f32,
+    /// Reject shifts whose Jacobian `J` has `max(J, 1/J)` above this (symmetric, so unbiased);
+    /// 0 (default) rejects none.
+    pub max_jacobian: f32,
     /// Negative control only: use Jacobian 1 in every shift (biased).
     pub unit_jacobian: bool,
 }
@@ -51,6 +54,7 @@ impl RestirPtSettings {
             normal_cos: 25f32.to_radians().cos(),
             depth_tolerance: 0.1,
             near_distance: 0.01,
+            max_jacobian: 0.0,
             unit_jacobian: false,
         }
     }
@@ -114,6 +118,13 @@ impl RestirPtSettings {
                 "depth_threshold" => self.depth_tolerance = parse_positive(name, v)?,
                 "near_distance" | "distance_threshold" => {
                     self.near_distance = parse_positive(name, v)?;
+                }
+                "max_jacobian" | "jacobian_threshold" => {
+                    let j = parse_positive(name, v)?;
+                    if j <= 1.0 {
+                        return Err(format!("{name} = {v}: expected a number above 1"));
+                    }
+                    self.max_jacobian = j;
                 }
                 "unit_jacobian" => self.unit_jacobian = parse_bool(name, v)?,
                 _ => unknown.push(name.clone()),
