@@ -264,6 +264,13 @@ fn unbiased_against_the_path_tracer() {
     );
     eprintln!("max_depth 4, 2 rounds × 5 neighbours, 2 candidates: max |z| = {z:.2}");
     assert!(z < Z_MAX, "2 rounds: max |z| = {z:.2}");
+    // Direct light path traced per pixel, the reservoirs carrying the rest.
+    let z = max_z(
+        &statistics(&scene, "restir-pt", &[("direct", "path")], 1, 400),
+        &reference,
+    );
+    eprintln!("max_depth 4, direct light path traced: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "direct = path: max |z| = {z:.2}");
     // Negative controls: the biased variants are caught by the same statistic.
     let uniform = statistics(&scene, "restir-pt", &[("mis", "uniform")], 1, 2000);
     for (a, b) in uniform.iter().zip(&reference) {

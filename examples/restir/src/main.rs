@@ -124,6 +124,13 @@ struct RestirArgs {
     /// restir-pt shift map: reconnection (the only one implemented).
     #[arg(long)]
     shift: Option<String>,
+    /// restir-pt: reject shifts with max(J, 1/J) above this (unbiased) [default: none].
+    #[arg(long)]
+    max_jacobian: Option<f32>,
+    /// restir-pt: direct light in the reservoirs (reservoir) or path traced per pixel (path)
+    /// [default: reservoir].
+    #[arg(long)]
+    direct: Option<String>,
 }
 
 impl RestirArgs {
@@ -150,6 +157,8 @@ impl RestirArgs {
             self.visibility_reuse.then(|| "true".into()),
         );
         put("shift", self.shift.clone());
+        put("max_jacobian", self.max_jacobian.map(|v| v.to_string()));
+        put("direct", self.direct.clone());
         p
     }
 }

@@ -58,11 +58,21 @@ pub struct RestirPtIntegrator {
 struct Candidates<'a> {
     stream: &'a mut StreamingReservoir<PathSample>,
     scale: f32,
+    /// Whether direct-light paths are path traced instead of resampled.
+    direct_path_traced: bool,
+    /// Their sum (already divided by the number of walks).
+    direct: Vec3,
 }
 
 impl Candidates<'_> {
     #[inline]
     fn push(&mut self, sample: PathSample, contribution: Vec3, rng: &mut Pcg32) {
+        if self.direct_path_traced && sample.is_direct() {
+            if contribution.is_finite() {
+                self.direct += contribution * self.scale;
+            }
+            return;
+        }
         let u = rng.next_f32();
         let w = luminance(contribution) * self.scale;
         if w > 0.0 && w.is_finite() {
@@ -131,15 +141,18 @@ impl RestirPtIntegrator {
             let w = gbuf.width;
             rays += current
                 .par_chunks_mut(w * BAND_ROWS)
+                .zip(radiance.par_chunks_mut(w * BAND_ROWS))
                 .enumerate()
-                .map(|(band, out)| {
+                .map(|(band, (out, rad))| {
                     let mut rays = 0;
-                    for (i, res) in out.iter_mut().enumerate() {
+                    for (i, (res, l)) in out.iter_mut().zip(rad.iter_mut()).enumerate() {
                         let index = band * w * BAND_ROWS + i;
                         if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
-                            let (init, nr) = self.initial(scene, r, gbuf.ng[index], &mut rng);
+                            let (init, direct, nr) =
+                                self.initial(scene, r, gbuf.ng[index], &mut rng);
                             *res = init;
+                            *l += direct;
                             rays += nr;
                         }
                     }
@@ -150,40 +163,44 @@ impl RestirPtIntegrator {
         (gbuf, current, radiance, rays)
     }
 
-    /// Initial sampling at receiver `r`: `N` walks, every light connection a candidate.
+    /// Initial sampling at receiver `r`: `N` walks, every light connection a candidate. Returns
+    /// the reservoir, the path-traced direct light (with `direct = path`) and the rays.
     fn initial(
         &self,
         scene: &Scene,
         r: &Receiver,
         ng: Vec3,
         rng: &mut Pcg32,
-    ) -> (PtReservoir, u64) {
+    ) -> (PtReservoir, Vec3, u64) {
         let bsdf = &scene.bsdfs[r.bsdf as usize];
         let empty = Reservoir {
             confidence: 1.0,
             ..Reservoir::empty()
         };
         if !bsdf.has_smooth_lobe() {
-            return (empty, 0);
+            return (empty, Vec3::ZERO, 0);
         }
         let n = self.settings.candidates;
         let mut stream = StreamingReservoir::new();
         let mut cands = Candidates {
             stream: &mut stream,
             scale: 1.0 / n as f32,
+            direct_path_traced: self.settings.direct_path_traced,
+            direct: Vec3::ZERO,
         };
         let mut rays = 0;
         for _ in 0..n {
             rays += self.walk(scene, r, ng, rng, &mut cands);
         }
+        let direct = cands.direct;
         let Some(y) = stream.selected().copied() else {
-            return (empty, rays);
+            return (empty, direct, rays);
         };
         let v = resolve_vertex(scene, &y);
         let (f, _) = evaluate_unshadowed(scene, r, &y, &v);
         let mut res = stream.finalize(luminance(f));
         res.confidence = 1.0;
-        (res, rays)
+        (res, direct, rays)
     }
 
     /// One random walk from the primary hit; streams its light connections. Returns the rays.
@@ -578,7 +595,7 @@ impl Integrator for RestirPtIntegrator {
         let s = &self.settings;
         format!(
             "restir-pt max_depth={} candidates={} neighbors={} radius={} spatial_rounds={} \
-             mis={} mcap={} shift=reconnection near_distance={} max_jacobian={}{}",
+             mis={} mcap={} shift=reconnection near_distance={} max_jacobian={} direct={}{}",
             s.path.max_depth,
             s.candidates,
             s.neighbors,
@@ -588,6 +605,11 @@ impl Integrator for RestirPtIntegrator {
             s.mcap,
             s.near_distance,
             s.max_jacobian,
+            if s.direct_path_traced {
+                "path"
+            } else {
+                "reservoir"
+            },
             if s.is_unbiased() { "" } else { " (biased)" }
         )
     }

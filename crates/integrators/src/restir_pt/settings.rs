@@ -36,6 +36,10 @@ pub struct RestirPtSettings {
     /// Reject shifts whose Jacobian `J` has `max(J, 1/J)` above this (symmetric, so unbiased);
     /// 0 (default) rejects none.
     pub max_jacobian: f32,
+    /// Path-trace the direct light at the primary hit (light sampling and BSDF sampling with
+    /// the power heuristic, per pixel) instead of carrying it in the reservoirs (`direct = path`;
+    /// default `reservoir`).
+    pub direct_path_traced: bool,
     /// Negative control only: use Jacobian 1 in every shift (biased).
     pub unit_jacobian: bool,
 }
@@ -55,6 +59,7 @@ impl RestirPtSettings {
             depth_tolerance: 0.1,
             near_distance: 0.01,
             max_jacobian: 0.0,
+            direct_path_traced: false,
             unit_jacobian: false,
         }
     }
@@ -125,6 +130,18 @@ impl RestirPtSettings {
                         return Err(format!("{name} = {v}: expected a number above 1"));
                     }
                     self.max_jacobian = j;
+                }
+                "direct" => {
+                    self.direct_path_traced = match v.to_ascii_lowercase().as_str() {
+                        "reservoir" | "reservoirs" => false,
+                        "path" => true,
+                        _ => {
+                            return Err(format!(
+                                "{name} = '{v}': expected reservoir or path (restir-di is not \
+                                 implemented)"
+                            ));
+                        }
+                    };
                 }
                 "unit_jacobian" => self.unit_jacobian = parse_bool(name, v)?,
                 _ => unknown.push(name.clone()),
