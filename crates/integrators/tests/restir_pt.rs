@@ -271,6 +271,13 @@ fn unbiased_against_the_path_tracer() {
     );
     eprintln!("max_depth 4, direct light path traced: max |z| = {z:.2}");
     assert!(z < Z_MAX, "direct = path: max |z| = {z:.2}");
+    // Temporal reuse across 4 passes (history capped at mcap), then spatial reuse.
+    let z = max_z(
+        &statistics(&scene, "restir-pt", &[("temporal", "true")], 4, 200),
+        &reference,
+    );
+    eprintln!("max_depth 4, temporal: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "temporal: max |z| = {z:.2}");
     // Negative controls: the biased variants are caught by the same statistic.
     let uniform = statistics(&scene, "restir-pt", &[("mis", "uniform")], 1, 2000);
     for (a, b) in uniform.iter().zip(&reference) {
@@ -333,7 +340,14 @@ fn same_image_for_one_and_two_threads() {
             .unwrap()
             .install(|| render_image(&scene, "restir-pt", params, 2, 5))
     };
-    for params in [&[][..], &[("spatial_rounds", "2"), ("mis", "balance")][..]] {
+    for params in [
+        &[][..],
+        &[
+            ("spatial_rounds", "2"),
+            ("mis", "balance"),
+            ("temporal", "true"),
+        ][..],
+    ] {
         assert!(
             run(1, params).pixels == run(2, params).pixels,
             "{params:?}: images differ between 1 and 2 threads"

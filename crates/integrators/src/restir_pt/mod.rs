@@ -18,10 +18,12 @@
 pub mod sample;
 mod settings;
 
+use std::sync::Mutex;
+
 use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
 use restir_geometry::{Ray, offset_ray_origin, shadow_ray_between, shadow_ray_towards};
-use restir_gris::{Reservoir, StreamingReservoir, resample};
+use restir_gris::{MisScheme, Reservoir, StreamingReservoir, resample};
 use restir_materials::LobeFlags;
 use restir_sampling::{Pcg32, luminance, sequences::r2, warp::power_heuristic};
 use restir_scene::Scene;
@@ -38,6 +40,7 @@ use sample::{evaluate_unshadowed, resolve_vertex};
 
 /// Random-stream stages (see [`PassContext::stage_rng`]).
 const STAGE_INITIAL: u64 = 101;
+const STAGE_TEMPORAL: u64 = 102;
 const STAGE_SHADE: u64 = 103;
 const STAGE_SPATIAL: u64 = 116;
 
@@ -47,11 +50,19 @@ const OFFSET_COUNT: usize = 8192;
 /// The reservoir type.
 pub type PtReservoir = Reservoir<PathSample>;
 
+/// What temporal reuse keeps from the previous pass.
+#[derive(Debug)]
+struct History {
+    gbuffer: GBuffer,
+    reservoirs: Vec<PtReservoir>,
+}
+
 /// The ReSTIR PT estimator (`--integrator restir-pt`).
 #[derive(Debug)]
 pub struct RestirPtIntegrator {
     settings: RestirPtSettings,
     offsets: Vec<Vec2>,
+    history: Mutex<Option<History>>,
 }
 
 /// Collects a walk's candidates.
@@ -94,7 +105,11 @@ impl RestirPtIntegrator {
                 offsets.push(p);
             }
         }
-        Self { settings, offsets }
+        Self {
+            settings,
+            offsets,
+            history: Mutex::new(None),
+        }
     }
 
     /// The settings.
@@ -116,6 +131,7 @@ impl RestirPtIntegrator {
         PtShift {
             scene,
             gbuf,
+            prev: None,
             near_distance2: d * d,
             max_jacobian: self.settings.max_jacobian,
             unit_jacobian: self.settings.unit_jacobian,
@@ -595,7 +611,7 @@ impl Integrator for RestirPtIntegrator {
         let s = &self.settings;
         format!(
             "restir-pt max_depth={} candidates={} neighbors={} radius={} spatial_rounds={} \
-             mis={} mcap={} shift=reconnection near_distance={} max_jacobian={} direct={}{}",
+             mis={} mcap={} temporal={} shift=reconnection near_distance={} max_jacobian={} direct={}{}",
             s.path.max_depth,
             s.candidates,
             s.neighbors,
@@ -603,6 +619,7 @@ impl Integrator for RestirPtIntegrator {
             s.spatial_rounds,
             mis_name(s.mis),
             s.mcap,
+            s.temporal,
             s.near_distance,
             s.max_jacobian,
             if s.direct_path_traced {
@@ -616,7 +633,12 @@ impl Integrator for RestirPtIntegrator {
 
     fn buffer_bytes_per_pixel(&self) -> usize {
         let hit_bytes = std::mem::size_of::<Receiver>() + std::mem::size_of::<Vec3>();
-        2 * Self::RESERVOIR_BYTES + hit_bytes + std::mem::size_of::<Vec3>()
+        let (reservoirs, hits) = if self.settings.temporal {
+            (3, 2)
+        } else {
+            (2, 1)
+        };
+        reservoirs * Self::RESERVOIR_BYTES + hits * hit_bytes + std::mem::size_of::<Vec3>()
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
@@ -625,9 +647,54 @@ impl Integrator for RestirPtIntegrator {
         let (gbuf, mut current, mut radiance, mut rays) = self.initial_reservoirs(scene, ctx);
         if self.max_depth() >= 2 {
             let w = gbuf.width;
-            let shift = self.shift_map(scene, &gbuf);
+            let history = if s.temporal {
+                self.history.lock().map(|mut h| h.take()).unwrap_or(None)
+            } else {
+                None
+            };
+            let history = history.filter(|h| h.reservoirs.len() == n);
+            let mut shift = self.shift_map(scene, &gbuf);
+            shift.prev = history.as_ref().map(|h| &h.gbuffer);
+            // Domains: pixel `i` of this pass is `i`, of the previous pass `n + i`.
+            let indices: Vec<usize> = (0..2 * n).collect();
+            if let Some(hist) = &history {
+                // Two techniques, one carrying up to `mcap` passes of history: the generalized
+                // balance heuristic, as ReSTIR DI's temporal reuse.
+                let temporal_mis = if s.mis.is_unbiased() {
+                    MisScheme::GeneralizedBalance
+                } else {
+                    s.mis
+                };
+                current
+                    .par_chunks_mut(w * BAND_ROWS)
+                    .enumerate()
+                    .for_each(|(band, out)| {
+                        for (i, res) in out.iter_mut().enumerate() {
+                            let index = band * w * BAND_ROWS + i;
+                            let (Some(r), Some(prev_r)) =
+                                (gbuf.receiver(index), hist.gbuffer.receiver(index))
+                            else {
+                                continue;
+                            };
+                            if !r.is_similar(prev_r, s.normal_cos, s.depth_tolerance) {
+                                continue;
+                            }
+                            let prev = hist.reservoirs[index].with_confidence_cap(s.mcap);
+                            let mut rng = ctx.stage_rng(index, STAGE_TEMPORAL);
+                            *res = resample(
+                                &shift,
+                                temporal_mis,
+                                &indices[index],
+                                res,
+                                &[(&indices[n + index], &prev)],
+                                || rng.next_f32(),
+                            )
+                            .with_confidence_cap(s.mcap);
+                        }
+                    });
+            }
+            shift.prev = None;
             if s.neighbors > 0 && s.spatial_rounds > 0 {
-                let indices: Vec<usize> = (0..n).collect();
                 let mut next = vec![PtReservoir::empty(); n];
                 for round in 0..s.spatial_rounds {
                     let input = &current;
@@ -671,6 +738,14 @@ impl Integrator for RestirPtIntegrator {
                     rays
                 })
                 .sum::<u64>();
+            if s.temporal
+                && let Ok(mut h) = self.history.lock()
+            {
+                *h = Some(History {
+                    gbuffer: gbuf,
+                    reservoirs: current,
+                });
+            }
         }
         accum
             .par_iter_mut()

@@ -263,13 +263,16 @@ pub fn visible(scene: &Scene, r: &Receiver, ng: Vec3, target: Target) -> bool {
     !scene.occluded(&ray, t_max)
 }
 
-/// The reconnection shift between the pixels of one G-buffer; a domain is a pixel index.
+/// The reconnection shift between pixels; a domain is a pixel index into `gbuf`, or, from the
+/// pixel count on, `pixel count + index` into `prev` (the previous pass, for temporal reuse).
 #[derive(Debug)]
 pub struct PtShift<'a> {
     /// The scene.
     pub scene: &'a Scene,
     /// The primary hits.
     pub gbuf: &'a GBuffer,
+    /// The previous pass's primary hits (temporal reuse).
+    pub prev: Option<&'a GBuffer>,
     /// Square of the shortest reconnection segment.
     pub near_distance2: f32,
     /// Symmetric Jacobian rejection bound (`max(J, 1/J)`); 0 for none.
@@ -279,13 +282,25 @@ pub struct PtShift<'a> {
 }
 
 impl PtShift<'_> {
+    /// The primary hit and geometric normal of domain `d`.
+    #[inline]
+    fn hit(&self, d: usize) -> Option<(&Receiver, Vec3)> {
+        let n = self.gbuf.receivers.len();
+        let (buf, i) = if d < n {
+            (self.gbuf, d)
+        } else {
+            (self.prev?, d - n)
+        };
+        buf.receiver(i).map(|r| (r, buf.ng[i]))
+    }
+
     /// The target (with visibility) and the Jacobian of shifting `s` from pixel `from` to pixel
     /// `to`; `None` if the shift is not defined there.
     pub fn shift_full(&self, from: usize, to: usize, s: &PathSample) -> Option<(f32, f32, Vec3)> {
         if s.kind == Kind::Frozen {
             return None;
         }
-        let (src, dst) = (self.gbuf.receiver(from)?, self.gbuf.receiver(to)?);
+        let ((src, _), (dst, dst_ng)) = (self.hit(from)?, self.hit(to)?);
         let bsdfs = &self.scene.bsdfs;
         if !connectible(&bsdfs[src.bsdf as usize]) || !connectible(&bsdfs[dst.bsdf as usize]) {
             return None;
@@ -317,7 +332,7 @@ impl PtShift<'_> {
         let jacobian = if self.unit_jacobian { 1.0 } else { jacobian };
         let (f, target) = evaluate_unshadowed(self.scene, dst, s, &v);
         let mut p = luminance(f);
-        if !(p > 0.0 && p.is_finite() && visible(self.scene, dst, self.gbuf.ng[to], target)) {
+        if !(p > 0.0 && p.is_finite() && visible(self.scene, dst, dst_ng, target)) {
             p = 0.0;
         }
         Some((p, jacobian, if p > 0.0 { f } else { Vec3::ZERO }))

@@ -26,6 +26,8 @@ pub struct RestirPtSettings {
     pub mis: MisScheme,
     /// Absolute confidence cap after every reuse step (default 20).
     pub mcap: f32,
+    /// Reuse the previous pass's reservoirs (default off).
+    pub temporal: bool,
     /// Largest angle between neighbour shading normals, as a cosine (default cos 25°).
     pub normal_cos: f32,
     /// Largest relative difference of camera distances (default 0.1).
@@ -55,6 +57,7 @@ impl RestirPtSettings {
             spatial_rounds: 1,
             mis: MisScheme::DefensivePairwise,
             mcap: 20.0,
+            temporal: false,
             normal_cos: 25f32.to_radians().cos(),
             depth_tolerance: 0.1,
             near_distance: 0.01,
@@ -101,6 +104,7 @@ impl RestirPtSettings {
                 "mcap" | "m_cap" | "m_capping" | "max_history" => {
                     self.mcap = parse_positive(name, v)?;
                 }
+                "temporal" | "temporal_reuse" => self.temporal = parse_bool(name, v)?,
                 "shift" => {
                     let s = v.to_ascii_lowercase();
                     if !SHIFT_NAMES.contains(&s.as_str()) {
