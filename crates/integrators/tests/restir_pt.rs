@@ -273,7 +273,7 @@ fn unbiased_against_the_path_tracer() {
     assert!(z < Z_MAX, "direct = path: max |z| = {z:.2}");
     // Temporal reuse across 4 passes (history capped at mcap), then spatial reuse.
     let z = max_z(
-        &statistics(&scene, "restir-pt", &[("temporal", "true")], 4, 200),
+        &statistics(&scene, "restir-pt", &[("temporal", "true")], 16, 200),
         &reference,
     );
     eprintln!("max_depth 4, temporal: max |z| = {z:.2}");
