@@ -18,6 +18,7 @@
 pub mod sample;
 mod settings;
 
+use std::cell::Cell;
 use std::sync::Mutex;
 
 use glam::{DVec3, Vec2, Vec3};
@@ -132,6 +133,7 @@ impl RestirPtIntegrator {
             scene,
             gbuf,
             prev: None,
+            rays: Cell::new(0),
             near_distance2: d * d,
             max_jacobian: self.settings.max_jacobian,
             unit_jacobian: self.settings.unit_jacobian,
@@ -653,8 +655,14 @@ impl Integrator for RestirPtIntegrator {
                 None
             };
             let history = history.filter(|h| h.reservoirs.len() == n);
-            let mut shift = self.shift_map(scene, &gbuf);
-            shift.prev = history.as_ref().map(|h| &h.gbuffer);
+            // One shift map per band: it counts the shadow rays its shifts trace.
+            let shift_for = |temporal: bool| {
+                let mut shift = self.shift_map(scene, &gbuf);
+                if temporal {
+                    shift.prev = history.as_ref().map(|h| &h.gbuffer);
+                }
+                shift
+            };
             // Domains: pixel `i` of this pass is `i`, of the previous pass `n + i`.
             let indices: Vec<usize> = (0..2 * n).collect();
             if let Some(hist) = &history {
@@ -665,10 +673,11 @@ impl Integrator for RestirPtIntegrator {
                 } else {
                     s.mis
                 };
-                current
+                rays += current
                     .par_chunks_mut(w * BAND_ROWS)
                     .enumerate()
-                    .for_each(|(band, out)| {
+                    .map(|(band, out)| {
+                        let shift = shift_for(true);
                         for (i, res) in out.iter_mut().enumerate() {
                             let index = band * w * BAND_ROWS + i;
                             let (Some(r), Some(prev_r)) =
@@ -691,16 +700,19 @@ impl Integrator for RestirPtIntegrator {
                             )
                             .with_confidence_cap(s.mcap);
                         }
-                    });
+                        shift.rays.get()
+                    })
+                    .sum::<u64>();
             }
-            shift.prev = None;
             if s.neighbors > 0 && s.spatial_rounds > 0 {
                 let mut next = vec![PtReservoir::empty(); n];
                 for round in 0..s.spatial_rounds {
                     let input = &current;
-                    next.par_chunks_mut(w * BAND_ROWS)
+                    rays += next
+                        .par_chunks_mut(w * BAND_ROWS)
                         .enumerate()
-                        .for_each(|(band, out)| {
+                        .map(|(band, out)| {
+                            let shift = shift_for(false);
                             let mut scratch = Vec::with_capacity(s.neighbors as usize);
                             for (i, res) in out.iter_mut().enumerate() {
                                 let index = band * w * BAND_ROWS + i;
@@ -716,7 +728,9 @@ impl Integrator for RestirPtIntegrator {
                                     &mut scratch,
                                 );
                             }
-                        });
+                            shift.rays.get()
+                        })
+                        .sum::<u64>();
                     std::mem::swap(&mut current, &mut next);
                 }
             }

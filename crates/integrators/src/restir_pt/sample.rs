@@ -28,6 +28,8 @@
 //! `x2` are rough, both primary hits are at least `d_near` from `x2`, and `x2` did not scatter by
 //! a delta lobe. Visibility of `y1 → x2` is part of the target.
 
+use std::cell::Cell;
+
 use glam::{Vec2, Vec3};
 use restir_geometry::{SurfaceInteraction, shadow_ray_between, shadow_ray_towards, surface_at};
 use restir_gris::jacobian::{reconnection_jacobian_from_points, reject_jacobian};
@@ -273,6 +275,8 @@ pub struct PtShift<'a> {
     pub gbuf: &'a GBuffer,
     /// The previous pass's primary hits (temporal reuse).
     pub prev: Option<&'a GBuffer>,
+    /// Shadow rays traced by this map's shifts.
+    pub rays: Cell<u64>,
     /// Square of the shortest reconnection segment.
     pub near_distance2: f32,
     /// Symmetric Jacobian rejection bound (`max(J, 1/J)`); 0 for none.
@@ -332,8 +336,13 @@ impl PtShift<'_> {
         let jacobian = if self.unit_jacobian { 1.0 } else { jacobian };
         let (f, target) = evaluate_unshadowed(self.scene, dst, s, &v);
         let mut p = luminance(f);
-        if !(p > 0.0 && p.is_finite() && visible(self.scene, dst, dst_ng, target)) {
+        if !(p > 0.0 && p.is_finite()) {
             p = 0.0;
+        } else {
+            self.rays.set(self.rays.get() + 1);
+            if !visible(self.scene, dst, dst_ng, target) {
+                p = 0.0;
+            }
         }
         Some((p, jacobian, if p > 0.0 { f } else { Vec3::ZERO }))
     }
