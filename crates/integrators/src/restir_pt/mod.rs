@@ -9,10 +9,13 @@
 //!    every light connection is one candidate with resampling weight `lum(contribution)/N`.
 //!    Only paths whose first bounce used a non-delta lobe are sampled here; the reservoir counts
 //!    as confidence 1.
-//! 3. **Spatial reuse**: `R` rounds of `k` neighbours (pattern and similarity tests as ReSTIR
+//!    With `direct = path` the direct-light connections at `x1` are summed per pixel instead.
+//! 3. **Temporal reuse** (optional): the pixel's reservoir of the previous pass, its domain the
+//!    previous pass's primary hit, generalized balance MIS, confidence capped at `mcap`.
+//! 4. **Spatial reuse**: `R` rounds of `k` neighbours (pattern and similarity tests as ReSTIR
 //!    DI) resampled through [`restir_gris::resample`] with the reconnection shift
 //!    ([`sample::PtShift`]). Confidence is capped at `mcap` after every round.
-//! 4. **Shading**: the selected path's integrand at the pixel times `W`, plus the paths whose
+//! 5. **Shading**: the selected path's integrand at the pixel times `W`, plus the paths whose
 //!    first bounce is a delta lobe, path traced.
 
 pub mod sample;
