@@ -12,6 +12,7 @@ use restir_integrators::film::Filter;
 use restir_integrators::path::PathSettings;
 use restir_integrators::restir_di::MIS_NAMES;
 use restir_integrators::restir_pt::Kind;
+use restir_integrators::restir_pt::sample::{evaluate_unshadowed, resolve_vertex};
 use restir_integrators::{
     Image, IntegratorOptions, PassContext, RenderSettings, RestirPtIntegrator, RestirPtSettings,
     make_integrator, render,
@@ -198,10 +199,14 @@ fn check_shifts(scene: &Scene, pt: RestirPtIntegrator) -> [usize; 6] {
         for (i, res) in reservoirs.iter().enumerate() {
             let Some(x) = res.sample else { continue };
             kinds[x.kind as usize] += 1;
-            if let Some((t, j, _)) = shift.shift_full(i, i, &x)
+            if let Some((t, j, f)) = shift.shift_full(i, i, &x)
                 && t > 0.0
             {
                 assert_eq!(j, 1.0, "pixel {i}: self-shift Jacobian");
+                // The same RGB contribution as the pixel's own evaluation, bit for bit.
+                let r = gbuf.receiver(i).unwrap();
+                let (own, _) = evaluate_unshadowed(scene, r, &x, &resolve_vertex(scene, &x));
+                assert_eq!(f, own, "pixel {i}: self-shift contribution");
                 let rel = (t - res.target_pdf).abs() / res.target_pdf;
                 assert!(
                     rel <= 1e-6,
