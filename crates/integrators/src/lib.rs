@@ -22,19 +22,22 @@ pub mod film;
 pub mod gbuffer;
 mod image_io;
 pub mod metrics;
+mod params;
 pub mod path;
 mod render;
 pub mod restir_di;
+pub mod restir_pt;
 
 pub use image_io::{Image, ImageError};
 pub use metrics::{ErrorMetrics, compare};
 pub use render::{Integrator, PassContext, PathIntegrator, RenderOutput, RenderSettings, render};
 pub use restir_di::{RestirDiIntegrator, RestirDiSettings};
+pub use restir_pt::{RestirPtIntegrator, RestirPtSettings};
 
 use restir_scene::Scene;
 
 /// The integrators this crate provides, by command-line name.
-pub const INTEGRATORS: &[&str] = &["path", "restir-di"];
+pub const INTEGRATORS: &[&str] = &["path", "restir-di", "restir-pt"];
 
 /// Command-line choices that override the scene's integrator settings.
 #[derive(Clone, Debug, Default)]
@@ -91,6 +94,14 @@ pub fn make_integrator(
                 unused_params,
             })
         }
+        "restir-pt" => {
+            let mut s = RestirPtSettings::new(settings);
+            let unused_params = s.apply(&params)?;
+            Ok(MadeIntegrator {
+                integrator: Box::new(RestirPtIntegrator::new(s)),
+                unused_params,
+            })
+        }
         other => Err(format!(
             "unknown integrator '{other}' (available: {})",
             INTEGRATORS.join(", ")
@@ -98,10 +109,12 @@ pub fn make_integrator(
     }
 }
 
-/// The command-line name for the names scene files use (`restir` is ReSTIR DI, as in Lajolla).
+/// The command-line name for the names scene files use (`restir` is ReSTIR DI, as in Lajolla;
+/// `restir_pt` is ReSTIR PT).
 fn canonical_name(name: &str) -> &str {
     match name {
         "restir" | "restir_di" | "restirdi" => "restir-di",
+        "restir_pt" | "restirpt" => "restir-pt",
         other => other,
     }
 }

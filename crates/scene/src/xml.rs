@@ -1006,6 +1006,10 @@ impl<'a, 'i> Importer<'a, 'i> {
                 integ.kind = "restir-di".into();
                 keep_params = true;
             }
+            "restir_pt" | "restir-pt" | "restirpt" => {
+                integ.kind = "restir-pt".into();
+                keep_params = true;
+            }
             other => {
                 self.warn(
                     node,

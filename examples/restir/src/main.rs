@@ -55,7 +55,7 @@ struct RenderArgs {
     /// filename from the scene, else <scene name>.exr.
     #[arg(short = 'o', long = "output")]
     output: Option<PathBuf>,
-    /// Estimator: path or restir-di (default: the scene's, else path).
+    /// Estimator: path, restir-di or restir-pt (default: the scene's, else path).
     #[arg(long)]
     integrator: Option<String>,
     /// Passes (samples per pixel); overrides the scene.
@@ -96,7 +96,8 @@ struct RenderArgs {
 #[derive(clap::Args, Debug)]
 #[command(next_help_heading = "ReSTIR")]
 struct RestirArgs {
-    /// Light candidates per pixel in initial resampling [default: 32].
+    /// Initial candidates per pixel: light samples for restir-di [default: 32], paths for
+    /// restir-pt [default: 1].
     #[arg(long)]
     candidates: Option<u32>,
     /// Where candidates' lights come from: power (the power-based sampler) or tiles (per
@@ -128,6 +129,16 @@ struct RestirArgs {
     /// Drop occluded initial candidates (biased at shadow edges).
     #[arg(long)]
     visibility_reuse: bool,
+    /// restir-pt shift map: reconnection (the only one implemented).
+    #[arg(long)]
+    shift: Option<String>,
+    /// restir-pt: reject shifts with max(J, 1/J) above this (unbiased) [default: none].
+    #[arg(long)]
+    max_jacobian: Option<f32>,
+    /// restir-pt: direct light in the reservoirs (reservoir) or path traced per pixel (path)
+    /// [default: reservoir].
+    #[arg(long)]
+    direct: Option<String>,
 }
 
 impl RestirArgs {
@@ -154,6 +165,9 @@ impl RestirArgs {
             "visibility_reuse",
             self.visibility_reuse.then(|| "true".into()),
         );
+        put("shift", self.shift.clone());
+        put("max_jacobian", self.max_jacobian.map(|v| v.to_string()));
+        put("direct", self.direct.clone());
         p
     }
 }

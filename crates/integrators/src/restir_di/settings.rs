@@ -3,6 +3,7 @@
 
 use restir_gris::MisScheme;
 
+use crate::params::{parse_bool, parse_count, parse_mis, parse_positive};
 use crate::path::PathSettings;
 
 /// How spatial and temporal reuse weight their inputs (`--mis`).
@@ -130,24 +131,7 @@ impl RestirDiSettings {
                 | "spatial_passes" => {
                     self.spatial_rounds = parse_count(name, v, 0)?;
                 }
-                "mis" | "bias_correction" => {
-                    self.mis = MIS_NAMES
-                        .iter()
-                        .find(|(n, _)| {
-                            n.replace('-', "_") == v.to_ascii_lowercase().replace('-', "_")
-                        })
-                        .map(|(_, s)| *s)
-                        .ok_or_else(|| {
-                            format!(
-                                "{name} = '{v}': expected one of {}",
-                                MIS_NAMES
-                                    .iter()
-                                    .map(|(n, _)| *n)
-                                    .collect::<Vec<_>>()
-                                    .join(", ")
-                            )
-                        })?;
-                }
+                "mis" | "bias_correction" => self.mis = parse_mis(name, v)?,
                 "mcap" | "m_cap" | "m_capping" | "max_history" => {
                     self.mcap = parse_positive(name, v)?;
                 }
@@ -167,37 +151,6 @@ impl RestirDiSettings {
             }
         }
         Ok(unknown)
-    }
-}
-
-fn parse_count(name: &str, v: &str, min: u32) -> Result<u32, String> {
-    let n: u32 = v
-        .parse()
-        .map_err(|_| format!("{name} = '{v}': expected a whole number"))?;
-    if n < min || n > 1 << 20 {
-        return Err(format!(
-            "{name} = {n}: expected a number from {min} to {}",
-            1 << 20
-        ));
-    }
-    Ok(n)
-}
-
-fn parse_positive(name: &str, v: &str) -> Result<f32, String> {
-    let x: f32 = v
-        .parse()
-        .map_err(|_| format!("{name} = '{v}': expected a number"))?;
-    if !(x > 0.0 && x.is_finite()) {
-        return Err(format!("{name} = {v}: expected a positive finite number"));
-    }
-    Ok(x)
-}
-
-fn parse_bool(name: &str, v: &str) -> Result<bool, String> {
-    match v.to_ascii_lowercase().as_str() {
-        "true" | "1" | "yes" | "on" => Ok(true),
-        "false" | "0" | "no" | "off" => Ok(false),
-        _ => Err(format!("{name} = '{v}': expected true or false")),
     }
 }
 

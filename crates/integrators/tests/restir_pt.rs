@@ -1,0 +1,422 @@
+//! ReSTIR PT with the reconnection shift: the shift's contract on real scene paths (identity,
+//! round trip, symmetric failure) and unbiasedness against the path tracer on a small room lit
+//! mostly indirectly (the light is hidden behind a partition and shines at the ceiling), with
+//! diffuse, rough-conductor and rough-plastic surfaces and a dim environment through the open
+//! front. Means over independent renders are compared block by block with the standard error
+//! measured across seeds (the test pattern of `tests/restir_di.rs`); biased variants must fail.
+
+use std::sync::atomic::AtomicBool;
+
+use restir_gris::ShiftMap;
+use restir_integrators::film::Filter;
+use restir_integrators::path::PathSettings;
+use restir_integrators::restir_di::MIS_NAMES;
+use restir_integrators::restir_pt::Kind;
+use restir_integrators::restir_pt::sample::{evaluate_unshadowed, resolve_vertex};
+use restir_integrators::{
+    Image, IntegratorOptions, PassContext, RenderSettings, RestirPtIntegrator, RestirPtSettings,
+    make_integrator, render,
+};
+use restir_sampling::Pcg32;
+use restir_scene::{Scene, parse_ron};
+
+const SIZE: u32 = 24;
+const BLOCK: u32 = 8;
+
+fn scene() -> Scene {
+    scene_with("")
+}
+
+/// The room with a smooth glass sphere and a smooth plastic sphere: delta lobes at primary hits
+/// (path traced) and at reconnection vertices (paths that cannot be shifted).
+fn glass_scene() -> Scene {
+    scene_with(
+        r#"(geometry: Sphere(center: (-0.6, 0.45, 0.6), radius: 0.4),
+             material: Some(Inline(Dielectric()))),
+            (geometry: Sphere(center: (0.9, 1.2, -0.3), radius: 0.3),
+             material: Some(Inline(Plastic(diffuse_reflectance: (0.3, 0.6, 0.3))))),"#,
+    )
+}
+
+fn scene_with(extra: &str) -> Scene {
+    let ron = format!(
+        r#"(
+        camera: (fov: 55, to_world: [LookAt(origin: (0, 1, 4.5), target: (0, 0.7, 0), up: (0, 1, 0))]),
+        film: (width: {SIZE}, height: {SIZE}, filter: Box),
+        integrator: (max_depth: 4),
+        shapes: [
+            (geometry: Rectangle, to_world: [Scale((2, 2, 1)), Rotate(axis: (1, 0, 0), angle: -90)],
+             material: Some(Inline(Diffuse(reflectance: (0.7, 0.7, 0.7))))),
+            (geometry: Rectangle, to_world: [Scale((2, 2, 1)), Rotate(axis: (1, 0, 0), angle: 90),
+             Translate((0, 2, 0))], material: Some(Inline(Diffuse(reflectance: (0.8, 0.8, 0.8))))),
+            (geometry: Rectangle, to_world: [Scale((2, 1, 1)), Translate((0, 1, -2))],
+             material: Some(Inline(RoughPlastic(diffuse_reflectance: (0.2, 0.4, 0.7),
+             roughness: (alpha: 0.15))))),
+            (geometry: Rectangle, to_world: [Scale((2, 1, 1)), Rotate(axis: (0, 1, 0), angle: 90),
+             Translate((-2, 1, 0))], material: Some(Inline(RoughConductor(ior: (material: Some("Au")),
+             roughness: (alpha: 0.25))))),
+            (geometry: Rectangle, to_world: [Scale((2, 1, 1)), Rotate(axis: (0, 1, 0), angle: -90),
+             Translate((2, 1, 0))], material: Some(Inline(Diffuse(reflectance: (0.7, 0.2, 0.2))))),
+            (geometry: Rectangle, to_world: [Scale((2, 0.65, 1)), Translate((0, 0.65, -0.8))],
+             material: Some(Inline(TwoSided(Diffuse(reflectance: (0.6, 0.6, 0.5)))))),
+            (geometry: Rectangle, to_world: [Scale((0.5, 1, 1)), Rotate(axis: (1, 0, 0), angle: -90),
+             Translate((-0.6, 0.002, 1))], material: Some(Inline(Black))),
+            (geometry: Cube, to_world: [Scale((0.3, 0.3, 0.3)), Translate((0.7, 0.3, 0.8))],
+             material: Some(Inline(RoughPlastic(diffuse_reflectance: (0.6, 0.5, 0.2),
+             roughness: (alpha: 0.1))))),
+            (geometry: Rectangle, to_world: [Scale((0.5, 0.5, 1)), Rotate(axis: (1, 0, 0), angle: -90),
+             Translate((0, 0.05, -1.4))], emission: Some((20, 20, 20))),
+            {extra}
+        ],
+        lights: [
+            Constant(radiance: (0.02, 0.03, 0.05)),
+        ],
+    )"#
+    );
+    let desc = parse_ron(&ron, "pt-test.ron".as_ref()).unwrap();
+    Scene::build(&desc, ".".as_ref(), "pt-test.ron".as_ref()).unwrap()
+}
+
+fn render_image(scene: &Scene, name: &str, params: &[(&str, &str)], spp: u32, seed: u64) -> Image {
+    let max_depth = params
+        .iter()
+        .find(|(k, _)| *k == "max_depth")
+        .map(|(_, v)| v.parse().unwrap());
+    let params: Vec<_> = params.iter().filter(|(k, _)| *k != "max_depth").collect();
+    let options = IntegratorOptions {
+        name: Some(name.into()),
+        max_depth,
+        params: params
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect(),
+    };
+    let mut options = options;
+    if name == "restir-pt" {
+        // Neighbours within a third of this small image (the default 30 px would mostly miss).
+        options.params.insert(0, ("radius".into(), "8".into()));
+    }
+    let made = make_integrator(scene, &options).unwrap();
+    assert!(made.unused_params.is_empty());
+    let settings = RenderSettings {
+        spp,
+        time_limit: None,
+        seed,
+    };
+    let out = render(
+        scene,
+        made.integrator.as_ref(),
+        &settings,
+        &AtomicBool::new(false),
+        &mut |_, _| {},
+    );
+    assert_eq!(
+        out.nonfinite_pixels, 0,
+        "{name} {params:?}: non-finite pixels"
+    );
+    out.image
+}
+
+fn block_means(img: &Image) -> Vec<f64> {
+    let blocks = SIZE / BLOCK;
+    let mut out = vec![0.0; (blocks * blocks) as usize];
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            let p = img.pixels[(y * SIZE + x) as usize];
+            out[((y / BLOCK) * blocks + x / BLOCK) as usize] +=
+                f64::from(p.x + p.y + p.z) / 3.0 / f64::from(BLOCK * BLOCK);
+        }
+    }
+    out
+}
+
+fn statistics(
+    scene: &Scene,
+    name: &str,
+    params: &[(&str, &str)],
+    spp: u32,
+    seeds: u64,
+) -> Vec<(f64, f64)> {
+    let samples: Vec<Vec<f64>> = (0..seeds)
+        .map(|s| block_means(&render_image(scene, name, params, spp, 2000 + s)))
+        .collect();
+    let n = seeds as f64;
+    (0..samples[0].len())
+        .map(|b| {
+            let mean = samples.iter().map(|v| v[b]).sum::<f64>() / n;
+            let var = samples.iter().map(|v| (v[b] - mean).powi(2)).sum::<f64>() / (n - 1.0);
+            (mean, (var / n).sqrt())
+        })
+        .collect()
+}
+
+fn max_z(a: &[(f64, f64)], b: &[(f64, f64)]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(&(ma, sa), &(mb, sb))| (ma - mb).abs() / (sa * sa + sb * sb).sqrt().max(1e-12))
+        .fold(0.0, f64::max)
+}
+
+/// 9 blocks × a few configurations: a Bonferroni-style bound of 4.5 standard errors.
+const Z_MAX: f64 = 4.5;
+
+fn integrator(max_depth: i32) -> RestirPtIntegrator {
+    RestirPtIntegrator::new(RestirPtSettings::new(PathSettings {
+        max_depth,
+        rr_depth: 3,
+        hide_emitters: false,
+    }))
+}
+
+/// Shifting a pixel's own path to itself is the identity (J = 1, same target); on pairs of
+/// pixels the forward shift succeeds iff the inverse does and their Jacobians multiply to 1.
+#[test]
+fn shift_identity_and_round_trip_on_scene_paths() {
+    let kinds = check_shifts(&scene(), integrator(-1));
+    assert!(kinds[Kind::Continue as usize] > 100 && kinds[Kind::DirectNee as usize] > 0);
+    let kinds = check_shifts(&glass_scene(), integrator(-1));
+    assert!(kinds[Kind::Frozen as usize] > 0, "{kinds:?}");
+    // Symmetric Jacobian rejection keeps forward and inverse failures together.
+    let mut settings = *integrator(-1).settings();
+    settings.max_jacobian = 2.0;
+    check_shifts(&scene(), RestirPtIntegrator::new(settings));
+}
+
+/// Runs the shift checks on four passes of `scene`; returns how many reservoirs hold each kind.
+fn check_shifts(scene: &Scene, pt: RestirPtIntegrator) -> [usize; 6] {
+    let filter = Filter::new(scene.filter);
+    let (mut identity, mut kinds, mut pairs, mut both, mut one_way) = (0, [0usize; 6], 0, 0, 0);
+    for pass in 0..4 {
+        let ctx = PassContext {
+            seed: 7,
+            pass,
+            filter: &filter,
+        };
+        let (gbuf, reservoirs, _, _) = pt.initial_reservoirs(scene, &ctx);
+        let shift = pt.shift_map(scene, &gbuf);
+        let n = reservoirs.len();
+        let mut rng = Pcg32::new(11, u64::from(pass));
+        for (i, res) in reservoirs.iter().enumerate() {
+            let Some(x) = res.sample else { continue };
+            kinds[x.kind as usize] += 1;
+            if let Some((t, j, f)) = shift.shift_full(i, i, &x)
+                && t > 0.0
+            {
+                assert_eq!(j, 1.0, "pixel {i}: self-shift Jacobian");
+                // The same RGB contribution as the pixel's own evaluation, bit for bit.
+                let r = gbuf.receiver(i).unwrap();
+                let (own, _) = evaluate_unshadowed(scene, r, &x, &resolve_vertex(scene, &x));
+                assert_eq!(f, own, "pixel {i}: self-shift contribution");
+                let rel = (t - res.target_pdf).abs() / res.target_pdf;
+                assert!(
+                    rel <= 1e-6,
+                    "pixel {i}: self-shift target {t} vs {}",
+                    res.target_pdf
+                );
+                identity += 1;
+            }
+            for _ in 0..8 {
+                let k = (rng.next_u32() as usize) % n;
+                if k == i || gbuf.receiver(k).is_none() {
+                    continue;
+                }
+                pairs += 1;
+                let fwd = shift.shift(&i, &k, &x);
+                let inv = shift.shift(&k, &i, &x);
+                assert_eq!(
+                    fwd.is_some(),
+                    inv.is_some(),
+                    "pixels {i}->{k}: forward and inverse disagree ({x:?})"
+                );
+                if let (Some(f), Some(b)) = (fwd, inv) {
+                    both += 1;
+                    let prod = f64::from(f.jacobian) * f64::from(b.jacobian);
+                    assert!((prod - 1.0).abs() < 1e-4, "pixels {i}->{k}: J·J⁻¹ = {prod}");
+                    if (f.target_pdf > 0.0) != (b.target_pdf > 0.0) {
+                        one_way += 1;
+                    }
+                }
+            }
+        }
+    }
+    eprintln!(
+        "identity checks {identity}, kinds {kinds:?}, pairs {pairs}, both succeeded {both}, \
+         visible one way only {one_way}"
+    );
+    assert!(identity > 500, "too few identity checks: {identity}");
+    assert!(both > 200, "too few successful shifts: {both}");
+    kinds
+}
+
+#[test]
+fn unbiased_against_the_path_tracer() {
+    let scene = scene();
+    let reference = statistics(&scene, "path", &[], 128, 64);
+    for mis in ["defensive-pairwise", "balance"] {
+        let pt = statistics(&scene, "restir-pt", &[("mis", mis)], 1, 400);
+        let z = max_z(&pt, &reference);
+        eprintln!("max_depth 4, {mis}: max |z| = {z:.2}");
+        assert!(z < Z_MAX, "{mis}: max |z| = {z:.2}");
+    }
+    // The other unbiased schemes.
+    for (mis, scheme) in MIS_NAMES {
+        if !scheme.is_unbiased() || ["defensive-pairwise", "balance"].contains(mis) {
+            continue;
+        }
+        let pt = statistics(&scene, "restir-pt", &[("mis", mis)], 1, 300);
+        let z = max_z(&pt, &reference);
+        eprintln!("max_depth 4, {mis}: max |z| = {z:.2}");
+        assert!(z < Z_MAX, "{mis}: max |z| = {z:.2}");
+    }
+    // Two rounds of five neighbours and two candidate paths.
+    let params = [
+        ("spatial_rounds", "2"),
+        ("neighbors", "5"),
+        ("candidates", "2"),
+    ];
+    let z = max_z(
+        &statistics(&scene, "restir-pt", &params, 1, 200),
+        &reference,
+    );
+    eprintln!("max_depth 4, 2 rounds × 5 neighbours, 2 candidates: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "2 rounds: max |z| = {z:.2}");
+    // Direct light path traced per pixel, the reservoirs carrying the rest.
+    let z = max_z(
+        &statistics(&scene, "restir-pt", &[("direct", "path")], 1, 400),
+        &reference,
+    );
+    eprintln!("max_depth 4, direct light path traced: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "direct = path: max |z| = {z:.2}");
+    // Temporal reuse across 4 passes (history capped at mcap), then spatial reuse.
+    let z = max_z(
+        &statistics(&scene, "restir-pt", &[("temporal", "true")], 16, 200),
+        &reference,
+    );
+    eprintln!("max_depth 4, temporal: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "temporal: max |z| = {z:.2}");
+    // Negative controls: the biased variants are caught by the same statistic.
+    let uniform = statistics(&scene, "restir-pt", &[("mis", "uniform")], 1, 2000);
+    for (a, b) in uniform.iter().zip(&reference) {
+        eprintln!(
+            "1/M: {:.4} ± {:.4}   path: {:.4} ± {:.4}",
+            a.0, a.1, b.0, b.1
+        );
+    }
+    let z = max_z(&uniform, &reference);
+    eprintln!("uniform (1/M) weights: max |z| = {z:.2}");
+    assert!(z > Z_MAX, "uniform weights should be biased: {z:.2}");
+    let nojac = statistics(&scene, "restir-pt", &[("unit_jacobian", "true")], 1, 2000);
+    for (a, b) in nojac.iter().zip(&reference) {
+        eprintln!(
+            "J = 1: {:.4} ± {:.4}   path: {:.4} ± {:.4}",
+            a.0, a.1, b.0, b.1
+        );
+    }
+    let z = max_z(&nojac, &reference);
+    eprintln!("Jacobian omitted: max |z| = {z:.2}");
+    assert!(z > Z_MAX, "J = 1 should be biased: {z:.2}");
+}
+
+#[test]
+fn unbiased_with_unbounded_depth() {
+    let scene = scene();
+    let reference = statistics(&scene, "path", &[("max_depth", "-1")], 64, 32);
+    let pt = statistics(&scene, "restir-pt", &[("max_depth", "-1")], 1, 160);
+    let z = max_z(&pt, &reference);
+    eprintln!("max_depth -1: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "max_depth -1: max |z| = {z:.2}");
+    // Direct light only differs from it: the comparison can fail.
+    let direct = statistics(&scene, "path", &[("max_depth", "2")], 64, 32);
+    let z = max_z(&pt, &direct);
+    eprintln!("against direct light only: max |z| = {z:.2}");
+    assert!(
+        z > 2.0 * Z_MAX,
+        "indirect light should be detectable: {z:.2}"
+    );
+}
+
+/// Delta lobes: glass and smooth plastic at primary hits and at reconnection vertices.
+#[test]
+fn unbiased_with_glass() {
+    let scene = glass_scene();
+    let reference = statistics(&scene, "path", &[("max_depth", "5")], 128, 64);
+    let pt = statistics(&scene, "restir-pt", &[("max_depth", "5")], 1, 400);
+    let z = max_z(&pt, &reference);
+    eprintln!("glass, max_depth 5: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "glass: max |z| = {z:.2}");
+}
+
+#[test]
+fn same_image_for_one_and_two_threads() {
+    let scene = scene();
+    let run = |threads: usize, params: &[(&str, &str)]| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| render_image(&scene, "restir-pt", params, 2, 5))
+    };
+    for params in [
+        &[][..],
+        &[
+            ("spatial_rounds", "2"),
+            ("mis", "balance"),
+            ("temporal", "true"),
+        ][..],
+    ] {
+        assert!(
+            run(1, params).pixels == run(2, params).pixels,
+            "{params:?}: images differ between 1 and 2 threads"
+        );
+    }
+    let c = render_image(&scene, "restir-pt", &[], 2, 6);
+    assert!(c.pixels != run(1, &[]).pixels);
+}
+
+/// `<integrator type="restir_pt">` selects ReSTIR PT with the XML parameters; command-line
+/// options win; unsupported shifts are an error naming the supported one.
+#[test]
+fn xml_restir_pt_integrator_and_parameters() {
+    let xml = r#"<scene version="3.0.0">
+        <integrator type="restir_pt">
+            <integer name="neighbour_select" value="5"/>
+            <integer name="spatial_iteration" value="2"/>
+            <integer name="candidates" value="4"/>
+            <string name="mis" value="balance"/>
+            <integer name="maxDepth" value="6"/>
+        </integrator>
+        <sensor type="perspective"><float name="fov" value="40"/>
+            <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film>
+        </sensor>
+        <shape type="rectangle"><bsdf type="diffuse"/></shape>
+    </scene>"#;
+    let (desc, warnings) = restir_scene::xml::parse_xml(xml, "pt.xml".as_ref(), &[]).unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let scene = Scene::build(&desc, ".".as_ref(), "pt.xml".as_ref()).unwrap();
+    let made = make_integrator(&scene, &IntegratorOptions::default()).unwrap();
+    assert!(made.unused_params.is_empty());
+    let d = made.integrator.describe();
+    assert!(d.starts_with("restir-pt max_depth=6 candidates=4"), "{d}");
+    assert!(
+        d.contains("neighbors=5") && d.contains("spatial_rounds=2") && d.contains("mis=balance"),
+        "{d}"
+    );
+    let options = IntegratorOptions {
+        params: vec![("neighbors".into(), "2".into())],
+        ..Default::default()
+    };
+    let d = make_integrator(&scene, &options)
+        .unwrap()
+        .integrator
+        .describe();
+    assert!(
+        d.contains("neighbors=2") && d.contains("candidates=4"),
+        "{d}"
+    );
+    let options = IntegratorOptions {
+        params: vec![("shift".into(), "hybrid".into())],
+        ..Default::default()
+    };
+    let err = make_integrator(&scene, &options).unwrap_err();
+    assert!(err.contains("reconnection"), "{err}");
+}
