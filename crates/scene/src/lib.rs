@@ -24,6 +24,8 @@
 mod build;
 pub mod desc;
 mod error;
+mod meshio;
+pub mod spectrum;
 pub mod xml;
 
 use std::path::{Path, PathBuf};

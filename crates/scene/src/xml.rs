@@ -7,13 +7,14 @@
 //! Unknown *properties* are warnings with `file:line` (legacy files carry many that do not matter,
 //! such as `nearClip`); unknown *plugin types* and malformed values are errors with `file:line`.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
 use std::path::Path;
 
 use roxmltree::{Document, Node};
 
 use crate::desc::*;
+use crate::spectrum::{self, SpectrumUse};
 use crate::{SceneError, SceneWarning};
 
 type Result<T> = core::result::Result<T, SceneError>;
@@ -44,6 +45,8 @@ enum Value {
     Rgb([f32; 3]),
     /// `<spectrum value="v"/>`: a constant spectrum.
     SpectrumConst(f32),
+    /// `<spectrum value="λ1:v1, λ2:v2, …"/>`: a sampled spectrum (nm, value).
+    Spectrum(Vec<(f64, f64)>),
     Point([f32; 3]),
     Transform(Vec<TransformOp>),
 }
@@ -56,7 +59,7 @@ impl Value {
             Value::Bool(_) => "boolean",
             Value::Str(_) => "string",
             Value::Rgb(_) => "rgb",
-            Value::SpectrumConst(_) => "spectrum",
+            Value::SpectrumConst(_) | Value::Spectrum(_) => "spectrum",
             Value::Point(_) => "point",
             Value::Transform(_) => "transform",
         }
@@ -93,7 +96,7 @@ struct Importer<'a, 'i> {
     file: &'a Path,
     doc: &'a Document<'i>,
     defaults: HashMap<String, String>,
-    warnings: Vec<SceneWarning>,
+    warnings: RefCell<Vec<SceneWarning>>,
     bsdf_ids: HashMap<String, ()>,
     bsdf_anon: usize,
 }
@@ -117,9 +120,9 @@ impl<'a, 'i> Importer<'a, 'i> {
         SceneError::new(self.loc(node), msg)
     }
 
-    fn warn(&mut self, node: Node, msg: impl Into<String>) {
+    fn warn(&self, node: Node, msg: impl Into<String>) {
         let location = self.loc(node);
-        self.warnings.push(SceneWarning {
+        self.warnings.borrow_mut().push(SceneWarning {
             location,
             message: msg.into(),
         });
@@ -331,13 +334,12 @@ impl<'a, 'i> Importer<'a, 'i> {
                 "spectrum" => {
                     let s = self.req_attr(c, "value")?;
                     if s.contains(':') {
-                        return Err(self.err(
-                            c,
-                            "wavelength:value spectra are not supported yet; give an <rgb> value",
-                        ));
+                        Value::Spectrum(
+                            crate::spectrum::parse_pairs(&s).map_err(|e| self.err(c, e))?,
+                        )
+                    } else {
+                        Value::SpectrumConst(self.parse_float(c, &s)? as f32)
                     }
-                    let v = self.parse_float(c, &s)? as f32;
-                    Value::SpectrumConst(v)
                 }
                 "point" | "vector" => Value::Point(self.xyz(c, 0.0)?),
                 "transform" => Value::Transform(self.parse_transform(c)?),
@@ -450,14 +452,39 @@ impl Props<'_, '_> {
         let Some(p) = self.get(name) else {
             return Ok(None);
         };
-        let c = match p.value {
-            Value::Rgb(v) => v,
-            Value::Float(v) => [v as f32; 3],
-            Value::Int(v) => [v as f32; 3],
+        let c = match &p.value {
+            Value::Rgb(v) => *v,
+            Value::Float(v) => [*v as f32; 3],
+            Value::Int(v) => [*v as f32; 3],
             Value::SpectrumConst(v) => match usage {
-                ColorUse::Reflectance | ColorUse::Unbounded => [v; 3],
+                ColorUse::Reflectance | ColorUse::Unbounded => [*v; 3],
                 ColorUse::Emission => EQUAL_ENERGY_RGB.map(|c| c * v),
             },
+            Value::Spectrum(pairs) => {
+                // MATERIALS.md §7: BSDF parameters are D65-weighted, emitters are not; bounded
+                // parameters are clipped to [0, 1] with a warning, others clamped at 0.
+                let su = match usage {
+                    ColorUse::Emission => SpectrumUse::Emission,
+                    ColorUse::Reflectance | ColorUse::Unbounded => SpectrumUse::Reflectance,
+                };
+                let rgb = spectrum::to_rgb(pairs, su).map(|x| x as f32);
+                let hi = if usage == ColorUse::Reflectance {
+                    1.0
+                } else {
+                    f32::INFINITY
+                };
+                let clipped = rgb.map(|x| x.clamp(0.0, hi));
+                if clipped.iter().zip(&rgb).any(|(a, b)| (a - b).abs() > 1e-6) {
+                    imp.warn(
+                        p.node,
+                        format!(
+                            "{}: spectrum '{}' converts to RGB {rgb:?}, clipped to {clipped:?}",
+                            self.what, p.name
+                        ),
+                    );
+                }
+                clipped
+            }
             _ => return Err(self.type_err(imp, p, "a colour (rgb, spectrum or float)")),
         };
         if c.iter().any(|x| !x.is_finite()) {
@@ -815,6 +842,28 @@ impl<'a, 'i> Importer<'a, 'i> {
                     .ok_or_else(|| self.err(node, "obj shape needs a 'filename'"))?;
                 GeometryDesc::Obj { filename: f }
             }
+            "ply" => {
+                let f = props
+                    .string(self, "filename")?
+                    .ok_or_else(|| self.err(node, "ply shape needs a 'filename'"))?;
+                GeometryDesc::Ply { filename: f }
+            }
+            "serialized" => {
+                let f = props
+                    .string(self, "filename")?
+                    .ok_or_else(|| self.err(node, "serialized shape needs a 'filename'"))?;
+                let i = props.int(self, "shape_index")?.unwrap_or(0);
+                let shape_index = u32::try_from(i).map_err(|_| {
+                    self.err(
+                        node,
+                        format!("shape_index {i} must be a non-negative integer"),
+                    )
+                })?;
+                GeometryDesc::Serialized {
+                    filename: f,
+                    shape_index,
+                }
+            }
             other => return Err(self.err(node, format!("unknown shape type '{other}'"))),
         };
         let to_world = props.transform(self, "to_world")?;
@@ -1129,7 +1178,7 @@ pub fn parse_xml(
         file,
         doc: &doc,
         defaults: HashMap::new(),
-        warnings: Vec::new(),
+        warnings: RefCell::new(Vec::new()),
         bsdf_ids: HashMap::new(),
         bsdf_anon: 0,
     };
@@ -1154,7 +1203,7 @@ pub fn parse_xml(
     }
     for (k, v) in defines {
         if !imp.defaults.contains_key(k) {
-            imp.warnings.push(SceneWarning {
+            imp.warnings.borrow_mut().push(SceneWarning {
                 location: Location {
                     file: file.to_path_buf(),
                     line: 0,
@@ -1211,5 +1260,5 @@ pub fn parse_xml(
     if !saw_sensor {
         return Err(imp.err(root, "the scene has no <sensor>"));
     }
-    Ok((desc, imp.warnings))
+    Ok((desc, imp.warnings.into_inner()))
 }
