@@ -26,6 +26,7 @@ pub mod desc;
 mod error;
 mod meshio;
 pub mod spectrum;
+pub mod texture;
 pub mod xml;
 
 use std::path::{Path, PathBuf};

@@ -15,6 +15,7 @@ use roxmltree::{Document, Node};
 
 use crate::desc::*;
 use crate::spectrum::{self, SpectrumUse};
+use crate::texture::{TextureDesc, UvTransform};
 use crate::{SceneError, SceneWarning};
 
 type Result<T> = core::result::Result<T, SceneError>;
@@ -99,6 +100,8 @@ struct Importer<'a, 'i> {
     warnings: RefCell<Vec<SceneWarning>>,
     bsdf_ids: HashMap<String, ()>,
     bsdf_anon: usize,
+    /// Top-level textures by id, with the line that declares them.
+    textures: HashMap<String, (TextureDesc, u32)>,
 }
 
 fn parse_numbers(s: &str) -> Option<Vec<f64>> {
@@ -509,6 +512,13 @@ impl Props<'_, '_> {
     }
 }
 
+fn texture_kind(t: &TextureDesc) -> &'static str {
+    match t {
+        TextureDesc::Bitmap { .. } => "bitmap texture",
+        TextureDesc::Checkerboard { .. } => "checkerboard texture",
+    }
+}
+
 fn elements<'a, 'i>(node: Node<'a, 'i>) -> impl Iterator<Item = Node<'a, 'i>> {
     node.children().filter(Node::is_element)
 }
@@ -538,6 +548,40 @@ impl<'a, 'i> Importer<'a, 'i> {
         let nested: Vec<Node> = elements(node)
             .filter(|c| c.tag_name().name() == "bsdf")
             .collect();
+        // Parameters given as textures (nested or by reference): decoded and checked, but the
+        // materials cannot use them yet, so they are reported below with their line.
+        let mut textured: Vec<(Node, String, String)> = Vec::new();
+        for c in elements(node) {
+            let tag = c.tag_name().name();
+            if tag == "texture" {
+                let name = self.req_attr(c, "name")?;
+                let t = self.texture(c)?;
+                textured.push((c, snake_case(&name), texture_kind(&t).into()));
+            } else if tag == "ref"
+                && let Some(name) = self.attr(c, "name")?
+            {
+                let id = self.req_attr(c, "id")?;
+                let (t, line) = self.textures.get(&id).ok_or_else(|| {
+                    self.err(
+                        c,
+                        format!("bsdf '{ty}': reference to undefined texture '{id}'"),
+                    )
+                })?;
+                textured.push((
+                    c,
+                    snake_case(&name),
+                    format!("{} (texture '{id}', line {line})", texture_kind(t)),
+                ));
+            }
+        }
+        if let Some((c, name, what)) = textured.first() {
+            return Err(self.err(
+                *c,
+                format!(
+                    "bsdf '{ty}': '{name}' is a {what}; textured material parameters are not supported yet (give an rgb value)"
+                ),
+            ));
+        }
         let m = match ty.as_str() {
             "diffuse" => {
                 let r = props
@@ -675,6 +719,73 @@ impl<'a, 'i> Importer<'a, 'i> {
         }
         self.finish(props);
         Ok(m)
+    }
+
+    /// A `<texture>`: `bitmap` or `checkerboard`, with Mitsuba 0.6 `uscale`/`vscale`/
+    /// `uoffset`/`voffset` or Mitsuba 3 `to_uv` (scale and translation only).
+    fn texture(&mut self, node: Node<'a, 'i>) -> Result<TextureDesc> {
+        let ty = self.plugin_type(node)?;
+        let props = self.props(node, format!("texture '{ty}'"))?;
+        let mut uv = UvTransform::default();
+        let to_uv = props.transform(self, "to_uv")?;
+        if !to_uv.is_empty() {
+            let m = crate::transform_matrix(&to_uv).map_err(|e| self.err(node, e))?;
+            if m.x_axis.y.abs() > 1e-6 || m.y_axis.x.abs() > 1e-6 {
+                return Err(self.err(
+                    node,
+                    format!("texture '{ty}': to_uv may only scale and translate"),
+                ));
+            }
+            uv.scale = glam::Vec2::new(m.x_axis.x, m.y_axis.y);
+            uv.offset = glam::Vec2::new(m.w_axis.x, m.w_axis.y);
+        }
+        let (us, vs) = (props.float(self, "uscale")?, props.float(self, "vscale")?);
+        let (uo, vo) = (props.float(self, "uoffset")?, props.float(self, "voffset")?);
+        uv.scale *= glam::Vec2::new(us.unwrap_or(1.0), vs.unwrap_or(1.0));
+        uv.offset += glam::Vec2::new(uo.unwrap_or(0.0), vo.unwrap_or(0.0));
+        let t = match ty.as_str() {
+            "bitmap" => {
+                let filename = props
+                    .string(self, "filename")?
+                    .ok_or_else(|| self.err(node, "bitmap texture needs a 'filename'"))?;
+                let raw = props.bool(self, "raw")?.unwrap_or(false);
+                if let Some(f) = props.string(self, "filter_type")?
+                    && f != "bilinear"
+                {
+                    self.warn(
+                        node,
+                        format!("texture 'bitmap': filter_type '{f}' is replaced by bilinear"),
+                    );
+                }
+                if let Some(w) = props.string(self, "wrap_mode")?
+                    && w != "repeat"
+                {
+                    self.warn(
+                        node,
+                        format!("texture 'bitmap': wrap_mode '{w}' is replaced by repeat"),
+                    );
+                }
+                TextureDesc::Bitmap { filename, raw, uv }
+            }
+            "checkerboard" => TextureDesc::Checkerboard {
+                color0: props
+                    .color(self, "color0", ColorUse::Reflectance)?
+                    .unwrap_or([0.4; 3]),
+                color1: props
+                    .color(self, "color1", ColorUse::Reflectance)?
+                    .unwrap_or([0.2; 3]),
+                uv,
+            },
+            other => return Err(self.err(node, format!("unknown texture type '{other}'"))),
+        };
+        for c in elements(node) {
+            let tag = c.tag_name().name();
+            if !PROPERTY_TAGS.contains(&tag) {
+                return Err(self.err(c, format!("unexpected <{tag}> inside a texture")));
+            }
+        }
+        self.finish(props);
+        Ok(t)
     }
 
     /// `int_ior`/`ext_ior`: a number or a name from Mitsuba's IOR table.
@@ -1181,6 +1292,7 @@ pub fn parse_xml(
         warnings: RefCell::new(Vec::new()),
         bsdf_ids: HashMap::new(),
         bsdf_anon: 0,
+        textures: HashMap::new(),
     };
     if root.tag_name().name() != "scene" {
         return Err(imp.err(
@@ -1242,6 +1354,12 @@ pub fn parse_xml(
                 };
                 imp.bsdf_ids.insert(name.clone(), ());
                 desc.materials.push(NamedMaterial { name, material });
+            }
+            "texture" => {
+                let id = imp.req_attr(c, "id")?;
+                let t = imp.texture(c)?;
+                let line = imp.loc(c).line;
+                imp.textures.insert(id, (t, line));
             }
             "shape" => {
                 let s = imp.shape(c)?;
