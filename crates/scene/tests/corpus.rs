@@ -161,7 +161,7 @@ fn serialized_meshes_of_the_corpus() {
 }
 
 #[test]
-fn corpus_exr_decodes() {
+fn corpus_exr_and_jpeg_decode() {
     let Some(dir) = corpus() else { return };
     let desc = TextureDesc::Bitmap {
         filename: "envmap.exr".into(),
@@ -171,4 +171,13 @@ fn corpus_exr_decodes() {
     let t = Texture::load(&desc, &dir.join("lajolla/matpreview")).unwrap();
     let m = t.mean();
     assert!(m.is_finite() && m.min_element() > 0.0, "{m:?}");
+
+    let jpeg = TextureDesc::Bitmap {
+        filename: "textures/KAMEN.JPG".into(),
+        raw: false,
+        uv: UvTransform::default(),
+    };
+    let t = Texture::load(&jpeg, &dir.join("lajolla/sponza")).unwrap();
+    let m = t.mean();
+    assert!(m.max_element() <= 1.0 && m.min_element() > 0.0, "{m:?}");
 }
