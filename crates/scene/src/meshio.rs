@@ -539,13 +539,18 @@ impl Inflate<'_> {
             ));
         }
         self.budget -= n;
-        let mut v = vec![0u8; n as usize];
-        self.inner.read_exact(&mut v).map_err(|e| {
-            format!(
-                "shape {}: compressed data ends early or is damaged ({e})",
+        // Grows with the data actually decompressed, so a lying count cannot allocate much.
+        let mut v = Vec::new();
+        let read = (&mut self.inner)
+            .take(n)
+            .read_to_end(&mut v)
+            .map_err(|e| format!("shape {}: compressed data is damaged ({e})", self.index))?;
+        if read as u64 != n {
+            return Err(format!(
+                "shape {}: compressed data ends early (truncated file?)",
                 self.index
-            )
-        })?;
+            ));
+        }
         Ok(v)
     }
     fn u32(&mut self) -> Result<u32, String> {
