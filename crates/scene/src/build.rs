@@ -250,13 +250,12 @@ fn material_bsdf(m: &MaterialDesc) -> Result<Bsdf, String> {
     })
 }
 
-/// Positions, optional normals, optional uvs and triangles of a mesh file.
-type MeshData = (
-    Vec<Vec3>,
-    Option<Vec<Vec3>>,
-    Option<Vec<Vec2>>,
-    Vec<[u32; 3]>,
-);
+use crate::meshio::MeshData;
+
+/// Reads a whole mesh file.
+fn read_mesh_file(path: &Path) -> Result<Vec<u8>, String> {
+    std::fs::read(path).map_err(|e| format!("cannot read mesh '{}': {e}", path.display()))
+}
 
 fn load_obj(path: &Path) -> Result<MeshData, String> {
     let opts = tobj::LoadOptions {
@@ -343,6 +342,30 @@ fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<Shape, String> {
         GeometryDesc::Obj { filename } => {
             let path = base_dir.join(filename);
             let (p, n, uv, idx) = load_obj(&path)?;
+            let n = if desc.face_normals { None } else { n };
+            mesh(
+                TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
+                    .map_err(|e| format!("mesh '{}': {e}", path.display()))?,
+            )?
+        }
+        GeometryDesc::Ply { filename } => {
+            let path = base_dir.join(filename);
+            let (p, n, uv, idx) = crate::meshio::read_ply(&read_mesh_file(&path)?)
+                .map_err(|e| format!("mesh '{}': {e}", path.display()))?;
+            let n = if desc.face_normals { None } else { n };
+            mesh(
+                TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
+                    .map_err(|e| format!("mesh '{}': {e}", path.display()))?,
+            )?
+        }
+        GeometryDesc::Serialized {
+            filename,
+            shape_index,
+        } => {
+            let path = base_dir.join(filename);
+            let (p, n, uv, idx) =
+                crate::meshio::read_serialized(&read_mesh_file(&path)?, *shape_index as usize)
+                    .map_err(|e| format!("mesh '{}': {e}", path.display()))?;
             let n = if desc.face_normals { None } else { n };
             mesh(
                 TriangleMesh::new(p, n, uv, idx, desc.flip_normals)

@@ -468,6 +468,19 @@ pub enum GeometryDesc {
         /// Path.
         filename: String,
     },
+    /// A PLY file (ASCII or binary), relative to the scene file.
+    Ply {
+        /// Path.
+        filename: String,
+    },
+    /// One shape of a Mitsuba `.serialized` file, relative to the scene file.
+    Serialized {
+        /// Path.
+        filename: String,
+        /// Which shape of the file (default 0).
+        #[serde(default)]
+        shape_index: u32,
+    },
     /// Triangles given inline.
     Mesh {
         /// Vertex positions.

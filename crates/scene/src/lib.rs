@@ -24,6 +24,9 @@
 mod build;
 pub mod desc;
 mod error;
+mod meshio;
+pub mod spectrum;
+pub mod texture;
 pub mod xml;
 
 use std::path::{Path, PathBuf};

@@ -7,13 +7,15 @@
 //! Unknown *properties* are warnings with `file:line` (legacy files carry many that do not matter,
 //! such as `nearClip`); unknown *plugin types* and malformed values are errors with `file:line`.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
 use std::path::Path;
 
 use roxmltree::{Document, Node};
 
 use crate::desc::*;
+use crate::spectrum::{self, SpectrumUse};
+use crate::texture::{TextureDesc, UvTransform};
 use crate::{SceneError, SceneWarning};
 
 type Result<T> = core::result::Result<T, SceneError>;
@@ -44,6 +46,8 @@ enum Value {
     Rgb([f32; 3]),
     /// `<spectrum value="v"/>`: a constant spectrum.
     SpectrumConst(f32),
+    /// `<spectrum value="λ1:v1, λ2:v2, …"/>`: a sampled spectrum (nm, value).
+    Spectrum(Vec<(f64, f64)>),
     Point([f32; 3]),
     Transform(Vec<TransformOp>),
 }
@@ -56,7 +60,7 @@ impl Value {
             Value::Bool(_) => "boolean",
             Value::Str(_) => "string",
             Value::Rgb(_) => "rgb",
-            Value::SpectrumConst(_) => "spectrum",
+            Value::SpectrumConst(_) | Value::Spectrum(_) => "spectrum",
             Value::Point(_) => "point",
             Value::Transform(_) => "transform",
         }
@@ -93,9 +97,11 @@ struct Importer<'a, 'i> {
     file: &'a Path,
     doc: &'a Document<'i>,
     defaults: HashMap<String, String>,
-    warnings: Vec<SceneWarning>,
+    warnings: RefCell<Vec<SceneWarning>>,
     bsdf_ids: HashMap<String, ()>,
     bsdf_anon: usize,
+    /// Top-level textures by id, with the line that declares them.
+    textures: HashMap<String, (TextureDesc, u32)>,
 }
 
 fn parse_numbers(s: &str) -> Option<Vec<f64>> {
@@ -117,9 +123,9 @@ impl<'a, 'i> Importer<'a, 'i> {
         SceneError::new(self.loc(node), msg)
     }
 
-    fn warn(&mut self, node: Node, msg: impl Into<String>) {
+    fn warn(&self, node: Node, msg: impl Into<String>) {
         let location = self.loc(node);
-        self.warnings.push(SceneWarning {
+        self.warnings.borrow_mut().push(SceneWarning {
             location,
             message: msg.into(),
         });
@@ -331,13 +337,12 @@ impl<'a, 'i> Importer<'a, 'i> {
                 "spectrum" => {
                     let s = self.req_attr(c, "value")?;
                     if s.contains(':') {
-                        return Err(self.err(
-                            c,
-                            "wavelength:value spectra are not supported yet; give an <rgb> value",
-                        ));
+                        Value::Spectrum(
+                            crate::spectrum::parse_pairs(&s).map_err(|e| self.err(c, e))?,
+                        )
+                    } else {
+                        Value::SpectrumConst(self.parse_float(c, &s)? as f32)
                     }
-                    let v = self.parse_float(c, &s)? as f32;
-                    Value::SpectrumConst(v)
                 }
                 "point" | "vector" => Value::Point(self.xyz(c, 0.0)?),
                 "transform" => Value::Transform(self.parse_transform(c)?),
@@ -450,14 +455,39 @@ impl Props<'_, '_> {
         let Some(p) = self.get(name) else {
             return Ok(None);
         };
-        let c = match p.value {
-            Value::Rgb(v) => v,
-            Value::Float(v) => [v as f32; 3],
-            Value::Int(v) => [v as f32; 3],
+        let c = match &p.value {
+            Value::Rgb(v) => *v,
+            Value::Float(v) => [*v as f32; 3],
+            Value::Int(v) => [*v as f32; 3],
             Value::SpectrumConst(v) => match usage {
-                ColorUse::Reflectance | ColorUse::Unbounded => [v; 3],
+                ColorUse::Reflectance | ColorUse::Unbounded => [*v; 3],
                 ColorUse::Emission => EQUAL_ENERGY_RGB.map(|c| c * v),
             },
+            Value::Spectrum(pairs) => {
+                // MATERIALS.md §7: BSDF parameters are D65-weighted, emitters are not; bounded
+                // parameters are clipped to [0, 1] with a warning, others clamped at 0.
+                let su = match usage {
+                    ColorUse::Emission => SpectrumUse::Emission,
+                    ColorUse::Reflectance | ColorUse::Unbounded => SpectrumUse::Reflectance,
+                };
+                let rgb = spectrum::to_rgb(pairs, su).map(|x| x as f32);
+                let hi = if usage == ColorUse::Reflectance {
+                    1.0
+                } else {
+                    f32::INFINITY
+                };
+                let clipped = rgb.map(|x| x.clamp(0.0, hi));
+                if clipped.iter().zip(&rgb).any(|(a, b)| (a - b).abs() > 1e-6) {
+                    imp.warn(
+                        p.node,
+                        format!(
+                            "{}: spectrum '{}' converts to RGB {rgb:?}, clipped to {clipped:?}",
+                            self.what, p.name
+                        ),
+                    );
+                }
+                clipped
+            }
             _ => return Err(self.type_err(imp, p, "a colour (rgb, spectrum or float)")),
         };
         if c.iter().any(|x| !x.is_finite()) {
@@ -479,6 +509,13 @@ impl Props<'_, '_> {
             ));
         }
         Ok(Some(c))
+    }
+}
+
+fn texture_kind(t: &TextureDesc) -> &'static str {
+    match t {
+        TextureDesc::Bitmap { .. } => "bitmap texture",
+        TextureDesc::Checkerboard { .. } => "checkerboard texture",
     }
 }
 
@@ -511,6 +548,40 @@ impl<'a, 'i> Importer<'a, 'i> {
         let nested: Vec<Node> = elements(node)
             .filter(|c| c.tag_name().name() == "bsdf")
             .collect();
+        // Parameters given as textures (nested or by reference): decoded and checked, but the
+        // materials cannot use them yet, so they are reported below with their line.
+        let mut textured: Vec<(Node, String, String)> = Vec::new();
+        for c in elements(node) {
+            let tag = c.tag_name().name();
+            if tag == "texture" {
+                let name = self.req_attr(c, "name")?;
+                let t = self.texture(c)?;
+                textured.push((c, snake_case(&name), texture_kind(&t).into()));
+            } else if tag == "ref"
+                && let Some(name) = self.attr(c, "name")?
+            {
+                let id = self.req_attr(c, "id")?;
+                let (t, line) = self.textures.get(&id).ok_or_else(|| {
+                    self.err(
+                        c,
+                        format!("bsdf '{ty}': reference to undefined texture '{id}'"),
+                    )
+                })?;
+                textured.push((
+                    c,
+                    snake_case(&name),
+                    format!("{} (texture '{id}', line {line})", texture_kind(t)),
+                ));
+            }
+        }
+        if let Some((c, name, what)) = textured.first() {
+            return Err(self.err(
+                *c,
+                format!(
+                    "bsdf '{ty}': '{name}' is a {what}; textured material parameters are not supported yet (give an rgb value)"
+                ),
+            ));
+        }
         let m = match ty.as_str() {
             "diffuse" => {
                 let r = props
@@ -648,6 +719,73 @@ impl<'a, 'i> Importer<'a, 'i> {
         }
         self.finish(props);
         Ok(m)
+    }
+
+    /// A `<texture>`: `bitmap` or `checkerboard`, with Mitsuba 0.6 `uscale`/`vscale`/
+    /// `uoffset`/`voffset` or Mitsuba 3 `to_uv` (scale and translation only).
+    fn texture(&mut self, node: Node<'a, 'i>) -> Result<TextureDesc> {
+        let ty = self.plugin_type(node)?;
+        let props = self.props(node, format!("texture '{ty}'"))?;
+        let mut uv = UvTransform::default();
+        let to_uv = props.transform(self, "to_uv")?;
+        if !to_uv.is_empty() {
+            let m = crate::transform_matrix(&to_uv).map_err(|e| self.err(node, e))?;
+            if m.x_axis.y.abs() > 1e-6 || m.y_axis.x.abs() > 1e-6 {
+                return Err(self.err(
+                    node,
+                    format!("texture '{ty}': to_uv may only scale and translate"),
+                ));
+            }
+            uv.scale = glam::Vec2::new(m.x_axis.x, m.y_axis.y);
+            uv.offset = glam::Vec2::new(m.w_axis.x, m.w_axis.y);
+        }
+        let (us, vs) = (props.float(self, "uscale")?, props.float(self, "vscale")?);
+        let (uo, vo) = (props.float(self, "uoffset")?, props.float(self, "voffset")?);
+        uv.scale *= glam::Vec2::new(us.unwrap_or(1.0), vs.unwrap_or(1.0));
+        uv.offset += glam::Vec2::new(uo.unwrap_or(0.0), vo.unwrap_or(0.0));
+        let t = match ty.as_str() {
+            "bitmap" => {
+                let filename = props
+                    .string(self, "filename")?
+                    .ok_or_else(|| self.err(node, "bitmap texture needs a 'filename'"))?;
+                let raw = props.bool(self, "raw")?.unwrap_or(false);
+                if let Some(f) = props.string(self, "filter_type")?
+                    && f != "bilinear"
+                {
+                    self.warn(
+                        node,
+                        format!("texture 'bitmap': filter_type '{f}' is replaced by bilinear"),
+                    );
+                }
+                if let Some(w) = props.string(self, "wrap_mode")?
+                    && w != "repeat"
+                {
+                    self.warn(
+                        node,
+                        format!("texture 'bitmap': wrap_mode '{w}' is replaced by repeat"),
+                    );
+                }
+                TextureDesc::Bitmap { filename, raw, uv }
+            }
+            "checkerboard" => TextureDesc::Checkerboard {
+                color0: props
+                    .color(self, "color0", ColorUse::Reflectance)?
+                    .unwrap_or([0.4; 3]),
+                color1: props
+                    .color(self, "color1", ColorUse::Reflectance)?
+                    .unwrap_or([0.2; 3]),
+                uv,
+            },
+            other => return Err(self.err(node, format!("unknown texture type '{other}'"))),
+        };
+        for c in elements(node) {
+            let tag = c.tag_name().name();
+            if !PROPERTY_TAGS.contains(&tag) {
+                return Err(self.err(c, format!("unexpected <{tag}> inside a texture")));
+            }
+        }
+        self.finish(props);
+        Ok(t)
     }
 
     /// `int_ior`/`ext_ior`: a number or a name from Mitsuba's IOR table.
@@ -814,6 +952,28 @@ impl<'a, 'i> Importer<'a, 'i> {
                     .string(self, "filename")?
                     .ok_or_else(|| self.err(node, "obj shape needs a 'filename'"))?;
                 GeometryDesc::Obj { filename: f }
+            }
+            "ply" => {
+                let f = props
+                    .string(self, "filename")?
+                    .ok_or_else(|| self.err(node, "ply shape needs a 'filename'"))?;
+                GeometryDesc::Ply { filename: f }
+            }
+            "serialized" => {
+                let f = props
+                    .string(self, "filename")?
+                    .ok_or_else(|| self.err(node, "serialized shape needs a 'filename'"))?;
+                let i = props.int(self, "shape_index")?.unwrap_or(0);
+                let shape_index = u32::try_from(i).map_err(|_| {
+                    self.err(
+                        node,
+                        format!("shape_index {i} must be a non-negative integer"),
+                    )
+                })?;
+                GeometryDesc::Serialized {
+                    filename: f,
+                    shape_index,
+                }
             }
             other => return Err(self.err(node, format!("unknown shape type '{other}'"))),
         };
@@ -1133,9 +1293,10 @@ pub fn parse_xml(
         file,
         doc: &doc,
         defaults: HashMap::new(),
-        warnings: Vec::new(),
+        warnings: RefCell::new(Vec::new()),
         bsdf_ids: HashMap::new(),
         bsdf_anon: 0,
+        textures: HashMap::new(),
     };
     if root.tag_name().name() != "scene" {
         return Err(imp.err(
@@ -1158,7 +1319,7 @@ pub fn parse_xml(
     }
     for (k, v) in defines {
         if !imp.defaults.contains_key(k) {
-            imp.warnings.push(SceneWarning {
+            imp.warnings.borrow_mut().push(SceneWarning {
                 location: Location {
                     file: file.to_path_buf(),
                     line: 0,
@@ -1198,6 +1359,12 @@ pub fn parse_xml(
                 imp.bsdf_ids.insert(name.clone(), ());
                 desc.materials.push(NamedMaterial { name, material });
             }
+            "texture" => {
+                let id = imp.req_attr(c, "id")?;
+                let t = imp.texture(c)?;
+                let line = imp.loc(c).line;
+                imp.textures.insert(id, (t, line));
+            }
             "shape" => {
                 let s = imp.shape(c)?;
                 desc.shapes.push(s);
@@ -1215,5 +1382,5 @@ pub fn parse_xml(
     if !saw_sensor {
         return Err(imp.err(root, "the scene has no <sensor>"));
     }
-    Ok((desc, imp.warnings))
+    Ok((desc, imp.warnings.into_inner()))
 }

@@ -1,0 +1,291 @@
+//! Textures of the XML format: `bitmap` (PNG, JPEG, EXR) and `checkerboard`, decoded and
+//! evaluated in the scene crate.
+//!
+//! Status: textures are parsed and decoded here, but the materials cannot take them yet, so a
+//! bsdf parameter that refers to a texture is a load error naming the texture (see
+//! `docs/SCENES.md`). [`Texture::eval`] is what the materials path will call once it exists.
+
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+
+/// The `uv` transform of a texture: `uv' = uv · scale + offset` (Mitsuba 0.6 `uscale`/`vscale`/
+/// `uoffset`/`voffset`, Mitsuba 3 `to_uv` with scale and translate).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvTransform {
+    /// Per-axis scale.
+    pub scale: Vec2,
+    /// Offset added after scaling.
+    pub offset: Vec2,
+}
+
+impl Default for UvTransform {
+    fn default() -> Self {
+        Self {
+            scale: Vec2::ONE,
+            offset: Vec2::ZERO,
+        }
+    }
+}
+
+impl UvTransform {
+    /// Applies the transform.
+    #[inline]
+    pub fn apply(&self, uv: Vec2) -> Vec2 {
+        uv * self.scale + self.offset
+    }
+}
+
+/// A texture as the scene file describes it (file not yet read).
+#[derive(Clone, Debug, PartialEq)]
+pub enum TextureDesc {
+    /// An image file, relative to the scene file.
+    Bitmap {
+        /// Path.
+        filename: String,
+        /// `raw = true`: 8-bit values are used as they are, not sRGB-decoded.
+        raw: bool,
+        /// uv transform.
+        uv: UvTransform,
+    },
+    /// Two colours alternating in a 2×2 pattern per unit square of (transformed) uv.
+    Checkerboard {
+        /// Colour where `u mod 1` and `v mod 1` are on the same side of ½.
+        color0: [f32; 3],
+        /// The other colour.
+        color1: [f32; 3],
+        /// uv transform.
+        uv: UvTransform,
+    },
+}
+
+/// A decoded texture.
+#[derive(Clone, Debug)]
+pub enum Texture {
+    /// Linear RGB texels, rows top to bottom, bilinearly filtered, repeating.
+    Bitmap {
+        /// Width in texels.
+        width: usize,
+        /// Height in texels.
+        height: usize,
+        /// `width × height` linear RGB texels, the first row at the top of the image.
+        texels: Vec<Vec3>,
+        /// uv transform.
+        uv: UvTransform,
+    },
+    /// See [`TextureDesc::Checkerboard`].
+    Checkerboard {
+        /// First colour.
+        color0: Vec3,
+        /// Second colour.
+        color1: Vec3,
+        /// uv transform.
+        uv: UvTransform,
+    },
+}
+
+/// sRGB transfer function → linear.
+fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+impl Texture {
+    /// Reads the files a description names; `base_dir` resolves relative paths.
+    pub fn load(desc: &TextureDesc, base_dir: &Path) -> Result<Texture, String> {
+        match desc {
+            TextureDesc::Checkerboard { color0, color1, uv } => Ok(Texture::Checkerboard {
+                color0: Vec3::from(*color0),
+                color1: Vec3::from(*color1),
+                uv: *uv,
+            }),
+            TextureDesc::Bitmap { filename, raw, uv } => {
+                let path = base_dir.join(filename);
+                let (width, height, texels) = read_image(&path, *raw)?;
+                Ok(Texture::Bitmap {
+                    width,
+                    height,
+                    texels,
+                    uv: *uv,
+                })
+            }
+        }
+    }
+
+    /// The texture's value at surface coordinates `uv` (`v = 0` is the image's bottom row, as
+    /// in OBJ texture coordinates).
+    pub fn eval(&self, uv: Vec2) -> Vec3 {
+        match self {
+            Texture::Checkerboard {
+                color0,
+                color1,
+                uv: t,
+            } => {
+                let p = t.apply(uv);
+                let (u, v) = (p.x - p.x.floor(), p.y - p.y.floor());
+                if (u > 0.5) == (v > 0.5) {
+                    *color0
+                } else {
+                    *color1
+                }
+            }
+            Texture::Bitmap {
+                width,
+                height,
+                texels,
+                uv: t,
+            } => {
+                let p = t.apply(uv);
+                // Texel centres at (i + ½)/size; repeat wrapping.
+                let x = p.x * *width as f32 - 0.5;
+                let y = (1.0 - p.y) * *height as f32 - 0.5;
+                let (x0, y0) = (x.floor(), y.floor());
+                let (fx, fy) = (x - x0, y - y0);
+                let wrap = |i: f32, n: usize| -> usize {
+                    let n = n as i64;
+                    let i = if i.is_finite() { i as i64 } else { 0 };
+                    i.rem_euclid(n) as usize
+                };
+                let at = |xi: f32, yi: f32| texels[wrap(yi, *height) * width + wrap(xi, *width)];
+                let top = at(x0, y0) * (1.0 - fx) + at(x0 + 1.0, y0) * fx;
+                let bottom = at(x0, y0 + 1.0) * (1.0 - fx) + at(x0 + 1.0, y0 + 1.0) * fx;
+                top * (1.0 - fy) + bottom * fy
+            }
+        }
+    }
+
+    /// The mean texel value (the average reflectance of a bitmap, or the checkerboard's).
+    pub fn mean(&self) -> Vec3 {
+        match self {
+            Texture::Checkerboard { color0, color1, .. } => 0.5 * (*color0 + *color1),
+            Texture::Bitmap { texels, .. } => {
+                texels.iter().copied().sum::<Vec3>() / texels.len().max(1) as f32
+            }
+        }
+    }
+}
+
+/// Reads PNG/JPEG (8- or 16-bit, sRGB-decoded unless `raw`) or EXR (linear) as linear RGB.
+fn read_image(path: &Path, raw: bool) -> Result<(usize, usize, Vec<Vec3>), String> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    let fail =
+        |e: &dyn core::fmt::Display| format!("cannot read texture '{}': {e}", path.display());
+    let (w, h, texels) = if ext == "exr" {
+        let img = exr::prelude::read_first_rgba_layer_from_file(
+            path,
+            |res, _| (res.width(), vec![Vec3::ZERO; res.width() * res.height()]),
+            |(w, px): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                if let Some(t) = px.get_mut(pos.y() * *w + pos.x()) {
+                    *t = Vec3::new(r, g, b);
+                }
+            },
+        )
+        .map_err(|e| fail(&e))?;
+        let size = img.layer_data.size;
+        (
+            size.width(),
+            size.height(),
+            img.layer_data.channel_data.pixels.1,
+        )
+    } else {
+        let img = image::ImageReader::open(path)
+            .map_err(|e| fail(&e))?
+            .with_guessed_format()
+            .map_err(|e| fail(&e))?
+            .decode()
+            .map_err(|e| fail(&e))?;
+        let (w, h) = (img.width() as usize, img.height() as usize);
+        let rgb = img.to_rgb32f();
+        let decode = |c: f32| if raw { c } else { srgb_to_linear(c) };
+        let texels = rgb
+            .pixels()
+            .map(|p| Vec3::new(decode(p.0[0]), decode(p.0[1]), decode(p.0[2])))
+            .collect();
+        (w, h, texels)
+    };
+    if w == 0 || h == 0 || texels.len() != w * h {
+        return Err(fail(&"empty or inconsistent image"));
+    }
+    if texels.iter().any(|t| !t.is_finite()) {
+        return Err(fail(&"non-finite texel values"));
+    }
+    Ok((w, h, texels))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn checkerboard_pattern_and_scale() {
+        let t = Texture::Checkerboard {
+            color0: Vec3::ONE,
+            color1: Vec3::ZERO,
+            uv: UvTransform {
+                scale: Vec2::splat(2.0),
+                offset: Vec2::ZERO,
+            },
+        };
+        assert_eq!(t.eval(Vec2::new(0.1, 0.1)), Vec3::ONE);
+        assert_eq!(t.eval(Vec2::new(0.3, 0.1)), Vec3::ZERO);
+        assert_eq!(t.eval(Vec2::new(0.3, 0.3)), Vec3::ONE);
+        assert_eq!(t.eval(Vec2::new(-0.1, 0.1)), Vec3::ZERO);
+        assert_eq!(t.mean(), Vec3::splat(0.5));
+    }
+
+    #[test]
+    fn png_is_srgb_decoded_and_bilinear() {
+        let dir = std::env::temp_dir().join(format!("restir-tex-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // 2×1 image: black | sRGB 188 (≈ linear 0.5).
+        let img = image::RgbImage::from_raw(2, 1, vec![0, 0, 0, 188, 188, 188]).unwrap();
+        img.save(dir.join("t.png")).unwrap();
+        let desc = TextureDesc::Bitmap {
+            filename: "t.png".into(),
+            raw: false,
+            uv: UvTransform::default(),
+        };
+        let t = Texture::load(&desc, &dir).unwrap();
+        let lin = srgb_to_linear(188.0 / 255.0);
+        assert!((lin - 0.5).abs() < 0.01);
+        // Texel centres at u = 0.25 and 0.75; halfway between is the average.
+        assert!((t.eval(Vec2::new(0.75, 0.5)).x - lin).abs() < 1e-5);
+        assert!(t.eval(Vec2::new(0.25, 0.5)).x.abs() < 1e-6);
+        assert!((t.eval(Vec2::new(0.5, 0.5)).x - 0.5 * lin).abs() < 1e-5);
+        // Wrapping: u = 0 is halfway between the last and the first texel.
+        assert!((t.eval(Vec2::new(0.0, 0.5)).x - 0.5 * lin).abs() < 1e-5);
+        let raw = TextureDesc::Bitmap {
+            filename: "t.png".into(),
+            raw: true,
+            uv: UvTransform::default(),
+        };
+        let t = Texture::load(&raw, &dir).unwrap();
+        assert!((t.eval(Vec2::new(0.75, 0.5)).x - 188.0 / 255.0).abs() < 1e-5);
+        // Missing and malformed files are errors.
+        let missing = TextureDesc::Bitmap {
+            filename: "nope.png".into(),
+            raw: false,
+            uv: UvTransform::default(),
+        };
+        assert!(
+            Texture::load(&missing, &dir)
+                .unwrap_err()
+                .contains("nope.png")
+        );
+        std::fs::write(dir.join("bad.png"), b"not a png").unwrap();
+        let bad = TextureDesc::Bitmap {
+            filename: "bad.png".into(),
+            raw: false,
+            uv: UvTransform::default(),
+        };
+        assert!(Texture::load(&bad, &dir).is_err());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

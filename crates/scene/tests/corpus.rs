@@ -1,0 +1,183 @@
+//! Loads every scene of the shared corpus (`../shared/corpus` beside the workspace): the ones the
+//! importer supports must load, the others must fail with a clear `file:line` message. When the
+//! corpus is absent the test fails under CI (`CI` set) and is skipped otherwise.
+
+use std::path::{Path, PathBuf};
+
+use restir_scene::texture::{Texture, TextureDesc, UvTransform};
+use restir_scene::{LoadedScene, load_scene};
+
+fn corpus() -> Option<PathBuf> {
+    let dir = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/corpus"
+    ));
+    if dir.is_dir() {
+        return Some(dir.to_path_buf());
+    }
+    if std::env::var_os("CI").is_some() {
+        panic!(
+            "the scene corpus is missing at {} (required when CI is set)",
+            dir.display()
+        );
+    }
+    eprintln!("skipped: no scene corpus at {}", dir.display());
+    None
+}
+
+fn load(dir: &Path, rel: &str) -> LoadedScene {
+    let path = dir.join(rel);
+    load_scene(&path, &[]).unwrap_or_else(|e| panic!("{rel} should load: {e}"))
+}
+
+fn load_err(dir: &Path, rel: &str) -> String {
+    match load_scene(&dir.join(rel), &[]) {
+        Ok(_) => panic!("{rel} loads; update this test and docs/SCENES.md"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn supported_corpus_scenes_load() {
+    let Some(dir) = corpus() else { return };
+
+    // Cornell box: OBJ meshes, measured reflectance spectra, a spectral area light.
+    let cbox = load(&dir, "lajolla/cbox/cbox.xml");
+    assert_eq!(cbox.scene.lights.len(), 1);
+    let light = cbox
+        .desc
+        .shapes
+        .iter()
+        .find_map(|s| s.emission)
+        .expect("cbox has an area light");
+    // "400:0, 500:8, 600:15.6, 700:18.4" without D65: warm, all channels positive.
+    assert!(
+        light[0] > light[1] && light[1] > light[2] && light[2] > 0.0,
+        "{light:?}"
+    );
+
+    // Veach's MIS plates: sphere lights, rough plastic.
+    let mi = load(&dir, "lajolla/veach_mi/mi.xml");
+    assert!(mi.scene.lights.len() >= 4);
+
+    // ReSTIR test scene: PLY meshes, spectra, 100+ emissive spheres, unknown parameters.
+    let t = load(&dir, "restir_test_scene/test.xml");
+    assert!(t.scene.lights.len() >= 100, "{}", t.scene.lights.len());
+    assert!(t.desc.shapes.iter().any(|s| matches!(
+        &s.geometry,
+        restir_scene::GeometryDesc::Ply { filename } if filename.contains("bunny")
+    )));
+}
+
+#[test]
+fn unsupported_corpus_scenes_fail_clearly() {
+    let Some(dir) = corpus() else { return };
+    let cases = [
+        // Environment maps are not implemented yet.
+        (
+            "lajolla/matpreview/matpreview.xml",
+            "matpreview.xml:49: unknown emitter type 'envmap'",
+        ),
+        // Materials cannot take textures yet.
+        (
+            "lajolla/sponza/sponza.xml",
+            "sponza.xml:60: bsdf 'diffuse': 'reflectance' is a bitmap texture",
+        ),
+        (
+            "lajolla/pixel_filter_test/pixel_filter_test.xml",
+            "pixel_filter_test.xml:45: bsdf 'diffuse': 'reflectance' is a checkerboard texture",
+        ),
+    ];
+    for (rel, want) in cases {
+        let e = load_err(&dir, rel);
+        assert!(e.contains(want), "{rel}: got \"{e}\", want \"{want}\"");
+    }
+}
+
+/// A scene around one shape, written next to the test's temporary files.
+fn shape_scene(name: &str, shape: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("restir-corpus-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    let xml = format!(
+        r#"<scene version="0.6.0">
+    <sensor type="perspective"><float name="fov" value="40"/>
+        <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film>
+    </sensor>
+{shape}
+</scene>
+"#
+    );
+    std::fs::write(&path, xml).unwrap();
+    path
+}
+
+#[test]
+fn serialized_meshes_of_the_corpus() {
+    let Some(dir) = corpus() else { return };
+    let mp = dir.join("lajolla/matpreview/matpreview.serialized");
+    let sp = dir.join("lajolla/sponza/sponza.serialized");
+    let mut shapes = String::new();
+    for i in 0..3 {
+        shapes += &format!(
+            "<shape type=\"serialized\"><string name=\"filename\" value=\"{}\"/><integer name=\"shapeIndex\" value=\"{i}\"/><boolean name=\"faceNormals\" value=\"true\"/></shape>\n",
+            mp.display()
+        );
+    }
+    shapes += &format!(
+        "<shape type=\"serialized\"><string name=\"filename\" value=\"{}\"/><integer name=\"shape_index\" value=\"5\"/><boolean name=\"flip_normals\" value=\"true\"/></shape>\n",
+        sp.display()
+    );
+    let path = shape_scene("serialized.xml", &shapes);
+    let s = load_scene(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.scene.shapes.len(), 4);
+
+    // An index past the file's shapes: an error at the shape's line.
+    let bad = format!(
+        "<shape type=\"serialized\">\n<string name=\"filename\" value=\"{}\"/><integer name=\"shape_index\" value=\"99\"/></shape>",
+        mp.display()
+    );
+    let e = load_scene(&shape_scene("bad-index.xml", &bad), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("bad-index.xml:5:") && e.contains("shape_index 99 is out of range"),
+        "{e}"
+    );
+    // A missing file.
+    let e = load_scene(
+        &shape_scene(
+            "missing.xml",
+            "<shape type=\"ply\"><string name=\"filename\" value=\"nope.ply\"/></shape>",
+        ),
+        &[],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("missing.xml:5:") && e.contains("nope.ply"),
+        "{e}"
+    );
+}
+
+#[test]
+fn corpus_exr_and_jpeg_decode() {
+    let Some(dir) = corpus() else { return };
+    let desc = TextureDesc::Bitmap {
+        filename: "envmap.exr".into(),
+        raw: false,
+        uv: UvTransform::default(),
+    };
+    let t = Texture::load(&desc, &dir.join("lajolla/matpreview")).unwrap();
+    let m = t.mean();
+    assert!(m.is_finite() && m.min_element() > 0.0, "{m:?}");
+
+    let jpeg = TextureDesc::Bitmap {
+        filename: "textures/KAMEN.JPG".into(),
+        raw: false,
+        uv: UvTransform::default(),
+    };
+    let t = Texture::load(&jpeg, &dir.join("lajolla/sponza")).unwrap();
+    let m = t.mean();
+    assert!(m.max_element() <= 1.0 && m.min_element() > 0.0, "{m:?}");
+}
