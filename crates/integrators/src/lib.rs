@@ -22,6 +22,7 @@ pub mod film;
 pub mod gbuffer;
 mod image_io;
 pub mod metrics;
+pub mod neighbors;
 mod params;
 pub mod path;
 mod render;

@@ -24,16 +24,17 @@ pub mod tiles;
 
 use std::sync::Mutex;
 
-use glam::{DVec3, Vec2, Vec3};
+use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use restir_geometry::{Ray, offset_ray_origin, shadow_ray_between, shadow_ray_towards};
 use restir_gris::{MisScheme, Reservoir, ShiftMap, Shifted, StreamingReservoir, resample};
-use restir_sampling::{Pcg32, sequences::r2};
+use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
 pub use settings::{LightSampler, MIS_NAMES, RestirDiSettings, mis_name};
 
 use crate::gbuffer::{GBuffer, Receiver};
+use crate::neighbors::{NeighborPattern, NeighborRule};
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
 use crate::render::{BAND_ROWS, Integrator, PassContext};
 use light_point::{
@@ -45,10 +46,6 @@ const STAGE_INITIAL: u64 = 1;
 const STAGE_TEMPORAL: u64 = 2;
 const STAGE_SHADE: u64 = 3;
 const STAGE_SPATIAL: u64 = 16;
-
-/// Points of the neighbour pattern (R2 sequence inside the unit disk); a power of two, so that
-/// indices wrap with a mask.
-const OFFSET_COUNT: usize = 8192;
 
 /// The reservoir type: 16-byte sample, `W`, `M`, `p̂`.
 pub type DiReservoir = Reservoir<LightPoint>;
@@ -65,7 +62,7 @@ struct History {
 pub struct RestirDiIntegrator {
     settings: RestirDiSettings,
     counts: StrategyCounts,
-    offsets: Vec<Vec2>,
+    pattern: NeighborPattern,
     history: Mutex<Option<History>>,
 }
 
@@ -117,23 +114,13 @@ impl ShiftMap<LightPoint> for DiShift<'_> {
 impl RestirDiIntegrator {
     /// An integrator with `settings`.
     pub fn new(settings: RestirDiSettings) -> Self {
-        let mut offsets = Vec::with_capacity(OFFSET_COUNT);
-        let mut i = 0u64;
-        while offsets.len() < OFFSET_COUNT {
-            let [u, v] = r2(i, [0.5, 0.5]);
-            i += 1;
-            let p = Vec2::new(2.0 * u - 1.0, 2.0 * v - 1.0);
-            if p.length_squared() <= 1.0 {
-                offsets.push(p);
-            }
-        }
         Self {
             counts: StrategyCounts {
                 light: settings.candidates as f32,
                 bsdf: settings.bsdf_candidates as f32,
             },
             settings,
-            offsets,
+            pattern: NeighborPattern::new(),
             history: Mutex::new(None),
         }
     }
@@ -253,35 +240,26 @@ impl RestirDiIntegrator {
         input: &'a [DiReservoir],
         index: usize,
         rng: &mut Pcg32,
+        picked: &mut Vec<usize>,
         neighbors: &mut Vec<(&'a Receiver, &'a DiReservoir)>,
     ) -> DiReservoir {
         let canonical = &input[index];
         let Some(r) = gbuf.receiver(index) else {
             return *canonical;
         };
-        let (w, h) = (gbuf.width as i64, gbuf.height as i64);
-        let (x, y) = ((index as i64) % w, (index as i64) / w);
-        let k = self.settings.neighbors as usize;
+        let rule = NeighborRule {
+            count: self.settings.neighbors as usize,
+            radius: self.settings.radius,
+            normal_cos: self.settings.normal_cos,
+            depth_tolerance: self.settings.depth_tolerance,
+        };
+        self.pattern.select(gbuf, index, &rule, rng, picked);
         neighbors.clear();
-        let mask = self.offsets.len() - 1; // a power of two
-        let start = rng.next_u32() as usize;
-        let radius = self.settings.radius;
-        for attempt in 0..2 * k {
-            if neighbors.len() == k {
-                break;
-            }
-            let o = self.offsets[(start + attempt) & mask] * radius;
-            let (nx, ny) = (x + round(o.x), y + round(o.y));
-            if nx < 0 || ny < 0 || nx >= w || ny >= h || (nx == x && ny == y) {
-                continue;
-            }
-            let q = (ny * w + nx) as usize;
-            if let Some(rq) = gbuf.receiver(q)
-                && r.is_similar(rq, self.settings.normal_cos, self.settings.depth_tolerance)
-            {
-                neighbors.push((rq, &input[q]));
-            }
-        }
+        neighbors.extend(
+            picked
+                .iter()
+                .filter_map(|&q| gbuf.receiver(q).map(|rq| (rq, &input[q]))),
+        );
         let shift = DiShift::new(scene, self.counts, canonical);
         resample(&shift, self.settings.mis, r, canonical, neighbors, || {
             rng.next_f32()
@@ -372,12 +350,6 @@ impl RestirDiIntegrator {
         }
         (l, rays)
     }
-}
-
-/// Nearest integer (half away from zero) without a libm call.
-#[inline]
-fn round(v: f32) -> i64 {
-    (v + 0.5f32.copysign(v)) as i64
 }
 
 /// Whether the light point `c` is visible from receiver `r` (one shadow ray).
@@ -512,6 +484,7 @@ impl Integrator for RestirDiIntegrator {
                     next.par_chunks_mut(w * BAND_ROWS)
                         .enumerate()
                         .for_each(|(band, out)| {
+                            let mut picked = Vec::with_capacity(s.neighbors as usize);
                             let mut scratch = Vec::with_capacity(s.neighbors as usize);
                             for (i, res) in out.iter_mut().enumerate() {
                                 let index = band * w * BAND_ROWS + i;
@@ -523,6 +496,7 @@ impl Integrator for RestirDiIntegrator {
                                     input,
                                     index,
                                     &mut rng,
+                                    &mut picked,
                                     &mut scratch,
                                 );
                             }

@@ -24,18 +24,19 @@ mod settings;
 use std::cell::Cell;
 use std::sync::Mutex;
 
-use glam::{DVec3, Vec2, Vec3};
+use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use restir_geometry::{Ray, offset_ray_origin, shadow_ray_between, shadow_ray_towards};
 use restir_gris::{MisScheme, Reservoir, StreamingReservoir, resample};
 use restir_materials::LobeFlags;
-use restir_sampling::{Pcg32, luminance, sequences::r2, warp::power_heuristic};
+use restir_sampling::{Pcg32, luminance, warp::power_heuristic};
 use restir_scene::Scene;
 
 pub use sample::{Kind, PathSample, PtShift};
 pub use settings::{RestirPtSettings, SHIFT_NAMES};
 
 use crate::gbuffer::{GBuffer, Receiver};
+use crate::neighbors::{NeighborPattern, NeighborRule};
 use crate::path::{EmissionMis, PrevVertex, trace_path};
 use crate::render::{BAND_ROWS, Integrator, PassContext};
 use crate::restir_di::light_point::LightPoint;
@@ -47,9 +48,6 @@ const STAGE_INITIAL: u64 = 101;
 const STAGE_TEMPORAL: u64 = 102;
 const STAGE_SHADE: u64 = 103;
 const STAGE_SPATIAL: u64 = 116;
-
-/// Points of the neighbour pattern (R2 sequence inside the unit disk); a power of two.
-const OFFSET_COUNT: usize = 8192;
 
 /// The reservoir type.
 pub type PtReservoir = Reservoir<PathSample>;
@@ -65,7 +63,7 @@ struct History {
 #[derive(Debug)]
 pub struct RestirPtIntegrator {
     settings: RestirPtSettings,
-    offsets: Vec<Vec2>,
+    pattern: NeighborPattern,
     history: Mutex<Option<History>>,
 }
 
@@ -99,19 +97,9 @@ impl Candidates<'_> {
 impl RestirPtIntegrator {
     /// An integrator with `settings`.
     pub fn new(settings: RestirPtSettings) -> Self {
-        let mut offsets = Vec::with_capacity(OFFSET_COUNT);
-        let mut i = 0u64;
-        while offsets.len() < OFFSET_COUNT {
-            let [u, v] = r2(i, [0.5, 0.5]);
-            i += 1;
-            let p = Vec2::new(2.0 * u - 1.0, 2.0 * v - 1.0);
-            if p.length_squared() <= 1.0 {
-                offsets.push(p);
-            }
-        }
         Self {
             settings,
-            offsets,
+            pattern: NeighborPattern::new(),
             history: Mutex::new(None),
         }
     }
@@ -475,35 +463,22 @@ impl RestirPtIntegrator {
         indices: &'a [usize],
         index: usize,
         rng: &mut Pcg32,
+        picked: &mut Vec<usize>,
         neighbors: &mut Vec<(&'a usize, &'a PtReservoir)>,
     ) -> PtReservoir {
         let canonical = &input[index];
-        let Some(r) = gbuf.receiver(index) else {
+        if gbuf.receiver(index).is_none() {
             return *canonical;
-        };
-        let (w, h) = (gbuf.width as i64, gbuf.height as i64);
-        let (x, y) = ((index as i64) % w, (index as i64) / w);
-        let k = self.settings.neighbors as usize;
-        neighbors.clear();
-        let mask = self.offsets.len() - 1;
-        let start = rng.next_u32() as usize;
-        let radius = self.settings.radius;
-        for attempt in 0..2 * k {
-            if neighbors.len() == k {
-                break;
-            }
-            let o = self.offsets[(start + attempt) & mask] * radius;
-            let (nx, ny) = (x + round(o.x), y + round(o.y));
-            if nx < 0 || ny < 0 || nx >= w || ny >= h || (nx == x && ny == y) {
-                continue;
-            }
-            let q = (ny * w + nx) as usize;
-            if let Some(rq) = gbuf.receiver(q)
-                && r.is_similar(rq, self.settings.normal_cos, self.settings.depth_tolerance)
-            {
-                neighbors.push((&indices[q], &input[q]));
-            }
         }
+        let rule = NeighborRule {
+            count: self.settings.neighbors as usize,
+            radius: self.settings.radius,
+            normal_cos: self.settings.normal_cos,
+            depth_tolerance: self.settings.depth_tolerance,
+        };
+        self.pattern.select(gbuf, index, &rule, rng, picked);
+        neighbors.clear();
+        neighbors.extend(picked.iter().map(|&q| (&indices[q], &input[q])));
         resample(
             shift,
             self.settings.mis,
@@ -599,12 +574,6 @@ fn shadow_visible(scene: &Scene, p: Vec3, ng: Vec3, lp: Vec3, wi: Vec3, dist: f3
         shadow_ray_towards(p, ng, wi, f32::INFINITY)
     };
     !scene.occluded(&ray, t_max)
-}
-
-/// Nearest integer (half away from zero).
-#[inline]
-fn round(v: f32) -> i64 {
-    (v + 0.5f32.copysign(v)) as i64
 }
 
 impl Integrator for RestirPtIntegrator {
@@ -716,6 +685,7 @@ impl Integrator for RestirPtIntegrator {
                         .enumerate()
                         .map(|(band, out)| {
                             let shift = shift_for(false);
+                            let mut picked = Vec::with_capacity(s.neighbors as usize);
                             let mut scratch = Vec::with_capacity(s.neighbors as usize);
                             for (i, res) in out.iter_mut().enumerate() {
                                 let index = band * w * BAND_ROWS + i;
@@ -728,6 +698,7 @@ impl Integrator for RestirPtIntegrator {
                                     &indices,
                                     index,
                                     &mut rng,
+                                    &mut picked,
                                     &mut scratch,
                                 );
                             }
