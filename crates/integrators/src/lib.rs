@@ -76,20 +76,36 @@ pub fn make_integrator(
     }
     let scene_kind = canonical_name(&scene.integrator.kind);
     let name = options.name.as_deref().map_or(scene_kind, canonical_name);
-    // The scene's parameters belong to the scene's estimator.
-    let mut params = Vec::new();
-    if name == scene_kind {
-        params.extend(scene.integrator.params.iter().cloned());
-    }
-    params.extend(options.params.iter().cloned());
+    // The scene's parameters belong to the scene's estimator; their errors name the scene file.
+    let scene_params: &[(String, String)] = if name == scene_kind {
+        &scene.integrator.params
+    } else {
+        &[]
+    };
+    let location = &scene.integrator.location;
+    let apply = |apply: &mut dyn FnMut(&[(String, String)]) -> Result<Vec<String>, String>| {
+        let mut unused = apply(scene_params).map_err(|e| {
+            if location.file.as_os_str().is_empty() {
+                e
+            } else {
+                format!("{location}: integrator: {e}")
+            }
+        })?;
+        unused.extend(apply(&options.params)?);
+        Ok::<_, String>(unused)
+    };
     match name {
         "path" => Ok(MadeIntegrator {
             integrator: Box::new(PathIntegrator { settings }),
-            unused_params: params.into_iter().map(|(k, _)| k).collect(),
+            unused_params: scene_params
+                .iter()
+                .chain(&options.params)
+                .map(|(k, _)| k.clone())
+                .collect(),
         }),
         "restir-di" => {
             let mut s = RestirDiSettings::new(settings);
-            let unused_params = s.apply(&params)?;
+            let unused_params = apply(&mut |p| s.apply(p))?;
             Ok(MadeIntegrator {
                 integrator: Box::new(RestirDiIntegrator::new(s)),
                 unused_params,
@@ -97,7 +113,7 @@ pub fn make_integrator(
         }
         "restir-pt" => {
             let mut s = RestirPtSettings::new(settings);
-            let unused_params = s.apply(&params)?;
+            let unused_params = apply(&mut |p| s.apply(p))?;
             Ok(MadeIntegrator {
                 integrator: Box::new(RestirPtIntegrator::new(s)),
                 unused_params,

@@ -209,6 +209,9 @@ pub struct IntegratorDesc {
     /// Estimator-specific parameters as `name = value` strings (e.g. ReSTIR settings).
     #[serde(default)]
     pub params: Vec<(String, String)>,
+    /// Where the integrator was declared (for errors in `params`); set by the loaders.
+    #[serde(skip)]
+    pub location: Location,
 }
 
 fn default_integrator() -> String {
@@ -229,6 +232,7 @@ impl Default for IntegratorDesc {
             rr_depth: 5,
             hide_emitters: false,
             params: Vec::new(),
+            location: Location::default(),
         }
     }
 }

@@ -1214,6 +1214,7 @@ impl<'a, 'i> Importer<'a, 'i> {
             integ.hide_emitters = h;
         }
         self.finish(props);
+        integ.location = self.loc(node);
         desc.integrator = integ;
         Ok(())
     }

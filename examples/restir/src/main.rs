@@ -220,7 +220,11 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         .parent()
         .map(Path::to_path_buf)
         .unwrap_or_default();
-    let scene = Scene::build(&desc, &base, &args.scene).map_err(|e| e.to_string())?;
+    let mut scene = Scene::build(&desc, &base, &args.scene).map_err(|e| e.to_string())?;
+    if scene.integrator.location.file.as_os_str().is_empty() {
+        // RON scenes carry no line numbers; errors in their parameters still name the file.
+        scene.integrator.location.file = args.scene.clone();
+    }
     let load_seconds = load_start.elapsed().as_secs_f64();
 
     let options = IntegratorOptions {

@@ -144,6 +144,48 @@ fn unknown_plugin_type() {
     );
 }
 
+/// A bad ReSTIR parameter in the scene's `<integrator>` names the scene file and the line of
+/// the integrator; the same value on the command line is reported as a flag.
+#[test]
+fn bad_integrator_parameter_in_scene() {
+    let dir = temp_dir("integrator-param");
+    let scene = write(
+        &dir,
+        "restir.xml",
+        "<scene version=\"3.0.0\">\n    <integrator type=\"restir\">\n        \
+         <integer name=\"reservior_size\" value=\"0\"/>\n    </integrator>\n    \
+         <sensor type=\"perspective\"/>\n    <shape type=\"rectangle\"/>\n</scene>\n",
+    );
+    let out = dir.join("o.png");
+    fails(
+        &[
+            "render",
+            s(&scene),
+            "-o",
+            s(&out),
+            "--width",
+            "8",
+            "--height",
+            "8",
+        ],
+        &[&format!("{}:2:", s(&scene)), "reservior_size"],
+    );
+    let line = fails(
+        &[
+            "render",
+            s(&cornell()),
+            "-o",
+            s(&out),
+            "--integrator",
+            "restir-di",
+            "--mis",
+            "magic",
+        ],
+        &["mis", "defensive-pairwise"],
+    );
+    assert!(!line.contains(".xml"), "{line}");
+}
+
 #[test]
 fn nan_in_a_parameter() {
     let dir = temp_dir("nan");
