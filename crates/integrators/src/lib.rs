@@ -60,6 +60,9 @@ pub struct MadeIntegrator {
     pub unused_params: Vec<String>,
 }
 
+/// A settings type's `apply`: takes `name = value` pairs, returns the names it did not use.
+type ApplyParams<'a> = dyn FnMut(&[(String, String)]) -> Result<Vec<String>, String> + 'a;
+
 /// Builds the integrator for `scene`: the scene's choice and parameters, overridden by `options`.
 pub fn make_integrator(
     scene: &Scene,
@@ -83,7 +86,7 @@ pub fn make_integrator(
         &[]
     };
     let location = &scene.integrator.location;
-    let apply = |apply: &mut dyn FnMut(&[(String, String)]) -> Result<Vec<String>, String>| {
+    let apply = |apply: &mut ApplyParams| {
         let mut unused = apply(scene_params).map_err(|e| {
             if location.file.as_os_str().is_empty() {
                 e
