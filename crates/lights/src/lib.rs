@@ -1,7 +1,8 @@
 //! Emitters and light selection for the `restir` renderer.
 //!
 //! - [`Light`]: diffuse area lights on shapes (one-sided, as in Mitsuba: they emit on the side their
-//!   shading normal points to), point lights, directional lights and a constant environment.
+//!   shading normal points to), point lights, directional lights, a constant environment and
+//!   an image environment ([`EnvMap`], Mitsuba's `envmap`; its image lives in the [`LightSet`]).
 //! - [`LightSet`]: every light of a scene and an alias table that picks lights proportionally to
 //!   their power. [`LightSet::sample`] returns a [`LightSample`] whose `pdf_sa` already includes
 //!   the selection probability; [`LightSet::pdf_sa`] returns exactly that density for a point
@@ -10,10 +11,15 @@
 //! Measures: `pdf_sa` is per unit solid angle at the receiving point; for delta lights (point,
 //! directional) it is the discrete selection probability and `delta` is set.
 
+mod envmap;
+
+pub use envmap::EnvMap;
+
 use core::f32::consts::PI;
 use glam::{Vec2, Vec3};
 use restir_geometry::Shape;
 use restir_sampling::{AliasTable, luminance, warp};
+use std::sync::Arc;
 
 /// An emitter.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -44,6 +50,9 @@ pub enum Light {
         /// Radiance.
         radiance: Vec3,
     },
+    /// Radiance at infinity from a latitude-longitude image: the [`EnvMap`] given to
+    /// [`LightSet::with_envmap`] (at most one per set).
+    Envmap,
 }
 
 /// A point (or direction) on a light chosen for next-event estimation.
@@ -82,6 +91,10 @@ pub enum LightError {
     MissingShape(u32),
     /// A light has a negative or non-finite parameter.
     BadParameter(usize, &'static str),
+    /// A second environment light (constant or envmap); a scene has at most one, as in Mitsuba.
+    SecondEnvironment(usize),
+    /// An `Envmap` light without an [`EnvMap`], or an [`EnvMap`] without an `Envmap` light.
+    EnvmapMismatch,
 }
 
 impl core::fmt::Display for LightError {
@@ -90,6 +103,13 @@ impl core::fmt::Display for LightError {
             LightError::MissingShape(s) => write!(f, "area light on missing shape {s}"),
             LightError::BadParameter(i, what) => {
                 write!(f, "light {i}: {what} must be finite and non-negative")
+            }
+            LightError::SecondEnvironment(i) => write!(
+                f,
+                "light {i}: only one environment emitter (constant or envmap) is allowed per scene"
+            ),
+            LightError::EnvmapMismatch => {
+                write!(f, "an envmap light needs exactly one environment image")
             }
         }
     }
@@ -109,6 +129,8 @@ pub struct LightSet {
     /// For each shape, the area light on it.
     shape_light: Vec<Option<u32>>,
     environment: Option<u32>,
+    /// The image of the `Envmap` light, if there is one.
+    envmap: Option<Arc<EnvMap>>,
     scene_radius: f32,
 }
 
@@ -124,6 +146,21 @@ impl LightSet {
         shapes: &[Shape],
         scene_bounds: (Vec3, Vec3),
     ) -> Result<Self, LightError> {
+        Self::with_envmap(lights, None, shapes, scene_bounds)
+    }
+
+    /// Builds the set with the image of its [`Light::Envmap`] (which `lights` must then hold
+    /// exactly once).
+    pub fn with_envmap(
+        lights: Vec<Light>,
+        envmap: Option<EnvMap>,
+        shapes: &[Shape],
+        scene_bounds: (Vec3, Vec3),
+    ) -> Result<Self, LightError> {
+        let envmap_lights = lights.iter().filter(|l| **l == Light::Envmap).count();
+        if envmap_lights != envmap.is_some() as usize {
+            return Err(LightError::EnvmapMismatch);
+        }
         let extent = scene_bounds.1 - scene_bounds.0;
         let scene_radius = if extent.is_finite() {
             (0.5 * extent.length()).max(1e-3)
@@ -138,7 +175,7 @@ impl LightSet {
             spheres.push(match *l {
                 Light::Area { shape, .. } => shapes.get(shape as usize).map(bounding_sphere),
                 Light::Point { position, .. } => Some((position, 0.0)),
-                Light::Directional { .. } | Light::Constant { .. } => None,
+                Light::Directional { .. } | Light::Constant { .. } | Light::Envmap => None,
             });
             let power = match *l {
                 Light::Area { shape, radiance } => {
@@ -173,8 +210,18 @@ impl LightSet {
                     if !valid(radiance) {
                         return Err(LightError::BadParameter(i, "radiance"));
                     }
-                    environment = Some(i as u32);
+                    if environment.replace(i as u32).is_some() {
+                        return Err(LightError::SecondEnvironment(i));
+                    }
+                    // π R² · ∫ lum(L) dω with ∫ = 4π·lum(L).
                     4.0 * PI * PI * scene_radius * scene_radius * luminance(radiance)
+                }
+                Light::Envmap => {
+                    if environment.replace(i as u32).is_some() {
+                        return Err(LightError::SecondEnvironment(i));
+                    }
+                    let map = envmap.as_ref().ok_or(LightError::EnvmapMismatch)?;
+                    PI * scene_radius * scene_radius * map.luminance_integral()
                 }
             };
             powers.push(if power.is_finite() { power } else { 0.0 });
@@ -199,6 +246,7 @@ impl LightSet {
             spheres,
             shape_light,
             environment,
+            envmap: envmap.map(Arc::new),
             scene_radius,
         })
     }
@@ -229,6 +277,11 @@ impl LightSet {
         self.environment
     }
 
+    /// The image of the [`Light::Envmap`] light, if there is one.
+    pub fn envmap(&self) -> Option<&EnvMap> {
+        self.envmap.as_deref()
+    }
+
     /// Radius of the scene's bounding sphere.
     pub fn scene_radius(&self) -> f32 {
         self.scene_radius
@@ -243,7 +296,7 @@ impl LightSet {
 
     /// The power (selection weight) of light `light`: `π·A·lum(L)` for area lights, `4π·lum(I)`
     /// for point lights, and the power through the scene's bounding sphere for lights at
-    /// infinity.
+    /// infinity (`π·R²·lum(E)` for directional lights, `π·R²·∫lum(L)dω` for environments).
     pub fn power(&self, light: u32) -> f32 {
         self.powers[light as usize]
     }
@@ -272,9 +325,10 @@ impl LightSet {
     /// Radiance arriving from the environment along a ray that left the scene in direction `d`
     /// (unit, pointing away from the scene).
     #[inline]
-    pub fn environment_radiance(&self, _d: Vec3) -> Vec3 {
+    pub fn environment_radiance(&self, d: Vec3) -> Vec3 {
         match self.environment.map(|i| self.lights[i as usize]) {
             Some(Light::Constant { radiance }) => radiance,
+            Some(Light::Envmap) => self.envmap.as_ref().map_or(Vec3::ZERO, |m| m.eval(d)),
             _ => Vec3::ZERO,
         }
     }
@@ -386,12 +440,29 @@ impl LightSet {
                     param: Vec2::ZERO,
                 })
             }
+            Light::Envmap => {
+                let (wi, le, pdf_sa) = self.envmap.as_ref()?.sample(u)?;
+                Some(LightSample {
+                    light,
+                    p: ref_p + wi * (2.0 * self.scene_radius),
+                    n: -wi,
+                    ng: -wi,
+                    wi,
+                    dist: f32::INFINITY,
+                    le,
+                    pdf_sa,
+                    delta: false,
+                    prim: 0,
+                    param: Vec2::ZERO,
+                })
+            }
         }
     }
 
     /// The solid-angle density, including the selection probability, with which
     /// [`LightSet::sample`] would return point `p` (geometric normal `n`) on light `light` from `ref_p`; for
-    /// the environment `p` is ignored and `n` is unused. Zero for delta lights.
+    /// the environment `p` is ignored and `n` must be the direction back from the environment
+    /// (`−wi`, as [`LightSample::ng`] is). Zero for delta lights.
     #[inline]
     pub fn pdf_sa(&self, shapes: &[Shape], light: u32, ref_p: Vec3, p: Vec3, n: Vec3) -> f32 {
         let pmf = self.pmf(light);
@@ -401,6 +472,10 @@ impl LightSet {
         match self.lights[light as usize] {
             Light::Area { shape, .. } => pmf * shapes[shape as usize].pdf_sa_from(ref_p, p, n),
             Light::Constant { .. } => pmf * warp::UNIFORM_SPHERE_PDF,
+            Light::Envmap => self
+                .envmap
+                .as_ref()
+                .map_or(0.0, |m| pmf * m.pdf(-n.normalize_or_zero())),
             Light::Point { .. } | Light::Directional { .. } => 0.0,
         }
     }

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 use restir_geometry::{Accel, Camera, FovAxis as GeoFovAxis, Shape, Sphere, TriangleMesh};
-use restir_lights::{Light, LightSet};
+use restir_lights::{EnvMap, Light, LightSet};
 use restir_materials::{Bsdf, Distribution, LobeFlags, Microfacet};
 
 use crate::desc::*;
@@ -316,6 +316,18 @@ fn load_obj(path: &Path) -> Result<MeshData, String> {
     ))
 }
 
+/// Reads an environment map's image and sets up its lookup and sampling.
+fn build_envmap(
+    filename: &str,
+    scale: f32,
+    to_world: &[TransformOp],
+    base_dir: &Path,
+) -> Result<EnvMap, String> {
+    let m = transform_matrix(to_world)?;
+    let (w, h, texels) = crate::texture::read_image(&base_dir.join(filename), false)?;
+    EnvMap::new(w, h, texels, scale, glam::Mat3::from_mat4(m))
+}
+
 fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<Shape, String> {
     let m = transform_matrix(&desc.to_world)?;
     let mesh = |mut mesh: TriangleMesh| -> Result<Shape, String> {
@@ -538,6 +550,7 @@ impl Scene {
             shapes.push(shape);
             shape_bsdf.push(bsdf);
         }
+        let mut envmap = None;
         for l in &desc.lights {
             let light = match l {
                 LightDesc::Point {
@@ -557,13 +570,31 @@ impl Scene {
                 LightDesc::Constant { radiance } => Light::Constant {
                     radiance: v3(radiance),
                 },
+                LightDesc::Envmap {
+                    filename,
+                    scale,
+                    to_world,
+                    location,
+                } => {
+                    if envmap.is_some() {
+                        return Err(at(
+                            location,
+                            "a second envmap emitter; only one environment is allowed per scene"
+                                .into(),
+                        ));
+                    }
+                    let map = build_envmap(filename, *scale, to_world, base_dir)
+                        .map_err(|e| at(location, format!("envmap: {e}")))?;
+                    envmap = Some(map);
+                    Light::Envmap
+                }
             };
             lights.push(light);
         }
 
         let accel = Accel::build(&shapes);
-        let light_set =
-            LightSet::new(lights, &shapes, accel.bounds()).map_err(|e| whole(e.to_string()))?;
+        let light_set = LightSet::with_envmap(lights, envmap, &shapes, accel.bounds())
+            .map_err(|e| whole(e.to_string()))?;
 
         // Feature summary, decided once.
         let used: Vec<&Bsdf> = shape_bsdf.iter().map(|&b| &bsdfs[b as usize]).collect();

@@ -546,4 +546,23 @@ pub enum LightDesc {
         /// Radiance.
         radiance: V3,
     },
+    /// Environment from a latitude-longitude image (Mitsuba's `envmap`): EXR or Radiance `.hdr`
+    /// (linear), or PNG/JPEG (sRGB-decoded).
+    Envmap {
+        /// Image path, relative to the scene file.
+        filename: String,
+        /// Radiance multiplier.
+        #[serde(default = "default_scale")]
+        scale: f32,
+        /// Rotation of the map (Mitsuba's orientation: `+Y` up, `u = 0` towards `−Z`).
+        #[serde(default)]
+        to_world: Vec<TransformOp>,
+        /// Where the emitter was declared (set by importers, not part of the RON format).
+        #[serde(skip)]
+        location: Location,
+    },
+}
+
+fn default_scale() -> f32 {
+    1.0
 }

@@ -168,15 +168,16 @@ impl Texture {
     }
 }
 
-/// Reads PNG/JPEG (8- or 16-bit, sRGB-decoded unless `raw`) or EXR (linear) as linear RGB.
-fn read_image(path: &Path, raw: bool) -> Result<(usize, usize, Vec<Vec3>), String> {
+/// Reads PNG/JPEG (8- or 16-bit, sRGB-decoded unless `raw`), EXR or Radiance HDR (linear) as
+/// linear RGB, the first row at the top. Also used for environment maps.
+pub(crate) fn read_image(path: &Path, raw: bool) -> Result<(usize, usize, Vec<Vec3>), String> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
     let fail =
-        |e: &dyn core::fmt::Display| format!("cannot read texture '{}': {e}", path.display());
+        |e: &dyn core::fmt::Display| format!("cannot read image '{}': {e}", path.display());
     let (w, h, texels) = if ext == "exr" {
         let img = exr::prelude::read_first_rgba_layer_from_file(
             path,
@@ -202,8 +203,10 @@ fn read_image(path: &Path, raw: bool) -> Result<(usize, usize, Vec<Vec3>), Strin
             .decode()
             .map_err(|e| fail(&e))?;
         let (w, h) = (img.width() as usize, img.height() as usize);
+        // Float formats (Radiance HDR) hold linear values already.
+        let linear = raw || matches!(img, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
         let rgb = img.to_rgb32f();
-        let decode = |c: f32| if raw { c } else { srgb_to_linear(c) };
+        let decode = |c: f32| if linear { c } else { srgb_to_linear(c) };
         let texels = rgb
             .pixels()
             .map(|p| Vec3::new(decode(p.0[0]), decode(p.0[1]), decode(p.0[2])))

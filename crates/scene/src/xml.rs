@@ -1266,6 +1266,24 @@ impl<'a, 'i> Importer<'a, 'i> {
                     .unwrap_or([1.0; 3]);
                 LightDesc::Constant { radiance }
             }
+            "envmap" => {
+                let filename = props.string(self, "filename")?.ok_or_else(|| {
+                    self.err(node, "envmap emitter needs a 'filename' (EXR, HDR, PNG or JPEG)")
+                })?;
+                let scale = props.float(self, "scale")?.unwrap_or(1.0);
+                if !(scale.is_finite() && scale >= 0.0) {
+                    return Err(self.err(
+                        node,
+                        format!("envmap scale {scale} must be finite and non-negative"),
+                    ));
+                }
+                LightDesc::Envmap {
+                    filename,
+                    scale,
+                    to_world: props.transform(self, "to_world")?,
+                    location: self.loc(node),
+                }
+            }
             "area" => return Err(self.err(node, "an area emitter must be inside a <shape>")),
             other => return Err(self.err(node, format!("unknown emitter type '{other}'"))),
         };
@@ -1372,6 +1390,16 @@ pub fn parse_xml(
             }
             "emitter" => {
                 let l = imp.emitter(c)?;
+                // Mitsuba allows one environment emitter per scene.
+                let is_env = |l: &LightDesc| {
+                    matches!(l, LightDesc::Constant { .. } | LightDesc::Envmap { .. })
+                };
+                if is_env(&l) && desc.lights.iter().any(is_env) {
+                    return Err(imp.err(
+                        c,
+                        "a second environment emitter (constant or envmap); only one is allowed per scene",
+                    ));
+                }
                 desc.lights.push(l);
             }
             t if PROPERTY_TAGS.contains(&t) => {

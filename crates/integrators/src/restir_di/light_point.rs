@@ -151,7 +151,7 @@ pub fn resolve(scene: &Scene, sample: &LightPoint) -> Resolved {
             le: irradiance,
             delta: true,
         },
-        Light::Constant { .. } => {
+        Light::Constant { .. } | Light::Envmap => {
             let (_, wi) = Sphere::new(Vec3::ZERO, 1.0, false).point_at(sample.param);
             Resolved::Direction {
                 wi,
