@@ -67,9 +67,14 @@ impl EnvMap {
             ));
         }
         if !(scale.is_finite() && scale >= 0.0) {
-            return Err(format!("envmap scale {scale} must be finite and non-negative"));
+            return Err(format!(
+                "envmap scale {scale} must be finite and non-negative"
+            ));
         }
-        if texels.iter().any(|t| !t.is_finite() || t.min_element() < 0.0) {
+        if texels
+            .iter()
+            .any(|t| !t.is_finite() || t.min_element() < 0.0)
+        {
             return Err("envmap image has negative or non-finite texels".into());
         }
         // Only rotations (and reflections) keep directions unit length and the density's
@@ -167,9 +172,7 @@ impl EnvMap {
         let fy = (uv.y.clamp(0.0, 1.0) * (h - 1) as f32).max(0.0);
         let y0 = (fy as usize).min(h - 2);
         let ty = (fy - y0 as f32).clamp(0.0, 1.0);
-        let row = |y: usize| {
-            self.texels[y * w + x0] * (1.0 - tx) + self.texels[y * w + x1] * tx
-        };
+        let row = |y: usize| self.texels[y * w + x0] * (1.0 - tx) + self.texels[y * w + x1] * tx;
         row(y0) * (1.0 - ty) + row(y0 + 1) * ty
     }
 
@@ -208,7 +211,7 @@ impl EnvMap {
         };
         let v = (self.to_local * d).normalize_or_zero();
         let sin_theta = v.x.hypot(v.z);
-        if !(sin_theta > 0.0) {
+        if sin_theta.is_nan() || sin_theta <= 0.0 {
             return 0.0;
         }
         let uv = Self::local_to_uv(v);
@@ -216,7 +219,10 @@ impl EnvMap {
         if s < 0.0 {
             s += 1.0;
         }
-        let p = Vec2::new(s.min(restir_sampling::ONE_MINUS_EPSILON), uv.y.min(restir_sampling::ONE_MINUS_EPSILON));
+        let p = Vec2::new(
+            s.min(restir_sampling::ONE_MINUS_EPSILON),
+            uv.y.min(restir_sampling::ONE_MINUS_EPSILON),
+        );
         dist.pdf(p) / (2.0 * PI * PI * sin_theta)
     }
 }
@@ -256,15 +262,22 @@ mod tests {
             for y in 0..5 {
                 let uv = Vec2::new((x as f32 + 0.5) / 8.0, y as f32 / 4.0);
                 let l = m.eval_uv(uv);
-                assert!((l - Vec3::new(x as f32, y as f32, 1.0)).length() < 1e-4, "{uv}: {l}");
+                assert!(
+                    (l - Vec3::new(x as f32, y as f32, 1.0)).length() < 1e-4,
+                    "{uv}: {l}"
+                );
             }
         }
         // +Y is the top row; −Z (u = 0) is halfway between the last and the first column.
         assert!((m.eval(Vec3::Y).y).abs() < 1e-5);
         assert!((m.eval(-Vec3::Y).y - 4.0).abs() < 1e-5);
-        assert!((m.eval(-Vec3::Z).x - 3.5).abs() < 1e-4, "{}", m.eval(-Vec3::Z));
+        assert!(
+            (m.eval(-Vec3::Z).x - 3.5).abs() < 1e-4,
+            "{}",
+            m.eval(-Vec3::Z)
+        );
         assert!((m.eval(Vec3::X).x - 1.5).abs() < 1e-4);
-        // to_world rotates the map: a map turned 90° about +Y shows at +X what was at −Z... 
+        // to_world rotates the map: a map turned 90° about +Y shows at +X what was at −Z...
         let r = Mat3::from_rotation_y(core::f32::consts::FRAC_PI_2);
         let t: Vec<Vec3> = (0..5)
             .flat_map(|y| (0..8).map(move |x| Vec3::new(x as f32, y as f32, 1.0)))

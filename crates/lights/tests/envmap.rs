@@ -86,10 +86,7 @@ fn histogram(set: &LightSet, grid: &SphereGrid, n: usize) -> Histogram {
 fn envmap_directions_follow_pdf() {
     let set = set();
     let grid = SphereGrid::new(24, 48).unwrap();
-    let p = grid.integrate(
-        |w| set.pdf_sa(&[], 0, Vec3::ZERO, w, -w) as f64,
-        &QUAD,
-    );
+    let p = grid.integrate(|w| set.pdf_sa(&[], 0, Vec3::ZERO, w, -w) as f64, &QUAD);
     let mass: f64 = p.iter().sum();
     assert!((mass - 1.0).abs() < 2e-3, "∫ pdf = {mass}");
     let hist = histogram(&set, &grid, 1_000_000);
@@ -102,10 +99,7 @@ fn envmap_directions_follow_pdf() {
     let axis = map(1.0);
     let turn = Mat3::from_rotation_y(2.0 * core::f32::consts::PI / 32.0);
     let r = Mat3::from_rotation_x(0.5) * Mat3::from_rotation_z(-0.3) * Mat3::from_rotation_y(1.0);
-    let wrong = grid.integrate(
-        |w| axis.pdf(r * turn * r.transpose() * w) as f64,
-        &QUAD,
-    );
+    let wrong = grid.integrate(|w| axis.pdf(r * turn * r.transpose() * w) as f64, &QUAD);
     // Samples where the wrong density is zero (the dark quadrant moved) reject it outright.
     match hist.chi2(&wrong) {
         Ok(o) => {

@@ -176,8 +176,7 @@ pub(crate) fn read_image(path: &Path, raw: bool) -> Result<(usize, usize, Vec<Ve
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
-    let fail =
-        |e: &dyn core::fmt::Display| format!("cannot read image '{}': {e}", path.display());
+    let fail = |e: &dyn core::fmt::Display| format!("cannot read image '{}': {e}", path.display());
     let (w, h, texels) = if ext == "exr" {
         let img = exr::prelude::read_first_rgba_layer_from_file(
             path,
@@ -204,7 +203,11 @@ pub(crate) fn read_image(path: &Path, raw: bool) -> Result<(usize, usize, Vec<Ve
             .map_err(|e| fail(&e))?;
         let (w, h) = (img.width() as usize, img.height() as usize);
         // Float formats (Radiance HDR) hold linear values already.
-        let linear = raw || matches!(img, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
+        let linear = raw
+            || matches!(
+                img,
+                image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+            );
         let rgb = img.to_rgb32f();
         let decode = |c: f32| if linear { c } else { srgb_to_linear(c) };
         let texels = rgb

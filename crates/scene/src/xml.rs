@@ -1268,7 +1268,10 @@ impl<'a, 'i> Importer<'a, 'i> {
             }
             "envmap" => {
                 let filename = props.string(self, "filename")?.ok_or_else(|| {
-                    self.err(node, "envmap emitter needs a 'filename' (EXR, HDR, PNG or JPEG)")
+                    self.err(
+                        node,
+                        "envmap emitter needs a 'filename' (EXR, HDR, PNG or JPEG)",
+                    )
                 })?;
                 let scale = props.float(self, "scale")?.unwrap_or(1.0);
                 if !(scale.is_finite() && scale >= 0.0) {

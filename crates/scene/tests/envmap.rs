@@ -73,7 +73,10 @@ fn envmap_formats_orientation_and_scale() {
         assert!((at(Vec3::Y).y - 1.0).abs() < tol, "{file}: {}", at(Vec3::Y));
         assert!((at(-Vec3::Y).y - 3.0).abs() < 3.0 * tol, "{file}");
         let eq = at(Vec3::X);
-        assert!((eq - Vec3::new(1.5, 2.0, 1.0)).abs().max_element() < 3.0 * tol, "{file}: {eq}");
+        assert!(
+            (eq - Vec3::new(1.5, 2.0, 1.0)).abs().max_element() < 3.0 * tol,
+            "{file}: {eq}"
+        );
         // u = 0 (−Z) lies halfway between the last and the first column.
         assert!((at(-Vec3::Z).x - 2.5).abs() < 3.0 * tol, "{file}");
     }
