@@ -17,8 +17,9 @@ use std::sync::atomic::AtomicBool;
 use restir_integrators::{Image, IntegratorOptions, RenderSettings, make_integrator, render};
 use restir_scene::{Scene, parse_ron};
 
-fn temp_dir() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("restir-envmap-int-{}", std::process::id()));
+/// A fresh directory per test (tests run in parallel and each removes its own).
+fn temp_dir(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("restir-envmap-int-{}-{test}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
@@ -118,7 +119,7 @@ const FURNACE_Z: f64 = 4.0;
 
 #[test]
 fn furnace_constant_envmap_equals_constant_emitter() {
-    let dir = temp_dir();
+    let dir = temp_dir("furnace");
     let l = [0.5f32, 1.0, 2.0];
     let map = dir.join("const.exr");
     write_exr(&map, 32, 16, |_, _| l);
@@ -239,8 +240,7 @@ const Z_MAX: f64 = 4.0;
 
 #[test]
 fn restir_di_and_pt_with_envmap_match_path_tracer() {
-    let dir = temp_dir().join("sky");
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("sky");
     let map = sky_map(&dir);
 
     // Direct light (max_depth 2): ReSTIR DI.
@@ -305,8 +305,7 @@ fn matpreview_renders() {
         )
         .replace("value=\"683\"", "value=\"32\"")
         .replace("value=\"512\"", "value=\"24\"");
-    let dir = temp_dir().join("mp");
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("matpreview");
     let path = dir.join("matpreview.xml");
     std::fs::write(&path, xml).unwrap();
     let loaded = restir_scene::load_scene(&path, &[]).unwrap();

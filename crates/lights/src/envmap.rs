@@ -24,16 +24,69 @@
 //! The bilinear patches form a `W × (H−1)` grid (patch `(x, y)` spans columns `x, x+1` and rows
 //! `y, y+1`, i.e. it is shifted by half a texel in `u`). Each patch gets the mean luminance of
 //! its four corners times `sin θ` at its centre, and a piecewise-*constant* 2-D distribution
-//! ([`Distribution2D`]) samples `(u, vv)` from that grid. A patch whose four corners are black is
+//! (a marginal over rows and one conditional per row) samples `(u, vv)` from that grid. A patch whose four corners are black is
 //! black everywhere, so the density is positive wherever the radiance is. The solid-angle
-//! density is `pdf_uv / (2π² sin θ)`.
+//! density is `pdf_uv / (2π² sin θ)`. The patch is picked in O(1) by alias tables (one over the
+//! rows, one per row over its patches) instead of binary searches through cdfs: the tables
+//! (and the texels) of a large map do not stay in cache, and each cdf search cost several misses.
 //!
 //! Mitsuba instead warps with a piecewise-*bilinear* `Hierarchical2D` over the texels; the
 //! expected image is the same, only the noise differs.
 
 use core::f32::consts::PI;
 use glam::{Mat3, Vec2, Vec3};
-use restir_sampling::{Distribution2D, luminance};
+use restir_sampling::{AliasTable, luminance};
+
+/// Piecewise-constant density on `[0, 1)²` over a `width × rows` grid, sampled by alias tables.
+#[derive(Clone, Debug)]
+struct PatchSampler {
+    width: usize,
+    rows: usize,
+    marginal: AliasTable,
+    /// One per row; a row of zero mass (never picked) gets a uniform table.
+    conditional: Vec<AliasTable>,
+}
+
+impl PatchSampler {
+    fn new(grid: &[f32], width: usize, rows: usize) -> Option<Self> {
+        let row_sums: Vec<f32> = grid
+            .chunks_exact(width)
+            .map(|r| r.iter().map(|&v| v as f64).sum::<f64>() as f32)
+            .collect();
+        let marginal = AliasTable::new(&row_sums)?;
+        let uniform = AliasTable::new(&vec![1.0; width])?;
+        let conditional = grid
+            .chunks_exact(width)
+            .map(|r| AliasTable::new(r).unwrap_or_else(|| uniform.clone()))
+            .collect();
+        Some(Self {
+            width,
+            rows,
+            marginal,
+            conditional,
+        })
+    }
+
+    /// A point of `[0, 1)²` and its density.
+    #[inline]
+    fn sample(&self, u: Vec2) -> (Vec2, f32) {
+        let (row, pmf_row, ry) = self.marginal.sample(u.y);
+        let (col, pmf_col, rx) = self.conditional[row].sample(u.x);
+        let p = Vec2::new(
+            ((col as f32 + rx) / self.width as f32).min(restir_sampling::ONE_MINUS_EPSILON),
+            ((row as f32 + ry) / self.rows as f32).min(restir_sampling::ONE_MINUS_EPSILON),
+        );
+        (p, pmf_row * pmf_col * (self.width * self.rows) as f32)
+    }
+
+    /// The density of [`PatchSampler::sample`] at `p ∈ [0, 1)²`.
+    #[inline]
+    fn pdf(&self, p: Vec2) -> f32 {
+        let row = ((p.y * self.rows as f32) as usize).min(self.rows - 1);
+        let col = ((p.x * self.width as f32) as usize).min(self.width - 1);
+        self.marginal.pmf(row) * self.conditional[row].pmf(col) * (self.width * self.rows) as f32
+    }
+}
 
 /// A latitude-longitude environment map with its sampling distribution.
 #[derive(Clone, Debug)]
@@ -45,7 +98,7 @@ pub struct EnvMap {
     to_world: Mat3,
     to_local: Mat3,
     /// Over the `width × (height − 1)` bilinear patches; `None` for a black map.
-    dist: Option<Distribution2D>,
+    dist: Option<PatchSampler>,
     /// `∫ lum(L(ω)) dω` over the sphere (of the sampling grid).
     luminance_integral: f32,
 }
@@ -108,7 +161,7 @@ impl EnvMap {
                 sum += v as f64;
             }
         }
-        let dist = Distribution2D::new(&grid, width, rows);
+        let dist = PatchSampler::new(&grid, width, rows);
         // ∫ f(u, vv)·2π² du dvv over the unit square, f = lum·sin θ.
         let luminance_integral = (2.0 * PI as f64 * PI as f64 * sum / (width * rows) as f64) as f32;
         Ok(Self {

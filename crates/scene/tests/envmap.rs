@@ -6,8 +6,9 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use restir_scene::load_scene;
 
-fn temp_dir() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("restir-envmap-{}", std::process::id()));
+/// A fresh directory per test (tests run in parallel and each removes its own).
+fn temp_dir(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("restir-envmap-{}-{test}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
@@ -44,7 +45,7 @@ fn write_exr(path: &Path) {
 
 #[test]
 fn envmap_formats_orientation_and_scale() {
-    let dir = temp_dir();
+    let dir = temp_dir("formats");
     write_exr(&dir.join("map.exr"));
     let mut hdr = Vec::new();
     let pixels: Vec<image::Rgb<f32>> = (0..3)
@@ -111,8 +112,7 @@ fn envmap_formats_orientation_and_scale() {
 
 #[test]
 fn envmap_bad_input_names_file_and_line() {
-    let dir = temp_dir().join("bad");
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("bad");
     write_exr(&dir.join("ok.exr"));
     let bytes = std::fs::read(dir.join("ok.exr")).unwrap();
     std::fs::write(dir.join("truncated.exr"), &bytes[..bytes.len() / 2]).unwrap();
