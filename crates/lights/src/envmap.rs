@@ -180,8 +180,8 @@ impl EnvMap {
         (self.width, self.height)
     }
 
-    /// `∫ lum(L(ω)) dω` over the sphere, from the sampling grid (the power of the map through a
-    /// disk of unit area is `π⁻¹·…`; see [`crate::LightSet::power`]).
+    /// `∫ lum(L(ω)) dω` over the sphere, from the sampling grid (patch means × `sin θ` at the
+    /// patch centres). The light's power is `π R²` times this ([`crate::LightSet::power`]).
     pub fn luminance_integral(&self) -> f32 {
         self.luminance_integral
     }
