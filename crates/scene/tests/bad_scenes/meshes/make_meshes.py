@@ -89,3 +89,8 @@ raw = struct.pack("<I", 0x1000) + b"tri\0" + struct.pack("<QQ", 1 << 40, 1)
 raw += b"".join(struct.pack("<3f", *v) for v in QUAD[:3]) + struct.pack("<3I", 0, 1, 2)
 write("lying_count.serialized",
       serialized_file([struct.pack("<HH", 0x041C, 4) + zlib.compress(raw)]))
+# An element with no properties and 1.8·10¹⁹ instances before a valid mesh: nothing to read, so
+# it must not take 10¹⁹ steps either (the mesh then fails on its out-of-range face).
+write("empty_element.ply",
+      "ply\nformat ascii 1.0\nelement junk 18000000000000000000\n"
+      + ascii_ply(QUAD, [(0, 1, 2), (0, 2, 5)]).split("\n", 2)[2])
