@@ -264,6 +264,8 @@ fn load_obj(path: &Path) -> Result<MeshData, String> {
         ignore_points: true,
         ignore_lines: true,
     };
+    // tobj reports a missing file as "open file failed"; say why.
+    std::fs::File::open(path).map_err(|e| format!("cannot read mesh '{}': {e}", path.display()))?;
     let (models, _) = tobj::load_obj(path, &opts)
         .map_err(|e| format!("cannot read mesh '{}': {e}", path.display()))?;
     let mut positions = Vec::new();

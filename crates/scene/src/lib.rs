@@ -171,9 +171,18 @@ pub fn load_desc(
 
 /// Loads and builds a scene file.
 pub fn load_scene(path: &Path, defines: &[(String, String)]) -> Result<LoadedScene, SceneError> {
-    let (desc, warnings) = load_desc(path, defines)?;
+    let (desc, mut warnings) = load_desc(path, defines)?;
     let base: PathBuf = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let scene = Scene::build(&desc, &base, path)?;
+    if scene.lights.is_empty() {
+        warnings.push(SceneWarning {
+            location: Location {
+                file: path.to_path_buf(),
+                line: 0,
+            },
+            message: "the scene has no light sources (no emitter with positive radiance): the image will be black".into(),
+        });
+    }
     Ok(LoadedScene {
         scene,
         warnings,

@@ -301,7 +301,9 @@ pub(crate) fn read_ply(bytes: &[u8]) -> Result<MeshData, String> {
                     }
                 }
             }
-        } else {
+        } else if !e.props.is_empty() {
+            // (An element without properties occupies no bytes, whatever its count: skipping it
+            // must not take `count` steps.)
             for _ in 0..e.count {
                 for p in &e.props {
                     match p.list {

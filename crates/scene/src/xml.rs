@@ -98,7 +98,8 @@ struct Importer<'a, 'i> {
     doc: &'a Document<'i>,
     defaults: HashMap<String, String>,
     warnings: RefCell<Vec<SceneWarning>>,
-    bsdf_ids: HashMap<String, ()>,
+    /// Top-level bsdf ids, with the line that declares them.
+    bsdf_ids: HashMap<String, u32>,
     bsdf_anon: usize,
     /// Top-level textures by id, with the line that declares them.
     textures: HashMap<String, (TextureDesc, u32)>,
@@ -178,10 +179,16 @@ impl<'a, 'i> Importer<'a, 'i> {
     }
 
     fn finite(&self, node: Node, v: f64, what: &str) -> Result<f64> {
-        if v.is_finite() {
-            Ok(v)
-        } else {
+        if !v.is_finite() {
             Err(self.err(node, format!("{what} is not a finite number")))
+        } else if !(v as f32).is_finite() {
+            // Values are stored as f32: 1e39 would become infinite.
+            Err(self.err(
+                node,
+                format!("{what} is out of range (beyond ±3.4e38, the largest 32-bit float)"),
+            ))
+        } else {
+            Ok(v)
         }
     }
 
@@ -313,42 +320,56 @@ impl<'a, 'i> Importer<'a, 'i> {
         let mut items = Vec::new();
         for c in plugin.children().filter(Node::is_element) {
             let tag = c.tag_name().name();
-            let value = match tag {
-                "float" => Value::Float(self.parse_float(c, &self.req_attr(c, "value")?)?),
-                "integer" => {
-                    let s = self.req_attr(c, "value")?;
-                    let v = s
-                        .trim()
-                        .parse::<i64>()
-                        .map_err(|_| self.err(c, format!("cannot parse \"{s}\" as an integer")))?;
-                    Value::Int(v)
-                }
-                "boolean" => {
-                    let s = self.req_attr(c, "value")?;
-                    match s.trim().to_ascii_lowercase().as_str() {
-                        "true" | "1" => Value::Bool(true),
-                        "false" | "0" => Value::Bool(false),
-                        _ => return Err(self.err(c, format!("cannot parse \"{s}\" as a boolean"))),
-                    }
-                }
-                "string" => Value::Str(self.req_attr(c, "value")?),
-                "rgb" | "color" => Value::Rgb(self.parse_vec3(c, &self.req_attr(c, "value")?)?),
-                "srgb" => Value::Rgb(self.srgb_hex(c, &self.req_attr(c, "value")?)?),
-                "spectrum" => {
-                    let s = self.req_attr(c, "value")?;
-                    if s.contains(':') {
-                        Value::Spectrum(
-                            crate::spectrum::parse_pairs(&s).map_err(|e| self.err(c, e))?,
-                        )
-                    } else {
-                        Value::SpectrumConst(self.parse_float(c, &s)? as f32)
-                    }
-                }
-                "point" | "vector" => Value::Point(self.xyz(c, 0.0)?),
-                "transform" => Value::Transform(self.parse_transform(c)?),
-                _ => continue,
-            };
+            if !PROPERTY_TAGS.contains(&tag) {
+                continue;
+            }
             let name = self.req_attr(c, "name")?;
+            // Value errors name the property: `<float name="alpha">: "abc" is not a number`.
+            let named = |mut e: SceneError| {
+                e.message = format!("<{tag} name=\"{name}\">: {}", e.message);
+                e
+            };
+            let value = (|| -> Result<Value> {
+                Ok(match tag {
+                    "float" => Value::Float(self.parse_float(c, &self.req_attr(c, "value")?)?),
+                    "integer" => {
+                        let s = self.req_attr(c, "value")?;
+                        let v = s.trim().parse::<i64>().map_err(|_| {
+                            self.err(c, format!("cannot parse \"{s}\" as an integer"))
+                        })?;
+                        Value::Int(v)
+                    }
+                    "boolean" => {
+                        let s = self.req_attr(c, "value")?;
+                        match s.trim().to_ascii_lowercase().as_str() {
+                            "true" | "1" => Value::Bool(true),
+                            "false" | "0" => Value::Bool(false),
+                            _ => {
+                                return Err(
+                                    self.err(c, format!("cannot parse \"{s}\" as a boolean"))
+                                );
+                            }
+                        }
+                    }
+                    "string" => Value::Str(self.req_attr(c, "value")?),
+                    "rgb" | "color" => Value::Rgb(self.parse_vec3(c, &self.req_attr(c, "value")?)?),
+                    "srgb" => Value::Rgb(self.srgb_hex(c, &self.req_attr(c, "value")?)?),
+                    "spectrum" => {
+                        let s = self.req_attr(c, "value")?;
+                        if s.contains(':') {
+                            Value::Spectrum(
+                                crate::spectrum::parse_pairs(&s).map_err(|e| self.err(c, e))?,
+                            )
+                        } else {
+                            Value::SpectrumConst(self.parse_float(c, &s)? as f32)
+                        }
+                    }
+                    "point" | "vector" => Value::Point(self.xyz(c, 0.0)?),
+                    "transform" => Value::Transform(self.parse_transform(c)?),
+                    other => return Err(self.err(c, format!("<{other}> is not a property"))),
+                })
+            })()
+            .map_err(named)?;
             items.push(Prop {
                 name: snake_case(&name),
                 value,
@@ -591,6 +612,13 @@ impl<'a, 'i> Importer<'a, 'i> {
             }
             "twosided" => {
                 let inner = match nested.first() {
+                    // Checked before recursing, so nesting depth is bounded (a file with
+                    // thousands of nested twosided elements would overflow the stack).
+                    Some(n)
+                        if n.attribute("type").map(snake_case).as_deref() == Some("twosided") =>
+                    {
+                        return Err(self.err(*n, "bsdf 'twosided' wraps another twosided"));
+                    }
                     Some(n) => self.bsdf(*n)?,
                     None => {
                         self.warn(
@@ -715,6 +743,12 @@ impl<'a, 'i> Importer<'a, 'i> {
             let tag = c.tag_name().name();
             if !PROPERTY_TAGS.contains(&tag) && tag != "bsdf" {
                 return Err(self.err(c, format!("unexpected <{tag}> inside a bsdf")));
+            }
+            if tag == "bsdf" && ty != "twosided" {
+                return Err(self.err(
+                    c,
+                    format!("bsdf '{ty}' takes no nested bsdf (only twosided wraps one)"),
+                ));
             }
         }
         self.finish(props);
@@ -1007,6 +1041,9 @@ impl<'a, 'i> Importer<'a, 'i> {
                             self.err(c, format!("shapes carry only 'area' emitters, not '{ety}'"))
                         );
                     }
+                    if emission.is_some() {
+                        return Err(self.err(c, "a shape takes one emitter"));
+                    }
                     let ep = self.props(c, "emitter 'area'".into())?;
                     let r = ep
                         .color(self, "radiance", ColorUse::Emission)?
@@ -1036,8 +1073,16 @@ impl<'a, 'i> Importer<'a, 'i> {
             return Err(self.err(node, format!("unknown sensor type '{ty}'")));
         }
         let props = self.props(node, format!("sensor '{ty}'"))?;
+        let fov = props.float(self, "fov")?.unwrap_or(45.0);
+        if !(fov > 0.0 && fov < 180.0) {
+            let at = props.get("fov").map_or(node, |p| p.node);
+            return Err(self.err(
+                at,
+                format!("sensor '{ty}': fov {fov} must lie in (0, 180) degrees"),
+            ));
+        }
         let mut cam = CameraDesc {
-            fov: props.float(self, "fov")?.unwrap_or(45.0),
+            fov,
             to_world: props.transform(self, "to_world")?,
             ..CameraDesc::default()
         };
@@ -1084,6 +1129,31 @@ impl<'a, 'i> Importer<'a, 'i> {
                 t => return Err(self.err(c, format!("unexpected <{t}> inside a sensor"))),
             }
         }
+        // Everything the builder would reject about the camera, reported with the sensor's line.
+        if let Err(e) = crate::transform_matrix(&cam.to_world).and_then(|m| {
+            let axis = restir_geometry::FovAxis::X;
+            let res = (desc.film.width, desc.film.height);
+            restir_geometry::Camera::thin_lens(
+                m,
+                cam.fov,
+                axis,
+                res,
+                cam.aperture_radius,
+                cam.focus_distance,
+            )
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+        }) {
+            let lens = if ty == "thinlens" {
+                format!(
+                    " (aperture_radius {}, focus_distance {})",
+                    cam.aperture_radius, cam.focus_distance
+                )
+            } else {
+                String::new()
+            };
+            return Err(self.err(node, format!("sensor '{ty}': camera: {e}{lens}")));
+        }
         self.finish(props);
         desc.camera = cam;
         Ok(())
@@ -1091,18 +1161,36 @@ impl<'a, 'i> Importer<'a, 'i> {
 
     fn film(&mut self, node: Node<'a, 'i>, film: &mut FilmDesc) -> Result<()> {
         let ty = self.plugin_type(node)?;
+        // Mitsuba 3's hdrfilm and specfilm, Mitsuba 0.6's ldrfilm and tiledhdrfilm: all give an
+        // image; the output format comes from the output file name.
+        if !matches!(
+            ty.as_str(),
+            "hdrfilm" | "ldrfilm" | "tiledhdrfilm" | "specfilm"
+        ) {
+            return Err(self.err(node, format!("unknown film type '{ty}'")));
+        }
         let props = self.props(node, format!("film '{ty}'"))?;
-        let dim = |v: Option<i64>, what: &str, d: u32| -> Result<u32> {
-            match v {
+        let dim = |what: &str, d: u32| -> Result<u32> {
+            match props.int(self, what)? {
                 None => Ok(d),
                 Some(n) if (1..=32768).contains(&n) => Ok(n as u32),
-                Some(n) => {
-                    Err(self.err(node, format!("film {what} {n} is out of range (1..=32768)")))
-                }
+                Some(n) => Err(self.err(
+                    props.get(what).map_or(node, |p| p.node),
+                    format!("film {what} {n} is out of range (1..=32768)"),
+                )),
             }
         };
-        film.width = dim(props.int(self, "width")?, "width", 768)?;
-        film.height = dim(props.int(self, "height")?, "height", 576)?;
+        film.width = dim("width", 768)?;
+        film.height = dim("height", 576)?;
+        if film.width as u64 * film.height as u64 > 1 << 28 {
+            return Err(self.err(
+                node,
+                format!(
+                    "film resolution {}×{} has too many pixels (at most 2^28)",
+                    film.width, film.height
+                ),
+            ));
+        }
         film.filename = props.string(self, "filename")?;
         film.filter = FilterDesc::Gaussian { stddev: 0.5 };
         for c in elements(node) {
@@ -1372,13 +1460,21 @@ pub fn parse_xml(
             "bsdf" => {
                 let material = imp.bsdf(c)?;
                 let name = match imp.attr(c, "id")? {
-                    Some(id) => id,
+                    Some(id) => {
+                        if let Some(line) = imp.bsdf_ids.get(&id) {
+                            return Err(imp.err(
+                                c,
+                                format!("bsdf id '{id}' is already declared at line {line}"),
+                            ));
+                        }
+                        id
+                    }
                     None => {
                         imp.bsdf_anon += 1;
                         format!("__anonymous_{}", imp.bsdf_anon)
                     }
                 };
-                imp.bsdf_ids.insert(name.clone(), ());
+                imp.bsdf_ids.insert(name.clone(), imp.loc(c).line);
                 desc.materials.push(NamedMaterial { name, material });
             }
             "texture" => {

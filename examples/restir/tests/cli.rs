@@ -313,6 +313,38 @@ fn bad_numbers_on_the_command_line() {
     }
 }
 
+/// Files of the scene crate's bad-scene suite through the command: a truncated binary PLY (an
+/// error found while building), 3000 nested bsdfs (once a stack overflow) and a 10⁶×10⁶ film
+/// (rejected before anything is allocated) exit with code 1 and the suite's message.
+#[test]
+fn bad_scene_suite_files() {
+    let dir = temp_dir("badsuite");
+    let out = dir.join("o.png");
+    let suite =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../crates/scene/tests/bad_scenes");
+    for (file, needles) in [
+        (
+            "ply_truncated_binary.xml",
+            &["ply_truncated_binary.xml:9:", "truncated"][..],
+        ),
+        (
+            "xml_deep_nesting.xml",
+            &["xml_deep_nesting.xml:10:", "wraps another twosided"][..],
+        ),
+        (
+            "film_million_squared.xml",
+            &[
+                "film_million_squared.xml:5:",
+                "film width 1000000 is out of range",
+            ][..],
+        ),
+    ] {
+        let scene = suite.join(file);
+        fails(&["render", s(&scene), "-o", s(&out)], needles);
+    }
+    assert!(!out.exists(), "no image is written for a bad scene");
+}
+
 #[test]
 fn compare_bad_inputs() {
     let dir = temp_dir("compare");
