@@ -1,17 +1,20 @@
-//! Textures of the XML format: `bitmap` (PNG, JPEG, EXR) and `checkerboard`, decoded and
-//! evaluated in the scene crate.
+//! Textures: `bitmap` (PNG, JPEG, EXR) and `checkerboard`, decoded once when the scene is built
+//! and evaluated at a hit's texture coordinates by [`crate::Scene::bsdf_at`].
 //!
-//! Status: textures are parsed and decoded here, but the materials cannot take them yet, so a
-//! bsdf parameter that refers to a texture is a load error naming the texture (see
-//! `docs/SCENES.md`). [`Texture::eval`] is what the materials path will call once it exists.
+//! Conventions are Mitsuba 3's: `uv = (0, 0)` is the top-left corner of the image (the first
+//! row), `v` grows downwards; texel centres are at `(i + ½)/size`; lookups are bilinear with
+//! repeat wrapping. OBJ files count `v` from the bottom, so the OBJ reader flips it (as Mitsuba's
+//! does); PLY and `.serialized` texture coordinates are used as stored.
 
 use std::path::Path;
 
 use glam::{Vec2, Vec3};
+use serde::{Deserialize, Serialize};
 
 /// The `uv` transform of a texture: `uv' = uv · scale + offset` (Mitsuba 0.6 `uscale`/`vscale`/
 /// `uoffset`/`voffset`, Mitsuba 3 `to_uv` with scale and translate).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct UvTransform {
     /// Per-axis scale.
     pub scale: Vec2,
@@ -36,27 +39,42 @@ impl UvTransform {
     }
 }
 
-/// A texture as the scene file describes it (file not yet read).
-#[derive(Clone, Debug, PartialEq)]
+/// A texture as the scene file describes it (file not yet read). In RON:
+/// `Bitmap(filename: "wood.png")` (optional `raw: true`, `uv: (scale: (4, 4), offset: (0, 0))`)
+/// or `Checkerboard(color0: (1, 1, 1), color1: (0, 0, 0))` (defaults 0.4 and 0.2, as Mitsuba).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum TextureDesc {
     /// An image file, relative to the scene file.
     Bitmap {
         /// Path.
         filename: String,
         /// `raw = true`: 8-bit values are used as they are, not sRGB-decoded.
+        #[serde(default)]
         raw: bool,
         /// uv transform.
+        #[serde(default)]
         uv: UvTransform,
     },
     /// Two colours alternating in a 2×2 pattern per unit square of (transformed) uv.
     Checkerboard {
         /// Colour where `u mod 1` and `v mod 1` are on the same side of ½.
+        #[serde(default = "checker0")]
         color0: [f32; 3],
         /// The other colour.
+        #[serde(default = "checker1")]
         color1: [f32; 3],
         /// uv transform.
+        #[serde(default)]
         uv: UvTransform,
     },
+}
+
+fn checker0() -> [f32; 3] {
+    [0.4; 3]
+}
+fn checker1() -> [f32; 3] {
+    [0.2; 3]
 }
 
 /// A decoded texture.
@@ -96,6 +114,22 @@ fn srgb_to_linear(c: f32) -> f32 {
 impl Texture {
     /// Reads the files a description names; `base_dir` resolves relative paths.
     pub fn load(desc: &TextureDesc, base_dir: &Path) -> Result<Texture, String> {
+        let uv = match desc {
+            TextureDesc::Bitmap { uv, .. } | TextureDesc::Checkerboard { uv, .. } => uv,
+        };
+        if !(uv.scale.is_finite() && uv.offset.is_finite()) {
+            return Err(format!(
+                "texture uv transform (scale {}, offset {}) is not finite",
+                uv.scale, uv.offset
+            ));
+        }
+        if let TextureDesc::Checkerboard { color0, color1, .. } = desc {
+            for (name, c) in [("color0", color0), ("color1", color1)] {
+                if !c.iter().all(|x| (0.0..=1.0).contains(x)) {
+                    return Err(format!("checkerboard {name} {c:?} must lie in [0, 1]"));
+                }
+            }
+        }
         match desc {
             TextureDesc::Checkerboard { color0, color1, uv } => Ok(Texture::Checkerboard {
                 color0: Vec3::from(*color0),
@@ -115,8 +149,8 @@ impl Texture {
         }
     }
 
-    /// The texture's value at surface coordinates `uv` (`v = 0` is the image's bottom row, as
-    /// in OBJ texture coordinates).
+    /// The texture's value at surface coordinates `uv` (`v = 0` is the image's top row, as in
+    /// Mitsuba 3).
     pub fn eval(&self, uv: Vec2) -> Vec3 {
         match self {
             Texture::Checkerboard {
@@ -141,7 +175,7 @@ impl Texture {
                 let p = t.apply(uv);
                 // Texel centres at (i + ½)/size; repeat wrapping.
                 let x = p.x * *width as f32 - 0.5;
-                let y = (1.0 - p.y) * *height as f32 - 0.5;
+                let y = p.y * *height as f32 - 0.5;
                 let (x0, y0) = (x.floor(), y.floor());
                 let (fx, fy) = (x - x0, y - y0);
                 let wrap = |i: f32, n: usize| -> usize {

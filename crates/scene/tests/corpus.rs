@@ -78,20 +78,55 @@ fn unsupported_corpus_scenes_fail_clearly() {
             "lajolla/matpreview/matpreview.xml",
             "matpreview.xml:49: unknown emitter type 'envmap'",
         ),
-        // Materials cannot take textures yet.
-        (
-            "lajolla/sponza/sponza.xml",
-            "sponza.xml:60: bsdf 'diffuse': 'reflectance' is a bitmap texture",
-        ),
-        (
-            "lajolla/pixel_filter_test/pixel_filter_test.xml",
-            "pixel_filter_test.xml:45: bsdf 'diffuse': 'reflectance' is a checkerboard texture",
-        ),
     ];
     for (rel, want) in cases {
         let e = load_err(&dir, rel);
         assert!(e.contains(want), "{rel}: got \"{e}\", want \"{want}\"");
     }
+}
+
+/// The textured scenes load, and their materials vary over the surface as their textures do.
+#[test]
+fn textured_corpus_scenes_load() {
+    let Some(dir) = corpus() else { return };
+    let centre_hit = |scene: &restir_scene::Scene| {
+        let (w, h) = scene.camera.resolution();
+        let film = glam::Vec2::new(w as f32 / 2.0, h as f32 * 0.9);
+        let ray = scene.camera.generate_ray(film, glam::Vec2::splat(0.5));
+        scene.intersect(&ray).expect("the camera sees the floor")
+    };
+    let reflectance = |b: restir_materials::Bsdf| match b.kind {
+        restir_materials::BsdfKind::Diffuse { reflectance } => reflectance,
+        k => panic!("expected a diffuse floor, got {k:?}"),
+    };
+
+    // Checkerboard reflectance (1000 × 1000 checks of 1 and 0) on an OBJ floor.
+    let pft = load(&dir, "lajolla/pixel_filter_test/pixel_filter_test.xml").scene;
+    assert!(pft.features.has_textures);
+    assert_eq!(pft.textures.len(), 1);
+    let mut si = centre_hit(&pft);
+    let mut seen = [false; 2];
+    for k in 0..64 {
+        si.uv = glam::Vec2::new(0.37 + k as f32 * 0.0005, 0.61);
+        let r = reflectance(pft.bsdf(&si));
+        assert!(r == glam::Vec3::ONE || r == glam::Vec3::ZERO, "{r}");
+        seen[(r.x > 0.5) as usize] = true;
+    }
+    assert_eq!(seen, [true, true], "both checker colours along a row");
+
+    // Sponza: JPEG textures on `.serialized` meshes with texture coordinates.
+    let sponza = load(&dir, "lajolla/sponza/sponza.xml").scene;
+    assert!(sponza.features.has_textures);
+    assert_eq!(
+        sponza.textures.len(),
+        10,
+        "each distinct bitmap decoded once"
+    );
+    let mut si = centre_hit(&sponza);
+    let r0 = reflectance(sponza.bsdf(&si));
+    si.uv += glam::Vec2::new(0.25, 0.25);
+    let r1 = reflectance(sponza.bsdf(&si));
+    assert!(r0 != r1 && r0.max_element() <= 1.0, "{r0} {r1}");
 }
 
 /// A scene around one shape, written next to the test's temporary files.
