@@ -281,13 +281,11 @@ impl Shape {
                 });
                 let b = n.cross(a);
                 let base = positions.len() as u32;
-                for (i, (sa, sb)) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
-                    .into_iter()
-                    .enumerate()
-                {
-                    positions.push(n + sa * a + sb * b);
+                for (sa, sb) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                    let p = n + sa * a + sb * b;
+                    positions.push(p);
                     normals.push(n);
-                    uvs.push(Vec2::new([0.0, 1.0, 1.0, 0.0][i], [0.0, 0.0, 1.0, 1.0][i]));
+                    uvs.push(cube_uv(p, axis, sign));
                 }
                 indices.push([base, base + 1, base + 2]);
                 indices.push([base + 2, base + 3, base]);
@@ -298,20 +296,44 @@ impl Shape {
     }
 
     /// A disk of radius 1 in the `z = 0` plane, normal `+z`, as a fan of `segments` triangles.
+    /// Texture coordinates are Mitsuba's `(r, φ/2π)`: every triangle has its own centre vertex
+    /// (at `v` of the middle of its segment) and the seam has two rim vertices (`v = 0` and
+    /// `v = 1`), so `u` is exact to `1 − cos(π/segments)` and `v` to `½/segments` near the centre.
     pub fn disk(segments: u32) -> Result<TriangleMesh, MeshError> {
         let segments = segments.max(3);
-        let mut positions = vec![Vec3::ZERO];
-        let mut uvs = vec![Vec2::new(0.0, 0.0)];
-        for i in 0..segments {
-            let phi = 2.0 * PI * i as f32 / segments as f32;
+        let n = segments as usize;
+        let mut positions = Vec::with_capacity(2 * n + 1);
+        let mut uvs = Vec::with_capacity(2 * n + 1);
+        // Rim vertices 0..=n (the last one closes the seam at v = 1), then the centres.
+        for i in 0..=n {
+            let phi = 2.0 * PI * (i % n) as f32 / segments as f32;
             positions.push(Vec3::new(phi.cos(), phi.sin(), 0.0));
             uvs.push(Vec2::new(1.0, i as f32 / segments as f32));
         }
+        for i in 0..n {
+            positions.push(Vec3::ZERO);
+            uvs.push(Vec2::new(0.0, (i as f32 + 0.5) / segments as f32));
+        }
         let normals = vec![Vec3::Z; positions.len()];
         let indices = (0..segments)
-            .map(|i| [0, 1 + i, 1 + (i + 1) % segments])
+            .map(|i| [segments + 1 + i, i, i + 1])
             .collect();
         TriangleMesh::new(positions, Some(normals), Some(uvs), indices, false)
+    }
+}
+
+/// Mitsuba 3's texture coordinates on face `sign·axis` of the cube `[-1, 1]³` (read off
+/// Mitsuba's `cube` shape: linear on each face, so exact at the vertices is exact everywhere).
+fn cube_uv(p: Vec3, axis: usize, sign: f32) -> Vec2 {
+    let h = |x: f32| 0.5 * (1.0 + x);
+    let (x, y, z) = (p.x, p.y, p.z);
+    match (axis, sign > 0.0) {
+        (0, true) => Vec2::new(h(y), h(-z)),
+        (0, false) => Vec2::new(h(y), h(z)),
+        (1, true) => Vec2::new(h(-x), h(-z)),
+        (1, false) => Vec2::new(h(z), h(x)),
+        (2, true) => Vec2::new(h(y), h(x)),
+        _ => Vec2::new(h(-y), h(x)),
     }
 }
 
@@ -347,6 +369,66 @@ mod tests {
             assert!((0.0..=1.0).contains(&e.x) && (0.0..=1.0).contains(&e.y));
             let m = octahedral_decode(e);
             assert!((m - n).length() < 1e-6, "{n} -> {e} -> {m}");
+        }
+    }
+
+    /// Texture coordinates of the built-in shapes are Mitsuba 3's (values read off Mitsuba 3.6
+    /// `scalar_rgb` with `ray_intersect` at the same points).
+    #[test]
+    fn builtin_uvs_match_mitsuba() {
+        let at = |m: &TriangleMesh, o: Vec3, d: Vec3| -> Vec2 {
+            let shapes = vec![Shape::Mesh(m.clone())];
+            let accel = crate::Accel::build(&shapes);
+            let ray = crate::Ray::new(o, d);
+            let hit = accel
+                .intersect(&ray, f32::INFINITY)
+                .unwrap_or_else(|| panic!("no hit from {o} along {d}"));
+            accel.surface_interaction(&shapes, &hit, &ray).uv
+        };
+        let close =
+            |a: Vec2, b: Vec2, tol: f32| assert!((a - b).abs().max_element() < tol, "{a} vs {b}");
+        let rect = Shape::rectangle();
+        close(
+            at(&rect, Vec3::new(-0.5, -0.5, 2.0), -Vec3::Z),
+            Vec2::new(0.25, 0.25),
+            1e-5,
+        );
+        close(
+            at(&rect, Vec3::new(0.5, 0.5, 2.0), -Vec3::Z),
+            Vec2::new(0.75, 0.75),
+            1e-5,
+        );
+        let cube = Shape::cube();
+        let cases = [
+            ((0.3, 0.6, 3.0), (0.0, 0.0, -1.0), (0.8, 0.65)),
+            ((0.3, 0.6, -3.0), (0.0, 0.0, 1.0), (0.2, 0.65)),
+            ((3.0, 0.3, 0.6), (-1.0, 0.0, 0.0), (0.65, 0.2)),
+            ((-3.0, 0.3, 0.6), (1.0, 0.0, 0.0), (0.65, 0.8)),
+            ((0.3, 3.0, 0.6), (0.0, -1.0, 0.0), (0.35, 0.2)),
+            ((0.3, -3.0, 0.6), (0.0, 1.0, 0.0), (0.8, 0.65)),
+        ];
+        for (o, d, uv) in cases {
+            close(
+                at(&cube, Vec3::from(o), Vec3::from(d)),
+                Vec2::from(uv),
+                1e-5,
+            );
+        }
+        let disk = Shape::disk(256).unwrap();
+        let cases = [
+            ((0.5, 0.0), (0.5, 0.0)),
+            ((1e-4, 0.5), (0.5, 0.25)),
+            ((-0.5, 0.0), (0.5, 0.5)),
+            ((1e-4, -0.5), (0.5, 0.75)),
+            ((0.25, 0.25), (0.353_553, 0.125)),
+            ((0.3, -1e-3), (0.3, 0.999_47)),
+        ];
+        for ((x, y), uv) in cases {
+            close(
+                at(&disk, Vec3::new(x, y, 2.0), -Vec3::Z),
+                Vec2::from(uv),
+                2e-3,
+            );
         }
     }
 

@@ -2,16 +2,17 @@
 //! estimators. Camera rays are jittered by the film's filter with the pixel's pass stream, the
 //! same numbers the path tracer draws first, so both see the same pixel footprint.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use restir_geometry::Frame;
+use restir_materials::Bsdf;
 use restir_scene::Scene;
 
 use crate::render::{BAND_ROWS, PassContext};
 
 /// What a reuse pass needs to know about a pixel's primary hit: the shading point, its frame,
-/// its material, the direction to the camera and what the neighbour-similarity tests compare.
-/// One cache line (spatial reuse reads it at random neighbours); the second tangent of the
+/// its material and texture coordinates, the direction to the camera and what the
+/// neighbour-similarity tests compare. One cache line (spatial reuse reads it at random neighbours); the second tangent of the
 /// shading frame is recomputed as `n × s`.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
@@ -28,6 +29,8 @@ pub struct Receiver {
     pub bsdf: u32,
     /// Distance from the camera.
     pub depth: f32,
+    /// Texture coordinates (where [`Scene::bsdf_at`] looks up the material's textures).
+    pub uv: Vec2,
 }
 
 impl Receiver {
@@ -41,11 +44,12 @@ impl Receiver {
         wo: Vec3::Z,
         bsdf: Self::NO_HIT,
         depth: 0.0,
+        uv: Vec2::ZERO,
     };
 
-    /// A receiver at a surface point with shading frame `(s, ·, n)`, seen from direction
-    /// `to_camera` (world space, unit) at distance `depth`.
-    pub fn new(p: Vec3, frame: &Frame, to_camera: Vec3, bsdf: u32, depth: f32) -> Self {
+    /// A receiver at a surface point with shading frame `(s, ·, n)` and texture coordinates
+    /// `uv`, seen from direction `to_camera` (world space, unit) at distance `depth`.
+    pub fn new(p: Vec3, frame: &Frame, uv: Vec2, to_camera: Vec3, bsdf: u32, depth: f32) -> Self {
         let mut r = Self {
             p,
             n: frame.n,
@@ -53,9 +57,16 @@ impl Receiver {
             wo: Vec3::Z,
             bsdf,
             depth,
+            uv,
         };
         r.wo = r.frame().to_local(to_camera);
         r
+    }
+
+    /// The BSDF at this point, textures resolved ([`Scene::bsdf_at`]).
+    #[inline]
+    pub fn resolve_bsdf(&self, scene: &Scene) -> Bsdf {
+        scene.bsdf_at(self.bsdf, self.uv)
     }
 
     /// The shading frame.
@@ -142,6 +153,7 @@ impl GBuffer {
                         recv[i] = Receiver::new(
                             si.p,
                             &si.shading,
+                            si.uv,
                             -ray.d,
                             scene.shape_bsdf[si.shape as usize],
                             si.t,

@@ -150,10 +150,36 @@ fn one_sided(kind: BsdfKind) -> Bsdf {
     }
 }
 
+/// The colour parameters of a model as the scene gives them (before any precomputation), for
+/// replacing them per shading point with texture values: [`Bsdf::with_params`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReflectanceParams {
+    /// `diffuse`'s `reflectance`, the plastics' `diffuse_reflectance`.
+    pub diffuse: Vec3,
+    /// `specular_reflectance` (conductors, dielectrics, plastics).
+    pub specular: Vec3,
+    /// The dielectrics' `specular_transmittance`.
+    pub transmittance: Vec3,
+    /// The plastics' `nonlinear` flag (it decides how `diffuse` is precomputed).
+    pub nonlinear: bool,
+}
+
 /// Mitsuba's specular sampling weight `mean(ks) / (mean(ρd) + mean(ks))` (1 when both are 0).
 fn specular_weight(diffuse: Vec3, specular: Vec3) -> f32 {
     let (d, s) = (mean(diffuse), mean(specular));
     if d + s > 0.0 { s / (d + s) } else { 1.0 }
+}
+
+/// A plastic's `ρ' / η²`: the base reflectance `ρd` after the internal-reflection series
+/// (`ρd / (1 − R_int)`, or `ρd / (1 − ρd R_int)` if `nonlinear`) times the radiance scale `1/η²`.
+#[inline]
+fn plastic_diffuse_scaled(eta: f32, diffuse: Vec3, r_int: f32, nonlinear: bool) -> Vec3 {
+    let rho = if nonlinear {
+        diffuse / (Vec3::ONE - diffuse * r_int)
+    } else {
+        diffuse / (1.0 - r_int)
+    };
+    rho / (eta * eta)
 }
 
 const REFLECT_DIFFUSE: LobeFlags = LobeFlags::DIFFUSE.union(LobeFlags::REFLECTION);
@@ -241,14 +267,9 @@ impl Bsdf {
         nonlinear: bool,
     ) -> Self {
         let fdr_int = fresnel_diffuse_reflectance(1.0 / eta);
-        let rho = if nonlinear {
-            diffuse_reflectance / (Vec3::ONE - diffuse_reflectance * fdr_int)
-        } else {
-            diffuse_reflectance / (1.0 - fdr_int)
-        };
         one_sided(BsdfKind::Plastic(Plastic {
             eta,
-            diffuse_scaled: rho / (eta * eta),
+            diffuse_scaled: plastic_diffuse_scaled(eta, diffuse_reflectance, fdr_int, nonlinear),
             specular_reflectance,
             specular_weight: specular_weight(diffuse_reflectance, specular_reflectance),
         }))
@@ -266,20 +287,81 @@ impl Bsdf {
     ) -> Self {
         let microfacet = Microfacet::new(distribution, alpha);
         let table = rough_plastic_table(distribution, microfacet.alpha_u, eta);
-        let r_int = table.internal_reflectance;
-        let rho = if nonlinear {
-            diffuse_reflectance / (Vec3::ONE - diffuse_reflectance * r_int)
-        } else {
-            diffuse_reflectance / (1.0 - r_int)
-        };
         one_sided(BsdfKind::RoughPlastic(RoughPlastic {
             eta,
-            diffuse_scaled: rho / (eta * eta),
+            diffuse_scaled: plastic_diffuse_scaled(
+                eta,
+                diffuse_reflectance,
+                table.internal_reflectance,
+                nonlinear,
+            ),
             specular_reflectance,
             specular_weight: specular_weight(diffuse_reflectance, specular_reflectance),
             microfacet,
             table,
         }))
+    }
+
+    /// The same model with its colour parameters replaced by `p` (each model takes the ones it
+    /// has; the others are ignored). Cheap: the rough plastic's coating tables depend on the
+    /// IOR and roughness only and are kept, so only the reflectance-derived terms
+    /// (`diffuse_scaled`, `specular_weight`) are recomputed. Equal to building the model with
+    /// these parameters in the first place.
+    #[inline]
+    pub fn with_params(&self, p: &ReflectanceParams) -> Self {
+        let kind = match self.kind {
+            BsdfKind::Diffuse { .. } => BsdfKind::Diffuse {
+                reflectance: p.diffuse,
+            },
+            BsdfKind::Conductor { eta, k, .. } => BsdfKind::Conductor {
+                eta,
+                k,
+                specular_reflectance: p.specular,
+            },
+            BsdfKind::RoughConductor {
+                eta, k, microfacet, ..
+            } => BsdfKind::RoughConductor {
+                eta,
+                k,
+                specular_reflectance: p.specular,
+                microfacet,
+            },
+            BsdfKind::Dielectric { eta, .. } => BsdfKind::Dielectric {
+                eta,
+                specular_reflectance: p.specular,
+                specular_transmittance: p.transmittance,
+            },
+            BsdfKind::RoughDielectric {
+                eta, microfacet, ..
+            } => BsdfKind::RoughDielectric {
+                eta,
+                specular_reflectance: p.specular,
+                specular_transmittance: p.transmittance,
+                microfacet,
+            },
+            BsdfKind::Plastic(q) => {
+                let fdr_int = fresnel_diffuse_reflectance(1.0 / q.eta);
+                BsdfKind::Plastic(Plastic {
+                    diffuse_scaled: plastic_diffuse_scaled(q.eta, p.diffuse, fdr_int, p.nonlinear),
+                    specular_reflectance: p.specular,
+                    specular_weight: specular_weight(p.diffuse, p.specular),
+                    ..q
+                })
+            }
+            BsdfKind::RoughPlastic(q) => BsdfKind::RoughPlastic(RoughPlastic {
+                diffuse_scaled: plastic_diffuse_scaled(
+                    q.eta,
+                    p.diffuse,
+                    q.table.internal_reflectance,
+                    p.nonlinear,
+                ),
+                specular_reflectance: p.specular,
+                specular_weight: specular_weight(p.diffuse, p.specular),
+                ..q
+            }),
+            k @ (BsdfKind::Null | BsdfKind::Black) => k,
+        };
+        Self { kind, ..*self }
     }
 
     /// The same model, visible from both sides (no effect on transmitting models).
@@ -758,6 +840,54 @@ mod tests {
                 prop_assert!((f_ab - f_ba).abs().max_element() < 1e-4);
             } else {
                 prop_assert!(!two && wo.z <= 0.0);
+            }
+        }
+    }
+
+    /// Replacing the colour parameters gives exactly the model built with them.
+    #[test]
+    fn with_params_equals_fresh_construction() {
+        let (d0, s0, t0) = (Vec3::splat(0.5), Vec3::ONE, Vec3::ONE);
+        let (d1, s1, t1) = (
+            Vec3::new(0.1, 0.7, 0.3),
+            Vec3::new(0.9, 0.4, 0.2),
+            Vec3::new(0.3, 0.8, 0.6),
+        );
+        let mf = Microfacet::new(Distribution::Ggx, 0.3);
+        let (eta, k) = (Vec3::new(0.2, 0.9, 1.1), Vec3::new(3.9, 2.4, 2.1));
+        for nonlinear in [false, true] {
+            let p = ReflectanceParams {
+                diffuse: d1,
+                specular: s1,
+                transmittance: t1,
+                nonlinear,
+            };
+            let pairs = [
+                (Bsdf::diffuse(d0), Bsdf::diffuse(d1)),
+                (Bsdf::conductor(eta, k, s0), Bsdf::conductor(eta, k, s1)),
+                (
+                    Bsdf::rough_conductor(eta, k, s0, mf),
+                    Bsdf::rough_conductor(eta, k, s1, mf),
+                ),
+                (Bsdf::dielectric(1.5, s0, t0), Bsdf::dielectric(1.5, s1, t1)),
+                (
+                    Bsdf::rough_dielectric(1.5, s0, t0, mf),
+                    Bsdf::rough_dielectric(1.5, s1, t1, mf),
+                ),
+                (
+                    Bsdf::plastic(1.49, d0, s0, nonlinear),
+                    Bsdf::plastic(1.49, d1, s1, nonlinear),
+                ),
+                (
+                    Bsdf::rough_plastic(1.49, d0, s0, nonlinear, Distribution::Beckmann, 0.2),
+                    Bsdf::rough_plastic(1.49, d1, s1, nonlinear, Distribution::Beckmann, 0.2),
+                ),
+                (Bsdf::null(), Bsdf::null()),
+                (Bsdf::black(), Bsdf::black()),
+            ];
+            for (base, want) in pairs {
+                assert_eq!(base.with_params(&p), want);
+                assert_eq!(base.two_sided().with_params(&p), want.two_sided());
             }
         }
     }

@@ -63,6 +63,6 @@ mod lobe;
 pub mod microfacet;
 pub mod plastic;
 
-pub use bsdf::{Bsdf, BsdfKind, BsdfSample, Plastic, RoughPlastic};
+pub use bsdf::{Bsdf, BsdfKind, BsdfSample, Plastic, ReflectanceParams, RoughPlastic};
 pub use lobe::LobeFlags;
 pub use microfacet::{Distribution, Microfacet};

@@ -6,10 +6,11 @@ use std::path::Path;
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 use restir_geometry::{Accel, Camera, FovAxis as GeoFovAxis, Shape, Sphere, TriangleMesh};
 use restir_lights::{EnvMap, Light, LightSet};
-use restir_materials::{Bsdf, Distribution, LobeFlags, Microfacet};
+use restir_materials::{Bsdf, Distribution, LobeFlags, Microfacet, ReflectanceParams};
 
 use crate::desc::*;
-use crate::{Scene, SceneError, SceneFeatures};
+use crate::texture::Texture;
+use crate::{Scene, SceneError, SceneFeatures, TexturedParams};
 
 /// Composes transform steps (first step applied first) into one matrix.
 pub fn transform_matrix(ops: &[TransformOp]) -> Result<Mat4, String> {
@@ -247,7 +248,164 @@ fn material_bsdf(m: &MaterialDesc) -> Result<Bsdf, String> {
             b.two_sided()
         }
         MaterialDesc::Black => Bsdf::black(),
+        MaterialDesc::Textured { material, textures } => {
+            let b = material_bsdf(material)?;
+            let allowed = color_params(material);
+            if matches!(**material, MaterialDesc::Textured { .. }) {
+                return Err("a textured material cannot wrap another textured material".into());
+            }
+            for (i, t) in textures.iter().enumerate() {
+                if !allowed.contains(&t.param) {
+                    let names: Vec<&str> = allowed.iter().map(|p| p.name()).collect();
+                    return Err(format!(
+                        "texture for '{}': this material has no such parameter (its colour parameters: {})",
+                        t.param.name(),
+                        if names.is_empty() {
+                            "none".to_string()
+                        } else {
+                            names.join(", ")
+                        }
+                    ));
+                }
+                if textures[..i].iter().any(|u| u.param == t.param) {
+                    return Err(format!("two textures for '{}'", t.param.name()));
+                }
+            }
+            b
+        }
     })
+}
+
+/// The colour parameters of a material that textures may replace.
+pub(crate) fn color_params(m: &MaterialDesc) -> &'static [ColorParam] {
+    use ColorParam::*;
+    match m {
+        MaterialDesc::Diffuse { .. } => &[Reflectance],
+        MaterialDesc::Conductor { .. } | MaterialDesc::RoughConductor { .. } => {
+            &[SpecularReflectance]
+        }
+        MaterialDesc::Dielectric { .. } | MaterialDesc::RoughDielectric { .. } => {
+            &[SpecularReflectance, SpecularTransmittance]
+        }
+        MaterialDesc::Plastic { .. } | MaterialDesc::RoughPlastic { .. } => {
+            &[DiffuseReflectance, SpecularReflectance]
+        }
+        MaterialDesc::TwoSided(inner) => color_params(inner),
+        MaterialDesc::Textured { material, .. } => color_params(material),
+        MaterialDesc::Null | MaterialDesc::Black => &[],
+    }
+}
+
+/// The constant colour parameters of a material as written (defaults where a model has none)
+/// and the textures that replace some of them.
+fn material_colors(m: &MaterialDesc) -> (ReflectanceParams, &[TextureBinding]) {
+    let mut p = ReflectanceParams {
+        diffuse: Vec3::splat(0.5),
+        specular: Vec3::ONE,
+        transmittance: Vec3::ONE,
+        nonlinear: false,
+    };
+    let mut bindings: &[TextureBinding] = &[];
+    let mut m = m;
+    loop {
+        match m {
+            MaterialDesc::TwoSided(inner) => m = inner,
+            MaterialDesc::Textured { material, textures } => {
+                bindings = textures;
+                m = material;
+            }
+            _ => break,
+        }
+    }
+    match m {
+        MaterialDesc::Diffuse { reflectance } => p.diffuse = v3(reflectance),
+        MaterialDesc::Conductor {
+            specular_reflectance,
+            ..
+        }
+        | MaterialDesc::RoughConductor {
+            specular_reflectance,
+            ..
+        } => p.specular = v3(specular_reflectance),
+        MaterialDesc::Dielectric {
+            specular_reflectance,
+            specular_transmittance,
+            ..
+        }
+        | MaterialDesc::RoughDielectric {
+            specular_reflectance,
+            specular_transmittance,
+            ..
+        } => {
+            p.specular = v3(specular_reflectance);
+            p.transmittance = v3(specular_transmittance);
+        }
+        MaterialDesc::Plastic {
+            diffuse_reflectance,
+            specular_reflectance,
+            nonlinear,
+            ..
+        }
+        | MaterialDesc::RoughPlastic {
+            diffuse_reflectance,
+            specular_reflectance,
+            nonlinear,
+            ..
+        } => {
+            p.diffuse = v3(diffuse_reflectance);
+            p.specular = v3(specular_reflectance);
+            p.nonlinear = *nonlinear;
+        }
+        _ => {}
+    }
+    (p, bindings)
+}
+
+/// Decoded textures, each distinct description loaded once.
+#[derive(Default)]
+struct TextureCache {
+    descs: Vec<TextureDesc>,
+    textures: Vec<Texture>,
+}
+
+impl TextureCache {
+    fn get(&mut self, d: &TextureDesc, base_dir: &Path) -> Result<u32, String> {
+        if let Some(i) = self.descs.iter().position(|e| e == d) {
+            return Ok(i as u32);
+        }
+        let t = Texture::load(d, base_dir)?;
+        self.descs.push(d.clone());
+        self.textures.push(t);
+        Ok(self.textures.len() as u32 - 1)
+    }
+}
+
+/// A material's BSDF and, if some of its parameters are textures, their slots.
+fn material(
+    m: &MaterialDesc,
+    cache: &mut TextureCache,
+    base_dir: &Path,
+) -> Result<(Bsdf, Option<TexturedParams>), String> {
+    let bsdf = material_bsdf(m)?;
+    let (base, bindings) = material_colors(m);
+    if bindings.is_empty() {
+        return Ok((bsdf, None));
+    }
+    let mut t = TexturedParams {
+        base,
+        diffuse: None,
+        specular: None,
+        transmittance: None,
+    };
+    for b in bindings {
+        let id = Some(cache.get(&b.texture, base_dir)?);
+        match b.param {
+            ColorParam::Reflectance | ColorParam::DiffuseReflectance => t.diffuse = id,
+            ColorParam::SpecularReflectance => t.specular = id,
+            ColorParam::SpecularTransmittance => t.transmittance = id,
+        }
+    }
+    Ok((bsdf, Some(t)))
 }
 
 use crate::meshio::MeshData;
@@ -300,7 +458,8 @@ fn load_obj(path: &Path) -> Result<MeshData, String> {
             uvs.extend(
                 mesh.texcoords
                     .chunks_exact(2)
-                    .map(|c| Vec2::new(c[0], c[1])),
+                    // OBJ counts v from the bottom of the image; Mitsuba flips it on load.
+                    .map(|c| Vec2::new(c[0], 1.0 - c[1])),
             );
         }
         for t in mesh.indices.chunks_exact(3) {
@@ -501,12 +660,15 @@ impl Scene {
 
         // Materials.
         let mut bsdfs = vec![Bsdf::diffuse(Vec3::splat(0.5)), Bsdf::black()];
+        let mut bsdf_textures = vec![None, None];
+        let mut cache = TextureCache::default();
         let mut names = std::collections::HashMap::new();
         for nm in &desc.materials {
-            let b = material_bsdf(&nm.material)
+            let (b, t) = material(&nm.material, &mut cache, base_dir)
                 .map_err(|e| whole(format!("material '{}': {e}", nm.name)))?;
             names.insert(nm.name.clone(), bsdfs.len() as u32);
             bsdfs.push(b);
+            bsdf_textures.push(t);
         }
 
         // Shapes, their materials and area lights.
@@ -524,9 +686,10 @@ impl Scene {
                     )
                 })?,
                 Some(MaterialRef::Inline(m)) => {
-                    let b = material_bsdf(m)
+                    let (b, t) = material(m, &mut cache, base_dir)
                         .map_err(|e| at(&sd.location, format!("shape {i}: {e}")))?;
                     bsdfs.push(b);
+                    bsdf_textures.push(t);
                     bsdfs.len() as u32 - 1
                 }
                 None if sd.emission.is_some() => 1,
@@ -603,7 +766,9 @@ impl Scene {
         let features = SceneFeatures {
             has_delta_lobes: used.iter().any(|b| b.flags().contains(LobeFlags::DELTA)),
             has_glossy_lobes: used.iter().any(|b| b.flags().contains(LobeFlags::GLOSSY)),
-            has_textures: false,
+            has_textures: shape_bsdf
+                .iter()
+                .any(|&b| bsdf_textures[b as usize].is_some()),
             has_environment: light_set.environment().is_some(),
             has_delta_lights: light_set
                 .lights()
@@ -616,6 +781,8 @@ impl Scene {
             shapes,
             shape_bsdf,
             bsdfs,
+            bsdf_textures,
+            textures: cache.textures,
             accel,
             lights: light_set,
             camera,

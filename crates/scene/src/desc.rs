@@ -5,6 +5,8 @@
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
+pub use crate::texture::{TextureDesc, UvTransform};
+
 /// Where a description item came from, for error messages (`file:line`).
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Location {
@@ -439,6 +441,63 @@ pub enum MaterialDesc {
     TwoSided(Box<MaterialDesc>),
     /// Absorbs all light.
     Black,
+    /// `material` with some of its colour parameters given by textures, looked up at each
+    /// shading point's texture coordinates; the constant values in `material` are unused for
+    /// those parameters. In RON: `Textured(material: Diffuse(reflectance: (0.5, 0.5, 0.5)),
+    /// textures: [(param: Reflectance, texture: Bitmap(filename: "wood.png"))])`.
+    Textured {
+        /// The material (any model with the parameters named in `textures`).
+        material: Box<MaterialDesc>,
+        /// Which parameter each texture replaces.
+        textures: Vec<TextureBinding>,
+    },
+}
+
+/// A colour parameter of a material that a texture can provide.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum ColorParam {
+    /// `Diffuse`'s `reflectance`.
+    Reflectance,
+    /// The plastics' `diffuse_reflectance`.
+    DiffuseReflectance,
+    /// `specular_reflectance` (conductors, dielectrics, plastics).
+    SpecularReflectance,
+    /// The dielectrics' `specular_transmittance`.
+    SpecularTransmittance,
+}
+
+impl ColorParam {
+    /// The parameter's name in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            ColorParam::Reflectance => "reflectance",
+            ColorParam::DiffuseReflectance => "diffuse_reflectance",
+            ColorParam::SpecularReflectance => "specular_reflectance",
+            ColorParam::SpecularTransmittance => "specular_transmittance",
+        }
+    }
+
+    /// The parameter named `name` (snake_case), if it is one.
+    pub fn from_name(name: &str) -> Option<Self> {
+        [
+            ColorParam::Reflectance,
+            ColorParam::DiffuseReflectance,
+            ColorParam::SpecularReflectance,
+            ColorParam::SpecularTransmittance,
+        ]
+        .into_iter()
+        .find(|p| p.name() == name)
+    }
+}
+
+/// A texture bound to a material parameter.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TextureBinding {
+    /// The parameter.
+    pub param: ColorParam,
+    /// The texture.
+    pub texture: TextureDesc,
 }
 
 /// A shape's material: by name or inline.

@@ -35,9 +35,11 @@ pub use build::transform_matrix;
 pub use desc::*;
 pub use error::{SceneError, SceneWarning};
 
+use glam::{Vec2, Vec3};
 use restir_geometry::{Accel, Camera, Hit, Ray, Shape, SurfaceInteraction};
 use restir_lights::LightSet;
-use restir_materials::Bsdf;
+use restir_materials::{Bsdf, ReflectanceParams};
+use texture::Texture;
 
 /// What a scene contains, decided once at build time so that integrators can pick cheaper code
 /// paths instead of testing inside their loops.
@@ -64,8 +66,12 @@ pub struct Scene {
     pub shapes: Vec<Shape>,
     /// For each shape, the index of its BSDF in `bsdfs`.
     pub shape_bsdf: Vec<u32>,
-    /// The materials.
+    /// The materials (with their constant parameters; see [`Scene::bsdf_at`]).
     pub bsdfs: Vec<Bsdf>,
+    /// For each entry of `bsdfs`, the textures of its parameters, if it has any.
+    pub bsdf_textures: Vec<Option<TexturedParams>>,
+    /// The decoded textures that `bsdf_textures` refer to.
+    pub textures: Vec<Texture>,
     /// The BVH over `shapes`.
     pub accel: Accel,
     /// Lights and light selection.
@@ -98,10 +104,56 @@ impl Scene {
         self.accel.occluded(ray, t_max)
     }
 
-    /// The BSDF of a surface point.
+    /// The BSDF of a surface point (its material with textures looked up at `si.uv`).
     #[inline]
-    pub fn bsdf(&self, si: &SurfaceInteraction) -> &Bsdf {
-        &self.bsdfs[self.shape_bsdf[si.shape as usize] as usize]
+    pub fn bsdf(&self, si: &SurfaceInteraction) -> Bsdf {
+        self.bsdf_at(self.shape_bsdf[si.shape as usize], si.uv)
+    }
+
+    /// Material `bsdf` (an index into `bsdfs`) at texture coordinates `uv`: the one place where
+    /// textures are resolved. A scene without textures (decided at build time,
+    /// [`SceneFeatures::has_textures`]) returns the stored BSDF without looking at `uv`.
+    #[inline]
+    pub fn bsdf_at(&self, bsdf: u32, uv: Vec2) -> Bsdf {
+        let base = self.bsdfs[bsdf as usize];
+        if !self.features.has_textures {
+            return base;
+        }
+        match &self.bsdf_textures[bsdf as usize] {
+            None => base,
+            Some(t) => base.with_params(&t.eval(&self.textures, uv)),
+        }
+    }
+}
+
+/// The textured colour parameters of one material: texture indices into [`Scene::textures`]
+/// per parameter, and the constant values of the others.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TexturedParams {
+    /// The constant parameters (used where no texture is given).
+    pub base: ReflectanceParams,
+    /// Texture of the diffuse reflectance (`reflectance`, `diffuse_reflectance`).
+    pub diffuse: Option<u32>,
+    /// Texture of `specular_reflectance`.
+    pub specular: Option<u32>,
+    /// Texture of `specular_transmittance`.
+    pub transmittance: Option<u32>,
+}
+
+impl TexturedParams {
+    /// The parameters at `uv`; texture values are clamped to `[0, 1]` (reflectances).
+    #[inline]
+    pub fn eval(&self, textures: &[Texture], uv: Vec2) -> ReflectanceParams {
+        let look = |slot: Option<u32>, constant: Vec3| match slot {
+            Some(i) => textures[i as usize].eval(uv).clamp(Vec3::ZERO, Vec3::ONE),
+            None => constant,
+        };
+        ReflectanceParams {
+            diffuse: look(self.diffuse, self.base.diffuse),
+            specular: look(self.specular, self.base.specular),
+            transmittance: look(self.transmittance, self.base.transmittance),
+            nonlinear: self.base.nonlinear,
+        }
     }
 }
 

@@ -1,17 +1,20 @@
-//! Textures of the XML format: `bitmap` (PNG, JPEG, EXR) and `checkerboard`, decoded and
-//! evaluated in the scene crate.
+//! Textures: `bitmap` (PNG, JPEG, EXR) and `checkerboard`, decoded once when the scene is built
+//! and evaluated at a hit's texture coordinates by [`crate::Scene::bsdf_at`].
 //!
-//! Status: textures are parsed and decoded here, but the materials cannot take them yet, so a
-//! bsdf parameter that refers to a texture is a load error naming the texture (see
-//! `docs/SCENES.md`). [`Texture::eval`] is what the materials path will call once it exists.
+//! Conventions are Mitsuba 3's: `uv = (0, 0)` is the top-left corner of the image (the first
+//! row), `v` grows downwards; texel centres are at `(i + ½)/size`; lookups are bilinear with
+//! repeat wrapping. OBJ files count `v` from the bottom, so the OBJ reader flips it (as Mitsuba's
+//! does); PLY and `.serialized` texture coordinates are used as stored.
 
 use std::path::Path;
 
 use glam::{Vec2, Vec3};
+use serde::{Deserialize, Serialize};
 
 /// The `uv` transform of a texture: `uv' = uv · scale + offset` (Mitsuba 0.6 `uscale`/`vscale`/
 /// `uoffset`/`voffset`, Mitsuba 3 `to_uv` with scale and translate).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct UvTransform {
     /// Per-axis scale.
     pub scale: Vec2,
@@ -36,27 +39,42 @@ impl UvTransform {
     }
 }
 
-/// A texture as the scene file describes it (file not yet read).
-#[derive(Clone, Debug, PartialEq)]
+/// A texture as the scene file describes it (file not yet read). In RON:
+/// `Bitmap(filename: "wood.png")` (optional `raw: true`, `uv: (scale: (4, 4), offset: (0, 0))`)
+/// or `Checkerboard(color0: (1, 1, 1), color1: (0, 0, 0))` (defaults 0.4 and 0.2, as Mitsuba).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum TextureDesc {
     /// An image file, relative to the scene file.
     Bitmap {
         /// Path.
         filename: String,
         /// `raw = true`: 8-bit values are used as they are, not sRGB-decoded.
+        #[serde(default)]
         raw: bool,
         /// uv transform.
+        #[serde(default)]
         uv: UvTransform,
     },
     /// Two colours alternating in a 2×2 pattern per unit square of (transformed) uv.
     Checkerboard {
         /// Colour where `u mod 1` and `v mod 1` are on the same side of ½.
+        #[serde(default = "checker0")]
         color0: [f32; 3],
         /// The other colour.
+        #[serde(default = "checker1")]
         color1: [f32; 3],
         /// uv transform.
+        #[serde(default)]
         uv: UvTransform,
     },
+}
+
+fn checker0() -> [f32; 3] {
+    [0.4; 3]
+}
+fn checker1() -> [f32; 3] {
+    [0.2; 3]
 }
 
 /// A decoded texture.
@@ -96,6 +114,22 @@ fn srgb_to_linear(c: f32) -> f32 {
 impl Texture {
     /// Reads the files a description names; `base_dir` resolves relative paths.
     pub fn load(desc: &TextureDesc, base_dir: &Path) -> Result<Texture, String> {
+        let uv = match desc {
+            TextureDesc::Bitmap { uv, .. } | TextureDesc::Checkerboard { uv, .. } => uv,
+        };
+        if !(uv.scale.is_finite() && uv.offset.is_finite()) {
+            return Err(format!(
+                "texture uv transform (scale {}, offset {}) is not finite",
+                uv.scale, uv.offset
+            ));
+        }
+        if let TextureDesc::Checkerboard { color0, color1, .. } = desc {
+            for (name, c) in [("color0", color0), ("color1", color1)] {
+                if !c.iter().all(|x| (0.0..=1.0).contains(x)) {
+                    return Err(format!("checkerboard {name} {c:?} must lie in [0, 1]"));
+                }
+            }
+        }
         match desc {
             TextureDesc::Checkerboard { color0, color1, uv } => Ok(Texture::Checkerboard {
                 color0: Vec3::from(*color0),
@@ -115,8 +149,8 @@ impl Texture {
         }
     }
 
-    /// The texture's value at surface coordinates `uv` (`v = 0` is the image's bottom row, as
-    /// in OBJ texture coordinates).
+    /// The texture's value at surface coordinates `uv` (`v = 0` is the image's top row, as in
+    /// Mitsuba 3).
     pub fn eval(&self, uv: Vec2) -> Vec3 {
         match self {
             Texture::Checkerboard {
@@ -141,7 +175,7 @@ impl Texture {
                 let p = t.apply(uv);
                 // Texel centres at (i + ½)/size; repeat wrapping.
                 let x = p.x * *width as f32 - 0.5;
-                let y = (1.0 - p.y) * *height as f32 - 0.5;
+                let y = p.y * *height as f32 - 0.5;
                 let (x0, y0) = (x.floor(), y.floor());
                 let (fx, fy) = (x - x0, y - y0);
                 let wrap = |i: f32, n: usize| -> usize {
@@ -244,6 +278,148 @@ mod tests {
         assert_eq!(t.eval(Vec2::new(0.3, 0.3)), Vec3::ONE);
         assert_eq!(t.eval(Vec2::new(-0.1, 0.1)), Vec3::ZERO);
         assert_eq!(t.mean(), Vec3::splat(0.5));
+    }
+
+    fn temp_dir(tag: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("restir-tex-{tag}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    /// Checkerboard values agree with Mitsuba 3's at points read off its `checkerboard` (also for
+    /// negative coordinates and on the ½ lines), with a uv offset.
+    #[test]
+    fn checkerboard_matches_mitsuba_and_offsets() {
+        let t = Texture::Checkerboard {
+            color0: Vec3::X,
+            color1: Vec3::Z,
+            uv: UvTransform::default(),
+        };
+        for (u, v, want) in [
+            (0.25, 0.25, Vec3::X),
+            (0.75, 0.25, Vec3::Z),
+            (0.25, 0.75, Vec3::Z),
+            (0.75, 0.75, Vec3::X),
+            (-0.25, 0.25, Vec3::Z),
+            (-0.75, -0.25, Vec3::Z),
+            (1.25, 0.25, Vec3::X),
+            (0.5, 0.25, Vec3::X),
+            (0.25, 0.5, Vec3::X),
+        ] {
+            assert_eq!(t.eval(Vec2::new(u, v)), want, "({u}, {v})");
+        }
+        let shifted = Texture::Checkerboard {
+            color0: Vec3::X,
+            color1: Vec3::Z,
+            uv: UvTransform {
+                scale: Vec2::ONE,
+                offset: Vec2::new(0.5, 0.0),
+            },
+        };
+        assert_eq!(shifted.eval(Vec2::new(0.25, 0.25)), Vec3::Z);
+    }
+
+    /// `uv = (0, 0)` is the image's top-left corner (Mitsuba 3: its bitmap at uv (0.25, 0.25)
+    /// of a 2×2 image is the first texel of the first row); scale and offset apply before the
+    /// lookup; lookups repeat.
+    #[test]
+    fn bitmap_orientation_scale_offset_and_wrap() {
+        let dir = temp_dir("orient");
+        // Row 0 (top): red, green; row 1: blue, white. Raw, so values are exact.
+        let img =
+            image::RgbImage::from_raw(2, 2, vec![255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255])
+                .unwrap();
+        img.save(dir.join("q.png")).unwrap();
+        let load = |scale: Vec2, offset: Vec2| {
+            let desc = TextureDesc::Bitmap {
+                filename: "q.png".into(),
+                raw: true,
+                uv: UvTransform { scale, offset },
+            };
+            Texture::load(&desc, &dir).unwrap()
+        };
+        let t = load(Vec2::ONE, Vec2::ZERO);
+        let (red, green, blue) = (Vec3::X, Vec3::Y, Vec3::Z);
+        assert_eq!(t.eval(Vec2::new(0.25, 0.25)), red);
+        assert_eq!(t.eval(Vec2::new(0.75, 0.25)), green);
+        assert_eq!(t.eval(Vec2::new(0.25, 0.75)), blue);
+        assert_eq!(t.eval(Vec2::new(0.75, 0.75)), Vec3::ONE);
+        // Repeat: one period further in each direction (and negative) is the same.
+        assert_eq!(t.eval(Vec2::new(1.25, -0.75)), red);
+        assert_eq!(t.eval(Vec2::new(-1.25, 2.25)), green);
+        // Bilinear: the centre of the image is the mean of the four texels.
+        let centre = t.eval(Vec2::splat(0.5));
+        assert!((centre - Vec3::new(0.5, 0.5, 0.5)).abs().max_element() < 1e-6);
+        // Halfway between the two texel centres of the top row.
+        let top = t.eval(Vec2::new(0.5, 0.25));
+        assert!((top - Vec3::new(0.5, 0.5, 0.0)).abs().max_element() < 1e-6);
+        // uv' = uv · scale + offset.
+        let scaled = load(Vec2::splat(2.0), Vec2::ZERO);
+        assert_eq!(scaled.eval(Vec2::new(0.375, 0.125)), green);
+        assert_eq!(scaled.eval(Vec2::new(0.625, 0.125)), red);
+        let offset = load(Vec2::ONE, Vec2::new(0.5, 0.5));
+        assert_eq!(offset.eval(Vec2::new(0.25, 0.25)), Vec3::ONE);
+        assert_eq!(offset.eval(Vec2::new(0.75, 0.75)), red);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// 8-bit values go through the exact sRGB curve (both branches), unless `raw`.
+    #[test]
+    fn srgb_decoding_of_8_bit_values() {
+        let dir = temp_dir("srgb");
+        let codes = [0u8, 5, 10, 11, 64, 128, 200, 255];
+        let img = image::GrayImage::from_raw(codes.len() as u32, 1, codes.to_vec()).unwrap();
+        img.save(dir.join("g.png")).unwrap();
+        let desc = TextureDesc::Bitmap {
+            filename: "g.png".into(),
+            raw: false,
+            uv: UvTransform::default(),
+        };
+        let t = Texture::load(&desc, &dir).unwrap();
+        let n = codes.len() as f32;
+        for (i, &c) in codes.iter().enumerate() {
+            let x = c as f32 / 255.0;
+            let want = if x <= 0.04045 {
+                x / 12.92
+            } else {
+                ((x + 0.055) / 1.055).powf(2.4)
+            };
+            // At the texel centre, bilinear filtering returns the texel itself.
+            let got = t.eval(Vec2::new((i as f32 + 0.5) / n, 0.5));
+            assert!(
+                (got - Vec3::splat(want)).abs().max_element() < 1e-6,
+                "code {c}: {got} vs {want}"
+            );
+        }
+        assert!((srgb_to_linear(0.5) - 0.214_041).abs() < 1e-5);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn bad_texture_parameters_are_errors() {
+        let bad = TextureDesc::Checkerboard {
+            color0: [1.5, 0.0, 0.0],
+            color1: [0.0; 3],
+            uv: UvTransform::default(),
+        };
+        assert!(
+            Texture::load(&bad, Path::new("."))
+                .unwrap_err()
+                .contains("color0")
+        );
+        let bad = TextureDesc::Checkerboard {
+            color0: [0.5; 3],
+            color1: [0.0; 3],
+            uv: UvTransform {
+                scale: Vec2::new(f32::NAN, 1.0),
+                offset: Vec2::ZERO,
+            },
+        };
+        assert!(
+            Texture::load(&bad, Path::new("."))
+                .unwrap_err()
+                .contains("not finite")
+        );
     }
 
     #[test]

@@ -533,13 +533,6 @@ impl Props<'_, '_> {
     }
 }
 
-fn texture_kind(t: &TextureDesc) -> &'static str {
-    match t {
-        TextureDesc::Bitmap { .. } => "bitmap texture",
-        TextureDesc::Checkerboard { .. } => "checkerboard texture",
-    }
-}
-
 fn elements<'a, 'i>(node: Node<'a, 'i>) -> impl Iterator<Item = Node<'a, 'i>> {
     node.children().filter(Node::is_element)
 }
@@ -569,39 +562,46 @@ impl<'a, 'i> Importer<'a, 'i> {
         let nested: Vec<Node> = elements(node)
             .filter(|c| c.tag_name().name() == "bsdf")
             .collect();
-        // Parameters given as textures (nested or by reference): decoded and checked, but the
-        // materials cannot use them yet, so they are reported below with their line.
-        let mut textured: Vec<(Node, String, String)> = Vec::new();
+        // Parameters given as textures, nested or by reference; wrapped around the material
+        // below (the constant value of such a parameter is unused).
+        let mut textured: Vec<(Node, TextureBinding)> = Vec::new();
         for c in elements(node) {
             let tag = c.tag_name().name();
-            if tag == "texture" {
-                let name = self.req_attr(c, "name")?;
-                let t = self.texture(c)?;
-                textured.push((c, snake_case(&name), texture_kind(&t).into()));
+            let (name, texture) = if tag == "texture" {
+                (self.req_attr(c, "name")?, self.texture(c)?)
             } else if tag == "ref"
                 && let Some(name) = self.attr(c, "name")?
             {
                 let id = self.req_attr(c, "id")?;
-                let (t, line) = self.textures.get(&id).ok_or_else(|| {
+                let (t, _) = self.textures.get(&id).ok_or_else(|| {
                     self.err(
                         c,
                         format!("bsdf '{ty}': reference to undefined texture '{id}'"),
                     )
                 })?;
-                textured.push((
+                (name, t.clone())
+            } else {
+                continue;
+            };
+            let name = snake_case(&name);
+            let param = ColorParam::from_name(&name).ok_or_else(|| {
+                self.err(
                     c,
-                    snake_case(&name),
-                    format!("{} (texture '{id}', line {line})", texture_kind(t)),
+                    format!(
+                        "bsdf '{ty}': '{name}' cannot be a texture (only reflectances can: reflectance, diffuse_reflectance, specular_reflectance, specular_transmittance)"
+                    ),
+                )
+            })?;
+            if props.get(&name).is_some() {
+                return Err(self.err(
+                    c,
+                    format!("bsdf '{ty}': '{name}' is given twice (as a value and as a texture)"),
                 ));
             }
-        }
-        if let Some((c, name, what)) = textured.first() {
-            return Err(self.err(
-                *c,
-                format!(
-                    "bsdf '{ty}': '{name}' is a {what}; textured material parameters are not supported yet (give an rgb value)"
-                ),
-            ));
+            if textured.iter().any(|(_, b)| b.param == param) {
+                return Err(self.err(c, format!("bsdf '{ty}': two textures for '{name}'")));
+            }
+            textured.push((c, TextureBinding { param, texture }));
         }
         let m = match ty.as_str() {
             "diffuse" => {
@@ -736,12 +736,27 @@ impl<'a, 'i> Importer<'a, 'i> {
                 "twosided cannot wrap a transmitting bsdf (dielectric, roughdielectric, null), as in Mitsuba",
             ));
         }
+        let m = if textured.is_empty() {
+            m
+        } else {
+            let allowed = crate::build::color_params(&m);
+            if let Some((c, b)) = textured.iter().find(|(_, b)| !allowed.contains(&b.param)) {
+                return Err(self.err(
+                    *c,
+                    format!("bsdf '{ty}' has no parameter '{}'", b.param.name()),
+                ));
+            }
+            MaterialDesc::Textured {
+                material: Box::new(m),
+                textures: textured.into_iter().map(|(_, b)| b).collect(),
+            }
+        };
         // Everything the builder would reject, reported here with this bsdf's line.
         crate::build::check_material(&m)
             .map_err(|e| self.err(node, format!("bsdf '{ty}': {e}")))?;
         for c in elements(node) {
             let tag = c.tag_name().name();
-            if !PROPERTY_TAGS.contains(&tag) && tag != "bsdf" {
+            if !PROPERTY_TAGS.contains(&tag) && !["bsdf", "texture", "ref"].contains(&tag) {
                 return Err(self.err(c, format!("unexpected <{tag}> inside a bsdf")));
             }
             if tag == "bsdf" && ty != "twosided" {
@@ -782,6 +797,13 @@ impl<'a, 'i> Importer<'a, 'i> {
                 let filename = props
                     .string(self, "filename")?
                     .ok_or_else(|| self.err(node, "bitmap texture needs a 'filename'"))?;
+                let path = self.file.parent().unwrap_or(Path::new("")).join(&filename);
+                if !path.is_file() {
+                    return Err(self.err(
+                        node,
+                        format!("bitmap texture: file '{}' not found", path.display()),
+                    ));
+                }
                 let raw = props.bool(self, "raw")?.unwrap_or(false);
                 if let Some(f) = props.string(self, "filter_type")?
                     && f != "bilinear"

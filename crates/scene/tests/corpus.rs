@@ -60,6 +60,11 @@ fn supported_corpus_scenes_load() {
     let mi = load(&dir, "lajolla/veach_mi/mi.xml");
     assert!(mi.scene.lights.len() >= 4);
 
+    // Material preview: a `.serialized` mesh, an envmap and a checkerboard-textured floor.
+    let mp = load(&dir, "lajolla/matpreview/matpreview.xml");
+    assert!(mp.scene.features.has_environment && mp.scene.lights.envmap().is_some());
+    assert!(mp.scene.features.has_textures);
+
     // ReSTIR test scene: PLY meshes, spectra, 100+ emissive spheres, unknown parameters.
     let t = load(&dir, "restir_test_scene/test.xml");
     assert!(t.scene.lights.len() >= 100, "{}", t.scene.lights.len());
@@ -69,29 +74,48 @@ fn supported_corpus_scenes_load() {
     )));
 }
 
+/// The textured scenes load, and their materials vary over the surface as their textures do.
 #[test]
-fn unsupported_corpus_scenes_fail_clearly() {
+fn textured_corpus_scenes_load() {
     let Some(dir) = corpus() else { return };
-    let cases = [
-        // Materials cannot take textures yet. (matpreview's envmap, line 49, loads; its plane's
-        // checkerboard does not.)
-        (
-            "lajolla/matpreview/matpreview.xml",
-            "matpreview.xml:72: bsdf 'diffuse': 'reflectance' is a checkerboard texture",
-        ),
-        (
-            "lajolla/sponza/sponza.xml",
-            "sponza.xml:60: bsdf 'diffuse': 'reflectance' is a bitmap texture",
-        ),
-        (
-            "lajolla/pixel_filter_test/pixel_filter_test.xml",
-            "pixel_filter_test.xml:45: bsdf 'diffuse': 'reflectance' is a checkerboard texture",
-        ),
-    ];
-    for (rel, want) in cases {
-        let e = load_err(&dir, rel);
-        assert!(e.contains(want), "{rel}: got \"{e}\", want \"{want}\"");
+    let centre_hit = |scene: &restir_scene::Scene| {
+        let (w, h) = scene.camera.resolution();
+        let film = glam::Vec2::new(w as f32 / 2.0, h as f32 * 0.9);
+        let ray = scene.camera.generate_ray(film, glam::Vec2::splat(0.5));
+        scene.intersect(&ray).expect("the camera sees the floor")
+    };
+    let reflectance = |b: restir_materials::Bsdf| match b.kind {
+        restir_materials::BsdfKind::Diffuse { reflectance } => reflectance,
+        k => panic!("expected a diffuse floor, got {k:?}"),
+    };
+
+    // Checkerboard reflectance (1000 × 1000 checks of 1 and 0) on an OBJ floor.
+    let pft = load(&dir, "lajolla/pixel_filter_test/pixel_filter_test.xml").scene;
+    assert!(pft.features.has_textures);
+    assert_eq!(pft.textures.len(), 1);
+    let mut si = centre_hit(&pft);
+    let mut seen = [false; 2];
+    for k in 0..64 {
+        si.uv = glam::Vec2::new(0.37 + k as f32 * 0.0005, 0.61);
+        let r = reflectance(pft.bsdf(&si));
+        assert!(r == glam::Vec3::ONE || r == glam::Vec3::ZERO, "{r}");
+        seen[(r.x > 0.5) as usize] = true;
     }
+    assert_eq!(seen, [true, true], "both checker colours along a row");
+
+    // Sponza: JPEG textures on `.serialized` meshes with texture coordinates.
+    let sponza = load(&dir, "lajolla/sponza/sponza.xml").scene;
+    assert!(sponza.features.has_textures);
+    assert_eq!(
+        sponza.textures.len(),
+        10,
+        "each distinct bitmap decoded once"
+    );
+    let mut si = centre_hit(&sponza);
+    let r0 = reflectance(sponza.bsdf(&si));
+    si.uv += glam::Vec2::new(0.25, 0.25);
+    let r1 = reflectance(sponza.bsdf(&si));
+    assert!(r0 != r1 && r0.max_element() <= 1.0, "{r0} {r1}");
 }
 
 /// A scene around one shape, written next to the test's temporary files.

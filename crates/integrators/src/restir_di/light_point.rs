@@ -262,7 +262,7 @@ pub fn evaluate(
     known_light_pdf_sa: Option<f32>,
     counts: StrategyCounts,
 ) -> Evaluated {
-    let bsdf = &scene.bsdfs[r.bsdf as usize];
+    let bsdf = &r.resolve_bsdf(scene);
     let wi = r.frame().to_local(c.wi);
     let f = bsdf.eval(r.wo, wi);
     if f == Vec3::ZERO {

@@ -143,7 +143,7 @@ impl RestirDiIntegrator {
         tile: Option<&restir_sampling::AliasTable>,
         rng: &mut Pcg32,
     ) -> (DiReservoir, u64) {
-        let bsdf = &scene.bsdfs[r.bsdf as usize];
+        let bsdf = &r.resolve_bsdf(scene);
         if !bsdf.has_smooth_lobe() || scene.lights.is_empty() {
             return (
                 Reservoir {
@@ -300,7 +300,7 @@ impl RestirDiIntegrator {
         };
         let continues = max_depth > 2 || scene.features.has_delta_lobes;
         let samples = self.settings.bsdf_candidates.max(u32::from(continues));
-        let bsdf = &scene.bsdfs[r.bsdf as usize];
+        let bsdf = &r.resolve_bsdf(scene);
         // BSDF samples after the first only look for emitters at their first hit.
         let direct_only = PathSettings {
             max_depth: 2,

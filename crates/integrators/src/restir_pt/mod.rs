@@ -181,7 +181,7 @@ impl RestirPtIntegrator {
         ng: Vec3,
         rng: &mut Pcg32,
     ) -> (PtReservoir, Vec3, u64) {
-        let bsdf = &scene.bsdfs[r.bsdf as usize];
+        let bsdf = &r.resolve_bsdf(scene);
         let empty = Reservoir {
             confidence: 1.0,
             ..Reservoir::empty()
@@ -228,7 +228,7 @@ impl RestirPtIntegrator {
         let rr_depth = self.settings.path.rr_depth;
         let mut rays = 0u64;
         let frame1 = r.frame();
-        let bsdf1 = &scene.bsdfs[r.bsdf as usize];
+        let bsdf1 = &r.resolve_bsdf(scene);
 
         // Light sampling at x1: the path reconnects at its light point.
         let (u_select, u_light) = (rng.next_f32(), rng.next_2d());
@@ -506,7 +506,7 @@ impl RestirPtIntegrator {
             let (f, _) = evaluate_unshadowed(scene, r, y, &v);
             l += f * res.ucw;
         }
-        let bsdf = &scene.bsdfs[r.bsdf as usize];
+        let bsdf = &r.resolve_bsdf(scene);
         if bsdf.flags().intersects(LobeFlags::DELTA) {
             let settings = &self.settings.path;
             let (u_lobe, u_dir, u_rr) = (rng.next_f32(), rng.next_2d(), rng.next_f32());

@@ -182,7 +182,7 @@ pub fn evaluate_unshadowed(
     s: &PathSample,
     v: &Vertex,
 ) -> (Vec3, Target) {
-    let bsdf1 = &scene.bsdfs[r.bsdf as usize];
+    let bsdf1 = &r.resolve_bsdf(scene);
     let frame1 = r.frame();
     match v {
         Vertex::Light(resolved) => {
@@ -305,13 +305,14 @@ impl PtShift<'_> {
             return None;
         }
         let ((src, _), (dst, dst_ng)) = (self.hit(from)?, self.hit(to)?);
-        let bsdfs = &self.scene.bsdfs;
-        if !connectible(&bsdfs[src.bsdf as usize]) || !connectible(&bsdfs[dst.bsdf as usize]) {
+        if !connectible(&src.resolve_bsdf(self.scene))
+            || !connectible(&dst.resolve_bsdf(self.scene))
+        {
             return None;
         }
         let v = resolve_vertex(self.scene, s);
         if let Vertex::Surface(si) = &v
-            && !connectible(self.scene.bsdf(si))
+            && !connectible(&self.scene.bsdf(si))
         {
             return None;
         }
