@@ -117,11 +117,53 @@ impl core::fmt::Display for LightError {
 
 impl std::error::Error for LightError {}
 
+/// How a light is picked, decided once when the set is built: a scene with one light (with
+/// power) skips the alias table, and a scene without lights has nothing to pick.
+#[derive(Clone, Debug)]
+enum Selection {
+    /// No light has power.
+    Empty,
+    /// Exactly one light has power: it is always picked, with probability 1.
+    Single(usize),
+    /// Power-proportional alias table.
+    Alias(AliasTable),
+}
+
+impl Selection {
+    fn new(powers: &[f32]) -> Self {
+        let mut with_power = powers.iter().enumerate().filter(|(_, p)| **p > 0.0);
+        match (with_power.next(), with_power.next()) {
+            (None, _) => Self::Empty,
+            (Some((i, _)), None) => Self::Single(i),
+            _ => AliasTable::new(powers).map_or(Self::Empty, Self::Alias),
+        }
+    }
+
+    /// `(index, pmf, u_remapped)` as [`AliasTable::sample`]; a single light passes `u` through.
+    #[inline]
+    fn sample(&self, u: f32) -> Option<(usize, f32, f32)> {
+        match self {
+            Self::Empty => None,
+            Self::Single(i) => Some((*i, 1.0, u)),
+            Self::Alias(t) => Some(t.sample(u)),
+        }
+    }
+
+    #[inline]
+    fn pmf(&self, i: usize) -> f32 {
+        match self {
+            Self::Empty => 0.0,
+            Self::Single(j) => f32::from(u8::from(i == *j)),
+            Self::Alias(t) => t.pmf(i),
+        }
+    }
+}
+
 /// All lights of a scene with power-proportional selection.
 #[derive(Clone, Debug)]
 pub struct LightSet {
     lights: Vec<Light>,
-    sampler: Option<AliasTable>,
+    sampler: Selection,
     /// Each light's power (the selection weights).
     powers: Vec<f32>,
     /// Each light's bounding sphere; `None` for lights at infinity.
@@ -241,7 +283,7 @@ impl LightSet {
             .collect();
         Ok(Self {
             lights,
-            sampler: AliasTable::new(&powers),
+            sampler: Selection::new(&powers),
             powers,
             spheres,
             shape_light,
@@ -263,7 +305,7 @@ impl LightSet {
 
     /// Whether there are no lights (or none with power).
     pub fn is_empty(&self) -> bool {
-        self.sampler.is_none()
+        matches!(self.sampler, Selection::Empty)
     }
 
     /// The area light on shape `shape`, if any.
@@ -290,7 +332,7 @@ impl LightSet {
     /// Picks a light by power: `(index, probability)`.
     #[inline]
     pub fn select(&self, u: f32) -> Option<(u32, f32)> {
-        let (index, pmf, _) = self.sampler.as_ref()?.sample(u);
+        let (index, pmf, _) = self.sampler.sample(u)?;
         Some((index as u32, pmf))
     }
 
@@ -309,7 +351,7 @@ impl LightSet {
     /// Probability that [`LightSet::sample`] picks light `light`.
     #[inline]
     pub fn pmf(&self, light: u32) -> f32 {
-        self.sampler.as_ref().map_or(0.0, |s| s.pmf(light as usize))
+        self.sampler.pmf(light as usize)
     }
 
     /// Radiance leaving an area light's surface point with shading normal `n` towards unit `w`
@@ -342,7 +384,7 @@ impl LightSet {
         u_select: f32,
         u: Vec2,
     ) -> Option<LightSample> {
-        let (index, pmf, _) = self.sampler.as_ref()?.sample(u_select);
+        let (index, pmf, _) = self.sampler.sample(u_select)?;
         let mut s = self.sample_light(shapes, index as u32, ref_p, u)?;
         s.pdf_sa *= pmf;
         Some(s)
@@ -536,6 +578,41 @@ mod tests {
         (shapes, set)
     }
 
+    /// A set whose only light with power is one of several skips the alias table: that light is
+    /// always picked with probability 1, the others never, and `sample` agrees with `pdf_sa`.
+    #[test]
+    fn single_light_selection() {
+        let (shapes, _) = setup();
+        let lights = vec![
+            Light::Area {
+                shape: 0,
+                radiance: Vec3::ZERO,
+            },
+            Light::Area {
+                shape: 1,
+                radiance: Vec3::new(5.0, 1.0, 1.0),
+            },
+        ];
+        let set = LightSet::new(lights, &shapes, (Vec3::splat(-3.0), Vec3::splat(3.0))).unwrap();
+        assert!(matches!(set.sampler, Selection::Single(1)));
+        assert_eq!((set.pmf(0), set.pmf(1)), (0.0, 1.0));
+        let mut rng = Pcg32::new(5, 0);
+        for _ in 0..1000 {
+            let u = rng.next_f32();
+            assert_eq!(set.select(u), Some((1, 1.0)));
+            if let Some(s) = set.sample(&shapes, Vec3::ZERO, u, rng.next_2d()) {
+                let pdf = set.pdf_sa(&shapes, 1, Vec3::ZERO, s.p, s.ng);
+                assert!(
+                    (pdf - s.pdf_sa).abs() <= 1e-3 * pdf,
+                    "{pdf} vs {}",
+                    s.pdf_sa
+                );
+            }
+        }
+        let empty = LightSet::new(vec![], &shapes, (Vec3::splat(-3.0), Vec3::splat(3.0))).unwrap();
+        assert!(empty.is_empty() && empty.select(0.5).is_none());
+    }
+
     /// The pdf a sample reports equals what `pdf_sa` recomputes, and the empirical selection
     /// frequencies match `pmf` within 4 standard errors.
     #[test]
@@ -546,7 +623,7 @@ mod tests {
         let mut counts = [0u32; 3];
         for _ in 0..n {
             let (us, u) = (rng.next_f32(), rng.next_2d());
-            let Some((index, _, _)) = set.sampler.as_ref().map(|s| s.sample(us)) else {
+            let Some((index, _, _)) = set.sampler.sample(us) else {
                 panic!()
             };
             counts[index] += 1;
