@@ -11,8 +11,7 @@ use restir_gris::ShiftMap;
 use restir_integrators::film::Filter;
 use restir_integrators::path::PathSettings;
 use restir_integrators::restir_di::MIS_NAMES;
-use restir_integrators::restir_pt::Kind;
-use restir_integrators::restir_pt::sample::{evaluate_unshadowed, resolve_vertex};
+use restir_integrators::restir_pt::{Kind, ShiftKind};
 use restir_integrators::{
     Image, IntegratorOptions, PassContext, RenderSettings, RestirPtIntegrator, RestirPtSettings,
     make_integrator, render,
@@ -168,24 +167,50 @@ fn integrator(max_depth: i32) -> RestirPtIntegrator {
     }))
 }
 
-/// Shifting a pixel's own path to itself is the identity (J = 1, same target); on pairs of
-/// pixels the forward shift succeeds iff the inverse does and their Jacobians multiply to 1.
+fn with_shift(pt: RestirPtIntegrator, shift: ShiftKind) -> RestirPtIntegrator {
+    let mut settings = *pt.settings();
+    settings.shift = shift;
+    RestirPtIntegrator::new(settings)
+}
+
+/// Shifting a pixel's own path to itself is the identity (J = 1, the same contribution bit for
+/// bit); on pairs of pixels, when the forward shift succeeds the inverse shift of its result
+/// succeeds, their Jacobians multiply to 1 and the round trip gives the path's contribution back.
 #[test]
 fn shift_identity_and_round_trip_on_scene_paths() {
-    let kinds = check_shifts(&scene(), integrator(-1));
-    assert!(kinds[Kind::Continue as usize] > 100 && kinds[Kind::DirectNee as usize] > 0);
-    let kinds = check_shifts(&glass_scene(), integrator(-1));
-    assert!(kinds[Kind::Frozen as usize] > 0, "{kinds:?}");
+    for shift in [
+        ShiftKind::Reconnection,
+        ShiftKind::Replay,
+        ShiftKind::Hybrid,
+    ] {
+        let pt = with_shift(integrator(-1), shift);
+        let stats = check_shifts(&scene(), &pt);
+        assert!(stats.kinds[Kind::DirectNee as usize] + stats.kinds[Kind::Frozen as usize] > 0);
+        let stats = check_shifts(&glass_scene(), &pt);
+        assert!(stats.kinds[Kind::Frozen as usize] > 0, "{:?}", stats.kinds);
+        if shift == ShiftKind::Hybrid {
+            // Paths through the glass reconnect after it.
+            assert!(stats.rc[3..].iter().sum::<usize>() >= 5, "{:?}", stats.rc);
+        }
+    }
     // Symmetric Jacobian rejection keeps forward and inverse failures together.
     let mut settings = *integrator(-1).settings();
     settings.max_jacobian = 2.0;
-    check_shifts(&scene(), RestirPtIntegrator::new(settings));
+    check_shifts(&glass_scene(), &RestirPtIntegrator::new(settings));
 }
 
-/// Runs the shift checks on four passes of `scene`; returns how many reservoirs hold each kind.
-fn check_shifts(scene: &Scene, pt: RestirPtIntegrator) -> [usize; 6] {
+#[derive(Debug, Default)]
+struct ShiftStats {
+    kinds: [usize; 6],
+    /// Reservoirs by reconnection index (0 = none).
+    rc: [usize; 8],
+}
+
+/// Runs the shift checks on four passes of `scene`.
+fn check_shifts(scene: &Scene, pt: &RestirPtIntegrator) -> ShiftStats {
     let filter = Filter::new(scene.filter);
-    let (mut identity, mut kinds, mut pairs, mut both, mut one_way) = (0, [0usize; 6], 0, 0, 0);
+    let mut stats = ShiftStats::default();
+    let (mut identity, mut pairs, mut fwd_ok, mut visible, mut exact) = (0, 0, 0, 0, 0);
     for pass in 0..4 {
         let ctx = PassContext {
             seed: 7,
@@ -198,21 +223,19 @@ fn check_shifts(scene: &Scene, pt: RestirPtIntegrator) -> [usize; 6] {
         let mut rng = Pcg32::new(11, u64::from(pass));
         for (i, res) in reservoirs.iter().enumerate() {
             let Some(x) = res.sample else { continue };
-            kinds[x.kind as usize] += 1;
-            if let Some((t, j, f)) = shift.shift_full(i, i, &x)
+            assert!(x.value.is_finite() && res.ucw.is_finite());
+            stats.kinds[x.kind as usize] += 1;
+            stats.rc[usize::from(x.rc).min(7)] += 1;
+            if let Some((t, j, y)) = shift.shift_full(i, i, &x)
                 && t > 0.0
             {
                 assert_eq!(j, 1.0, "pixel {i}: self-shift Jacobian");
-                // The same RGB contribution as the pixel's own evaluation, bit for bit.
-                let r = gbuf.receiver(i).unwrap();
-                let (own, _) = evaluate_unshadowed(scene, r, &x, &resolve_vertex(scene, &x));
-                assert_eq!(f, own, "pixel {i}: self-shift contribution");
-                let rel = (t - res.target_pdf).abs() / res.target_pdf;
-                assert!(
-                    rel <= 1e-6,
-                    "pixel {i}: self-shift target {t} vs {}",
-                    res.target_pdf
+                // The same RGB contribution as initial sampling computed, bit for bit.
+                assert_eq!(
+                    y.value, x.value,
+                    "pixel {i}: self-shift contribution ({x:?})"
                 );
+                assert_eq!(t, res.target_pdf, "pixel {i}: self-shift target");
                 identity += 1;
             }
             for _ in 0..8 {
@@ -221,31 +244,40 @@ fn check_shifts(scene: &Scene, pt: RestirPtIntegrator) -> [usize; 6] {
                     continue;
                 }
                 pairs += 1;
-                let fwd = shift.shift(&i, &k, &x);
-                let inv = shift.shift(&k, &i, &x);
-                assert_eq!(
-                    fwd.is_some(),
-                    inv.is_some(),
-                    "pixels {i}->{k}: forward and inverse disagree ({x:?})"
-                );
-                if let (Some(f), Some(b)) = (fwd, inv) {
-                    both += 1;
-                    let prod = f64::from(f.jacobian) * f64::from(b.jacobian);
-                    assert!((prod - 1.0).abs() < 1e-4, "pixels {i}->{k}: J·J⁻¹ = {prod}");
-                    if (f.target_pdf > 0.0) != (b.target_pdf > 0.0) {
-                        one_way += 1;
-                    }
+                let Some(f) = shift.shift(&i, &k, &x) else {
+                    continue;
+                };
+                fwd_ok += 1;
+                let b = shift.shift(&k, &i, &f.sample).unwrap_or_else(|| {
+                    panic!("pixels {i}->{k}: forward succeeded, inverse failed ({x:?})")
+                });
+                let prod = f64::from(f.jacobian) * f64::from(b.jacobian);
+                assert!((prod - 1.0).abs() < 1e-4, "pixels {i}->{k}: J·J⁻¹ = {prod}");
+                if f.target_pdf > 0.0 && b.target_pdf > 0.0 {
+                    visible += 1;
+                    let err =
+                        (b.sample.value - x.value).abs().max_element() / x.value.max_element();
+                    assert!(
+                        err < 1e-4,
+                        "pixels {i}->{k}: round trip {:?} vs {:?}",
+                        b.sample.value,
+                        x.value
+                    );
+                    exact += usize::from(b.sample.value == x.value);
                 }
             }
         }
     }
     eprintln!(
-        "identity checks {identity}, kinds {kinds:?}, pairs {pairs}, both succeeded {both}, \
-         visible one way only {one_way}"
+        "{}: identity checks {identity}, kinds {:?}, rc {:?}, pairs {pairs}, forward succeeded \
+         {fwd_ok}, visible both ways {visible} (round trip bit-exact {exact})",
+        pt.effective_shift(scene).name(),
+        stats.kinds,
+        stats.rc
     );
     assert!(identity > 500, "too few identity checks: {identity}");
-    assert!(both > 200, "too few successful shifts: {both}");
-    kinds
+    assert!(visible > 200, "too few successful shifts: {visible}");
+    stats
 }
 
 #[test]

@@ -20,28 +20,29 @@
 
 pub mod sample;
 mod settings;
+pub mod walk;
 
 use std::cell::Cell;
 use std::sync::Mutex;
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use restir_geometry::{Ray, offset_ray_origin, shadow_ray_between, shadow_ray_towards};
+use restir_geometry::{Ray, offset_ray_origin};
 use restir_gris::{MisScheme, Reservoir, StreamingReservoir, resample};
 use restir_materials::LobeFlags;
-use restir_sampling::{Pcg32, luminance, warp::power_heuristic};
+use restir_sampling::{Pcg32, luminance};
 use restir_scene::Scene;
 
-pub use sample::{Kind, PathSample, PtShift};
+pub use sample::{Kind, PathSample, PtShift, ShiftKind};
 pub use settings::{RestirPtSettings, SHIFT_NAMES};
 
 use crate::gbuffer::{GBuffer, Receiver};
 use crate::neighbors::{NeighborPattern, NeighborRule};
 use crate::path::{EmissionMis, PrevVertex, trace_path};
 use crate::render::{BAND_ROWS, Integrator, PassContext};
-use crate::restir_di::light_point::LightPoint;
 use crate::restir_di::mis_name;
-use sample::{evaluate_unshadowed, resolve_vertex};
+use sample::connectible;
+use walk::{Vtx, Walker};
 
 /// Random-stream stages (see [`PassContext::stage_rng`]).
 const STAGE_INITIAL: u64 = 101;
@@ -67,33 +68,6 @@ pub struct RestirPtIntegrator {
     history: Mutex<Option<History>>,
 }
 
-/// Collects a walk's candidates.
-struct Candidates<'a> {
-    stream: &'a mut StreamingReservoir<PathSample>,
-    scale: f32,
-    /// Whether direct-light paths are path traced instead of resampled.
-    direct_path_traced: bool,
-    /// Their sum (already divided by the number of walks).
-    direct: Vec3,
-}
-
-impl Candidates<'_> {
-    #[inline]
-    fn push(&mut self, sample: PathSample, contribution: Vec3, rng: &mut Pcg32) {
-        if self.direct_path_traced && sample.is_direct() {
-            if contribution.is_finite() {
-                self.direct += contribution * self.scale;
-            }
-            return;
-        }
-        let u = rng.next_f32();
-        let w = luminance(contribution) * self.scale;
-        if w > 0.0 && w.is_finite() {
-            self.stream.add(sample, w, u);
-        }
-    }
-}
-
 impl RestirPtIntegrator {
     /// An integrator with `settings`.
     pub fn new(settings: RestirPtSettings) -> Self {
@@ -117,15 +91,37 @@ impl RestirPtIntegrator {
         if d < 0 { u32::MAX } else { d as u32 }
     }
 
+    /// The shift used for this scene: `--shift`, except that `hybrid` becomes `reconnection` in
+    /// scenes where every material is connectible (nothing to replay through; decided once here).
+    pub fn effective_shift(&self, scene: &Scene) -> ShiftKind {
+        let s = self.settings.shift;
+        if s == ShiftKind::Hybrid && !has_near_specular(scene) {
+            ShiftKind::Reconnection
+        } else {
+            s
+        }
+    }
+
+    /// The walks' rules for `scene`.
+    pub fn walker<'a>(&self, scene: &'a Scene) -> Walker<'a> {
+        let d = self.settings.near_distance * scene.lights.scene_radius();
+        Walker {
+            scene,
+            shift: self.effective_shift(scene),
+            max_depth: self.max_depth(),
+            rr_depth: self.settings.path.rr_depth,
+            near2: d * d,
+            skip_invertibility: self.settings.skip_invertibility,
+        }
+    }
+
     /// The shift map over the pixels of `gbuf`.
     pub fn shift_map<'a>(&self, scene: &'a Scene, gbuf: &'a GBuffer) -> PtShift<'a> {
-        let d = self.settings.near_distance * scene.lights.scene_radius();
         PtShift {
-            scene,
+            walker: self.walker(scene),
             gbuf,
             prev: None,
             rays: Cell::new(0),
-            near_distance2: d * d,
             max_jacobian: self.settings.max_jacobian,
             unit_jacobian: self.settings.unit_jacobian,
         }
@@ -190,267 +186,43 @@ impl RestirPtIntegrator {
             return (empty, Vec3::ZERO, 0);
         }
         let n = self.settings.candidates;
+        let scale = 1.0 / n as f32;
+        let direct_path_traced = self.settings.direct_path_traced;
         let mut stream = StreamingReservoir::new();
-        let mut cands = Candidates {
-            stream: &mut stream,
-            scale: 1.0 / n as f32,
-            direct_path_traced: self.settings.direct_path_traced,
-            direct: Vec3::ZERO,
-        };
+        let mut direct = Vec3::ZERO;
         let mut rays = 0;
+        let walker = self.walker(scene);
+        let x1 = Vtx::primary(scene, r, ng);
         for _ in 0..n {
-            rays += self.walk(scene, r, ng, rng, &mut cands);
+            // The walk's own generator (stored in its samples for replay); candidate selection
+            // draws from `rng`.
+            let seed = Pcg32::new(
+                (u64::from(rng.next_u32()) << 32) | u64::from(rng.next_u32()),
+                u64::from(rng.next_u32()),
+            );
+            let mut sink = |sample: PathSample, contribution: Vec3| {
+                if direct_path_traced && sample.length == 2 {
+                    if contribution.is_finite() {
+                        direct += contribution * scale;
+                    }
+                    return;
+                }
+                let u = rng.next_f32();
+                let target = luminance(sample.value);
+                let w = luminance(contribution) * scale;
+                if target > 0.0 && target.is_finite() && w > 0.0 && w.is_finite() {
+                    stream.add_candidate(sample, target, w, 0.0, u);
+                }
+            };
+            let (_, nr) = walker.walk(&x1, seed, None, &mut sink);
+            rays += nr;
         }
-        let direct = cands.direct;
-        let Some(y) = stream.selected().copied() else {
+        if stream.selected().is_none() {
             return (empty, direct, rays);
-        };
-        let v = resolve_vertex(scene, &y);
-        let (f, _) = evaluate_unshadowed(scene, r, &y, &v);
-        let mut res = stream.finalize(luminance(f));
+        }
+        let mut res = stream.finalize_recorded();
         res.confidence = 1.0;
         (res, direct, rays)
-    }
-
-    /// One random walk from the primary hit; streams its light connections. Returns the rays.
-    #[allow(clippy::too_many_lines)]
-    fn walk(
-        &self,
-        scene: &Scene,
-        r: &Receiver,
-        ng: Vec3,
-        rng: &mut Pcg32,
-        cands: &mut Candidates,
-    ) -> u64 {
-        let lights = &scene.lights;
-        let shapes = &scene.shapes;
-        let max_depth = self.max_depth();
-        let rr_depth = self.settings.path.rr_depth;
-        let mut rays = 0u64;
-        let frame1 = r.frame();
-        let bsdf1 = &scene.bsdfs[r.bsdf as usize];
-
-        // Light sampling at x1: the path reconnects at its light point.
-        let (u_select, u_light) = (rng.next_f32(), rng.next_2d());
-        if let Some(ls) = lights.sample(shapes, r.p, u_select, u_light) {
-            let wi = frame1.to_local(ls.wi);
-            let f = bsdf1.eval(r.wo, wi);
-            if f != Vec3::ZERO {
-                rays += 1;
-                if shadow_visible(scene, r.p, ng, ls.p, ls.wi, ls.dist) {
-                    let w = if ls.delta {
-                        1.0
-                    } else {
-                        power_heuristic(ls.pdf_sa, bsdf1.pdf_sa(r.wo, wi))
-                    };
-                    let sample =
-                        PathSample::direct(LightPoint::from_light_sample(&ls), Kind::DirectNee);
-                    cands.push(sample, f * ls.le * (w / ls.pdf_sa), rng);
-                }
-            }
-        }
-
-        // BSDF sampling at x1 (the delta part of x1 is path traced at shading).
-        let Some(bs) = bsdf1.sample(r.wo, rng.next_f32(), rng.next_2d()) else {
-            return rays;
-        };
-        if bs.lobe.is_delta() {
-            return rays;
-        }
-        let mut beta = bs.f / bs.pdf_sa;
-        let mut eta_scale = bs.eta;
-        if !russian_roulette(&mut beta, eta_scale, 1, rr_depth, rng) {
-            return rays;
-        }
-        let d1 = frame1.to_world(bs.wi);
-        let ray = Ray::new(offset_ray_origin(r.p, ng, d1), d1);
-        rays += 1;
-        let Some(si2) = scene.intersect(&ray) else {
-            if let Some(env) = lights.environment() {
-                let le = lights.environment_radiance(d1);
-                let lp = lights.pdf_sa(shapes, env, r.p, r.p + d1, -d1);
-                let w = power_heuristic(bs.pdf_sa, lp);
-                let sample = PathSample::direct(LightPoint::environment(env, d1), Kind::DirectHit);
-                cands.push(sample, beta * le * w, rng);
-            }
-            return rays;
-        };
-        if let Some(light) = lights.light_on_shape(si2.shape) {
-            let le = lights.area_radiance(light, si2.shading.n, -d1);
-            if le != Vec3::ZERO {
-                let lp = lights.pdf_sa(shapes, light, r.p, si2.p, si2.ng);
-                let w = power_heuristic(bs.pdf_sa, lp);
-                let sample = PathSample::direct(
-                    LightPoint {
-                        light,
-                        prim: si2.prim,
-                        param: si2.param,
-                    },
-                    Kind::DirectHit,
-                );
-                cands.push(sample, beta * le * w, rng);
-            }
-        }
-        if max_depth < 3 {
-            return rays;
-        }
-
-        // x2: the reconnection vertex.
-        let base = PathSample {
-            id: si2.shape,
-            prim: si2.prim,
-            param: si2.param,
-            dir: Vec3::ZERO,
-            radiance: Vec3::ZERO,
-            light_pdf: 0.0,
-            kind: Kind::Continue,
-            length: 3,
-        };
-        let bsdf2 = scene.bsdf(&si2);
-        let wo2 = si2.shading.to_local(-d1);
-        let (u_select, u_light) = (rng.next_f32(), rng.next_2d());
-        if bsdf2.has_smooth_lobe()
-            && let Some(ls) = lights.sample(shapes, si2.p, u_select, u_light)
-        {
-            let wi = si2.shading.to_local(ls.wi);
-            let f = bsdf2.eval(wo2, wi);
-            if f != Vec3::ZERO {
-                rays += 1;
-                if shadow_visible(scene, si2.p, si2.ng, ls.p, ls.wi, ls.dist) {
-                    let w = if ls.delta {
-                        1.0
-                    } else {
-                        power_heuristic(ls.pdf_sa, bsdf2.pdf_sa(wo2, wi))
-                    };
-                    let sample = PathSample {
-                        dir: ls.wi,
-                        radiance: ls.le,
-                        light_pdf: if ls.delta { 0.0 } else { ls.pdf_sa },
-                        kind: Kind::NeeAtX2,
-                        ..base
-                    };
-                    cands.push(sample, beta * f * ls.le * (w / ls.pdf_sa), rng);
-                }
-            }
-        }
-        let Some(bs2) = bsdf2.sample(wo2, rng.next_f32(), rng.next_2d()) else {
-            return rays;
-        };
-        let frozen = bs2.lobe.is_delta();
-        let t2 = bs2.f; // x2's term of a frozen path
-        beta *= bs2.f / bs2.pdf_sa;
-        eta_scale *= bs2.eta;
-        if !russian_roulette(&mut beta, eta_scale, 2, rr_depth, rng) {
-            return rays;
-        }
-        let d2 = si2.shading.to_world(bs2.wi);
-        let suffix = |kind: Kind, radiance: Vec3, light_pdf: f32, length: u32| {
-            if frozen {
-                PathSample {
-                    radiance: t2 * radiance,
-                    kind: Kind::Frozen,
-                    length: length.min(255) as u8,
-                    ..base
-                }
-            } else {
-                PathSample {
-                    dir: d2,
-                    radiance,
-                    light_pdf,
-                    kind,
-                    length: length.min(255) as u8,
-                    ..base
-                }
-            }
-        };
-
-        // The rest of the walk: `rest` is the throughput after x2 (without Russian roulette).
-        let mut rest = Vec3::ONE;
-        let mut prev = PrevVertex {
-            p: si2.p,
-            pdf_sa: bs2.pdf_sa,
-            delta: bs2.lobe.is_delta(),
-            mis: EmissionMis::Power,
-        };
-        let mut ray = Ray::new(offset_ray_origin(si2.p, si2.ng, d2), d2);
-        // Segments from the camera to the vertex the ray will hit.
-        let mut length = 3u32;
-        loop {
-            rays += 1;
-            let Some(si) = scene.intersect(&ray) else {
-                if let Some(env) = lights.environment() {
-                    let le = lights.environment_radiance(ray.d);
-                    let lp = lights.pdf_sa(shapes, env, prev.p, prev.p + ray.d, -ray.d);
-                    let w = prev.emission_weight(lp);
-                    let sample = if length == 3 {
-                        suffix(Kind::HitAtX3, le, lp, length)
-                    } else {
-                        suffix(Kind::Continue, rest * le * w, 0.0, length)
-                    };
-                    cands.push(sample, beta * le * w, rng);
-                }
-                break;
-            };
-            if let Some(light) = lights.light_on_shape(si.shape) {
-                let le = lights.area_radiance(light, si.shading.n, -ray.d);
-                if le != Vec3::ZERO {
-                    let lp = lights.pdf_sa(shapes, light, prev.p, si.p, si.ng);
-                    let w = prev.emission_weight(lp);
-                    let sample = if length == 3 {
-                        suffix(Kind::HitAtX3, le, if prev.delta { 0.0 } else { lp }, length)
-                    } else {
-                        suffix(Kind::Continue, rest * le * w, 0.0, length)
-                    };
-                    cands.push(sample, beta * le * w, rng);
-                }
-            }
-            // Connections from this vertex have `length + 1` segments.
-            if length + 1 > max_depth {
-                break;
-            }
-            let bsdf = scene.bsdf(&si);
-            let wo = si.shading.to_local(-ray.d);
-            let (u_select, u_light) = (rng.next_f32(), rng.next_2d());
-            if bsdf.has_smooth_lobe()
-                && let Some(ls) = lights.sample(shapes, si.p, u_select, u_light)
-            {
-                let wi = si.shading.to_local(ls.wi);
-                let f = bsdf.eval(wo, wi);
-                if f != Vec3::ZERO {
-                    rays += 1;
-                    if shadow_visible(scene, si.p, si.ng, ls.p, ls.wi, ls.dist) {
-                        let w = if ls.delta {
-                            1.0
-                        } else {
-                            power_heuristic(ls.pdf_sa, bsdf.pdf_sa(wo, wi))
-                        };
-                        let l = f * ls.le * (w / ls.pdf_sa);
-                        let sample = suffix(Kind::Continue, rest * l, 0.0, length + 1);
-                        cands.push(sample, beta * l, rng);
-                    }
-                }
-            }
-            let Some(bs) = bsdf.sample(wo, rng.next_f32(), rng.next_2d()) else {
-                break;
-            };
-            let t = bs.f / bs.pdf_sa;
-            rest *= t;
-            beta *= t;
-            eta_scale *= bs.eta;
-            if !russian_roulette(&mut beta, eta_scale, length, rr_depth, rng) {
-                break;
-            }
-            let d = si.shading.to_world(bs.wi);
-            prev = PrevVertex {
-                p: si.p,
-                pdf_sa: bs.pdf_sa,
-                delta: bs.lobe.is_delta(),
-                mis: EmissionMis::Power,
-            };
-            ray = Ray::new(offset_ray_origin(si.p, si.ng, d), d);
-            length += 1;
-        }
-        rays
     }
 
     /// One spatial round at pixel `index`.
@@ -502,9 +274,8 @@ impl RestirPtIntegrator {
         let mut l = Vec3::ZERO;
         let mut rays = 0;
         if let Some(y) = &res.sample {
-            let v = resolve_vertex(scene, y);
-            let (f, _) = evaluate_unshadowed(scene, r, y, &v);
-            l += f * res.ucw;
+            // The sample's value is its integrand at this pixel (set by the last shift).
+            l += y.value * res.ucw;
         }
         let bsdf = &scene.bsdfs[r.bsdf as usize];
         if bsdf.flags().intersects(LobeFlags::DELTA) {
@@ -539,41 +310,13 @@ impl RestirPtIntegrator {
     }
 }
 
-/// Russian roulette after the bounce that made the path `depth` segments long, as the path
-/// tracer does it. Returns whether the path survives (`beta` is divided by the survival
-/// probability).
-#[inline]
-fn russian_roulette(
-    beta: &mut Vec3,
-    eta_scale: f32,
-    depth: u32,
-    rr_depth: u32,
-    rng: &mut Pcg32,
-) -> bool {
-    let u = rng.next_f32();
-    let bmax = beta.max_element();
-    if !(bmax > 0.0 && beta.is_finite()) {
-        return false;
-    }
-    if depth >= rr_depth {
-        let q = (bmax * eta_scale * eta_scale).min(0.95);
-        if u >= q {
-            return false;
-        }
-        *beta /= q;
-    }
-    true
-}
-
-/// Whether a light sample is visible from surface point `p`.
-#[inline]
-fn shadow_visible(scene: &Scene, p: Vec3, ng: Vec3, lp: Vec3, wi: Vec3, dist: f32) -> bool {
-    let (ray, t_max) = if dist.is_finite() {
-        shadow_ray_between(p, ng, lp)
-    } else {
-        shadow_ray_towards(p, ng, wi, f32::INFINITY)
-    };
-    !scene.occluded(&ray, t_max)
+/// Whether some material of `scene` is not connectible (a delta or near-specular lobe) and can
+/// be scattered from.
+pub fn has_near_specular(scene: &Scene) -> bool {
+    scene
+        .bsdfs
+        .iter()
+        .any(|b| !connectible(b) && b.flags() != LobeFlags::NONE)
 }
 
 impl Integrator for RestirPtIntegrator {
@@ -585,7 +328,7 @@ impl Integrator for RestirPtIntegrator {
         let s = &self.settings;
         format!(
             "restir-pt max_depth={} candidates={} neighbors={} radius={} spatial_rounds={} \
-             mis={} mcap={} temporal={} shift=reconnection near_distance={} max_jacobian={} direct={}{}",
+             mis={} mcap={} temporal={} shift={} near_distance={} max_jacobian={} direct={}{}",
             s.path.max_depth,
             s.candidates,
             s.neighbors,
@@ -594,6 +337,7 @@ impl Integrator for RestirPtIntegrator {
             mis_name(s.mis),
             s.mcap,
             s.temporal,
+            s.shift.name(),
             s.near_distance,
             s.max_jacobian,
             if s.direct_path_traced {
