@@ -383,7 +383,8 @@ impl PtShift<'_> {
                 _ => return None,
             }
         };
-        if !prev.conn {
+        // Invertibility (ii): the inverse shift reconnects from `y_{k−1}` only if it is rough.
+        if !prev.conn && !walker.skip_invertibility {
             return None;
         }
         let v = resolve_vertex(scene, s);

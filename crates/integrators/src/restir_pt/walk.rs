@@ -103,8 +103,9 @@ pub struct Walker<'a> {
     pub rr_depth: u32,
     /// Square of the shortest reconnection segment.
     pub near2: f32,
-    /// Negative control only: skip the checks that a replayed prefix has no earlier
-    /// reconnection vertex (biased).
+    /// Negative control only: skip the invertibility checks (the replayed prefix has no earlier
+    /// reconnection vertex; the vertex reconnected from is rough), which makes the shift
+    /// non-bijective (biased).
     pub skip_invertibility: bool,
 }
 
