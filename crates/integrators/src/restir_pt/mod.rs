@@ -27,7 +27,6 @@ use std::sync::Mutex;
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use restir_geometry::{Ray, offset_ray_origin};
 use restir_gris::{MisScheme, Reservoir, StreamingReservoir, resample};
 use restir_materials::LobeFlags;
 use restir_sampling::{Pcg32, luminance};
@@ -38,7 +37,7 @@ pub use settings::{RestirPtSettings, SHIFT_NAMES};
 
 use crate::gbuffer::{GBuffer, Receiver};
 use crate::neighbors::{NeighborPattern, NeighborRule};
-use crate::path::{EmissionMis, PrevVertex, trace_path};
+
 use crate::render::{BAND_ROWS, Integrator, PassContext};
 use crate::restir_di::mis_name;
 use sample::connectible;
@@ -47,7 +46,6 @@ use walk::{Vtx, Walker};
 /// Random-stream stages (see [`PassContext::stage_rng`]).
 const STAGE_INITIAL: u64 = 101;
 const STAGE_TEMPORAL: u64 = 102;
-const STAGE_SHADE: u64 = 103;
 const STAGE_SPATIAL: u64 = 116;
 
 /// The reservoir type.
@@ -182,7 +180,7 @@ impl RestirPtIntegrator {
             confidence: 1.0,
             ..Reservoir::empty()
         };
-        if !bsdf.has_smooth_lobe() {
+        if bsdf.flags() == LobeFlags::NONE {
             return (empty, Vec3::ZERO, 0);
         }
         let n = self.settings.candidates;
@@ -262,51 +260,12 @@ impl RestirPtIntegrator {
         .with_confidence_cap(self.settings.mcap)
     }
 
-    /// Shading: the reservoir's path times `W`, plus the delta part of the primary hit.
-    fn shade(
-        &self,
-        scene: &Scene,
-        r: &Receiver,
-        ng: Vec3,
-        res: &PtReservoir,
-        rng: &mut Pcg32,
-    ) -> (Vec3, u64) {
-        let mut l = Vec3::ZERO;
-        let mut rays = 0;
-        if let Some(y) = &res.sample {
-            // The sample's value is its integrand at this pixel (set by the last shift).
-            l += y.value * res.ucw;
-        }
-        let bsdf = &scene.bsdfs[r.bsdf as usize];
-        if bsdf.flags().intersects(LobeFlags::DELTA) {
-            let settings = &self.settings.path;
-            let (u_lobe, u_dir, u_rr) = (rng.next_f32(), rng.next_2d(), rng.next_f32());
-            if let Some(bs) = bsdf.sample(r.wo, u_lobe, u_dir)
-                && bs.lobe.is_delta()
-            {
-                let mut beta = bs.f / bs.pdf_sa;
-                let mut alive = true;
-                if settings.rr_depth <= 1 {
-                    let q = (beta.max_element() * bs.eta * bs.eta).min(0.95);
-                    alive = u_rr < q;
-                    beta /= q;
-                }
-                if alive && beta.is_finite() && beta.max_element() > 0.0 {
-                    let d = r.frame().to_world(bs.wi);
-                    let ray = Ray::new(offset_ray_origin(r.p, ng, d), d);
-                    let prev = PrevVertex {
-                        p: r.p,
-                        pdf_sa: bs.pdf_sa,
-                        delta: true,
-                        mis: EmissionMis::Power,
-                    };
-                    let (li, n) = trace_path(scene, settings, ray, 1, beta, Some(prev), rng);
-                    l += li;
-                    rays += n;
-                }
-            }
-        }
-        (l, rays)
+    /// Shading: the reservoir's path times `W` (its value is its integrand at this pixel, set by
+    /// initial sampling or by the last shift).
+    fn shade(res: &PtReservoir) -> Vec3 {
+        res.sample
+            .as_ref()
+            .map_or(Vec3::ZERO, |y| y.value * res.ucw)
     }
 }
 
@@ -452,24 +411,10 @@ impl Integrator for RestirPtIntegrator {
                     std::mem::swap(&mut current, &mut next);
                 }
             }
-            rays += radiance
-                .par_chunks_mut(w * BAND_ROWS)
-                .enumerate()
-                .map(|(band, out)| {
-                    let mut rays = 0;
-                    for (i, l) in out.iter_mut().enumerate() {
-                        let index = band * w * BAND_ROWS + i;
-                        if let Some(r) = gbuf.receiver(index) {
-                            let mut rng = ctx.stage_rng(index, STAGE_SHADE);
-                            let (li, nr) =
-                                self.shade(scene, r, gbuf.ng[index], &current[index], &mut rng);
-                            *l += li;
-                            rays += nr;
-                        }
-                    }
-                    rays
-                })
-                .sum::<u64>();
+            radiance
+                .par_iter_mut()
+                .zip(current.par_iter())
+                .for_each(|(l, res)| *l += Self::shade(res));
             if s.temporal
                 && let Ok(mut h) = self.history.lock()
             {

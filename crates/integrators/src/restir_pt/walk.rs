@@ -349,10 +349,6 @@ impl Walker<'_> {
             let Some(bs) = bsdf.sample(cur.r.wo, u_lobe, u_dir) else {
                 return (Fail, rays);
             };
-            // The delta part of the primary hit is path traced at shading.
-            if j == 1 && bs.lobe.is_delta() {
-                return (Fail, rays);
-            }
             let bits = lobe_bits(bs.lobe);
             if j <= 16 {
                 let shift = 2 * (j - 1);
