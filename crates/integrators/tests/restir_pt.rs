@@ -193,6 +193,12 @@ fn shift_identity_and_round_trip_on_scene_paths() {
             assert!(stats.rc[3..].iter().sum::<usize>() >= 5, "{:?}", stats.rc);
         }
     }
+    // The striped near-specular floor: many hybrid paths replay one or more bounces.
+    let stats = check_shifts(
+        &striped_floor_scene(0.01),
+        &with_shift(integrator(-1), ShiftKind::Hybrid),
+    );
+    assert!(stats.rc[3..].iter().sum::<usize>() >= 50, "{:?}", stats.rc);
     // Symmetric Jacobian rejection keeps forward and inverse failures together.
     let mut settings = *integrator(-1).settings();
     settings.max_jacobian = 2.0;
