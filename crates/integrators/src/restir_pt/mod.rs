@@ -1,5 +1,5 @@
-//! ReSTIR PT (Lin et al. 2022): reservoir-based path reuse across pixels with the reconnection
-//! shift, combined unbiasedly with the MIS schemes of `restir-gris` (`docs/RESTIR_PT.md`).
+//! ReSTIR PT (Lin et al. 2022): reservoir-based path reuse across pixels with the reconnection,
+//! random-replay and hybrid shifts, combined unbiasedly with the MIS schemes of `restir-gris` (`docs/RESTIR_PT.md`).
 //!
 //! One pass, for every pixel at once (ALGORITHMS.md §4):
 //!
@@ -7,16 +7,15 @@
 //! 2. **Initial sampling**: `--candidates` random walks from the primary hit with next-event
 //!    estimation and BSDF sampling (power heuristic and Russian roulette as the path tracer);
 //!    every light connection is one candidate with resampling weight `lum(contribution)/N`.
-//!    Only paths whose first bounce used a non-delta lobe are sampled here; the reservoir counts
-//!    as confidence 1.
+//!    Each walk draws from its own generator, whose state the samples keep for replay
+//!    ([`walk`]); the reservoir counts as confidence 1.
 //!    With `direct = path` the direct-light connections at `x1` are summed per pixel instead.
 //! 3. **Temporal reuse** (optional): the pixel's reservoir of the previous pass, its domain the
 //!    previous pass's primary hit, generalized balance MIS, confidence capped at `mcap`.
 //! 4. **Spatial reuse**: `R` rounds of `k` neighbours (pattern and similarity tests as ReSTIR
-//!    DI) resampled through [`restir_gris::resample`] with the reconnection shift
+//!    DI) resampled through [`restir_gris::resample`] with the shift of `--shift`
 //!    ([`sample::PtShift`]). Confidence is capped at `mcap` after every round.
-//! 5. **Shading**: the selected path's integrand at the pixel times `W`, plus the paths whose
-//!    first bounce is a delta lobe, path traced.
+//! 5. **Shading**: the selected path's integrand at the pixel (kept in the sample) times `W`.
 
 pub mod sample;
 mod settings;

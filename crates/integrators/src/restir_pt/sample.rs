@@ -1,32 +1,40 @@
 //! The ReSTIR PT sample (a path from the primary hit, stored compactly), its integrand at any
-//! pixel and the reconnection shift between pixels.
+//! pixel and the shift map between pixels (reconnection, random replay, hybrid).
 //!
 //! # Sample space and measure
 //!
 //! A pixel's domain is its primary hit `x1`. A sample is a path `x1 → x2 → …` ending in one light
 //! connection, together with the technique of that connection (light sampling or BSDF
-//! sampling). Its measure is the product of
+//! sampling), and its reconnection vertex `x_k` if it has one ([`super::walk`]). The sample space
+//! is split by length, technique and `k`; the measure of each part is the product of
 //!
-//! * the solid angle of the direction `ω1` from `x1` to `x2` (counting measure when `x2` is a
-//!   point light; the direction itself for lights at infinity),
-//! * the solid angle of the direction `ω2` leaving `x2` (area measure of the light point turned
-//!   into solid angle at `x2`, which does not move), and
-//! * for everything after `x3`, the base path's own sampling density without Russian roulette
-//!   (`μ_rest`): it depends only on vertices from `x2` on, which the shift keeps.
+//! * primary sample space (the random numbers) for the bounces at `x1 … x_{k−2}`,
+//! * the solid angle of the direction `ω_{k−1}` from `x_{k−1}` to `x_k` (counting measure when
+//!   `x_k` is a point light; the direction itself for lights at infinity),
+//! * the solid angle of the direction `ω_k` leaving `x_k` (area measure of the light point turned
+//!   into solid angle at `x_k`, which does not move), and
+//! * for everything after `x_{k+1}`, the base path's own sampling density without Russian
+//!   roulette (`μ_rest`): it depends only on vertices from `x_k` on, which the shift keeps.
 //!
-//! The integrand is `f_s(x1)·|cos|·V(x1, x2) · f_s(x2)·|cos| · L_rest · m`, where `m` is the
-//! NEE/BSDF power-heuristic weight of the path's light connection. When that connection is at
-//! `x1` or `x2` the weight depends on the incoming direction and is recomputed at every pixel;
-//! further down it is part of the stored suffix radiance.
+//! Paths without a reconnection vertex ([`Kind::Frozen`]) are in primary sample space
+//! throughout. The integrand is `Π f_s|cos|/p (replayed bounces) · f_s(x_{k−1})·|cos|·
+//! V(x_{k−1}, x_k) · f_s(x_k)·|cos| · L_rest · m`, where `m` is the NEE/BSDF power-heuristic
+//! weight of the path's light connection. When that connection is at `x_{k−1}` or `x_k` the
+//! weight depends on the incoming direction and is recomputed at every pixel; further down it
+//! is part of the stored suffix radiance.
 //!
-//! # Reconnection shift
+//! # Shifts
 //!
-//! `T_{i→c}` keeps `x2` and everything after it and replaces `x1` by pixel `c`'s primary hit
-//! `y1`. Only `ω1` changes, so the Jacobian is the solid-angle reconnection Jacobian
-//! `(cos θ_y / cos θ_x)·(d_x² / d_y²)` with `x2`'s geometric normal (1 for point lights and
-//! lights at infinity). The shift fails, in both directions alike, unless both primary hits and
-//! `x2` are rough, both primary hits are at least `d_near` from `x2`, and `x2` did not scatter by
-//! a delta lobe. Visibility of `y1 → x2` is part of the target.
+//! `T_{i→c}` replays the bounces at `x1 … x_{k−2}` from pixel `c`'s primary hit `y1` with the
+//! sample's random numbers (nothing for `k = 2`: the reconnection shift), keeps `x_k` and
+//! everything after it, and reconnects `y_{k−1} → x_k`. Replayed bounces have Jacobian 1
+//! (primary sample space); the reconnection has the solid-angle Jacobian
+//! `(cos θ_y / cos θ_x)·(d_x² / d_y²) = G_y / G_x` with `x_k`'s geometric normal (1 for point
+//! lights and lights at infinity), from the `G_x` cached in the sample. Frozen paths are replayed
+//! whole (Jacobian 1). The shift fails, in both directions alike, when the replayed prefix leaves
+//! the sample's subspace (different lobes, an earlier reconnection vertex), when `y_{k−1}` is
+//! not rough or closer than `d_near` to `x_k`, or by the symmetric Jacobian bound. Visibility of
+//! `y_{k−1} → x_k` is part of the target.
 
 use std::cell::Cell;
 
