@@ -446,6 +446,14 @@ fn shifts_unbiased_with_glass_and_near_specular() {
             );
         }
         if label == "glass" {
+            // Temporal reuse (8 passes) with the hybrid shift into the previous pass's pixels.
+            let params = [depth, ("temporal", "true")];
+            let z = max_z(
+                &statistics(&scene, "restir-pt", &params, 8, 150),
+                &reference,
+            );
+            eprintln!("{label}, hybrid, temporal: max |z| = {z:.2}");
+            assert!(z < Z_MAX, "{label}, temporal: max |z| = {z:.2}");
             continue;
         }
         // Negative controls, with more reuse (3 rounds of 6 neighbours) to make bias visible.
