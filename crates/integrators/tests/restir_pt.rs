@@ -325,6 +325,13 @@ fn unbiased_against_the_path_tracer() {
     );
     eprintln!("max_depth 4, direct light path traced: max |z| = {z:.2}");
     assert!(z < Z_MAX, "direct = path: max |z| = {z:.2}");
+    // Direct light (and the emitters the camera sees) from a ReSTIR DI pass.
+    let z = max_z(
+        &statistics(&scene, "restir-pt", &[("direct", "restir-di")], 1, 300),
+        &reference,
+    );
+    eprintln!("max_depth 4, direct light from ReSTIR DI: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "direct = restir-di: max |z| = {z:.2}");
     // Temporal reuse across 4 passes (history capped at mcap), then spatial reuse.
     let z = max_z(
         &statistics(&scene, "restir-pt", &[("temporal", "true")], 16, 200),
@@ -454,6 +461,14 @@ fn shifts_unbiased_with_glass_and_near_specular() {
             );
             eprintln!("{label}, hybrid, temporal: max |z| = {z:.2}");
             assert!(z < Z_MAX, "{label}, temporal: max |z| = {z:.2}");
+            // Direct light (delta reflections of the light included) from ReSTIR DI.
+            let params = [depth, ("direct", "restir-di")];
+            let z = max_z(
+                &statistics(&scene, "restir-pt", &params, 1, 300),
+                &reference,
+            );
+            eprintln!("{label}, hybrid, direct = restir-di: max |z| = {z:.2}");
+            assert!(z < Z_MAX, "{label}, direct = restir-di: max |z| = {z:.2}");
             continue;
         }
         // Negative controls, with more reuse (3 rounds of 6 neighbours) to make bias visible.

@@ -37,8 +37,10 @@ pub use settings::{RestirPtSettings, SHIFT_NAMES};
 use crate::gbuffer::{GBuffer, Receiver};
 use crate::neighbors::{NeighborPattern, NeighborRule};
 
+use crate::path::PathSettings;
 use crate::render::{BAND_ROWS, Integrator, PassContext};
 use crate::restir_di::mis_name;
+use crate::restir_di::{RestirDiIntegrator, RestirDiSettings};
 use sample::connectible;
 use walk::{Vtx, Walker};
 
@@ -61,6 +63,8 @@ struct History {
 #[derive(Debug)]
 pub struct RestirPtIntegrator {
     settings: RestirPtSettings,
+    /// The ReSTIR DI pass that takes the direct light with `direct = restir-di`.
+    di: Option<RestirDiIntegrator>,
     pattern: NeighborPattern,
     history: Mutex<Option<History>>,
 }
@@ -68,8 +72,24 @@ pub struct RestirPtIntegrator {
 impl RestirPtIntegrator {
     /// An integrator with `settings`.
     pub fn new(settings: RestirPtSettings) -> Self {
+        let di = settings.direct_restir_di.then(|| {
+            let mut d = RestirDiSettings::new(PathSettings {
+                max_depth: 2,
+                ..settings.path
+            });
+            d.neighbors = settings.neighbors;
+            d.radius = settings.radius;
+            d.spatial_rounds = settings.spatial_rounds;
+            d.mis = settings.mis;
+            d.mcap = settings.mcap;
+            d.temporal = settings.temporal;
+            d.normal_cos = settings.normal_cos;
+            d.depth_tolerance = settings.depth_tolerance;
+            RestirDiIntegrator::new(d)
+        });
         Self {
             settings,
+            di,
             pattern: NeighborPattern::new(),
             history: Mutex::new(None),
         }
@@ -137,7 +157,14 @@ impl RestirPtIntegrator {
         let mut radiance = vec![Vec3::ZERO; n];
         let keep = self.max_depth() >= 2;
         let (gbuf, mut rays) =
-            GBuffer::trace(scene, ctx, s.path.hide_emitters, keep, &mut radiance);
+            // With `direct = restir-di` the ReSTIR DI pass adds the emitters the camera sees.
+            GBuffer::trace(
+                scene,
+                ctx,
+                s.path.hide_emitters || s.direct_restir_di,
+                keep,
+                &mut radiance,
+            );
         let mut current = vec![PtReservoir::empty(); n];
         if keep {
             let w = gbuf.width;
@@ -185,6 +212,7 @@ impl RestirPtIntegrator {
         let n = self.settings.candidates;
         let scale = 1.0 / n as f32;
         let direct_path_traced = self.settings.direct_path_traced;
+        let direct_elsewhere = self.settings.direct_restir_di;
         let mut stream = StreamingReservoir::new();
         let mut direct = Vec3::ZERO;
         let mut rays = 0;
@@ -198,6 +226,9 @@ impl RestirPtIntegrator {
                 u64::from(rng.next_u32()),
             );
             let mut sink = |sample: PathSample, contribution: Vec3| {
+                if direct_elsewhere && sample.length == 2 {
+                    return; // ReSTIR DI's pass has it
+                }
                 if direct_path_traced && sample.length == 2 {
                     if contribution.is_finite() {
                         direct += contribution * scale;
@@ -300,6 +331,8 @@ impl Integrator for RestirPtIntegrator {
             s.max_jacobian,
             if s.direct_path_traced {
                 "path"
+            } else if s.direct_restir_di {
+                "restir-di"
             } else {
                 "reservoir"
             },
@@ -314,13 +347,23 @@ impl Integrator for RestirPtIntegrator {
         } else {
             (2, 1)
         };
-        reservoirs * Self::RESERVOIR_BYTES + hits * hit_bytes + std::mem::size_of::<Vec3>()
+        reservoirs * Self::RESERVOIR_BYTES
+            + hits * hit_bytes
+            + std::mem::size_of::<Vec3>()
+            + self.di.as_ref().map_or(0, |d| d.buffer_bytes_per_pixel())
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
         let s = &self.settings;
         let n = accum.len();
-        let (gbuf, mut current, mut radiance, mut rays) = self.initial_reservoirs(scene, ctx);
+        // Emitters seen by the camera and the direct light at the primary hit (paths of one and
+        // two segments) from ReSTIR DI; the reservoirs below carry the longer paths.
+        let mut rays = self
+            .di
+            .as_ref()
+            .map_or(0, |di| di.render_pass(scene, ctx, accum));
+        let (gbuf, mut current, mut radiance, nr) = self.initial_reservoirs(scene, ctx);
+        rays += nr;
         if self.max_depth() >= 2 {
             let w = gbuf.width;
             let history = if s.temporal {

@@ -44,6 +44,10 @@ pub struct RestirPtSettings {
     /// the power heuristic, per pixel) instead of carrying it in the reservoirs (`direct = path`;
     /// default `reservoir`).
     pub direct_path_traced: bool,
+    /// Hand the direct light at the primary hit (and the emitters the camera sees) to a ReSTIR DI
+    /// pass with the same reuse settings; the reservoirs carry the paths of three or more
+    /// segments (`direct = restir-di`).
+    pub direct_restir_di: bool,
     /// Negative control only: use Jacobian 1 in every shift (biased).
     pub unit_jacobian: bool,
     /// The shift between pixels (default hybrid; plain reconnection in scenes without
@@ -70,6 +74,7 @@ impl RestirPtSettings {
             near_distance: 0.01,
             max_jacobian: 0.0,
             direct_path_traced: false,
+            direct_restir_di: false,
             unit_jacobian: false,
             shift: ShiftKind::Hybrid,
             skip_invertibility: false,
@@ -148,16 +153,17 @@ impl RestirPtSettings {
                     self.max_jacobian = j;
                 }
                 "direct" => {
-                    self.direct_path_traced = match v.to_ascii_lowercase().as_str() {
-                        "reservoir" | "reservoirs" => false,
-                        "path" => true,
-                        _ => {
-                            return Err(format!(
-                                "{name} = '{v}': expected reservoir or path (restir-di is not \
-                                 implemented)"
-                            ));
-                        }
-                    };
+                    (self.direct_path_traced, self.direct_restir_di) =
+                        match v.to_ascii_lowercase().replace('_', "-").as_str() {
+                            "reservoir" | "reservoirs" => (false, false),
+                            "path" => (true, false),
+                            "restir-di" | "restirdi" | "di" => (false, true),
+                            _ => {
+                                return Err(format!(
+                                    "{name} = '{v}': expected reservoir, path or restir-di"
+                                ));
+                            }
+                        };
                 }
                 "unit_jacobian" => self.unit_jacobian = parse_bool(name, v)?,
                 "skip_invertibility" => self.skip_invertibility = parse_bool(name, v)?,
