@@ -136,7 +136,8 @@ struct RestirArgs {
     /// restir-pt: reject shifts with max(J, 1/J) above this (unbiased) [default: none].
     #[arg(long)]
     max_jacobian: Option<f32>,
-    /// restir-pt: direct light in the reservoirs (reservoir) or path traced per pixel (path)
+    /// restir-pt: direct light in the reservoirs (reservoir), path traced per pixel (path) or
+    /// from a ReSTIR DI pass (restir-di)
     /// [default: reservoir].
     #[arg(long)]
     direct: Option<String>,

@@ -73,8 +73,14 @@ impl RestirPtIntegrator {
     /// An integrator with `settings`.
     pub fn new(settings: RestirPtSettings) -> Self {
         let di = settings.direct_restir_di.then(|| {
+            // Paths of at most two segments (fewer if max_depth says so).
+            let max_depth = if settings.path.max_depth < 0 {
+                2
+            } else {
+                settings.path.max_depth.min(2)
+            };
             let mut d = RestirDiSettings::new(PathSettings {
-                max_depth: 2,
+                max_depth,
                 ..settings.path
             });
             d.neighbors = settings.neighbors;
