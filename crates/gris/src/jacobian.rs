@@ -154,6 +154,20 @@ pub fn reconnection_jacobian_pss_area(
     finish((py / px) * (qy / qx))
 }
 
+/// Reconnection Jacobian in **solid angle** from the two geometry terms `G = |cos θ| / d²` of the
+/// reconnection vertex seen from the shifted (`geometry_y`) and base (`geometry_x`) predecessors
+/// (see [`solid_angle_to_area`]): `J = G_y / G_x`, equal to
+/// [`reconnection_jacobian_solid_angle`]. A shift that caches its base path's `G_x` in the sample
+/// and stores `G_y` in the shifted sample gets `J·J⁻¹ = 1` without recomputing the base path,
+/// and exactly `J = 1` for the identity. Returns 0 (shift fails) if either term is invalid.
+#[inline]
+pub fn reconnection_jacobian_from_geometry(geometry_y: f32, geometry_x: f32) -> f32 {
+    let (Some(gy), Some(gx)) = (positive(geometry_y), positive(geometry_x)) else {
+        return 0.0;
+    };
+    finish(gy / gx)
+}
+
 /// Jacobian of the inverse shift at the shifted point: `1 / J`, or 0 if `J` is invalid.
 #[inline]
 pub fn inverse_jacobian(jacobian: f32) -> f32 {
@@ -205,6 +219,24 @@ pub fn reconnection_jacobian_from_points(
     let (cos_x, dist2_x) = geometry(prev_x);
     let (cos_y, dist2_y) = geometry(prev_y);
     reconnection_jacobian_solid_angle(cos_y, dist2_y, cos_x, dist2_x)
+}
+
+/// The geometry term `G = |cos θ| / d²` of `vertex` (geometric normal `normal`, any length) seen
+/// from `prev` (**requires the `std` feature**), for [`reconnection_jacobian_from_geometry`].
+/// Computed in `f64`; 0 for a grazing angle or a zero distance.
+#[cfg(feature = "std")]
+pub fn geometry_term(prev: [f32; 3], vertex: [f32; 3], normal: [f32; 3]) -> f32 {
+    let v = [
+        f64::from(prev[0]) - f64::from(vertex[0]),
+        f64::from(prev[1]) - f64::from(vertex[1]),
+        f64::from(prev[2]) - f64::from(vertex[2]),
+    ];
+    let n = normal.map(f64::from);
+    let d2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    let cos = ((n[0] * v[0] + n[1] * v[1] + n[2] * v[2]) / (d2 * nn).sqrt()).abs();
+    let g = (cos / d2) as f32;
+    if g > 0.0 && g.is_finite() { g } else { 0.0 }
 }
 
 #[cfg(test)]
@@ -270,6 +302,24 @@ mod tests {
         assert!(!reject_jacobian(9.0, 10.0));
         assert!(reject_jacobian(f32::NAN, 10.0));
         assert!(reject_jacobian(0.0, 10.0));
+    }
+
+    #[test]
+    fn geometry_form_agrees() {
+        let (px, py, v, n) = (
+            [0.1, 0.9, 0.3],
+            [-0.7, 1.4, 0.2],
+            [0.2, 0.0, -0.4],
+            [0.1, 1.0, 0.2],
+        );
+        let a = reconnection_jacobian_from_points(px, py, v, n);
+        let b =
+            reconnection_jacobian_from_geometry(geometry_term(py, v, n), geometry_term(px, v, n));
+        assert!((a - b).abs() <= 1e-6 * a, "{a} {b}");
+        let g = geometry_term(px, v, n);
+        assert_eq!(reconnection_jacobian_from_geometry(g, g), 1.0);
+        assert_eq!(reconnection_jacobian_from_geometry(0.0, g), 0.0);
+        assert_eq!(reconnection_jacobian_from_geometry(g, f32::NAN), 0.0);
     }
 
     #[test]

@@ -129,13 +129,15 @@ struct RestirArgs {
     /// Drop occluded initial candidates (biased at shadow edges).
     #[arg(long)]
     visibility_reuse: bool,
-    /// restir-pt shift map: reconnection (the only one implemented).
+    /// restir-pt shift map: reconnection, replay or hybrid [default: hybrid; reconnection in
+    /// scenes without delta or near-specular materials].
     #[arg(long)]
     shift: Option<String>,
     /// restir-pt: reject shifts with max(J, 1/J) above this (unbiased) [default: none].
     #[arg(long)]
     max_jacobian: Option<f32>,
-    /// restir-pt: direct light in the reservoirs (reservoir) or path traced per pixel (path)
+    /// restir-pt: direct light in the reservoirs (reservoir), path traced per pixel (path) or
+    /// from a ReSTIR DI pass (restir-di)
     /// [default: reservoir].
     #[arg(long)]
     direct: Option<String>,

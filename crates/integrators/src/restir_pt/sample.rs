@@ -1,95 +1,147 @@
 //! The ReSTIR PT sample (a path from the primary hit, stored compactly), its integrand at any
-//! pixel and the reconnection shift between pixels.
+//! pixel and the shift map between pixels (reconnection, random replay, hybrid).
 //!
 //! # Sample space and measure
 //!
 //! A pixel's domain is its primary hit `x1`. A sample is a path `x1 → x2 → …` ending in one light
 //! connection, together with the technique of that connection (light sampling or BSDF
-//! sampling). Its measure is the product of
+//! sampling), and its reconnection vertex `x_k` if it has one ([`super::walk`]). The sample space
+//! is split by length, technique and `k`; the measure of each part is the product of
 //!
-//! * the solid angle of the direction `ω1` from `x1` to `x2` (counting measure when `x2` is a
-//!   point light; the direction itself for lights at infinity),
-//! * the solid angle of the direction `ω2` leaving `x2` (area measure of the light point turned
-//!   into solid angle at `x2`, which does not move), and
-//! * for everything after `x3`, the base path's own sampling density without Russian roulette
-//!   (`μ_rest`): it depends only on vertices from `x2` on, which the shift keeps.
+//! * primary sample space (the random numbers) for the bounces at `x1 … x_{k−2}`,
+//! * the solid angle of the direction `ω_{k−1}` from `x_{k−1}` to `x_k` (counting measure when
+//!   `x_k` is a point light; the direction itself for lights at infinity),
+//! * the solid angle of the direction `ω_k` leaving `x_k` (area measure of the light point turned
+//!   into solid angle at `x_k`, which does not move), and
+//! * for everything after `x_{k+1}`, the base path's own sampling density without Russian
+//!   roulette (`μ_rest`): it depends only on vertices from `x_k` on, which the shift keeps.
 //!
-//! The integrand is `f_s(x1)·|cos|·V(x1, x2) · f_s(x2)·|cos| · L_rest · m`, where `m` is the
-//! NEE/BSDF power-heuristic weight of the path's light connection. When that connection is at
-//! `x1` or `x2` the weight depends on the incoming direction and is recomputed at every pixel;
-//! further down it is part of the stored suffix radiance.
+//! Paths without a reconnection vertex ([`Kind::Frozen`]) are in primary sample space
+//! throughout. The integrand is `Π f_s|cos|/p (replayed bounces) · f_s(x_{k−1})·|cos|·
+//! V(x_{k−1}, x_k) · f_s(x_k)·|cos| · L_rest · m`, where `m` is the NEE/BSDF power-heuristic
+//! weight of the path's light connection. When that connection is at `x_{k−1}` or `x_k` the
+//! weight depends on the incoming direction and is recomputed at every pixel; further down it
+//! is part of the stored suffix radiance.
 //!
-//! # Reconnection shift
+//! # Shifts
 //!
-//! `T_{i→c}` keeps `x2` and everything after it and replaces `x1` by pixel `c`'s primary hit
-//! `y1`. Only `ω1` changes, so the Jacobian is the solid-angle reconnection Jacobian
-//! `(cos θ_y / cos θ_x)·(d_x² / d_y²)` with `x2`'s geometric normal (1 for point lights and
-//! lights at infinity). The shift fails, in both directions alike, unless both primary hits and
-//! `x2` are rough, both primary hits are at least `d_near` from `x2`, and `x2` did not scatter by
-//! a delta lobe. Visibility of `y1 → x2` is part of the target.
+//! `T_{i→c}` replays the bounces at `x1 … x_{k−2}` from pixel `c`'s primary hit `y1` with the
+//! sample's random numbers (nothing for `k = 2`: the reconnection shift), keeps `x_k` and
+//! everything after it, and reconnects `y_{k−1} → x_k`. Replayed bounces have Jacobian 1
+//! (primary sample space); the reconnection has the solid-angle Jacobian
+//! `(cos θ_y / cos θ_x)·(d_x² / d_y²) = G_y / G_x` with `x_k`'s geometric normal (1 for point
+//! lights and lights at infinity), from the `G_x` cached in the sample. Frozen paths are replayed
+//! whole (Jacobian 1). The shift fails, in both directions alike, when the replayed prefix leaves
+//! the sample's subspace (different lobes, an earlier reconnection vertex), when `y_{k−1}` is
+//! not rough or closer than `d_near` to `x_k`, or by the symmetric Jacobian bound. Visibility of
+//! `y_{k−1} → x_k` is part of the target.
 
 use std::cell::Cell;
 
 use glam::{Vec2, Vec3};
 use restir_geometry::{SurfaceInteraction, shadow_ray_between, shadow_ray_towards, surface_at};
-use restir_gris::jacobian::{reconnection_jacobian_from_points, reject_jacobian};
+use restir_gris::jacobian::{reconnection_jacobian_from_geometry, reject_jacobian};
 use restir_gris::{ShiftMap, Shifted};
 use restir_materials::{Bsdf, BsdfKind};
-use restir_sampling::{luminance, warp::power_heuristic};
+use restir_sampling::{Pcg32, luminance, warp::power_heuristic};
 use restir_scene::Scene;
 
 use crate::gbuffer::{GBuffer, Receiver};
 use crate::restir_di::light_point::{LightPoint, Resolved, resolve};
 
+use super::walk::{Replayed, Vtx, Walker};
+
 /// Smallest microfacet roughness (Mitsuba `alpha`) a surface may have to reconnect at.
 pub const ROUGH_ALPHA: f32 = 0.04;
 
-/// How a stored path ends, relative to its reconnection vertex `x2`.
+/// How a stored path ends, relative to its reconnection vertex `x_k` (the names are those of
+/// `k = 2`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
 pub enum Kind {
-    /// Light sampling at `x1`; `x2` is the light point.
+    /// Light sampling at `x_{k−1}`; `x_k` is the light point.
     DirectNee,
-    /// The BSDF ray from `x1` hit an emitter (or left the scene) at `x2`.
+    /// The BSDF ray from `x_{k−1}` hit an emitter (or left the scene) at `x_k`.
     DirectHit,
-    /// Light sampling at `x2` towards `dir`.
+    /// Light sampling at `x_k` towards `dir`.
     NeeAtX2,
-    /// The BSDF ray from `x2` along `dir` hit an emitter (or left the scene).
+    /// The BSDF ray from `x_k` along `dir` hit an emitter (or left the scene).
     HitAtX3,
-    /// The path continues from `x2` along `dir`; its light connection is at `x3` or later.
+    /// The path continues from `x_k` along `dir`; its light connection is further down.
     Continue,
-    /// `x2` scattered by a delta lobe: the path cannot be reconnected at `x2`; `radiance` holds
-    /// everything after `x1`.
+    /// The path has no reconnection vertex: the hybrid and replay shifts replay all of it, the
+    /// reconnection shift never moves it.
     Frozen,
 }
 
-/// A path sample: 48 bytes.
+/// The shift between pixels (`--shift`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShiftKind {
+    /// Reconnection at `x2` only (paths whose `x1`/`x2` are not rough or too close stay put).
+    Reconnection,
+    /// Random replay of the whole path from the destination's primary hit.
+    Replay,
+    /// Replay up to `x_{k−1}`, then reconnection at the first connectible vertex `x_k`.
+    Hybrid,
+}
+
+impl ShiftKind {
+    /// The name `--shift` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            ShiftKind::Reconnection => "reconnection",
+            ShiftKind::Replay => "replay",
+            ShiftKind::Hybrid => "hybrid",
+        }
+    }
+}
+
+/// A path sample: a path from the primary hit `x1`, named by its walk's random-number state
+/// and, when it has one, its reconnection vertex `x_k` (the "rc vertex"; `k ≥ 2`, `x1` is the
+/// primary hit). Geometry is never copied: `x_k` is named by (shape, primitive, parameters).
+/// The kinds are relative to `x_k`; `id`, `prim`, `param`, `dir`, `radiance` and `light_pdf`
+/// describe `x_k` and what follows it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathSample {
-    /// The light (direct kinds) or the shape of `x2`.
+    /// The light (direct kinds) or the shape of `x_k`.
     pub id: u32,
-    /// Primitive of `x2`.
+    /// Primitive of `x_k`.
     pub prim: u32,
-    /// Barycentrics / sphere parameters of `x2` (for the environment: the direction's encoding).
+    /// Barycentrics / sphere parameters of `x_k` (for the environment: the direction's encoding).
     pub param: Vec2,
-    /// Direction leaving `x2` (world space; unused by the direct kinds).
+    /// Direction leaving `x_k` (world space; unused by the direct kinds).
     pub dir: Vec3,
-    /// Radiance arriving at `x2` along `dir`: the light's for [`Kind::NeeAtX2`] and
+    /// Radiance arriving at `x_k` along `dir`: the light's for [`Kind::NeeAtX2`] and
     /// [`Kind::HitAtX3`], the suffix estimate (throughput over sampling densities, times the
-    /// emission and its MIS weight) for [`Kind::Continue`], everything after `x1` for
-    /// [`Kind::Frozen`].
+    /// emission and its MIS weight) for [`Kind::Continue`].
     pub radiance: Vec3,
-    /// Light-sampling density (solid angle at `x2`, selection included) of the light connection
-    /// at `x2`, for its MIS weight; 0 for delta lights.
+    /// Light-sampling density (solid angle at `x_k`, selection included) of the light connection
+    /// at `x_k`, for its MIS weight; 0 for delta lights.
     pub light_pdf: f32,
+    /// The integrand (RGB, in the sample's measure) at the domain the sample currently lives in:
+    /// set by initial sampling and by every shift, so shading needs no re-evaluation.
+    pub value: Vec3,
+    /// Geometry term `|cos θ| / d²` of `x_k` (geometric normal) seen from `x_{k−1}` on this
+    /// path: the cached part of the reconnection Jacobian (0 for point lights and directions).
+    pub geometry: f32,
+    /// The walk's random-number state before its first number: replaying it from another
+    /// primary hit regenerates the prefix (`x2 … x_{k−1}`, or the whole path for
+    /// [`Kind::Frozen`]).
+    pub seed: Pcg32,
+    /// Lobe flags of the first 16 bounces (`x1`, `x2`, …), 2 bits each: delta, transmission.
+    pub lobes: u32,
     /// How the path ends.
     pub kind: Kind,
     /// Path length in segments from the camera.
     pub length: u8,
+    /// Index `k` of the reconnection vertex (2: the first bounce vertex); 0 for [`Kind::Frozen`].
+    pub rc: u8,
+    /// Whether the path's light connection is light sampling (else a BSDF ray hit an emitter).
+    pub nee: bool,
 }
 
 impl PathSample {
-    /// A path whose light connection is at `x1` (light point `y`).
+    /// A path whose light connection is at `x_{k−1}` (light point `y`, which is `x_k`).
     pub fn direct(y: LightPoint, kind: Kind) -> Self {
         Self {
             id: y.light,
@@ -98,12 +150,18 @@ impl PathSample {
             dir: Vec3::ZERO,
             radiance: Vec3::ZERO,
             light_pdf: 0.0,
+            value: Vec3::ZERO,
+            geometry: 0.0,
+            seed: Pcg32::default(),
+            lobes: 0,
             kind,
             length: 2,
+            rc: 2,
+            nee: kind == Kind::DirectNee,
         }
     }
 
-    /// Whether `x2` is a light point (the path ends there).
+    /// Whether `x_k` is a light point (the path ends there).
     #[inline]
     pub fn is_direct(&self) -> bool {
         matches!(self.kind, Kind::DirectNee | Kind::DirectHit)
@@ -219,9 +277,7 @@ pub fn evaluate_unshadowed(
             if f1 == Vec3::ZERO {
                 return (Vec3::ZERO, Target::None);
             }
-            let term = if s.kind == Kind::Frozen {
-                s.radiance
-            } else {
+            let term = {
                 let bsdf2 = scene.bsdf(si);
                 let wo2 = si.shading.to_local(-w1);
                 let wi2 = si.shading.to_local(s.dir);
@@ -265,20 +321,19 @@ pub fn visible(scene: &Scene, r: &Receiver, ng: Vec3, target: Target) -> bool {
     !scene.occluded(&ray, t_max)
 }
 
-/// The reconnection shift between pixels; a domain is a pixel index into `gbuf`, or, from the
-/// pixel count on, `pixel count + index` into `prev` (the previous pass, for temporal reuse).
+/// The shift between pixels (reconnection, replay or hybrid, as [`Walker::shift`] says); a
+/// domain is a pixel index into `gbuf`, or, from the pixel count on, `pixel count + index` into
+/// `prev` (the previous pass, for temporal reuse).
 #[derive(Debug)]
 pub struct PtShift<'a> {
-    /// The scene.
-    pub scene: &'a Scene,
+    /// The walks' rules (scene, shift, depth, `d_near`).
+    pub walker: Walker<'a>,
     /// The primary hits.
     pub gbuf: &'a GBuffer,
     /// The previous pass's primary hits (temporal reuse).
     pub prev: Option<&'a GBuffer>,
-    /// Shadow rays traced by this map's shifts.
+    /// Rays traced by this map's shifts (shadow rays and replayed segments).
     pub rays: Cell<u64>,
-    /// Square of the shortest reconnection segment.
-    pub near_distance2: f32,
     /// Symmetric Jacobian rejection bound (`max(J, 1/J)`); 0 for none.
     pub max_jacobian: f32,
     /// Negative control: Jacobian 1 (biased).
@@ -286,47 +341,76 @@ pub struct PtShift<'a> {
 }
 
 impl PtShift<'_> {
-    /// The primary hit and geometric normal of domain `d`.
+    /// The primary hit of domain `d`.
     #[inline]
-    fn hit(&self, d: usize) -> Option<(&Receiver, Vec3)> {
+    fn hit(&self, d: usize) -> Option<Vtx> {
         let n = self.gbuf.receivers.len();
         let (buf, i) = if d < n {
             (self.gbuf, d)
         } else {
             (self.prev?, d - n)
         };
-        buf.receiver(i).map(|r| (r, buf.ng[i]))
+        buf.receiver(i)
+            .map(|r| Vtx::primary(self.walker.scene, r, buf.ng[i]))
     }
 
-    /// The target (with visibility) and the Jacobian of shifting `s` from pixel `from` to pixel
-    /// `to`; `None` if the shift is not defined there.
-    pub fn shift_full(&self, from: usize, to: usize, s: &PathSample) -> Option<(f32, f32, Vec3)> {
+    /// The target (luminance, with visibility), the Jacobian and the shifted sample (its
+    /// `value` the integrand at `to`) of shifting `s` from pixel `from` to pixel `to`; `None` if
+    /// the shift is not defined there.
+    pub fn shift_full(
+        &self,
+        from: usize,
+        to: usize,
+        s: &PathSample,
+    ) -> Option<(f32, f32, PathSample)> {
+        let _ = from;
+        let walker = &self.walker;
+        let scene = walker.scene;
+        let y1 = self.hit(to)?;
         if s.kind == Kind::Frozen {
+            if walker.shift == ShiftKind::Reconnection {
+                return None;
+            }
+            let (out, rays) = walker.walk(&y1, s.seed, Some(s), &mut |_, _| {});
+            self.rays.set(self.rays.get() + rays);
+            let Replayed::Value(f) = out else {
+                return None;
+            };
+            let p = luminance(f);
+            let p = if p > 0.0 && p.is_finite() { p } else { 0.0 };
+            let value = if p > 0.0 { f } else { Vec3::ZERO };
+            return Some((p, 1.0, PathSample { value, ..*s }));
+        }
+        let (prev, thp) = if s.rc <= 2 {
+            (y1, Vec3::ONE)
+        } else {
+            let (out, rays) = walker.walk(&y1, s.seed, Some(s), &mut |_, _| {});
+            self.rays.set(self.rays.get() + rays);
+            match out {
+                Replayed::Prefix { v, thp } => (v, thp),
+                _ => return None,
+            }
+        };
+        // Invertibility (ii): the inverse shift reconnects from `y_{k−1}` only if it is rough.
+        if !prev.conn && !walker.skip_invertibility {
             return None;
         }
-        let ((src, _), (dst, dst_ng)) = (self.hit(from)?, self.hit(to)?);
-        if !connectible(&src.resolve_bsdf(self.scene))
-            || !connectible(&dst.resolve_bsdf(self.scene))
-        {
-            return None;
-        }
-        let v = resolve_vertex(self.scene, s);
+        let v = resolve_vertex(scene, s);
         if let Vertex::Surface(si) = &v
-            && !connectible(&self.scene.bsdf(si))
+            && !connectible(&scene.bsdf(si))
         {
             return None;
         }
         if let Some(p) = v.position()
-            && ((p - src.p).length_squared() < self.near_distance2
-                || (p - dst.p).length_squared() < self.near_distance2)
+            && (p - prev.r.p).length_squared() < walker.near2
         {
             return None;
         }
-        let jacobian = match v.area_point() {
-            Some((p, n)) => {
-                reconnection_jacobian_from_points(src.p.into(), dst.p.into(), p.into(), n.into())
-            }
-            None => 1.0,
+        let (geometry, f, target) = walker.reconnect(&prev, thp, s, &v);
+        let jacobian = if v.area_point().is_some() {
+            reconnection_jacobian_from_geometry(geometry, s.geometry)
+        } else {
+            1.0
         };
         if jacobian.is_nan() || jacobian <= 0.0 {
             return None;
@@ -335,17 +419,21 @@ impl PtShift<'_> {
             return None;
         }
         let jacobian = if self.unit_jacobian { 1.0 } else { jacobian };
-        let (f, target) = evaluate_unshadowed(self.scene, dst, s, &v);
         let mut p = luminance(f);
         if !(p > 0.0 && p.is_finite()) {
             p = 0.0;
         } else {
             self.rays.set(self.rays.get() + 1);
-            if !visible(self.scene, dst, dst_ng, target) {
+            if !visible(scene, &prev.r, prev.ng, target) {
                 p = 0.0;
             }
         }
-        Some((p, jacobian, if p > 0.0 { f } else { Vec3::ZERO }))
+        let shifted = PathSample {
+            geometry,
+            value: if p > 0.0 { f } else { Vec3::ZERO },
+            ..*s
+        };
+        Some((p, jacobian, shifted))
     }
 }
 
@@ -354,9 +442,9 @@ impl ShiftMap<PathSample> for PtShift<'_> {
 
     #[inline]
     fn shift(&self, from: &usize, to: &usize, x: &PathSample) -> Option<Shifted<PathSample>> {
-        let (target_pdf, jacobian, _) = self.shift_full(*from, *to, x)?;
+        let (target_pdf, jacobian, sample) = self.shift_full(*from, *to, x)?;
         Some(Shifted {
-            sample: *x,
+            sample,
             jacobian,
             target_pdf,
         })

@@ -6,8 +6,10 @@ use restir_gris::MisScheme;
 use crate::params::{parse_bool, parse_count, parse_mis, parse_positive};
 use crate::path::PathSettings;
 
-/// The shifts `--shift` accepts (only reconnection is implemented).
-pub const SHIFT_NAMES: &[&str] = &["reconnection"];
+use super::sample::ShiftKind;
+
+/// The shifts `--shift` accepts.
+pub const SHIFT_NAMES: &[&str] = &["reconnection", "replay", "hybrid"];
 
 /// Everything ReSTIR PT can be told.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,8 +44,17 @@ pub struct RestirPtSettings {
     /// the power heuristic, per pixel) instead of carrying it in the reservoirs (`direct = path`;
     /// default `reservoir`).
     pub direct_path_traced: bool,
+    /// Hand the direct light at the primary hit (and the emitters the camera sees) to a ReSTIR DI
+    /// pass with the same reuse settings; the reservoirs carry the paths of three or more
+    /// segments (`direct = restir-di`).
+    pub direct_restir_di: bool,
     /// Negative control only: use Jacobian 1 in every shift (biased).
     pub unit_jacobian: bool,
+    /// The shift between pixels (default hybrid; plain reconnection in scenes without
+    /// near-specular materials).
+    pub shift: ShiftKind,
+    /// Negative control only: skip the hybrid shift's invertibility checks (biased).
+    pub skip_invertibility: bool,
 }
 
 impl RestirPtSettings {
@@ -63,13 +74,16 @@ impl RestirPtSettings {
             near_distance: 0.01,
             max_jacobian: 0.0,
             direct_path_traced: false,
+            direct_restir_di: false,
             unit_jacobian: false,
+            shift: ShiftKind::Hybrid,
+            skip_invertibility: false,
         }
     }
 
     /// Whether the estimator is unbiased with these settings.
     pub fn is_unbiased(&self) -> bool {
-        self.mis.is_unbiased() && !self.unit_jacobian
+        self.mis.is_unbiased() && !self.unit_jacobian && !self.skip_invertibility
     }
 
     /// Applies `name = value` parameters in order (later ones win). Names are case-insensitive,
@@ -105,15 +119,18 @@ impl RestirPtSettings {
                     self.mcap = parse_positive(name, v)?;
                 }
                 "temporal" | "temporal_reuse" => self.temporal = parse_bool(name, v)?,
-                "shift" => {
-                    let s = v.to_ascii_lowercase();
-                    if !SHIFT_NAMES.contains(&s.as_str()) {
-                        return Err(format!(
-                            "{name} = '{v}': only {} is implemented (random replay and the \
-                             hybrid shift are not)",
-                            SHIFT_NAMES.join(", ")
-                        ));
-                    }
+                "shift" | "shift_mapping" => {
+                    self.shift = match v.to_ascii_lowercase().as_str() {
+                        "reconnection" | "reconnect" => ShiftKind::Reconnection,
+                        "replay" | "random_replay" | "random-replay" => ShiftKind::Replay,
+                        "hybrid" => ShiftKind::Hybrid,
+                        _ => {
+                            return Err(format!(
+                                "{name} = '{v}': expected one of {}",
+                                SHIFT_NAMES.join(", ")
+                            ));
+                        }
+                    };
                 }
                 "normal_threshold" => {
                     let deg = parse_positive(name, v)?;
@@ -136,18 +153,20 @@ impl RestirPtSettings {
                     self.max_jacobian = j;
                 }
                 "direct" => {
-                    self.direct_path_traced = match v.to_ascii_lowercase().as_str() {
-                        "reservoir" | "reservoirs" => false,
-                        "path" => true,
-                        _ => {
-                            return Err(format!(
-                                "{name} = '{v}': expected reservoir or path (restir-di is not \
-                                 implemented)"
-                            ));
-                        }
-                    };
+                    (self.direct_path_traced, self.direct_restir_di) =
+                        match v.to_ascii_lowercase().replace('_', "-").as_str() {
+                            "reservoir" | "reservoirs" => (false, false),
+                            "path" => (true, false),
+                            "restir-di" | "restirdi" | "di" => (false, true),
+                            _ => {
+                                return Err(format!(
+                                    "{name} = '{v}': expected reservoir, path or restir-di"
+                                ));
+                            }
+                        };
                 }
                 "unit_jacobian" => self.unit_jacobian = parse_bool(name, v)?,
+                "skip_invertibility" => self.skip_invertibility = parse_bool(name, v)?,
                 _ => unknown.push(name.clone()),
             }
         }
@@ -180,10 +199,12 @@ mod tests {
         assert_eq!(unknown, vec!["foo".to_string()]);
         assert_eq!((s.neighbors, s.spatial_rounds, s.candidates), (5, 2, 4));
         assert_eq!(s.mis, MisScheme::GeneralizedBalance);
+        s.apply(&[p("shift", "replay")]).unwrap();
+        assert_eq!(s.shift, ShiftKind::Replay);
         assert!(
-            s.apply(&[p("shift", "hybrid")])
+            s.apply(&[p("shift", "manifold")])
                 .unwrap_err()
-                .contains("reconnection")
+                .contains("reconnection, replay, hybrid")
         );
         assert!(s.apply(&[p("candidates", "0")]).is_err());
     }
