@@ -30,13 +30,6 @@ fn load(dir: &Path, rel: &str) -> LoadedScene {
     load_scene(&path, &[]).unwrap_or_else(|e| panic!("{rel} should load: {e}"))
 }
 
-fn load_err(dir: &Path, rel: &str) -> String {
-    match load_scene(&dir.join(rel), &[]) {
-        Ok(_) => panic!("{rel} loads; update this test and docs/SCENES.md"),
-        Err(e) => e.to_string(),
-    }
-}
-
 #[test]
 fn supported_corpus_scenes_load() {
     let Some(dir) = corpus() else { return };
