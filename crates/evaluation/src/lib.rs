@@ -120,8 +120,10 @@ pub struct Strip {
     pub crop: (u32, u32, u32, u32),
     /// Budget of the cropped renders.
     pub budget: f64,
-    /// Reference crop, then one crop per configuration.
+    /// Reference crop, then one crop per configuration that rendered the scene.
     pub crops: Vec<Image>,
+    /// `"reference"`, then the label of each configuration crop.
+    pub labels: Vec<String>,
 }
 
 /// The machine the suite ran on.
@@ -468,7 +470,7 @@ pub fn run_suite(
     let mut scenes = Vec::new();
     for entry in &suite.scenes {
         let loaded = load_suite_scene(entry, &opts.suite_dir)?;
-        for config in &suite.integrators {
+        for config in suite.integrators.iter().filter(|c| entry.runs(&c.label)) {
             build_integrator(&loaded.scene, config, entry)?;
         }
         let (w, h) = loaded.scene.camera.resolution();
@@ -476,8 +478,14 @@ pub fn run_suite(
         scenes.push((entry, loaded, rect));
     }
 
-    let per_scene = (suite.budgets.len() * suite.integrators.len()) as u64 * suite.seeds as u64;
-    let total = scenes.len() as u64 * (1 + per_scene);
+    let per_config = suite.budgets.len() as u64 * suite.seeds as u64;
+    let total: u64 = scenes
+        .iter()
+        .map(|(entry, _, _)| {
+            let configs = suite.integrators.iter().filter(|c| entry.runs(&c.label));
+            1 + configs.count() as u64 * per_config
+        })
+        .sum();
     let mut done = 0u64;
     let strip_budget = suite
         .strip_budget
@@ -500,13 +508,21 @@ pub fn run_suite(
         let integrators = suite
             .integrators
             .iter()
-            .map(|c| build_integrator(&loaded.scene, c, entry))
+            .map(|c| {
+                entry
+                    .runs(&c.label)
+                    .then(|| build_integrator(&loaded.scene, c, entry))
+                    .transpose()
+            })
             .collect::<Result<Vec<_>, _>>()?;
         // Seeds outermost, so that a load spike on the shared machine hits every configuration
         // and budget rather than all seeds of one.
         for seed in 0..suite.seeds as u64 {
             for &budget in &suite.budgets {
                 for (ci, config) in suite.integrators.iter().enumerate() {
+                    let Some(integrator) = integrators[ci].as_deref() else {
+                        continue;
+                    };
                     progress(&Progress {
                         done,
                         total,
@@ -515,7 +531,6 @@ pub fn run_suite(
                             loaded.name, config.label
                         ),
                     });
-                    let integrator = integrators[ci].as_ref();
                     let settings = RenderSettings {
                         spp: u32::MAX,
                         time_limit: Some(Duration::from_secs_f64(budget)),
@@ -552,12 +567,19 @@ pub fn run_suite(
             }
         }
         let mut crops = vec![crop(&reference, *rect)];
-        crops.extend(strip_crops.into_iter().flatten());
+        let mut labels = vec!["reference".to_string()];
+        for (config, c) in suite.integrators.iter().zip(strip_crops) {
+            if let Some(c) = c {
+                crops.push(c);
+                labels.push(config.label.clone());
+            }
+        }
         strips.push(Strip {
             scene: loaded.name.clone(),
             crop: *rect,
             budget: strip_budget,
             crops,
+            labels,
         });
     }
     progress(&Progress {
@@ -606,6 +628,7 @@ mod tests {
             reference: None,
             reference_spp: None,
             crop: None,
+            integrators: None,
         };
         assert_eq!(crop_rect(&entry, 64, 32).unwrap(), (16, 8, 32, 16));
         let bad = SuiteScene {

@@ -363,8 +363,7 @@ pub fn report_markdown(results: &BenchResults, h: &str, link: &str) -> String {
         );
         let (cx, cy, cw, ch) = strip.crop;
         let k = strip_scale(strip);
-        let mut names = vec!["reference".to_string()];
-        names.extend(results.suite.integrators.iter().map(|c| c.label.clone()));
+        let names = &strip.labels;
         let _ = writeln!(
             s,
             "![crops, {}]({link}strip-{}.png)\n\nCrops, left to right: {}. Pixels ({cx}, {cy}) to \
@@ -500,6 +499,10 @@ pub fn write_outputs(results: &BenchResults, out: &Path) -> Result<(), String> {
                     .map(|x| (x.seconds, x.relmse))
                     .collect(),
             })
+            .collect();
+        let series: Vec<Series> = series
+            .into_iter()
+            .filter(|s| !s.points.is_empty())
             .collect();
         relmse_plot(
             &out.join(format!("relmse-{}.svg", r.scene)),

@@ -55,6 +55,9 @@ pub struct SuiteScene {
     /// central quarter of the image).
     #[serde(default)]
     pub crop: Option<(u32, u32, u32, u32)>,
+    /// Labels of the integrator configurations that render this scene (default: all of them).
+    #[serde(default)]
+    pub integrators: Option<Vec<String>>,
 }
 
 /// One integrator configuration: what `IntegratorOptions` takes, plus a label.
@@ -90,6 +93,13 @@ impl IntegratorConfig {
 }
 
 impl SuiteScene {
+    /// Whether the configuration labelled `label` renders this scene.
+    pub fn runs(&self, label: &str) -> bool {
+        self.integrators
+            .as_ref()
+            .is_none_or(|l| l.iter().any(|x| x == label))
+    }
+
     /// The scene's name in the outputs.
     pub fn display_name(&self) -> String {
         self.name.clone().unwrap_or_else(|| {
@@ -197,6 +207,23 @@ impl Suite {
             }
             labels.push(&c.label);
         }
+        for s in &self.scenes {
+            let Some(list) = &s.integrators else {
+                continue;
+            };
+            if list.is_empty() {
+                return Err(format!(
+                    "{}: empty `integrators` list (leave it out for all)",
+                    s.path.display()
+                ));
+            }
+            if let Some(bad) = list.iter().find(|l| !labels.contains(&l.as_str())) {
+                return Err(format!(
+                    "{}: `integrators` names '{bad}', which is not a configuration label",
+                    s.path.display()
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -247,5 +274,11 @@ mod tests {
         assert!(e.contains("time budget -1"), "{e}");
         let e = Suite::parse(&GOOD.replace("\"di\"", "\"path\""), Path::new("s.ron")).unwrap_err();
         assert!(e.contains("used twice"), "{e}");
+        let only = GOOD.replace("height: Some(16)", "height: 16, integrators: [\"di\"]");
+        let s = Suite::parse(&only, Path::new("s.ron")).unwrap();
+        assert!(s.scenes[0].runs("di") && !s.scenes[0].runs("path"));
+        let e =
+            Suite::parse(&only.replace("[\"di\"]", "[\"dj\"]"), Path::new("s.ron")).unwrap_err();
+        assert!(e.contains("'dj'"), "{e}");
     }
 }

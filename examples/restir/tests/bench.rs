@@ -101,9 +101,16 @@ fn smoke_suite_end_to_end() {
     let header = fields(lines.next().unwrap());
     let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
     let rows: Vec<Vec<&str>> = lines.map(fields).collect();
-    assert_eq!(rows.len(), 2 * 3, "{csv}");
+    // Each scene renders only the configurations its `integrators` list names.
+    assert_eq!(rows.len(), 3 + 3 + 2, "{csv}");
     let scenes: Vec<&str> = rows.iter().map(|r| r[col("scene")]).collect();
     assert!(scenes.contains(&"cornell-box") && scenes.contains(&"many-lights"));
+    let room: Vec<&str> = rows
+        .iter()
+        .filter(|r| r[col("scene")] == "indirect-room")
+        .map(|r| r[col("label")])
+        .collect();
+    assert_eq!(room, ["path", "restir-pt"], "{csv}");
     for r in &rows {
         assert_eq!(r.len(), header.len(), "{r:?}");
         let num = |name: &str| r[col(name)].parse::<f64>().unwrap();
@@ -126,6 +133,8 @@ fn smoke_suite_end_to_end() {
         let png = std::fs::read(out_dir.join(format!("strip-{scene}.png"))).unwrap();
         assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"));
     }
+    let svg = std::fs::read_to_string(out_dir.join("relmse-indirect-room.svg")).unwrap();
+    assert!(svg.contains("restir-pt") && !svg.contains("restir-di"));
 
     let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
     for needle in [
@@ -135,6 +144,7 @@ fn smoke_suite_end_to_end() {
         "relmse-many-lights.svg",
         "strip-cornell-box.png",
         "| restir-di tuned |",
+        "Crops, left to right: reference, path, restir-pt.",
         "equal-time ratio",
         "own relMSE",
     ] {
