@@ -9,6 +9,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use clap::{Parser, Subcommand};
+use restir_geometry::Shape;
 use restir_integrators::{
     Image, IntegratorOptions, RenderSettings, compare, make_integrator, render,
 };
@@ -183,6 +184,10 @@ struct Stats<'a> {
     integrator: &'a str,
     integrator_settings: String,
     buffer_bytes_per_pixel: usize,
+    /// Triangles and analytic spheres in the scene.
+    triangles: usize,
+    spheres: usize,
+    lights: usize,
     seconds: f64,
     load_seconds: f64,
     spp: u32,
@@ -386,6 +391,20 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
             integrator: integrator.name(),
             integrator_settings: integrator.describe(),
             buffer_bytes_per_pixel: integrator.buffer_bytes_per_pixel(),
+            triangles: scene
+                .shapes
+                .iter()
+                .map(|s| match s {
+                    Shape::Mesh(m) => m.triangle_count(),
+                    Shape::Sphere(_) => 0,
+                })
+                .sum(),
+            spheres: scene
+                .shapes
+                .iter()
+                .filter(|s| matches!(s, Shape::Sphere(_)))
+                .count(),
+            lights: scene.lights.len(),
             seconds: out.seconds,
             load_seconds,
             spp: out.passes,
