@@ -12,10 +12,11 @@
 //!   materials are not wired yet) renders without non-finite pixels.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
 
-use restir_integrators::{Image, IntegratorOptions, RenderSettings, make_integrator, render};
 use restir_scene::{Scene, parse_ron};
+
+mod common;
+use common::{block_statistics, max_z, render_image};
 
 /// A fresh directory per test (tests run in parallel and each removes its own).
 fn temp_dir(test: &str) -> PathBuf {
@@ -36,33 +37,6 @@ fn write_exr(path: &Path, w: usize, h: usize, f: impl Fn(usize, usize) -> [f32; 
 fn build(ron: &str) -> Scene {
     let desc = parse_ron(ron, "envmap-test.ron".as_ref()).unwrap();
     Scene::build(&desc, ".".as_ref(), "envmap-test.ron".as_ref()).unwrap()
-}
-
-fn render_image(scene: &Scene, name: &str, params: &[(&str, &str)], spp: u32, seed: u64) -> Image {
-    let options = IntegratorOptions {
-        name: Some(name.into()),
-        max_depth: None,
-        params: params
-            .iter()
-            .map(|(k, v)| (k.to_string(), v.to_string()))
-            .collect(),
-    };
-    let made = make_integrator(scene, &options).unwrap();
-    assert!(made.unused_params.is_empty());
-    let settings = RenderSettings {
-        spp,
-        time_limit: None,
-        seed,
-    };
-    let out = render(
-        scene,
-        made.integrator.as_ref(),
-        &settings,
-        &AtomicBool::new(false),
-        &mut |_, _| {},
-    );
-    assert_eq!(out.nonfinite_pixels, 0, "{name}: non-finite pixels");
-    out.image
 }
 
 // ------------------------------------------------------------------------------------------
@@ -195,19 +169,6 @@ fn sky_map(dir: &Path) -> PathBuf {
     path
 }
 
-fn block_means(img: &Image) -> Vec<f64> {
-    let blocks = SIZE / BLOCK;
-    let mut out = vec![0.0; (blocks * blocks) as usize];
-    for y in 0..SIZE {
-        for x in 0..SIZE {
-            let p = img.pixels[(y * SIZE + x) as usize];
-            out[((y / BLOCK) * blocks + x / BLOCK) as usize] +=
-                f64::from(p.x + p.y + p.z) / 3.0 / f64::from(BLOCK * BLOCK);
-        }
-    }
-    out
-}
-
 fn statistics(
     scene: &Scene,
     name: &str,
@@ -215,24 +176,8 @@ fn statistics(
     spp: u32,
     seeds: u64,
 ) -> Vec<(f64, f64)> {
-    let samples: Vec<Vec<f64>> = (0..seeds)
-        .map(|s| block_means(&render_image(scene, name, params, spp, 2000 + s)))
-        .collect();
-    let n = seeds as f64;
-    (0..samples[0].len())
-        .map(|b| {
-            let mean = samples.iter().map(|v| v[b]).sum::<f64>() / n;
-            let var = samples.iter().map(|v| (v[b] - mean).powi(2)).sum::<f64>() / (n - 1.0);
-            (mean, (var / n).sqrt())
-        })
-        .collect()
-}
-
-fn max_z(a: &[(f64, f64)], b: &[(f64, f64)]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(&(ma, sa), &(mb, sb))| (ma - mb).abs() / (sa * sa + sb * sb).sqrt().max(1e-12))
-        .fold(0.0, f64::max)
+    let render_one = |seed| render_image(scene, name, params, spp, seed);
+    block_statistics(render_one, seeds, 2000, BLOCK)
 }
 
 /// 16 blocks per comparison.

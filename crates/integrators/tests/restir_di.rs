@@ -5,11 +5,12 @@
 //! *across seeds* (spatial reuse correlates the pixels of one render). The biased options
 //! (constant 1/M weights, visibility reuse) must fail the same test.
 
-use std::sync::atomic::AtomicBool;
-
 use restir_integrators::restir_di::MIS_NAMES;
-use restir_integrators::{Image, IntegratorOptions, RenderSettings, make_integrator, render};
+use restir_integrators::{IntegratorOptions, make_integrator};
 use restir_scene::{Scene, parse_ron};
+
+mod common;
+use common::{block_statistics, max_z, render_image};
 
 const SIZE: u32 = 32;
 const BLOCK: u32 = 8;
@@ -43,56 +44,6 @@ fn scene() -> Scene {
     Scene::build(&desc, ".".as_ref(), "di-test.ron".as_ref()).unwrap()
 }
 
-fn render_image(scene: &Scene, name: &str, params: &[(&str, &str)], spp: u32, seed: u64) -> Image {
-    // "max_depth" is the command line's --max-depth; the rest are estimator parameters.
-    let max_depth = params
-        .iter()
-        .find(|(k, _)| *k == "max_depth")
-        .map(|(_, v)| v.parse().unwrap());
-    let params: Vec<_> = params.iter().filter(|(k, _)| *k != "max_depth").collect();
-    let options = IntegratorOptions {
-        name: Some(name.into()),
-        max_depth,
-        params: params
-            .iter()
-            .map(|(k, v)| (k.to_string(), v.to_string()))
-            .collect(),
-    };
-    let made = make_integrator(scene, &options).unwrap();
-    assert!(made.unused_params.is_empty());
-    let settings = RenderSettings {
-        spp,
-        time_limit: None,
-        seed,
-    };
-    let out = render(
-        scene,
-        made.integrator.as_ref(),
-        &settings,
-        &AtomicBool::new(false),
-        &mut |_, _| {},
-    );
-    assert_eq!(
-        out.nonfinite_pixels, 0,
-        "{name} {params:?}: non-finite pixels"
-    );
-    out.image
-}
-
-/// Mean RGB-average of each `BLOCK`×`BLOCK` block of the image.
-fn block_means(img: &Image) -> Vec<f64> {
-    let blocks = SIZE / BLOCK;
-    let mut out = vec![0.0; (blocks * blocks) as usize];
-    for y in 0..SIZE {
-        for x in 0..SIZE {
-            let p = img.pixels[(y * SIZE + x) as usize];
-            out[((y / BLOCK) * blocks + x / BLOCK) as usize] +=
-                f64::from(p.x + p.y + p.z) / 3.0 / f64::from(BLOCK * BLOCK);
-        }
-    }
-    out
-}
-
 /// Per block: mean and standard error of the mean over `seeds` independent renders.
 fn statistics(
     scene: &Scene,
@@ -101,25 +52,8 @@ fn statistics(
     spp: u32,
     seeds: u64,
 ) -> Vec<(f64, f64)> {
-    let samples: Vec<Vec<f64>> = (0..seeds)
-        .map(|s| block_means(&render_image(scene, name, params, spp, seed_base() + s)))
-        .collect();
-    let n = seeds as f64;
-    (0..samples[0].len())
-        .map(|b| {
-            let mean = samples.iter().map(|v| v[b]).sum::<f64>() / n;
-            let var = samples.iter().map(|v| (v[b] - mean).powi(2)).sum::<f64>() / (n - 1.0);
-            (mean, (var / n).sqrt())
-        })
-        .collect()
-}
-
-/// The largest |z| over blocks between two sets of block statistics.
-fn max_z(a: &[(f64, f64)], b: &[(f64, f64)]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(&(ma, sa), &(mb, sb))| (ma - mb).abs() / (sa * sa + sb * sb).sqrt().max(1e-12))
-        .fold(0.0, f64::max)
+    let render_one = |seed| render_image(scene, name, params, spp, seed);
+    block_statistics(render_one, seeds, seed_base(), BLOCK)
 }
 
 fn direct_reference(scene: &Scene) -> Vec<(f64, f64)> {

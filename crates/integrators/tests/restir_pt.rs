@@ -5,19 +5,19 @@
 //! front. Means over independent renders are compared block by block with the standard error
 //! measured across seeds (the test pattern of `tests/restir_di.rs`); biased variants must fail.
 
-use std::sync::atomic::AtomicBool;
-
 use restir_gris::ShiftMap;
 use restir_integrators::film::Filter;
 use restir_integrators::path::PathSettings;
 use restir_integrators::restir_di::MIS_NAMES;
 use restir_integrators::restir_pt::{Kind, ShiftKind};
 use restir_integrators::{
-    Image, IntegratorOptions, PassContext, RenderSettings, RestirPtIntegrator, RestirPtSettings,
-    make_integrator, render,
+    Image, IntegratorOptions, PassContext, RestirPtIntegrator, RestirPtSettings, make_integrator,
 };
 use restir_sampling::Pcg32;
 use restir_scene::{Scene, parse_ron};
+
+mod common;
+use common::{block_statistics, max_z};
 
 const SIZE: u32 = 24;
 const BLOCK: u32 = 8;
@@ -77,56 +77,14 @@ fn scene_with(extra: &str) -> Scene {
 }
 
 fn render_image(scene: &Scene, name: &str, params: &[(&str, &str)], spp: u32, seed: u64) -> Image {
-    let max_depth = params
-        .iter()
-        .find(|(k, _)| *k == "max_depth")
-        .map(|(_, v)| v.parse().unwrap());
-    let params: Vec<_> = params.iter().filter(|(k, _)| *k != "max_depth").collect();
-    let options = IntegratorOptions {
-        name: Some(name.into()),
-        max_depth,
-        params: params
-            .iter()
-            .map(|(k, v)| (k.to_string(), v.to_string()))
-            .collect(),
-    };
-    let mut options = options;
+    // Neighbours within a third of this small image (the default 30 px would mostly miss); a
+    // radius given in `params` comes later and wins.
+    let mut all = Vec::with_capacity(params.len() + 1);
     if name == "restir-pt" {
-        // Neighbours within a third of this small image (the default 30 px would mostly miss).
-        options.params.insert(0, ("radius".into(), "8".into()));
+        all.push(("radius", "8"));
     }
-    let made = make_integrator(scene, &options).unwrap();
-    assert!(made.unused_params.is_empty());
-    let settings = RenderSettings {
-        spp,
-        time_limit: None,
-        seed,
-    };
-    let out = render(
-        scene,
-        made.integrator.as_ref(),
-        &settings,
-        &AtomicBool::new(false),
-        &mut |_, _| {},
-    );
-    assert_eq!(
-        out.nonfinite_pixels, 0,
-        "{name} {params:?}: non-finite pixels"
-    );
-    out.image
-}
-
-fn block_means(img: &Image) -> Vec<f64> {
-    let blocks = SIZE / BLOCK;
-    let mut out = vec![0.0; (blocks * blocks) as usize];
-    for y in 0..SIZE {
-        for x in 0..SIZE {
-            let p = img.pixels[(y * SIZE + x) as usize];
-            out[((y / BLOCK) * blocks + x / BLOCK) as usize] +=
-                f64::from(p.x + p.y + p.z) / 3.0 / f64::from(BLOCK * BLOCK);
-        }
-    }
-    out
+    all.extend_from_slice(params);
+    common::render_image(scene, name, &all, spp, seed)
 }
 
 fn statistics(
@@ -136,24 +94,8 @@ fn statistics(
     spp: u32,
     seeds: u64,
 ) -> Vec<(f64, f64)> {
-    let samples: Vec<Vec<f64>> = (0..seeds)
-        .map(|s| block_means(&render_image(scene, name, params, spp, 2000 + s)))
-        .collect();
-    let n = seeds as f64;
-    (0..samples[0].len())
-        .map(|b| {
-            let mean = samples.iter().map(|v| v[b]).sum::<f64>() / n;
-            let var = samples.iter().map(|v| (v[b] - mean).powi(2)).sum::<f64>() / (n - 1.0);
-            (mean, (var / n).sqrt())
-        })
-        .collect()
-}
-
-fn max_z(a: &[(f64, f64)], b: &[(f64, f64)]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(&(ma, sa), &(mb, sb))| (ma - mb).abs() / (sa * sa + sb * sb).sqrt().max(1e-12))
-        .fold(0.0, f64::max)
+    let render_one = |seed| render_image(scene, name, params, spp, seed);
+    block_statistics(render_one, seeds, 2000, BLOCK)
 }
 
 /// 9 blocks × a few configurations: a Bonferroni-style bound of 4.5 standard errors.

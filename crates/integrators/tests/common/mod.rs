@@ -1,0 +1,95 @@
+//! Helpers shared by the integrators' statistical tests: render a scene with an estimator and
+//! compare per-block means of independent renders by their standard errors.
+#![allow(dead_code)] // each test file uses a different subset
+
+use std::sync::atomic::AtomicBool;
+
+use restir_integrators::{Image, IntegratorOptions, RenderSettings, make_integrator, render};
+use restir_scene::Scene;
+
+/// Renders `scene` with estimator `name`. `params` are the estimator's parameters, except
+/// `max_depth`, which is taken as the command line's `--max-depth`. Every parameter must be used
+/// and every pixel finite.
+pub fn render_image(
+    scene: &Scene,
+    name: &str,
+    params: &[(&str, &str)],
+    spp: u32,
+    seed: u64,
+) -> Image {
+    let max_depth = params
+        .iter()
+        .find(|(k, _)| *k == "max_depth")
+        .map(|(_, v)| v.parse().unwrap());
+    let params: Vec<_> = params.iter().filter(|(k, _)| *k != "max_depth").collect();
+    let options = IntegratorOptions {
+        name: Some(name.into()),
+        max_depth,
+        params: params
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect(),
+    };
+    let made = make_integrator(scene, &options).unwrap();
+    assert!(made.unused_params.is_empty());
+    let settings = RenderSettings {
+        spp,
+        time_limit: None,
+        seed,
+    };
+    let out = render(
+        scene,
+        made.integrator.as_ref(),
+        &settings,
+        &AtomicBool::new(false),
+        &mut |_, _| {},
+    );
+    assert_eq!(
+        out.nonfinite_pixels, 0,
+        "{name} {params:?}: non-finite pixels"
+    );
+    out.image
+}
+
+/// Mean RGB-average of each `block`×`block` block of the image (row-major blocks).
+pub fn block_means(img: &Image, block: u32) -> Vec<f64> {
+    let (bx, by) = (img.width / block, img.height / block);
+    let mut out = vec![0.0; (bx * by) as usize];
+    for y in 0..by * block {
+        for x in 0..bx * block {
+            let p = img.pixels[(y * img.width + x) as usize];
+            out[((y / block) * bx + x / block) as usize] +=
+                f64::from(p.x + p.y + p.z) / 3.0 / f64::from(block * block);
+        }
+    }
+    out
+}
+
+/// Per block: mean and standard error of the mean over `seeds` independent renders with seeds
+/// `seed_base`, `seed_base + 1`, ….
+pub fn block_statistics(
+    render_one: impl Fn(u64) -> Image,
+    seeds: u64,
+    seed_base: u64,
+    block: u32,
+) -> Vec<(f64, f64)> {
+    let samples: Vec<Vec<f64>> = (0..seeds)
+        .map(|s| block_means(&render_one(seed_base + s), block))
+        .collect();
+    let n = seeds as f64;
+    (0..samples[0].len())
+        .map(|b| {
+            let mean = samples.iter().map(|v| v[b]).sum::<f64>() / n;
+            let var = samples.iter().map(|v| (v[b] - mean).powi(2)).sum::<f64>() / (n - 1.0);
+            (mean, (var / n).sqrt())
+        })
+        .collect()
+}
+
+/// The largest |z| over blocks between two sets of block statistics.
+pub fn max_z(a: &[(f64, f64)], b: &[(f64, f64)]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(&(ma, sa), &(mb, sb))| (ma - mb).abs() / (sa * sa + sb * sb).sqrt().max(1e-12))
+        .fold(0.0, f64::max)
+}
