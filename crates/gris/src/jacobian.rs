@@ -205,15 +205,7 @@ pub fn reconnection_jacobian_from_points(
     normal: [f32; 3],
 ) -> f32 {
     let geometry = |prev: [f32; 3]| -> (f32, f32) {
-        let v = [
-            f64::from(prev[0]) - f64::from(vertex[0]),
-            f64::from(prev[1]) - f64::from(vertex[1]),
-            f64::from(prev[2]) - f64::from(vertex[2]),
-        ];
-        let n = normal.map(f64::from);
-        let d2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-        let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-        let cos = (n[0] * v[0] + n[1] * v[1] + n[2] * v[2]) / (d2 * nn).sqrt();
+        let (cos, d2) = cos_and_dist2(prev, vertex, normal);
         (cos as f32, d2 as f32)
     };
     let (cos_x, dist2_x) = geometry(prev_x);
@@ -226,6 +218,15 @@ pub fn reconnection_jacobian_from_points(
 /// Computed in `f64`; 0 for a grazing angle or a zero distance.
 #[cfg(feature = "std")]
 pub fn geometry_term(prev: [f32; 3], vertex: [f32; 3], normal: [f32; 3]) -> f32 {
+    let (cos, d2) = cos_and_dist2(prev, vertex, normal);
+    let g = (cos.abs() / d2) as f32;
+    if g > 0.0 && g.is_finite() { g } else { 0.0 }
+}
+
+/// The signed cosine between `normal` (any length) and the direction from `vertex` to `prev`,
+/// and their squared distance, in `f64`.
+#[cfg(feature = "std")]
+fn cos_and_dist2(prev: [f32; 3], vertex: [f32; 3], normal: [f32; 3]) -> (f64, f64) {
     let v = [
         f64::from(prev[0]) - f64::from(vertex[0]),
         f64::from(prev[1]) - f64::from(vertex[1]),
@@ -234,9 +235,10 @@ pub fn geometry_term(prev: [f32; 3], vertex: [f32; 3], normal: [f32; 3]) -> f32 
     let n = normal.map(f64::from);
     let d2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
     let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-    let cos = ((n[0] * v[0] + n[1] * v[1] + n[2] * v[2]) / (d2 * nn).sqrt()).abs();
-    let g = (cos / d2) as f32;
-    if g > 0.0 && g.is_finite() { g } else { 0.0 }
+    (
+        (n[0] * v[0] + n[1] * v[1] + n[2] * v[2]) / (d2 * nn).sqrt(),
+        d2,
+    )
 }
 
 #[cfg(test)]
