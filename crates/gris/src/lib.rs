@@ -115,7 +115,7 @@
 //! # Modules
 //!
 //! * [`reservoir`] — [`Reservoir`] (stored) and [`StreamingReservoir`] (running WRS state).
-//! * [`gris`] — [`GrisResampler`], [`PairwiseResampler`], [`resample`].
+//! * [`resampling`] — [`GrisResampler`], [`PairwiseResampler`], [`resample`].
 //! * [`mis`] — every MIS weight with its formula and source; [`MisScheme`].
 //! * [`confidence`] — M-capping.
 //! * [`shift`] — the [`ShiftMap`] contract and [`Shifted`].
@@ -125,17 +125,17 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod confidence;
-pub mod gris;
 pub mod jacobian;
 pub mod mis;
+pub mod resampling;
 pub mod reservoir;
 pub mod shift;
 
 pub use confidence::{cap_confidence, cap_confidence_relative};
-pub use gris::{
+pub use mis::MisScheme;
+pub use resampling::{
     GrisInput, GrisResampler, PairwiseNeighbor, PairwiseResampler, PairwiseVariant, resample,
 };
-pub use mis::MisScheme;
 pub use reservoir::{Reservoir, StreamingReservoir};
 pub use shift::{ShiftMap, Shifted};
 

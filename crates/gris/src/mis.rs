@@ -26,7 +26,7 @@
 //! | defensive pairwise | [`defensive_pairwise_neighbor`], [`defensive_pairwise_canonical`] | yes | Lin et al. 2022 (GRIS / ReSTIR PT) |
 //! | confidence-weighted defensive pairwise | [`confidence_weighted_pairwise_neighbor`], [`confidence_weighted_pairwise_canonical`] | yes | Wyman et al. 2023, "A Gentle Introduction to ReSTIR" course notes |
 
-/// Selects an MIS scheme for the drivers in [`crate::gris`].
+/// Selects an MIS scheme for the drivers in [`crate::resampling`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum MisScheme {
     /// Constant weights `c_i/Σc` (legacy "1/M"). **Biased** whenever the domains differ in support

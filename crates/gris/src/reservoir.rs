@@ -24,7 +24,7 @@
 /// * `confidence` (`M`) is finite and `≥ 0`; it is a float because capping and pairwise
 ///   heuristics produce fractional values;
 /// * `target_pdf` is `p̂(Y)`, the target function of the domain that owns the reservoir evaluated
-///   at the selected sample (0 when empty). The MIS helpers in [`crate::gris`] use it as
+///   at the selected sample (0 when empty). The MIS helpers in [`crate::resampling`] use it as
 ///   `p̂_i(X_i)`, so it must be the same function the shift map evaluates for that domain.
 ///
 /// `E[f(Y)·W] = ∫ f` over the support of the target whenever the reservoir came out of an
@@ -222,7 +222,7 @@ impl<S> StreamingReservoir<S> {
     /// all candidates one by one. Returns `true` if `other`'s sample was taken.
     ///
     /// This is *not* GRIS reservoir reuse; to resample finalised reservoirs from other domains use
-    /// [`crate::gris`].
+    /// [`crate::resampling`].
     pub fn merge(&mut self, other: StreamingReservoir<S>, u: f32) -> bool {
         self.confidence += other.confidence;
         let Some(sample) = other.selected else {

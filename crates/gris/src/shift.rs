@@ -49,7 +49,7 @@ impl<S> Shifted<S> {
     }
 
     /// `true` when the Jacobian is finite and positive and the target finite and non-negative.
-    /// The drivers in [`crate::gris`] treat an invalid result like a failed shift.
+    /// The drivers in [`crate::resampling`] treat an invalid result like a failed shift.
     pub fn is_valid(&self) -> bool {
         self.jacobian > 0.0
             && self.jacobian.is_finite()

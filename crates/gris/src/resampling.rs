@@ -1,4 +1,4 @@
-//! GRIS: resampling finalised reservoirs from several domains into one receiving domain.
+//! Resampling finalised reservoirs from several domains into one receiving domain (GRIS).
 //!
 //! Implements one generalized-RIS step (Lin et al. 2022, "Generalized Resampled Importance
 //! Sampling: Foundations of ReSTIR"; `ALGORITHMS.md` §3.1): every input reservoir
