@@ -259,7 +259,10 @@ fn gris_without_neighbours_reduces_to_ris() {
     for _ in 0..1000 {
         let rc = canonical.sample(&mut rng);
         for scheme in MisScheme::ALL {
-            let out = resample(&PowerShift, scheme, &canonical, &rc, &[], || rng.next_f32());
+            let none: &[(&ToyDomain, &Reservoir<f64>)] = &[];
+            let out = resample(&PowerShift, scheme, &canonical, &rc, none, || {
+                rng.next_f32()
+            });
             assert_eq!(out.sample, rc.sample, "{scheme:?}");
             assert!((out.ucw - rc.ucw).abs() <= 1e-6 * rc.ucw, "{scheme:?}");
         }

@@ -5,6 +5,8 @@
 //! weighted by inverse shifts into every domain), and the constant-weight family (constant
 //! resampling weights, the MIS normalisation applied to the selected sample only).
 
+use core::borrow::Borrow;
+
 use super::{GrisInput, GrisResampler, PairwiseNeighbor, PairwiseResampler, PairwiseVariant};
 use crate::mis::{MisScheme, clean};
 use crate::reservoir::{Reservoir, sanitize_non_negative};
@@ -28,7 +30,11 @@ fn shift_in<S, M: ShiftMap<S>>(
 ///
 /// * `canonical` is the receiving domain's own reservoir; its `target_pdf` must be `p̂_c(X_c)`.
 /// * `neighbors` lists each neighbour's domain and reservoir (`target_pdf = p̂_i(X_i)`); empty
-///   reservoirs are allowed and still count as techniques.
+///   reservoirs are allowed and still count as techniques. A domain is anything that borrows as
+///   `M::Domain`: a reference (`&Receiver`) or, for a small `Copy` domain such as a pixel index,
+///   the value itself (`(usize, &Reservoir<S>)`), so the caller does not have to keep the domains
+///   alive elsewhere just to lend them. An empty list needs its element type spelled out, e.g.
+///   `let none: &[(&Domain, &Reservoir<S>)] = &[];`.
 /// * `next_u` supplies independent uniform numbers in `[0, 1)` (one per input).
 ///
 /// Shift cost per scheme (k neighbours): constant O(k); 1/Z and contribution O(k) + O(k) inverse
@@ -58,17 +64,18 @@ fn shift_in<S, M: ShiftMap<S>>(
 /// assert_eq!(out.confidence, 3.0);
 /// assert!(out.sample.is_some() && out.ucw > 0.0);
 /// ```
-pub fn resample<S, M>(
+pub fn resample<S, M, D>(
     map: &M,
     scheme: MisScheme,
     canonical_domain: &M::Domain,
     canonical: &Reservoir<S>,
-    neighbors: &[(&M::Domain, &Reservoir<S>)],
+    neighbors: &[(D, &Reservoir<S>)],
     next_u: impl FnMut() -> f32,
 ) -> Reservoir<S>
 where
     S: Clone,
     M: ShiftMap<S>,
+    D: Borrow<M::Domain>,
 {
     match scheme {
         MisScheme::Pairwise => pairwise(
@@ -107,20 +114,22 @@ where
 
 /// The pairwise family: every neighbour streams through a [`PairwiseResampler`] with its forward
 /// shift and the inverse shift of the canonical sample (2k shifts), the canonical sample last.
-fn pairwise<S, M>(
+fn pairwise<S, M, D>(
     map: &M,
     variant: PairwiseVariant,
     canonical_domain: &M::Domain,
     canonical: &Reservoir<S>,
-    neighbors: &[(&M::Domain, &Reservoir<S>)],
+    neighbors: &[(D, &Reservoir<S>)],
     mut next_u: impl FnMut() -> f32,
 ) -> Reservoir<S>
 where
     S: Clone,
     M: ShiftMap<S>,
+    D: Borrow<M::Domain>,
 {
     let mut step = PairwiseResampler::new(variant, neighbors.len(), canonical.clone());
-    for &(domain, reservoir) in neighbors {
+    for (domain, reservoir) in neighbors {
+        let domain = domain.borrow();
         let canonical_sample_target_pdf = canonical.sample.as_ref().map_or(0.0, |xc| {
             map.pulled_back_target_pdf(canonical_domain, domain, xc)
         });
@@ -139,16 +148,17 @@ where
 /// The generalized balance heuristic: each candidate (canonical first) is weighted by
 /// `m_i = P_i / Σ_j P_j` at its shifted sample, with inverse shifts into every other domain
 /// (O(k²) shifts); the weights are normalised, so the step finalises with `W = Σ w_i / p̂_c(Y)`.
-fn generalized_balance<S, M>(
+fn generalized_balance<S, M, D>(
     map: &M,
     canonical_domain: &M::Domain,
     canonical: &Reservoir<S>,
-    neighbors: &[(&M::Domain, &Reservoir<S>)],
+    neighbors: &[(D, &Reservoir<S>)],
     mut next_u: impl FnMut() -> f32,
 ) -> Reservoir<S>
 where
     S: Clone,
     M: ShiftMap<S>,
+    D: Borrow<M::Domain>,
 {
     let cc = sanitize_non_negative(canonical.confidence);
     let pc_own = canonical.target_pdf;
@@ -158,8 +168,9 @@ where
             .iter()
             .enumerate()
             .filter(|&(j, _)| Some(j) != skip)
-            .map(|(_, &(d, r))| {
-                clean(r.confidence) * clean(map.pulled_back_target_pdf(canonical_domain, d, y))
+            .map(|(_, (d, r))| {
+                clean(r.confidence)
+                    * clean(map.pulled_back_target_pdf(canonical_domain, d.borrow(), y))
             })
             .sum()
     };
@@ -172,8 +183,8 @@ where
         }
         None => stream.add_failed(cc),
     }
-    for (i, &(domain, reservoir)) in neighbors.iter().enumerate() {
-        let Some(shifted) = shift_in(map, domain, canonical_domain, reservoir) else {
+    for (i, (domain, reservoir)) in neighbors.iter().enumerate() {
+        let Some(shifted) = shift_in(map, domain.borrow(), canonical_domain, reservoir) else {
             stream.add_failed(reservoir.confidence);
             continue;
         };
@@ -191,17 +202,18 @@ where
 /// resampled with their confidences as weights (O(k) shifts); the MIS normalisation (`1/Σc`,
 /// `1/Z(y)` or the contribution factor) is applied to the selected sample `y` only, with O(k)
 /// inverse shifts of `y` for the unbiased two.
-fn constant_weights<S, M>(
+fn constant_weights<S, M, D>(
     map: &M,
     scheme: MisScheme,
     canonical_domain: &M::Domain,
     canonical: &Reservoir<S>,
-    neighbors: &[(&M::Domain, &Reservoir<S>)],
+    neighbors: &[(D, &Reservoir<S>)],
     mut next_u: impl FnMut() -> f32,
 ) -> Reservoir<S>
 where
     S: Clone,
     M: ShiftMap<S>,
+    D: Borrow<M::Domain>,
 {
     let cc = sanitize_non_negative(canonical.confidence);
     let pc_own = canonical.target_pdf;
@@ -216,8 +228,8 @@ where
         }
         None => stream.add_failed(cc),
     }
-    for &(domain, reservoir) in neighbors {
-        match shift_in(map, domain, canonical_domain, reservoir) {
+    for (domain, reservoir) in neighbors {
+        match shift_in(map, domain.borrow(), canonical_domain, reservoir) {
             Some(shifted) => {
                 let (j, t) = (shifted.jacobian, reservoir.target_pdf);
                 let c = sanitize_non_negative(reservoir.confidence);
@@ -252,8 +264,8 @@ where
                     // The selected technique's own sample: p̂_s(x_s)/J_s, no extra shift.
                     (f64::from(selected_source_target) / f64::from(selected_jacobian)) as f32
                 } else {
-                    let (d, _) = neighbors[j - 1];
-                    map.pulled_back_target_pdf(canonical_domain, d, &y)
+                    let (d, _) = &neighbors[j - 1];
+                    map.pulled_back_target_pdf(canonical_domain, d.borrow(), &y)
                 }
             };
             let conf = |j: usize| -> f32 {
