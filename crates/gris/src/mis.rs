@@ -181,26 +181,36 @@ pub fn contribution_scale(selected: usize, confidences: &[f32], target_pdfs: &[f
     }
 }
 
+/// What the pairwise weights of one neighbour `i` need at a point `y` of the canonical domain:
+/// both techniques' confidences and targets, named so that a neighbour's value cannot silently
+/// take a canonical one's place. Both targets are in the canonical domain's measure.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairTerms {
+    /// Neighbour `i`'s confidence `c_i`.
+    pub neighbor_confidence: f32,
+    /// Neighbour `i`'s target pulled back into the canonical domain, `p̂_{←i}(y)` (0 where the
+    /// shift into domain `i` fails).
+    pub neighbor_target_pdf: f32,
+    /// The canonical technique's confidence `c_c`.
+    pub canonical_confidence: f32,
+    /// The canonical domain's own target at `y`, `p̂_c(y)`.
+    pub canonical_target_pdf: f32,
+}
+
 /// Pairwise pair weight `a_i(y) = P_i / (P_i + P_c/k)` of neighbour `i` against the canonical
 /// technique, where the canonical spends `1/k` of its confidence on each of the `k` pairs.
 ///
 /// `neighbor_count` is the configured `k` (values below 1 are treated as 1). Returns 0 when both
 /// terms are 0. This is the building block of every pairwise variant (`ALGORITHMS.md` §3.3 (e)).
 #[inline]
-pub fn pairwise_pair_weight(
-    neighbor_confidence: f32,
-    neighbor_target_pdf: f32,
-    canonical_confidence: f32,
-    canonical_target_pdf: f32,
-    neighbor_count: f32,
-) -> f32 {
+pub fn pairwise_pair_weight(pair: PairTerms, neighbor_count: f32) -> f32 {
     let k = if neighbor_count > 1.0 {
         f64::from(neighbor_count)
     } else {
         1.0
     };
-    let pi = technique(neighbor_confidence, neighbor_target_pdf);
-    let pc = technique(canonical_confidence, canonical_target_pdf) / k;
+    let pi = technique(pair.neighbor_confidence, pair.neighbor_target_pdf);
+    let pc = technique(pair.canonical_confidence, pair.canonical_target_pdf) / k;
     if pi > 0.0 { ratio(pi, pi + pc) } else { 0.0 }
 }
 
@@ -211,24 +221,12 @@ pub fn pairwise_pair_weight(
 /// Together with [`pairwise_canonical`] over the same `k` neighbours the weights sum to one.
 /// Non-defensive: the canonical weight can approach 0 where neighbours dominate.
 #[inline]
-pub fn pairwise_neighbor(
-    neighbor_confidence: f32,
-    neighbor_target_pdf: f32,
-    canonical_confidence: f32,
-    canonical_target_pdf: f32,
-    neighbor_count: usize,
-) -> f32 {
+pub fn pairwise_neighbor(pair: PairTerms, neighbor_count: usize) -> f32 {
     if neighbor_count == 0 {
         return 0.0;
     }
     let k = neighbor_count as f32;
-    pairwise_pair_weight(
-        neighbor_confidence,
-        neighbor_target_pdf,
-        canonical_confidence,
-        canonical_target_pdf,
-        k,
-    ) / k
+    pairwise_pair_weight(pair, k) / k
 }
 
 /// Sum `Σ_i (1 − a_i(y))` of the canonical pair shares over `k = neighbor_confidences.len()`
@@ -244,13 +242,13 @@ fn canonical_pair_shares(
         .iter()
         .zip(neighbor_target_pdfs)
         .map(|(&c, &p)| {
-            1.0 - f64::from(pairwise_pair_weight(
-                c,
-                p,
+            let pair = PairTerms {
+                neighbor_confidence: c,
+                neighbor_target_pdf: p,
                 canonical_confidence,
                 canonical_target_pdf,
-                k as f32,
-            ))
+            };
+            1.0 - f64::from(pairwise_pair_weight(pair, k as f32))
         })
         .sum();
     (sum, k)
@@ -285,20 +283,8 @@ pub fn pairwise_canonical(
 /// (Lin et al. 2022; ReSTIR PT spatial reuse default;
 /// `ALGORITHMS.md` §3.3 (f)).
 #[inline]
-pub fn defensive_pairwise_neighbor(
-    neighbor_confidence: f32,
-    neighbor_target_pdf: f32,
-    canonical_confidence: f32,
-    canonical_target_pdf: f32,
-    neighbor_count: usize,
-) -> f32 {
-    pairwise_pair_weight(
-        neighbor_confidence,
-        neighbor_target_pdf,
-        canonical_confidence,
-        canonical_target_pdf,
-        neighbor_count as f32,
-    ) / (neighbor_count as f32 + 1.0)
+pub fn defensive_pairwise_neighbor(pair: PairTerms, neighbor_count: usize) -> f32 {
+    pairwise_pair_weight(pair, neighbor_count as f32) / (neighbor_count as f32 + 1.0)
 }
 
 /// **(f) Defensive pairwise MIS**, canonical weight `m_c(y) = (1 + Σ_i (1 − a_i(y)))/(k+1)`.
@@ -330,18 +316,12 @@ pub fn defensive_pairwise_canonical(
 /// form). Neighbours with more confidence get proportionally more weight; the canonical keeps at
 /// least `c_c/(c_c + C_N)`. `neighbor_confidence_sum` is `C_N` over *all* neighbours of this
 /// step.
-pub fn confidence_weighted_pairwise_neighbor(
-    neighbor_confidence: f32,
-    neighbor_target_pdf: f32,
-    canonical_confidence: f32,
-    canonical_target_pdf: f32,
-    neighbor_confidence_sum: f32,
-) -> f32 {
+pub fn confidence_weighted_pairwise_neighbor(pair: PairTerms, neighbor_confidence_sum: f32) -> f32 {
     let cn = clean(neighbor_confidence_sum);
-    let cc = clean(canonical_confidence);
-    let ci = clean(neighbor_confidence);
-    let pi = clean(neighbor_target_pdf);
-    let pc = clean(canonical_target_pdf);
+    let cc = clean(pair.canonical_confidence);
+    let ci = clean(pair.neighbor_confidence);
+    let pi = clean(pair.neighbor_target_pdf);
+    let pc = clean(pair.canonical_target_pdf);
     let den = cn * pi + cc * pc;
     if !(ci > 0.0 && pi > 0.0 && den > 0.0 && cn + cc > 0.0) {
         return 0.0;
@@ -420,7 +400,13 @@ mod tests {
         let p = [1e30, 1e30, 1e-30];
         let s: f32 = (0..3).map(|i| generalized_balance(i, &c, &p)).sum();
         assert!((s - 1.0).abs() < 1e-6);
-        let a = pairwise_pair_weight(1e30, 1e30, 1e30, 1e30, 3.0);
+        let pair = PairTerms {
+            neighbor_confidence: 1e30,
+            neighbor_target_pdf: 1e30,
+            canonical_confidence: 1e30,
+            canonical_target_pdf: 1e30,
+        };
+        let a = pairwise_pair_weight(pair, 3.0);
         assert!(a.is_finite() && (a - 0.75).abs() < 1e-6);
     }
 

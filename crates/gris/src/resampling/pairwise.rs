@@ -5,7 +5,7 @@
 //! so nothing has to be stored per neighbour. The weights themselves are in [`crate::mis`].
 
 use super::{GrisInput, GrisResampler};
-use crate::mis::{self, clean};
+use crate::mis::{self, PairTerms, clean};
 use crate::reservoir::Reservoir;
 use crate::shift::Shifted;
 
@@ -106,7 +106,13 @@ impl<S> PairwiseResampler<S> {
         let p_ic = neighbor.canonical_sample_target_pdf;
         match self.variant {
             PairwiseVariant::Plain | PairwiseVariant::Defensive => {
-                let a = mis::pairwise_pair_weight(ci, p_ic, cc, pc, self.neighbor_count);
+                let pair = PairTerms {
+                    neighbor_confidence: ci,
+                    neighbor_target_pdf: p_ic,
+                    canonical_confidence: cc,
+                    canonical_target_pdf: pc,
+                };
+                let a = mis::pairwise_pair_weight(pair, self.neighbor_count);
                 self.canonical_weight += 1.0 - f64::from(a);
             }
             PairwiseVariant::ConfidenceWeighted {
@@ -129,19 +135,19 @@ impl<S> PairwiseResampler<S> {
         };
         let p_i = shifted.source_target_pdf_at_receiver(neighbor.target_pdf);
         let p_c = shifted.target_pdf;
+        let pair = PairTerms {
+            neighbor_confidence: ci,
+            neighbor_target_pdf: p_i,
+            canonical_confidence: cc,
+            canonical_target_pdf: p_c,
+        };
         let m = match self.variant {
             PairwiseVariant::Plain | PairwiseVariant::Defensive => {
-                mis::pairwise_pair_weight(ci, p_i, cc, p_c, self.neighbor_count)
+                mis::pairwise_pair_weight(pair, self.neighbor_count)
             }
             PairwiseVariant::ConfidenceWeighted {
                 neighbor_confidence_sum,
-            } => mis::confidence_weighted_pairwise_neighbor(
-                ci,
-                p_i,
-                cc,
-                p_c,
-                neighbor_confidence_sum,
-            ),
+            } => mis::confidence_weighted_pairwise_neighbor(pair, neighbor_confidence_sum),
         };
         let input = GrisInput::from_shift(shifted, neighbor.ucw, ci);
         self.stream.add(input, m, u)
