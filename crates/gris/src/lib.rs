@@ -95,7 +95,7 @@
 //!   are `f64`. Zero, negative, NaN and infinite candidates count towards confidence but are never
 //!   selected and never enter `weight_sum`; no public function returns NaN or infinity.
 //!
-//! # What the caller must guarantee for unbiasedness (`ALGORITHMS.md` §3.2)
+//! # What the caller must guarantee for unbiasedness (Lin et al. 2022; `docs/GRIS.md` §3.1)
 //!
 //! 1. Every input `W_i` is a valid unbiased contribution weight for `X_i` in its own domain
 //!    (inputs may be correlated).
@@ -111,6 +111,26 @@
 //!    temporal neighbours), and the receiver's `p̂_c` in the resampling weights and in
 //!    `W = Σ w / p̂_c(Y)` is the same function.
 //! 6. The uniform numbers passed in are independent of each other and of the candidates.
+//!
+//! # References
+//!
+//! Citations like "`docs/GRIS.md` §4.5" point to the derivations shipped with the source
+//! repository (<https://github.com/restir-rs/restir/blob/main/docs/GRIS.md>), written in this
+//! crate's notation. The papers:
+//!
+//! * J. Talbot, D. Cline, P. Egbert, "Importance Resampling for Global Illumination", EGSR 2005
+//!   (resampled importance sampling).
+//! * B. Bitterli, C. Wyman, M. Pharr, P. Shirley, A. Lefohn, W. Jarosz, "Spatiotemporal reservoir
+//!   resampling for real-time ray tracing with dynamic direct lighting", ACM TOG 39(4), 2020
+//!   (streaming RIS, reservoir reuse, the 1/Z and MIS-like unbiased combinations).
+//! * D. Lin, M. Kettunen, B. Bitterli, J. Pantaleoni, C. Yuksel, C. Wyman, "Generalized Resampled
+//!   Importance Sampling: Foundations of ReSTIR", ACM TOG 41(4), 2022 (GRIS, shift maps and
+//!   their Jacobians, defensive pairwise MIS, ReSTIR PT).
+//! * B. Bitterli, "Correlations and Reuse for Fast and Accurate Physically Based Light
+//!   Transport", PhD thesis, Dartmouth College, 2022, §9.1 (pairwise MIS).
+//! * C. Wyman, M. Kettunen, D. Lin, B. Bitterli, C. Yuksel, W. Jarosz, P. Kozlowski,
+//!   G. De Francesco, "A Gentle Introduction to ReSTIR: Path Reuse in Real-time", SIGGRAPH 2023
+//!   Courses (the reservoir conventions used here; confidence-weighted pairwise MIS).
 //!
 //! # Modules
 //!

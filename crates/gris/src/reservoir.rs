@@ -2,7 +2,8 @@
 //!
 //! Implements the reservoir definitions in the course-notes / GRIS form (Lin et al. 2022,
 //! "Generalized Resampled Importance Sampling"; Wyman et al. 2023, "A Gentle Introduction to
-//! ReSTIR"); see `ALGORITHMS.md` §1.1–1.4 of this workspace.
+//! ReSTIR"), with RIS from Talbot et al. 2005 and streaming from Bitterli et al. 2020;
+//! derivations in `docs/GRIS.md` §2.
 //!
 //! Two types, kept apart on purpose:
 //!

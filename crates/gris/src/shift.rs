@@ -5,7 +5,7 @@
 //! shifted sample, three things: the shifted sample, the Jacobian determinant `|∂T_{i→j}/∂x|`
 //! and the target function of domain `j` at the shifted sample. A shift either delivers all three
 //! or fails explicitly (`None`); it never returns partially-filled state
-//! (`ALGORITHMS.md` §3.5, §5 pitfall 7).
+//! (`docs/GRIS.md` §6.1).
 //!
 //! # Measures
 //!

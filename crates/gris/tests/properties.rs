@@ -1,4 +1,4 @@
-//! Property tests (proptest, fixed RNG seed) for the invariants of ALGORITHMS.md §6:
+//! Property tests (proptest, fixed RNG seed) for the invariants listed in docs/GRIS.md §7:
 //! MIS partition of unity, defensive bounds, merge order/grouping invariance, confidence
 //! bookkeeping, `W ≥ 0` and finite for every finite input, and Jacobian round trips.
 // Uses `reconnection_jacobian_from_points`, which needs the `std` feature (square roots).

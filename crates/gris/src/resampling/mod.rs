@@ -1,7 +1,7 @@
 //! Resampling finalised reservoirs from several domains into one receiving domain (GRIS).
 //!
 //! Implements one generalized-RIS step (Lin et al. 2022, "Generalized Resampled Importance
-//! Sampling: Foundations of ReSTIR"; `ALGORITHMS.md` §3.1): every input reservoir
+//! Sampling: Foundations of ReSTIR"; derivation in `docs/GRIS.md` §3): every input reservoir
 //! `(X_i, W_i, c_i)` is shifted into the receiving (canonical) domain `c`, `Y_i = T_{i→c}(X_i)`,
 //! and resampled with weight
 //!

@@ -9,7 +9,7 @@ use crate::mis::{self, PairTerms, clean};
 use crate::reservoir::Reservoir;
 use crate::shift::Shifted;
 
-/// Which pairwise MIS variant a [`PairwiseResampler`] uses (`ALGORITHMS.md` §3.3 (e), (f)).
+/// Which pairwise MIS variant a [`PairwiseResampler`] uses (`docs/GRIS.md` §4.5–4.7).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PairwiseVariant {
     /// Non-defensive pairwise: [`mis::pairwise_neighbor`] / [`mis::pairwise_canonical`].
@@ -46,7 +46,7 @@ pub struct PairwiseNeighbor<S> {
 }
 
 /// Streaming pairwise-MIS GRIS step (Bitterli 2022, PhD thesis §9.1; Lin et al. 2022;
-/// `ALGORITHMS.md` §3.3 (e)–(f)).
+/// `docs/GRIS.md` §4.5–4.7).
 ///
 /// Create it with the canonical reservoir, add every neighbour **including empty ones and ones
 /// whose shifts failed** (each contributes its canonical pair share; skipping one breaks the

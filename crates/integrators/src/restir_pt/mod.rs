@@ -1,7 +1,7 @@
 //! ReSTIR PT (Lin et al. 2022): reservoir-based path reuse across pixels with the reconnection,
 //! random-replay and hybrid shifts, combined unbiasedly with the MIS schemes of `restir-gris` (`docs/RESTIR_PT.md`).
 //!
-//! One pass, for every pixel at once (ALGORITHMS.md §4):
+//! One pass, for every pixel at once (`docs/RESTIR_PT.md`):
 //!
 //! 1. **Primary hits** ([`GBuffer`]), adding what the camera sees directly.
 //! 2. **Initial sampling**: `--candidates` random walks from the primary hit with next-event
