@@ -11,7 +11,8 @@
 //! symmetric under `J ↔ 1/J`, so the forward shift is rejected iff the inverse one is, which
 //! keeps the shift's domain consistent (unbiased, given a canonical technique) instead of
 //! clamping (biased). The computation is done in `f64`; only `+ − × /` are used, so everything
-//! except [`reconnection_jacobian_from_points`] works without `std`.
+//! works without `std` except `reconnection_jacobian_from_points` and `geometry_term`, which need
+//! a square root (feature `std`).
 
 /// Results outside `[1/JACOBIAN_LIMIT, JACOBIAN_LIMIT]` are rejected (returned as 0).
 pub const JACOBIAN_LIMIT: f32 = 1e30;

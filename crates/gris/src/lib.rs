@@ -4,8 +4,9 @@
 //! streaming RIS (weighted reservoir sampling), GRIS resampling of reservoirs across domains,
 //! the resampling MIS weights, confidence (M) capping, the shift-map contract and the standard
 //! shift Jacobians. It is generic over the sample payload (a light sample, a path descriptor,
-//! anything), has no dependencies and is `no_std` (the default `std` feature only adds
-//! [`jacobian::reconnection_jacobian_from_points`]).
+//! anything), has no dependencies and is `no_std`: the default `std` feature only adds the two
+//! helpers that need a square root, `jacobian::reconnection_jacobian_from_points` and
+//! `jacobian::geometry_term`.
 //!
 //! # Example: RIS on a 1-D integral, then reuse across two domains with GRIS
 //!
@@ -141,6 +142,7 @@
 //! * [`shift`] — the [`ShiftMap`] contract and [`Shifted`].
 //! * [`jacobian`] — reconnection (solid angle, area, PSS), random replay, symmetric rejection.
 #![cfg_attr(not(feature = "std"), no_std)]
+#![deny(missing_docs)]
 // `!(x > 0.0)` is deliberate throughout: it is true for NaN, which must be rejected too.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
