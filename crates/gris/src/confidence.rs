@@ -2,7 +2,7 @@
 //!
 //! Confidence weights enter only the MIS weights of later resampling steps, so any non-negative
 //! choice keeps GRIS unbiased as long as those MIS weights form a partition of unity
-//! (`ALGORITHMS.md` §3.4; Lin et al. 2022, §5). Capping bounds how much stale history can dominate
+//! (Lin et al. 2022; `docs/GRIS.md` §5). Capping bounds how much stale history can dominate
 //! the reuse (lag, ghosting, correlation); a lower cap means more noise.
 //!
 //! Every function here maps NaN and negative inputs to 0 and never returns NaN.

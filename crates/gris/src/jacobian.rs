@@ -1,4 +1,4 @@
-//! Standard shift-map Jacobians (`ALGORITHMS.md` §3.5, summary table §3.7).
+//! Standard shift-map Jacobians (derivations and a summary table: `docs/GRIS.md` §6).
 //!
 //! Notation for a reconnection at vertex `x_k` (geometric normal `n_k`): the base path arrives
 //! from `x_{k−1}`, the shifted path from `y_{k−1}`;
@@ -11,7 +11,8 @@
 //! symmetric under `J ↔ 1/J`, so the forward shift is rejected iff the inverse one is, which
 //! keeps the shift's domain consistent (unbiased, given a canonical technique) instead of
 //! clamping (biased). The computation is done in `f64`; only `+ − × /` are used, so everything
-//! except [`reconnection_jacobian_from_points`] works without `std`.
+//! works without `std` except `reconnection_jacobian_from_points` and `geometry_term`, which need
+//! a square root (feature `std`).
 
 /// Results outside `[1/JACOBIAN_LIMIT, JACOBIAN_LIMIT]` are rejected (returned as 0).
 pub const JACOBIAN_LIMIT: f32 = 1e30;
@@ -59,7 +60,7 @@ fn finish(j: f64) -> f32 {
 /// ```
 ///
 /// mapping solid angle at `x_{k−1}` to solid angle at `y_{k−1}` (Lin et al. 2022, reconnection
-/// shift; `ALGORITHMS.md` §3.5.1). Cosines are taken in absolute value. The inverse shift's
+/// shift; `docs/GRIS.md` §6.2). Cosines are taken in absolute value. The inverse shift's
 /// Jacobian is obtained by swapping the roles (`= 1/J`). Returns 0 (shift fails) for a grazing
 /// angle, a zero distance, or a non-finite result.
 #[inline]
@@ -104,7 +105,7 @@ pub fn solid_angle_to_area(cos: f32, dist2: f32) -> f32 {
 ///   direction when `x_k` continues by BSDF sampling; pass `1, 1` when the path ends at `x_k`
 ///   (NEE there, or `x_k` is the emitter).
 ///
-/// (`ALGORITHMS.md` §3.5.2.) Returns 0 if any factor is invalid.
+/// (`docs/GRIS.md` §6.4.) Returns 0 if any factor is invalid.
 #[inline]
 pub fn reconnection_jacobian_pss(
     pdf_sa_y: f32,
@@ -182,7 +183,7 @@ pub fn inverse_jacobian(jacobian: f32) -> f32 {
 ///
 /// Because the test is symmetric under `J ↔ 1/J` and the inverse shift's Jacobian is `1/J`,
 /// the forward and inverse shifts are rejected together, so the restriction keeps GRIS unbiased
-/// given a canonical technique (`ALGORITHMS.md` §3.5.2, §5 pitfalls 2–3). Clamping `J` instead is
+/// given a canonical technique (`docs/GRIS.md` §6.6). Clamping `J` instead is
 /// biased. `max_ratio ≤ 1` rejects everything except `J = 1`.
 #[inline]
 pub fn reject_jacobian(jacobian: f32, max_ratio: f32) -> bool {

@@ -4,8 +4,9 @@
 //! streaming RIS (weighted reservoir sampling), GRIS resampling of reservoirs across domains,
 //! the resampling MIS weights, confidence (M) capping, the shift-map contract and the standard
 //! shift Jacobians. It is generic over the sample payload (a light sample, a path descriptor,
-//! anything), has no dependencies and is `no_std` (the default `std` feature only adds
-//! [`jacobian::reconnection_jacobian_from_points`]).
+//! anything), has no dependencies and is `no_std`: the default `std` feature only adds the two
+//! helpers that need a square root, `jacobian::reconnection_jacobian_from_points` and
+//! `jacobian::geometry_term`.
 //!
 //! # Example: RIS on a 1-D integral, then reuse across two domains with GRIS
 //!
@@ -95,7 +96,7 @@
 //!   are `f64`. Zero, negative, NaN and infinite candidates count towards confidence but are never
 //!   selected and never enter `weight_sum`; no public function returns NaN or infinity.
 //!
-//! # What the caller must guarantee for unbiasedness (`ALGORITHMS.md` §3.2)
+//! # What the caller must guarantee for unbiasedness (Lin et al. 2022; `docs/GRIS.md` §3.1)
 //!
 //! 1. Every input `W_i` is a valid unbiased contribution weight for `X_i` in its own domain
 //!    (inputs may be correlated).
@@ -112,30 +113,51 @@
 //!    `W = Σ w / p̂_c(Y)` is the same function.
 //! 6. The uniform numbers passed in are independent of each other and of the candidates.
 //!
+//! # References
+//!
+//! Citations like "`docs/GRIS.md` §4.5" point to the derivations shipped with the source
+//! repository (<https://github.com/restir-rs/restir/blob/main/docs/GRIS.md>), written in this
+//! crate's notation. The papers:
+//!
+//! * J. Talbot, D. Cline, P. Egbert, "Importance Resampling for Global Illumination", EGSR 2005
+//!   (resampled importance sampling).
+//! * B. Bitterli, C. Wyman, M. Pharr, P. Shirley, A. Lefohn, W. Jarosz, "Spatiotemporal reservoir
+//!   resampling for real-time ray tracing with dynamic direct lighting", ACM TOG 39(4), 2020
+//!   (streaming RIS, reservoir reuse, the 1/Z and MIS-like unbiased combinations).
+//! * D. Lin, M. Kettunen, B. Bitterli, J. Pantaleoni, C. Yuksel, C. Wyman, "Generalized Resampled
+//!   Importance Sampling: Foundations of ReSTIR", ACM TOG 41(4), 2022 (GRIS, shift maps and
+//!   their Jacobians, defensive pairwise MIS, ReSTIR PT).
+//! * B. Bitterli, "Correlations and Reuse for Fast and Accurate Physically Based Light
+//!   Transport", PhD thesis, Dartmouth College, 2022, §9.1 (pairwise MIS).
+//! * C. Wyman, M. Kettunen, D. Lin, B. Bitterli, C. Yuksel, W. Jarosz, P. Kozlowski,
+//!   G. De Francesco, "A Gentle Introduction to ReSTIR: Path Reuse in Real-time", SIGGRAPH 2023
+//!   Courses (the reservoir conventions used here; confidence-weighted pairwise MIS).
+//!
 //! # Modules
 //!
 //! * [`reservoir`] — [`Reservoir`] (stored) and [`StreamingReservoir`] (running WRS state).
-//! * [`gris`] — [`GrisResampler`], [`PairwiseResampler`], [`resample`].
+//! * [`resampling`] — [`GrisResampler`], [`PairwiseResampler`], [`resample`].
 //! * [`mis`] — every MIS weight with its formula and source; [`MisScheme`].
 //! * [`confidence`] — M-capping.
 //! * [`shift`] — the [`ShiftMap`] contract and [`Shifted`].
 //! * [`jacobian`] — reconnection (solid angle, area, PSS), random replay, symmetric rejection.
 #![cfg_attr(not(feature = "std"), no_std)]
+#![deny(missing_docs)]
 // `!(x > 0.0)` is deliberate throughout: it is true for NaN, which must be rejected too.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod confidence;
-pub mod gris;
 pub mod jacobian;
 pub mod mis;
+pub mod resampling;
 pub mod reservoir;
 pub mod shift;
 
 pub use confidence::{cap_confidence, cap_confidence_relative};
-pub use gris::{
+pub use mis::MisScheme;
+pub use resampling::{
     GrisInput, GrisResampler, PairwiseNeighbor, PairwiseResampler, PairwiseVariant, resample,
 };
-pub use mis::MisScheme;
 pub use reservoir::{Reservoir, StreamingReservoir};
 pub use shift::{ShiftMap, Shifted};
 

@@ -9,7 +9,7 @@
 //!
 //! i.e. domain `j`'s target expressed in the canonical domain's measure, and 0 when the inverse
 //! shift `T_{c→j}` fails. For the canonical technique `p̂_{←c} = p̂_c`. Write
-//! `P_j(y) = c_j · p̂_{←j}(y)`. See `ALGORITHMS.md` §3.3 for the derivations and §3.2 for the
+//! `P_j(y) = c_j · p̂_{←j}(y)`. See `docs/GRIS.md` §4 for the derivations and §3.1 for the
 //! conditions under which the estimator is unbiased.
 //!
 //! Numerics: products and sums are formed in `f64`, so confidences and targets anywhere in the
@@ -26,7 +26,7 @@
 //! | defensive pairwise | [`defensive_pairwise_neighbor`], [`defensive_pairwise_canonical`] | yes | Lin et al. 2022 (GRIS / ReSTIR PT) |
 //! | confidence-weighted defensive pairwise | [`confidence_weighted_pairwise_neighbor`], [`confidence_weighted_pairwise_canonical`] | yes | Wyman et al. 2023, "A Gentle Introduction to ReSTIR" course notes |
 
-/// Selects an MIS scheme for the drivers in [`crate::gris`].
+/// Selects an MIS scheme for the drivers in [`crate::resampling`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum MisScheme {
     /// Constant weights `c_i/Σc` (legacy "1/M"). **Biased** whenever the domains differ in support
@@ -97,7 +97,7 @@ fn ratio(num: f64, den: f64) -> f32 {
 ///
 /// `confidence_sum` is `Σ_j c_j` over all participating techniques (canonical included). The
 /// weights sum to one everywhere, but a technique that cannot produce `y` still takes its share,
-/// so the estimate loses (or gains) energy wherever supports differ (`ALGORITHMS.md` §3.3 (a);
+/// so the estimate loses (or gains) energy wherever supports differ (`docs/GRIS.md` §4.1;
 /// Bitterli et al. 2020, Alg. 4 (RTXDI `OFF`)). Use only as a fast approximation or a negative control.
 #[inline]
 pub fn constant_biased(confidence_i: f32, confidence_sum: f32) -> f32 {
@@ -111,7 +111,7 @@ pub fn constant_biased(confidence_i: f32, confidence_sum: f32) -> f32 {
 /// [`crate::StreamingReservoir::finalize_scaled`]. The implied MIS weight is `m_i = c_i/Z(y)` for
 /// every technique that can produce `y` — a partition of unity, hence unbiased, provided
 /// `p̂_{←j}(y) > 0` exactly on the image of domain `j`'s sample support (Bitterli et al. 2020;
-/// `ALGORITHMS.md` §3.3 (b)).
+/// `docs/GRIS.md` §4.2).
 ///
 /// `confidences[j]` and `target_pdfs[j]` describe the same technique; extra entries of the
 /// longer slice are ignored.
@@ -133,7 +133,7 @@ pub fn one_over_z(confidences: &[f32], target_pdfs: &[f32]) -> f32 {
 /// **(d) Generalized balance heuristic** `m_i(y) = c_i·p̂_{←i}(y) / Σ_j c_j·p̂_{←j}(y)`.
 ///
 /// Needs every technique's pulled-back target at every candidate: O((k+1)²) shifts
-/// (Lin et al. 2022; `ALGORITHMS.md` §3.3 (d)). Returns 0 when the denominator is 0 or
+/// (Lin et al. 2022; `docs/GRIS.md` §4.4). Returns 0 when the denominator is 0 or
 /// `i` is out of range. The weights over all `i` sum to 1 whenever some `P_j(y) > 0`.
 pub fn generalized_balance(i: usize, confidences: &[f32], target_pdfs: &[f32]) -> f32 {
     let (Some(&ci), Some(&pi)) = (confidences.get(i), target_pdfs.get(i)) else {
@@ -153,7 +153,7 @@ pub fn generalized_balance(i: usize, confidences: &[f32], target_pdfs: &[f32]) -
 /// Numerically identical to [`generalized_balance`]; the difference is where it is applied:
 /// candidates are resampled with constant weights `w_i = c_i·p̂_c(Y_i)·W_i·J_i`, and only the
 /// selected sample's technique `s` is weighted, at finalisation (see [`contribution_scale`]).
-/// O(k) inverse shifts of one sample (Bitterli et al. 2020; RTXDI `BASIC`; `ALGORITHMS.md` §2.6, §3.3 (c)).
+/// O(k) inverse shifts of one sample (Bitterli et al. 2020; RTXDI `BASIC`; `docs/GRIS.md` §3.2, §4.3).
 pub fn contribution(selected: usize, confidences: &[f32], target_pdfs: &[f32]) -> f32 {
     generalized_balance(selected, confidences, target_pdfs)
 }
@@ -181,54 +181,52 @@ pub fn contribution_scale(selected: usize, confidences: &[f32], target_pdfs: &[f
     }
 }
 
+/// What the pairwise weights of one neighbour `i` need at a point `y` of the canonical domain:
+/// both techniques' confidences and targets, named so that a neighbour's value cannot silently
+/// take a canonical one's place. Both targets are in the canonical domain's measure.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairTerms {
+    /// Neighbour `i`'s confidence `c_i`.
+    pub neighbor_confidence: f32,
+    /// Neighbour `i`'s target pulled back into the canonical domain, `p̂_{←i}(y)` (0 where the
+    /// shift into domain `i` fails).
+    pub neighbor_target_pdf: f32,
+    /// The canonical technique's confidence `c_c`.
+    pub canonical_confidence: f32,
+    /// The canonical domain's own target at `y`, `p̂_c(y)`.
+    pub canonical_target_pdf: f32,
+}
+
 /// Pairwise pair weight `a_i(y) = P_i / (P_i + P_c/k)` of neighbour `i` against the canonical
 /// technique, where the canonical spends `1/k` of its confidence on each of the `k` pairs.
 ///
 /// `neighbor_count` is the configured `k` (values below 1 are treated as 1). Returns 0 when both
-/// terms are 0. This is the building block of every pairwise variant (`ALGORITHMS.md` §3.3 (e)).
+/// terms are 0. This is the building block of every pairwise variant (`docs/GRIS.md` §4.5).
 #[inline]
-pub fn pairwise_pair_weight(
-    neighbor_confidence: f32,
-    neighbor_target_pdf: f32,
-    canonical_confidence: f32,
-    canonical_target_pdf: f32,
-    neighbor_count: f32,
-) -> f32 {
+pub fn pairwise_pair_weight(pair: PairTerms, neighbor_count: f32) -> f32 {
     let k = if neighbor_count > 1.0 {
         f64::from(neighbor_count)
     } else {
         1.0
     };
-    let pi = technique(neighbor_confidence, neighbor_target_pdf);
-    let pc = technique(canonical_confidence, canonical_target_pdf) / k;
+    let pi = technique(pair.neighbor_confidence, pair.neighbor_target_pdf);
+    let pc = technique(pair.canonical_confidence, pair.canonical_target_pdf) / k;
     if pi > 0.0 { ratio(pi, pi + pc) } else { 0.0 }
 }
 
 /// **(e) Pairwise MIS**, neighbour weight `m_i(y) = a_i(y)/k` with `a_i` from
 /// [`pairwise_pair_weight`] (Bitterli 2022, PhD thesis §9.1; RTXDI DI `PAIRWISE`;
-/// `ALGORITHMS.md` §3.3 (e)).
+/// `docs/GRIS.md` §4.5).
 ///
 /// Together with [`pairwise_canonical`] over the same `k` neighbours the weights sum to one.
 /// Non-defensive: the canonical weight can approach 0 where neighbours dominate.
 #[inline]
-pub fn pairwise_neighbor(
-    neighbor_confidence: f32,
-    neighbor_target_pdf: f32,
-    canonical_confidence: f32,
-    canonical_target_pdf: f32,
-    neighbor_count: usize,
-) -> f32 {
+pub fn pairwise_neighbor(pair: PairTerms, neighbor_count: usize) -> f32 {
     if neighbor_count == 0 {
         return 0.0;
     }
     let k = neighbor_count as f32;
-    pairwise_pair_weight(
-        neighbor_confidence,
-        neighbor_target_pdf,
-        canonical_confidence,
-        canonical_target_pdf,
-        k,
-    ) / k
+    pairwise_pair_weight(pair, k) / k
 }
 
 /// Sum `Σ_i (1 − a_i(y))` of the canonical pair shares over `k = neighbor_confidences.len()`
@@ -244,13 +242,13 @@ fn canonical_pair_shares(
         .iter()
         .zip(neighbor_target_pdfs)
         .map(|(&c, &p)| {
-            1.0 - f64::from(pairwise_pair_weight(
-                c,
-                p,
+            let pair = PairTerms {
+                neighbor_confidence: c,
+                neighbor_target_pdf: p,
                 canonical_confidence,
                 canonical_target_pdf,
-                k as f32,
-            ))
+            };
+            1.0 - f64::from(pairwise_pair_weight(pair, k as f32))
         })
         .sum();
     (sum, k)
@@ -261,7 +259,7 @@ fn canonical_pair_shares(
 /// `neighbor_target_pdfs[i]` is `p̂_{←i}(y)` for the point `y` being weighted (for the canonical
 /// sample, the canonical sample shifted into neighbour `i`). Every neighbour counted in `k` must be
 /// listed, including ones whose reservoir is empty or whose shift failed (target 0 ⇒ share 1);
-/// skipping one breaks the partition of unity (`ALGORITHMS.md` §5, pitfall 8).
+/// skipping one breaks the partition of unity (`docs/GRIS.md` §4.5).
 pub fn pairwise_canonical(
     canonical_confidence: f32,
     canonical_target_pdf: f32,
@@ -283,22 +281,10 @@ pub fn pairwise_canonical(
 
 /// **(f) Defensive pairwise MIS**, neighbour weight `m_i(y) = a_i(y)/(k+1)`
 /// (Lin et al. 2022; ReSTIR PT spatial reuse default;
-/// `ALGORITHMS.md` §3.3 (f)).
+/// `docs/GRIS.md` §4.6).
 #[inline]
-pub fn defensive_pairwise_neighbor(
-    neighbor_confidence: f32,
-    neighbor_target_pdf: f32,
-    canonical_confidence: f32,
-    canonical_target_pdf: f32,
-    neighbor_count: usize,
-) -> f32 {
-    pairwise_pair_weight(
-        neighbor_confidence,
-        neighbor_target_pdf,
-        canonical_confidence,
-        canonical_target_pdf,
-        neighbor_count as f32,
-    ) / (neighbor_count as f32 + 1.0)
+pub fn defensive_pairwise_neighbor(pair: PairTerms, neighbor_count: usize) -> f32 {
+    pairwise_pair_weight(pair, neighbor_count as f32) / (neighbor_count as f32 + 1.0)
 }
 
 /// **(f) Defensive pairwise MIS**, canonical weight `m_c(y) = (1 + Σ_i (1 − a_i(y)))/(k+1)`.
@@ -326,22 +312,16 @@ pub fn defensive_pairwise_canonical(
 /// m_i = (C_N/(C_N + c_c)) · c_i·p̂_{←i} / (C_N·p̂_{←i} + c_c·p̂_c),   C_N = Σ_{j∈N} c_j
 /// ```
 ///
-/// (Wyman et al. 2023 course notes, confidence-weighted pairwise; `ALGORITHMS.md` §3.3, last
-/// form). Neighbours with more confidence get proportionally more weight; the canonical keeps at
+/// (Wyman et al. 2023 course notes, confidence-weighted pairwise; `docs/GRIS.md`
+/// §4.7). Neighbours with more confidence get proportionally more weight; the canonical keeps at
 /// least `c_c/(c_c + C_N)`. `neighbor_confidence_sum` is `C_N` over *all* neighbours of this
 /// step.
-pub fn confidence_weighted_pairwise_neighbor(
-    neighbor_confidence: f32,
-    neighbor_target_pdf: f32,
-    canonical_confidence: f32,
-    canonical_target_pdf: f32,
-    neighbor_confidence_sum: f32,
-) -> f32 {
+pub fn confidence_weighted_pairwise_neighbor(pair: PairTerms, neighbor_confidence_sum: f32) -> f32 {
     let cn = clean(neighbor_confidence_sum);
-    let cc = clean(canonical_confidence);
-    let ci = clean(neighbor_confidence);
-    let pi = clean(neighbor_target_pdf);
-    let pc = clean(canonical_target_pdf);
+    let cc = clean(pair.canonical_confidence);
+    let ci = clean(pair.neighbor_confidence);
+    let pi = clean(pair.neighbor_target_pdf);
+    let pc = clean(pair.canonical_target_pdf);
     let den = cn * pi + cc * pc;
     if !(ci > 0.0 && pi > 0.0 && den > 0.0 && cn + cc > 0.0) {
         return 0.0;
@@ -420,7 +400,13 @@ mod tests {
         let p = [1e30, 1e30, 1e-30];
         let s: f32 = (0..3).map(|i| generalized_balance(i, &c, &p)).sum();
         assert!((s - 1.0).abs() < 1e-6);
-        let a = pairwise_pair_weight(1e30, 1e30, 1e30, 1e30, 3.0);
+        let pair = PairTerms {
+            neighbor_confidence: 1e30,
+            neighbor_target_pdf: 1e30,
+            canonical_confidence: 1e30,
+            canonical_target_pdf: 1e30,
+        };
+        let a = pairwise_pair_weight(pair, 3.0);
         assert!(a.is_finite() && (a - 0.75).abs() < 1e-6);
     }
 

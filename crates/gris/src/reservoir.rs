@@ -2,7 +2,8 @@
 //!
 //! Implements the reservoir definitions in the course-notes / GRIS form (Lin et al. 2022,
 //! "Generalized Resampled Importance Sampling"; Wyman et al. 2023, "A Gentle Introduction to
-//! ReSTIR"); see `ALGORITHMS.md` §1.1–1.4 of this workspace.
+//! ReSTIR"), with RIS from Talbot et al. 2005 and streaming from Bitterli et al. 2020;
+//! derivations in `docs/GRIS.md` §2.
 //!
 //! Two types, kept apart on purpose:
 //!
@@ -24,7 +25,7 @@
 /// * `confidence` (`M`) is finite and `≥ 0`; it is a float because capping and pairwise
 ///   heuristics produce fractional values;
 /// * `target_pdf` is `p̂(Y)`, the target function of the domain that owns the reservoir evaluated
-///   at the selected sample (0 when empty). The MIS helpers in [`crate::gris`] use it as
+///   at the selected sample (0 when empty). The MIS helpers in [`crate::resampling`] use it as
 ///   `p̂_i(X_i)`, so it must be the same function the shift map evaluates for that domain.
 ///
 /// `E[f(Y)·W] = ∫ f` over the support of the target whenever the reservoir came out of an
@@ -222,7 +223,7 @@ impl<S> StreamingReservoir<S> {
     /// all candidates one by one. Returns `true` if `other`'s sample was taken.
     ///
     /// This is *not* GRIS reservoir reuse; to resample finalised reservoirs from other domains use
-    /// [`crate::gris`].
+    /// [`crate::resampling`].
     pub fn merge(&mut self, other: StreamingReservoir<S>, u: f32) -> bool {
         self.confidence += other.confidence;
         let Some(sample) = other.selected else {

@@ -5,7 +5,7 @@
 //! shifted sample, three things: the shifted sample, the Jacobian determinant `|∂T_{i→j}/∂x|`
 //! and the target function of domain `j` at the shifted sample. A shift either delivers all three
 //! or fails explicitly (`None`); it never returns partially-filled state
-//! (`ALGORITHMS.md` §3.5, §5 pitfall 7).
+//! (`docs/GRIS.md` §6.1).
 //!
 //! # Measures
 //!
@@ -49,7 +49,7 @@ impl<S> Shifted<S> {
     }
 
     /// `true` when the Jacobian is finite and positive and the target finite and non-negative.
-    /// The drivers in [`crate::gris`] treat an invalid result like a failed shift.
+    /// The drivers in [`crate::resampling`] treat an invalid result like a failed shift.
     pub fn is_valid(&self) -> bool {
         self.jacobian > 0.0
             && self.jacobian.is_finite()

@@ -1,5 +1,5 @@
 //! The analytic reconnection Jacobian `(cos θ_y / cos θ_x)·(d_x²/d_y²)` agrees with a
-//! finite-difference measurement of the direction map ω_x ↦ ω_y (ALGORITHMS.md §3.5.1, §6.5).
+//! finite-difference measurement of the direction map ω_x ↦ ω_y (docs/GRIS.md §6.2).
 //!
 //! The map: a ray leaves `x_prev` in direction ω, hits the plane through the reconnection vertex
 //! `v` with normal `n` at a point `p(ω)`, and ω_y = normalize(p(ω) − y_prev). Its Jacobian is the

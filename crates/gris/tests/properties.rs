@@ -1,4 +1,4 @@
-//! Property tests (proptest, fixed RNG seed) for the invariants of ALGORITHMS.md §6:
+//! Property tests (proptest, fixed RNG seed) for the invariants listed in docs/GRIS.md §7:
 //! MIS partition of unity, defensive bounds, merge order/grouping invariance, confidence
 //! bookkeeping, `W ≥ 0` and finite for every finite input, and Jacobian round trips.
 // Uses `reconnection_jacobian_from_points`, which needs the `std` feature (square roots).
@@ -103,12 +103,13 @@ proptest! {
         let (cc, pc) = (c[0], p[0]);
         let (nc, np) = (&c[1..], &p[1..]);
         let k = nc.len();
+        let pair = |i: usize| mis::PairTerms { neighbor_confidence: nc[i], neighbor_target_pdf: np[i], canonical_confidence: cc, canonical_target_pdf: pc };
 
         let mc = mis::pairwise_canonical(cc, pc, nc, np);
         let mut sum = f64::from(mc);
         assert_unit(mc);
         for i in 0..k {
-            let m = mis::pairwise_neighbor(nc[i], np[i], cc, pc, k);
+            let m = mis::pairwise_neighbor(pair(i), k);
             assert_unit(m);
             sum += f64::from(m);
         }
@@ -118,7 +119,7 @@ proptest! {
         prop_assert!(f64::from(mc) >= 1.0 / (k as f64 + 1.0) - 1e-6, "defensive canonical {mc}");
         let mut sum = f64::from(mc);
         for i in 0..k {
-            let m = mis::defensive_pairwise_neighbor(nc[i], np[i], cc, pc, k);
+            let m = mis::defensive_pairwise_neighbor(pair(i), k);
             assert_unit(m);
             sum += f64::from(m);
         }
@@ -133,7 +134,7 @@ proptest! {
         }
         let mut sum = f64::from(mc);
         for i in 0..k {
-            let m = mis::confidence_weighted_pairwise_neighbor(nc[i], np[i], cc, pc, cn);
+            let m = mis::confidence_weighted_pairwise_neighbor(pair(i), cn);
             assert_unit(m);
             sum += f64::from(m);
         }
@@ -274,9 +275,10 @@ proptest! {
             ws.push(mis::generalized_balance(i, c, p));
             ws.push(mis::contribution(i, c, p));
             if i > 0 {
-                ws.push(mis::pairwise_neighbor(c[i], p[i], c[0], p[0], k));
-                ws.push(mis::defensive_pairwise_neighbor(c[i], p[i], c[0], p[0], k));
-                ws.push(mis::confidence_weighted_pairwise_neighbor(c[i], p[i], c[0], p[0], c[1..].iter().sum()));
+                let pair = mis::PairTerms { neighbor_confidence: c[i], neighbor_target_pdf: p[i], canonical_confidence: c[0], canonical_target_pdf: p[0] };
+                ws.push(mis::pairwise_neighbor(pair, k));
+                ws.push(mis::defensive_pairwise_neighbor(pair, k));
+                ws.push(mis::confidence_weighted_pairwise_neighbor(pair, c[1..].iter().sum()));
             }
         }
         for w in ws {

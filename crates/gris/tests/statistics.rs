@@ -259,7 +259,10 @@ fn gris_without_neighbours_reduces_to_ris() {
     for _ in 0..1000 {
         let rc = canonical.sample(&mut rng);
         for scheme in MisScheme::ALL {
-            let out = resample(&PowerShift, scheme, &canonical, &rc, &[], || rng.next_f32());
+            let none: &[(&ToyDomain, &Reservoir<f64>)] = &[];
+            let out = resample(&PowerShift, scheme, &canonical, &rc, none, || {
+                rng.next_f32()
+            });
             assert_eq!(out.sample, rc.sample, "{scheme:?}");
             assert!((out.ucw - rc.ucw).abs() <= 1e-6 * rc.ucw, "{scheme:?}");
         }
@@ -396,23 +399,25 @@ fn manual_step(
         let (cc, pc) = (confidences[0], p[0]);
         let nc = &confidences[1..];
         let np = &p[1..];
+        let pair = |i: usize| mis::PairTerms {
+            neighbor_confidence: nc[i - 1],
+            neighbor_target_pdf: np[i - 1],
+            canonical_confidence: cc,
+            canonical_target_pdf: pc,
+        };
         let m = match scheme {
             Manual::OneOverZ | Manual::Contribution => confidences[i],
             Manual::Balance => mis::generalized_balance(i, &confidences, &p),
             Manual::Pairwise if i == 0 => mis::pairwise_canonical(cc, pc, nc, np),
-            Manual::Pairwise => mis::pairwise_neighbor(nc[i - 1], np[i - 1], cc, pc, k),
+            Manual::Pairwise => mis::pairwise_neighbor(pair(i), k),
             Manual::Defensive if i == 0 => mis::defensive_pairwise_canonical(cc, pc, nc, np),
-            Manual::Defensive => mis::defensive_pairwise_neighbor(nc[i - 1], np[i - 1], cc, pc, k),
+            Manual::Defensive => mis::defensive_pairwise_neighbor(pair(i), k),
             Manual::ConfidenceWeighted if i == 0 => {
                 mis::confidence_weighted_pairwise_canonical(cc, pc, nc, np)
             }
-            Manual::ConfidenceWeighted => mis::confidence_weighted_pairwise_neighbor(
-                nc[i - 1],
-                np[i - 1],
-                cc,
-                pc,
-                nc.iter().sum(),
-            ),
+            Manual::ConfidenceWeighted => {
+                mis::confidence_weighted_pairwise_neighbor(pair(i), nc.iter().sum())
+            }
             Manual::StreamingDefensive => unreachable!(),
         };
         let input = GrisInput {

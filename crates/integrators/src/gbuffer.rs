@@ -81,7 +81,7 @@ impl Receiver {
 
     /// Whether `other` is similar enough to be a reuse neighbour: shading normals within
     /// `normal_cos` (cosine of the largest angle) and camera distances within a relative
-    /// `depth_tolerance` (ALGORITHMS.md §2.4). These tests only pick participating domains;
+    /// `depth_tolerance` (`docs/RESTIR_DI.md`, spatial reuse). These tests only pick participating domains;
     /// the estimators stay unbiased whatever they decide.
     #[inline]
     pub fn is_similar(&self, other: &Receiver, normal_cos: f32, depth_tolerance: f32) -> bool {

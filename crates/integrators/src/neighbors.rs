@@ -1,5 +1,5 @@
 //! Spatial-reuse neighbour selection shared by the screen-space ReSTIR estimators
-//! (ALGORITHMS.md §2.4–2.5).
+//! (`docs/RESTIR_DI.md`, spatial reuse).
 //!
 //! A fixed table of points of the R2 low-discrepancy sequence inside the unit disk; each pixel
 //! walks it from its own random start, so neighbour sets differ between pixels (no correlation

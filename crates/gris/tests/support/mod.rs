@@ -111,7 +111,7 @@ pub fn chi_square(counts: &[u64], probs: &[f64], n: u64) -> (f64, usize) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The toy GRIS problem (our own construction, in the spirit of ALGORITHMS.md §6.3).
+// The toy GRIS problem (our own construction; docs/GRIS.md §7).
 //
 // Every domain d lives on [0, support_max_d] ⊂ [0, 1] and carries an exponent s_d; the shift
 // T_{a→b}(x) = x^{s_a/s_b} (canonical s = 1) with Jacobian (s_a/s_b)·x^{s_a/s_b − 1}. A shift fails

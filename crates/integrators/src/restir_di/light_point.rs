@@ -6,7 +6,7 @@
 //! A sample is a point on an area light (area measure), a point light (counting measure), a
 //! directional light (counting measure) or a direction towards the environment (solid-angle
 //! measure on the sphere at infinity). None of these depend on the receiver, so the shift
-//! between pixels is the identity with Jacobian 1 (ALGORITHMS.md §2.1); each pixel's target and
+//! between pixels is the identity with Jacobian 1 (`docs/GRIS.md` §6.7); each pixel's target and
 //! source densities are expressed in these measures.
 //!
 //! # Integrand and target

@@ -1,7 +1,7 @@
 //! ReSTIR DI (Bitterli et al. 2020): reservoir-based direct lighting with spatial (and optional
 //! temporal) reuse, combined unbiasedly with the MIS schemes of `restir-gris`.
 //!
-//! One pass, for every pixel at once (ALGORITHMS.md §2):
+//! One pass, for every pixel at once (`docs/RESTIR_DI.md`):
 //!
 //! 1. **Primary hits** ([`GBuffer`]), adding what the camera sees directly.
 //! 2. **Initial resampling**: `N_L` light candidates from the power-based light sampler
@@ -443,7 +443,7 @@ impl Integrator for RestirDiIntegrator {
             // Two techniques, one of them carrying up to `mcap` passes of history: the generalized
             // balance heuristic (4 target evaluations) lets the history weigh by its confidence,
             // where defensive pairwise would keep half the weight on the fresh sample
-            // (ALGORITHMS.md §3.3 (d); ReSTIR PT's temporal reuse does the same).
+            // (`docs/GRIS.md` §4.4; ReSTIR PT's temporal reuse does the same).
             let temporal_mis = if s.mis.is_unbiased() {
                 MisScheme::GeneralizedBalance
             } else {

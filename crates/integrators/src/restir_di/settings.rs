@@ -68,7 +68,7 @@ pub struct RestirDiSettings {
 }
 
 impl RestirDiSettings {
-    /// The defaults (Bitterli et al. 2020's unbiased configuration, ALGORITHMS.md §2.9).
+    /// The defaults (Bitterli et al. 2020's unbiased configuration; `docs/RESTIR_DI.md`).
     pub fn new(path: PathSettings) -> Self {
         Self {
             path,

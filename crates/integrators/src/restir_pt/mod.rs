@@ -1,7 +1,7 @@
 //! ReSTIR PT (Lin et al. 2022): reservoir-based path reuse across pixels with the reconnection,
 //! random-replay and hybrid shifts, combined unbiasedly with the MIS schemes of `restir-gris` (`docs/RESTIR_PT.md`).
 //!
-//! One pass, for every pixel at once (ALGORITHMS.md §4):
+//! One pass, for every pixel at once (`docs/RESTIR_PT.md`):
 //!
 //! 1. **Primary hits** ([`GBuffer`]), adding what the camera sees directly.
 //! 2. **Initial sampling**: `--candidates` random walks from the primary hit with next-event
@@ -266,11 +266,10 @@ impl RestirPtIntegrator {
         shift: &PtShift,
         gbuf: &GBuffer,
         input: &'a [PtReservoir],
-        indices: &'a [usize],
         index: usize,
         rng: &mut Pcg32,
         picked: &mut Vec<usize>,
-        neighbors: &mut Vec<(&'a usize, &'a PtReservoir)>,
+        neighbors: &mut Vec<(usize, &'a PtReservoir)>,
     ) -> PtReservoir {
         let canonical = &input[index];
         if gbuf.receiver(index).is_none() {
@@ -284,11 +283,11 @@ impl RestirPtIntegrator {
         };
         self.pattern.select(gbuf, index, &rule, rng, picked);
         neighbors.clear();
-        neighbors.extend(picked.iter().map(|&q| (&indices[q], &input[q])));
+        neighbors.extend(picked.iter().map(|&q| (q, &input[q])));
         resample(
             shift,
             self.settings.mis,
-            &indices[index],
+            &index,
             canonical,
             neighbors,
             || rng.next_f32(),
@@ -387,7 +386,6 @@ impl Integrator for RestirPtIntegrator {
                 shift
             };
             // Domains: pixel `i` of this pass is `i`, of the previous pass `n + i`.
-            let indices: Vec<usize> = (0..2 * n).collect();
             if let Some(hist) = &history {
                 // Two techniques, one carrying up to `mcap` passes of history: the generalized
                 // balance heuristic, as ReSTIR DI's temporal reuse.
@@ -416,9 +414,9 @@ impl Integrator for RestirPtIntegrator {
                             *res = resample(
                                 &shift,
                                 temporal_mis,
-                                &indices[index],
+                                &index,
                                 res,
-                                &[(&indices[n + index], &prev)],
+                                &[(n + index, &prev)],
                                 || rng.next_f32(),
                             )
                             .with_confidence_cap(s.mcap);
@@ -446,7 +444,6 @@ impl Integrator for RestirPtIntegrator {
                                     &shift,
                                     &gbuf,
                                     input,
-                                    &indices,
                                     index,
                                     &mut rng,
                                     &mut picked,

@@ -1,0 +1,185 @@
+//! Pairwise MIS as a streaming GRIS step: [`PairwiseResampler`] and what it needs per neighbour.
+//!
+//! The spatial-reuse form of pairwise, defensive pairwise and confidence-weighted pairwise MIS:
+//! the canonical technique's weight is accumulated pair by pair while the neighbours stream in,
+//! so nothing has to be stored per neighbour. The weights themselves are in [`crate::mis`].
+
+use super::{GrisInput, GrisResampler};
+use crate::mis::{self, PairTerms, clean};
+use crate::reservoir::Reservoir;
+use crate::shift::Shifted;
+
+/// Which pairwise MIS variant a [`PairwiseResampler`] uses (`docs/GRIS.md` §4.5–4.7).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PairwiseVariant {
+    /// Non-defensive pairwise: [`mis::pairwise_neighbor`] / [`mis::pairwise_canonical`].
+    Plain,
+    /// Defensive pairwise (canonical keeps `≥ 1/(n+1)`): [`mis::defensive_pairwise_neighbor`] /
+    /// [`mis::defensive_pairwise_canonical`].
+    Defensive,
+    /// Confidence-weighted defensive pairwise: [`mis::confidence_weighted_pairwise_neighbor`] /
+    /// [`mis::confidence_weighted_pairwise_canonical`]. `neighbor_confidence_sum` is `C_N`, the
+    /// sum of the confidences of **all** neighbours that will be added.
+    ConfidenceWeighted {
+        /// `C_N = Σ_i c_i` over the neighbours of this step.
+        neighbor_confidence_sum: f32,
+    },
+}
+
+/// What a [`PairwiseResampler`] needs to know about one neighbour.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairwiseNeighbor<S> {
+    /// Forward shift `T_{i→c}(X_i)` of the neighbour's sample into the canonical domain, or
+    /// `None` if the neighbour's reservoir is empty or the shift failed.
+    pub shifted: Option<Shifted<S>>,
+    /// Neighbour's `W_i`.
+    pub ucw: f32,
+    /// Neighbour's confidence `c_i`.
+    pub confidence: f32,
+    /// Neighbour's target at its own sample, `p̂_i(X_i)` (its `Reservoir::target_pdf`).
+    pub target_pdf: f32,
+    /// Inverse direction: the canonical sample shifted into the neighbour's domain and pulled
+    /// back, `p̂_{←i}(X_c) = p̂_i(T_{c→i}(X_c)) · J_{c→i}(X_c)`
+    /// ([`Shifted::pulled_back_target_pdf`]); 0 if that shift fails or there is no canonical
+    /// sample.
+    pub canonical_sample_target_pdf: f32,
+}
+
+/// Streaming pairwise-MIS GRIS step (Bitterli 2022, PhD thesis §9.1; Lin et al. 2022;
+/// `docs/GRIS.md` §4.5–4.7).
+///
+/// Create it with the canonical reservoir, add every neighbour **including empty ones and ones
+/// whose shifts failed** (each contributes its canonical pair share; skipping one breaks the
+/// partition of unity), then [`finalize`](Self::finalize), which streams the canonical sample
+/// last with the accumulated canonical weight. Two shifts per neighbour: forward (neighbour
+/// sample into the canonical domain) and inverse (canonical sample into the neighbour's domain).
+///
+/// `neighbor_count` is the configured `k` used inside the pair weights; the normalisation uses
+/// the number of neighbours actually added (still a partition of unity).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairwiseResampler<S> {
+    stream: GrisResampler<S>,
+    canonical: Reservoir<S>,
+    variant: PairwiseVariant,
+    neighbor_count: f32,
+    added: u32,
+    canonical_weight: f64,
+}
+
+impl<S> PairwiseResampler<S> {
+    /// Starts a step for the canonical reservoir `canonical` (whose `target_pdf` must be
+    /// `p̂_c(X_c)`) with `neighbor_count` configured neighbours.
+    pub fn new(variant: PairwiseVariant, neighbor_count: usize, canonical: Reservoir<S>) -> Self {
+        let canonical_weight = match variant {
+            PairwiseVariant::Plain => 0.0,
+            PairwiseVariant::Defensive => 1.0,
+            PairwiseVariant::ConfidenceWeighted {
+                neighbor_confidence_sum,
+            } => {
+                let cc = clean(canonical.confidence);
+                let total = cc + clean(neighbor_confidence_sum);
+                if total > 0.0 { cc / total } else { 1.0 }
+            }
+        };
+        Self {
+            stream: GrisResampler::new(),
+            canonical,
+            variant,
+            neighbor_count: neighbor_count.max(1) as f32,
+            added: 0,
+            canonical_weight,
+        }
+    }
+
+    /// The canonical reservoir this step was created with.
+    pub fn canonical(&self) -> &Reservoir<S> {
+        &self.canonical
+    }
+
+    /// Adds one neighbour with uniform `u ∈ [0, 1)`; returns `true` if its sample was selected.
+    pub fn add_neighbor(&mut self, neighbor: PairwiseNeighbor<S>, u: f32) -> bool {
+        self.added += 1;
+        let cc = self.canonical.confidence;
+        let pc = self.canonical.target_pdf;
+        let ci = neighbor.confidence;
+        // Canonical share at the canonical sample X_c.
+        let p_ic = neighbor.canonical_sample_target_pdf;
+        match self.variant {
+            PairwiseVariant::Plain | PairwiseVariant::Defensive => {
+                let pair = PairTerms {
+                    neighbor_confidence: ci,
+                    neighbor_target_pdf: p_ic,
+                    canonical_confidence: cc,
+                    canonical_target_pdf: pc,
+                };
+                let a = mis::pairwise_pair_weight(pair, self.neighbor_count);
+                self.canonical_weight += 1.0 - f64::from(a);
+            }
+            PairwiseVariant::ConfidenceWeighted {
+                neighbor_confidence_sum,
+            } => {
+                let cn = clean(neighbor_confidence_sum);
+                let (cc, pc, ci) = (clean(cc), clean(pc), clean(ci));
+                let total = cc + cn;
+                if total > 0.0 {
+                    let den = cn * clean(p_ic) + cc * pc;
+                    let share = if den > 0.0 { cc * pc / den } else { 1.0 };
+                    self.canonical_weight += ci / total * share;
+                }
+            }
+        }
+        // Forward direction: the neighbour's own sample in the canonical domain.
+        let Some(shifted) = neighbor.shifted.filter(Shifted::is_valid) else {
+            self.stream.add_failed(ci);
+            return false;
+        };
+        let p_i = shifted.source_target_pdf_at_receiver(neighbor.target_pdf);
+        let p_c = shifted.target_pdf;
+        let pair = PairTerms {
+            neighbor_confidence: ci,
+            neighbor_target_pdf: p_i,
+            canonical_confidence: cc,
+            canonical_target_pdf: p_c,
+        };
+        let m = match self.variant {
+            PairwiseVariant::Plain | PairwiseVariant::Defensive => {
+                mis::pairwise_pair_weight(pair, self.neighbor_count)
+            }
+            PairwiseVariant::ConfidenceWeighted {
+                neighbor_confidence_sum,
+            } => mis::confidence_weighted_pairwise_neighbor(pair, neighbor_confidence_sum),
+        };
+        let input = GrisInput::from_shift(shifted, neighbor.ucw, ci);
+        self.stream.add(input, m, u)
+    }
+
+    /// Unnormalised canonical weight accumulated so far (`Σ(1 − a_i)`, `1 + Σ(1 − a_i)`, or the
+    /// confidence-weighted canonical weight).
+    pub fn canonical_weight(&self) -> f64 {
+        self.canonical_weight
+    }
+
+    /// Streams the canonical sample last (with uniform `u ∈ [0, 1)`) and finalises:
+    /// `W = Σ w_i · scale / p̂_c(Y)` with `scale = 1/n` (plain, 1 if `n = 0`), `1/(n+1)`
+    /// (defensive) or 1 (confidence-weighted), `n` = neighbours added.
+    pub fn finalize(self, u: f32) -> Reservoir<S> {
+        let n = self.added as f32;
+        let (canonical_mis, scale) = match self.variant {
+            PairwiseVariant::Plain if self.added == 0 => (1.0, 1.0),
+            PairwiseVariant::Plain => (self.canonical_weight as f32, 1.0 / n),
+            PairwiseVariant::Defensive => (self.canonical_weight as f32, 1.0 / (n + 1.0)),
+            PairwiseVariant::ConfidenceWeighted { .. } => {
+                (self.canonical_weight.clamp(0.0, 1.0) as f32, 1.0)
+            }
+        };
+        let mut stream = self.stream;
+        let canonical_confidence = self.canonical.confidence;
+        match GrisInput::canonical(self.canonical) {
+            Some(input) => {
+                stream.add(input, canonical_mis, u);
+            }
+            None => stream.add_failed(canonical_confidence),
+        }
+        stream.finalize_scaled(scale)
+    }
+}
