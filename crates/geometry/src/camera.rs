@@ -1,3 +1,6 @@
+//! The perspective camera (pinhole or thin lens) with Mitsuba 3's conventions, its field-of-view
+//! axis and the errors that stop it being built.
+
 use glam::{Mat4, Vec2, Vec3};
 
 use crate::Ray;

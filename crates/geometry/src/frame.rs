@@ -1,3 +1,6 @@
+//! Orthonormal shading frames: the change of basis between world space and the local frame in
+//! which the normal is `+z`.
+
 use glam::Vec3;
 
 /// An orthonormal frame `(s, t, n)`; local coordinates have `n` as `+z`.

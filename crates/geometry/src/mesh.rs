@@ -1,3 +1,6 @@
+//! Indexed triangle meshes in world space: vertices, optional normals and texture coordinates,
+//! per-triangle areas for uniform area sampling, and the errors that make a mesh unusable.
+
 use glam::{Affine3A, Vec2, Vec3};
 use restir_sampling::Distribution1D;
 

@@ -1,3 +1,6 @@
+//! Rays and the ray-origin offsets (Mitsuba 3's relative epsilon) for spawning rays and shadow
+//! rays from surfaces without hitting them again.
+
 use glam::Vec3;
 
 /// A ray `o + t·d`. `d` need not be normalised, but every ray the renderer spawns has a unit `d`.

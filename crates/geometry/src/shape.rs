@@ -1,3 +1,7 @@
+//! Shapes: analytic spheres and triangle meshes behind one [`Shape`] enum, their area and
+//! solid-angle sampling, the built-in rectangle, cube and disk meshes, the octahedral encoding of
+//! unit vectors and the area-to-solid-angle pdf conversion.
+
 use core::f32::consts::PI;
 use glam::{Vec2, Vec3};
 use restir_sampling::warp;

@@ -31,10 +31,13 @@
 //!
 //! [`BsdfKind`] holds Mitsuba 3's `diffuse`, `conductor`, `roughconductor`, `dielectric`,
 //! `roughdielectric`, `plastic`, `roughplastic` and `null` with Mitsuba's parameters, defaults and
-//! formulas (`shared/MATERIALS.md` is the specification, with Mitsuba source paths):
-//! [`microfacet`] (GGX and Beckmann, anisotropic, separable Smith, visible-normal sampling),
-//! [`fresnel`] (exact dielectric and conductor Fresnel, the diffuse Fresnel fit), [`ior`]
-//! (named IORs and metals) and [`plastic`] (the rough plastic's precomputed coating tables).
+//! formulas (`shared/MATERIALS.md` is the specification, with Mitsuba source paths). Each family's
+//! maths sits in one file of `src/models/` (`diffuse`, `conductor`, `dielectric`, `plastic`: its
+//! parameters, `eval`, `pdf` and `sample` and their tests); `src/bsdf.rs` holds [`Bsdf`] and the
+//! dispatch, one `match` per method. Beneath them: [`microfacet`] (GGX and Beckmann,
+//! anisotropic, separable Smith, visible-normal sampling), [`fresnel`] (exact dielectric and
+//! conductor Fresnel, the diffuse Fresnel fit), [`ior`] (named IORs and metals) and [`plastic`]
+//! (the rough plastic's precomputed coating tables, in `src/models/plastic/tables.rs`).
 //! Deliberate differences from Mitsuba, none of which changes an expected value:
 //! - visible normals are always sampled (Mitsuba's `sample_visible = false` samples `D` instead);
 //! - the VNDF pdf uses the exact Beckmann Smith term (Mitsuba's rational G1 fit stays in `eval`),
@@ -61,8 +64,11 @@ pub mod fresnel;
 pub mod ior;
 mod lobe;
 pub mod microfacet;
-pub mod plastic;
+mod models;
 
-pub use bsdf::{Bsdf, BsdfKind, BsdfSample, Plastic, ReflectanceParams, RoughPlastic};
+pub use bsdf::{Bsdf, BsdfKind, ReflectanceParams};
 pub use lobe::LobeFlags;
 pub use microfacet::{Distribution, Microfacet};
+pub use models::BsdfSample;
+pub use models::plastic::tables as plastic;
+pub use models::plastic::{Plastic, RoughPlastic};

@@ -1,3 +1,6 @@
+//! Lobe flags: what kind of scattering a BSDF lobe does (diffuse, glossy or delta; reflection or
+//! transmission), and the combinations the models report.
+
 /// Which kind of scattering a lobe does. ReSTIR PT decides where paths may reconnect from these.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub struct LobeFlags(u8);
@@ -50,3 +53,14 @@ impl core::ops::BitOrAssign for LobeFlags {
         *self = self.union(rhs);
     }
 }
+
+/// A Lambertian reflection lobe.
+pub(crate) const REFLECT_DIFFUSE: LobeFlags = LobeFlags::DIFFUSE.union(LobeFlags::REFLECTION);
+/// A microfacet reflection lobe.
+pub(crate) const REFLECT_GLOSSY: LobeFlags = LobeFlags::GLOSSY.union(LobeFlags::REFLECTION);
+/// A mirror reflection.
+pub(crate) const REFLECT_DELTA: LobeFlags = LobeFlags::DELTA.union(LobeFlags::REFLECTION);
+/// A microfacet transmission lobe.
+pub(crate) const TRANSMIT_GLOSSY: LobeFlags = LobeFlags::GLOSSY.union(LobeFlags::TRANSMISSION);
+/// A smooth refraction (or the null surface's pass-through).
+pub(crate) const TRANSMIT_DELTA: LobeFlags = LobeFlags::DELTA.union(LobeFlags::TRANSMISSION);
