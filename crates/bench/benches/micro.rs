@@ -28,7 +28,7 @@ use glam::{Vec2, Vec3};
 use restir_geometry::{Ray, shadow_ray_between};
 use restir_integrators::PassContext;
 use restir_integrators::film::Filter;
-use restir_integrators::gbuffer::GBuffer;
+use restir_integrators::reuse::gbuffer::GBuffer;
 use restir_integrators::restir_di::tiles;
 use restir_materials::{Bsdf, Distribution};
 use restir_sampling::Pcg32;

@@ -19,15 +19,14 @@
 //! ```
 
 pub mod film;
-pub mod gbuffer;
 mod image_io;
 pub mod metrics;
-pub mod neighbors;
 mod params;
 pub mod path;
 mod render;
 pub mod restir_di;
 pub mod restir_pt;
+pub mod reuse;
 
 pub use image_io::{Image, ImageError};
 pub use metrics::{ErrorMetrics, compare};

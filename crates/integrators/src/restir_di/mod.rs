@@ -10,16 +10,17 @@
 //! 3. **Temporal reuse** (optional): the same pixel's reservoir from the previous pass.
 //! 4. **Spatial reuse**: `R` rounds of `k` neighbours from a low-discrepancy disk pattern with a
 //!    per-pixel random start, rejected by normal and depth similarity, resampled with the chosen
-//!    MIS scheme ([`restir_gris::resample`]; the shift is the identity, see [`light_point`]).
+//!    MIS scheme ([`restir_gris::resample`]; the shift is the identity, see
+//!    [`crate::reuse::light_point`]).
 //!    Each round reads the previous round's buffer and writes a new one, so the result does not
 //!    depend on scheduling. Confidence is capped at `mcap` after every step.
 //! 5. **Shading**: the selected sample with a shadow ray, times its `W`; plus `N_B` BSDF samples
 //!    weighted by the balance heuristic against the light strategy (the exact split is explained
-//!    in [`light_point`]); the first BSDF sample continues as a path-traced path when
+//!    in [`target`]); the first BSDF sample continues as a path-traced path when
 //!    `max_depth > 2` (indirect light) or when it followed a delta lobe.
 
-pub mod light_point;
 mod settings;
+pub mod target;
 pub mod tiles;
 
 use std::sync::Mutex;
@@ -33,13 +34,12 @@ use restir_scene::Scene;
 
 pub use settings::{LightSampler, MIS_NAMES, RestirDiSettings, mis_name};
 
-use crate::gbuffer::{GBuffer, Receiver};
-use crate::neighbors::{NeighborPattern, NeighborRule};
+use crate::reuse::gbuffer::{GBuffer, Receiver};
+use crate::reuse::neighbors::{NeighborPattern, NeighborRule};
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
 use crate::render::{BAND_ROWS, Integrator, PassContext};
-use light_point::{
-    Contact, LightPoint, Resolved, StrategyCounts, contact, evaluate, resolve, target,
-};
+use crate::reuse::light_point::{Contact, LightPoint, Resolved, contact, resolve};
+use target::{StrategyCounts, evaluate, target};
 
 /// Random-stream stages (see [`PassContext::stage_rng`]).
 const STAGE_INITIAL: u64 = 1;

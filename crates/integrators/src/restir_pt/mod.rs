@@ -34,8 +34,8 @@ use restir_scene::Scene;
 pub use sample::{Kind, PathSample, PtShift, ShiftKind};
 pub use settings::{RestirPtSettings, SHIFT_NAMES};
 
-use crate::gbuffer::{GBuffer, Receiver};
-use crate::neighbors::{NeighborPattern, NeighborRule};
+use crate::reuse::gbuffer::{GBuffer, Receiver};
+use crate::reuse::neighbors::{NeighborPattern, NeighborRule};
 
 use crate::path::PathSettings;
 use crate::render::{BAND_ROWS, Integrator, PassContext};

@@ -46,8 +46,8 @@ use restir_materials::{Bsdf, BsdfKind};
 use restir_sampling::{Pcg32, luminance, warp::power_heuristic};
 use restir_scene::Scene;
 
-use crate::gbuffer::{GBuffer, Receiver};
-use crate::restir_di::light_point::{LightPoint, Resolved, resolve};
+use crate::reuse::gbuffer::{GBuffer, Receiver};
+use crate::reuse::light_point::{LightPoint, Resolved, resolve};
 
 use super::walk::{Replayed, Vtx, Walker};
 

@@ -31,9 +31,9 @@ use restir_scene::Scene;
 
 use super::sample::resolve_vertex;
 use super::sample::{Kind, PathSample, ShiftKind, Vertex, connectible, evaluate_unshadowed};
-use crate::gbuffer::Receiver;
+use crate::reuse::gbuffer::Receiver;
 use crate::path::{EmissionMis, PrevVertex};
-use crate::restir_di::light_point::LightPoint;
+use crate::reuse::light_point::LightPoint;
 
 pub use crate::path::RANDOMS_PER_BOUNCE;
 
