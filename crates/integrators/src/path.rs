@@ -30,6 +30,12 @@ impl PathSettings {
             hide_emitters: scene.integrator.hide_emitters,
         }
     }
+
+    /// The longest path in segments, `u32::MAX` for unbounded (`max_depth = -1`).
+    #[inline]
+    pub fn max_segments(&self) -> u32 {
+        u32::try_from(self.max_depth).unwrap_or(u32::MAX)
+    }
 }
 
 /// Random numbers each bounce consumes, whatever happens at it: light selection (1), point on the
@@ -112,11 +118,7 @@ pub fn trace_path(
 ) -> (Vec3, u64) {
     let mut radiance = Vec3::ZERO;
     let mut rays = 0u64;
-    let max_depth = if settings.max_depth < 0 {
-        u32::MAX
-    } else {
-        settings.max_depth as u32
-    };
+    let max_depth = settings.max_segments();
     if depth >= max_depth {
         return (radiance, rays);
     }

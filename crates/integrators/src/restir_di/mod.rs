@@ -28,14 +28,15 @@ use std::sync::Mutex;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use restir_geometry::{Ray, offset_ray_origin, shadow_ray_between, shadow_ray_towards};
-use restir_gris::{MisScheme, Reservoir, ShiftMap, Shifted, StreamingReservoir, resample};
+use restir_gris::{Reservoir, ShiftMap, Shifted, StreamingReservoir, resample};
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
-pub use settings::{LightSampler, MIS_NAMES, RestirDiSettings, mis_name};
+pub use settings::{LightSampler, RestirDiSettings};
 
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::neighbors::{NeighborPattern, NeighborRule};
+use crate::reuse::settings::mis_name;
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
 use crate::render::{BAND_ROWS, Integrator, PassContext};
 use crate::reuse::light_point::{Contact, LightPoint, Resolved, contact, resolve};
@@ -240,6 +241,7 @@ impl RestirDiIntegrator {
         input: &'a [DiReservoir],
         index: usize,
         rng: &mut Pcg32,
+        rule: &NeighborRule,
         picked: &mut Vec<usize>,
         neighbors: &mut Vec<(&'a Receiver, &'a DiReservoir)>,
     ) -> DiReservoir {
@@ -247,13 +249,7 @@ impl RestirDiIntegrator {
         let Some(r) = gbuf.receiver(index) else {
             return *canonical;
         };
-        let rule = NeighborRule {
-            count: self.settings.neighbors as usize,
-            radius: self.settings.radius,
-            normal_cos: self.settings.normal_cos,
-            depth_tolerance: self.settings.depth_tolerance,
-        };
-        self.pattern.select(gbuf, index, &rule, rng, picked);
+        self.pattern.select(gbuf, index, rule, rng, picked);
         neighbors.clear();
         neighbors.extend(
             picked
@@ -261,10 +257,10 @@ impl RestirDiIntegrator {
                 .filter_map(|&q| gbuf.receiver(q).map(|rq| (rq, &input[q]))),
         );
         let shift = DiShift::new(scene, self.counts, canonical);
-        resample(&shift, self.settings.mis, r, canonical, neighbors, || {
+        resample(&shift, self.settings.reuse.mis, r, canonical, neighbors, || {
             rng.next_f32()
         })
-        .with_confidence_cap(self.settings.mcap)
+        .with_confidence_cap(self.settings.reuse.mcap)
     }
 
     /// Shading at receiver `r` with its final reservoir: the reservoir's sample with a shadow
@@ -293,11 +289,7 @@ impl RestirDiIntegrator {
 
         // BSDF samples; the first continues the path when indirect light or delta lobes need it.
         let settings = &self.settings.path;
-        let max_depth = if settings.max_depth < 0 {
-            u32::MAX
-        } else {
-            settings.max_depth as u32
-        };
+        let max_depth = settings.max_segments();
         let continues = max_depth > 2 || scene.features.has_delta_lobes;
         let samples = self.settings.bsdf_candidates.max(u32::from(continues));
         let bsdf = &r.resolve_bsdf(scene);
@@ -375,34 +367,32 @@ impl Integrator for RestirDiIntegrator {
              radius={} spatial_rounds={} mis={} mcap={} temporal={} visibility_reuse={}{}",
             s.path.max_depth,
             s.candidates,
-            match s.light_sampler {
-                LightSampler::Power => "power",
-                LightSampler::Tiles => "tiles",
-            },
+            s.light_sampler.name(),
             s.bsdf_candidates,
-            s.neighbors,
-            s.radius,
-            s.spatial_rounds,
-            mis_name(s.mis),
-            s.mcap,
-            s.temporal,
+            s.reuse.neighbors,
+            s.reuse.radius,
+            s.reuse.spatial_rounds,
+            mis_name(s.reuse.mis),
+            s.reuse.mcap,
+            s.reuse.temporal,
             s.visibility_reuse,
             if s.is_unbiased() { "" } else { " (biased)" }
         )
     }
 
     fn buffer_bytes_per_pixel(&self) -> usize {
-        let reservoirs = if self.settings.temporal { 3 } else { 2 };
-        let hits = if self.settings.temporal { 2 } else { 1 };
+        let reservoirs = if self.settings.reuse.temporal { 3 } else { 2 };
+        let hits = if self.settings.reuse.temporal { 2 } else { 1 };
         let hit_bytes = std::mem::size_of::<Receiver>() + std::mem::size_of::<Vec3>();
         reservoirs * Self::RESERVOIR_BYTES + hits * hit_bytes + std::mem::size_of::<Vec3>()
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
         let s = &self.settings;
+        let reuse = &s.reuse;
         let n = accum.len();
         let mut radiance = vec![Vec3::ZERO; n];
-        let keep = s.path.max_depth < 0 || s.path.max_depth >= 2;
+        let keep = s.path.max_segments() >= 2;
         let (gbuf, mut rays) =
             GBuffer::trace(scene, ctx, s.path.hide_emitters, keep, &mut radiance);
         let w = gbuf.width;
@@ -435,7 +425,7 @@ impl Integrator for RestirDiIntegrator {
                 .sum::<u64>();
 
             // Temporal reuse.
-            let history = if s.temporal {
+            let history = if reuse.temporal {
                 self.history.lock().map(|mut h| h.take()).unwrap_or(None)
             } else {
                 None
@@ -444,11 +434,7 @@ impl Integrator for RestirDiIntegrator {
             // balance heuristic (4 target evaluations) lets the history weigh by its confidence,
             // where defensive pairwise would keep half the weight on the fresh sample
             // (ALGORITHMS.md §3.3 (d); ReSTIR PT's temporal reuse does the same).
-            let temporal_mis = if s.mis.is_unbiased() {
-                MisScheme::GeneralizedBalance
-            } else {
-                s.mis
-            };
+            let temporal_mis = reuse.temporal_mis();
             if let Some(hist) = history.as_ref().filter(|h| h.reservoirs.len() == n) {
                 current
                     .par_chunks_mut(w * BAND_ROWS)
@@ -461,31 +447,32 @@ impl Integrator for RestirDiIntegrator {
                             else {
                                 continue;
                             };
-                            if !r.is_similar(prev_r, s.normal_cos, s.depth_tolerance) {
+                            if !r.is_similar(prev_r, reuse.normal_cos, reuse.depth_tolerance) {
                                 continue;
                             }
-                            let prev = hist.reservoirs[index].with_confidence_cap(s.mcap);
+                            let prev = hist.reservoirs[index].with_confidence_cap(reuse.mcap);
                             let mut rng = ctx.stage_rng(index, STAGE_TEMPORAL);
                             let shift = DiShift::new(scene, self.counts, res);
                             *res =
                                 resample(&shift, temporal_mis, r, res, &[(prev_r, &prev)], || {
                                     rng.next_f32()
                                 })
-                                .with_confidence_cap(s.mcap);
+                                .with_confidence_cap(reuse.mcap);
                         }
                     });
             }
 
             // Spatial reuse, ping-ponging two buffers.
-            if s.neighbors > 0 {
+            if reuse.neighbors > 0 {
+                let rule = reuse.neighbor_rule();
                 let mut next = vec![DiReservoir::empty(); n];
-                for round in 0..s.spatial_rounds {
+                for round in 0..reuse.spatial_rounds {
                     let input = &current;
                     next.par_chunks_mut(w * BAND_ROWS)
                         .enumerate()
                         .for_each(|(band, out)| {
-                            let mut picked = Vec::with_capacity(s.neighbors as usize);
-                            let mut scratch = Vec::with_capacity(s.neighbors as usize);
+                            let mut picked = Vec::with_capacity(reuse.neighbors as usize);
+                            let mut scratch = Vec::with_capacity(reuse.neighbors as usize);
                             for (i, res) in out.iter_mut().enumerate() {
                                 let index = band * w * BAND_ROWS + i;
                                 let mut rng =
@@ -496,6 +483,7 @@ impl Integrator for RestirDiIntegrator {
                                     input,
                                     index,
                                     &mut rng,
+                                    &rule,
                                     &mut picked,
                                     &mut scratch,
                                 );
@@ -525,7 +513,7 @@ impl Integrator for RestirDiIntegrator {
                 })
                 .sum::<u64>();
 
-            if s.temporal
+            if reuse.temporal
                 && let Ok(mut h) = self.history.lock()
             {
                 *h = Some(History {

@@ -26,21 +26,21 @@ use std::sync::Mutex;
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use restir_gris::{MisScheme, Reservoir, StreamingReservoir, resample};
+use restir_gris::{Reservoir, StreamingReservoir, resample};
 use restir_materials::LobeFlags;
 use restir_sampling::{Pcg32, luminance};
 use restir_scene::Scene;
 
 pub use sample::{Kind, PathSample, PtShift, ShiftKind};
-pub use settings::{RestirPtSettings, SHIFT_NAMES};
+pub use settings::{DirectLight, RestirPtSettings, SHIFT_NAMES};
 
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::neighbors::{NeighborPattern, NeighborRule};
 
 use crate::path::PathSettings;
 use crate::render::{BAND_ROWS, Integrator, PassContext};
-use crate::restir_di::mis_name;
 use crate::restir_di::{RestirDiIntegrator, RestirDiSettings};
+use crate::reuse::settings::mis_name;
 use sample::connectible;
 use walk::{Vtx, Walker};
 
@@ -72,26 +72,16 @@ pub struct RestirPtIntegrator {
 impl RestirPtIntegrator {
     /// An integrator with `settings`.
     pub fn new(settings: RestirPtSettings) -> Self {
-        let di = settings.direct_restir_di.then(|| {
-            // Paths of at most two segments (fewer if max_depth says so).
-            let max_depth = if settings.path.max_depth < 0 {
-                2
-            } else {
-                settings.path.max_depth.min(2)
-            };
-            let mut d = RestirDiSettings::new(PathSettings {
-                max_depth,
+        let di = (settings.direct == DirectLight::RestirDi).then(|| {
+            // Paths of at most two segments (fewer if max_depth says so), the same reuse.
+            let path = PathSettings {
+                max_depth: settings.path.max_segments().min(2) as i32,
                 ..settings.path
-            });
-            d.neighbors = settings.neighbors;
-            d.radius = settings.radius;
-            d.spatial_rounds = settings.spatial_rounds;
-            d.mis = settings.mis;
-            d.mcap = settings.mcap;
-            d.temporal = settings.temporal;
-            d.normal_cos = settings.normal_cos;
-            d.depth_tolerance = settings.depth_tolerance;
-            RestirDiIntegrator::new(d)
+            };
+            RestirDiIntegrator::new(RestirDiSettings {
+                reuse: settings.reuse,
+                ..RestirDiSettings::new(path)
+            })
         });
         Self {
             settings,
@@ -110,8 +100,7 @@ impl RestirPtIntegrator {
     pub const RESERVOIR_BYTES: usize = std::mem::size_of::<PtReservoir>();
 
     fn max_depth(&self) -> u32 {
-        let d = self.settings.path.max_depth;
-        if d < 0 { u32::MAX } else { d as u32 }
+        self.settings.path.max_segments()
     }
 
     /// The shift used for this scene: `--shift`, except that `hybrid` becomes `reconnection` in
@@ -167,7 +156,7 @@ impl RestirPtIntegrator {
             GBuffer::trace(
                 scene,
                 ctx,
-                s.path.hide_emitters || s.direct_restir_di,
+                s.path.hide_emitters || s.direct == DirectLight::RestirDi,
                 keep,
                 &mut radiance,
             );
@@ -217,8 +206,8 @@ impl RestirPtIntegrator {
         }
         let n = self.settings.candidates;
         let scale = 1.0 / n as f32;
-        let direct_path_traced = self.settings.direct_path_traced;
-        let direct_elsewhere = self.settings.direct_restir_di;
+        let direct_path_traced = self.settings.direct == DirectLight::Path;
+        let direct_elsewhere = self.settings.direct == DirectLight::RestirDi;
         let mut stream = StreamingReservoir::new();
         let mut direct = Vec3::ZERO;
         let mut rays = 0;
@@ -269,6 +258,7 @@ impl RestirPtIntegrator {
         indices: &'a [usize],
         index: usize,
         rng: &mut Pcg32,
+        rule: &NeighborRule,
         picked: &mut Vec<usize>,
         neighbors: &mut Vec<(&'a usize, &'a PtReservoir)>,
     ) -> PtReservoir {
@@ -276,24 +266,18 @@ impl RestirPtIntegrator {
         if gbuf.receiver(index).is_none() {
             return *canonical;
         }
-        let rule = NeighborRule {
-            count: self.settings.neighbors as usize,
-            radius: self.settings.radius,
-            normal_cos: self.settings.normal_cos,
-            depth_tolerance: self.settings.depth_tolerance,
-        };
-        self.pattern.select(gbuf, index, &rule, rng, picked);
+        self.pattern.select(gbuf, index, rule, rng, picked);
         neighbors.clear();
         neighbors.extend(picked.iter().map(|&q| (&indices[q], &input[q])));
         resample(
             shift,
-            self.settings.mis,
+            self.settings.reuse.mis,
             &indices[index],
             canonical,
             neighbors,
             || rng.next_f32(),
         )
-        .with_confidence_cap(self.settings.mcap)
+        .with_confidence_cap(self.settings.reuse.mcap)
     }
 
     /// Shading: the reservoir's path times `W` (its value is its integrand at this pixel, set by
@@ -326,29 +310,23 @@ impl Integrator for RestirPtIntegrator {
              mis={} mcap={} temporal={} shift={} near_distance={} max_jacobian={} direct={}{}",
             s.path.max_depth,
             s.candidates,
-            s.neighbors,
-            s.radius,
-            s.spatial_rounds,
-            mis_name(s.mis),
-            s.mcap,
-            s.temporal,
+            s.reuse.neighbors,
+            s.reuse.radius,
+            s.reuse.spatial_rounds,
+            mis_name(s.reuse.mis),
+            s.reuse.mcap,
+            s.reuse.temporal,
             s.shift.name(),
             s.near_distance,
             s.max_jacobian,
-            if s.direct_path_traced {
-                "path"
-            } else if s.direct_restir_di {
-                "restir-di"
-            } else {
-                "reservoir"
-            },
+            s.direct.name(),
             if s.is_unbiased() { "" } else { " (biased)" }
         )
     }
 
     fn buffer_bytes_per_pixel(&self) -> usize {
         let hit_bytes = std::mem::size_of::<Receiver>() + std::mem::size_of::<Vec3>();
-        let (reservoirs, hits) = if self.settings.temporal {
+        let (reservoirs, hits) = if self.settings.reuse.temporal {
             (3, 2)
         } else {
             (2, 1)
@@ -360,7 +338,7 @@ impl Integrator for RestirPtIntegrator {
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
-        let s = &self.settings;
+        let s = &self.settings.reuse;
         let n = accum.len();
         // Emitters seen by the camera and the direct light at the primary hit (paths of one and
         // two segments) from ReSTIR DI; the reservoirs below carry the longer paths.
@@ -391,11 +369,7 @@ impl Integrator for RestirPtIntegrator {
             if let Some(hist) = &history {
                 // Two techniques, one carrying up to `mcap` passes of history: the generalized
                 // balance heuristic, as ReSTIR DI's temporal reuse.
-                let temporal_mis = if s.mis.is_unbiased() {
-                    MisScheme::GeneralizedBalance
-                } else {
-                    s.mis
-                };
+                let temporal_mis = s.temporal_mis();
                 rays += current
                     .par_chunks_mut(w * BAND_ROWS)
                     .enumerate()
@@ -428,6 +402,7 @@ impl Integrator for RestirPtIntegrator {
                     .sum::<u64>();
             }
             if s.neighbors > 0 && s.spatial_rounds > 0 {
+                let rule = s.neighbor_rule();
                 let mut next = vec![PtReservoir::empty(); n];
                 for round in 0..s.spatial_rounds {
                     let input = &current;
@@ -449,6 +424,7 @@ impl Integrator for RestirPtIntegrator {
                                     &indices,
                                     index,
                                     &mut rng,
+                                    &rule,
                                     &mut picked,
                                     &mut scratch,
                                 );
