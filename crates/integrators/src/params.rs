@@ -162,7 +162,9 @@ impl fmt::Display for ParamError {
                 write!(f, "{name} = {v}: expected a positive finite number")
             }
             ParamProblem::NotBool => write!(f, "{name} = '{v}': expected true or false"),
-            ParamProblem::NotChoice { expected } => write!(f, "{name} = '{v}': expected {expected}"),
+            ParamProblem::NotChoice { expected } => {
+                write!(f, "{name} = '{v}': expected {expected}")
+            }
             ParamProblem::AngleTooLarge => {
                 write!(f, "{name} = {v}: expected an angle in degrees up to 180")
             }

@@ -8,8 +8,8 @@
 use restir_gris::ShiftMap;
 use restir_integrators::film::Filter;
 use restir_integrators::path::PathSettings;
-use restir_integrators::reuse::MIS_NAMES;
 use restir_integrators::restir_pt::{Kind, ShiftKind};
+use restir_integrators::reuse::MIS_NAMES;
 use restir_integrators::{
     Image, IntegratorOptions, PassContext, RestirPtIntegrator, RestirPtSettings, make_integrator,
 };

@@ -155,8 +155,14 @@ impl RestirArgs {
             }
         };
         put("candidates", self.candidates.map(ParamValue::Count));
-        put("light_sampler", self.light_sampler.clone().map(ParamValue::Text));
-        put("bsdf_candidates", self.bsdf_candidates.map(ParamValue::Count));
+        put(
+            "light_sampler",
+            self.light_sampler.clone().map(ParamValue::Text),
+        );
+        put(
+            "bsdf_candidates",
+            self.bsdf_candidates.map(ParamValue::Count),
+        );
         put("neighbors", self.neighbors.map(ParamValue::Count));
         put("radius", self.radius.map(ParamValue::Number));
         put("spatial_rounds", self.spatial_rounds.map(ParamValue::Count));

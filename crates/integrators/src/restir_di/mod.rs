@@ -23,23 +23,23 @@ mod settings;
 pub mod target;
 pub mod tiles;
 
-use std::sync::Mutex;
-
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use restir_geometry::{Ray, offset_ray_origin, shadow_ray_between, shadow_ray_towards};
-use restir_gris::{Reservoir, ShiftMap, Shifted, StreamingReservoir, resample};
+use restir_gris::{Reservoir, ShiftMap, Shifted, StreamingReservoir};
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
 pub use settings::{LightSampler, RestirDiSettings};
 
-use crate::reuse::gbuffer::{GBuffer, Receiver};
-use crate::reuse::neighbors::{NeighborPattern, NeighborRule};
-use crate::reuse::settings::mis_name;
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
-use crate::render::{BAND_ROWS, Integrator, PassContext};
+use crate::render::{Integrator, PassContext};
+use crate::reuse::bands::Bands;
+use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::light_point::{Contact, LightPoint, Resolved, contact, resolve};
+use crate::reuse::neighbors::NeighborPattern;
+use crate::reuse::passes::{self, HistorySlot, ReuseShift};
+use crate::reuse::settings::mis_name;
 use target::{StrategyCounts, evaluate, target};
 
 /// Random-stream stages (see [`PassContext::stage_rng`]).
@@ -51,20 +51,13 @@ const STAGE_SPATIAL: u64 = 16;
 /// The reservoir type: 16-byte sample, `W`, `M`, `p̂`.
 pub type DiReservoir = Reservoir<LightPoint>;
 
-/// What temporal reuse keeps from the previous pass.
-#[derive(Debug)]
-struct History {
-    gbuffer: GBuffer,
-    reservoirs: Vec<DiReservoir>,
-}
-
 /// The ReSTIR DI estimator (`--integrator restir-di`).
 #[derive(Debug)]
 pub struct RestirDiIntegrator {
     settings: RestirDiSettings,
     counts: StrategyCounts,
     pattern: NeighborPattern,
-    history: Mutex<Option<History>>,
+    history: HistorySlot<LightPoint>,
 }
 
 /// The identity shift between pixels: the sample stays on the light, `J = 1`; only the target
@@ -112,6 +105,39 @@ impl ShiftMap<LightPoint> for DiShift<'_> {
     }
 }
 
+/// ReSTIR DI's part in the reuse passes: the identity shift between receivers; a domain is a
+/// pixel's receiver in this pass or the previous one.
+struct DiReuse<'p> {
+    scene: &'p Scene,
+    counts: StrategyCounts,
+    gbuf: &'p GBuffer,
+    prev: Option<&'p GBuffer>,
+}
+
+impl ReuseShift for DiReuse<'_> {
+    type Sample = LightPoint;
+    type Domain = Receiver;
+    type Map<'m>
+        = DiShift<'m>
+    where
+        Self: 'm;
+
+    #[inline]
+    fn map(&self, canonical: &DiReservoir) -> DiShift<'_> {
+        DiShift::new(self.scene, self.counts, canonical)
+    }
+
+    #[inline]
+    fn domain(&self, index: usize, previous: bool) -> &Receiver {
+        let gbuf = if previous {
+            self.prev.expect("temporal reuse has a previous pass")
+        } else {
+            self.gbuf
+        };
+        &gbuf.receivers[index]
+    }
+}
+
 impl RestirDiIntegrator {
     /// An integrator with `settings`.
     pub fn new(settings: RestirDiSettings) -> Self {
@@ -122,7 +148,7 @@ impl RestirDiIntegrator {
             },
             settings,
             pattern: NeighborPattern::new(),
-            history: Mutex::new(None),
+            history: HistorySlot::default(),
         }
     }
 
@@ -228,39 +254,6 @@ impl RestirDiIntegrator {
             }
         }
         (res, rays)
-    }
-
-    /// One spatial round at pixel `index`: resamples the pixel's reservoir from `input` with up to
-    /// `k` similar neighbours.
-    #[allow(clippy::too_many_arguments)]
-    #[inline(never)]
-    fn spatial<'a>(
-        &self,
-        scene: &Scene,
-        gbuf: &'a GBuffer,
-        input: &'a [DiReservoir],
-        index: usize,
-        rng: &mut Pcg32,
-        rule: &NeighborRule,
-        picked: &mut Vec<usize>,
-        neighbors: &mut Vec<(&'a Receiver, &'a DiReservoir)>,
-    ) -> DiReservoir {
-        let canonical = &input[index];
-        let Some(r) = gbuf.receiver(index) else {
-            return *canonical;
-        };
-        self.pattern.select(gbuf, index, rule, rng, picked);
-        neighbors.clear();
-        neighbors.extend(
-            picked
-                .iter()
-                .filter_map(|&q| gbuf.receiver(q).map(|rq| (rq, &input[q]))),
-        );
-        let shift = DiShift::new(scene, self.counts, canonical);
-        resample(&shift, self.settings.reuse.mis, r, canonical, neighbors, || {
-            rng.next_f32()
-        })
-        .with_confidence_cap(self.settings.reuse.mcap)
     }
 
     /// Shading at receiver `r` with its final reservoir: the reservoir's sample with a shadow
@@ -396,6 +389,7 @@ impl Integrator for RestirDiIntegrator {
         let (gbuf, mut rays) =
             GBuffer::trace(scene, ctx, s.path.hide_emitters, keep, &mut radiance);
         let w = gbuf.width;
+        let bands = Bands::new(w);
         if keep {
             // Initial resampling.
             let light_tiles = match s.light_sampler {
@@ -404,12 +398,12 @@ impl Integrator for RestirDiIntegrator {
             };
             let mut current = vec![DiReservoir::empty(); n];
             rays += current
-                .par_chunks_mut(w * BAND_ROWS)
+                .par_chunks_mut(bands.pixels())
                 .enumerate()
                 .map(|(band, out)| {
                     let mut rays = 0;
                     for (i, res) in out.iter_mut().enumerate() {
-                        let index = band * w * BAND_ROWS + i;
+                        let index = bands.first(band) + i;
                         if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
                             let tile = light_tiles
@@ -424,83 +418,43 @@ impl Integrator for RestirDiIntegrator {
                 })
                 .sum::<u64>();
 
-            // Temporal reuse.
-            let history = if reuse.temporal {
-                self.history.lock().map(|mut h| h.take()).unwrap_or(None)
-            } else {
-                None
+            // Temporal and spatial reuse.
+            let history = self.history.take(reuse, n);
+            let shift = DiReuse {
+                scene,
+                counts: self.counts,
+                gbuf: &gbuf,
+                prev: history.as_ref().map(|h| &h.gbuffer),
             };
-            // Two techniques, one of them carrying up to `mcap` passes of history: the generalized
-            // balance heuristic (4 target evaluations) lets the history weigh by its confidence,
-            // where defensive pairwise would keep half the weight on the fresh sample
-            // (ALGORITHMS.md §3.3 (d); ReSTIR PT's temporal reuse does the same).
-            let temporal_mis = reuse.temporal_mis();
-            if let Some(hist) = history.as_ref().filter(|h| h.reservoirs.len() == n) {
-                current
-                    .par_chunks_mut(w * BAND_ROWS)
-                    .enumerate()
-                    .for_each(|(band, out)| {
-                        for (i, res) in out.iter_mut().enumerate() {
-                            let index = band * w * BAND_ROWS + i;
-                            let (Some(r), Some(prev_r)) =
-                                (gbuf.receiver(index), hist.gbuffer.receiver(index))
-                            else {
-                                continue;
-                            };
-                            if !r.is_similar(prev_r, reuse.normal_cos, reuse.depth_tolerance) {
-                                continue;
-                            }
-                            let prev = hist.reservoirs[index].with_confidence_cap(reuse.mcap);
-                            let mut rng = ctx.stage_rng(index, STAGE_TEMPORAL);
-                            let shift = DiShift::new(scene, self.counts, res);
-                            *res =
-                                resample(&shift, temporal_mis, r, res, &[(prev_r, &prev)], || {
-                                    rng.next_f32()
-                                })
-                                .with_confidence_cap(reuse.mcap);
-                        }
-                    });
+            if let Some(history) = &history {
+                rays += passes::temporal(
+                    &shift,
+                    reuse,
+                    ctx,
+                    &gbuf,
+                    history,
+                    STAGE_TEMPORAL,
+                    &mut current,
+                );
             }
-
-            // Spatial reuse, ping-ponging two buffers.
-            if reuse.neighbors > 0 {
-                let rule = reuse.neighbor_rule();
-                let mut next = vec![DiReservoir::empty(); n];
-                for round in 0..reuse.spatial_rounds {
-                    let input = &current;
-                    next.par_chunks_mut(w * BAND_ROWS)
-                        .enumerate()
-                        .for_each(|(band, out)| {
-                            let mut picked = Vec::with_capacity(reuse.neighbors as usize);
-                            let mut scratch = Vec::with_capacity(reuse.neighbors as usize);
-                            for (i, res) in out.iter_mut().enumerate() {
-                                let index = band * w * BAND_ROWS + i;
-                                let mut rng =
-                                    ctx.stage_rng(index, STAGE_SPATIAL + u64::from(round));
-                                *res = self.spatial(
-                                    scene,
-                                    &gbuf,
-                                    input,
-                                    index,
-                                    &mut rng,
-                                    &rule,
-                                    &mut picked,
-                                    &mut scratch,
-                                );
-                            }
-                        });
-                    std::mem::swap(&mut current, &mut next);
-                }
-            }
+            rays += passes::spatial(
+                &shift,
+                reuse,
+                &self.pattern,
+                ctx,
+                &gbuf,
+                STAGE_SPATIAL,
+                &mut current,
+            );
 
             // Shading.
             rays += radiance
-                .par_chunks_mut(w * BAND_ROWS)
+                .par_chunks_mut(bands.pixels())
                 .enumerate()
                 .map(|(band, out)| {
                     let mut rays = 0;
                     for (i, l) in out.iter_mut().enumerate() {
-                        let index = band * w * BAND_ROWS + i;
+                        let index = bands.first(band) + i;
                         if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_SHADE);
                             let ng = gbuf.ng[index];
@@ -513,14 +467,7 @@ impl Integrator for RestirDiIntegrator {
                 })
                 .sum::<u64>();
 
-            if reuse.temporal
-                && let Ok(mut h) = self.history.lock()
-            {
-                *h = Some(History {
-                    gbuffer: gbuf,
-                    reservoirs: current,
-                });
-            }
+            self.history.store(reuse, gbuf, current);
         }
         accum
             .par_iter_mut()

@@ -18,8 +18,10 @@ pub enum LightSampler {
 
 impl LightSampler {
     /// The names `--light-sampler` takes.
-    pub const NAMES: &[(&str, LightSampler)] =
-        &[("power", LightSampler::Power), ("tiles", LightSampler::Tiles)];
+    pub const NAMES: &[(&str, LightSampler)] = &[
+        ("power", LightSampler::Power),
+        ("tiles", LightSampler::Tiles),
+    ];
 
     /// The name `--light-sampler` takes.
     pub fn name(self) -> &'static str {
@@ -132,7 +134,9 @@ mod tests {
         );
         assert!(s.apply(&p("temporal", "maybe")).is_err());
         assert_eq!(
-            s.apply(&p("light_sampler", "near")).unwrap_err().to_string(),
+            s.apply(&p("light_sampler", "near"))
+                .unwrap_err()
+                .to_string(),
             "light_sampler = 'near': expected power or tiles"
         );
     }

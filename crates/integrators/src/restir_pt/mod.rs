@@ -22,11 +22,10 @@ mod settings;
 pub mod walk;
 
 use std::cell::Cell;
-use std::sync::Mutex;
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use restir_gris::{Reservoir, StreamingReservoir, resample};
+use restir_gris::{Reservoir, StreamingReservoir};
 use restir_materials::LobeFlags;
 use restir_sampling::{Pcg32, luminance};
 use restir_scene::Scene;
@@ -34,11 +33,13 @@ use restir_scene::Scene;
 pub use sample::{Kind, PathSample, PtShift, ShiftKind};
 pub use settings::{DirectLight, RestirPtSettings, SHIFT_NAMES};
 
+use crate::reuse::bands::Bands;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
-use crate::reuse::neighbors::{NeighborPattern, NeighborRule};
+use crate::reuse::neighbors::NeighborPattern;
+use crate::reuse::passes::{self, HistorySlot, ReuseShift};
 
 use crate::path::PathSettings;
-use crate::render::{BAND_ROWS, Integrator, PassContext};
+use crate::render::{Integrator, PassContext};
 use crate::restir_di::{RestirDiIntegrator, RestirDiSettings};
 use crate::reuse::settings::mis_name;
 use sample::connectible;
@@ -52,13 +53,6 @@ const STAGE_SPATIAL: u64 = 116;
 /// The reservoir type.
 pub type PtReservoir = Reservoir<PathSample>;
 
-/// What temporal reuse keeps from the previous pass.
-#[derive(Debug)]
-struct History {
-    gbuffer: GBuffer,
-    reservoirs: Vec<PtReservoir>,
-}
-
 /// The ReSTIR PT estimator (`--integrator restir-pt`).
 #[derive(Debug)]
 pub struct RestirPtIntegrator {
@@ -66,7 +60,62 @@ pub struct RestirPtIntegrator {
     /// The ReSTIR DI pass that takes the direct light with `direct = restir-di`.
     di: Option<RestirDiIntegrator>,
     pattern: NeighborPattern,
-    history: Mutex<Option<History>>,
+    history: HistorySlot<PathSample>,
+}
+
+/// ReSTIR PT's part in the reuse passes: its shift map between pixels, whose domains are pixel
+/// indices (`n + i` for pixel `i` of the previous pass).
+struct PtReuse<'p> {
+    /// The walks' rules.
+    walker: Walker<'p>,
+    /// The settings (the Jacobian options).
+    settings: &'p RestirPtSettings,
+    /// This pass's primary hits.
+    gbuf: &'p GBuffer,
+    /// The previous pass's primary hits.
+    prev: Option<&'p GBuffer>,
+    /// `0 .. 2n`: the domains, lent to the resampling.
+    indices: Vec<usize>,
+}
+
+impl<'p> PtReuse<'p> {
+    /// A shift map with its own ray count.
+    #[inline]
+    fn shift(&self) -> PtShift<'p> {
+        PtShift {
+            walker: self.walker,
+            gbuf: self.gbuf,
+            prev: self.prev,
+            rays: Cell::new(0),
+            max_jacobian: self.settings.max_jacobian,
+            unit_jacobian: self.settings.unit_jacobian,
+        }
+    }
+}
+
+impl ReuseShift for PtReuse<'_> {
+    type Sample = PathSample;
+    type Domain = usize;
+    type Map<'m>
+        = PtShift<'m>
+    where
+        Self: 'm;
+
+    #[inline]
+    fn map(&self, _canonical: &PtReservoir) -> PtShift<'_> {
+        self.shift()
+    }
+
+    #[inline]
+    fn rays(map: &PtShift<'_>) -> u64 {
+        map.rays.get()
+    }
+
+    #[inline]
+    fn domain(&self, index: usize, previous: bool) -> &usize {
+        let n = self.indices.len() / 2;
+        &self.indices[if previous { n + index } else { index }]
+    }
 }
 
 impl RestirPtIntegrator {
@@ -87,7 +136,7 @@ impl RestirPtIntegrator {
             settings,
             di,
             pattern: NeighborPattern::new(),
-            history: Mutex::new(None),
+            history: HistorySlot::default(),
         }
     }
 
@@ -128,15 +177,15 @@ impl RestirPtIntegrator {
     }
 
     /// The shift map over the pixels of `gbuf`.
-    pub fn shift_map<'a>(&self, scene: &'a Scene, gbuf: &'a GBuffer) -> PtShift<'a> {
-        PtShift {
+    pub fn shift_map<'a>(&'a self, scene: &'a Scene, gbuf: &'a GBuffer) -> PtShift<'a> {
+        PtReuse {
             walker: self.walker(scene),
+            settings: &self.settings,
             gbuf,
             prev: None,
-            rays: Cell::new(0),
-            max_jacobian: self.settings.max_jacobian,
-            unit_jacobian: self.settings.unit_jacobian,
+            indices: Vec::new(),
         }
+        .shift()
     }
 
     /// The primary hits and the initial reservoirs of pass `ctx` (what reuse starts from), with
@@ -162,15 +211,15 @@ impl RestirPtIntegrator {
             );
         let mut current = vec![PtReservoir::empty(); n];
         if keep {
-            let w = gbuf.width;
+            let bands = Bands::new(gbuf.width);
             rays += current
-                .par_chunks_mut(w * BAND_ROWS)
-                .zip(radiance.par_chunks_mut(w * BAND_ROWS))
+                .par_chunks_mut(bands.pixels())
+                .zip(radiance.par_chunks_mut(bands.pixels()))
                 .enumerate()
                 .map(|(band, (out, rad))| {
                     let mut rays = 0;
                     for (i, (res, l)) in out.iter_mut().zip(rad.iter_mut()).enumerate() {
-                        let index = band * w * BAND_ROWS + i;
+                        let index = bands.first(band) + i;
                         if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
                             let (init, direct, nr) =
@@ -248,38 +297,6 @@ impl RestirPtIntegrator {
         (res, direct, rays)
     }
 
-    /// One spatial round at pixel `index`.
-    #[allow(clippy::too_many_arguments)]
-    fn spatial<'a>(
-        &self,
-        shift: &PtShift,
-        gbuf: &GBuffer,
-        input: &'a [PtReservoir],
-        indices: &'a [usize],
-        index: usize,
-        rng: &mut Pcg32,
-        rule: &NeighborRule,
-        picked: &mut Vec<usize>,
-        neighbors: &mut Vec<(&'a usize, &'a PtReservoir)>,
-    ) -> PtReservoir {
-        let canonical = &input[index];
-        if gbuf.receiver(index).is_none() {
-            return *canonical;
-        }
-        self.pattern.select(gbuf, index, rule, rng, picked);
-        neighbors.clear();
-        neighbors.extend(picked.iter().map(|&q| (&indices[q], &input[q])));
-        resample(
-            shift,
-            self.settings.reuse.mis,
-            &indices[index],
-            canonical,
-            neighbors,
-            || rng.next_f32(),
-        )
-        .with_confidence_cap(self.settings.reuse.mcap)
-    }
-
     /// Shading: the reservoir's path times `W` (its value is its integrand at this pixel, set by
     /// initial sampling or by the last shift).
     fn shade(res: &PtReservoir) -> Vec3 {
@@ -349,104 +366,33 @@ impl Integrator for RestirPtIntegrator {
         let (gbuf, mut current, mut radiance, nr) = self.initial_reservoirs(scene, ctx);
         rays += nr;
         if self.max_depth() >= 2 {
-            let w = gbuf.width;
-            let history = if s.temporal {
-                self.history.lock().map(|mut h| h.take()).unwrap_or(None)
-            } else {
-                None
+            let history = self.history.take(s, n);
+            let shift = PtReuse {
+                walker: self.walker(scene),
+                settings: &self.settings,
+                gbuf: &gbuf,
+                prev: history.as_ref().map(|h| &h.gbuffer),
+                // Domains: pixel `i` of this pass is `i`, of the previous pass `n + i`.
+                indices: (0..2 * n).collect(),
             };
-            let history = history.filter(|h| h.reservoirs.len() == n);
-            // One shift map per band: it counts the shadow rays its shifts trace.
-            let shift_for = |temporal: bool| {
-                let mut shift = self.shift_map(scene, &gbuf);
-                if temporal {
-                    shift.prev = history.as_ref().map(|h| &h.gbuffer);
-                }
-                shift
-            };
-            // Domains: pixel `i` of this pass is `i`, of the previous pass `n + i`.
-            let indices: Vec<usize> = (0..2 * n).collect();
-            if let Some(hist) = &history {
-                // Two techniques, one carrying up to `mcap` passes of history: the generalized
-                // balance heuristic, as ReSTIR DI's temporal reuse.
-                let temporal_mis = s.temporal_mis();
-                rays += current
-                    .par_chunks_mut(w * BAND_ROWS)
-                    .enumerate()
-                    .map(|(band, out)| {
-                        let shift = shift_for(true);
-                        for (i, res) in out.iter_mut().enumerate() {
-                            let index = band * w * BAND_ROWS + i;
-                            let (Some(r), Some(prev_r)) =
-                                (gbuf.receiver(index), hist.gbuffer.receiver(index))
-                            else {
-                                continue;
-                            };
-                            if !r.is_similar(prev_r, s.normal_cos, s.depth_tolerance) {
-                                continue;
-                            }
-                            let prev = hist.reservoirs[index].with_confidence_cap(s.mcap);
-                            let mut rng = ctx.stage_rng(index, STAGE_TEMPORAL);
-                            *res = resample(
-                                &shift,
-                                temporal_mis,
-                                &indices[index],
-                                res,
-                                &[(&indices[n + index], &prev)],
-                                || rng.next_f32(),
-                            )
-                            .with_confidence_cap(s.mcap);
-                        }
-                        shift.rays.get()
-                    })
-                    .sum::<u64>();
+            if let Some(history) = &history {
+                rays +=
+                    passes::temporal(&shift, s, ctx, &gbuf, history, STAGE_TEMPORAL, &mut current);
             }
-            if s.neighbors > 0 && s.spatial_rounds > 0 {
-                let rule = s.neighbor_rule();
-                let mut next = vec![PtReservoir::empty(); n];
-                for round in 0..s.spatial_rounds {
-                    let input = &current;
-                    rays += next
-                        .par_chunks_mut(w * BAND_ROWS)
-                        .enumerate()
-                        .map(|(band, out)| {
-                            let shift = shift_for(false);
-                            let mut picked = Vec::with_capacity(s.neighbors as usize);
-                            let mut scratch = Vec::with_capacity(s.neighbors as usize);
-                            for (i, res) in out.iter_mut().enumerate() {
-                                let index = band * w * BAND_ROWS + i;
-                                let mut rng =
-                                    ctx.stage_rng(index, STAGE_SPATIAL + u64::from(round));
-                                *res = self.spatial(
-                                    &shift,
-                                    &gbuf,
-                                    input,
-                                    &indices,
-                                    index,
-                                    &mut rng,
-                                    &rule,
-                                    &mut picked,
-                                    &mut scratch,
-                                );
-                            }
-                            shift.rays.get()
-                        })
-                        .sum::<u64>();
-                    std::mem::swap(&mut current, &mut next);
-                }
-            }
+            rays += passes::spatial(
+                &shift,
+                s,
+                &self.pattern,
+                ctx,
+                &gbuf,
+                STAGE_SPATIAL,
+                &mut current,
+            );
             radiance
                 .par_iter_mut()
                 .zip(current.par_iter())
                 .for_each(|(l, res)| *l += Self::shade(res));
-            if s.temporal
-                && let Ok(mut h) = self.history.lock()
-            {
-                *h = Some(History {
-                    gbuffer: gbuf,
-                    reservoirs: current,
-                });
-            }
+            self.history.store(s, gbuf, current);
         }
         accum
             .par_iter_mut()

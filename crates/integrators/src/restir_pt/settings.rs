@@ -110,10 +110,8 @@ impl RestirPtSettings {
                     self.candidates = p.count(1)?;
                 }
                 "shift" | "shift_mapping" => {
-                    self.shift = p.choice(
-                        SHIFT_CHOICES,
-                        &format!("one of {}", SHIFT_NAMES.join(", ")),
-                    )?;
+                    self.shift =
+                        p.choice(SHIFT_CHOICES, &format!("one of {}", SHIFT_NAMES.join(", ")))?;
                 }
                 "near_distance" | "distance_threshold" => self.near_distance = p.positive()?,
                 "max_jacobian" | "jacobian_threshold" => {

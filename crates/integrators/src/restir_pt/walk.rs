@@ -31,8 +31,8 @@ use restir_scene::Scene;
 
 use super::sample::resolve_vertex;
 use super::sample::{Kind, PathSample, ShiftKind, Vertex, connectible, evaluate_unshadowed};
-use crate::reuse::gbuffer::Receiver;
 use crate::path::{EmissionMis, PrevVertex};
+use crate::reuse::gbuffer::Receiver;
 use crate::reuse::light_point::LightPoint;
 
 pub use crate::path::RANDOMS_PER_BOUNCE;

@@ -15,7 +15,6 @@ use restir_geometry::Sphere;
 use restir_lights::{Light, LightSample};
 use restir_scene::Scene;
 
-
 /// A ReSTIR DI sample: 16 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightPoint {
