@@ -27,6 +27,7 @@ mod render;
 pub mod restir_di;
 pub mod restir_pt;
 pub mod reuse;
+pub mod shadow;
 
 pub use image_io::{Image, ImageError};
 pub use metrics::{ErrorMetrics, compare};

@@ -6,9 +6,11 @@
 //! `min(max(β)·η², 0.95)`.
 
 use glam::{Vec2, Vec3};
-use restir_geometry::{Ray, offset_ray_origin, shadow_ray_between, shadow_ray_towards};
+use restir_geometry::{Ray, offset_ray_origin};
 use restir_sampling::{Pcg32, warp::power_heuristic};
 use restir_scene::Scene;
+
+use crate::shadow::{ShadowTarget, visible};
 
 /// Path tracer settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -184,13 +186,8 @@ pub fn trace_path(
             let wi = si.shading.to_local(ls.wi);
             let f = bsdf.eval(wo, wi);
             if f != Vec3::ZERO {
-                let (shadow, t_max) = if ls.dist.is_finite() {
-                    shadow_ray_between(si.p, si.ng, ls.p)
-                } else {
-                    shadow_ray_towards(si.p, si.ng, ls.wi, f32::INFINITY)
-                };
                 rays += 1;
-                if !scene.occluded(&shadow, t_max) {
+                if visible(scene, si.p, si.ng, ShadowTarget::new(ls.p, ls.wi, ls.dist)) {
                     let w = if ls.delta {
                         1.0
                     } else {

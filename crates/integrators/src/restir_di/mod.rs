@@ -25,7 +25,7 @@ pub mod tiles;
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use restir_geometry::{Ray, offset_ray_origin, shadow_ray_between, shadow_ray_towards};
+use restir_geometry::{Ray, offset_ray_origin};
 use restir_gris::{Reservoir, ShiftMap, Shifted, StreamingReservoir};
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
@@ -40,6 +40,7 @@ use crate::reuse::light_point::{Contact, LightPoint, Resolved, contact, resolve}
 use crate::reuse::neighbors::NeighborPattern;
 use crate::reuse::passes::{self, HistorySlot, ReuseShift};
 use crate::reuse::settings::mis_name;
+use crate::shadow::{self, ShadowTarget};
 use target::{StrategyCounts, evaluate, target};
 
 /// Random-stream stages (see [`PassContext::stage_rng`]).
@@ -340,12 +341,7 @@ impl RestirDiIntegrator {
 /// Whether the light point `c` is visible from receiver `r` (one shadow ray).
 #[inline]
 fn visible(scene: &Scene, r: &Receiver, ng: Vec3, c: &Contact) -> bool {
-    let (ray, t_max) = if c.dist.is_finite() {
-        shadow_ray_between(r.p, ng, c.p)
-    } else {
-        shadow_ray_towards(r.p, ng, c.wi, f32::INFINITY)
-    };
-    !scene.occluded(&ray, t_max)
+    shadow::visible(scene, r.p, ng, ShadowTarget::new(c.p, c.wi, c.dist))
 }
 
 impl Integrator for RestirDiIntegrator {

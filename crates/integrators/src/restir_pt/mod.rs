@@ -14,14 +14,14 @@
 //!    previous pass's primary hit, generalized balance MIS, confidence capped at `mcap`.
 //! 4. **Spatial reuse**: `R` rounds of `k` neighbours (pattern and similarity tests as ReSTIR
 //!    DI) resampled through [`restir_gris::resample`] with the shift of `--shift`
-//!    ([`sample::PtShift`]). Confidence is capped at `mcap` after every round.
+//!    ([`shift::PtShift`]). Confidence is capped at `mcap` after every round.
 //! 5. **Shading**: the selected path's integrand at the pixel (kept in the sample) times `W`.
 
+mod candidate;
 pub mod sample;
 mod settings;
+pub mod shift;
 pub mod walk;
-
-use std::cell::Cell;
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -30,20 +30,22 @@ use restir_materials::LobeFlags;
 use restir_sampling::{Pcg32, luminance};
 use restir_scene::Scene;
 
-pub use sample::{Kind, PathSample, PtShift, ShiftKind};
+pub use sample::{Kind, PathSample, ShiftKind};
 pub use settings::{DirectLight, RestirPtSettings, SHIFT_NAMES};
+use shift::PtReuse;
+pub use shift::PtShift;
 
 use crate::reuse::bands::Bands;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::neighbors::NeighborPattern;
-use crate::reuse::passes::{self, HistorySlot, ReuseShift};
+use crate::reuse::passes::{self, HistorySlot};
 
 use crate::path::PathSettings;
 use crate::render::{Integrator, PassContext};
 use crate::restir_di::{RestirDiIntegrator, RestirDiSettings};
 use crate::reuse::settings::mis_name;
 use sample::connectible;
-use walk::{Vtx, Walker};
+use walk::{ScatterVertex, Walker};
 
 /// Random-stream stages (see [`PassContext::stage_rng`]).
 const STAGE_INITIAL: u64 = 101;
@@ -61,61 +63,6 @@ pub struct RestirPtIntegrator {
     di: Option<RestirDiIntegrator>,
     pattern: NeighborPattern,
     history: HistorySlot<PathSample>,
-}
-
-/// ReSTIR PT's part in the reuse passes: its shift map between pixels, whose domains are pixel
-/// indices (`n + i` for pixel `i` of the previous pass).
-struct PtReuse<'p> {
-    /// The walks' rules.
-    walker: Walker<'p>,
-    /// The settings (the Jacobian options).
-    settings: &'p RestirPtSettings,
-    /// This pass's primary hits.
-    gbuf: &'p GBuffer,
-    /// The previous pass's primary hits.
-    prev: Option<&'p GBuffer>,
-    /// `0 .. 2n`: the domains, lent to the resampling.
-    indices: Vec<usize>,
-}
-
-impl<'p> PtReuse<'p> {
-    /// A shift map with its own ray count.
-    #[inline]
-    fn shift(&self) -> PtShift<'p> {
-        PtShift {
-            walker: self.walker,
-            gbuf: self.gbuf,
-            prev: self.prev,
-            rays: Cell::new(0),
-            max_jacobian: self.settings.max_jacobian,
-            unit_jacobian: self.settings.unit_jacobian,
-        }
-    }
-}
-
-impl ReuseShift for PtReuse<'_> {
-    type Sample = PathSample;
-    type Domain = usize;
-    type Map<'m>
-        = PtShift<'m>
-    where
-        Self: 'm;
-
-    #[inline]
-    fn map(&self, _canonical: &PtReservoir) -> PtShift<'_> {
-        self.shift()
-    }
-
-    #[inline]
-    fn rays(map: &PtShift<'_>) -> u64 {
-        map.rays.get()
-    }
-
-    #[inline]
-    fn domain(&self, index: usize, previous: bool) -> &usize {
-        let n = self.indices.len() / 2;
-        &self.indices[if previous { n + index } else { index }]
-    }
 }
 
 impl RestirPtIntegrator {
@@ -261,7 +208,7 @@ impl RestirPtIntegrator {
         let mut direct = Vec3::ZERO;
         let mut rays = 0;
         let walker = self.walker(scene);
-        let x1 = Vtx::primary(scene, r, ng);
+        let x1 = ScatterVertex::primary(scene, r, ng);
         for _ in 0..n {
             // The walk's own generator (stored in its samples for replay); candidate selection
             // draws from `rng`.
