@@ -13,7 +13,8 @@
 //!    MIS scheme ([`restir_gris::resample`]; the shift is the identity, see
 //!    [`crate::reuse::light_point`]).
 //!    Each round reads the previous round's buffer and writes a new one, so the result does not
-//!    depend on scheduling. Confidence is capped at `mcap` after every step.
+//!    depend on scheduling. Confidence is capped at `mcap` after every step. Steps 3 and 4
+//!    are the shared [`crate::reuse::passes`]; this module plugs in the identity shift.
 //! 5. **Shading**: the selected sample with a shadow ray, times its `W`; plus `N_B` BSDF samples
 //!    weighted by the balance heuristic against the light strategy (the exact split is explained
 //!    in [`target`]); the first BSDF sample continues as a path-traced path when

@@ -1,5 +1,6 @@
 //! ReSTIR PT (Lin et al. 2022): reservoir-based path reuse across pixels with the reconnection,
-//! random-replay and hybrid shifts, combined unbiasedly with the MIS schemes of `restir-gris` (`docs/RESTIR_PT.md`).
+//! random-replay and hybrid shifts, combined unbiasedly with the MIS schemes of `restir-gris`
+//! (`docs/RESTIR_PT.md`).
 //!
 //! One pass, for every pixel at once (ALGORITHMS.md §4):
 //!
@@ -14,7 +15,8 @@
 //!    previous pass's primary hit, generalized balance MIS, confidence capped at `mcap`.
 //! 4. **Spatial reuse**: `R` rounds of `k` neighbours (pattern and similarity tests as ReSTIR
 //!    DI) resampled through [`restir_gris::resample`] with the shift of `--shift`
-//!    ([`shift::PtShift`]). Confidence is capped at `mcap` after every round.
+//!    ([`shift::PtShift`]). Confidence is capped at `mcap` after every round. Steps 3 and 4
+//!    are the shared [`crate::reuse::passes`].
 //! 5. **Shading**: the selected path's integrand at the pixel (kept in the sample) times `W`.
 
 mod candidate;

@@ -255,9 +255,8 @@ impl Walker<'_> {
         }
 
         // BSDF sampling at `cur`, and the ray it traces.
-        let step = match self.sample_bsdf(w, bsdf, &frame, &u) {
-            Ok(step) => step,
-            Err(end) => return Some(end),
+        let Some(step) = self.sample_bsdf(w, bsdf, &frame, &u) else {
+            return Some(Replayed::Fail);
         };
         let ray = Ray::new(offset_ray_origin(w.cur.r.p, w.cur.ng, step.d), step.d);
         w.rays += 1;
@@ -338,25 +337,23 @@ impl Walker<'_> {
 
     /// BSDF sampling at `w.cur` with the bounce's numbers `u`: the lobe check of a replay,
     /// Russian roulette (initial sampling only) and the throughput update of the reconnection
-    /// vertex's suffix. `Err` is the walk's outcome.
+    /// vertex's suffix. `None` when the walk fails here.
     fn sample_bsdf(
         &self,
         w: &mut Walk,
         bsdf: &Bsdf,
         frame: &Frame,
         u: &BounceRandoms,
-    ) -> Result<BsdfStep, Replayed> {
+    ) -> Option<BsdfStep> {
         let (p, wo) = (w.cur.r.p, w.cur.r.wo);
-        let Some(bs) = bsdf.sample(wo, u.lobe, u.dir) else {
-            return Err(Replayed::Fail);
-        };
+        let bs = bsdf.sample(wo, u.lobe, u.dir)?;
         let bits = lobe_bits(bs.lobe);
         if w.j <= 16 {
             let shift = 2 * (w.j - 1);
             if let Some(s) = w.replay
                 && (s.lobes >> shift) & 3 != bits
             {
-                return Err(Replayed::Fail);
+                return None;
             }
             w.lobes |= bits << shift;
         }
@@ -365,13 +362,13 @@ impl Walker<'_> {
         let beta_rr = next_beta * w.inv_q;
         let bmax = beta_rr.max_element();
         if !(bmax > 0.0 && beta_rr.is_finite()) {
-            return Err(Replayed::Fail);
+            return None;
         }
         w.eta_scale *= bs.eta;
         if w.replay.is_none() && w.j >= self.rr_depth {
             let q = (bmax * w.eta_scale * w.eta_scale).min(0.95);
             if u.rr >= q {
-                return Err(Replayed::Fail);
+                return None;
             }
             w.inv_q /= q;
         }
@@ -383,7 +380,7 @@ impl Walker<'_> {
                 rc.rest *= factor;
             }
         }
-        Ok(BsdfStep {
+        Some(BsdfStep {
             d,
             next_beta,
             prev: PrevVertex {
