@@ -105,10 +105,7 @@ fn main() {
             let options = IntegratorOptions {
                 name: Some(kind.into()),
                 max_depth: None,
-                params: params
-                    .iter()
-                    .map(|(k, v)| (k.to_string(), v.to_string()))
-                    .collect(),
+                params: params.into(),
             };
             let integrator = make_integrator(&scene, &options).unwrap().integrator;
             bench_rows(&scene, name, label, integrator.as_ref(), budget, all);

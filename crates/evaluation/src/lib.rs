@@ -271,7 +271,7 @@ fn options_for(config: &IntegratorConfig, entry: &SuiteScene) -> IntegratorOptio
     IntegratorOptions {
         name: Some(config.integrator.clone()),
         max_depth: entry.max_depth,
-        params: config.params.clone(),
+        params: config.params.as_slice().into(),
     }
 }
 
@@ -287,8 +287,9 @@ fn build_integrator(
     if let Some(p) = made
         .unused_params
         .iter()
-        .find(|p| config.params.iter().any(|(k, _)| k == *p))
+        .find(|p| config.params.iter().any(|(k, _)| *k == p.name))
     {
+        let p = &p.name;
         return Err(format!(
             "integrator '{}': {} does not use the parameter '{p}'",
             config.label, config.integrator

@@ -19,18 +19,19 @@
 //! ```
 
 pub mod film;
-pub mod gbuffer;
 mod image_io;
 pub mod metrics;
-pub mod neighbors;
-mod params;
+pub mod params;
 pub mod path;
 mod render;
 pub mod restir_di;
 pub mod restir_pt;
+pub mod reuse;
+pub mod shadow;
 
 pub use image_io::{Image, ImageError};
 pub use metrics::{ErrorMetrics, compare};
+pub use params::{Param, ParamError, ParamSet, ParamSource, ParamValue};
 pub use render::{Integrator, PassContext, PathIntegrator, RenderOutput, RenderSettings, render};
 pub use restir_di::{RestirDiIntegrator, RestirDiSettings};
 pub use restir_pt::{RestirPtIntegrator, RestirPtSettings};
@@ -47,8 +48,8 @@ pub struct IntegratorOptions {
     pub name: Option<String>,
     /// Longest path; `None` takes the scene's.
     pub max_depth: Option<i32>,
-    /// Estimator parameters as `name = value`, applied after the scene's.
-    pub params: Vec<(String, String)>,
+    /// Estimator parameters, applied after the scene's.
+    pub params: ParamSet,
 }
 
 /// A built integrator and the scene parameters it did not recognise.
@@ -56,77 +57,87 @@ pub struct IntegratorOptions {
 pub struct MadeIntegrator {
     /// The estimator.
     pub integrator: Box<dyn Integrator>,
-    /// Names of scene or command-line parameters the estimator does not use.
-    pub unused_params: Vec<String>,
+    /// Scene or command-line parameters the estimator does not use, with where they were given.
+    pub unused_params: Vec<Param>,
 }
 
-/// A settings type's `apply`: takes `name = value` pairs, returns the names it did not use.
-type ApplyParams<'a> = dyn FnMut(&[(String, String)]) -> Result<Vec<String>, String> + 'a;
+/// Why [`make_integrator`] failed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum IntegratorError {
+    /// A maximum depth below -1.
+    MaxDepth(i32),
+    /// An estimator name this crate does not know.
+    Unknown(String),
+    /// A parameter with a bad value.
+    Param(ParamError),
+}
+
+impl std::fmt::Display for IntegratorError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            IntegratorError::MaxDepth(d) => {
+                write!(f, "max depth {d} must be -1 (unbounded) or non-negative")
+            }
+            IntegratorError::Unknown(name) => write!(
+                f,
+                "unknown integrator '{name}' (available: {})",
+                INTEGRATORS.join(", ")
+            ),
+            IntegratorError::Param(e) => e.fmt(f),
+        }
+    }
+}
+
+impl std::error::Error for IntegratorError {}
+
+impl From<ParamError> for IntegratorError {
+    fn from(e: ParamError) -> Self {
+        IntegratorError::Param(e)
+    }
+}
 
 /// Builds the integrator for `scene`: the scene's choice and parameters, overridden by `options`.
 pub fn make_integrator(
     scene: &Scene,
     options: &IntegratorOptions,
-) -> Result<MadeIntegrator, String> {
+) -> Result<MadeIntegrator, IntegratorError> {
     let mut settings = path::PathSettings::from_scene(scene);
     if let Some(d) = options.max_depth {
         if d < -1 {
-            return Err(format!(
-                "max depth {d} must be -1 (unbounded) or non-negative"
-            ));
+            return Err(IntegratorError::MaxDepth(d));
         }
         settings.max_depth = d;
     }
     let scene_kind = canonical_name(&scene.integrator.kind);
     let name = options.name.as_deref().map_or(scene_kind, canonical_name);
     // The scene's parameters belong to the scene's estimator; their errors name the scene file.
-    let scene_params: &[(String, String)] = if name == scene_kind {
-        &scene.integrator.params
+    let mut params = if name == scene_kind {
+        ParamSet::from_scene(&scene.integrator.params, &scene.integrator.location)
     } else {
-        &[]
+        ParamSet::new()
     };
-    let location = &scene.integrator.location;
-    let apply = |apply: &mut ApplyParams| {
-        let mut unused = apply(scene_params).map_err(|e| {
-            if location.file.as_os_str().is_empty() {
-                e
-            } else {
-                format!("{location}: integrator: {e}")
-            }
-        })?;
-        unused.extend(apply(&options.params)?);
-        Ok::<_, String>(unused)
-    };
-    match name {
-        "path" => Ok(MadeIntegrator {
-            integrator: Box::new(PathIntegrator { settings }),
-            unused_params: scene_params
-                .iter()
-                .chain(&options.params)
-                .map(|(k, _)| k.clone())
-                .collect(),
-        }),
+    params.extend(&options.params);
+    let (integrator, unused_params): (Box<dyn Integrator>, _) = match name {
+        "path" => (
+            Box::new(PathIntegrator { settings }),
+            params.iter().cloned().collect(),
+        ),
         "restir-di" => {
             let mut s = RestirDiSettings::new(settings);
-            let unused_params = apply(&mut |p| s.apply(p))?;
-            Ok(MadeIntegrator {
-                integrator: Box::new(RestirDiIntegrator::new(s)),
-                unused_params,
-            })
+            let unused = s.apply(&params)?;
+            (Box::new(RestirDiIntegrator::new(s)), unused)
         }
         "restir-pt" => {
             let mut s = RestirPtSettings::new(settings);
-            let unused_params = apply(&mut |p| s.apply(p))?;
-            Ok(MadeIntegrator {
-                integrator: Box::new(RestirPtIntegrator::new(s)),
-                unused_params,
-            })
+            let unused = s.apply(&params)?;
+            (Box::new(RestirPtIntegrator::new(s)), unused)
         }
-        other => Err(format!(
-            "unknown integrator '{other}' (available: {})",
-            INTEGRATORS.join(", ")
-        )),
-    }
+        other => return Err(IntegratorError::Unknown(other.to_string())),
+    };
+    Ok(MadeIntegrator {
+        integrator,
+        unused_params,
+    })
 }
 
 /// The command-line name for the names scene files use (`restir` is ReSTIR DI, as in Lajolla;

@@ -6,9 +6,11 @@
 //! `min(max(β)·η², 0.95)`.
 
 use glam::{Vec2, Vec3};
-use restir_geometry::{Ray, offset_ray_origin, shadow_ray_between, shadow_ray_towards};
+use restir_geometry::{Ray, offset_ray_origin};
 use restir_sampling::{Pcg32, warp::power_heuristic};
 use restir_scene::Scene;
+
+use crate::shadow::{ShadowTarget, visible};
 
 /// Path tracer settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,6 +31,12 @@ impl PathSettings {
             rr_depth: scene.integrator.rr_depth.max(1),
             hide_emitters: scene.integrator.hide_emitters,
         }
+    }
+
+    /// The longest path in segments, `u32::MAX` for unbounded (`max_depth = -1`).
+    #[inline]
+    pub fn max_segments(&self) -> u32 {
+        u32::try_from(self.max_depth).unwrap_or(u32::MAX)
     }
 }
 
@@ -112,11 +120,7 @@ pub fn trace_path(
 ) -> (Vec3, u64) {
     let mut radiance = Vec3::ZERO;
     let mut rays = 0u64;
-    let max_depth = if settings.max_depth < 0 {
-        u32::MAX
-    } else {
-        settings.max_depth as u32
-    };
+    let max_depth = settings.max_segments();
     if depth >= max_depth {
         return (radiance, rays);
     }
@@ -182,13 +186,8 @@ pub fn trace_path(
             let wi = si.shading.to_local(ls.wi);
             let f = bsdf.eval(wo, wi);
             if f != Vec3::ZERO {
-                let (shadow, t_max) = if ls.dist.is_finite() {
-                    shadow_ray_between(si.p, si.ng, ls.p)
-                } else {
-                    shadow_ray_towards(si.p, si.ng, ls.wi, f32::INFINITY)
-                };
                 rays += 1;
-                if !scene.occluded(&shadow, t_max) {
+                if visible(scene, si.p, si.ng, ShadowTarget::new(ls.p, ls.wi, ls.dist)) {
                     let w = if ls.delta {
                         1.0
                     } else {

@@ -5,7 +5,7 @@
 //! *across seeds* (spatial reuse correlates the pixels of one render). The biased options
 //! (constant 1/M weights, visibility reuse) must fail the same test.
 
-use restir_integrators::restir_di::MIS_NAMES;
+use restir_integrators::reuse::MIS_NAMES;
 use restir_integrators::{IntegratorOptions, make_integrator};
 use restir_scene::{Scene, parse_ron};
 
@@ -240,7 +240,7 @@ fn xml_restir_integrator_and_parameters() {
         "{d}"
     );
     let options = IntegratorOptions {
-        params: vec![("neighbors".into(), "2".into())],
+        params: vec![("neighbors", "2")].into(),
         ..Default::default()
     };
     let d = make_integrator(&scene, &options)

@@ -8,8 +8,8 @@
 use restir_gris::ShiftMap;
 use restir_integrators::film::Filter;
 use restir_integrators::path::PathSettings;
-use restir_integrators::restir_di::MIS_NAMES;
 use restir_integrators::restir_pt::{Kind, ShiftKind};
+use restir_integrators::reuse::MIS_NAMES;
 use restir_integrators::{
     Image, IntegratorOptions, PassContext, RestirPtIntegrator, RestirPtSettings, make_integrator,
 };
@@ -489,7 +489,7 @@ fn xml_restir_pt_integrator_and_parameters() {
         "{d}"
     );
     let options = IntegratorOptions {
-        params: vec![("neighbors".into(), "2".into())],
+        params: vec![("neighbors", "2")].into(),
         ..Default::default()
     };
     let d = make_integrator(&scene, &options)
@@ -501,7 +501,7 @@ fn xml_restir_pt_integrator_and_parameters() {
         "{d}"
     );
     let options = IntegratorOptions {
-        params: vec![("shift".into(), "replay".into())],
+        params: vec![("shift", "replay")].into(),
         ..Default::default()
     };
     let d = make_integrator(&scene, &options)
@@ -510,9 +510,12 @@ fn xml_restir_pt_integrator_and_parameters() {
         .describe();
     assert!(d.contains("shift=replay"), "{d}");
     let options = IntegratorOptions {
-        params: vec![("shift".into(), "manifold".into())],
+        params: vec![("shift", "manifold")].into(),
         ..Default::default()
     };
     let err = make_integrator(&scene, &options).unwrap_err();
-    assert!(err.contains("reconnection, replay, hybrid"), "{err}");
+    assert!(
+        err.to_string().contains("reconnection, replay, hybrid"),
+        "{err}"
+    );
 }

@@ -11,7 +11,8 @@ use std::time::{Duration, Instant};
 use clap::{Parser, Subcommand};
 use restir_geometry::Shape;
 use restir_integrators::{
-    Image, IntegratorOptions, RenderSettings, compare, make_integrator, render,
+    Image, IntegratorOptions, Param, ParamSet, ParamValue, RenderSettings, compare,
+    make_integrator, render,
 };
 use restir_scene::{Scene, load_desc};
 
@@ -145,32 +146,36 @@ struct RestirArgs {
 }
 
 impl RestirArgs {
-    fn params(&self) -> Vec<(String, String)> {
-        let mut p = Vec::new();
-        let mut put = |k: &str, v: Option<String>| {
+    /// The flags given, as typed parameters (the integrator checks their ranges).
+    fn params(&self) -> ParamSet {
+        let mut p = ParamSet::new();
+        let mut put = |k: &str, v: Option<ParamValue>| {
             if let Some(v) = v {
-                p.push((k.to_string(), v));
+                p.push(Param::flag(k, v));
             }
         };
-        put("candidates", self.candidates.map(|v| v.to_string()));
-        put("light_sampler", self.light_sampler.clone());
+        put("candidates", self.candidates.map(ParamValue::Count));
+        put(
+            "light_sampler",
+            self.light_sampler.clone().map(ParamValue::Text),
+        );
         put(
             "bsdf_candidates",
-            self.bsdf_candidates.map(|v| v.to_string()),
+            self.bsdf_candidates.map(ParamValue::Count),
         );
-        put("neighbors", self.neighbors.map(|v| v.to_string()));
-        put("radius", self.radius.map(|v| v.to_string()));
-        put("spatial_rounds", self.spatial_rounds.map(|v| v.to_string()));
-        put("mis", self.mis.clone());
-        put("mcap", self.mcap.map(|v| v.to_string()));
-        put("temporal", self.temporal.then(|| "true".into()));
+        put("neighbors", self.neighbors.map(ParamValue::Count));
+        put("radius", self.radius.map(ParamValue::Number));
+        put("spatial_rounds", self.spatial_rounds.map(ParamValue::Count));
+        put("mis", self.mis.clone().map(ParamValue::Text));
+        put("mcap", self.mcap.map(ParamValue::Number));
+        put("temporal", self.temporal.then_some(ParamValue::Bool(true)));
         put(
             "visibility_reuse",
-            self.visibility_reuse.then(|| "true".into()),
+            self.visibility_reuse.then_some(ParamValue::Bool(true)),
         );
-        put("shift", self.shift.clone());
-        put("max_jacobian", self.max_jacobian.map(|v| v.to_string()));
-        put("direct", self.direct.clone());
+        put("shift", self.shift.clone().map(ParamValue::Text));
+        put("max_jacobian", self.max_jacobian.map(ParamValue::Number));
+        put("direct", self.direct.clone().map(ParamValue::Text));
         p
     }
 }
@@ -239,12 +244,13 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         max_depth: args.max_depth,
         params: args.restir.params(),
     };
-    let made = make_integrator(&scene, &options)?;
+    let made = make_integrator(&scene, &options).map_err(|e| e.to_string())?;
     if !args.quiet {
         for p in &made.unused_params {
             eprintln!(
-                "warning: integrator '{}' does not use the parameter '{p}'",
-                made.integrator.name()
+                "warning: integrator '{}' does not use the parameter '{}'",
+                made.integrator.name(),
+                p.name
             );
         }
     }

@@ -10,36 +10,39 @@
 //! 3. **Temporal reuse** (optional): the same pixel's reservoir from the previous pass.
 //! 4. **Spatial reuse**: `R` rounds of `k` neighbours from a low-discrepancy disk pattern with a
 //!    per-pixel random start, rejected by normal and depth similarity, resampled with the chosen
-//!    MIS scheme ([`restir_gris::resample`]; the shift is the identity, see [`light_point`]).
+//!    MIS scheme ([`restir_gris::resample`]; the shift is the identity, see
+//!    [`crate::reuse::light_point`]).
 //!    Each round reads the previous round's buffer and writes a new one, so the result does not
-//!    depend on scheduling. Confidence is capped at `mcap` after every step.
+//!    depend on scheduling. Confidence is capped at `mcap` after every step. Steps 3 and 4
+//!    are the shared [`crate::reuse::passes`]; this module plugs in the identity shift.
 //! 5. **Shading**: the selected sample with a shadow ray, times its `W`; plus `N_B` BSDF samples
 //!    weighted by the balance heuristic against the light strategy (the exact split is explained
-//!    in [`light_point`]); the first BSDF sample continues as a path-traced path when
+//!    in [`target`]); the first BSDF sample continues as a path-traced path when
 //!    `max_depth > 2` (indirect light) or when it followed a delta lobe.
 
-pub mod light_point;
 mod settings;
+pub mod target;
 pub mod tiles;
-
-use std::sync::Mutex;
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use restir_geometry::{Ray, offset_ray_origin, shadow_ray_between, shadow_ray_towards};
-use restir_gris::{MisScheme, Reservoir, ShiftMap, Shifted, StreamingReservoir, resample};
+use restir_geometry::{Ray, offset_ray_origin};
+use restir_gris::{Reservoir, ShiftMap, Shifted, StreamingReservoir};
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
-pub use settings::{LightSampler, MIS_NAMES, RestirDiSettings, mis_name};
+pub use settings::{LightSampler, RestirDiSettings};
 
-use crate::gbuffer::{GBuffer, Receiver};
-use crate::neighbors::{NeighborPattern, NeighborRule};
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
-use crate::render::{BAND_ROWS, Integrator, PassContext};
-use light_point::{
-    Contact, LightPoint, Resolved, StrategyCounts, contact, evaluate, resolve, target,
-};
+use crate::render::{Integrator, PassContext};
+use crate::reuse::bands::Bands;
+use crate::reuse::gbuffer::{GBuffer, Receiver};
+use crate::reuse::light_point::{Contact, LightPoint, Resolved, contact, resolve};
+use crate::reuse::neighbors::NeighborPattern;
+use crate::reuse::passes::{self, HistorySlot, ReuseShift};
+use crate::reuse::settings::mis_name;
+use crate::shadow::{self, ShadowTarget};
+use target::{StrategyCounts, evaluate, target};
 
 /// Random-stream stages (see [`PassContext::stage_rng`]).
 const STAGE_INITIAL: u64 = 1;
@@ -50,20 +53,13 @@ const STAGE_SPATIAL: u64 = 16;
 /// The reservoir type: 16-byte sample, `W`, `M`, `p̂`.
 pub type DiReservoir = Reservoir<LightPoint>;
 
-/// What temporal reuse keeps from the previous pass.
-#[derive(Debug)]
-struct History {
-    gbuffer: GBuffer,
-    reservoirs: Vec<DiReservoir>,
-}
-
 /// The ReSTIR DI estimator (`--integrator restir-di`).
 #[derive(Debug)]
 pub struct RestirDiIntegrator {
     settings: RestirDiSettings,
     counts: StrategyCounts,
     pattern: NeighborPattern,
-    history: Mutex<Option<History>>,
+    history: HistorySlot<LightPoint>,
 }
 
 /// The identity shift between pixels: the sample stays on the light, `J = 1`; only the target
@@ -111,6 +107,43 @@ impl ShiftMap<LightPoint> for DiShift<'_> {
     }
 }
 
+/// ReSTIR DI's part in the reuse passes: the identity shift between receivers; a domain is a
+/// pixel's receiver in this pass or the previous one.
+struct DiReuse<'p> {
+    scene: &'p Scene,
+    counts: StrategyCounts,
+    gbuf: &'p GBuffer,
+    prev: Option<&'p GBuffer>,
+}
+
+impl ReuseShift for DiReuse<'_> {
+    type Sample = LightPoint;
+    type Domain = Receiver;
+    type DomainRef<'d>
+        = &'d Receiver
+    where
+        Self: 'd;
+    type Map<'m>
+        = DiShift<'m>
+    where
+        Self: 'm;
+
+    #[inline]
+    fn map(&self, canonical: &DiReservoir) -> DiShift<'_> {
+        DiShift::new(self.scene, self.counts, canonical)
+    }
+
+    #[inline]
+    fn domain(&self, index: usize, previous: bool) -> &Receiver {
+        let gbuf = if previous {
+            self.prev.expect("temporal reuse has a previous pass")
+        } else {
+            self.gbuf
+        };
+        &gbuf.receivers[index]
+    }
+}
+
 impl RestirDiIntegrator {
     /// An integrator with `settings`.
     pub fn new(settings: RestirDiSettings) -> Self {
@@ -121,7 +154,7 @@ impl RestirDiIntegrator {
             },
             settings,
             pattern: NeighborPattern::new(),
-            history: Mutex::new(None),
+            history: HistorySlot::default(),
         }
     }
 
@@ -229,44 +262,6 @@ impl RestirDiIntegrator {
         (res, rays)
     }
 
-    /// One spatial round at pixel `index`: resamples the pixel's reservoir from `input` with up to
-    /// `k` similar neighbours.
-    #[allow(clippy::too_many_arguments)]
-    #[inline(never)]
-    fn spatial<'a>(
-        &self,
-        scene: &Scene,
-        gbuf: &'a GBuffer,
-        input: &'a [DiReservoir],
-        index: usize,
-        rng: &mut Pcg32,
-        picked: &mut Vec<usize>,
-        neighbors: &mut Vec<(&'a Receiver, &'a DiReservoir)>,
-    ) -> DiReservoir {
-        let canonical = &input[index];
-        let Some(r) = gbuf.receiver(index) else {
-            return *canonical;
-        };
-        let rule = NeighborRule {
-            count: self.settings.neighbors as usize,
-            radius: self.settings.radius,
-            normal_cos: self.settings.normal_cos,
-            depth_tolerance: self.settings.depth_tolerance,
-        };
-        self.pattern.select(gbuf, index, &rule, rng, picked);
-        neighbors.clear();
-        neighbors.extend(
-            picked
-                .iter()
-                .filter_map(|&q| gbuf.receiver(q).map(|rq| (rq, &input[q]))),
-        );
-        let shift = DiShift::new(scene, self.counts, canonical);
-        resample(&shift, self.settings.mis, r, canonical, neighbors, || {
-            rng.next_f32()
-        })
-        .with_confidence_cap(self.settings.mcap)
-    }
-
     /// Shading at receiver `r` with its final reservoir: the reservoir's sample with a shadow
     /// ray, the BSDF samples, and the continuation. Returns radiance and rays.
     fn shade(
@@ -293,11 +288,7 @@ impl RestirDiIntegrator {
 
         // BSDF samples; the first continues the path when indirect light or delta lobes need it.
         let settings = &self.settings.path;
-        let max_depth = if settings.max_depth < 0 {
-            u32::MAX
-        } else {
-            settings.max_depth as u32
-        };
+        let max_depth = settings.max_segments();
         let continues = max_depth > 2 || scene.features.has_delta_lobes;
         let samples = self.settings.bsdf_candidates.max(u32::from(continues));
         let bsdf = &r.resolve_bsdf(scene);
@@ -355,12 +346,7 @@ impl RestirDiIntegrator {
 /// Whether the light point `c` is visible from receiver `r` (one shadow ray).
 #[inline]
 fn visible(scene: &Scene, r: &Receiver, ng: Vec3, c: &Contact) -> bool {
-    let (ray, t_max) = if c.dist.is_finite() {
-        shadow_ray_between(r.p, ng, c.p)
-    } else {
-        shadow_ray_towards(r.p, ng, c.wi, f32::INFINITY)
-    };
-    !scene.occluded(&ray, t_max)
+    shadow::visible(scene, r.p, ng, ShadowTarget::new(c.p, c.wi, c.dist))
 }
 
 impl Integrator for RestirDiIntegrator {
@@ -375,37 +361,36 @@ impl Integrator for RestirDiIntegrator {
              radius={} spatial_rounds={} mis={} mcap={} temporal={} visibility_reuse={}{}",
             s.path.max_depth,
             s.candidates,
-            match s.light_sampler {
-                LightSampler::Power => "power",
-                LightSampler::Tiles => "tiles",
-            },
+            s.light_sampler.name(),
             s.bsdf_candidates,
-            s.neighbors,
-            s.radius,
-            s.spatial_rounds,
-            mis_name(s.mis),
-            s.mcap,
-            s.temporal,
+            s.reuse.neighbors,
+            s.reuse.radius,
+            s.reuse.spatial_rounds,
+            mis_name(s.reuse.mis),
+            s.reuse.mcap,
+            s.reuse.temporal,
             s.visibility_reuse,
             if s.is_unbiased() { "" } else { " (biased)" }
         )
     }
 
     fn buffer_bytes_per_pixel(&self) -> usize {
-        let reservoirs = if self.settings.temporal { 3 } else { 2 };
-        let hits = if self.settings.temporal { 2 } else { 1 };
+        let reservoirs = if self.settings.reuse.temporal { 3 } else { 2 };
+        let hits = if self.settings.reuse.temporal { 2 } else { 1 };
         let hit_bytes = std::mem::size_of::<Receiver>() + std::mem::size_of::<Vec3>();
         reservoirs * Self::RESERVOIR_BYTES + hits * hit_bytes + std::mem::size_of::<Vec3>()
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
         let s = &self.settings;
+        let reuse = &s.reuse;
         let n = accum.len();
         let mut radiance = vec![Vec3::ZERO; n];
-        let keep = s.path.max_depth < 0 || s.path.max_depth >= 2;
+        let keep = s.path.max_segments() >= 2;
         let (gbuf, mut rays) =
             GBuffer::trace(scene, ctx, s.path.hide_emitters, keep, &mut radiance);
         let w = gbuf.width;
+        let bands = Bands::new(w);
         if keep {
             // Initial resampling.
             let light_tiles = match s.light_sampler {
@@ -414,12 +399,12 @@ impl Integrator for RestirDiIntegrator {
             };
             let mut current = vec![DiReservoir::empty(); n];
             rays += current
-                .par_chunks_mut(w * BAND_ROWS)
+                .par_chunks_mut(bands.pixels())
                 .enumerate()
                 .map(|(band, out)| {
                     let mut rays = 0;
                     for (i, res) in out.iter_mut().enumerate() {
-                        let index = band * w * BAND_ROWS + i;
+                        let index = bands.first(band) + i;
                         if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
                             let tile = light_tiles
@@ -434,85 +419,43 @@ impl Integrator for RestirDiIntegrator {
                 })
                 .sum::<u64>();
 
-            // Temporal reuse.
-            let history = if s.temporal {
-                self.history.lock().map(|mut h| h.take()).unwrap_or(None)
-            } else {
-                None
+            // Temporal and spatial reuse.
+            let history = self.history.take(reuse, n);
+            let shift = DiReuse {
+                scene,
+                counts: self.counts,
+                gbuf: &gbuf,
+                prev: history.as_ref().map(|h| &h.gbuffer),
             };
-            // Two techniques, one of them carrying up to `mcap` passes of history: the generalized
-            // balance heuristic (4 target evaluations) lets the history weigh by its confidence,
-            // where defensive pairwise would keep half the weight on the fresh sample
-            // (`docs/GRIS.md` §4.4; ReSTIR PT's temporal reuse does the same).
-            let temporal_mis = if s.mis.is_unbiased() {
-                MisScheme::GeneralizedBalance
-            } else {
-                s.mis
-            };
-            if let Some(hist) = history.as_ref().filter(|h| h.reservoirs.len() == n) {
-                current
-                    .par_chunks_mut(w * BAND_ROWS)
-                    .enumerate()
-                    .for_each(|(band, out)| {
-                        for (i, res) in out.iter_mut().enumerate() {
-                            let index = band * w * BAND_ROWS + i;
-                            let (Some(r), Some(prev_r)) =
-                                (gbuf.receiver(index), hist.gbuffer.receiver(index))
-                            else {
-                                continue;
-                            };
-                            if !r.is_similar(prev_r, s.normal_cos, s.depth_tolerance) {
-                                continue;
-                            }
-                            let prev = hist.reservoirs[index].with_confidence_cap(s.mcap);
-                            let mut rng = ctx.stage_rng(index, STAGE_TEMPORAL);
-                            let shift = DiShift::new(scene, self.counts, res);
-                            *res =
-                                resample(&shift, temporal_mis, r, res, &[(prev_r, &prev)], || {
-                                    rng.next_f32()
-                                })
-                                .with_confidence_cap(s.mcap);
-                        }
-                    });
+            if let Some(history) = &history {
+                rays += passes::temporal(
+                    &shift,
+                    reuse,
+                    ctx,
+                    &gbuf,
+                    history,
+                    STAGE_TEMPORAL,
+                    &mut current,
+                );
             }
-
-            // Spatial reuse, ping-ponging two buffers.
-            if s.neighbors > 0 {
-                let mut next = vec![DiReservoir::empty(); n];
-                for round in 0..s.spatial_rounds {
-                    let input = &current;
-                    next.par_chunks_mut(w * BAND_ROWS)
-                        .enumerate()
-                        .for_each(|(band, out)| {
-                            let mut picked = Vec::with_capacity(s.neighbors as usize);
-                            let mut scratch = Vec::with_capacity(s.neighbors as usize);
-                            for (i, res) in out.iter_mut().enumerate() {
-                                let index = band * w * BAND_ROWS + i;
-                                let mut rng =
-                                    ctx.stage_rng(index, STAGE_SPATIAL + u64::from(round));
-                                *res = self.spatial(
-                                    scene,
-                                    &gbuf,
-                                    input,
-                                    index,
-                                    &mut rng,
-                                    &mut picked,
-                                    &mut scratch,
-                                );
-                            }
-                        });
-                    std::mem::swap(&mut current, &mut next);
-                }
-            }
+            rays += passes::spatial(
+                &shift,
+                reuse,
+                &self.pattern,
+                ctx,
+                &gbuf,
+                STAGE_SPATIAL,
+                &mut current,
+            );
 
             // Shading.
             rays += radiance
-                .par_chunks_mut(w * BAND_ROWS)
+                .par_chunks_mut(bands.pixels())
                 .enumerate()
                 .map(|(band, out)| {
                     let mut rays = 0;
                     for (i, l) in out.iter_mut().enumerate() {
-                        let index = band * w * BAND_ROWS + i;
+                        let index = bands.first(band) + i;
                         if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_SHADE);
                             let ng = gbuf.ng[index];
@@ -525,14 +468,7 @@ impl Integrator for RestirDiIntegrator {
                 })
                 .sum::<u64>();
 
-            if s.temporal
-                && let Ok(mut h) = self.history.lock()
-            {
-                *h = Some(History {
-                    gbuffer: gbuf,
-                    reservoirs: current,
-                });
-            }
+            self.history.store(reuse, gbuf, current);
         }
         accum
             .par_iter_mut()

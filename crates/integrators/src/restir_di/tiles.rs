@@ -15,7 +15,7 @@ use rayon::prelude::*;
 use restir_sampling::AliasTable;
 use restir_scene::Scene;
 
-use crate::gbuffer::GBuffer;
+use crate::reuse::gbuffer::GBuffer;
 
 /// Tile side in pixels.
 pub const TILE: usize = 16;

@@ -1,5 +1,6 @@
 //! ReSTIR PT (Lin et al. 2022): reservoir-based path reuse across pixels with the reconnection,
-//! random-replay and hybrid shifts, combined unbiasedly with the MIS schemes of `restir-gris` (`docs/RESTIR_PT.md`).
+//! random-replay and hybrid shifts, combined unbiasedly with the MIS schemes of `restir-gris`
+//! (`docs/RESTIR_PT.md`).
 //!
 //! One pass, for every pixel at once (`docs/RESTIR_PT.md`):
 //!
@@ -14,35 +15,39 @@
 //!    previous pass's primary hit, generalized balance MIS, confidence capped at `mcap`.
 //! 4. **Spatial reuse**: `R` rounds of `k` neighbours (pattern and similarity tests as ReSTIR
 //!    DI) resampled through [`restir_gris::resample`] with the shift of `--shift`
-//!    ([`sample::PtShift`]). Confidence is capped at `mcap` after every round.
+//!    ([`shift::PtShift`]). Confidence is capped at `mcap` after every round. Steps 3 and 4
+//!    are the shared [`crate::reuse::passes`].
 //! 5. **Shading**: the selected path's integrand at the pixel (kept in the sample) times `W`.
 
+mod candidate;
 pub mod sample;
 mod settings;
+pub mod shift;
 pub mod walk;
-
-use std::cell::Cell;
-use std::sync::Mutex;
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use restir_gris::{MisScheme, Reservoir, StreamingReservoir, resample};
+use restir_gris::{Reservoir, StreamingReservoir};
 use restir_materials::LobeFlags;
 use restir_sampling::{Pcg32, luminance};
 use restir_scene::Scene;
 
-pub use sample::{Kind, PathSample, PtShift, ShiftKind};
-pub use settings::{RestirPtSettings, SHIFT_NAMES};
+pub use sample::{Kind, PathSample, ShiftKind};
+pub use settings::{DirectLight, RestirPtSettings, SHIFT_NAMES};
+use shift::PtReuse;
+pub use shift::PtShift;
 
-use crate::gbuffer::{GBuffer, Receiver};
-use crate::neighbors::{NeighborPattern, NeighborRule};
+use crate::reuse::bands::Bands;
+use crate::reuse::gbuffer::{GBuffer, Receiver};
+use crate::reuse::neighbors::NeighborPattern;
+use crate::reuse::passes::{self, HistorySlot};
 
 use crate::path::PathSettings;
-use crate::render::{BAND_ROWS, Integrator, PassContext};
-use crate::restir_di::mis_name;
+use crate::render::{Integrator, PassContext};
 use crate::restir_di::{RestirDiIntegrator, RestirDiSettings};
+use crate::reuse::settings::mis_name;
 use sample::connectible;
-use walk::{Vtx, Walker};
+use walk::{ScatterVertex, Walker};
 
 /// Random-stream stages (see [`PassContext::stage_rng`]).
 const STAGE_INITIAL: u64 = 101;
@@ -52,13 +57,6 @@ const STAGE_SPATIAL: u64 = 116;
 /// The reservoir type.
 pub type PtReservoir = Reservoir<PathSample>;
 
-/// What temporal reuse keeps from the previous pass.
-#[derive(Debug)]
-struct History {
-    gbuffer: GBuffer,
-    reservoirs: Vec<PtReservoir>,
-}
-
 /// The ReSTIR PT estimator (`--integrator restir-pt`).
 #[derive(Debug)]
 pub struct RestirPtIntegrator {
@@ -66,38 +64,28 @@ pub struct RestirPtIntegrator {
     /// The ReSTIR DI pass that takes the direct light with `direct = restir-di`.
     di: Option<RestirDiIntegrator>,
     pattern: NeighborPattern,
-    history: Mutex<Option<History>>,
+    history: HistorySlot<PathSample>,
 }
 
 impl RestirPtIntegrator {
     /// An integrator with `settings`.
     pub fn new(settings: RestirPtSettings) -> Self {
-        let di = settings.direct_restir_di.then(|| {
-            // Paths of at most two segments (fewer if max_depth says so).
-            let max_depth = if settings.path.max_depth < 0 {
-                2
-            } else {
-                settings.path.max_depth.min(2)
-            };
-            let mut d = RestirDiSettings::new(PathSettings {
-                max_depth,
+        let di = (settings.direct == DirectLight::RestirDi).then(|| {
+            // Paths of at most two segments (fewer if max_depth says so), the same reuse.
+            let path = PathSettings {
+                max_depth: settings.path.max_segments().min(2) as i32,
                 ..settings.path
-            });
-            d.neighbors = settings.neighbors;
-            d.radius = settings.radius;
-            d.spatial_rounds = settings.spatial_rounds;
-            d.mis = settings.mis;
-            d.mcap = settings.mcap;
-            d.temporal = settings.temporal;
-            d.normal_cos = settings.normal_cos;
-            d.depth_tolerance = settings.depth_tolerance;
-            RestirDiIntegrator::new(d)
+            };
+            RestirDiIntegrator::new(RestirDiSettings {
+                reuse: settings.reuse,
+                ..RestirDiSettings::new(path)
+            })
         });
         Self {
             settings,
             di,
             pattern: NeighborPattern::new(),
-            history: Mutex::new(None),
+            history: HistorySlot::default(),
         }
     }
 
@@ -110,8 +98,7 @@ impl RestirPtIntegrator {
     pub const RESERVOIR_BYTES: usize = std::mem::size_of::<PtReservoir>();
 
     fn max_depth(&self) -> u32 {
-        let d = self.settings.path.max_depth;
-        if d < 0 { u32::MAX } else { d as u32 }
+        self.settings.path.max_segments()
     }
 
     /// The shift used for this scene: `--shift`, except that `hybrid` becomes `reconnection` in
@@ -139,15 +126,15 @@ impl RestirPtIntegrator {
     }
 
     /// The shift map over the pixels of `gbuf`.
-    pub fn shift_map<'a>(&self, scene: &'a Scene, gbuf: &'a GBuffer) -> PtShift<'a> {
-        PtShift {
+    pub fn shift_map<'a>(&'a self, scene: &'a Scene, gbuf: &'a GBuffer) -> PtShift<'a> {
+        PtReuse {
             walker: self.walker(scene),
+            settings: &self.settings,
             gbuf,
             prev: None,
-            rays: Cell::new(0),
-            max_jacobian: self.settings.max_jacobian,
-            unit_jacobian: self.settings.unit_jacobian,
+            pixels: 0,
         }
+        .shift()
     }
 
     /// The primary hits and the initial reservoirs of pass `ctx` (what reuse starts from), with
@@ -167,21 +154,21 @@ impl RestirPtIntegrator {
             GBuffer::trace(
                 scene,
                 ctx,
-                s.path.hide_emitters || s.direct_restir_di,
+                s.path.hide_emitters || s.direct == DirectLight::RestirDi,
                 keep,
                 &mut radiance,
             );
         let mut current = vec![PtReservoir::empty(); n];
         if keep {
-            let w = gbuf.width;
+            let bands = Bands::new(gbuf.width);
             rays += current
-                .par_chunks_mut(w * BAND_ROWS)
-                .zip(radiance.par_chunks_mut(w * BAND_ROWS))
+                .par_chunks_mut(bands.pixels())
+                .zip(radiance.par_chunks_mut(bands.pixels()))
                 .enumerate()
                 .map(|(band, (out, rad))| {
                     let mut rays = 0;
                     for (i, (res, l)) in out.iter_mut().zip(rad.iter_mut()).enumerate() {
-                        let index = band * w * BAND_ROWS + i;
+                        let index = bands.first(band) + i;
                         if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
                             let (init, direct, nr) =
@@ -217,13 +204,13 @@ impl RestirPtIntegrator {
         }
         let n = self.settings.candidates;
         let scale = 1.0 / n as f32;
-        let direct_path_traced = self.settings.direct_path_traced;
-        let direct_elsewhere = self.settings.direct_restir_di;
+        let direct_path_traced = self.settings.direct == DirectLight::Path;
+        let direct_elsewhere = self.settings.direct == DirectLight::RestirDi;
         let mut stream = StreamingReservoir::new();
         let mut direct = Vec3::ZERO;
         let mut rays = 0;
         let walker = self.walker(scene);
-        let x1 = Vtx::primary(scene, r, ng);
+        let x1 = ScatterVertex::primary(scene, r, ng);
         for _ in 0..n {
             // The walk's own generator (stored in its samples for replay); candidate selection
             // draws from `rng`.
@@ -259,42 +246,6 @@ impl RestirPtIntegrator {
         (res, direct, rays)
     }
 
-    /// One spatial round at pixel `index`.
-    #[allow(clippy::too_many_arguments)]
-    fn spatial<'a>(
-        &self,
-        shift: &PtShift,
-        gbuf: &GBuffer,
-        input: &'a [PtReservoir],
-        index: usize,
-        rng: &mut Pcg32,
-        picked: &mut Vec<usize>,
-        neighbors: &mut Vec<(usize, &'a PtReservoir)>,
-    ) -> PtReservoir {
-        let canonical = &input[index];
-        if gbuf.receiver(index).is_none() {
-            return *canonical;
-        }
-        let rule = NeighborRule {
-            count: self.settings.neighbors as usize,
-            radius: self.settings.radius,
-            normal_cos: self.settings.normal_cos,
-            depth_tolerance: self.settings.depth_tolerance,
-        };
-        self.pattern.select(gbuf, index, &rule, rng, picked);
-        neighbors.clear();
-        neighbors.extend(picked.iter().map(|&q| (q, &input[q])));
-        resample(
-            shift,
-            self.settings.mis,
-            &index,
-            canonical,
-            neighbors,
-            || rng.next_f32(),
-        )
-        .with_confidence_cap(self.settings.mcap)
-    }
-
     /// Shading: the reservoir's path times `W` (its value is its integrand at this pixel, set by
     /// initial sampling or by the last shift).
     fn shade(res: &PtReservoir) -> Vec3 {
@@ -325,29 +276,23 @@ impl Integrator for RestirPtIntegrator {
              mis={} mcap={} temporal={} shift={} near_distance={} max_jacobian={} direct={}{}",
             s.path.max_depth,
             s.candidates,
-            s.neighbors,
-            s.radius,
-            s.spatial_rounds,
-            mis_name(s.mis),
-            s.mcap,
-            s.temporal,
+            s.reuse.neighbors,
+            s.reuse.radius,
+            s.reuse.spatial_rounds,
+            mis_name(s.reuse.mis),
+            s.reuse.mcap,
+            s.reuse.temporal,
             s.shift.name(),
             s.near_distance,
             s.max_jacobian,
-            if s.direct_path_traced {
-                "path"
-            } else if s.direct_restir_di {
-                "restir-di"
-            } else {
-                "reservoir"
-            },
+            s.direct.name(),
             if s.is_unbiased() { "" } else { " (biased)" }
         )
     }
 
     fn buffer_bytes_per_pixel(&self) -> usize {
         let hit_bytes = std::mem::size_of::<Receiver>() + std::mem::size_of::<Vec3>();
-        let (reservoirs, hits) = if self.settings.temporal {
+        let (reservoirs, hits) = if self.settings.reuse.temporal {
             (3, 2)
         } else {
             (2, 1)
@@ -359,7 +304,7 @@ impl Integrator for RestirPtIntegrator {
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
-        let s = &self.settings;
+        let s = &self.settings.reuse;
         let n = accum.len();
         // Emitters seen by the camera and the direct light at the primary hit (paths of one and
         // two segments) from ReSTIR DI; the reservoirs below carry the longer paths.
@@ -370,104 +315,33 @@ impl Integrator for RestirPtIntegrator {
         let (gbuf, mut current, mut radiance, nr) = self.initial_reservoirs(scene, ctx);
         rays += nr;
         if self.max_depth() >= 2 {
-            let w = gbuf.width;
-            let history = if s.temporal {
-                self.history.lock().map(|mut h| h.take()).unwrap_or(None)
-            } else {
-                None
+            let history = self.history.take(s, n);
+            let shift = PtReuse {
+                walker: self.walker(scene),
+                settings: &self.settings,
+                gbuf: &gbuf,
+                prev: history.as_ref().map(|h| &h.gbuffer),
+                // Domains: pixel `i` of this pass is `i`, of the previous pass `n + i`.
+                pixels: n,
             };
-            let history = history.filter(|h| h.reservoirs.len() == n);
-            // One shift map per band: it counts the shadow rays its shifts trace.
-            let shift_for = |temporal: bool| {
-                let mut shift = self.shift_map(scene, &gbuf);
-                if temporal {
-                    shift.prev = history.as_ref().map(|h| &h.gbuffer);
-                }
-                shift
-            };
-            // Domains: pixel `i` of this pass is `i`, of the previous pass `n + i`.
-            if let Some(hist) = &history {
-                // Two techniques, one carrying up to `mcap` passes of history: the generalized
-                // balance heuristic, as ReSTIR DI's temporal reuse.
-                let temporal_mis = if s.mis.is_unbiased() {
-                    MisScheme::GeneralizedBalance
-                } else {
-                    s.mis
-                };
-                rays += current
-                    .par_chunks_mut(w * BAND_ROWS)
-                    .enumerate()
-                    .map(|(band, out)| {
-                        let shift = shift_for(true);
-                        for (i, res) in out.iter_mut().enumerate() {
-                            let index = band * w * BAND_ROWS + i;
-                            let (Some(r), Some(prev_r)) =
-                                (gbuf.receiver(index), hist.gbuffer.receiver(index))
-                            else {
-                                continue;
-                            };
-                            if !r.is_similar(prev_r, s.normal_cos, s.depth_tolerance) {
-                                continue;
-                            }
-                            let prev = hist.reservoirs[index].with_confidence_cap(s.mcap);
-                            let mut rng = ctx.stage_rng(index, STAGE_TEMPORAL);
-                            *res = resample(
-                                &shift,
-                                temporal_mis,
-                                &index,
-                                res,
-                                &[(n + index, &prev)],
-                                || rng.next_f32(),
-                            )
-                            .with_confidence_cap(s.mcap);
-                        }
-                        shift.rays.get()
-                    })
-                    .sum::<u64>();
+            if let Some(history) = &history {
+                rays +=
+                    passes::temporal(&shift, s, ctx, &gbuf, history, STAGE_TEMPORAL, &mut current);
             }
-            if s.neighbors > 0 && s.spatial_rounds > 0 {
-                let mut next = vec![PtReservoir::empty(); n];
-                for round in 0..s.spatial_rounds {
-                    let input = &current;
-                    rays += next
-                        .par_chunks_mut(w * BAND_ROWS)
-                        .enumerate()
-                        .map(|(band, out)| {
-                            let shift = shift_for(false);
-                            let mut picked = Vec::with_capacity(s.neighbors as usize);
-                            let mut scratch = Vec::with_capacity(s.neighbors as usize);
-                            for (i, res) in out.iter_mut().enumerate() {
-                                let index = band * w * BAND_ROWS + i;
-                                let mut rng =
-                                    ctx.stage_rng(index, STAGE_SPATIAL + u64::from(round));
-                                *res = self.spatial(
-                                    &shift,
-                                    &gbuf,
-                                    input,
-                                    index,
-                                    &mut rng,
-                                    &mut picked,
-                                    &mut scratch,
-                                );
-                            }
-                            shift.rays.get()
-                        })
-                        .sum::<u64>();
-                    std::mem::swap(&mut current, &mut next);
-                }
-            }
+            rays += passes::spatial(
+                &shift,
+                s,
+                &self.pattern,
+                ctx,
+                &gbuf,
+                STAGE_SPATIAL,
+                &mut current,
+            );
             radiance
                 .par_iter_mut()
                 .zip(current.par_iter())
                 .for_each(|(l, res)| *l += Self::shade(res));
-            if s.temporal
-                && let Ok(mut h) = self.history.lock()
-            {
-                *h = Some(History {
-                    gbuffer: gbuf,
-                    reservoirs: current,
-                });
-            }
+            self.history.store(s, gbuf, current);
         }
         accum
             .par_iter_mut()

@@ -20,27 +20,30 @@
 //! vertices, materials and length), so a shifted path has the same `k` iff the shift checks it
 //! (the invertibility checks of [`Walker::walk`] in replay mode).
 
-use glam::Vec3;
-use restir_geometry::{
-    Ray, SurfaceInteraction, offset_ray_origin, shadow_ray_between, shadow_ray_towards,
-};
+use glam::{Vec2, Vec3};
+use restir_geometry::{Frame, Ray, SurfaceInteraction, offset_ray_origin};
 use restir_gris::jacobian::geometry_term;
-use restir_materials::LobeFlags;
+use restir_materials::{Bsdf, LobeFlags};
 use restir_sampling::{Pcg32, warp::power_heuristic};
 use restir_scene::Scene;
 
-use super::sample::resolve_vertex;
-use super::sample::{Kind, PathSample, ShiftKind, Vertex, connectible, evaluate_unshadowed};
-use crate::gbuffer::Receiver;
+use super::sample::{
+    Kind, PathSample, ShiftKind, Vertex, connectible, evaluate_unshadowed, resolve_vertex,
+};
 use crate::path::{EmissionMis, PrevVertex};
-use crate::restir_di::light_point::LightPoint;
+use crate::reuse::gbuffer::Receiver;
+use crate::reuse::light_point::LightPoint;
+use crate::shadow::{ShadowTarget, visible};
+
+use super::candidate::{Connection, Rc};
 
 pub use crate::path::RANDOMS_PER_BOUNCE;
 
-/// A scattering vertex of a walk: the shading point as a [`Receiver`] (frame, `wo`, material),
-/// its geometric normal and whether it is connectible.
+/// A vertex a walk scatters from (`x1`, the primary hit, or a later surface hit; [`Vertex`] is
+/// the reconnection vertex `x_k` resolved from a sample): the shading point as a [`Receiver`]
+/// (frame, `wo`, material), its geometric normal and whether it is connectible.
 #[derive(Clone, Copy, Debug)]
-pub struct Vtx {
+pub struct ScatterVertex {
     /// Shading point, frame, direction back along the path, material.
     pub r: Receiver,
     /// Geometric normal (ray offsets).
@@ -49,7 +52,7 @@ pub struct Vtx {
     pub conn: bool,
 }
 
-impl Vtx {
+impl ScatterVertex {
     /// A primary hit.
     #[inline]
     pub fn primary(scene: &Scene, r: &Receiver, ng: Vec3) -> Self {
@@ -78,12 +81,12 @@ pub enum Replayed {
     /// The replayed path leaves the sample's subspace (different lobes, an earlier connectible
     /// vertex, a miss, or a zero throughput): the shift fails.
     Fail,
-    /// The prefix reached `y_{k−1}`; `thp` is the throughput of the bounces before it.
+    /// The prefix reached `y_{k−1}`; `beta` is the throughput of the bounces before it.
     Prefix {
         /// `y_{k−1}`.
-        v: Vtx,
+        v: ScatterVertex,
         /// Product of `f·|cos|/pdf` over the replayed bounces.
-        thp: Vec3,
+        beta: Vec3,
     },
     /// The whole path was replayed ([`Kind::Frozen`]): its integrand (zero when the light
     /// connection is occluded or carries nothing).
@@ -107,21 +110,6 @@ pub struct Walker<'a> {
     /// reconnection vertex; the vertex reconnected from is rough), which makes the shift
     /// non-bijective (biased).
     pub skip_invertibility: bool,
-}
-
-/// The reconnection vertex found along a walk.
-#[derive(Clone, Copy, Debug)]
-struct Rc {
-    k: u32,
-    /// `x_{k−1}` and the throughput of the bounces before it.
-    prev: Vtx,
-    thp: Vec3,
-    /// The sample fields naming `x_k`.
-    base: PathSample,
-    /// Direction leaving `x_k` (set once sampled).
-    dir: Vec3,
-    /// Throughput of the bounces after `x_k`.
-    rest: Vec3,
 }
 
 /// The two bits of a bounce's lobe stored in [`PathSample::lobes`].
@@ -150,7 +138,7 @@ impl Walker<'_> {
     /// Whether the light vertex `v` (index `k`, the path's last) is the reconnection vertex of a
     /// path arriving from `prev`, given that no earlier vertex was.
     #[inline]
-    fn end_eligible(&self, k: u32, prev: &Vtx, v: &Vertex) -> bool {
+    fn end_eligible(&self, k: u32, prev: &ScatterVertex, v: &Vertex) -> bool {
         self.may_rc(k) && prev.conn && self.far(prev.r.p, v.position())
     }
 
@@ -158,7 +146,13 @@ impl Walker<'_> {
     /// vertex of a path arriving from `prev`, given that no earlier vertex was. `shape`, `prim`,
     /// `param` name it (its position is taken from them, as the shifts do).
     #[inline]
-    fn mid_eligible(&self, k: u32, prev: &Vtx, next: &Vtx, si: &SurfaceInteraction) -> bool {
+    fn mid_eligible(
+        &self,
+        k: u32,
+        prev: &ScatterVertex,
+        next: &ScatterVertex,
+        si: &SurfaceInteraction,
+    ) -> bool {
         if !(self.may_rc(k) && prev.conn && next.conn) {
             return false;
         }
@@ -166,33 +160,23 @@ impl Walker<'_> {
         self.far(prev.r.p, Some(p))
     }
 
-    /// The reconnection of sample `s` from `prev` (throughput `thp` before it): the geometry
+    /// The reconnection of sample `s` from `prev` (throughput `beta` before it): the geometry
     /// term of `x_k` seen from `prev`, and the integrand without the visibility of
     /// `prev → x_k`, with where the shadow ray goes.
     #[inline]
     pub fn reconnect(
         &self,
-        prev: &Vtx,
-        thp: Vec3,
+        prev: &ScatterVertex,
+        beta: Vec3,
         s: &PathSample,
         v: &Vertex,
-    ) -> (f32, Vec3, super::sample::Target) {
+    ) -> (f32, Vec3, Option<ShadowTarget>) {
         let geometry = match v.area_point() {
             Some((p, n)) => geometry_term(prev.r.p.into(), p.into(), n.into()),
             None => 0.0,
         };
         let (f, target) = evaluate_unshadowed(self.scene, &prev.r, s, v);
-        (geometry, thp * f, target)
-    }
-
-    /// Completes a candidate that reconnects at `rc` and computes its value.
-    #[inline]
-    fn rc_candidate(&self, rc: &Rc, mut s: PathSample) -> PathSample {
-        let v = resolve_vertex(self.scene, &s);
-        let (g, f, _) = self.reconnect(&rc.prev, rc.thp, &s, &v);
-        s.geometry = g;
-        s.value = f;
-        s
+        (geometry, beta * f, target)
     }
 
     /// One random walk from `x1` with the generator `seed`.
@@ -206,345 +190,380 @@ impl Walker<'_> {
     ///   and the replay fails if a bounce picks a different lobe (delta / transmission) or, with
     ///   the hybrid shift, a vertex before `k` is eligible as a reconnection vertex.
     ///
-    /// Returns the outcome and the rays traced.
-    #[allow(clippy::too_many_lines)]
+    /// Every bounce is [`Walker::bounce`]: light sampling, BSDF sampling, the emitter the BSDF
+    /// ray hits, and the step to the next vertex. Returns the outcome and the rays traced.
     pub fn walk(
         &self,
-        x1: &Vtx,
+        x1: &ScatterVertex,
         seed: Pcg32,
         replay: Option<&PathSample>,
         sink: &mut dyn FnMut(PathSample, Vec3),
     ) -> (Replayed, u64) {
-        use Replayed::{Fail, Prefix, Value};
-        let scene = self.scene;
-        let lights = &scene.lights;
-        let shapes = &scene.shapes;
-        let check = !self.skip_invertibility;
-        let mut rng = seed;
-        let mut rays = 0u64;
-        let mut cur = *x1;
-        // Index of `cur` = segments from the camera to it.
-        let mut j = 1u32;
-        let mut thp = Vec3::ONE;
-        let mut inv_q = 1.0f32;
-        let mut eta_scale = 1.0f32;
-        let mut lobes = 0u32;
-        let mut rc: Option<Rc> = None;
-        let frozen = PathSample {
+        let mut w = Walk {
+            replay,
+            terminal: replay.filter(|s| s.kind == Kind::Frozen),
+            check: !self.skip_invertibility,
             seed,
-            rc: 0,
-            kind: Kind::Frozen,
-            ..PathSample::direct(
-                LightPoint {
-                    light: 0,
-                    prim: 0,
-                    param: glam::Vec2::ZERO,
-                },
-                Kind::Frozen,
-            )
+            rng: seed,
+            rays: 0,
+            cur: *x1,
+            j: 1,
+            beta: Vec3::ONE,
+            inv_q: 1.0,
+            eta_scale: 1.0,
+            lobes: 0,
+            rc: None,
         };
-        // The light connection a replay of a frozen path evaluates.
-        let terminal = replay.filter(|s| s.kind == Kind::Frozen);
         if let Some(s) = replay
             && s.kind != Kind::Frozen
             && s.rc < 3
         {
-            return (Prefix { v: cur, thp }, 0);
+            return (
+                Replayed::Prefix {
+                    v: w.cur,
+                    beta: w.beta,
+                },
+                0,
+            );
         }
         loop {
-            let bsdf = &cur.r.resolve_bsdf(scene);
-            let frame = cur.r.frame();
-            let (u_select, u_light) = (rng.next_f32(), rng.next_2d());
-            let (u_lobe, u_dir) = (rng.next_f32(), rng.next_2d());
-            let u_rr = rng.next_f32();
-            let len = (j + 1).min(255) as u8;
+            if let Some(outcome) = self.bounce(&mut w, sink) {
+                return (outcome, w.rays);
+            }
+        }
+    }
 
-            // Light sampling at `cur`: a path of j + 1 segments.
-            let nee_here = terminal.is_some_and(|s| s.nee && u32::from(s.length) == j + 1);
-            if (replay.is_none() || nee_here)
-                && j < self.max_depth
-                && bsdf.has_smooth_lobe()
-                && let Some(ls) = lights.sample(shapes, cur.r.p, u_select, u_light)
+    /// One bounce at `w.cur`; returns the walk's outcome if it ends here.
+    fn bounce(&self, w: &mut Walk, sink: &mut dyn FnMut(PathSample, Vec3)) -> Option<Replayed> {
+        let bsdf = &w.cur.r.resolve_bsdf(self.scene);
+        let frame = w.cur.r.frame();
+        let u = BounceRandoms::draw(&mut w.rng);
+
+        // Light sampling at `cur`: a path of j + 1 segments.
+        let nee_here = w
+            .terminal
+            .is_some_and(|s| s.nee && u32::from(s.length) == w.j + 1);
+        if (w.replay.is_none() || nee_here)
+            && w.j < self.max_depth
+            && bsdf.has_smooth_lobe()
+            && let Some(end) = self.sample_light(w, bsdf, &frame, &u, nee_here, sink)
+        {
+            return Some(end);
+        }
+        if nee_here {
+            return Some(Replayed::Value(Vec3::ZERO));
+        }
+
+        // BSDF sampling at `cur`, and the ray it traces.
+        let Some(step) = self.sample_bsdf(w, bsdf, &frame, &u) else {
+            return Some(Replayed::Fail);
+        };
+        let ray = Ray::new(offset_ray_origin(w.cur.r.p, w.cur.ng, step.d), step.d);
+        w.rays += 1;
+        let hit = self.scene.intersect(&ray);
+
+        // Emission reached by the BSDF ray: a path of j + 1 segments.
+        let hit_here = w
+            .terminal
+            .is_some_and(|s| !s.nee && u32::from(s.length) == w.j + 1);
+        if (w.replay.is_none() || hit_here)
+            && let Some(end) = self.hit_emitter(w, &step, hit.as_ref(), hit_here, sink)
+        {
+            return Some(end);
+        }
+        if hit_here {
+            return Some(Replayed::Value(Vec3::ZERO));
+        }
+        let Some(si) = hit else {
+            return Some(Replayed::Fail);
+        };
+        self.advance(w, &step, &si)
+    }
+
+    /// Light sampling at `w.cur` with the bounce's numbers `u`: a candidate for `sink`, or, in a
+    /// replay whose light connection this is (`nee_here`), the outcome.
+    fn sample_light(
+        &self,
+        w: &mut Walk,
+        bsdf: &Bsdf,
+        frame: &Frame,
+        u: &BounceRandoms,
+        nee_here: bool,
+        sink: &mut dyn FnMut(PathSample, Vec3),
+    ) -> Option<Replayed> {
+        let scene = self.scene;
+        let cur = w.cur;
+        let ls = scene
+            .lights
+            .sample(&scene.shapes, cur.r.p, u.select, u.light)?;
+        let direct = PathSample::direct(LightPoint::from_light_sample(&ls), Kind::DirectNee);
+        let eligible =
+            w.rc.is_none() && self.end_eligible(w.j + 1, &cur, &resolve_vertex(scene, &direct));
+        if nee_here && eligible && w.check {
+            return Some(Replayed::Fail);
+        }
+        let wi = frame.to_local(ls.wi);
+        let f = bsdf.eval(cur.r.wo, wi);
+        if f == Vec3::ZERO {
+            return None;
+        }
+        w.rays += 1;
+        if !visible(
+            scene,
+            cur.r.p,
+            cur.ng,
+            ShadowTarget::new(ls.p, ls.wi, ls.dist),
+        ) {
+            return None;
+        }
+        let mis = if ls.delta {
+            1.0
+        } else {
+            power_heuristic(ls.pdf_sa, bsdf.pdf_sa(cur.r.wo, wi))
+        };
+        let connection = Connection::Nee {
+            wi: ls.wi,
+            le: ls.le,
+            light_pdf_sa: if ls.delta { 0.0 } else { ls.pdf_sa },
+            l: f * ls.le * (mis / ls.pdf_sa),
+        };
+        if nee_here {
+            return Some(Replayed::Value(connection.value(w.beta)));
+        }
+        let sample = self.candidate(w, &connection, direct, eligible);
+        sink(sample, connection.contribution(w.beta, w.inv_q));
+        None
+    }
+
+    /// BSDF sampling at `w.cur` with the bounce's numbers `u`: the lobe check of a replay,
+    /// Russian roulette (initial sampling only) and the throughput update of the reconnection
+    /// vertex's suffix. `None` when the walk fails here.
+    fn sample_bsdf(
+        &self,
+        w: &mut Walk,
+        bsdf: &Bsdf,
+        frame: &Frame,
+        u: &BounceRandoms,
+    ) -> Option<BsdfStep> {
+        let (p, wo) = (w.cur.r.p, w.cur.r.wo);
+        let bs = bsdf.sample(wo, u.lobe, u.dir)?;
+        let bits = lobe_bits(bs.lobe);
+        if w.j <= 16 {
+            let shift = 2 * (w.j - 1);
+            if let Some(s) = w.replay
+                && (s.lobes >> shift) & 3 != bits
             {
-                let direct =
-                    PathSample::direct(LightPoint::from_light_sample(&ls), Kind::DirectNee);
-                let eligible =
-                    rc.is_none() && self.end_eligible(j + 1, &cur, &resolve_vertex(scene, &direct));
-                if nee_here && eligible && check {
-                    return (Fail, rays);
-                }
-                let wi = frame.to_local(ls.wi);
-                let f = bsdf.eval(cur.r.wo, wi);
-                if f != Vec3::ZERO {
-                    rays += 1;
-                    if shadow_visible(scene, cur.r.p, cur.ng, ls.p, ls.wi, ls.dist) {
-                        let w = if ls.delta {
-                            1.0
-                        } else {
-                            power_heuristic(ls.pdf_sa, bsdf.pdf_sa(cur.r.wo, wi))
-                        };
-                        let l = f * ls.le * (w / ls.pdf_sa);
-                        if nee_here {
-                            return (Value(thp * l), rays);
-                        }
-                        let sample = if let Some(rc) = &rc {
-                            let s = if rc.k == j {
-                                PathSample {
-                                    dir: ls.wi,
-                                    radiance: ls.le,
-                                    light_pdf: if ls.delta { 0.0 } else { ls.pdf_sa },
-                                    kind: Kind::NeeAtX2,
-                                    length: len,
-                                    nee: true,
-                                    lobes,
-                                    ..rc.base
-                                }
-                            } else {
-                                PathSample {
-                                    dir: rc.dir,
-                                    radiance: rc.rest * l,
-                                    kind: Kind::Continue,
-                                    length: len,
-                                    nee: true,
-                                    lobes,
-                                    ..rc.base
-                                }
-                            };
-                            self.rc_candidate(rc, s)
-                        } else if eligible {
-                            let here = Rc {
-                                k: j + 1,
-                                prev: cur,
-                                thp,
-                                base: direct,
-                                dir: Vec3::ZERO,
-                                rest: Vec3::ONE,
-                            };
-                            let s = PathSample {
-                                seed,
-                                lobes,
-                                length: len,
-                                rc: len,
-                                ..direct
-                            };
-                            self.rc_candidate(&here, s)
-                        } else {
-                            PathSample {
-                                value: thp * l,
-                                lobes,
-                                length: len,
-                                nee: true,
-                                ..frozen
-                            }
-                        };
-                        sink(sample, thp * inv_q * l);
-                    }
-                }
+                return None;
             }
-            if nee_here {
-                return (Value(Vec3::ZERO), rays);
+            w.lobes |= bits << shift;
+        }
+        let factor = bs.f / bs.pdf_sa;
+        let next_beta = w.beta * factor;
+        let beta_rr = next_beta * w.inv_q;
+        let bmax = beta_rr.max_element();
+        if !(bmax > 0.0 && beta_rr.is_finite()) {
+            return None;
+        }
+        w.eta_scale *= bs.eta;
+        if w.replay.is_none() && w.j >= self.rr_depth {
+            let q = (bmax * w.eta_scale * w.eta_scale).min(0.95);
+            if u.rr >= q {
+                return None;
             }
-
-            // BSDF sampling at `cur`.
-            let Some(bs) = bsdf.sample(cur.r.wo, u_lobe, u_dir) else {
-                return (Fail, rays);
-            };
-            let bits = lobe_bits(bs.lobe);
-            if j <= 16 {
-                let shift = 2 * (j - 1);
-                if let Some(s) = replay
-                    && (s.lobes >> shift) & 3 != bits
-                {
-                    return (Fail, rays);
-                }
-                lobes |= bits << shift;
+            w.inv_q /= q;
+        }
+        let d = frame.to_world(bs.wi);
+        if let Some(rc) = &mut w.rc {
+            if rc.k == w.j {
+                rc.dir = d;
+            } else {
+                rc.rest *= factor;
             }
-            let factor = bs.f / bs.pdf_sa;
-            let next_thp = thp * factor;
-            let beta = next_thp * inv_q;
-            let bmax = beta.max_element();
-            if !(bmax > 0.0 && beta.is_finite()) {
-                return (Fail, rays);
-            }
-            eta_scale *= bs.eta;
-            if replay.is_none() && j >= self.rr_depth {
-                let q = (bmax * eta_scale * eta_scale).min(0.95);
-                if u_rr >= q {
-                    return (Fail, rays);
-                }
-                inv_q /= q;
-            }
-            let d = frame.to_world(bs.wi);
-            if let Some(rc) = &mut rc {
-                if rc.k == j {
-                    rc.dir = d;
-                } else {
-                    rc.rest *= factor;
-                }
-            }
-            let prev = PrevVertex {
-                p: cur.r.p,
+        }
+        Some(BsdfStep {
+            d,
+            next_beta,
+            prev: PrevVertex {
+                p,
                 pdf_sa: bs.pdf_sa,
                 delta: bs.lobe.is_delta(),
                 mis: EmissionMis::Power,
-            };
-            let ray = Ray::new(offset_ray_origin(cur.r.p, cur.ng, d), d);
-            rays += 1;
-            let hit = scene.intersect(&ray);
+            },
+        })
+    }
 
-            // Emission reached by the BSDF ray: a path of j + 1 segments.
-            let hit_here = terminal.is_some_and(|s| !s.nee && u32::from(s.length) == j + 1);
-            if replay.is_none() || hit_here {
-                let emitted = match &hit {
-                    None => lights.environment().map(|env| {
-                        let le = lights.environment_radiance(d);
-                        let lp = lights.pdf_sa(shapes, env, cur.r.p, cur.r.p + d, -d);
-                        (LightPoint::environment(env, d), le, lp)
-                    }),
-                    Some(si) => lights.light_on_shape(si.shape).and_then(|light| {
-                        let le = lights.area_radiance(light, si.shading.n, -d);
-                        (le != Vec3::ZERO).then(|| {
-                            let lp = lights.pdf_sa(shapes, light, cur.r.p, si.p, si.ng);
-                            let y = LightPoint {
-                                light,
-                                prim: si.prim,
-                                param: si.param,
-                            };
-                            (y, le, lp)
-                        })
-                    }),
-                };
-                if let Some((y, le, lp)) = emitted {
-                    let w = prev.emission_weight(lp);
-                    let direct = PathSample::direct(y, Kind::DirectHit);
-                    let eligible = rc.is_none()
-                        && self.end_eligible(j + 1, &cur, &resolve_vertex(scene, &direct));
-                    if hit_here {
-                        if eligible && check {
-                            return (Fail, rays);
-                        }
-                        return (Value(next_thp * le * w), rays);
-                    }
-                    let sample = if let Some(rc) = &rc {
-                        let s = if rc.k == j {
-                            PathSample {
-                                dir: rc.dir,
-                                radiance: le,
-                                light_pdf: if prev.delta { 0.0 } else { lp },
-                                kind: Kind::HitAtX3,
-                                length: len,
-                                nee: false,
-                                lobes,
-                                ..rc.base
-                            }
-                        } else {
-                            PathSample {
-                                dir: rc.dir,
-                                radiance: rc.rest * le * w,
-                                kind: Kind::Continue,
-                                length: len,
-                                nee: false,
-                                lobes,
-                                ..rc.base
-                            }
-                        };
-                        self.rc_candidate(rc, s)
-                    } else if eligible {
-                        let here = Rc {
-                            k: j + 1,
-                            prev: cur,
-                            thp,
-                            base: direct,
-                            dir: Vec3::ZERO,
-                            rest: Vec3::ONE,
-                        };
-                        let s = PathSample {
-                            seed,
-                            lobes,
-                            length: len,
-                            rc: len,
-                            ..direct
-                        };
-                        self.rc_candidate(&here, s)
-                    } else {
-                        PathSample {
-                            value: next_thp * le * w,
-                            lobes,
-                            length: len,
-                            nee: false,
-                            ..frozen
-                        }
+    /// The emitter (or the environment) the BSDF ray of `step` reached (`hit`, `None` for a
+    /// miss): a candidate for `sink`, or, in a replay whose light connection this is
+    /// (`hit_here`), the outcome.
+    fn hit_emitter(
+        &self,
+        w: &mut Walk,
+        step: &BsdfStep,
+        hit: Option<&SurfaceInteraction>,
+        hit_here: bool,
+        sink: &mut dyn FnMut(PathSample, Vec3),
+    ) -> Option<Replayed> {
+        let scene = self.scene;
+        let (lights, shapes) = (&scene.lights, &scene.shapes);
+        let (p, d) = (w.cur.r.p, step.d);
+        let (y, le, light_pdf_sa) = match hit {
+            None => lights.environment().map(|env| {
+                let le = lights.environment_radiance(d);
+                let lp = lights.pdf_sa(shapes, env, p, p + d, -d);
+                (LightPoint::environment(env, d), le, lp)
+            }),
+            Some(si) => lights.light_on_shape(si.shape).and_then(|light| {
+                let le = lights.area_radiance(light, si.shading.n, -d);
+                (le != Vec3::ZERO).then(|| {
+                    let lp = lights.pdf_sa(shapes, light, p, si.p, si.ng);
+                    let y = LightPoint {
+                        light,
+                        prim: si.prim,
+                        param: si.param,
                     };
-                    sink(sample, next_thp * inv_q * le * w);
+                    (y, le, lp)
+                })
+            }),
+        }?;
+        let mis = step.prev.emission_weight(light_pdf_sa);
+        let direct = PathSample::direct(y, Kind::DirectHit);
+        let eligible =
+            w.rc.is_none() && self.end_eligible(w.j + 1, &w.cur, &resolve_vertex(scene, &direct));
+        let connection = Connection::Hit {
+            le,
+            mis,
+            light_pdf_sa: if step.prev.delta { 0.0 } else { light_pdf_sa },
+            next_beta: step.next_beta,
+        };
+        if hit_here {
+            if eligible && w.check {
+                return Some(Replayed::Fail);
+            }
+            return Some(Replayed::Value(connection.value(w.beta)));
+        }
+        let sample = self.candidate(w, &connection, direct, eligible);
+        sink(sample, connection.contribution(w.beta, w.inv_q));
+        None
+    }
+
+    /// The step to the surface `si` the BSDF ray of `step` hit: the depth limit, the search for
+    /// the reconnection vertex (and a replay's invertibility check), and the end of a replayed
+    /// prefix at `y_{k−1}`.
+    fn advance(&self, w: &mut Walk, step: &BsdfStep, si: &SurfaceInteraction) -> Option<Replayed> {
+        // Connections from the next vertex have j + 2 segments.
+        if w.j + 2 > self.max_depth {
+            return Some(Replayed::Fail);
+        }
+        let next = ScatterVertex::at(self.scene, si, -step.d);
+        if w.rc.is_none() && self.mid_eligible(w.j + 1, &w.cur, &next, si) {
+            match w.replay {
+                None => {
+                    let base = PathSample {
+                        id: si.shape,
+                        prim: si.prim,
+                        param: si.param,
+                        seed: w.seed,
+                        rc: (w.j + 1).min(255) as u8,
+                        kind: Kind::Continue,
+                        nee: false,
+                        ..PathSample::frozen(w.seed)
+                    };
+                    w.rc = Some(Rc {
+                        k: w.j + 1,
+                        prev: w.cur,
+                        beta: w.beta,
+                        base,
+                        dir: Vec3::ZERO,
+                        rest: Vec3::ONE,
+                    });
                 }
-            }
-            if hit_here {
-                return (Value(Vec3::ZERO), rays);
-            }
-            let Some(si) = hit else {
-                return (Fail, rays);
-            };
-            // Connections from the next vertex have j + 2 segments.
-            if j + 2 > self.max_depth {
-                return (Fail, rays);
-            }
-            let next = Vtx::at(scene, &si, -d);
-            if rc.is_none() && self.mid_eligible(j + 1, &cur, &next, &si) {
-                match replay {
-                    None => {
-                        let base = PathSample {
-                            id: si.shape,
-                            prim: si.prim,
-                            param: si.param,
-                            seed,
-                            rc: (j + 1).min(255) as u8,
-                            kind: Kind::Continue,
-                            nee: false,
-                            ..frozen
-                        };
-                        rc = Some(Rc {
-                            k: j + 1,
-                            prev: cur,
-                            thp,
-                            base,
-                            dir: Vec3::ZERO,
-                            rest: Vec3::ONE,
-                        });
-                    }
-                    // An earlier reconnection vertex than the base path's: not invertible.
-                    Some(s) if check && (s.kind == Kind::Frozen || j + 1 < u32::from(s.rc)) => {
-                        return (Fail, rays);
-                    }
-                    Some(_) => {}
+                // An earlier reconnection vertex than the base path's: not invertible.
+                Some(s) if w.check && (s.kind == Kind::Frozen || w.j + 1 < u32::from(s.rc)) => {
+                    return Some(Replayed::Fail);
                 }
+                Some(_) => {}
             }
-            thp = next_thp;
-            cur = next;
-            j += 1;
-            if let Some(s) = replay
-                && s.kind != Kind::Frozen
-                && j + 1 == u32::from(s.rc)
-            {
-                return (Prefix { v: cur, thp }, rays);
-            }
+        }
+        w.beta = step.next_beta;
+        w.cur = next;
+        w.j += 1;
+        if let Some(s) = w.replay
+            && s.kind != Kind::Frozen
+            && w.j + 1 == u32::from(s.rc)
+        {
+            return Some(Replayed::Prefix {
+                v: w.cur,
+                beta: w.beta,
+            });
+        }
+        None
+    }
+}
+
+/// The random numbers of one bounce, drawn in this order whatever happens at it (see
+/// [`RANDOMS_PER_BOUNCE`]).
+struct BounceRandoms {
+    select: f32,
+    light: Vec2,
+    lobe: f32,
+    dir: Vec2,
+    rr: f32,
+}
+
+impl BounceRandoms {
+    #[inline]
+    fn draw(rng: &mut Pcg32) -> Self {
+        let select = rng.next_f32();
+        let light = rng.next_2d();
+        let lobe = rng.next_f32();
+        let dir = rng.next_2d();
+        let rr = rng.next_f32();
+        Self {
+            select,
+            light,
+            lobe,
+            dir,
+            rr,
         }
     }
 }
 
-/// Whether a light sample is visible from surface point `p`.
-#[inline]
-pub(crate) fn shadow_visible(
-    scene: &Scene,
-    p: Vec3,
-    ng: Vec3,
-    lp: Vec3,
-    wi: Vec3,
-    dist: f32,
-) -> bool {
-    let (ray, t_max) = if dist.is_finite() {
-        shadow_ray_between(p, ng, lp)
-    } else {
-        shadow_ray_towards(p, ng, wi, f32::INFINITY)
-    };
-    !scene.occluded(&ray, t_max)
+/// The state of one walk.
+pub(super) struct Walk<'s> {
+    /// The sample being replayed (`None` in initial sampling).
+    pub(super) replay: Option<&'s PathSample>,
+    /// The replayed sample when it is frozen: the replay evaluates its light connection.
+    pub(super) terminal: Option<&'s PathSample>,
+    /// Whether the replay checks invertibility (not with `skip_invertibility`).
+    pub(super) check: bool,
+    /// The generator's state before the walk's first number (stored in the candidates).
+    pub(super) seed: Pcg32,
+    /// The walk's generator.
+    pub(super) rng: Pcg32,
+    /// Rays traced so far.
+    pub(super) rays: u64,
+    /// The current vertex `x_j`.
+    pub(super) cur: ScatterVertex,
+    /// `j`: segments from the camera to `cur`.
+    pub(super) j: u32,
+    /// Throughput of the bounces before `cur` (`Π f·|cos|/p`, without Russian roulette).
+    pub(super) beta: Vec3,
+    /// The inverse of the Russian roulette survival probabilities so far.
+    pub(super) inv_q: f32,
+    /// Product of the relative indices of refraction crossed (for Russian roulette).
+    pub(super) eta_scale: f32,
+    /// Lobe bits of the bounces so far ([`PathSample::lobes`]).
+    pub(super) lobes: u32,
+    /// The reconnection vertex, once found.
+    pub(super) rc: Option<Rc>,
+}
+
+/// What BSDF sampling at a vertex produced.
+struct BsdfStep {
+    /// World-space direction of the continuation ray.
+    d: Vec3,
+    /// Throughput including this bounce.
+    next_beta: Vec3,
+    /// What MIS needs about this vertex when the ray hits an emitter.
+    prev: PrevVertex,
 }

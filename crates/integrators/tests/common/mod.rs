@@ -4,7 +4,9 @@
 
 use std::sync::atomic::AtomicBool;
 
-use restir_integrators::{Image, IntegratorOptions, RenderSettings, make_integrator, render};
+use restir_integrators::{
+    Image, IntegratorOptions, Param, ParamSource, RenderSettings, make_integrator, render,
+};
 use restir_scene::Scene;
 
 /// Renders `scene` with estimator `name`. `params` are the estimator's parameters, except
@@ -27,7 +29,7 @@ pub fn render_image(
         max_depth,
         params: params
             .iter()
-            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .map(|(k, v)| Param::new(*k, *v, ParamSource::Caller))
             .collect(),
     };
     let made = make_integrator(scene, &options).unwrap();

@@ -11,7 +11,7 @@
 use glam::Vec2;
 use restir_sampling::{Pcg32, sequences::r2};
 
-use crate::gbuffer::GBuffer;
+use crate::reuse::gbuffer::GBuffer;
 
 /// Points in the table; a power of two, so that indices wrap with a mask.
 const OFFSET_COUNT: usize = 8192;

@@ -8,7 +8,8 @@ use restir_geometry::Frame;
 use restir_materials::Bsdf;
 use restir_scene::Scene;
 
-use crate::render::{BAND_ROWS, PassContext};
+use crate::render::PassContext;
+use crate::reuse::bands::Bands;
 
 /// What a reuse pass needs to know about a pixel's primary hit: the shading point, its frame,
 /// its material and texture coordinates, the direction to the camera and what the
@@ -128,14 +129,15 @@ impl GBuffer {
         let mut receivers = vec![Receiver::EMPTY; w * h];
         let mut ng = vec![Vec3::ZERO; w * h];
         let lights = &scene.lights;
+        let bands = Bands::new(w);
         let rays = receivers
-            .par_chunks_mut(w * BAND_ROWS)
-            .zip(ng.par_chunks_mut(w * BAND_ROWS))
-            .zip(radiance.par_chunks_mut(w * BAND_ROWS))
+            .par_chunks_mut(bands.pixels())
+            .zip(ng.par_chunks_mut(bands.pixels()))
+            .zip(radiance.par_chunks_mut(bands.pixels()))
             .enumerate()
             .map(|(band, ((recv, ngs), rad))| {
                 for (i, l) in rad.iter_mut().enumerate() {
-                    let index = band * w * BAND_ROWS + i;
+                    let index = bands.first(band) + i;
                     let (x, y) = ((index % w) as u32, (index / w) as u32);
                     let mut rng = ctx.pixel_rng(index);
                     let film = ctx.film_position(x, y, &mut rng);

@@ -1,0 +1,216 @@
+//! The shift map of ReSTIR PT between pixels (reconnection, random replay and hybrid), and
+//! its part in the shared reuse passes ([`PtReuse`]).
+//!
+//! `T_{i→c}` replays the bounces at `x1 … x_{k−2}` from pixel `c`'s primary hit `y1` with the
+//! sample's random numbers (nothing for `k = 2`: the reconnection shift), keeps `x_k` and
+//! everything after it, and reconnects `y_{k−1} → x_k`. Replayed bounces have Jacobian 1
+//! (primary sample space); the reconnection has the solid-angle Jacobian
+//! `(cos θ_y / cos θ_x)·(d_x² / d_y²) = G_y / G_x` with `x_k`'s geometric normal (1 for point
+//! lights and lights at infinity), from the `G_x` cached in the sample. Frozen paths are replayed
+//! whole (Jacobian 1). The shift fails, in both directions alike, when the replayed prefix leaves
+//! the sample's subspace (different lobes, an earlier reconnection vertex), when `y_{k−1}` is
+//! not rough or closer than `d_near` to `x_k`, or by the symmetric Jacobian bound. Visibility of
+//! `y_{k−1} → x_k` is part of the target.
+
+use std::cell::Cell;
+
+use glam::Vec3;
+use restir_gris::jacobian::{reconnection_jacobian_from_geometry, reject_jacobian};
+use restir_gris::{ShiftMap, Shifted};
+use restir_sampling::luminance;
+
+use crate::reuse::gbuffer::GBuffer;
+use crate::reuse::passes::ReuseShift;
+use crate::shadow::visible;
+
+use super::sample::{Kind, PathSample, ShiftKind, Vertex, connectible, resolve_vertex};
+use super::walk::{Replayed, ScatterVertex, Walker};
+use super::{PtReservoir, RestirPtSettings};
+
+/// The shift between pixels (reconnection, replay or hybrid, as [`Walker::shift`] says); a
+/// domain is a pixel index into `gbuf`, or, from the pixel count on, `pixel count + index` into
+/// `prev` (the previous pass, for temporal reuse).
+#[derive(Debug)]
+pub struct PtShift<'a> {
+    /// The walks' rules (scene, shift, depth, `d_near`).
+    pub walker: Walker<'a>,
+    /// The primary hits.
+    pub gbuf: &'a GBuffer,
+    /// The previous pass's primary hits (temporal reuse).
+    pub prev: Option<&'a GBuffer>,
+    /// Rays traced by this map's shifts (shadow rays and replayed segments).
+    pub rays: Cell<u64>,
+    /// Symmetric Jacobian rejection bound (`max(J, 1/J)`); 0 for none.
+    pub max_jacobian: f32,
+    /// Negative control: Jacobian 1 (biased).
+    pub unit_jacobian: bool,
+}
+
+impl PtShift<'_> {
+    /// The primary hit of domain `d`.
+    #[inline]
+    fn hit(&self, d: usize) -> Option<ScatterVertex> {
+        let n = self.gbuf.receivers.len();
+        let (buf, i) = if d < n {
+            (self.gbuf, d)
+        } else {
+            (self.prev?, d - n)
+        };
+        buf.receiver(i)
+            .map(|r| ScatterVertex::primary(self.walker.scene, r, buf.ng[i]))
+    }
+
+    /// The target (luminance, with visibility), the Jacobian and the shifted sample (its
+    /// `value` the integrand at `to`) of shifting `s` from pixel `from` to pixel `to`; `None` if
+    /// the shift is not defined there.
+    pub fn shift_full(
+        &self,
+        from: usize,
+        to: usize,
+        s: &PathSample,
+    ) -> Option<(f32, f32, PathSample)> {
+        let _ = from;
+        let walker = &self.walker;
+        let scene = walker.scene;
+        let y1 = self.hit(to)?;
+        if s.kind == Kind::Frozen {
+            if walker.shift == ShiftKind::Reconnection {
+                return None;
+            }
+            let (out, rays) = walker.walk(&y1, s.seed, Some(s), &mut |_, _| {});
+            self.rays.set(self.rays.get() + rays);
+            let Replayed::Value(f) = out else {
+                return None;
+            };
+            let p = luminance(f);
+            let p = if p > 0.0 && p.is_finite() { p } else { 0.0 };
+            let value = if p > 0.0 { f } else { Vec3::ZERO };
+            return Some((p, 1.0, PathSample { value, ..*s }));
+        }
+        let (prev, beta) = if s.rc <= 2 {
+            (y1, Vec3::ONE)
+        } else {
+            let (out, rays) = walker.walk(&y1, s.seed, Some(s), &mut |_, _| {});
+            self.rays.set(self.rays.get() + rays);
+            match out {
+                Replayed::Prefix { v, beta } => (v, beta),
+                _ => return None,
+            }
+        };
+        // Invertibility (ii): the inverse shift reconnects from `y_{k−1}` only if it is rough.
+        if !prev.conn && !walker.skip_invertibility {
+            return None;
+        }
+        let v = resolve_vertex(scene, s);
+        if let Vertex::Surface(si) = &v
+            && !connectible(&scene.bsdf(si))
+        {
+            return None;
+        }
+        if let Some(p) = v.position()
+            && (p - prev.r.p).length_squared() < walker.near2
+        {
+            return None;
+        }
+        let (geometry, f, target) = walker.reconnect(&prev, beta, s, &v);
+        let jacobian = if v.area_point().is_some() {
+            reconnection_jacobian_from_geometry(geometry, s.geometry)
+        } else {
+            1.0
+        };
+        if jacobian.is_nan() || jacobian <= 0.0 {
+            return None;
+        }
+        if self.max_jacobian > 0.0 && reject_jacobian(jacobian, self.max_jacobian) {
+            return None;
+        }
+        let jacobian = if self.unit_jacobian { 1.0 } else { jacobian };
+        let mut p = luminance(f);
+        if !(p > 0.0 && p.is_finite()) {
+            p = 0.0;
+        } else {
+            self.rays.set(self.rays.get() + 1);
+            if !target.is_some_and(|t| visible(scene, prev.r.p, prev.ng, t)) {
+                p = 0.0;
+            }
+        }
+        let shifted = PathSample {
+            geometry,
+            value: if p > 0.0 { f } else { Vec3::ZERO },
+            ..*s
+        };
+        Some((p, jacobian, shifted))
+    }
+}
+
+impl ShiftMap<PathSample> for PtShift<'_> {
+    type Domain = usize;
+
+    #[inline]
+    fn shift(&self, from: &usize, to: &usize, x: &PathSample) -> Option<Shifted<PathSample>> {
+        let (target_pdf, jacobian, sample) = self.shift_full(*from, *to, x)?;
+        Some(Shifted {
+            sample,
+            jacobian,
+            target_pdf,
+        })
+    }
+}
+
+/// ReSTIR PT's part in the reuse passes: its shift map between pixels, whose domains are pixel
+/// indices (`n + i` for pixel `i` of the previous pass).
+pub(super) struct PtReuse<'p> {
+    /// The walks' rules.
+    pub(super) walker: Walker<'p>,
+    /// The settings (the Jacobian options).
+    pub(super) settings: &'p RestirPtSettings,
+    /// This pass's primary hits.
+    pub(super) gbuf: &'p GBuffer,
+    /// The previous pass's primary hits.
+    pub(super) prev: Option<&'p GBuffer>,
+    /// Pixels per pass: pixel `i` of the previous pass is domain `n + i`.
+    pub(super) pixels: usize,
+}
+
+impl<'p> PtReuse<'p> {
+    /// A shift map with its own ray count.
+    #[inline]
+    pub(super) fn shift(&self) -> PtShift<'p> {
+        PtShift {
+            walker: self.walker,
+            gbuf: self.gbuf,
+            prev: self.prev,
+            rays: Cell::new(0),
+            max_jacobian: self.settings.max_jacobian,
+            unit_jacobian: self.settings.unit_jacobian,
+        }
+    }
+}
+
+impl ReuseShift for PtReuse<'_> {
+    type Sample = PathSample;
+    type Domain = usize;
+    type DomainRef<'d>
+        = usize
+    where
+        Self: 'd;
+    type Map<'m>
+        = PtShift<'m>
+    where
+        Self: 'm;
+
+    #[inline]
+    fn map(&self, _canonical: &PtReservoir) -> PtShift<'_> {
+        self.shift()
+    }
+
+    #[inline]
+    fn rays(map: &PtShift<'_>) -> u64 {
+        map.rays.get()
+    }
+
+    #[inline]
+    fn domain(&self, index: usize, previous: bool) -> usize {
+        if previous { self.pixels + index } else { index }
+    }
+}

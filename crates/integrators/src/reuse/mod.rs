@@ -1,0 +1,15 @@
+//! What the screen-space ReSTIR estimators (ReSTIR DI and ReSTIR PT) share, one floor below
+//! them: the per-pixel primary hits ([`gbuffer`]), neighbour selection ([`neighbors`]) and
+//! the light-point sample ([`light_point`]), the reuse settings ([`settings`]) and the reuse
+//! passes themselves ([`passes`]: temporal reuse, the spatial rounds and the history, generic
+//! over the estimator's sample and shift map, as pbrt-v4's `ImageTileIntegrator` is over its
+//! `RayIntegrator`).
+
+pub(crate) mod bands;
+pub mod gbuffer;
+pub mod light_point;
+pub mod neighbors;
+pub mod passes;
+pub mod settings;
+
+pub use settings::{MIS_NAMES, ReuseSettings, mis_name};

@@ -1,0 +1,206 @@
+//! The reuse passes both screen-space ReSTIR estimators run between initial sampling and
+//! shading, written once: temporal reuse with the previous pass's reservoirs, the spatial
+//! rounds (ping-ponging two buffers, so the result does not depend on scheduling) and the
+//! history kept for the next pass.
+//!
+//! An estimator plugs in through [`ReuseShift`]: its sample type, the domain its shift map
+//! works on (DI: the receiver; PT: a pixel index) and the map itself. Every pixel's random
+//! numbers come from its own stage stream ([`PassContext::stage_rng`]), drawn in the same order
+//! whatever the estimator: the neighbour pattern's start, then resampling.
+
+use std::sync::Mutex;
+
+use rayon::prelude::*;
+use std::borrow::Borrow;
+
+use restir_gris::{Reservoir, ShiftMap, resample};
+
+use crate::render::PassContext;
+use crate::reuse::bands::Bands;
+use crate::reuse::gbuffer::GBuffer;
+use crate::reuse::neighbors::NeighborPattern;
+use crate::reuse::settings::ReuseSettings;
+
+/// What an estimator's reuse needs for one pass: its shift map between the pixels of this pass
+/// and the previous one.
+pub trait ReuseShift: Sync {
+    /// The reservoirs' sample.
+    type Sample: Copy + Send + Sync;
+    /// What the shift map calls a domain.
+    type Domain: Sync + ?Sized;
+    /// The shift map resampling a pixel uses.
+    type Map<'m>: ShiftMap<Self::Sample, Domain = Self::Domain>
+    where
+        Self: 'm;
+
+    /// The shift map for resampling into a pixel whose reservoir is `canonical`.
+    fn map(&self, canonical: &Reservoir<Self::Sample>) -> Self::Map<'_>;
+
+    /// Rays `map`'s shifts traced.
+    fn rays(map: &Self::Map<'_>) -> u64 {
+        let _ = map;
+        0
+    }
+
+    /// How [`Self::domain`] hands a domain out: a reference into the estimator's buffers, or a
+    /// small value (a pixel index) that needs no buffer to lend it.
+    type DomainRef<'d>: Borrow<Self::Domain> + Copy
+    where
+        Self: 'd;
+
+    /// The domain of pixel `index` (which has a primary hit) in this pass, or in the previous
+    /// pass with `previous`.
+    fn domain(&self, index: usize, previous: bool) -> Self::DomainRef<'_>;
+}
+
+/// What temporal reuse keeps from the previous pass.
+#[derive(Debug)]
+pub struct History<S> {
+    /// The previous pass's primary hits.
+    pub gbuffer: GBuffer,
+    /// Its final reservoirs.
+    pub reservoirs: Vec<Reservoir<S>>,
+}
+
+/// The history slot an integrator keeps between passes.
+#[derive(Debug)]
+pub struct HistorySlot<S>(Mutex<Option<History<S>>>);
+
+impl<S> Default for HistorySlot<S> {
+    fn default() -> Self {
+        Self(Mutex::new(None))
+    }
+}
+
+impl<S> HistorySlot<S> {
+    /// Takes the previous pass's history when temporal reuse is on and it matches a pass of
+    /// `pixels` pixels.
+    pub fn take(&self, settings: &ReuseSettings, pixels: usize) -> Option<History<S>> {
+        if !settings.temporal {
+            return None;
+        }
+        self.0
+            .lock()
+            .map(|mut h| h.take())
+            .unwrap_or(None)
+            .filter(|h| h.reservoirs.len() == pixels)
+    }
+
+    /// Keeps this pass's primary hits and final reservoirs when temporal reuse is on.
+    pub fn store(&self, settings: &ReuseSettings, gbuffer: GBuffer, reservoirs: Vec<Reservoir<S>>) {
+        if settings.temporal
+            && let Ok(mut h) = self.0.lock()
+        {
+            *h = Some(History {
+                gbuffer,
+                reservoirs,
+            });
+        }
+    }
+}
+
+/// Temporal reuse: every pixel whose primary hit is similar to the previous pass's resamples
+/// its reservoir with the previous one (confidence capped at `mcap`). Returns the rays traced.
+pub fn temporal<R: ReuseShift>(
+    reuse: &R,
+    settings: &ReuseSettings,
+    ctx: &PassContext,
+    gbuf: &GBuffer,
+    history: &History<R::Sample>,
+    stage: u64,
+    current: &mut [Reservoir<R::Sample>],
+) -> u64 {
+    let mis = settings.temporal_mis();
+    let bands = Bands::new(gbuf.width);
+    current
+        .par_chunks_mut(bands.pixels())
+        .enumerate()
+        .map(|(band, out)| {
+            let mut rays = 0;
+            for (i, res) in out.iter_mut().enumerate() {
+                let index = bands.first(band) + i;
+                let (Some(r), Some(prev_r)) =
+                    (gbuf.receiver(index), history.gbuffer.receiver(index))
+                else {
+                    continue;
+                };
+                if !r.is_similar(prev_r, settings.normal_cos, settings.depth_tolerance) {
+                    continue;
+                }
+                let prev = history.reservoirs[index].with_confidence_cap(settings.mcap);
+                let mut rng = ctx.stage_rng(index, stage);
+                let map = reuse.map(res);
+                *res = resample(
+                    &map,
+                    mis,
+                    reuse.domain(index, false).borrow(),
+                    res,
+                    &[(reuse.domain(index, true), &prev)],
+                    || rng.next_f32(),
+                )
+                .with_confidence_cap(settings.mcap);
+                rays += R::rays(&map);
+            }
+            rays
+        })
+        .sum()
+}
+
+/// `R` spatial rounds: each pixel with a primary hit resamples its reservoir with up to `k`
+/// similar neighbours of the previous round's buffer, writing a new buffer. Returns the rays
+/// traced.
+pub fn spatial<R: ReuseShift>(
+    reuse: &R,
+    settings: &ReuseSettings,
+    pattern: &NeighborPattern,
+    ctx: &PassContext,
+    gbuf: &GBuffer,
+    first_stage: u64,
+    current: &mut Vec<Reservoir<R::Sample>>,
+) -> u64 {
+    if settings.neighbors == 0 || settings.spatial_rounds == 0 {
+        return 0;
+    }
+    let rule = settings.neighbor_rule();
+    let bands = Bands::new(gbuf.width);
+    let mut next = vec![Reservoir::empty(); current.len()];
+    let mut rays = 0;
+    for round in 0..settings.spatial_rounds {
+        let input = &*current;
+        rays += next
+            .par_chunks_mut(bands.pixels())
+            .enumerate()
+            .map(|(band, out)| {
+                let mut rays = 0;
+                let mut picked = Vec::with_capacity(rule.count);
+                let mut neighbors = Vec::with_capacity(rule.count);
+                for (i, res) in out.iter_mut().enumerate() {
+                    let index = bands.first(band) + i;
+                    let canonical = &input[index];
+                    if gbuf.receiver(index).is_none() {
+                        *res = *canonical;
+                        continue;
+                    }
+                    let mut rng = ctx.stage_rng(index, first_stage + u64::from(round));
+                    pattern.select(gbuf, index, &rule, &mut rng, &mut picked);
+                    neighbors.clear();
+                    neighbors.extend(picked.iter().map(|&q| (reuse.domain(q, false), &input[q])));
+                    let map = reuse.map(canonical);
+                    *res = resample(
+                        &map,
+                        settings.mis,
+                        reuse.domain(index, false).borrow(),
+                        canonical,
+                        &neighbors,
+                        || rng.next_f32(),
+                    )
+                    .with_confidence_cap(settings.mcap);
+                    rays += R::rays(&map);
+                }
+                rays
+            })
+            .sum::<u64>();
+        std::mem::swap(current, &mut next);
+    }
+    rays
+}

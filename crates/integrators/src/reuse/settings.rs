@@ -1,0 +1,134 @@
+//! The settings every screen-space reuse pass shares (ReSTIR DI and ReSTIR PT): neighbours,
+//! radius, rounds, MIS, confidence cap, temporal reuse and the similarity thresholds, their
+//! names in scene files and on the command line, and their parsing.
+
+use restir_gris::MisScheme;
+
+use crate::params::{Param, ParamError, ParamProblem};
+use crate::reuse::neighbors::NeighborRule;
+
+/// How spatial and temporal reuse weight their inputs (`--mis`).
+pub const MIS_NAMES: &[(&str, MisScheme)] = &[
+    ("defensive-pairwise", MisScheme::DefensivePairwise),
+    ("pairwise", MisScheme::Pairwise),
+    ("confidence-pairwise", MisScheme::ConfidenceWeightedPairwise),
+    ("balance", MisScheme::GeneralizedBalance),
+    ("contribution", MisScheme::Contribution),
+    ("one-over-z", MisScheme::OneOverZ),
+    ("uniform", MisScheme::ConstantBiased),
+];
+
+/// The command-line name of an MIS scheme.
+pub fn mis_name(scheme: MisScheme) -> &'static str {
+    MIS_NAMES
+        .iter()
+        .find(|(_, s)| *s == scheme)
+        .map_or("?", |(n, _)| n)
+}
+
+impl Param {
+    /// An MIS scheme by one of [`MIS_NAMES`].
+    pub fn mis(&self) -> Result<MisScheme, ParamError> {
+        let names: Vec<&str> = MIS_NAMES.iter().map(|(n, _)| *n).collect();
+        self.choice(MIS_NAMES, &format!("one of {}", names.join(", ")))
+    }
+}
+
+/// Spatial and temporal reuse settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReuseSettings {
+    /// Spatial neighbours per round, `k` (default 3).
+    pub neighbors: u32,
+    /// Spatial radius in pixels (default 30).
+    pub radius: f32,
+    /// Spatial reuse rounds, `R` (default 1).
+    pub spatial_rounds: u32,
+    /// MIS for reuse (default defensive pairwise).
+    pub mis: MisScheme,
+    /// Absolute confidence cap after every reuse step (default 20).
+    pub mcap: f32,
+    /// Reuse the previous pass's reservoirs (default off).
+    pub temporal: bool,
+    /// Largest angle between neighbour shading normals, as a cosine (default cos 25°).
+    pub normal_cos: f32,
+    /// Largest relative difference of camera distances (default 0.1).
+    pub depth_tolerance: f32,
+}
+
+impl Default for ReuseSettings {
+    /// One round of three neighbours within 30 pixels, defensive pairwise MIS, `M` capped at 20,
+    /// no temporal reuse, 25° and 10 % similarity.
+    fn default() -> Self {
+        Self {
+            neighbors: 3,
+            radius: 30.0,
+            spatial_rounds: 1,
+            mis: MisScheme::DefensivePairwise,
+            mcap: 20.0,
+            temporal: false,
+            normal_cos: 25f32.to_radians().cos(),
+            depth_tolerance: 0.1,
+        }
+    }
+}
+
+impl ReuseSettings {
+    /// Whether reuse is unbiased with these settings.
+    pub fn is_unbiased(&self) -> bool {
+        self.mis.is_unbiased()
+    }
+
+    /// The neighbour rule of the spatial rounds.
+    pub fn neighbor_rule(&self) -> NeighborRule {
+        NeighborRule {
+            count: self.neighbors as usize,
+            radius: self.radius,
+            normal_cos: self.normal_cos,
+            depth_tolerance: self.depth_tolerance,
+        }
+    }
+
+    /// The MIS of temporal reuse. Two techniques, one of them carrying up to `mcap` passes of
+    /// history: the generalized balance heuristic (4 target evaluations) lets the history weigh
+    /// by its confidence, where defensive pairwise would keep half the weight on the fresh
+    /// sample (`docs/GRIS.md` §4.4). Biased schemes stay as chosen.
+    pub fn temporal_mis(&self) -> MisScheme {
+        if self.mis.is_unbiased() {
+            MisScheme::GeneralizedBalance
+        } else {
+            self.mis
+        }
+    }
+
+    /// Reads parameter `p` (normalized name `key`) if it is a reuse setting; returns whether
+    /// it was. The names Lajolla ReSTIR ports use are accepted too.
+    pub fn apply(&mut self, key: &str, p: &Param) -> Result<bool, ParamError> {
+        match key {
+            "neighbors"
+            | "neighbours"
+            | "neighbors_per_pixel"
+            | "neighbours_per_pixel"
+            | "neighbor_select"
+            | "neighbour_select"
+            | "num_neighbors"
+            | "spatial_neighbors" => self.neighbors = p.count(0)?,
+            "radius" | "max_radius" | "spatial_radius" => self.radius = p.positive()?,
+            "spatial_rounds" | "spatial_iteration" | "spatial_iterations" | "spatial_passes" => {
+                self.spatial_rounds = p.count(0)?;
+            }
+            "mis" | "bias_correction" => self.mis = p.mis()?,
+            "mcap" | "m_cap" | "m_capping" | "max_history" => self.mcap = p.positive()?,
+            "temporal" | "temporal_reuse" => self.temporal = p.boolean()?,
+            "normal_threshold" => {
+                let deg = p.positive()?;
+                if deg > 180.0 {
+                    return Err(p.error(ParamProblem::AngleTooLarge));
+                }
+                self.normal_cos = deg.to_radians().cos();
+            }
+            "depth_threshold" => self.depth_tolerance = p.positive()?,
+            _ => return Ok(false),
+        }
+        Ok(true)
+    }
+}
