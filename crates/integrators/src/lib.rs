@@ -2,7 +2,7 @@
 //! filters, image I/O and error metrics.
 //!
 //! The entry point for programs and tests is [`render`]: give it a built
-//! [`Scene`](restir_scene::Scene), an [`Integrator`] and [`RenderSettings`], and it returns the
+//! [`Scene`], an [`Integrator`] and [`RenderSettings`], and it returns the
 //! averaged image with statistics. A *pass* is one sample per pixel of the integrator's final
 //! estimator; images are bit-identical whatever the thread count, because every pixel's random
 //! numbers come from `(seed, pixel, pass)`.

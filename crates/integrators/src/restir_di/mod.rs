@@ -17,7 +17,7 @@
 //!    are the shared [`crate::reuse::passes`]; this module plugs in the identity shift.
 //! 5. **Shading**: the selected sample with a shadow ray, times its `W`; plus `N_B` BSDF samples
 //!    weighted by the balance heuristic against the light strategy (the exact split is explained
-//!    in [`target`]); the first BSDF sample continues as a path-traced path when
+//!    in [`mod@target`]); the first BSDF sample continues as a path-traced path when
 //!    `max_depth > 2` (indirect light) or when it followed a delta lobe.
 
 mod settings;

@@ -46,7 +46,7 @@ impl Evaluated {
     };
 }
 
-/// Evaluates `sample` at receiver `r` seen as `c` (from [`contact`]). `known_light_pdf_sa` is
+/// Evaluates `sample` at receiver `r` seen as `c` (from [`contact`](crate::reuse::light_point::contact)). `known_light_pdf_sa` is
 /// the light-sampling density at `r` if the caller has it (selection included; the pmf for
 /// delta lights); otherwise it is computed when the light/BSDF split needs it (`N_B > 0`).
 #[inline]

@@ -1,5 +1,5 @@
 //! The shift map of ReSTIR PT between pixels (reconnection, random replay and hybrid), and
-//! its part in the shared reuse passes ([`PtReuse`]).
+//! its part in the shared reuse passes (`PtReuse`).
 //!
 //! `T_{i→c}` replays the bounces at `x1 … x_{k−2}` from pixel `c`'s primary hit `y1` with the
 //! sample's random numbers (nothing for `k = 2`: the reconnection shift), keeps `x_k` and

@@ -190,7 +190,7 @@ impl Walker<'_> {
     ///   and the replay fails if a bounce picks a different lobe (delta / transmission) or, with
     ///   the hybrid shift, a vertex before `k` is eligible as a reconnection vertex.
     ///
-    /// Every bounce is [`Walker::bounce`]: light sampling, BSDF sampling, the emitter the BSDF
+    /// Every bounce is `Walker::bounce`: light sampling, BSDF sampling, the emitter the BSDF
     /// ray hits, and the step to the next vertex. Returns the outcome and the rays traced.
     pub fn walk(
         &self,
