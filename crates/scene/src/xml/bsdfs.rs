@@ -7,9 +7,9 @@ use super::props::{ColorUse, PROPERTY_TAGS, Props, Value};
 use super::{Importer, Result, elements, snake_case};
 use crate::desc::*;
 
-impl<'a, 'i> Importer<'a, 'i> {
+impl<'a> Importer<'a> {
     /// A `<bsdf>` element (top-level, nested in a shape or wrapped by `twosided`).
-    pub(super) fn bsdf(&self, node: Node<'a, 'i>) -> Result<MaterialDesc> {
+    pub(super) fn bsdf<'i>(&self, node: Node<'a, 'i>) -> Result<MaterialDesc> {
         let ty = self.plugin_type(node)?;
         let props = self.props(node, format!("bsdf '{ty}'"))?;
         let textured = self.texture_bindings(node, &ty, &props)?;
@@ -43,7 +43,7 @@ impl<'a, 'i> Importer<'a, 'i> {
 
     /// Parameters given as textures, nested or by reference; wrapped around the material by
     /// [`Self::bind_textures`] (the constant value of such a parameter is unused).
-    fn texture_bindings(
+    fn texture_bindings<'i>(
         &self,
         node: Node<'a, 'i>,
         ty: &str,
@@ -133,7 +133,7 @@ impl<'a, 'i> Importer<'a, 'i> {
     }
 
     /// `twosided`: the first nested bsdf on both sides; not around transmitting ones.
-    fn twosided(&self, node: Node<'a, 'i>) -> Result<MaterialDesc> {
+    fn twosided<'i>(&self, node: Node<'a, 'i>) -> Result<MaterialDesc> {
         let nested: Vec<Node> = elements(node)
             .filter(|c| c.tag_name().name() == "bsdf")
             .collect();

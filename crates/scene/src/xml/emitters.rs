@@ -7,8 +7,8 @@ use super::props::ColorUse;
 use super::{Importer, Result};
 use crate::desc::*;
 
-impl<'a, 'i> Importer<'a, 'i> {
-    pub(super) fn emitter(&self, node: Node<'a, 'i>) -> Result<LightDesc> {
+impl<'a> Importer<'a> {
+    pub(super) fn emitter<'i>(&self, node: Node<'a, 'i>) -> Result<LightDesc> {
         let ty = self.plugin_type(node)?;
         let props = self.props(node, format!("emitter '{ty}'"))?;
         let light = match ty.as_str() {

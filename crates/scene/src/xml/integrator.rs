@@ -6,8 +6,8 @@ use super::props::Value;
 use super::{Importer, Result};
 use crate::desc::*;
 
-impl<'a, 'i> Importer<'a, 'i> {
-    pub(super) fn integrator(&self, node: Node<'a, 'i>, desc: &mut SceneDesc) -> Result<()> {
+impl<'a> Importer<'a> {
+    pub(super) fn integrator<'i>(&self, node: Node<'a, 'i>, desc: &mut SceneDesc) -> Result<()> {
         let ty = self.plugin_type(node)?;
         let props = self.props(node, format!("integrator '{ty}'"))?;
         let mut integ = IntegratorDesc::default();

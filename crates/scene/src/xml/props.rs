@@ -87,7 +87,7 @@ const EQUAL_ENERGY_RGB: [f32; 3] = [1.204_79, 0.948_291, 0.908_916];
 
 /// The properties of one plugin element.
 pub(super) struct Props<'a, 'i> {
-    src: &'a Source<'a, 'i>,
+    src: &'a Source<'a>,
     /// What the plugin is (`bsdf 'diffuse'`), the prefix of messages.
     pub(super) what: String,
     /// The properties in file order (a later one of the same name wins).
@@ -97,11 +97,7 @@ pub(super) struct Props<'a, 'i> {
 impl<'a, 'i> Props<'a, 'i> {
     /// Reads the property children of `plugin`; nested plugins are left to the caller. `what`
     /// names the plugin in messages.
-    pub(super) fn read(
-        src: &'a Source<'a, 'i>,
-        plugin: Node<'a, 'i>,
-        what: String,
-    ) -> Result<Self> {
+    pub(super) fn read(src: &'a Source<'a>, plugin: Node<'a, 'i>, what: String) -> Result<Self> {
         let mut items = Vec::new();
         for c in plugin.children().filter(Node::is_element) {
             let tag = c.tag_name().name();
@@ -370,7 +366,7 @@ mod tests {
     /// with the warnings `finish` produced afterwards.
     fn with_props<R>(xml: &str, f: impl FnOnce(&Props) -> R) -> (R, Vec<String>) {
         let doc = Document::parse(xml).unwrap();
-        let mut src = Source::new(Path::new("t.xml"), &doc);
+        let mut src = Source::new(Path::new("t.xml"), xml);
         src.defaults.insert("a".into(), "0.25".into());
         let props = Props::read(&src, doc.root_element(), "bsdf 'test'".into()).unwrap();
         let r = f(&props);
@@ -381,7 +377,7 @@ mod tests {
 
     fn read_err(xml: &str) -> String {
         let doc = Document::parse(xml).unwrap();
-        let src = Source::new(Path::new("t.xml"), &doc);
+        let src = Source::new(Path::new("t.xml"), xml);
         match Props::read(&src, doc.root_element(), "bsdf 'test'".into()) {
             Ok(_) => panic!("{xml} should not read"),
             Err(e) => e.to_string(),

@@ -7,8 +7,8 @@ use super::props::PROPERTY_TAGS;
 use super::{Importer, Result, elements};
 use crate::desc::*;
 
-impl<'a, 'i> Importer<'a, 'i> {
-    pub(super) fn sensor(&self, node: Node<'a, 'i>, desc: &mut SceneDesc) -> Result<()> {
+impl<'a> Importer<'a> {
+    pub(super) fn sensor<'i>(&self, node: Node<'a, 'i>, desc: &mut SceneDesc) -> Result<()> {
         let ty = self.plugin_type(node)?;
         if ty != "perspective" && ty != "thinlens" {
             return Err(self.err(node, format!("unknown sensor type '{ty}'")));
@@ -100,7 +100,7 @@ impl<'a, 'i> Importer<'a, 'i> {
         Ok(())
     }
 
-    fn film(&self, node: Node<'a, 'i>, film: &mut FilmDesc) -> Result<()> {
+    fn film<'i>(&self, node: Node<'a, 'i>, film: &mut FilmDesc) -> Result<()> {
         let ty = self.plugin_type(node)?;
         // Mitsuba 3's hdrfilm and specfilm, Mitsuba 0.6's ldrfilm and tiledhdrfilm: all give an
         // image; the output format comes from the output file name.

@@ -7,8 +7,8 @@ use super::props::{ColorUse, PROPERTY_TAGS};
 use super::{Importer, Result, elements};
 use crate::desc::*;
 
-impl<'a, 'i> Importer<'a, 'i> {
-    pub(super) fn shape(&self, node: Node<'a, 'i>) -> Result<ShapeDesc> {
+impl<'a> Importer<'a> {
+    pub(super) fn shape<'i>(&self, node: Node<'a, 'i>) -> Result<ShapeDesc> {
         let ty = self.plugin_type(node)?;
         let props = self.props(node, format!("shape '{ty}'"))?;
         let geometry = match ty.as_str() {

@@ -1,32 +1,35 @@
 //! The XML file being read: its path, where each node sits (for `file:line` in messages), the
 //! `<default>` variables that `$name` in attributes refers to, and the warnings collected so far.
+//!
+//! Lines come from a [`LineIndex`] built once per file (the start of every line), so finding a
+//! node's line is a binary search rather than a scan from the start of the file.
 
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::path::Path;
 
-use roxmltree::{Document, Node};
+use roxmltree::Node;
 
 use super::{Result, snake_case};
 use crate::{Location, SceneError, SceneWarning};
 
 /// One XML scene file while it is imported.
-pub(super) struct Source<'a, 'i> {
+pub(super) struct Source<'a> {
     /// The scene file (named in every message).
     pub(super) file: &'a Path,
-    doc: &'a Document<'i>,
+    lines: LineIndex,
     /// `<default>` variables (the command line's `-D` included).
     pub(super) defaults: HashMap<String, String>,
     /// Warnings so far, in file order.
     pub(super) warnings: RefCell<Vec<SceneWarning>>,
 }
 
-impl<'a, 'i> Source<'a, 'i> {
-    /// A source for `doc`, parsed from `file`, with no variables yet.
-    pub(super) fn new(file: &'a Path, doc: &'a Document<'i>) -> Self {
+impl<'a> Source<'a> {
+    /// A source for `text`, read from `file`, with no variables yet.
+    pub(super) fn new(file: &'a Path, text: &str) -> Self {
         Self {
             file,
-            doc,
+            lines: LineIndex::new(text),
             defaults: HashMap::new(),
             warnings: RefCell::new(Vec::new()),
         }
@@ -36,7 +39,7 @@ impl<'a, 'i> Source<'a, 'i> {
     pub(super) fn loc(&self, node: Node) -> Location {
         Location {
             file: self.file.to_path_buf(),
-            line: self.doc.text_pos_at(node.range().start).row,
+            line: self.lines.line(node.range().start),
         }
     }
 
@@ -105,5 +108,59 @@ impl<'a, 'i> Source<'a, 'i> {
     /// A plugin element's `type`, in snake_case.
     pub(super) fn plugin_type(&self, node: Node) -> Result<String> {
         Ok(snake_case(&self.req_attr(node, "type")?))
+    }
+}
+
+/// The byte offsets at which the lines of a text start, for turning offsets into line numbers.
+pub(super) struct LineIndex {
+    /// Offsets of the `\n` bytes.
+    newlines: Vec<usize>,
+}
+
+impl LineIndex {
+    /// Indexes `text` (one pass over its bytes).
+    pub(super) fn new(text: &str) -> Self {
+        Self {
+            newlines: text
+                .bytes()
+                .enumerate()
+                .filter_map(|(i, b)| (b == b'\n').then_some(i))
+                .collect(),
+        }
+    }
+
+    /// The 1-based line holding byte `offset`: one more than the number of line breaks before
+    /// it, as `roxmltree::Document::text_pos_at` counts.
+    pub(super) fn line(&self, offset: usize) -> u32 {
+        (self.newlines.partition_point(|&nl| nl < offset) + 1) as u32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::LineIndex;
+
+    #[test]
+    fn lines_agree_with_roxmltree() {
+        let text = "<scene>\n  <a/>\n\n\r\n<b>ü\n</b>\n</scene>";
+        let doc = roxmltree::Document::parse(text).unwrap();
+        let index = LineIndex::new(text);
+        for offset in 0..=text.len() + 3 {
+            if text.is_char_boundary(offset.min(text.len())) {
+                assert_eq!(
+                    index.line(offset),
+                    doc.text_pos_at(offset).row,
+                    "offset {offset}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_text_without_line_breaks_is_line_one() {
+        let index = LineIndex::new("<scene/>");
+        assert_eq!(index.line(0), 1);
+        assert_eq!(index.line(100), 1);
+        assert_eq!(LineIndex::new("").line(0), 1);
     }
 }

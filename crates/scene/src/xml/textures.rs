@@ -8,10 +8,10 @@ use super::props::{ColorUse, PROPERTY_TAGS};
 use super::{Importer, Result, elements};
 use crate::texture::{TextureDesc, UvTransform};
 
-impl<'a, 'i> Importer<'a, 'i> {
+impl<'a> Importer<'a> {
     /// A `<texture>`: `bitmap` or `checkerboard`, with Mitsuba 0.6 `uscale`/`vscale`/
     /// `uoffset`/`voffset` or Mitsuba 3 `to_uv` (scale and translation only).
-    pub(super) fn texture(&self, node: Node<'a, 'i>) -> Result<TextureDesc> {
+    pub(super) fn texture<'i>(&self, node: Node<'a, 'i>) -> Result<TextureDesc> {
         let ty = self.plugin_type(node)?;
         let props = self.props(node, format!("texture '{ty}'"))?;
         let mut uv = UvTransform::default();

@@ -15,7 +15,7 @@ pub(super) fn parse_numbers(s: &str) -> Option<Vec<f64>> {
         .collect()
 }
 
-impl Source<'_, '_> {
+impl Source<'_> {
     pub(super) fn finite(&self, node: Node, v: f64, what: &str) -> Result<f64> {
         if !v.is_finite() {
             Err(self.err(node, format!("{what} is not a finite number")))
