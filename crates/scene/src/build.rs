@@ -104,8 +104,8 @@ fn conductor_ior(d: &ConductorIorDesc) -> Result<(Vec3, Vec3), String> {
             });
         }
     }
-    let eta = Vec3::from(d.eta.unwrap_or([0.0; 3]));
-    let k = Vec3::from(d.k.unwrap_or([1.0; 3]));
+    let eta = Vec3::from(d.eta.unwrap_or(defaults::CONDUCTOR_ETA));
+    let k = Vec3::from(d.k.unwrap_or(defaults::CONDUCTOR_K));
     for (name, v) in [("eta", eta), ("k", k)] {
         if !v.is_finite() || v.min_element() < 0.0 {
             return Err(format!(
@@ -300,9 +300,9 @@ pub(crate) fn color_params(m: &MaterialDesc) -> &'static [ColorParam] {
 /// and the textures that replace some of them.
 fn material_colors(m: &MaterialDesc) -> (ReflectanceParams, &[TextureBinding]) {
     let mut p = ReflectanceParams {
-        diffuse: Vec3::splat(0.5),
-        specular: Vec3::ONE,
-        transmittance: Vec3::ONE,
+        diffuse: v3(&defaults::DIFFUSE_REFLECTANCE),
+        specular: v3(&defaults::SPECULAR),
+        transmittance: v3(&defaults::SPECULAR),
         nonlinear: false,
     };
     let mut bindings: &[TextureBinding] = &[];
@@ -659,7 +659,10 @@ impl Scene {
         }
 
         // Materials.
-        let mut bsdfs = vec![Bsdf::diffuse(Vec3::splat(0.5)), Bsdf::black()];
+        let mut bsdfs = vec![
+            Bsdf::diffuse(v3(&defaults::DIFFUSE_REFLECTANCE)),
+            Bsdf::black(),
+        ];
         let mut bsdf_textures = vec![None, None];
         let mut cache = TextureCache::default();
         let mut names = std::collections::HashMap::new();

@@ -17,7 +17,7 @@ impl<'a> Importer<'a> {
             "diffuse" => MaterialDesc::Diffuse {
                 reflectance: props
                     .color("reflectance", ColorUse::Reflectance)?
-                    .unwrap_or([0.5; 3]),
+                    .unwrap_or(defaults::DIFFUSE_REFLECTANCE),
             },
             "twosided" => self.twosided(node)?,
             "conductor" | "roughconductor" => self.conductor(node, &ty, &props)?,
@@ -150,7 +150,7 @@ impl<'a> Importer<'a> {
                     "empty twosided bsdf wraps a default diffuse (reflectance 0.5)",
                 );
                 MaterialDesc::Diffuse {
-                    reflectance: [0.5; 3],
+                    reflectance: defaults::DIFFUSE_REFLECTANCE,
                 }
             }
         };
@@ -176,7 +176,7 @@ impl<'a> Importer<'a> {
         let ior = self.conductor_ior(props)?;
         let specular_reflectance = props
             .color("specular_reflectance", ColorUse::Reflectance)?
-            .unwrap_or([1.0; 3]);
+            .unwrap_or(defaults::SPECULAR);
         Ok(if ty == "conductor" {
             MaterialDesc::Conductor {
                 ior,
@@ -193,14 +193,14 @@ impl<'a> Importer<'a> {
 
     /// `dielectric` and `roughdielectric`.
     fn dielectric(&self, node: Node, ty: &str, props: &Props) -> Result<MaterialDesc> {
-        let int_ior = props.ior("int_ior", BK7_IOR)?;
-        let ext_ior = props.ior("ext_ior", AIR_IOR)?;
+        let int_ior = props.ior("int_ior", defaults::BK7_IOR)?;
+        let ext_ior = props.ior("ext_ior", defaults::AIR_IOR)?;
         let specular_reflectance = props
             .color("specular_reflectance", ColorUse::Reflectance)?
-            .unwrap_or([1.0; 3]);
+            .unwrap_or(defaults::SPECULAR);
         let specular_transmittance = props
             .color("specular_transmittance", ColorUse::Reflectance)?
-            .unwrap_or([1.0; 3]);
+            .unwrap_or(defaults::SPECULAR);
         Ok(if ty == "dielectric" {
             MaterialDesc::Dielectric {
                 int_ior,
@@ -221,14 +221,14 @@ impl<'a> Importer<'a> {
 
     /// `plastic` and `roughplastic`.
     fn plastic(&self, node: Node, ty: &str, props: &Props) -> Result<MaterialDesc> {
-        let int_ior = props.ior("int_ior", POLYPROPYLENE_IOR)?;
-        let ext_ior = props.ior("ext_ior", AIR_IOR)?;
+        let int_ior = props.ior("int_ior", defaults::POLYPROPYLENE_IOR)?;
+        let ext_ior = props.ior("ext_ior", defaults::AIR_IOR)?;
         let diffuse_reflectance = props
             .color("diffuse_reflectance", ColorUse::Reflectance)?
-            .unwrap_or([0.5; 3]);
+            .unwrap_or(defaults::DIFFUSE_REFLECTANCE);
         let specular_reflectance = props
             .color("specular_reflectance", ColorUse::Reflectance)?
-            .unwrap_or([1.0; 3]);
+            .unwrap_or(defaults::SPECULAR);
         let nonlinear = props.bool("nonlinear")?.unwrap_or(false);
         if ty == "plastic" {
             return Ok(MaterialDesc::Plastic {
@@ -324,7 +324,7 @@ impl<'a> Importer<'a> {
         let au = alpha("alpha_u")?;
         let av = alpha("alpha_v")?;
         match (au, av) {
-            (None, None) => r.alpha = a.unwrap_or(0.1),
+            (None, None) => r.alpha = a.unwrap_or(defaults::ALPHA),
             (Some(u), Some(v)) => {
                 if !anisotropic {
                     return Err(self.err(

@@ -15,7 +15,7 @@ impl<'a> Importer<'a> {
             "point" => {
                 let intensity = props
                     .color("intensity", ColorUse::Emission)?
-                    .unwrap_or([1.0; 3]);
+                    .unwrap_or(defaults::EMISSION);
                 let position = match props.point("position")? {
                     Some(p) => p,
                     None => {
@@ -32,7 +32,7 @@ impl<'a> Importer<'a> {
             "directional" => {
                 let irradiance = props
                     .color("irradiance", ColorUse::Emission)?
-                    .unwrap_or([1.0; 3]);
+                    .unwrap_or(defaults::EMISSION);
                 let direction = match props.point("direction")? {
                     Some(d) => d,
                     None => {
@@ -52,7 +52,7 @@ impl<'a> Importer<'a> {
             "constant" => {
                 let radiance = props
                     .color("radiance", ColorUse::Emission)?
-                    .unwrap_or([1.0; 3]);
+                    .unwrap_or(defaults::EMISSION);
                 LightDesc::Constant { radiance }
             }
             "envmap" => {
@@ -62,7 +62,7 @@ impl<'a> Importer<'a> {
                         "envmap emitter needs a 'filename' (EXR, HDR, PNG or JPEG)",
                     )
                 })?;
-                let scale = props.float("scale")?.unwrap_or(1.0);
+                let scale = props.float("scale")?.unwrap_or(defaults::ENVMAP_SCALE);
                 if !(scale.is_finite() && scale >= 0.0) {
                     return Err(self.err(
                         node,

@@ -138,7 +138,7 @@ pub fn parse_xml(
     };
 
     let mut desc = SceneDesc {
-        spp: 16,
+        spp: defaults::SPP,
         ..SceneDesc::default()
     };
     let mut saw_sensor = false;

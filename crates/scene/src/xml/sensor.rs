@@ -14,7 +14,7 @@ impl<'a> Importer<'a> {
             return Err(self.err(node, format!("unknown sensor type '{ty}'")));
         }
         let props = self.props(node, format!("sensor '{ty}'"))?;
-        let fov = props.float("fov")?.unwrap_or(45.0);
+        let fov = props.float("fov")?.unwrap_or(defaults::FOV);
         if !(fov > 0.0 && fov < 180.0) {
             let at = props.node_or("fov", node);
             return Err(self.err(
@@ -43,8 +43,12 @@ impl<'a> Importer<'a> {
             };
         }
         if ty == "thinlens" {
-            cam.aperture_radius = props.float("aperture_radius")?.unwrap_or(0.0);
-            cam.focus_distance = props.float("focus_distance")?.unwrap_or(1.0);
+            cam.aperture_radius = props
+                .float("aperture_radius")?
+                .unwrap_or(defaults::APERTURE_RADIUS);
+            cam.focus_distance = props
+                .float("focus_distance")?
+                .unwrap_or(defaults::FOCUS_DISTANCE);
         }
         for c in elements(node) {
             match c.tag_name().name() {
@@ -121,8 +125,8 @@ impl<'a> Importer<'a> {
                 )),
             }
         };
-        film.width = dim("width", 768)?;
-        film.height = dim("height", 576)?;
+        film.width = dim("width", defaults::FILM_WIDTH)?;
+        film.height = dim("height", defaults::FILM_HEIGHT)?;
         if film.width as u64 * film.height as u64 > 1 << 28 {
             return Err(self.err(
                 node,
@@ -133,7 +137,7 @@ impl<'a> Importer<'a> {
             ));
         }
         film.filename = props.string("filename")?;
-        film.filter = FilterDesc::Gaussian { stddev: 0.5 };
+        film.filter = FilterDesc::default();
         for c in elements(node) {
             match c.tag_name().name() {
                 "rfilter" => {
@@ -154,14 +158,14 @@ impl<'a> Importer<'a> {
                             let r = fp
                                 .float("radius")?
                                 .or(fp.float("width")?.map(|w| 0.5 * w))
-                                .unwrap_or(1.0);
+                                .unwrap_or(defaults::TENT_RADIUS);
                             if r <= 0.0 {
                                 return Err(self.err(c, "tent radius must be positive"));
                             }
                             FilterDesc::Tent { radius: r }
                         }
                         "gaussian" => {
-                            let s = fp.float("stddev")?.unwrap_or(0.5);
+                            let s = fp.float("stddev")?.unwrap_or(defaults::GAUSSIAN_STDDEV);
                             if s <= 0.0 {
                                 return Err(self.err(c, "gaussian stddev must be positive"));
                             }

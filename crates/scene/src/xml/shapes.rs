@@ -16,8 +16,8 @@ impl<'a> Importer<'a> {
             "cube" => GeometryDesc::Cube,
             "disk" => GeometryDesc::Disk,
             "sphere" => {
-                let center = props.point("center")?.unwrap_or([0.0; 3]);
-                let radius = props.float("radius")?.unwrap_or(1.0);
+                let center = props.point("center")?.unwrap_or(defaults::SPHERE_CENTER);
+                let radius = props.float("radius")?.unwrap_or(defaults::SPHERE_RADIUS);
                 if radius <= 0.0 {
                     return Err(self.err(node, format!("sphere radius {radius} must be positive")));
                 }
@@ -89,7 +89,7 @@ impl<'a> Importer<'a> {
                     let ep = self.props(c, "emitter 'area'".into())?;
                     let r = ep
                         .color("radiance", ColorUse::Emission)?
-                        .unwrap_or([1.0; 3]);
+                        .unwrap_or(defaults::EMISSION);
                     ep.finish();
                     emission = Some(r);
                 }

@@ -6,6 +6,7 @@ use roxmltree::Node;
 
 use super::props::{ColorUse, PROPERTY_TAGS};
 use super::{Importer, Result, elements};
+use crate::desc::defaults;
 use crate::texture::{TextureDesc, UvTransform};
 
 impl<'a> Importer<'a> {
@@ -65,10 +66,10 @@ impl<'a> Importer<'a> {
             "checkerboard" => TextureDesc::Checkerboard {
                 color0: props
                     .color("color0", ColorUse::Reflectance)?
-                    .unwrap_or([0.4; 3]),
+                    .unwrap_or(defaults::CHECKER_COLOR0),
                 color1: props
                     .color("color1", ColorUse::Reflectance)?
-                    .unwrap_or([0.2; 3]),
+                    .unwrap_or(defaults::CHECKER_COLOR1),
                 uv,
             },
             other => return Err(self.err(node, format!("unknown texture type '{other}'"))),
