@@ -408,75 +408,6 @@ fn material(
     Ok((bsdf, Some(t)))
 }
 
-use crate::meshio::MeshData;
-
-/// Reads a whole mesh file.
-fn read_mesh_file(path: &Path) -> Result<Vec<u8>, String> {
-    std::fs::read(path).map_err(|e| format!("cannot read mesh '{}': {e}", path.display()))
-}
-
-fn load_obj(path: &Path) -> Result<MeshData, String> {
-    let opts = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    // tobj reports a missing file as "open file failed"; say why.
-    std::fs::File::open(path).map_err(|e| format!("cannot read mesh '{}': {e}", path.display()))?;
-    let (models, _) = tobj::load_obj(path, &opts)
-        .map_err(|e| format!("cannot read mesh '{}': {e}", path.display()))?;
-    let mut positions = Vec::new();
-    let mut normals = Vec::new();
-    let mut uvs = Vec::new();
-    let mut indices = Vec::new();
-    let all_normals = models
-        .iter()
-        .all(|m| m.mesh.normals.len() == m.mesh.positions.len());
-    let all_uvs = models
-        .iter()
-        .all(|m| m.mesh.texcoords.len() / 2 == m.mesh.positions.len() / 3);
-    for m in &models {
-        let base = positions.len() as u32;
-        let mesh = &m.mesh;
-        if mesh.positions.len() % 3 != 0 || mesh.indices.len() % 3 != 0 {
-            return Err(format!("mesh '{}' is truncated", path.display()));
-        }
-        positions.extend(
-            mesh.positions
-                .chunks_exact(3)
-                .map(|c| Vec3::new(c[0], c[1], c[2])),
-        );
-        if all_normals {
-            normals.extend(
-                mesh.normals
-                    .chunks_exact(3)
-                    .map(|c| Vec3::new(c[0], c[1], c[2])),
-            );
-        }
-        if all_uvs {
-            uvs.extend(
-                mesh.texcoords
-                    .chunks_exact(2)
-                    // OBJ counts v from the bottom of the image; Mitsuba flips it on load.
-                    .map(|c| Vec2::new(c[0], 1.0 - c[1])),
-            );
-        }
-        for t in mesh.indices.chunks_exact(3) {
-            indices.push([base + t[0], base + t[1], base + t[2]]);
-        }
-    }
-    if indices.is_empty() {
-        return Err(format!("mesh '{}' has no triangles", path.display()));
-    }
-    Ok((
-        positions,
-        (all_normals && !normals.is_empty()).then_some(normals),
-        (all_uvs && !uvs.is_empty()).then_some(uvs),
-        indices,
-    ))
-}
-
 /// Reads an environment map's image and sets up its lookup and sampling.
 fn build_envmap(
     filename: &str,
@@ -514,7 +445,7 @@ fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<Shape, String> {
         }
         GeometryDesc::Obj { filename } => {
             let path = base_dir.join(filename);
-            let (p, n, uv, idx) = load_obj(&path)?;
+            let (p, n, uv, idx) = crate::meshio::load_obj(&path).map_err(|e| e.to_string())?;
             let n = if desc.face_normals { None } else { n };
             mesh(
                 TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
@@ -523,8 +454,7 @@ fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<Shape, String> {
         }
         GeometryDesc::Ply { filename } => {
             let path = base_dir.join(filename);
-            let (p, n, uv, idx) = crate::meshio::read_ply(&read_mesh_file(&path)?)
-                .map_err(|e| format!("mesh '{}': {e}", path.display()))?;
+            let (p, n, uv, idx) = crate::meshio::load_ply(&path).map_err(|e| e.to_string())?;
             let n = if desc.face_normals { None } else { n };
             mesh(
                 TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
@@ -536,9 +466,8 @@ fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<Shape, String> {
             shape_index,
         } => {
             let path = base_dir.join(filename);
-            let (p, n, uv, idx) =
-                crate::meshio::read_serialized(&read_mesh_file(&path)?, *shape_index as usize)
-                    .map_err(|e| format!("mesh '{}': {e}", path.display()))?;
+            let (p, n, uv, idx) = crate::meshio::load_serialized(&path, *shape_index as usize)
+                .map_err(|e| e.to_string())?;
             let n = if desc.face_normals { None } else { n };
             mesh(
                 TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
