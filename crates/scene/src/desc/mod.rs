@@ -7,9 +7,11 @@
 
 pub mod defaults;
 mod materials;
+mod transform;
 
 pub use defaults::{AIR_IOR, BK7_IOR, POLYPROPYLENE_IOR};
 pub use materials::*;
+pub use transform::{TransformError, TransformOp, transform_matrix};
 
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -63,35 +65,6 @@ pub struct SceneDesc {
 
 /// A 3-vector `(x, y, z)` or colour `(r, g, b)`.
 pub type V3 = [f32; 3];
-
-/// One step of a transform; steps apply in order (the first is applied to the object first),
-/// as in Mitsuba's `<transform>`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub enum TransformOp {
-    /// Translation.
-    Translate(V3),
-    /// Per-axis scale.
-    Scale(V3),
-    /// Rotation by `angle` degrees about `axis` (counter-clockwise looking down the axis).
-    Rotate {
-        /// Rotation axis (need not be unit length).
-        axis: V3,
-        /// Angle in degrees.
-        angle: f32,
-    },
-    /// Camera-style look-at: `+z` towards `target`, `+y` towards `up`, `+x = up × z`.
-    LookAt {
-        /// Eye position.
-        origin: V3,
-        /// Point looked at.
-        target: V3,
-        /// Up vector.
-        up: V3,
-    },
-    /// A row-major 4×4 matrix.
-    Matrix([f32; 16]),
-}
 
 /// Which axis the field of view spans.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]

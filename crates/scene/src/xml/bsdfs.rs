@@ -34,8 +34,7 @@ impl<'a> Importer<'a> {
         };
         let m = self.bind_textures(&ty, m, textured)?;
         // Everything the builder would reject, reported here with this bsdf's line.
-        crate::build::check_material(&m)
-            .map_err(|e| self.err(node, format!("bsdf '{ty}': {e}")))?;
+        crate::material::check(&m).map_err(|e| self.err(node, format!("bsdf '{ty}': {e}")))?;
         self.check_bsdf_children(node, &ty)?;
         props.finish();
         Ok(m)
@@ -101,7 +100,7 @@ impl<'a> Importer<'a> {
         if textured.is_empty() {
             return Ok(m);
         }
-        let allowed = crate::build::color_params(&m);
+        let allowed = crate::material::color_params(&m);
         if let Some((c, b)) = textured.iter().find(|(_, b)| !allowed.contains(&b.param)) {
             return Err(self.err(
                 *c,

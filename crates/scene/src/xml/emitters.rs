@@ -19,8 +19,8 @@ impl<'a> Importer<'a> {
                 let position = match props.point("position")? {
                     Some(p) => p,
                     None => {
-                        let m = crate::transform_matrix(&props.transform("to_world")?)
-                            .map_err(|e| self.err(node, e))?;
+                        let m = crate::desc::transform_matrix(&props.transform("to_world")?)
+                            .map_err(|e| self.err(node, e.to_string()))?;
                         m.transform_point3(glam::Vec3::ZERO).to_array()
                     }
                 };
@@ -36,8 +36,8 @@ impl<'a> Importer<'a> {
                 let direction = match props.point("direction")? {
                     Some(d) => d,
                     None => {
-                        let m = crate::transform_matrix(&props.transform("to_world")?)
-                            .map_err(|e| self.err(node, e))?;
+                        let m = crate::desc::transform_matrix(&props.transform("to_world")?)
+                            .map_err(|e| self.err(node, e.to_string()))?;
                         m.transform_vector3(glam::Vec3::Z).to_array()
                     }
                 };

@@ -75,20 +75,23 @@ impl<'a> Importer<'a> {
             }
         }
         // Everything the builder would reject about the camera, reported with the sensor's line.
-        if let Err(e) = crate::transform_matrix(&cam.to_world).and_then(|m| {
-            let axis = restir_geometry::FovAxis::X;
-            let res = (desc.film.width, desc.film.height);
-            restir_geometry::Camera::thin_lens(
-                m,
-                cam.fov,
-                axis,
-                res,
-                cam.aperture_radius,
-                cam.focus_distance,
-            )
-            .map(|_| ())
+        if let Err(e) = crate::desc::transform_matrix(&cam.to_world)
             .map_err(|e| e.to_string())
-        }) {
+            .and_then(|m| {
+                let axis = restir_geometry::FovAxis::X;
+                let res = (desc.film.width, desc.film.height);
+                restir_geometry::Camera::thin_lens(
+                    m,
+                    cam.fov,
+                    axis,
+                    res,
+                    cam.aperture_radius,
+                    cam.focus_distance,
+                )
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+            })
+        {
             let lens = if ty == "thinlens" {
                 format!(
                     " (aperture_radius {}, focus_distance {})",

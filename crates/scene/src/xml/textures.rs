@@ -18,7 +18,8 @@ impl<'a> Importer<'a> {
         let mut uv = UvTransform::default();
         let to_uv = props.transform("to_uv")?;
         if !to_uv.is_empty() {
-            let m = crate::transform_matrix(&to_uv).map_err(|e| self.err(node, e))?;
+            let m =
+                crate::desc::transform_matrix(&to_uv).map_err(|e| self.err(node, e.to_string()))?;
             if m.x_axis.y.abs() > 1e-6 || m.y_axis.x.abs() > 1e-6 {
                 return Err(self.err(
                     node,

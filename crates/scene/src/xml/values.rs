@@ -94,8 +94,8 @@ impl Source<'_> {
                         None => [0.0, 1.0, 0.0],
                     };
                     let op = TransformOp::LookAt { origin, target, up };
-                    crate::transform_matrix(std::slice::from_ref(&op))
-                        .map_err(|e| self.err(c, e))?;
+                    crate::desc::transform_matrix(std::slice::from_ref(&op))
+                        .map_err(|e| self.err(c, e.to_string()))?;
                     op
                 }
                 "matrix" => {
