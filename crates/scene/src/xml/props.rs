@@ -139,7 +139,8 @@ impl<'a, 'i> Props<'a, 'i> {
                         let s = src.req_attr(c, "value")?;
                         if s.contains(':') {
                             Value::Spectrum(
-                                crate::spectrum::parse_pairs(&s).map_err(|e| src.err(c, e))?,
+                                crate::spectrum::parse_pairs(&s)
+                                    .map_err(|e| src.err(c, e.to_string()))?,
                             )
                         } else {
                             Value::SpectrumConst(src.parse_float(c, &s)? as f32)
