@@ -6,53 +6,13 @@ use std::path::Path;
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 use restir_geometry::{Accel, Camera, FovAxis as GeoFovAxis, Shape, Sphere, TriangleMesh};
 use restir_lights::{EnvMap, Light, LightSet};
-use restir_materials::{Bsdf, Distribution, LobeFlags, Microfacet, ReflectanceParams};
+use restir_materials::{Bsdf, LobeFlags};
 
 use crate::desc::*;
+use crate::material::v3;
 use crate::texture::Texture;
+use crate::transform_matrix;
 use crate::{Scene, SceneError, SceneFeatures, TexturedParams};
-
-/// Composes transform steps (first step applied first) into one matrix.
-pub fn transform_matrix(ops: &[TransformOp]) -> Result<Mat4, String> {
-    let mut m = Mat4::IDENTITY;
-    for op in ops {
-        let step = match op {
-            TransformOp::Translate(t) => Mat4::from_translation(Vec3::from(*t)),
-            TransformOp::Scale(s) => Mat4::from_scale(Vec3::from(*s)),
-            TransformOp::Rotate { axis, angle } => {
-                let a = Vec3::from(*axis);
-                if a.length_squared() == 0.0 || !a.is_finite() {
-                    return Err("rotation axis is zero".into());
-                }
-                Mat4::from_axis_angle(a.normalize(), angle.to_radians())
-            }
-            TransformOp::LookAt { origin, target, up } => {
-                let (o, t, u) = (Vec3::from(*origin), Vec3::from(*target), Vec3::from(*up));
-                let dir = (t - o).normalize_or_zero();
-                let left = u.cross(dir).normalize_or_zero();
-                if dir == Vec3::ZERO || left == Vec3::ZERO {
-                    return Err(
-                        "lookat is degenerate: origin equals target or up is parallel to the view direction"
-                            .into(),
-                    );
-                }
-                let new_up = dir.cross(left);
-                Mat4::from_cols(
-                    left.extend(0.0),
-                    new_up.extend(0.0),
-                    dir.extend(0.0),
-                    o.extend(1.0),
-                )
-            }
-            TransformOp::Matrix(v) => Mat4::from_cols_array(v).transpose(),
-        };
-        m = step * m;
-    }
-    if !m.is_finite() {
-        return Err("transform has non-finite entries".into());
-    }
-    Ok(m)
-}
 
 fn affine(m: Mat4) -> Result<Affine3A, String> {
     let row3 = m.row(3);
@@ -69,296 +29,6 @@ fn affine(m: Mat4) -> Result<Affine3A, String> {
         return Err("transform is degenerate (zero scale)".into());
     }
     Ok(a)
-}
-
-fn unit_color(what: &str, c: &V3) -> Result<Vec3, String> {
-    let v = Vec3::from(*c);
-    if !v.is_finite() || v.min_element() < 0.0 || v.max_element() > 1.0 {
-        return Err(format!("{what} {c:?} must lie in [0, 1]"));
-    }
-    Ok(v)
-}
-
-fn relative_ior(int_ior: f32, ext_ior: f32) -> Result<f32, String> {
-    for (name, v) in [("int_ior", int_ior), ("ext_ior", ext_ior)] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(format!("{name} {v} must be a positive number"));
-        }
-    }
-    Ok(int_ior / ext_ior)
-}
-
-fn conductor_ior(d: &ConductorIorDesc) -> Result<(Vec3, Vec3), String> {
-    if let Some(name) = &d.material {
-        if name != "none" && (d.eta.is_some() || d.k.is_some()) {
-            return Err(format!(
-                "conductor material '{name}' cannot be combined with explicit eta or k"
-            ));
-        }
-        if d.eta.is_none() && d.k.is_none() {
-            return restir_materials::ior::conductor(name).ok_or_else(|| {
-                format!(
-                    "unknown conductor material '{name}' (known: {})",
-                    restir_materials::ior::conductor_names()
-                )
-            });
-        }
-    }
-    let eta = Vec3::from(d.eta.unwrap_or([0.0; 3]));
-    let k = Vec3::from(d.k.unwrap_or([1.0; 3]));
-    for (name, v) in [("eta", eta), ("k", k)] {
-        if !v.is_finite() || v.min_element() < 0.0 {
-            return Err(format!(
-                "conductor {name} {v} must be finite and non-negative"
-            ));
-        }
-    }
-    Ok((eta, k))
-}
-
-fn microfacet(r: &RoughnessDesc, anisotropy_allowed: bool) -> Result<Microfacet, String> {
-    let dist = match r.distribution {
-        MicrofacetDesc::Beckmann => Distribution::Beckmann,
-        MicrofacetDesc::Ggx => Distribution::Ggx,
-    };
-    let check = |name: &str, a: f32| {
-        if a.is_finite() && a >= 0.0 {
-            Ok(a)
-        } else {
-            Err(format!(
-                "{name} {a} must be a finite non-negative roughness"
-            ))
-        }
-    };
-    match (r.alpha_u, r.alpha_v) {
-        (None, None) => Ok(Microfacet::new(dist, check("alpha", r.alpha)?)),
-        (Some(u), Some(v)) => {
-            if !anisotropy_allowed {
-                return Err("this material is isotropic: give alpha, not alpha_u/alpha_v".into());
-            }
-            Ok(Microfacet::anisotropic(
-                dist,
-                check("alpha_u", u)?,
-                check("alpha_v", v)?,
-            ))
-        }
-        _ => Err("alpha_u and alpha_v must be given together".into()),
-    }
-}
-
-/// Checks a material the way [`Scene::build`] would, without keeping the result.
-pub(crate) fn check_material(m: &MaterialDesc) -> Result<(), String> {
-    material_bsdf(m).map(|_| ())
-}
-
-fn material_bsdf(m: &MaterialDesc) -> Result<Bsdf, String> {
-    Ok(match m {
-        MaterialDesc::Diffuse { reflectance } => {
-            Bsdf::diffuse(unit_color("diffuse reflectance", reflectance)?)
-        }
-        MaterialDesc::Conductor {
-            ior,
-            specular_reflectance,
-        } => {
-            let (eta, k) = conductor_ior(ior)?;
-            Bsdf::conductor(
-                eta,
-                k,
-                unit_color("specular_reflectance", specular_reflectance)?,
-            )
-        }
-        MaterialDesc::RoughConductor {
-            ior,
-            specular_reflectance,
-            roughness,
-        } => {
-            let (eta, k) = conductor_ior(ior)?;
-            Bsdf::rough_conductor(
-                eta,
-                k,
-                unit_color("specular_reflectance", specular_reflectance)?,
-                microfacet(roughness, true)?,
-            )
-        }
-        MaterialDesc::Dielectric {
-            int_ior,
-            ext_ior,
-            specular_reflectance,
-            specular_transmittance,
-        } => Bsdf::dielectric(
-            relative_ior(*int_ior, *ext_ior)?,
-            unit_color("specular_reflectance", specular_reflectance)?,
-            unit_color("specular_transmittance", specular_transmittance)?,
-        ),
-        MaterialDesc::RoughDielectric {
-            int_ior,
-            ext_ior,
-            specular_reflectance,
-            specular_transmittance,
-            roughness,
-        } => Bsdf::rough_dielectric(
-            relative_ior(*int_ior, *ext_ior)?,
-            unit_color("specular_reflectance", specular_reflectance)?,
-            unit_color("specular_transmittance", specular_transmittance)?,
-            microfacet(roughness, true)?,
-        ),
-        MaterialDesc::Plastic {
-            int_ior,
-            ext_ior,
-            diffuse_reflectance,
-            specular_reflectance,
-            nonlinear,
-        } => Bsdf::plastic(
-            relative_ior(*int_ior, *ext_ior)?,
-            unit_color("diffuse_reflectance", diffuse_reflectance)?,
-            unit_color("specular_reflectance", specular_reflectance)?,
-            *nonlinear,
-        ),
-        MaterialDesc::RoughPlastic {
-            int_ior,
-            ext_ior,
-            diffuse_reflectance,
-            specular_reflectance,
-            nonlinear,
-            roughness,
-        } => {
-            let eta = relative_ior(*int_ior, *ext_ior)?;
-            if eta == 1.0 {
-                return Err("roughplastic: int_ior must differ from ext_ior".into());
-            }
-            let mf = microfacet(roughness, false)?;
-            Bsdf::rough_plastic(
-                eta,
-                unit_color("diffuse_reflectance", diffuse_reflectance)?,
-                unit_color("specular_reflectance", specular_reflectance)?,
-                *nonlinear,
-                mf.distribution,
-                mf.alpha_u,
-            )
-        }
-        MaterialDesc::Null => Bsdf::null(),
-        MaterialDesc::TwoSided(inner) => {
-            let b = material_bsdf(inner)?;
-            if b.kind.transmits() {
-                return Err(
-                    "twosided cannot wrap a transmitting material (dielectric, roughdielectric, null), as in Mitsuba"
-                        .into(),
-                );
-            }
-            b.two_sided()
-        }
-        MaterialDesc::Black => Bsdf::black(),
-        MaterialDesc::Textured { material, textures } => {
-            let b = material_bsdf(material)?;
-            let allowed = color_params(material);
-            if matches!(**material, MaterialDesc::Textured { .. }) {
-                return Err("a textured material cannot wrap another textured material".into());
-            }
-            for (i, t) in textures.iter().enumerate() {
-                if !allowed.contains(&t.param) {
-                    let names: Vec<&str> = allowed.iter().map(|p| p.name()).collect();
-                    return Err(format!(
-                        "texture for '{}': this material has no such parameter (its colour parameters: {})",
-                        t.param.name(),
-                        if names.is_empty() {
-                            "none".to_string()
-                        } else {
-                            names.join(", ")
-                        }
-                    ));
-                }
-                if textures[..i].iter().any(|u| u.param == t.param) {
-                    return Err(format!("two textures for '{}'", t.param.name()));
-                }
-            }
-            b
-        }
-    })
-}
-
-/// The colour parameters of a material that textures may replace.
-pub(crate) fn color_params(m: &MaterialDesc) -> &'static [ColorParam] {
-    use ColorParam::*;
-    match m {
-        MaterialDesc::Diffuse { .. } => &[Reflectance],
-        MaterialDesc::Conductor { .. } | MaterialDesc::RoughConductor { .. } => {
-            &[SpecularReflectance]
-        }
-        MaterialDesc::Dielectric { .. } | MaterialDesc::RoughDielectric { .. } => {
-            &[SpecularReflectance, SpecularTransmittance]
-        }
-        MaterialDesc::Plastic { .. } | MaterialDesc::RoughPlastic { .. } => {
-            &[DiffuseReflectance, SpecularReflectance]
-        }
-        MaterialDesc::TwoSided(inner) => color_params(inner),
-        MaterialDesc::Textured { material, .. } => color_params(material),
-        MaterialDesc::Null | MaterialDesc::Black => &[],
-    }
-}
-
-/// The constant colour parameters of a material as written (defaults where a model has none)
-/// and the textures that replace some of them.
-fn material_colors(m: &MaterialDesc) -> (ReflectanceParams, &[TextureBinding]) {
-    let mut p = ReflectanceParams {
-        diffuse: Vec3::splat(0.5),
-        specular: Vec3::ONE,
-        transmittance: Vec3::ONE,
-        nonlinear: false,
-    };
-    let mut bindings: &[TextureBinding] = &[];
-    let mut m = m;
-    loop {
-        match m {
-            MaterialDesc::TwoSided(inner) => m = inner,
-            MaterialDesc::Textured { material, textures } => {
-                bindings = textures;
-                m = material;
-            }
-            _ => break,
-        }
-    }
-    match m {
-        MaterialDesc::Diffuse { reflectance } => p.diffuse = v3(reflectance),
-        MaterialDesc::Conductor {
-            specular_reflectance,
-            ..
-        }
-        | MaterialDesc::RoughConductor {
-            specular_reflectance,
-            ..
-        } => p.specular = v3(specular_reflectance),
-        MaterialDesc::Dielectric {
-            specular_reflectance,
-            specular_transmittance,
-            ..
-        }
-        | MaterialDesc::RoughDielectric {
-            specular_reflectance,
-            specular_transmittance,
-            ..
-        } => {
-            p.specular = v3(specular_reflectance);
-            p.transmittance = v3(specular_transmittance);
-        }
-        MaterialDesc::Plastic {
-            diffuse_reflectance,
-            specular_reflectance,
-            nonlinear,
-            ..
-        }
-        | MaterialDesc::RoughPlastic {
-            diffuse_reflectance,
-            specular_reflectance,
-            nonlinear,
-            ..
-        } => {
-            p.diffuse = v3(diffuse_reflectance);
-            p.specular = v3(specular_reflectance);
-            p.nonlinear = *nonlinear;
-        }
-        _ => {}
-    }
-    (p, bindings)
 }
 
 /// Decoded textures, each distinct description loaded once.
@@ -386,8 +56,8 @@ fn material(
     cache: &mut TextureCache,
     base_dir: &Path,
 ) -> Result<(Bsdf, Option<TexturedParams>), String> {
-    let bsdf = material_bsdf(m)?;
-    let (base, bindings) = material_colors(m);
+    let bsdf = crate::material::bsdf(m).map_err(|e| e.to_string())?;
+    let (base, bindings) = crate::material::colors(m);
     if bindings.is_empty() {
         return Ok((bsdf, None));
     }
@@ -408,75 +78,6 @@ fn material(
     Ok((bsdf, Some(t)))
 }
 
-use crate::meshio::MeshData;
-
-/// Reads a whole mesh file.
-fn read_mesh_file(path: &Path) -> Result<Vec<u8>, String> {
-    std::fs::read(path).map_err(|e| format!("cannot read mesh '{}': {e}", path.display()))
-}
-
-fn load_obj(path: &Path) -> Result<MeshData, String> {
-    let opts = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    // tobj reports a missing file as "open file failed"; say why.
-    std::fs::File::open(path).map_err(|e| format!("cannot read mesh '{}': {e}", path.display()))?;
-    let (models, _) = tobj::load_obj(path, &opts)
-        .map_err(|e| format!("cannot read mesh '{}': {e}", path.display()))?;
-    let mut positions = Vec::new();
-    let mut normals = Vec::new();
-    let mut uvs = Vec::new();
-    let mut indices = Vec::new();
-    let all_normals = models
-        .iter()
-        .all(|m| m.mesh.normals.len() == m.mesh.positions.len());
-    let all_uvs = models
-        .iter()
-        .all(|m| m.mesh.texcoords.len() / 2 == m.mesh.positions.len() / 3);
-    for m in &models {
-        let base = positions.len() as u32;
-        let mesh = &m.mesh;
-        if mesh.positions.len() % 3 != 0 || mesh.indices.len() % 3 != 0 {
-            return Err(format!("mesh '{}' is truncated", path.display()));
-        }
-        positions.extend(
-            mesh.positions
-                .chunks_exact(3)
-                .map(|c| Vec3::new(c[0], c[1], c[2])),
-        );
-        if all_normals {
-            normals.extend(
-                mesh.normals
-                    .chunks_exact(3)
-                    .map(|c| Vec3::new(c[0], c[1], c[2])),
-            );
-        }
-        if all_uvs {
-            uvs.extend(
-                mesh.texcoords
-                    .chunks_exact(2)
-                    // OBJ counts v from the bottom of the image; Mitsuba flips it on load.
-                    .map(|c| Vec2::new(c[0], 1.0 - c[1])),
-            );
-        }
-        for t in mesh.indices.chunks_exact(3) {
-            indices.push([base + t[0], base + t[1], base + t[2]]);
-        }
-    }
-    if indices.is_empty() {
-        return Err(format!("mesh '{}' has no triangles", path.display()));
-    }
-    Ok((
-        positions,
-        (all_normals && !normals.is_empty()).then_some(normals),
-        (all_uvs && !uvs.is_empty()).then_some(uvs),
-        indices,
-    ))
-}
-
 /// Reads an environment map's image and sets up its lookup and sampling.
 fn build_envmap(
     filename: &str,
@@ -484,13 +85,13 @@ fn build_envmap(
     to_world: &[TransformOp],
     base_dir: &Path,
 ) -> Result<EnvMap, String> {
-    let m = transform_matrix(to_world)?;
+    let m = transform_matrix(to_world).map_err(|e| e.to_string())?;
     let (w, h, texels) = crate::texture::read_image(&base_dir.join(filename), false)?;
     EnvMap::new(w, h, texels, scale, glam::Mat3::from_mat4(m))
 }
 
 fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<Shape, String> {
-    let m = transform_matrix(&desc.to_world)?;
+    let m = transform_matrix(&desc.to_world).map_err(|e| e.to_string())?;
     let mesh = |mut mesh: TriangleMesh| -> Result<Shape, String> {
         mesh.transform(&affine(m)?);
         Ok(Shape::Mesh(mesh))
@@ -514,7 +115,7 @@ fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<Shape, String> {
         }
         GeometryDesc::Obj { filename } => {
             let path = base_dir.join(filename);
-            let (p, n, uv, idx) = load_obj(&path)?;
+            let (p, n, uv, idx) = crate::meshio::load_obj(&path).map_err(|e| e.to_string())?;
             let n = if desc.face_normals { None } else { n };
             mesh(
                 TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
@@ -523,8 +124,7 @@ fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<Shape, String> {
         }
         GeometryDesc::Ply { filename } => {
             let path = base_dir.join(filename);
-            let (p, n, uv, idx) = crate::meshio::read_ply(&read_mesh_file(&path)?)
-                .map_err(|e| format!("mesh '{}': {e}", path.display()))?;
+            let (p, n, uv, idx) = crate::meshio::load_ply(&path).map_err(|e| e.to_string())?;
             let n = if desc.face_normals { None } else { n };
             mesh(
                 TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
@@ -536,9 +136,8 @@ fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<Shape, String> {
             shape_index,
         } => {
             let path = base_dir.join(filename);
-            let (p, n, uv, idx) =
-                crate::meshio::read_serialized(&read_mesh_file(&path)?, *shape_index as usize)
-                    .map_err(|e| format!("mesh '{}': {e}", path.display()))?;
+            let (p, n, uv, idx) = crate::meshio::load_serialized(&path, *shape_index as usize)
+                .map_err(|e| e.to_string())?;
             let n = if desc.face_normals { None } else { n };
             mesh(
                 TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
@@ -594,10 +193,6 @@ fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<Shape, String> {
         .map_err(|e| e.to_string())?;
     }
     Ok(shape)
-}
-
-fn v3(v: &V3) -> Vec3 {
-    Vec3::from(*v)
 }
 
 impl Scene {
@@ -659,7 +254,10 @@ impl Scene {
         }
 
         // Materials.
-        let mut bsdfs = vec![Bsdf::diffuse(Vec3::splat(0.5)), Bsdf::black()];
+        let mut bsdfs = vec![
+            Bsdf::diffuse(v3(&defaults::DIFFUSE_REFLECTANCE)),
+            Bsdf::black(),
+        ];
         let mut bsdf_textures = vec![None, None];
         let mut cache = TextureCache::default();
         let mut names = std::collections::HashMap::new();

@@ -24,6 +24,7 @@
 mod build;
 pub mod desc;
 mod error;
+mod material;
 mod meshio;
 pub mod spectrum;
 pub mod texture;
@@ -31,7 +32,6 @@ pub mod xml;
 
 use std::path::{Path, PathBuf};
 
-pub use build::transform_matrix;
 pub use desc::*;
 pub use error::{SceneError, SceneWarning};
 

@@ -105,36 +105,94 @@ fn table(t: &[f64; SAMPLES], lambda: f64) -> f64 {
     (1.0 - w) * t[i] + w * t[i + 1]
 }
 
+/// Why a sampled spectrum (`"λ1:v1, λ2:v2, …"`) cannot be read.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SpectrumError {
+    /// An entry without a `:`.
+    NotAPair {
+        /// The entry.
+        item: String,
+    },
+    /// A wavelength or value that is not a number.
+    NotANumber {
+        /// The text that is not a number.
+        text: String,
+        /// The entry holding it.
+        item: String,
+    },
+    /// A wavelength or value that is not finite.
+    NotFinite {
+        /// The entry.
+        item: String,
+    },
+    /// A wavelength not above the one before it.
+    NotIncreasing {
+        /// The wavelength (nm).
+        lambda: f64,
+        /// The one before it (nm).
+        previous: f64,
+    },
+    /// No entries.
+    Empty,
+}
+
+impl core::fmt::Display for SpectrumError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            SpectrumError::NotAPair { item } => {
+                write!(f, "spectrum entry \"{item}\" is not wavelength:value")
+            }
+            SpectrumError::NotANumber { text, item } => {
+                write!(f, "cannot parse \"{text}\" in spectrum entry \"{item}\"")
+            }
+            SpectrumError::NotFinite { item } => {
+                write!(f, "spectrum entry \"{item}\" is not finite")
+            }
+            SpectrumError::NotIncreasing { lambda, previous } => write!(
+                f,
+                "spectrum wavelengths must increase ({lambda} nm follows {previous} nm)"
+            ),
+            SpectrumError::Empty => f.write_str("empty spectrum"),
+        }
+    }
+}
+
+impl std::error::Error for SpectrumError {}
+
 /// Parses `"λ1:v1, λ2:v2, …"`. Wavelengths must be finite and strictly increasing, values finite.
-pub fn parse_pairs(s: &str) -> Result<Vec<(f64, f64)>, String> {
+pub fn parse_pairs(s: &str) -> Result<Vec<(f64, f64)>, SpectrumError> {
     let mut out: Vec<(f64, f64)> = Vec::new();
     for item in s.split(',').map(str::trim).filter(|t| !t.is_empty()) {
         let (l, v) = item
             .split_once(':')
-            .ok_or_else(|| format!("spectrum entry \"{item}\" is not wavelength:value"))?;
-        let parse = |t: &str| -> Result<f64, String> {
+            .ok_or_else(|| SpectrumError::NotAPair { item: item.into() })?;
+        let parse = |t: &str| -> Result<f64, SpectrumError> {
             let x = t
                 .trim()
                 .parse::<f64>()
-                .map_err(|_| format!("cannot parse \"{t}\" in spectrum entry \"{item}\""))?;
+                .map_err(|_| SpectrumError::NotANumber {
+                    text: t.into(),
+                    item: item.into(),
+                })?;
             if x.is_finite() {
                 Ok(x)
             } else {
-                Err(format!("spectrum entry \"{item}\" is not finite"))
+                Err(SpectrumError::NotFinite { item: item.into() })
             }
         };
         let (l, v) = (parse(l)?, parse(v)?);
         if let Some(&(prev, _)) = out.last()
             && l <= prev
         {
-            return Err(format!(
-                "spectrum wavelengths must increase ({l} nm follows {prev} nm)"
-            ));
+            return Err(SpectrumError::NotIncreasing {
+                lambda: l,
+                previous: prev,
+            });
         }
         out.push((l, v));
     }
     if out.is_empty() {
-        return Err("empty spectrum".into());
+        return Err(SpectrumError::Empty);
     }
     Ok(out)
 }

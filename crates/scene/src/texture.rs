@@ -71,10 +71,10 @@ pub enum TextureDesc {
 }
 
 fn checker0() -> [f32; 3] {
-    [0.4; 3]
+    crate::desc::defaults::CHECKER_COLOR0
 }
 fn checker1() -> [f32; 3] {
-    [0.2; 3]
+    crate::desc::defaults::CHECKER_COLOR1
 }
 
 /// A decoded texture.

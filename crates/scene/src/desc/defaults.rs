@@ -1,0 +1,148 @@
+//! Every default of the scene description, in one place: the values Mitsuba 3's plugins take
+//! when a property is absent. The RON format's serde defaults (the functions below) and the XML
+//! importer's absent properties both read them here, so the two formats cannot drift apart.
+
+use super::V3;
+
+/// Samples per pixel when the scene does not say (a sampler's `sample_count`).
+pub const SPP: u32 = 16;
+
+/// Field of view in degrees (`perspective`, `thinlens`).
+pub const FOV: f32 = 45.0;
+/// Lens radius of a thin lens (0 is a pinhole).
+pub const APERTURE_RADIUS: f32 = 0.0;
+/// Distance of the plane in focus (`thinlens`).
+pub const FOCUS_DISTANCE: f32 = 1.0;
+
+/// Film width in pixels (`hdrfilm`).
+pub const FILM_WIDTH: u32 = 768;
+/// Film height in pixels (`hdrfilm`).
+pub const FILM_HEIGHT: u32 = 576;
+/// Standard deviation of the Gaussian filter in pixels (Mitsuba's default filter).
+pub const GAUSSIAN_STDDEV: f32 = 0.5;
+/// Radius of the tent filter in pixels.
+pub const TENT_RADIUS: f32 = 1.0;
+
+/// The integrator when the scene names none.
+pub const INTEGRATOR: &str = "path";
+/// Longest path in segments; -1 is unbounded.
+pub const MAX_DEPTH: i32 = -1;
+/// Depth from which Russian roulette runs.
+pub const RR_DEPTH: u32 = 5;
+
+/// A diffuse reflectance (`diffuse`'s `reflectance`, the plastics' `diffuse_reflectance`, the
+/// material of a shape without one).
+pub const DIFFUSE_REFLECTANCE: V3 = [0.5; 3];
+/// `specular_reflectance` and `specular_transmittance` multipliers.
+pub const SPECULAR: V3 = [1.0; 3];
+/// Isotropic microfacet roughness `alpha`.
+pub const ALPHA: f32 = 0.1;
+/// `air` in Mitsuba's IOR table (every `ext_ior`).
+pub const AIR_IOR: f32 = 1.000_277;
+/// `bk7` in Mitsuba's IOR table (the dielectrics' default `int_ior`).
+pub const BK7_IOR: f32 = 1.5046;
+/// `polypropylene` in Mitsuba's IOR table (the plastics' default `int_ior`).
+pub const POLYPROPYLENE_IOR: f32 = 1.49;
+/// A conductor's real IOR part when only `k` is given.
+pub const CONDUCTOR_ETA: V3 = [0.0; 3];
+/// A conductor's imaginary IOR part when only `eta` is given.
+pub const CONDUCTOR_K: V3 = [1.0; 3];
+
+/// Radiance, intensity or irradiance of an emitter that does not give one.
+pub const EMISSION: V3 = [1.0; 3];
+/// An envmap's radiance multiplier.
+pub const ENVMAP_SCALE: f32 = 1.0;
+
+/// A sphere's centre.
+pub const SPHERE_CENTER: V3 = [0.0; 3];
+/// A sphere's radius.
+pub const SPHERE_RADIUS: f32 = 1.0;
+
+/// A checkerboard's `color0`.
+pub const CHECKER_COLOR0: V3 = [0.4; 3];
+/// A checkerboard's `color1`.
+pub const CHECKER_COLOR1: V3 = [0.2; 3];
+
+// Serde default functions for the RON format (serde takes a path to a function).
+
+pub(crate) fn spp() -> u32 {
+    SPP
+}
+pub(crate) fn focus_distance() -> f32 {
+    FOCUS_DISTANCE
+}
+pub(crate) fn integrator() -> String {
+    INTEGRATOR.into()
+}
+pub(crate) fn max_depth() -> i32 {
+    MAX_DEPTH
+}
+pub(crate) fn rr_depth() -> u32 {
+    RR_DEPTH
+}
+pub(crate) fn alpha() -> f32 {
+    ALPHA
+}
+pub(crate) fn specular() -> V3 {
+    SPECULAR
+}
+pub(crate) fn diffuse_reflectance() -> V3 {
+    DIFFUSE_REFLECTANCE
+}
+pub(crate) fn air_ior() -> f32 {
+    AIR_IOR
+}
+pub(crate) fn bk7_ior() -> f32 {
+    BK7_IOR
+}
+pub(crate) fn polypropylene_ior() -> f32 {
+    POLYPROPYLENE_IOR
+}
+pub(crate) fn envmap_scale() -> f32 {
+    ENVMAP_SCALE
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::desc::{MaterialDesc, SceneDesc};
+
+    /// The materials of a RON scene whose materials give no parameters.
+    fn ron_materials(models: &[&str]) -> Vec<MaterialDesc> {
+        let list: Vec<String> = models
+            .iter()
+            .enumerate()
+            .map(|(i, m)| format!("(name: \"m{i}\", material: {m})"))
+            .collect();
+        let ron = format!("(camera: (fov: 45), materials: [{}])", list.join(", "));
+        let desc: SceneDesc = crate::parse_ron(&ron, "t.ron".as_ref()).unwrap();
+        desc.materials.into_iter().map(|m| m.material).collect()
+    }
+
+    #[test]
+    fn ron_and_xml_share_the_defaults() {
+        let ron = ron_materials(&[
+            "Dielectric()",
+            "RoughDielectric()",
+            "Plastic()",
+            "RoughPlastic()",
+            "Conductor()",
+            "RoughConductor()",
+        ]);
+        let xml = r#"<scene><sensor type="perspective"/>
+            <bsdf type="dielectric"/><bsdf type="roughdielectric"/><bsdf type="plastic"/>
+            <bsdf type="roughplastic"/><bsdf type="conductor"/><bsdf type="roughconductor"/>
+            </scene>"#;
+        let (desc, _) = crate::xml::parse_xml(xml, "t.xml".as_ref(), &[]).unwrap();
+        let imported: Vec<MaterialDesc> = desc.materials.into_iter().map(|m| m.material).collect();
+        assert_eq!(ron, imported);
+
+        let ron: SceneDesc = crate::parse_ron("(camera: (fov: 45))", "t.ron".as_ref()).unwrap();
+        let xml =
+            r#"<scene><sensor type="perspective"><float name="fov" value="45"/></sensor></scene>"#;
+        let (imported, _) = crate::xml::parse_xml(xml, "t.xml".as_ref(), &[]).unwrap();
+        assert_eq!(ron.camera, imported.camera);
+        assert_eq!(ron.film, imported.film);
+        assert_eq!(ron.spp, imported.spp);
+        assert_eq!(ron.integrator, imported.integrator);
+    }
+}

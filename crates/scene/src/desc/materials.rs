@@ -1,0 +1,250 @@
+//! Material descriptions: the models (Mitsuba 3's BSDF plugins of the same names), their
+//! roughness and IOR, textures bound to colour parameters, and references from shapes.
+
+use serde::{Deserialize, Serialize};
+
+use super::{TextureDesc, V3, defaults};
+
+/// A material with a name.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NamedMaterial {
+    /// The name shapes use.
+    pub name: String,
+    /// The material.
+    pub material: MaterialDesc,
+}
+
+/// A microfacet normal distribution (Mitsuba's `distribution`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MicrofacetDesc {
+    /// Beckmann (Mitsuba's default).
+    #[default]
+    Beckmann,
+    /// GGX / Trowbridge–Reitz.
+    Ggx,
+}
+
+/// A conductor's complex IOR: Mitsuba's `material` preset or explicit `eta`/`k`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConductorIorDesc {
+    /// A named metal (`Au`, `Ag`, `Cu`, `Al`, `Cr`, …, `none` = perfect mirror); an error when
+    /// combined with `eta` or `k`. Default: `none` unless `eta`/`k` are given.
+    #[serde(default)]
+    pub material: Option<String>,
+    /// Real part of the IOR per channel (default 0).
+    #[serde(default)]
+    pub eta: Option<V3>,
+    /// Imaginary part per channel (default 1).
+    #[serde(default)]
+    pub k: Option<V3>,
+}
+
+/// Microfacet roughness: isotropic `alpha`, or `alpha_u` and `alpha_v` together.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RoughnessDesc {
+    /// Normal distribution (default Beckmann).
+    #[serde(default)]
+    pub distribution: MicrofacetDesc,
+    /// Isotropic roughness (Mitsuba `alpha`, default 0.1; clamped to at least 1e-4).
+    #[serde(default = "defaults::alpha")]
+    pub alpha: f32,
+    /// Anisotropic roughness along the tangent; needs `alpha_v` and replaces `alpha`.
+    #[serde(default)]
+    pub alpha_u: Option<f32>,
+    /// Anisotropic roughness along the bitangent; needs `alpha_u`.
+    #[serde(default)]
+    pub alpha_v: Option<f32>,
+}
+
+impl Default for RoughnessDesc {
+    fn default() -> Self {
+        Self {
+            distribution: MicrofacetDesc::Beckmann,
+            alpha: defaults::ALPHA,
+            alpha_u: None,
+            alpha_v: None,
+        }
+    }
+}
+
+/// A surface material. Every model and default is Mitsuba 3's plugin of the same name (see
+/// `docs/SCENES.md`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum MaterialDesc {
+    /// Lambertian reflection, black from the back.
+    Diffuse {
+        /// Albedo in `[0, 1]`.
+        reflectance: V3,
+    },
+    /// Smooth conductor (a delta mirror with the conductor Fresnel term), black from the back.
+    Conductor {
+        /// Complex IOR (default: `none`, a perfect mirror).
+        #[serde(default)]
+        ior: ConductorIorDesc,
+        /// Multiplier in `[0, 1]` (default 1).
+        #[serde(default = "defaults::specular")]
+        specular_reflectance: V3,
+    },
+    /// Rough conductor (microfacet), black from the back.
+    RoughConductor {
+        /// Complex IOR (default: `none`, a perfect mirror).
+        #[serde(default)]
+        ior: ConductorIorDesc,
+        /// Multiplier in `[0, 1]` (default 1).
+        #[serde(default = "defaults::specular")]
+        specular_reflectance: V3,
+        /// Distribution and roughness.
+        #[serde(default)]
+        roughness: RoughnessDesc,
+    },
+    /// Smooth dielectric interface (glass): delta reflection and refraction, from both sides.
+    Dielectric {
+        /// IOR inside (default 1.5046, `bk7`).
+        #[serde(default = "defaults::bk7_ior")]
+        int_ior: f32,
+        /// IOR outside (default 1.000277, `air`).
+        #[serde(default = "defaults::air_ior")]
+        ext_ior: f32,
+        /// Reflection multiplier in `[0, 1]` (default 1).
+        #[serde(default = "defaults::specular")]
+        specular_reflectance: V3,
+        /// Transmission multiplier in `[0, 1]` (default 1).
+        #[serde(default = "defaults::specular")]
+        specular_transmittance: V3,
+    },
+    /// Rough dielectric interface (microfacet), from both sides.
+    RoughDielectric {
+        /// IOR inside (default 1.5046, `bk7`).
+        #[serde(default = "defaults::bk7_ior")]
+        int_ior: f32,
+        /// IOR outside (default 1.000277, `air`).
+        #[serde(default = "defaults::air_ior")]
+        ext_ior: f32,
+        /// Reflection multiplier in `[0, 1]` (default 1).
+        #[serde(default = "defaults::specular")]
+        specular_reflectance: V3,
+        /// Transmission multiplier in `[0, 1]` (default 1).
+        #[serde(default = "defaults::specular")]
+        specular_transmittance: V3,
+        /// Distribution and roughness.
+        #[serde(default)]
+        roughness: RoughnessDesc,
+    },
+    /// Diffuse base under a smooth dielectric coating, black from the back.
+    Plastic {
+        /// IOR of the coating (default 1.49, `polypropylene`).
+        #[serde(default = "defaults::polypropylene_ior")]
+        int_ior: f32,
+        /// IOR outside (default 1.000277, `air`).
+        #[serde(default = "defaults::air_ior")]
+        ext_ior: f32,
+        /// Base albedo in `[0, 1]` (default 0.5).
+        #[serde(default = "defaults::diffuse_reflectance")]
+        diffuse_reflectance: V3,
+        /// Specular multiplier in `[0, 1]` (default 1).
+        #[serde(default = "defaults::specular")]
+        specular_reflectance: V3,
+        /// Mitsuba's `nonlinear` internal-scattering model (default false).
+        #[serde(default)]
+        nonlinear: bool,
+    },
+    /// Diffuse base under a rough dielectric coating, black from the back. Isotropic only.
+    RoughPlastic {
+        /// IOR of the coating (default 1.49, `polypropylene`); must differ from `ext_ior`.
+        #[serde(default = "defaults::polypropylene_ior")]
+        int_ior: f32,
+        /// IOR outside (default 1.000277, `air`).
+        #[serde(default = "defaults::air_ior")]
+        ext_ior: f32,
+        /// Base albedo in `[0, 1]` (default 0.5).
+        #[serde(default = "defaults::diffuse_reflectance")]
+        diffuse_reflectance: V3,
+        /// Specular multiplier in `[0, 1]` (default 1).
+        #[serde(default = "defaults::specular")]
+        specular_reflectance: V3,
+        /// Mitsuba's `nonlinear` internal-scattering model (default false).
+        #[serde(default)]
+        nonlinear: bool,
+        /// Distribution and roughness (`alpha_u`/`alpha_v` are an error).
+        #[serde(default)]
+        roughness: RoughnessDesc,
+    },
+    /// A surface light passes through unchanged (Mitsuba `null`).
+    Null,
+    /// The wrapped material on both sides (an error around transmitting materials, as in
+    /// Mitsuba).
+    TwoSided(Box<MaterialDesc>),
+    /// Absorbs all light.
+    Black,
+    /// `material` with some of its colour parameters given by textures, looked up at each
+    /// shading point's texture coordinates; the constant values in `material` are unused for
+    /// those parameters. In RON: `Textured(material: Diffuse(reflectance: (0.5, 0.5, 0.5)),
+    /// textures: [(param: Reflectance, texture: Bitmap(filename: "wood.png"))])`.
+    Textured {
+        /// The material (any model with the parameters named in `textures`).
+        material: Box<MaterialDesc>,
+        /// Which parameter each texture replaces.
+        textures: Vec<TextureBinding>,
+    },
+}
+
+/// A colour parameter of a material that a texture can provide.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum ColorParam {
+    /// `Diffuse`'s `reflectance`.
+    Reflectance,
+    /// The plastics' `diffuse_reflectance`.
+    DiffuseReflectance,
+    /// `specular_reflectance` (conductors, dielectrics, plastics).
+    SpecularReflectance,
+    /// The dielectrics' `specular_transmittance`.
+    SpecularTransmittance,
+}
+
+impl ColorParam {
+    /// The parameter's name in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            ColorParam::Reflectance => "reflectance",
+            ColorParam::DiffuseReflectance => "diffuse_reflectance",
+            ColorParam::SpecularReflectance => "specular_reflectance",
+            ColorParam::SpecularTransmittance => "specular_transmittance",
+        }
+    }
+
+    /// The parameter named `name` (snake_case), if it is one.
+    pub fn from_name(name: &str) -> Option<Self> {
+        [
+            ColorParam::Reflectance,
+            ColorParam::DiffuseReflectance,
+            ColorParam::SpecularReflectance,
+            ColorParam::SpecularTransmittance,
+        ]
+        .into_iter()
+        .find(|p| p.name() == name)
+    }
+}
+
+/// A texture bound to a material parameter.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TextureBinding {
+    /// The parameter.
+    pub param: ColorParam,
+    /// The texture.
+    pub texture: TextureDesc,
+}
+
+/// A shape's material: by name or inline.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum MaterialRef {
+    /// A material from [`SceneDesc::materials`].
+    Ref(String),
+    /// An inline material.
+    Inline(MaterialDesc),
+}

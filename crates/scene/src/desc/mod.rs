@@ -1,0 +1,319 @@
+//! Scene description types: what the RON format deserialises into and what the XML importer
+//! produces. Both go through [`crate::Scene::build`]. Every struct denies unknown fields, so a typo
+//! in a RON file is an error, not a silently ignored setting.
+//!
+//! The scene, camera, film, integrator, shapes and lights are here; materials are in
+//! [`materials`](self) (re-exported), and every default value is in [`defaults`].
+
+pub mod defaults;
+mod materials;
+mod transform;
+
+pub use defaults::{AIR_IOR, BK7_IOR, POLYPROPYLENE_IOR};
+pub use materials::*;
+pub use transform::{TransformError, TransformOp, transform_matrix};
+
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+pub use crate::texture::{TextureDesc, UvTransform};
+
+/// Where a description item came from, for error messages (`file:line`).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Location {
+    /// The scene file.
+    pub file: PathBuf,
+    /// 1-based line, 0 if unknown.
+    pub line: u32,
+}
+
+impl core::fmt::Display for Location {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        if self.line > 0 {
+            write!(f, "{}:{}", self.file.display(), self.line)
+        } else {
+            write!(f, "{}", self.file.display())
+        }
+    }
+}
+
+/// A whole scene.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneDesc {
+    /// The camera.
+    pub camera: CameraDesc,
+    /// Image size, reconstruction filter and output name.
+    #[serde(default)]
+    pub film: FilmDesc,
+    /// Samples per pixel (passes) when the command line does not say.
+    #[serde(default = "defaults::spp")]
+    pub spp: u32,
+    /// The integrator and its parameters.
+    #[serde(default)]
+    pub integrator: IntegratorDesc,
+    /// Named materials that shapes refer to with `Ref("name")`.
+    #[serde(default)]
+    pub materials: Vec<NamedMaterial>,
+    /// The geometry.
+    #[serde(default)]
+    pub shapes: Vec<ShapeDesc>,
+    /// Lights that are not attached to a shape.
+    #[serde(default)]
+    pub lights: Vec<LightDesc>,
+}
+
+/// A 3-vector `(x, y, z)` or colour `(r, g, b)`.
+pub type V3 = [f32; 3];
+
+/// Which axis the field of view spans.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FovAxis {
+    /// Horizontal.
+    #[default]
+    X,
+    /// Vertical.
+    Y,
+    /// Diagonal.
+    Diagonal,
+    /// The smaller image side.
+    Smaller,
+    /// The larger image side.
+    Larger,
+}
+
+/// A perspective or thin-lens camera.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    /// Field of view in degrees.
+    pub fov: f32,
+    /// The axis `fov` spans.
+    #[serde(default)]
+    pub fov_axis: FovAxis,
+    /// Camera-to-world transform.
+    #[serde(default)]
+    pub to_world: Vec<TransformOp>,
+    /// Lens radius; 0 is a pinhole.
+    #[serde(default)]
+    pub aperture_radius: f32,
+    /// Distance of the plane in focus (thin lens only).
+    #[serde(default = "defaults::focus_distance")]
+    pub focus_distance: f32,
+}
+
+impl Default for CameraDesc {
+    fn default() -> Self {
+        Self {
+            fov: defaults::FOV,
+            fov_axis: FovAxis::X,
+            to_world: Vec::new(),
+            aperture_radius: defaults::APERTURE_RADIUS,
+            focus_distance: defaults::FOCUS_DISTANCE,
+        }
+    }
+}
+
+/// A reconstruction filter; the renderer importance-samples it to place camera rays.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum FilterDesc {
+    /// One pixel wide: every sample lands in the pixel that made it.
+    Box,
+    /// `max(0, 1 − |x|/radius)` per axis.
+    Tent {
+        /// Radius in pixels (default 1).
+        radius: f32,
+    },
+    /// `max(0, exp(−x²/2σ²) − exp(−8))` per axis, truncated at 4σ (Mitsuba's default filter).
+    Gaussian {
+        /// Standard deviation in pixels (default 0.5).
+        stddev: f32,
+    },
+}
+
+impl Default for FilterDesc {
+    fn default() -> Self {
+        FilterDesc::Gaussian {
+            stddev: defaults::GAUSSIAN_STDDEV,
+        }
+    }
+}
+
+/// The image.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FilmDesc {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Reconstruction filter.
+    #[serde(default)]
+    pub filter: FilterDesc,
+    /// Default output file name.
+    #[serde(default)]
+    pub filename: Option<String>,
+}
+
+impl Default for FilmDesc {
+    fn default() -> Self {
+        Self {
+            width: defaults::FILM_WIDTH,
+            height: defaults::FILM_HEIGHT,
+            filter: FilterDesc::default(),
+            filename: None,
+        }
+    }
+}
+
+/// The integrator chosen by the scene (the command line may override it).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IntegratorDesc {
+    /// Name: `path` (default) or another estimator the renderer knows.
+    #[serde(default = "defaults::integrator")]
+    pub kind: String,
+    /// Longest path in segments from the camera; -1 is unbounded.
+    #[serde(default = "defaults::max_depth")]
+    pub max_depth: i32,
+    /// Depth from which Russian roulette runs.
+    #[serde(default = "defaults::rr_depth")]
+    pub rr_depth: u32,
+    /// Whether directly visible emitters are hidden.
+    #[serde(default)]
+    pub hide_emitters: bool,
+    /// Estimator-specific parameters as `name = value` strings (e.g. ReSTIR settings).
+    #[serde(default)]
+    pub params: Vec<(String, String)>,
+    /// Where the integrator was declared (for errors in `params`); set by the loaders.
+    #[serde(skip)]
+    pub location: Location,
+}
+
+impl Default for IntegratorDesc {
+    fn default() -> Self {
+        Self {
+            kind: defaults::integrator(),
+            max_depth: defaults::MAX_DEPTH,
+            rr_depth: defaults::RR_DEPTH,
+            hide_emitters: false,
+            params: Vec::new(),
+            location: Location::default(),
+        }
+    }
+}
+
+/// Geometry of a shape, before its transform.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum GeometryDesc {
+    /// `[-1, 1]²` in the `z = 0` plane, normal `+z`.
+    Rectangle,
+    /// `[-1, 1]³`.
+    Cube,
+    /// Unit disk in the `z = 0` plane, normal `+z`.
+    Disk,
+    /// A sphere (its transform may translate, rotate and scale uniformly).
+    Sphere {
+        /// Centre.
+        center: V3,
+        /// Radius.
+        radius: f32,
+    },
+    /// A Wavefront OBJ file, relative to the scene file.
+    Obj {
+        /// Path.
+        filename: String,
+    },
+    /// A PLY file (ASCII or binary), relative to the scene file.
+    Ply {
+        /// Path.
+        filename: String,
+    },
+    /// One shape of a Mitsuba `.serialized` file, relative to the scene file.
+    Serialized {
+        /// Path.
+        filename: String,
+        /// Which shape of the file (default 0).
+        #[serde(default)]
+        shape_index: u32,
+    },
+    /// Triangles given inline.
+    Mesh {
+        /// Vertex positions.
+        positions: Vec<V3>,
+        /// Triangles as index triples.
+        indices: Vec<[u32; 3]>,
+        /// Optional per-vertex normals.
+        #[serde(default)]
+        normals: Option<Vec<V3>>,
+    },
+}
+
+/// A shape with its transform, material and optional area emitter.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShapeDesc {
+    /// What it is.
+    pub geometry: GeometryDesc,
+    /// Object-to-world transform.
+    #[serde(default)]
+    pub to_world: Vec<TransformOp>,
+    /// Material; a default diffuse (ρ = 0.5) when absent, black for an emitter without one.
+    #[serde(default)]
+    pub material: Option<MaterialRef>,
+    /// Radiance when the shape is an area light.
+    #[serde(default)]
+    pub emission: Option<V3>,
+    /// Turn normals inside out.
+    #[serde(default)]
+    pub flip_normals: bool,
+    /// Ignore vertex normals (flat shading).
+    #[serde(default)]
+    pub face_normals: bool,
+    /// Where the shape was declared (set by importers, not part of the RON format).
+    #[serde(skip)]
+    pub location: Location,
+}
+
+/// A light that is not a shape.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum LightDesc {
+    /// Isotropic point light.
+    Point {
+        /// Position.
+        position: V3,
+        /// Intensity (W/sr).
+        intensity: V3,
+    },
+    /// Light arriving from one direction.
+    Directional {
+        /// Direction the light travels in.
+        direction: V3,
+        /// Irradiance.
+        irradiance: V3,
+    },
+    /// Uniform environment.
+    Constant {
+        /// Radiance.
+        radiance: V3,
+    },
+    /// Environment from a latitude-longitude image (Mitsuba's `envmap`): EXR or Radiance `.hdr`
+    /// (linear), or PNG/JPEG (sRGB-decoded).
+    Envmap {
+        /// Image path, relative to the scene file.
+        filename: String,
+        /// Radiance multiplier.
+        #[serde(default = "defaults::envmap_scale")]
+        scale: f32,
+        /// Rotation of the map (Mitsuba's orientation: `+Y` up, `u = 0` towards `−Z`).
+        #[serde(default)]
+        to_world: Vec<TransformOp>,
+        /// Where the emitter was declared (set by importers, not part of the RON format).
+        #[serde(skip)]
+        location: Location,
+    },
+}

@@ -1,0 +1,415 @@
+//! Material descriptions to BSDFs: the one conversion from [`MaterialDesc`] to
+//! `restir_materials::Bsdf` and the checks that go with it (colours in `[0, 1]`, positive IORs,
+//! known conductors, valid roughness, textures only on colour parameters). The XML importer uses
+//! it to report a bad material at its line; the builder uses it to make the scene's BSDFs.
+
+use glam::Vec3;
+use restir_materials::{Bsdf, Distribution, Microfacet, ReflectanceParams};
+
+use crate::desc::*;
+
+/// Why a material description cannot become a BSDF.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MaterialError {
+    /// A colour parameter outside `[0, 1]` (or not finite).
+    ColorOutOfRange {
+        /// The parameter (`diffuse reflectance`, `specular_reflectance`, …).
+        what: &'static str,
+        /// Its value.
+        value: V3,
+    },
+    /// `int_ior` or `ext_ior` not a positive number.
+    BadIor {
+        /// `int_ior` or `ext_ior`.
+        name: &'static str,
+        /// Its value.
+        value: f32,
+    },
+    /// A named conductor together with explicit `eta` or `k`.
+    ConductorPresetWithEtaK {
+        /// The conductor's name.
+        name: String,
+    },
+    /// A conductor name not in the table.
+    UnknownConductor {
+        /// The name given.
+        name: String,
+    },
+    /// A negative or non-finite conductor `eta` or `k`.
+    BadConductorIor {
+        /// `eta` or `k`.
+        name: &'static str,
+        /// Its value.
+        value: Vec3,
+    },
+    /// A negative or non-finite roughness.
+    BadRoughness {
+        /// `alpha`, `alpha_u` or `alpha_v`.
+        name: &'static str,
+        /// Its value.
+        value: f32,
+    },
+    /// `alpha_u`/`alpha_v` on an isotropic model.
+    Isotropic,
+    /// Only one of `alpha_u` and `alpha_v`.
+    AlphaPair,
+    /// A rough plastic whose coating has the IOR of its surroundings.
+    RoughPlasticSameIor,
+    /// `twosided` around a transmitting model.
+    TwoSidedTransmitting,
+    /// A textured material inside a textured material.
+    NestedTextured,
+    /// A texture for a parameter the model does not have.
+    NoSuchParameter {
+        /// The parameter textured.
+        param: ColorParam,
+        /// The model's colour parameters.
+        allowed: &'static [ColorParam],
+    },
+    /// Two textures for one parameter.
+    TwoTextures {
+        /// The parameter.
+        param: ColorParam,
+    },
+}
+
+impl core::fmt::Display for MaterialError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            MaterialError::ColorOutOfRange { what, value } => {
+                write!(f, "{what} {value:?} must lie in [0, 1]")
+            }
+            MaterialError::BadIor { name, value } => {
+                write!(f, "{name} {value} must be a positive number")
+            }
+            MaterialError::ConductorPresetWithEtaK { name } => write!(
+                f,
+                "conductor material '{name}' cannot be combined with explicit eta or k"
+            ),
+            MaterialError::UnknownConductor { name } => write!(
+                f,
+                "unknown conductor material '{name}' (known: {})",
+                restir_materials::ior::conductor_names()
+            ),
+            MaterialError::BadConductorIor { name, value } => write!(
+                f,
+                "conductor {name} {value} must be finite and non-negative"
+            ),
+            MaterialError::BadRoughness { name, value } => write!(
+                f,
+                "{name} {value} must be a finite non-negative roughness"
+            ),
+            MaterialError::Isotropic => {
+                f.write_str("this material is isotropic: give alpha, not alpha_u/alpha_v")
+            }
+            MaterialError::AlphaPair => f.write_str("alpha_u and alpha_v must be given together"),
+            MaterialError::RoughPlasticSameIor => {
+                f.write_str("roughplastic: int_ior must differ from ext_ior")
+            }
+            MaterialError::TwoSidedTransmitting => f.write_str(
+                "twosided cannot wrap a transmitting material (dielectric, roughdielectric, null), as in Mitsuba",
+            ),
+            MaterialError::NestedTextured => {
+                f.write_str("a textured material cannot wrap another textured material")
+            }
+            MaterialError::NoSuchParameter { param, allowed } => {
+                let names: Vec<&str> = allowed.iter().map(|p| p.name()).collect();
+                write!(
+                    f,
+                    "texture for '{}': this material has no such parameter (its colour parameters: {})",
+                    param.name(),
+                    if names.is_empty() {
+                        "none".to_string()
+                    } else {
+                        names.join(", ")
+                    }
+                )
+            }
+            MaterialError::TwoTextures { param } => {
+                write!(f, "two textures for '{}'", param.name())
+            }
+        }
+    }
+}
+
+impl std::error::Error for MaterialError {}
+
+type Result<T> = core::result::Result<T, MaterialError>;
+
+fn unit_color(what: &'static str, c: &V3) -> Result<Vec3> {
+    let v = Vec3::from(*c);
+    if !v.is_finite() || v.min_element() < 0.0 || v.max_element() > 1.0 {
+        return Err(MaterialError::ColorOutOfRange { what, value: *c });
+    }
+    Ok(v)
+}
+
+fn relative_ior(int_ior: f32, ext_ior: f32) -> Result<f32> {
+    for (name, value) in [("int_ior", int_ior), ("ext_ior", ext_ior)] {
+        if !(value.is_finite() && value > 0.0) {
+            return Err(MaterialError::BadIor { name, value });
+        }
+    }
+    Ok(int_ior / ext_ior)
+}
+
+fn conductor_ior(d: &ConductorIorDesc) -> Result<(Vec3, Vec3)> {
+    if let Some(name) = &d.material {
+        if name != "none" && (d.eta.is_some() || d.k.is_some()) {
+            return Err(MaterialError::ConductorPresetWithEtaK { name: name.clone() });
+        }
+        if d.eta.is_none() && d.k.is_none() {
+            return restir_materials::ior::conductor(name)
+                .ok_or_else(|| MaterialError::UnknownConductor { name: name.clone() });
+        }
+    }
+    let eta = Vec3::from(d.eta.unwrap_or(defaults::CONDUCTOR_ETA));
+    let k = Vec3::from(d.k.unwrap_or(defaults::CONDUCTOR_K));
+    for (name, value) in [("eta", eta), ("k", k)] {
+        if !value.is_finite() || value.min_element() < 0.0 {
+            return Err(MaterialError::BadConductorIor { name, value });
+        }
+    }
+    Ok((eta, k))
+}
+
+fn microfacet(r: &RoughnessDesc, anisotropy_allowed: bool) -> Result<Microfacet> {
+    let dist = match r.distribution {
+        MicrofacetDesc::Beckmann => Distribution::Beckmann,
+        MicrofacetDesc::Ggx => Distribution::Ggx,
+    };
+    let check = |name: &'static str, value: f32| {
+        if value.is_finite() && value >= 0.0 {
+            Ok(value)
+        } else {
+            Err(MaterialError::BadRoughness { name, value })
+        }
+    };
+    match (r.alpha_u, r.alpha_v) {
+        (None, None) => Ok(Microfacet::new(dist, check("alpha", r.alpha)?)),
+        (Some(u), Some(v)) => {
+            if !anisotropy_allowed {
+                return Err(MaterialError::Isotropic);
+            }
+            Ok(Microfacet::anisotropic(
+                dist,
+                check("alpha_u", u)?,
+                check("alpha_v", v)?,
+            ))
+        }
+        _ => Err(MaterialError::AlphaPair),
+    }
+}
+
+/// Checks a material the way [`crate::Scene::build`] would, without keeping the result.
+pub(crate) fn check(m: &MaterialDesc) -> Result<()> {
+    bsdf(m).map(|_| ())
+}
+
+/// The BSDF of a material with its constant parameters (textures are applied per shading point;
+/// see [`colors`]).
+pub(crate) fn bsdf(m: &MaterialDesc) -> Result<Bsdf> {
+    Ok(match m {
+        MaterialDesc::Diffuse { reflectance } => {
+            Bsdf::diffuse(unit_color("diffuse reflectance", reflectance)?)
+        }
+        MaterialDesc::Conductor {
+            ior,
+            specular_reflectance,
+        } => {
+            let (eta, k) = conductor_ior(ior)?;
+            Bsdf::conductor(
+                eta,
+                k,
+                unit_color("specular_reflectance", specular_reflectance)?,
+            )
+        }
+        MaterialDesc::RoughConductor {
+            ior,
+            specular_reflectance,
+            roughness,
+        } => {
+            let (eta, k) = conductor_ior(ior)?;
+            Bsdf::rough_conductor(
+                eta,
+                k,
+                unit_color("specular_reflectance", specular_reflectance)?,
+                microfacet(roughness, true)?,
+            )
+        }
+        MaterialDesc::Dielectric {
+            int_ior,
+            ext_ior,
+            specular_reflectance,
+            specular_transmittance,
+        } => Bsdf::dielectric(
+            relative_ior(*int_ior, *ext_ior)?,
+            unit_color("specular_reflectance", specular_reflectance)?,
+            unit_color("specular_transmittance", specular_transmittance)?,
+        ),
+        MaterialDesc::RoughDielectric {
+            int_ior,
+            ext_ior,
+            specular_reflectance,
+            specular_transmittance,
+            roughness,
+        } => Bsdf::rough_dielectric(
+            relative_ior(*int_ior, *ext_ior)?,
+            unit_color("specular_reflectance", specular_reflectance)?,
+            unit_color("specular_transmittance", specular_transmittance)?,
+            microfacet(roughness, true)?,
+        ),
+        MaterialDesc::Plastic {
+            int_ior,
+            ext_ior,
+            diffuse_reflectance,
+            specular_reflectance,
+            nonlinear,
+        } => Bsdf::plastic(
+            relative_ior(*int_ior, *ext_ior)?,
+            unit_color("diffuse_reflectance", diffuse_reflectance)?,
+            unit_color("specular_reflectance", specular_reflectance)?,
+            *nonlinear,
+        ),
+        MaterialDesc::RoughPlastic {
+            int_ior,
+            ext_ior,
+            diffuse_reflectance,
+            specular_reflectance,
+            nonlinear,
+            roughness,
+        } => {
+            let eta = relative_ior(*int_ior, *ext_ior)?;
+            if eta == 1.0 {
+                return Err(MaterialError::RoughPlasticSameIor);
+            }
+            let mf = microfacet(roughness, false)?;
+            Bsdf::rough_plastic(
+                eta,
+                unit_color("diffuse_reflectance", diffuse_reflectance)?,
+                unit_color("specular_reflectance", specular_reflectance)?,
+                *nonlinear,
+                mf.distribution,
+                mf.alpha_u,
+            )
+        }
+        MaterialDesc::Null => Bsdf::null(),
+        MaterialDesc::TwoSided(inner) => {
+            let b = bsdf(inner)?;
+            if b.kind.transmits() {
+                return Err(MaterialError::TwoSidedTransmitting);
+            }
+            b.two_sided()
+        }
+        MaterialDesc::Black => Bsdf::black(),
+        MaterialDesc::Textured { material, textures } => {
+            let b = bsdf(material)?;
+            let allowed = color_params(material);
+            if matches!(**material, MaterialDesc::Textured { .. }) {
+                return Err(MaterialError::NestedTextured);
+            }
+            for (i, t) in textures.iter().enumerate() {
+                if !allowed.contains(&t.param) {
+                    return Err(MaterialError::NoSuchParameter {
+                        param: t.param,
+                        allowed,
+                    });
+                }
+                if textures[..i].iter().any(|u| u.param == t.param) {
+                    return Err(MaterialError::TwoTextures { param: t.param });
+                }
+            }
+            b
+        }
+    })
+}
+
+/// The colour parameters of a material that textures may replace.
+pub(crate) fn color_params(m: &MaterialDesc) -> &'static [ColorParam] {
+    use ColorParam::*;
+    match m {
+        MaterialDesc::Diffuse { .. } => &[Reflectance],
+        MaterialDesc::Conductor { .. } | MaterialDesc::RoughConductor { .. } => {
+            &[SpecularReflectance]
+        }
+        MaterialDesc::Dielectric { .. } | MaterialDesc::RoughDielectric { .. } => {
+            &[SpecularReflectance, SpecularTransmittance]
+        }
+        MaterialDesc::Plastic { .. } | MaterialDesc::RoughPlastic { .. } => {
+            &[DiffuseReflectance, SpecularReflectance]
+        }
+        MaterialDesc::TwoSided(inner) => color_params(inner),
+        MaterialDesc::Textured { material, .. } => color_params(material),
+        MaterialDesc::Null | MaterialDesc::Black => &[],
+    }
+}
+
+/// The constant colour parameters of a material as written (defaults where a model has none)
+/// and the textures that replace some of them.
+pub(crate) fn colors(m: &MaterialDesc) -> (ReflectanceParams, &[TextureBinding]) {
+    let mut p = ReflectanceParams {
+        diffuse: v3(&defaults::DIFFUSE_REFLECTANCE),
+        specular: v3(&defaults::SPECULAR),
+        transmittance: v3(&defaults::SPECULAR),
+        nonlinear: false,
+    };
+    let mut bindings: &[TextureBinding] = &[];
+    let mut m = m;
+    loop {
+        match m {
+            MaterialDesc::TwoSided(inner) => m = inner,
+            MaterialDesc::Textured { material, textures } => {
+                bindings = textures;
+                m = material;
+            }
+            _ => break,
+        }
+    }
+    match m {
+        MaterialDesc::Diffuse { reflectance } => p.diffuse = v3(reflectance),
+        MaterialDesc::Conductor {
+            specular_reflectance,
+            ..
+        }
+        | MaterialDesc::RoughConductor {
+            specular_reflectance,
+            ..
+        } => p.specular = v3(specular_reflectance),
+        MaterialDesc::Dielectric {
+            specular_reflectance,
+            specular_transmittance,
+            ..
+        }
+        | MaterialDesc::RoughDielectric {
+            specular_reflectance,
+            specular_transmittance,
+            ..
+        } => {
+            p.specular = v3(specular_reflectance);
+            p.transmittance = v3(specular_transmittance);
+        }
+        MaterialDesc::Plastic {
+            diffuse_reflectance,
+            specular_reflectance,
+            nonlinear,
+            ..
+        }
+        | MaterialDesc::RoughPlastic {
+            diffuse_reflectance,
+            specular_reflectance,
+            nonlinear,
+            ..
+        } => {
+            p.diffuse = v3(diffuse_reflectance);
+            p.specular = v3(specular_reflectance);
+            p.nonlinear = *nonlinear;
+        }
+        _ => {}
+    }
+    (p, bindings)
+}
+
+/// A description vector as a `Vec3`.
+pub(crate) fn v3(v: &V3) -> Vec3 {
+    Vec3::from(*v)
+}

@@ -1,0 +1,367 @@
+//! `<bsdf>`: the material models (diffuse, conductors, dielectrics, plastics, twosided, null),
+//! their roughness and IOR properties, and textures bound to their colour parameters.
+
+use roxmltree::Node;
+
+use super::props::{ColorUse, PROPERTY_TAGS, Props, Value};
+use super::{Importer, Result, elements, snake_case};
+use crate::desc::*;
+
+impl<'a> Importer<'a> {
+    /// A `<bsdf>` element (top-level, nested in a shape or wrapped by `twosided`).
+    pub(super) fn bsdf<'i>(&self, node: Node<'a, 'i>) -> Result<MaterialDesc> {
+        let ty = self.plugin_type(node)?;
+        let props = self.props(node, format!("bsdf '{ty}'"))?;
+        let textured = self.texture_bindings(node, &ty, &props)?;
+        let m = match ty.as_str() {
+            "diffuse" => MaterialDesc::Diffuse {
+                reflectance: props
+                    .color("reflectance", ColorUse::Reflectance)?
+                    .unwrap_or(defaults::DIFFUSE_REFLECTANCE),
+            },
+            "twosided" => self.twosided(node)?,
+            "conductor" | "roughconductor" => self.conductor(node, &ty, &props)?,
+            "dielectric" | "roughdielectric" => self.dielectric(node, &ty, &props)?,
+            "plastic" | "roughplastic" => self.plastic(node, &ty, &props)?,
+            "null" => MaterialDesc::Null,
+            "thindielectric" => {
+                return Err(self.err(
+                    node,
+                    "bsdf 'thindielectric' is not supported yet (use 'dielectric' on a closed shape)",
+                ));
+            }
+            other => return Err(self.err(node, format!("unknown bsdf type '{other}'"))),
+        };
+        let m = self.bind_textures(&ty, m, textured)?;
+        // Everything the builder would reject, reported here with this bsdf's line.
+        crate::material::check(&m).map_err(|e| self.err(node, format!("bsdf '{ty}': {e}")))?;
+        self.check_bsdf_children(node, &ty)?;
+        props.finish();
+        Ok(m)
+    }
+
+    /// Parameters given as textures, nested or by reference; wrapped around the material by
+    /// [`Self::bind_textures`] (the constant value of such a parameter is unused).
+    fn texture_bindings<'i>(
+        &self,
+        node: Node<'a, 'i>,
+        ty: &str,
+        props: &Props,
+    ) -> Result<Vec<(Node<'a, 'i>, TextureBinding)>> {
+        let mut textured: Vec<(Node, TextureBinding)> = Vec::new();
+        for c in elements(node) {
+            let tag = c.tag_name().name();
+            let (name, texture) = if tag == "texture" {
+                (self.req_attr(c, "name")?, self.texture(c)?)
+            } else if tag == "ref"
+                && let Some(name) = self.attr(c, "name")?
+            {
+                let id = self.req_attr(c, "id")?;
+                let (t, _) = self.textures.get(&id).ok_or_else(|| {
+                    self.err(
+                        c,
+                        format!("bsdf '{ty}': reference to undefined texture '{id}'"),
+                    )
+                })?;
+                (name, t.clone())
+            } else {
+                continue;
+            };
+            let name = snake_case(&name);
+            let param = ColorParam::from_name(&name).ok_or_else(|| {
+                self.err(
+                    c,
+                    format!(
+                        "bsdf '{ty}': '{name}' cannot be a texture (only reflectances can: reflectance, diffuse_reflectance, specular_reflectance, specular_transmittance)"
+                    ),
+                )
+            })?;
+            if props.get(&name).is_some() {
+                return Err(self.err(
+                    c,
+                    format!("bsdf '{ty}': '{name}' is given twice (as a value and as a texture)"),
+                ));
+            }
+            if textured.iter().any(|(_, b)| b.param == param) {
+                return Err(self.err(c, format!("bsdf '{ty}': two textures for '{name}'")));
+            }
+            textured.push((c, TextureBinding { param, texture }));
+        }
+        Ok(textured)
+    }
+
+    /// `m` with the textures of `textured`, each of which must name a colour parameter of `m`.
+    fn bind_textures(
+        &self,
+        ty: &str,
+        m: MaterialDesc,
+        textured: Vec<(Node, TextureBinding)>,
+    ) -> Result<MaterialDesc> {
+        if textured.is_empty() {
+            return Ok(m);
+        }
+        let allowed = crate::material::color_params(&m);
+        if let Some((c, b)) = textured.iter().find(|(_, b)| !allowed.contains(&b.param)) {
+            return Err(self.err(
+                *c,
+                format!("bsdf '{ty}' has no parameter '{}'", b.param.name()),
+            ));
+        }
+        Ok(MaterialDesc::Textured {
+            material: Box::new(m),
+            textures: textured.into_iter().map(|(_, b)| b).collect(),
+        })
+    }
+
+    /// Only properties, textures and references inside a bsdf, and a nested bsdf only in
+    /// `twosided`.
+    fn check_bsdf_children(&self, node: Node, ty: &str) -> Result<()> {
+        for c in elements(node) {
+            let tag = c.tag_name().name();
+            if !PROPERTY_TAGS.contains(&tag) && !["bsdf", "texture", "ref"].contains(&tag) {
+                return Err(self.err(c, format!("unexpected <{tag}> inside a bsdf")));
+            }
+            if tag == "bsdf" && ty != "twosided" {
+                return Err(self.err(
+                    c,
+                    format!("bsdf '{ty}' takes no nested bsdf (only twosided wraps one)"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// `twosided`: the first nested bsdf on both sides; not around transmitting ones.
+    fn twosided<'i>(&self, node: Node<'a, 'i>) -> Result<MaterialDesc> {
+        let nested: Vec<Node> = elements(node)
+            .filter(|c| c.tag_name().name() == "bsdf")
+            .collect();
+        let inner = match nested.first() {
+            // Checked before recursing, so nesting depth is bounded (a file with
+            // thousands of nested twosided elements would overflow the stack).
+            Some(n) if n.attribute("type").map(snake_case).as_deref() == Some("twosided") => {
+                return Err(self.err(*n, "bsdf 'twosided' wraps another twosided"));
+            }
+            Some(n) => self.bsdf(*n)?,
+            None => {
+                self.warn(
+                    node,
+                    "empty twosided bsdf wraps a default diffuse (reflectance 0.5)",
+                );
+                MaterialDesc::Diffuse {
+                    reflectance: defaults::DIFFUSE_REFLECTANCE,
+                }
+            }
+        };
+        if nested.len() > 1 {
+            self.warn(nested[1], "twosided with two different bsdfs is not supported; the back side uses the front bsdf");
+        }
+        if matches!(
+            inner,
+            MaterialDesc::Dielectric { .. }
+                | MaterialDesc::RoughDielectric { .. }
+                | MaterialDesc::Null
+        ) {
+            return Err(self.err(
+                node,
+                "twosided cannot wrap a transmitting bsdf (dielectric, roughdielectric, null), as in Mitsuba",
+            ));
+        }
+        Ok(MaterialDesc::TwoSided(Box::new(inner)))
+    }
+
+    /// `conductor` and `roughconductor`.
+    fn conductor(&self, node: Node, ty: &str, props: &Props) -> Result<MaterialDesc> {
+        let ior = self.conductor_ior(props)?;
+        let specular_reflectance = props
+            .color("specular_reflectance", ColorUse::Reflectance)?
+            .unwrap_or(defaults::SPECULAR);
+        Ok(if ty == "conductor" {
+            MaterialDesc::Conductor {
+                ior,
+                specular_reflectance,
+            }
+        } else {
+            MaterialDesc::RoughConductor {
+                ior,
+                specular_reflectance,
+                roughness: self.roughness(node, props, true)?,
+            }
+        })
+    }
+
+    /// `dielectric` and `roughdielectric`.
+    fn dielectric(&self, node: Node, ty: &str, props: &Props) -> Result<MaterialDesc> {
+        let int_ior = props.ior("int_ior", defaults::BK7_IOR)?;
+        let ext_ior = props.ior("ext_ior", defaults::AIR_IOR)?;
+        let specular_reflectance = props
+            .color("specular_reflectance", ColorUse::Reflectance)?
+            .unwrap_or(defaults::SPECULAR);
+        let specular_transmittance = props
+            .color("specular_transmittance", ColorUse::Reflectance)?
+            .unwrap_or(defaults::SPECULAR);
+        Ok(if ty == "dielectric" {
+            MaterialDesc::Dielectric {
+                int_ior,
+                ext_ior,
+                specular_reflectance,
+                specular_transmittance,
+            }
+        } else {
+            MaterialDesc::RoughDielectric {
+                int_ior,
+                ext_ior,
+                specular_reflectance,
+                specular_transmittance,
+                roughness: self.roughness(node, props, true)?,
+            }
+        })
+    }
+
+    /// `plastic` and `roughplastic`.
+    fn plastic(&self, node: Node, ty: &str, props: &Props) -> Result<MaterialDesc> {
+        let int_ior = props.ior("int_ior", defaults::POLYPROPYLENE_IOR)?;
+        let ext_ior = props.ior("ext_ior", defaults::AIR_IOR)?;
+        let diffuse_reflectance = props
+            .color("diffuse_reflectance", ColorUse::Reflectance)?
+            .unwrap_or(defaults::DIFFUSE_REFLECTANCE);
+        let specular_reflectance = props
+            .color("specular_reflectance", ColorUse::Reflectance)?
+            .unwrap_or(defaults::SPECULAR);
+        let nonlinear = props.bool("nonlinear")?.unwrap_or(false);
+        if ty == "plastic" {
+            return Ok(MaterialDesc::Plastic {
+                int_ior,
+                ext_ior,
+                diffuse_reflectance,
+                specular_reflectance,
+                nonlinear,
+            });
+        }
+        if int_ior == ext_ior {
+            return Err(self.err(
+                node,
+                format!(
+                    "bsdf 'roughplastic': int_ior and ext_ior are both {int_ior}; they must differ"
+                ),
+            ));
+        }
+        Ok(MaterialDesc::RoughPlastic {
+            int_ior,
+            ext_ior,
+            diffuse_reflectance,
+            specular_reflectance,
+            nonlinear,
+            roughness: self.roughness(node, props, false)?,
+        })
+    }
+
+    /// Conductor `material` / `eta` / `k` (Mitsuba: `eta` with a named material is an error).
+    fn conductor_ior(&self, props: &Props) -> Result<ConductorIorDesc> {
+        let material_node = props.get("material").map(|p| p.node);
+        let material = props.string("material")?;
+        let eta = props.color("eta", ColorUse::Unbounded)?;
+        let k = props.color("k", ColorUse::Unbounded)?;
+        if let (Some(name), Some(n)) = (&material, material_node) {
+            if restir_materials::ior::conductor(name).is_none() {
+                return Err(self.err(
+                    n,
+                    format!(
+                        "{}: unknown conductor material '{name}' (known: {})",
+                        props.what,
+                        restir_materials::ior::conductor_names()
+                    ),
+                ));
+            }
+            if name != "none" && (eta.is_some() || k.is_some()) {
+                return Err(self.err(
+                    n,
+                    format!(
+                        "{}: give either material '{name}' or eta/k, not both",
+                        props.what
+                    ),
+                ));
+            }
+        }
+        Ok(ConductorIorDesc { material, eta, k })
+    }
+
+    /// `distribution`, `alpha` or `alpha_u`/`alpha_v`, and `sample_visible`.
+    fn roughness(&self, node: Node, props: &Props, anisotropic: bool) -> Result<RoughnessDesc> {
+        let mut r = RoughnessDesc::default();
+        if let Some(p) = props.get("distribution") {
+            let Value::Str(d) = &p.value else {
+                return Err(props.type_err(p, "a string"));
+            };
+            r.distribution = match d.as_str() {
+                "beckmann" => MicrofacetDesc::Beckmann,
+                "ggx" => MicrofacetDesc::Ggx,
+                other => {
+                    return Err(self.err(
+                        p.node,
+                        format!(
+                            "{}: unknown distribution '{other}' (beckmann, ggx)",
+                            props.what
+                        ),
+                    ));
+                }
+            };
+        }
+        let alpha = |name: &str| -> Result<Option<f32>> {
+            match props.float(name)? {
+                Some(a) if a.is_nan() || a < 0.0 => Err(self.err(
+                    props.node_or(name, node),
+                    format!(
+                        "{}: {name} {a} must be a non-negative roughness",
+                        props.what
+                    ),
+                )),
+                a => Ok(a),
+            }
+        };
+        let a = alpha("alpha")?;
+        let au = alpha("alpha_u")?;
+        let av = alpha("alpha_v")?;
+        match (au, av) {
+            (None, None) => r.alpha = a.unwrap_or(defaults::ALPHA),
+            (Some(u), Some(v)) => {
+                if !anisotropic {
+                    return Err(self.err(
+                        node,
+                        format!(
+                            "{}: anisotropic roughness is not supported; give 'alpha'",
+                            props.what
+                        ),
+                    ));
+                }
+                if a.is_some() {
+                    return Err(self.err(
+                        node,
+                        format!(
+                            "{}: give either alpha or alpha_u/alpha_v, not both",
+                            props.what
+                        ),
+                    ));
+                }
+                r.alpha_u = Some(u);
+                r.alpha_v = Some(v);
+            }
+            _ => {
+                return Err(self.err(
+                    node,
+                    format!("{}: alpha_u and alpha_v must be given together", props.what),
+                ));
+            }
+        }
+        if props.bool("sample_visible")? == Some(false) {
+            self.warn(
+                node,
+                format!(
+                    "{}: sample_visible=false is ignored; visible normals are always sampled (the same expected image, different noise)",
+                    props.what
+                ),
+            );
+        }
+        Ok(r)
+    }
+}

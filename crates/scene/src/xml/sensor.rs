@@ -1,0 +1,188 @@
+//! `<sensor>` with its `<film>` (and `<rfilter>`) and `<sampler>`: the camera, the image and
+//! the sample count.
+
+use roxmltree::Node;
+
+use super::props::PROPERTY_TAGS;
+use super::{Importer, Result, elements};
+use crate::desc::*;
+
+impl<'a> Importer<'a> {
+    pub(super) fn sensor<'i>(&self, node: Node<'a, 'i>, desc: &mut SceneDesc) -> Result<()> {
+        let ty = self.plugin_type(node)?;
+        if ty != "perspective" && ty != "thinlens" {
+            return Err(self.err(node, format!("unknown sensor type '{ty}'")));
+        }
+        let props = self.props(node, format!("sensor '{ty}'"))?;
+        let fov = props.float("fov")?.unwrap_or(defaults::FOV);
+        if !(fov > 0.0 && fov < 180.0) {
+            let at = props.node_or("fov", node);
+            return Err(self.err(
+                at,
+                format!("sensor '{ty}': fov {fov} must lie in (0, 180) degrees"),
+            ));
+        }
+        let mut cam = CameraDesc {
+            fov,
+            to_world: props.transform("to_world")?,
+            ..CameraDesc::default()
+        };
+        if let Some(axis) = props.string("fov_axis")? {
+            cam.fov_axis = match axis.as_str() {
+                "x" => FovAxis::X,
+                "y" => FovAxis::Y,
+                "diagonal" => FovAxis::Diagonal,
+                "smaller" => FovAxis::Smaller,
+                "larger" => FovAxis::Larger,
+                other => {
+                    return Err(self.err(
+                        node,
+                        format!("unknown fov_axis '{other}' (x, y, diagonal, smaller, larger)"),
+                    ));
+                }
+            };
+        }
+        if ty == "thinlens" {
+            cam.aperture_radius = props
+                .float("aperture_radius")?
+                .unwrap_or(defaults::APERTURE_RADIUS);
+            cam.focus_distance = props
+                .float("focus_distance")?
+                .unwrap_or(defaults::FOCUS_DISTANCE);
+        }
+        for c in elements(node) {
+            match c.tag_name().name() {
+                "film" => self.film(c, &mut desc.film)?,
+                "sampler" => {
+                    let sty = self.plugin_type(c)?;
+                    let sp = self.props(c, format!("sampler '{sty}'"))?;
+                    if let Some(n) = sp.int("sample_count")? {
+                        if !(1..=1 << 24).contains(&n) {
+                            return Err(self.err(c, format!("sample_count {n} is out of range")));
+                        }
+                        desc.spp = n as u32;
+                    }
+                    if sty != "independent" {
+                        self.warn(
+                            c,
+                            format!("sampler '{sty}' is replaced by this renderer's own sampler"),
+                        );
+                    }
+                    sp.finish();
+                }
+                t if PROPERTY_TAGS.contains(&t) => {}
+                t => return Err(self.err(c, format!("unexpected <{t}> inside a sensor"))),
+            }
+        }
+        // Everything the builder would reject about the camera, reported with the sensor's line.
+        if let Err(e) = crate::desc::transform_matrix(&cam.to_world)
+            .map_err(|e| e.to_string())
+            .and_then(|m| {
+                let axis = restir_geometry::FovAxis::X;
+                let res = (desc.film.width, desc.film.height);
+                restir_geometry::Camera::thin_lens(
+                    m,
+                    cam.fov,
+                    axis,
+                    res,
+                    cam.aperture_radius,
+                    cam.focus_distance,
+                )
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+            })
+        {
+            let lens = if ty == "thinlens" {
+                format!(
+                    " (aperture_radius {}, focus_distance {})",
+                    cam.aperture_radius, cam.focus_distance
+                )
+            } else {
+                String::new()
+            };
+            return Err(self.err(node, format!("sensor '{ty}': camera: {e}{lens}")));
+        }
+        props.finish();
+        desc.camera = cam;
+        Ok(())
+    }
+
+    fn film<'i>(&self, node: Node<'a, 'i>, film: &mut FilmDesc) -> Result<()> {
+        let ty = self.plugin_type(node)?;
+        // Mitsuba 3's hdrfilm and specfilm, Mitsuba 0.6's ldrfilm and tiledhdrfilm: all give an
+        // image; the output format comes from the output file name.
+        if !matches!(
+            ty.as_str(),
+            "hdrfilm" | "ldrfilm" | "tiledhdrfilm" | "specfilm"
+        ) {
+            return Err(self.err(node, format!("unknown film type '{ty}'")));
+        }
+        let props = self.props(node, format!("film '{ty}'"))?;
+        let dim = |what: &str, d: u32| -> Result<u32> {
+            match props.int(what)? {
+                None => Ok(d),
+                Some(n) if (1..=32768).contains(&n) => Ok(n as u32),
+                Some(n) => Err(self.err(
+                    props.node_or(what, node),
+                    format!("film {what} {n} is out of range (1..=32768)"),
+                )),
+            }
+        };
+        film.width = dim("width", defaults::FILM_WIDTH)?;
+        film.height = dim("height", defaults::FILM_HEIGHT)?;
+        if film.width as u64 * film.height as u64 > 1 << 28 {
+            return Err(self.err(
+                node,
+                format!(
+                    "film resolution {}×{} has too many pixels (at most 2^28)",
+                    film.width, film.height
+                ),
+            ));
+        }
+        film.filename = props.string("filename")?;
+        film.filter = FilterDesc::default();
+        for c in elements(node) {
+            match c.tag_name().name() {
+                "rfilter" => {
+                    let fty = self.plugin_type(c)?;
+                    let fp = self.props(c, format!("rfilter '{fty}'"))?;
+                    film.filter = match fty.as_str() {
+                        "box" => {
+                            // Lajolla's box filter `width`; Mitsuba's box is one pixel.
+                            if let Some(w) =
+                                fp.float("width")?.or(fp.float("radius")?.map(|r| 2.0 * r))
+                                && (w - 1.0).abs() > 1e-6
+                            {
+                                self.warn(c, format!("box filter width {w} is treated as 1 pixel"));
+                            }
+                            FilterDesc::Box
+                        }
+                        "tent" => {
+                            let r = fp
+                                .float("radius")?
+                                .or(fp.float("width")?.map(|w| 0.5 * w))
+                                .unwrap_or(defaults::TENT_RADIUS);
+                            if r <= 0.0 {
+                                return Err(self.err(c, "tent radius must be positive"));
+                            }
+                            FilterDesc::Tent { radius: r }
+                        }
+                        "gaussian" => {
+                            let s = fp.float("stddev")?.unwrap_or(defaults::GAUSSIAN_STDDEV);
+                            if s <= 0.0 {
+                                return Err(self.err(c, "gaussian stddev must be positive"));
+                            }
+                            FilterDesc::Gaussian { stddev: s }
+                        }
+                        other => return Err(self.err(c, format!("unknown rfilter type '{other}'"))),
+                    };
+                    fp.finish();
+                }
+                t if PROPERTY_TAGS.contains(&t) => {}
+                t => return Err(self.err(c, format!("unexpected <{t}> inside a film"))),
+            }
+        }
+        props.finish();
+        Ok(())
+    }
+}

@@ -1,0 +1,111 @@
+//! `<shape>`: built-in shapes and mesh files, with their bsdf (nested or by reference) and area
+//! emitter.
+
+use roxmltree::Node;
+
+use super::props::{ColorUse, PROPERTY_TAGS};
+use super::{Importer, Result, elements};
+use crate::desc::*;
+
+impl<'a> Importer<'a> {
+    pub(super) fn shape<'i>(&self, node: Node<'a, 'i>) -> Result<ShapeDesc> {
+        let ty = self.plugin_type(node)?;
+        let props = self.props(node, format!("shape '{ty}'"))?;
+        let geometry = match ty.as_str() {
+            "rectangle" => GeometryDesc::Rectangle,
+            "cube" => GeometryDesc::Cube,
+            "disk" => GeometryDesc::Disk,
+            "sphere" => {
+                let center = props.point("center")?.unwrap_or(defaults::SPHERE_CENTER);
+                let radius = props.float("radius")?.unwrap_or(defaults::SPHERE_RADIUS);
+                if radius <= 0.0 {
+                    return Err(self.err(node, format!("sphere radius {radius} must be positive")));
+                }
+                GeometryDesc::Sphere { center, radius }
+            }
+            "obj" => {
+                let f = props
+                    .string("filename")?
+                    .ok_or_else(|| self.err(node, "obj shape needs a 'filename'"))?;
+                GeometryDesc::Obj { filename: f }
+            }
+            "ply" => {
+                let f = props
+                    .string("filename")?
+                    .ok_or_else(|| self.err(node, "ply shape needs a 'filename'"))?;
+                GeometryDesc::Ply { filename: f }
+            }
+            "serialized" => {
+                let f = props
+                    .string("filename")?
+                    .ok_or_else(|| self.err(node, "serialized shape needs a 'filename'"))?;
+                let i = props.int("shape_index")?.unwrap_or(0);
+                let shape_index = u32::try_from(i).map_err(|_| {
+                    self.err(
+                        node,
+                        format!("shape_index {i} must be a non-negative integer"),
+                    )
+                })?;
+                GeometryDesc::Serialized {
+                    filename: f,
+                    shape_index,
+                }
+            }
+            other => return Err(self.err(node, format!("unknown shape type '{other}'"))),
+        };
+        let to_world = props.transform("to_world")?;
+        let flip_normals = props.bool("flip_normals")?.unwrap_or(false);
+        let face_normals = props.bool("face_normals")?.unwrap_or(false);
+        let mut material = None;
+        let mut emission = None;
+        for c in elements(node) {
+            match c.tag_name().name() {
+                "bsdf" => {
+                    if material.is_some() {
+                        return Err(self.err(c, "a shape takes one bsdf"));
+                    }
+                    material = Some(MaterialRef::Inline(self.bsdf(c)?));
+                }
+                "ref" => {
+                    let id = self.req_attr(c, "id")?;
+                    if !self.bsdf_ids.contains_key(&id) {
+                        return Err(self.err(c, format!("reference to undefined id '{id}'")));
+                    }
+                    if material.is_some() {
+                        return Err(self.err(c, "a shape takes one bsdf"));
+                    }
+                    material = Some(MaterialRef::Ref(id));
+                }
+                "emitter" => {
+                    let ety = self.plugin_type(c)?;
+                    if ety != "area" {
+                        return Err(
+                            self.err(c, format!("shapes carry only 'area' emitters, not '{ety}'"))
+                        );
+                    }
+                    if emission.is_some() {
+                        return Err(self.err(c, "a shape takes one emitter"));
+                    }
+                    let ep = self.props(c, "emitter 'area'".into())?;
+                    let r = ep
+                        .color("radiance", ColorUse::Emission)?
+                        .unwrap_or(defaults::EMISSION);
+                    ep.finish();
+                    emission = Some(r);
+                }
+                t if PROPERTY_TAGS.contains(&t) => {}
+                t => return Err(self.err(c, format!("unexpected <{t}> inside a shape"))),
+            }
+        }
+        props.finish();
+        Ok(ShapeDesc {
+            geometry,
+            to_world,
+            material,
+            emission,
+            flip_normals,
+            face_normals,
+            location: self.loc(node),
+        })
+    }
+}

@@ -1,0 +1,87 @@
+//! `<texture>`: `bitmap` and `checkerboard`, with their uv transform.
+
+use std::path::Path;
+
+use roxmltree::Node;
+
+use super::props::{ColorUse, PROPERTY_TAGS};
+use super::{Importer, Result, elements};
+use crate::desc::defaults;
+use crate::texture::{TextureDesc, UvTransform};
+
+impl<'a> Importer<'a> {
+    /// A `<texture>`: `bitmap` or `checkerboard`, with Mitsuba 0.6 `uscale`/`vscale`/
+    /// `uoffset`/`voffset` or Mitsuba 3 `to_uv` (scale and translation only).
+    pub(super) fn texture<'i>(&self, node: Node<'a, 'i>) -> Result<TextureDesc> {
+        let ty = self.plugin_type(node)?;
+        let props = self.props(node, format!("texture '{ty}'"))?;
+        let mut uv = UvTransform::default();
+        let to_uv = props.transform("to_uv")?;
+        if !to_uv.is_empty() {
+            let m =
+                crate::desc::transform_matrix(&to_uv).map_err(|e| self.err(node, e.to_string()))?;
+            if m.x_axis.y.abs() > 1e-6 || m.y_axis.x.abs() > 1e-6 {
+                return Err(self.err(
+                    node,
+                    format!("texture '{ty}': to_uv may only scale and translate"),
+                ));
+            }
+            uv.scale = glam::Vec2::new(m.x_axis.x, m.y_axis.y);
+            uv.offset = glam::Vec2::new(m.w_axis.x, m.w_axis.y);
+        }
+        let (us, vs) = (props.float("uscale")?, props.float("vscale")?);
+        let (uo, vo) = (props.float("uoffset")?, props.float("voffset")?);
+        uv.scale *= glam::Vec2::new(us.unwrap_or(1.0), vs.unwrap_or(1.0));
+        uv.offset += glam::Vec2::new(uo.unwrap_or(0.0), vo.unwrap_or(0.0));
+        let t = match ty.as_str() {
+            "bitmap" => {
+                let filename = props
+                    .string("filename")?
+                    .ok_or_else(|| self.err(node, "bitmap texture needs a 'filename'"))?;
+                let path = self.file.parent().unwrap_or(Path::new("")).join(&filename);
+                if !path.is_file() {
+                    return Err(self.err(
+                        node,
+                        format!("bitmap texture: file '{}' not found", path.display()),
+                    ));
+                }
+                let raw = props.bool("raw")?.unwrap_or(false);
+                if let Some(f) = props.string("filter_type")?
+                    && f != "bilinear"
+                {
+                    self.warn(
+                        node,
+                        format!("texture 'bitmap': filter_type '{f}' is replaced by bilinear"),
+                    );
+                }
+                if let Some(w) = props.string("wrap_mode")?
+                    && w != "repeat"
+                {
+                    self.warn(
+                        node,
+                        format!("texture 'bitmap': wrap_mode '{w}' is replaced by repeat"),
+                    );
+                }
+                TextureDesc::Bitmap { filename, raw, uv }
+            }
+            "checkerboard" => TextureDesc::Checkerboard {
+                color0: props
+                    .color("color0", ColorUse::Reflectance)?
+                    .unwrap_or(defaults::CHECKER_COLOR0),
+                color1: props
+                    .color("color1", ColorUse::Reflectance)?
+                    .unwrap_or(defaults::CHECKER_COLOR1),
+                uv,
+            },
+            other => return Err(self.err(node, format!("unknown texture type '{other}'"))),
+        };
+        for c in elements(node) {
+            let tag = c.tag_name().name();
+            if !PROPERTY_TAGS.contains(&tag) {
+                return Err(self.err(c, format!("unexpected <{tag}> inside a texture")));
+            }
+        }
+        props.finish();
+        Ok(t)
+    }
+}
