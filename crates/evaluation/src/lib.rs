@@ -35,7 +35,7 @@ use std::time::{Duration, Instant};
 use restir_integrators::{
     Image, IntegratorOptions, RenderSettings, compare, make_integrator, render,
 };
-use restir_scene::{Scene, load_desc};
+use restir_scene::{LoadOptions, Scene, load_scene};
 
 mod plot;
 mod report;
@@ -251,15 +251,14 @@ fn load_suite_scene(entry: &SuiteScene, suite_dir: &Path) -> Result<LoadedSuiteS
     let path = suite_dir.join(&entry.path);
     let file_bytes =
         std::fs::read(&path).map_err(|e| format!("{}: cannot read scene: {e}", path.display()))?;
-    let (mut desc, _warnings) = load_desc(&path, &[]).map_err(|e| e.to_string())?;
-    if let Some(w) = entry.width {
-        desc.film.width = w;
-    }
-    if let Some(h) = entry.height {
-        desc.film.height = h;
-    }
-    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let scene = Scene::build(&desc, &base, &path).map_err(|e| e.to_string())?;
+    let options = LoadOptions {
+        width: entry.width,
+        height: entry.height,
+        ..LoadOptions::default()
+    };
+    let scene = load_scene(&path, &options)
+        .map_err(|e| e.to_string())?
+        .scene;
     Ok(LoadedSuiteScene {
         name: entry.display_name(),
         scene,

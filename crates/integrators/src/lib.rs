@@ -10,7 +10,8 @@
 //! ```no_run
 //! use std::sync::atomic::AtomicBool;
 //! use restir_integrators::{make_integrator, render, IntegratorOptions, RenderSettings};
-//! let loaded = restir_scene::load_scene("scenes/cornell-box.xml".as_ref(), &[]).unwrap();
+//! use restir_scene::{LoadOptions, load_scene};
+//! let loaded = load_scene("scenes/cornell-box.xml".as_ref(), &LoadOptions::default()).unwrap();
 //! let options = IntegratorOptions { name: Some("restir-di".into()), ..Default::default() };
 //! let made = make_integrator(&loaded.scene, &options).unwrap();
 //! let settings = RenderSettings { spp: 16, time_limit: None, seed: 0 };

@@ -13,7 +13,7 @@ use restir_geometry::Shape;
 use restir_integrators::{
     Image, IntegratorOptions, RenderSettings, compare, make_integrator, render,
 };
-use restir_scene::{Scene, load_desc};
+use restir_scene::{LoadOptions, load_scene};
 
 mod bench;
 mod generate;
@@ -210,28 +210,20 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
             .ok_or_else(|| format!("-D {d}: expected NAME=VALUE"))?;
         defines.push((k.trim().to_string(), v.trim().to_string()));
     }
-    let (mut desc, warnings) = load_desc(&args.scene, &defines).map_err(|e| e.to_string())?;
+    let options = LoadOptions {
+        defines,
+        width: args.width,
+        height: args.height,
+        // The command line has never warned about unlit scenes.
+        warn_no_lights: false,
+    };
+    let loaded = load_scene(&args.scene, &options).map_err(|e| e.to_string())?;
     if !args.quiet {
-        for w in &warnings {
+        for w in &loaded.warnings {
             eprintln!("{w}");
         }
     }
-    if let Some(w) = args.width {
-        desc.film.width = w;
-    }
-    if let Some(h) = args.height {
-        desc.film.height = h;
-    }
-    let base = args
-        .scene
-        .parent()
-        .map(Path::to_path_buf)
-        .unwrap_or_default();
-    let mut scene = Scene::build(&desc, &base, &args.scene).map_err(|e| e.to_string())?;
-    if scene.integrator.location.file.as_os_str().is_empty() {
-        // RON scenes carry no line numbers; errors in their parameters still name the file.
-        scene.integrator.location.file = args.scene.clone();
-    }
+    let scene = loaded.scene;
     let load_seconds = load_start.elapsed().as_secs_f64();
 
     let options = IntegratorOptions {
