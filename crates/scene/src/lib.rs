@@ -24,6 +24,7 @@
 mod build;
 pub mod desc;
 mod error;
+pub mod generate;
 mod load;
 mod meshio;
 pub mod spectrum;
