@@ -32,9 +32,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-use restir_integrators::{
-    Image, IntegratorOptions, RenderSettings, compare, make_integrator, render,
-};
+use restir_integrators::{Image, IntegratorOptions, RenderJob, compare, make_integrator, render};
 use restir_scene::{LoadOptions, Scene, load_scene};
 
 mod plot;
@@ -330,12 +328,12 @@ fn crop(image: &Image, (x0, y0, w, h): (u32, u32, u32, u32)) -> Image {
 fn render_once(
     scene: &Scene,
     integrator: &dyn restir_integrators::Integrator,
-    settings: &RenderSettings,
+    job: &RenderJob,
 ) -> restir_integrators::RenderOutput {
     render(
         scene,
         integrator,
-        settings,
+        job,
         &AtomicBool::new(false),
         &mut |_, _| {},
     )
@@ -419,12 +417,12 @@ fn reference_for(
     let halves: Vec<Image> = REFERENCE_SEEDS
         .iter()
         .map(|&seed| {
-            let settings = RenderSettings {
+            let job = RenderJob {
                 spp: spp / 2,
-                time_limit: None,
                 seed,
+                ..RenderJob::default()
             };
-            render_once(&loaded.scene, integrator.as_ref(), &settings).image
+            render_once(&loaded.scene, integrator.as_ref(), &job).image
         })
         .collect();
     let seconds = start.elapsed().as_secs_f64();
@@ -530,14 +528,15 @@ pub fn run_suite(
                             loaded.name, config.label
                         ),
                     });
-                    let settings = RenderSettings {
+                    let job = RenderJob {
                         spp: u32::MAX,
                         time_limit: Some(Duration::from_secs_f64(budget)),
                         seed,
+                        output: None,
                     };
                     reset_peak_rss();
                     let before = vm_hwm_kib();
-                    let out = render_once(&loaded.scene, integrator, &settings);
+                    let out = render_once(&loaded.scene, integrator, &job);
                     let after = vm_hwm_kib();
                     let m = compare(&out.image, &reference).ok_or("reference size mismatch")?;
                     if seed == 0 && budget == strip_budget {

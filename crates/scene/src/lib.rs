@@ -79,14 +79,10 @@ pub struct Scene {
     pub lights: LightSet,
     /// The camera (its resolution is the film's).
     pub camera: Camera,
-    /// Reconstruction filter.
+    /// Reconstruction filter (how camera rays are jittered within a pixel).
     pub filter: FilterDesc,
-    /// Samples per pixel the scene asks for.
-    pub spp: u32,
     /// The scene's integrator settings.
     pub integrator: IntegratorDesc,
-    /// Output file name the scene asks for.
-    pub output: Option<String>,
     /// What the scene contains.
     pub features: SceneFeatures,
 }

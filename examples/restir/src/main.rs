@@ -10,9 +10,7 @@ use std::time::{Duration, Instant};
 
 use clap::{Parser, Subcommand};
 use restir_geometry::Shape;
-use restir_integrators::{
-    Image, IntegratorOptions, RenderSettings, compare, make_integrator, render,
-};
+use restir_integrators::{Image, IntegratorOptions, RenderJob, compare, make_integrator, render};
 use restir_scene::{LoadOptions, load_scene};
 
 mod bench;
@@ -224,6 +222,9 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         }
     }
     let scene = loaded.scene;
+    // The scene's sample count and file name are the job's defaults.
+    let mut job = RenderJob::from_desc(&loaded.desc);
+    job.seed = args.seed;
     let load_seconds = load_start.elapsed().as_secs_f64();
 
     let options = IntegratorOptions {
@@ -241,7 +242,7 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         }
     }
     let integrator = made.integrator;
-    let spp = args.spp.unwrap_or(scene.spp);
+    let spp = args.spp.unwrap_or(job.spp);
     if spp == 0 {
         return Err("--spp must be at least 1".into());
     }
@@ -257,24 +258,24 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         None => None,
     };
     // With only a time limit, keep rendering until it runs out.
-    let spp = if args.time_limit.is_some() && args.spp.is_none() {
+    job.spp = if args.time_limit.is_some() && args.spp.is_none() {
         u32::MAX
     } else {
         spp
     };
-    let output = match &args.output {
-        Some(o) => o.clone(),
-        None => match &scene.output {
-            Some(f) => PathBuf::from(f),
-            None => PathBuf::from(format!(
-                "{}.exr",
-                args.scene
-                    .file_stem()
-                    .and_then(|s| s.to_str())
-                    .unwrap_or("render")
-            )),
-        },
+    job.time_limit = time_limit;
+    let spp = job.spp;
+    let output = match args.output.clone().or(job.output.take()) {
+        Some(o) => o,
+        None => PathBuf::from(format!(
+            "{}.exr",
+            args.scene
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("render")
+        )),
     };
+    job.output = Some(output.clone());
     match output
         .extension()
         .and_then(|e| e.to_str())
@@ -347,16 +348,11 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         None
     };
 
-    let settings = RenderSettings {
-        spp,
-        time_limit,
-        seed: args.seed,
-    };
     let out = pool.install(|| {
         render(
             &scene,
             integrator.as_ref(),
-            &settings,
+            &job,
             &cancel,
             &mut |passes, elapsed| {
                 if let Some(b) = &bar {

@@ -4,7 +4,7 @@
 
 use std::sync::atomic::AtomicBool;
 
-use restir_integrators::{Image, IntegratorOptions, RenderSettings, make_integrator, render};
+use restir_integrators::{Image, IntegratorOptions, RenderJob, make_integrator, render};
 use restir_scene::Scene;
 
 /// Renders `scene` with estimator `name`. `params` are the estimator's parameters, except
@@ -32,10 +32,10 @@ pub fn render_image(
     };
     let made = make_integrator(scene, &options).unwrap();
     assert!(made.unused_params.is_empty());
-    let settings = RenderSettings {
+    let settings = RenderJob {
         spp,
-        time_limit: None,
         seed,
+        ..RenderJob::default()
     };
     let out = render(
         scene,
