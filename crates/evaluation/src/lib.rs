@@ -35,15 +35,17 @@ use std::time::{Duration, Instant};
 use restir_integrators::{Image, IntegratorOptions, RenderJob, compare, make_integrator, render};
 use restir_scene::{LoadOptions, Scene, load_scene};
 
+mod error;
 mod plot;
 mod report;
 pub mod suite;
 
+pub use error::BenchError;
 pub use report::{
     BEGIN_MARKER, END_MARKER, Summary, TimeToError, check_doc, summarize, time_to_error,
     update_doc, write_outputs,
 };
-pub use suite::{IntegratorConfig, Suite, SuiteScene};
+pub use suite::{IntegratorConfig, Suite, SuiteError, SuiteScene};
 
 /// Seeds of the two reference halves; benchmark runs use seeds `0..seeds`.
 pub const REFERENCE_SEEDS: [u64; 2] = [0x5eed_0000_0000_0001, 0x5eed_0000_0000_0002];
@@ -245,18 +247,15 @@ struct LoadedSuiteScene {
     file_bytes: Vec<u8>,
 }
 
-fn load_suite_scene(entry: &SuiteScene, suite_dir: &Path) -> Result<LoadedSuiteScene, String> {
+fn load_suite_scene(entry: &SuiteScene, suite_dir: &Path) -> Result<LoadedSuiteScene, BenchError> {
     let path = suite_dir.join(&entry.path);
-    let file_bytes =
-        std::fs::read(&path).map_err(|e| format!("{}: cannot read scene: {e}", path.display()))?;
+    let file_bytes = std::fs::read(&path).map_err(BenchError::io(&path, "cannot read scene: "))?;
     let options = LoadOptions {
         width: entry.width,
         height: entry.height,
         ..LoadOptions::default()
     };
-    let scene = load_scene(&path, &options)
-        .map_err(|e| e.to_string())?
-        .scene;
+    let scene = load_scene(&path, &options)?.scene;
     Ok(LoadedSuiteScene {
         name: entry.display_name(),
         scene,
@@ -278,32 +277,41 @@ fn build_integrator(
     scene: &Scene,
     config: &IntegratorConfig,
     entry: &SuiteScene,
-) -> Result<Box<dyn restir_integrators::Integrator>, String> {
-    let made = make_integrator(scene, &options_for(config, entry))
-        .map_err(|e| format!("integrator '{}': {e}", config.label))?;
+) -> Result<Box<dyn restir_integrators::Integrator>, BenchError> {
+    let made = make_integrator(scene, &options_for(config, entry)).map_err(|e| {
+        BenchError::Integrator {
+            label: config.label.clone(),
+            message: e.to_string(),
+        }
+    })?;
     if let Some(p) = made
         .unused_params
         .iter()
         .find(|p| config.params.iter().any(|(k, _)| k == *p))
     {
-        return Err(format!(
-            "integrator '{}': {} does not use the parameter '{p}'",
-            config.label, config.integrator
-        ));
+        return Err(BenchError::Integrator {
+            label: config.label.clone(),
+            message: format!("{} does not use the parameter '{p}'", config.integrator),
+        });
     }
     Ok(made.integrator)
 }
 
-fn crop_rect(entry: &SuiteScene, width: u32, height: u32) -> Result<(u32, u32, u32, u32), String> {
+fn crop_rect(
+    entry: &SuiteScene,
+    width: u32,
+    height: u32,
+) -> Result<(u32, u32, u32, u32), BenchError> {
     match entry.crop {
         Some((x, y, w, h)) => {
             if x.checked_add(w).is_none_or(|r| r > width)
                 || y.checked_add(h).is_none_or(|b| b > height)
             {
-                Err(format!(
-                    "{}: crop ({x}, {y}, {w}, {h}) does not fit in {width}×{height}",
-                    entry.path.display()
-                ))
+                Err(BenchError::Crop {
+                    scene: entry.path.clone(),
+                    rect: (x, y, w, h),
+                    size: (width, height),
+                })
             } else {
                 Ok((x, y, w, h))
             }
@@ -345,18 +353,17 @@ fn reference_for(
     loaded: &LoadedSuiteScene,
     suite: &Suite,
     opts: &RunOptions,
-) -> Result<(Image, ReferenceInfo), String> {
+) -> Result<(Image, ReferenceInfo), BenchError> {
     let (w, h) = loaded.scene.camera.resolution();
     if let Some(given) = &entry.reference {
         let path = opts.suite_dir.join(given);
-        let image = Image::read_exr(&path).map_err(|e| e.to_string())?;
+        let image = Image::read_exr(&path)?;
         if (image.width, image.height) != (w, h) {
-            return Err(format!(
-                "{}: reference is {}×{} but the scene renders {w}×{h}",
-                path.display(),
-                image.width,
-                image.height
-            ));
+            return Err(BenchError::ReferenceSize {
+                path,
+                reference: (image.width, image.height),
+                scene: (w, h),
+            });
         }
         return Ok((
             image,
@@ -405,8 +412,7 @@ fn reference_for(
             },
         ));
     }
-    std::fs::create_dir_all(&dir)
-        .map_err(|e| format!("{}: cannot create directory: {e}", dir.display()))?;
+    std::fs::create_dir_all(&dir).map_err(BenchError::io(&dir, "cannot create directory: "))?;
     let path_config = IntegratorConfig {
         label: "reference".into(),
         integrator: "path".into(),
@@ -431,9 +437,8 @@ fn reference_for(
         *p = 0.5 * (halves[0].pixels[i] + halves[1].pixels[i]);
     }
     let noise = compare(&halves[0], &halves[1]).map_or(f64::NAN, |m| m.relmse / 4.0);
-    image.write(&exr).map_err(|e| e.to_string())?;
-    std::fs::write(&noise_file, format!("{noise:e}\n"))
-        .map_err(|e| format!("{}: {e}", noise_file.display()))?;
+    image.write(&exr)?;
+    std::fs::write(&noise_file, format!("{noise:e}\n")).map_err(BenchError::io(&noise_file, ""))?;
     Ok((
         image,
         ReferenceInfo {
@@ -452,7 +457,7 @@ pub fn run_suite(
     suite: &Suite,
     opts: &RunOptions,
     progress: &mut dyn FnMut(&Progress),
-) -> Result<BenchResults, String> {
+) -> Result<BenchResults, BenchError> {
     suite.validate()?;
     let started_unix = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
@@ -538,7 +543,7 @@ pub fn run_suite(
                     let before = vm_hwm_kib();
                     let out = render_once(&loaded.scene, integrator, &job);
                     let after = vm_hwm_kib();
-                    let m = compare(&out.image, &reference).ok_or("reference size mismatch")?;
+                    let m = compare(&out.image, &reference).ok_or(BenchError::ReferenceMismatch)?;
                     if seed == 0 && budget == strip_budget {
                         strip_crops[ci] = Some(crop(&out.image, *rect));
                     }
