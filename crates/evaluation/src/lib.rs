@@ -32,20 +32,20 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-use restir_integrators::{
-    Image, IntegratorOptions, RenderSettings, compare, make_integrator, render,
-};
-use restir_scene::{Scene, load_desc};
+use restir_integrators::{Image, IntegratorOptions, RenderJob, compare, make_integrator, render};
+use restir_scene::{LoadOptions, Scene, load_scene};
 
+mod error;
 mod plot;
 mod report;
 pub mod suite;
 
+pub use error::BenchError;
 pub use report::{
     BEGIN_MARKER, END_MARKER, Summary, TimeToError, check_doc, summarize, time_to_error,
     update_doc, write_outputs,
 };
-pub use suite::{IntegratorConfig, Suite, SuiteScene};
+pub use suite::{IntegratorConfig, Suite, SuiteError, SuiteScene};
 
 /// Seeds of the two reference halves; benchmark runs use seeds `0..seeds`.
 pub const REFERENCE_SEEDS: [u64; 2] = [0x5eed_0000_0000_0001, 0x5eed_0000_0000_0002];
@@ -247,19 +247,15 @@ struct LoadedSuiteScene {
     file_bytes: Vec<u8>,
 }
 
-fn load_suite_scene(entry: &SuiteScene, suite_dir: &Path) -> Result<LoadedSuiteScene, String> {
+fn load_suite_scene(entry: &SuiteScene, suite_dir: &Path) -> Result<LoadedSuiteScene, BenchError> {
     let path = suite_dir.join(&entry.path);
-    let file_bytes =
-        std::fs::read(&path).map_err(|e| format!("{}: cannot read scene: {e}", path.display()))?;
-    let (mut desc, _warnings) = load_desc(&path, &[]).map_err(|e| e.to_string())?;
-    if let Some(w) = entry.width {
-        desc.film.width = w;
-    }
-    if let Some(h) = entry.height {
-        desc.film.height = h;
-    }
-    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let scene = Scene::build(&desc, &base, &path).map_err(|e| e.to_string())?;
+    let file_bytes = std::fs::read(&path).map_err(BenchError::io(&path, "cannot read scene: "))?;
+    let options = LoadOptions {
+        width: entry.width,
+        height: entry.height,
+        ..LoadOptions::default()
+    };
+    let scene = load_scene(&path, &options)?.scene;
     Ok(LoadedSuiteScene {
         name: entry.display_name(),
         scene,
@@ -281,33 +277,42 @@ fn build_integrator(
     scene: &Scene,
     config: &IntegratorConfig,
     entry: &SuiteScene,
-) -> Result<Box<dyn restir_integrators::Integrator>, String> {
-    let made = make_integrator(scene, &options_for(config, entry))
-        .map_err(|e| format!("integrator '{}': {e}", config.label))?;
+) -> Result<Box<dyn restir_integrators::Integrator>, BenchError> {
+    let made = make_integrator(scene, &options_for(config, entry)).map_err(|e| {
+        BenchError::Integrator {
+            label: config.label.clone(),
+            message: e.to_string(),
+        }
+    })?;
     if let Some(p) = made
         .unused_params
         .iter()
         .find(|p| config.params.iter().any(|(k, _)| *k == p.name))
     {
         let p = &p.name;
-        return Err(format!(
-            "integrator '{}': {} does not use the parameter '{p}'",
-            config.label, config.integrator
-        ));
+        return Err(BenchError::Integrator {
+            label: config.label.clone(),
+            message: format!("{} does not use the parameter '{p}'", config.integrator),
+        });
     }
     Ok(made.integrator)
 }
 
-fn crop_rect(entry: &SuiteScene, width: u32, height: u32) -> Result<(u32, u32, u32, u32), String> {
+fn crop_rect(
+    entry: &SuiteScene,
+    width: u32,
+    height: u32,
+) -> Result<(u32, u32, u32, u32), BenchError> {
     match entry.crop {
         Some((x, y, w, h)) => {
             if x.checked_add(w).is_none_or(|r| r > width)
                 || y.checked_add(h).is_none_or(|b| b > height)
             {
-                Err(format!(
-                    "{}: crop ({x}, {y}, {w}, {h}) does not fit in {width}×{height}",
-                    entry.path.display()
-                ))
+                Err(BenchError::Crop {
+                    scene: entry.path.clone(),
+                    rect: (x, y, w, h),
+                    size: (width, height),
+                })
             } else {
                 Ok((x, y, w, h))
             }
@@ -332,12 +337,12 @@ fn crop(image: &Image, (x0, y0, w, h): (u32, u32, u32, u32)) -> Image {
 fn render_once(
     scene: &Scene,
     integrator: &dyn restir_integrators::Integrator,
-    settings: &RenderSettings,
+    job: &RenderJob,
 ) -> restir_integrators::RenderOutput {
     render(
         scene,
         integrator,
-        settings,
+        job,
         &AtomicBool::new(false),
         &mut |_, _| {},
     )
@@ -349,18 +354,17 @@ fn reference_for(
     loaded: &LoadedSuiteScene,
     suite: &Suite,
     opts: &RunOptions,
-) -> Result<(Image, ReferenceInfo), String> {
+) -> Result<(Image, ReferenceInfo), BenchError> {
     let (w, h) = loaded.scene.camera.resolution();
     if let Some(given) = &entry.reference {
         let path = opts.suite_dir.join(given);
-        let image = Image::read_exr(&path).map_err(|e| e.to_string())?;
+        let image = Image::read_exr(&path)?;
         if (image.width, image.height) != (w, h) {
-            return Err(format!(
-                "{}: reference is {}×{} but the scene renders {w}×{h}",
-                path.display(),
-                image.width,
-                image.height
-            ));
+            return Err(BenchError::ReferenceSize {
+                path,
+                reference: (image.width, image.height),
+                scene: (w, h),
+            });
         }
         return Ok((
             image,
@@ -409,8 +413,7 @@ fn reference_for(
             },
         ));
     }
-    std::fs::create_dir_all(&dir)
-        .map_err(|e| format!("{}: cannot create directory: {e}", dir.display()))?;
+    std::fs::create_dir_all(&dir).map_err(BenchError::io(&dir, "cannot create directory: "))?;
     let path_config = IntegratorConfig {
         label: "reference".into(),
         integrator: "path".into(),
@@ -421,12 +424,12 @@ fn reference_for(
     let halves: Vec<Image> = REFERENCE_SEEDS
         .iter()
         .map(|&seed| {
-            let settings = RenderSettings {
+            let job = RenderJob {
                 spp: spp / 2,
-                time_limit: None,
                 seed,
+                ..RenderJob::default()
             };
-            render_once(&loaded.scene, integrator.as_ref(), &settings).image
+            render_once(&loaded.scene, integrator.as_ref(), &job).image
         })
         .collect();
     let seconds = start.elapsed().as_secs_f64();
@@ -435,9 +438,8 @@ fn reference_for(
         *p = 0.5 * (halves[0].pixels[i] + halves[1].pixels[i]);
     }
     let noise = compare(&halves[0], &halves[1]).map_or(f64::NAN, |m| m.relmse / 4.0);
-    image.write(&exr).map_err(|e| e.to_string())?;
-    std::fs::write(&noise_file, format!("{noise:e}\n"))
-        .map_err(|e| format!("{}: {e}", noise_file.display()))?;
+    image.write(&exr)?;
+    std::fs::write(&noise_file, format!("{noise:e}\n")).map_err(BenchError::io(&noise_file, ""))?;
     Ok((
         image,
         ReferenceInfo {
@@ -456,7 +458,7 @@ pub fn run_suite(
     suite: &Suite,
     opts: &RunOptions,
     progress: &mut dyn FnMut(&Progress),
-) -> Result<BenchResults, String> {
+) -> Result<BenchResults, BenchError> {
     suite.validate()?;
     let started_unix = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
@@ -532,16 +534,17 @@ pub fn run_suite(
                             loaded.name, config.label
                         ),
                     });
-                    let settings = RenderSettings {
+                    let job = RenderJob {
                         spp: u32::MAX,
                         time_limit: Some(Duration::from_secs_f64(budget)),
                         seed,
+                        output: None,
                     };
                     reset_peak_rss();
                     let before = vm_hwm_kib();
-                    let out = render_once(&loaded.scene, integrator, &settings);
+                    let out = render_once(&loaded.scene, integrator, &job);
                     let after = vm_hwm_kib();
-                    let m = compare(&out.image, &reference).ok_or("reference size mismatch")?;
+                    let m = compare(&out.image, &reference).ok_or(BenchError::ReferenceMismatch)?;
                     if seed == 0 && budget == strip_budget {
                         strip_crops[ci] = Some(crop(&out.image, *rect));
                     }

@@ -5,6 +5,8 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
+use crate::BenchError;
+
 /// One configuration's curve.
 pub(crate) struct Series {
     /// Legend text.
@@ -58,9 +60,11 @@ pub(crate) fn relmse_plot(
     title: &str,
     series: &[Series],
     reference_noise: Option<f64>,
-) -> Result<(), String> {
-    draw(path, title, series, reference_noise)
-        .map_err(|e| format!("{}: cannot draw plot: {e}", path.display()))
+) -> Result<(), BenchError> {
+    draw(path, title, series, reference_noise).map_err(|e| BenchError::Plot {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
 }
 
 fn draw(

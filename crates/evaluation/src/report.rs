@@ -8,7 +8,7 @@ use glam::Vec3;
 use restir_integrators::Image;
 
 use crate::plot::{Series, relmse_plot};
-use crate::{BenchResults, RunRecord, Strip};
+use crate::{BenchError, BenchResults, RunRecord, Strip};
 
 /// Start marker of the generated section in a Markdown file.
 pub const BEGIN_MARKER: &str = "<!-- restir bench results begin -->";
@@ -470,14 +470,13 @@ pub fn report_markdown(results: &BenchResults, h: &str, link: &str) -> String {
     s
 }
 
-fn write_file(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+fn write_file(path: &Path, bytes: &[u8]) -> Result<(), BenchError> {
+    std::fs::write(path, bytes).map_err(BenchError::io(path, ""))
 }
 
 /// Writes `results.csv`, `relmse-<scene>.svg`, `strip-<scene>.png` and `report.md` into `out`.
-pub fn write_outputs(results: &BenchResults, out: &Path) -> Result<(), String> {
-    std::fs::create_dir_all(out)
-        .map_err(|e| format!("{}: cannot create directory: {e}", out.display()))?;
+pub fn write_outputs(results: &BenchResults, out: &Path) -> Result<(), BenchError> {
+    std::fs::create_dir_all(out).map_err(BenchError::io(out, "cannot create directory: "))?;
     write_file(&out.join("results.csv"), csv(results).as_bytes())?;
     let summaries = summarize(results);
     for r in &results.references {
@@ -512,9 +511,7 @@ pub fn write_outputs(results: &BenchResults, out: &Path) -> Result<(), String> {
         )?;
     }
     for strip in &results.strips {
-        strip_image(strip)
-            .write(&out.join(format!("strip-{}.png", strip.scene)))
-            .map_err(|e| e.to_string())?;
+        strip_image(strip).write(&out.join(format!("strip-{}.png", strip.scene)))?;
     }
     write_file(
         &out.join("report.md"),
@@ -546,38 +543,30 @@ fn relative(from: &Path, to: &Path) -> PathBuf {
 }
 
 /// Positions just after the begin marker and at the end marker.
-fn find_markers(text: &str, doc: &Path) -> Result<(usize, usize), String> {
-    let begin = text.find(BEGIN_MARKER).ok_or_else(|| {
-        format!(
-            "{}: no '{BEGIN_MARKER}' marker: add the markers where the results belong",
-            doc.display()
-        )
-    })?;
+fn find_markers(text: &str, doc: &Path) -> Result<(usize, usize), BenchError> {
+    let missing = |begin| BenchError::Marker {
+        doc: doc.to_path_buf(),
+        begin,
+    };
+    let begin = text.find(BEGIN_MARKER).ok_or_else(|| missing(true))?;
     let after_begin = begin + BEGIN_MARKER.len();
     let end = text[after_begin..]
         .find(END_MARKER)
         .map(|i| after_begin + i)
-        .ok_or_else(|| {
-            format!(
-                "{}: no '{END_MARKER}' after the begin marker",
-                doc.display()
-            )
-        })?;
+        .ok_or_else(|| missing(false))?;
     Ok((after_begin, end))
 }
 
 /// Checks that `doc` can be read and has both markers (before spending time on a run).
-pub fn check_doc(doc: &Path) -> Result<(), String> {
-    let text =
-        std::fs::read_to_string(doc).map_err(|e| format!("{}: cannot read: {e}", doc.display()))?;
+pub fn check_doc(doc: &Path) -> Result<(), BenchError> {
+    let text = std::fs::read_to_string(doc).map_err(BenchError::io(doc, "cannot read: "))?;
     find_markers(&text, doc).map(|_| ())
 }
 
 /// Replaces the text between [`BEGIN_MARKER`] and [`END_MARKER`] in the Markdown file `doc` with
 /// the report (links relative to the document); the rest of the file is kept as it is.
-pub fn update_doc(results: &BenchResults, out: &Path, doc: &Path) -> Result<(), String> {
-    let text =
-        std::fs::read_to_string(doc).map_err(|e| format!("{}: cannot read: {e}", doc.display()))?;
+pub fn update_doc(results: &BenchResults, out: &Path, doc: &Path) -> Result<(), BenchError> {
+    let text = std::fs::read_to_string(doc).map_err(BenchError::io(doc, "cannot read: "))?;
     let (after_begin, end) = find_markers(&text, doc)?;
     let doc_dir = doc
         .parent()

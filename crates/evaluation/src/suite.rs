@@ -112,98 +112,152 @@ impl SuiteScene {
     }
 }
 
+/// A suite file that cannot be read or parsed, or a suite that breaks a rule: where (when
+/// known) and what.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SuiteError {
+    /// The suite file, when known.
+    pub file: Option<PathBuf>,
+    /// Line and column in the file, for syntax errors.
+    pub position: Option<(usize, usize)>,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl SuiteError {
+    /// A broken rule, not yet tied to a file.
+    fn rule(message: impl Into<String>) -> Self {
+        Self {
+            file: None,
+            position: None,
+            message: message.into(),
+        }
+    }
+
+    /// The same error, in `file`.
+    fn in_file(self, file: &Path) -> Self {
+        Self {
+            file: Some(file.to_path_buf()),
+            ..self
+        }
+    }
+}
+
+impl std::fmt::Display for SuiteError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match (&self.file, self.position) {
+            (Some(file), Some((line, col))) => {
+                write!(f, "{}:{line}:{col}: {}", file.display(), self.message)
+            }
+            (Some(file), None) => write!(f, "{}: {}", file.display(), self.message),
+            (None, _) => f.write_str(&self.message),
+        }
+    }
+}
+
+impl std::error::Error for SuiteError {}
+
 impl Suite {
     /// Parses a suite; errors read `file:line:column: message`.
-    pub fn parse(text: &str, file: &Path) -> Result<Suite, String> {
+    pub fn parse(text: &str, file: &Path) -> Result<Suite, SuiteError> {
         let suite: Suite = ron::Options::default()
             .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
             .from_str(text)
-            .map_err(|e| {
-                format!(
-                    "{}:{}:{}: {}",
-                    file.display(),
-                    e.span.start.line,
-                    e.span.start.col,
-                    e.code
-                )
+            .map_err(|e| SuiteError {
+                file: Some(file.to_path_buf()),
+                position: Some((e.span.start.line, e.span.start.col)),
+                message: e.code.to_string(),
             })?;
-        suite
-            .validate()
-            .map_err(|m| format!("{}: {m}", file.display()))?;
+        suite.validate().map_err(|e| e.in_file(file))?;
         Ok(suite)
     }
 
     /// Reads and parses a suite file.
-    pub fn load(file: &Path) -> Result<Suite, String> {
+    pub fn load(file: &Path) -> Result<Suite, SuiteError> {
         let text = std::fs::read_to_string(file)
-            .map_err(|e| format!("{}: cannot read suite: {e}", file.display()))?;
+            .map_err(|e| SuiteError::rule(format!("cannot read suite: {e}")).in_file(file))?;
         Self::parse(&text, file)
     }
 
     /// Checks what the format cannot: non-empty lists, positive budgets, unique names.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), SuiteError> {
         if self.scenes.is_empty() {
-            return Err("the suite has no scenes".into());
+            return Err(SuiteError::rule("the suite has no scenes"));
         }
         if self.integrators.is_empty() {
-            return Err("the suite has no integrators".into());
+            return Err(SuiteError::rule("the suite has no integrators"));
         }
         check_budgets(&self.budgets)?;
         if self.seeds == 0 || self.seeds > 10_000 {
-            return Err(format!("seeds {}: expected 1 to 10000", self.seeds));
+            return Err(SuiteError::rule(format!(
+                "seeds {}: expected 1 to 10000",
+                self.seeds
+            )));
         }
         let check_spp = |spp: u32| {
             if (2..=1 << 24).contains(&spp) {
                 Ok(())
             } else {
-                Err(format!("reference_spp {spp}: expected 2 to 16777216"))
+                Err(SuiteError::rule(format!(
+                    "reference_spp {spp}: expected 2 to 16777216"
+                )))
             }
         };
         check_spp(self.reference_spp)?;
         if let Some(b) = self.strip_budget.filter(|b| !self.budgets.contains(b)) {
-            return Err(format!("strip_budget {b} is not one of the budgets"));
+            return Err(SuiteError::rule(format!(
+                "strip_budget {b} is not one of the budgets"
+            )));
         }
         let mut names = Vec::new();
         for s in &self.scenes {
             let name = s.display_name();
             if names.contains(&name) {
-                return Err(format!("two scenes are named '{name}': give one a `name`"));
+                return Err(SuiteError::rule(format!(
+                    "two scenes are named '{name}': give one a `name`"
+                )));
             }
             if name.is_empty()
                 || !name
                     .chars()
                     .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
             {
-                return Err(format!(
+                return Err(SuiteError::rule(format!(
                     "scene name '{name}': use letters, digits, '-', '_' or '.'"
-                ));
+                )));
             }
             names.push(name);
             for (what, v) in [("width", s.width), ("height", s.height)] {
                 if v.is_some_and(|v| !(1..=16384).contains(&v)) {
-                    return Err(format!("{}: {what} must be 1 to 16384", s.path.display()));
+                    return Err(SuiteError::rule(format!(
+                        "{}: {what} must be 1 to 16384",
+                        s.path.display()
+                    )));
                 }
             }
             if let Some(spp) = s.reference_spp {
                 check_spp(spp)?;
             }
             if s.crop.is_some_and(|(_, _, w, h)| w == 0 || h == 0) {
-                return Err(format!("{}: empty crop rectangle", s.path.display()));
+                return Err(SuiteError::rule(format!(
+                    "{}: empty crop rectangle",
+                    s.path.display()
+                )));
             }
         }
         let mut labels: Vec<&str> = Vec::new();
         for c in &self.integrators {
             if c.label.is_empty() || labels.contains(&c.label.as_str()) {
-                return Err(format!(
+                return Err(SuiteError::rule(format!(
                     "integrator label '{}' is empty or used twice",
                     c.label
-                ));
+                )));
             }
             if c.label.contains(['\n', '"', '|']) {
-                return Err(format!(
+                return Err(SuiteError::rule(format!(
                     "integrator label '{}': no newlines, quotes or '|'",
                     c.label
-                ));
+                )));
             }
             labels.push(&c.label);
         }
@@ -212,16 +266,16 @@ impl Suite {
                 continue;
             };
             if list.is_empty() {
-                return Err(format!(
+                return Err(SuiteError::rule(format!(
                     "{}: empty `integrators` list (leave it out for all)",
                     s.path.display()
-                ));
+                )));
             }
             if let Some(bad) = list.iter().find(|l| !labels.contains(&l.as_str())) {
-                return Err(format!(
+                return Err(SuiteError::rule(format!(
                     "{}: `integrators` names '{bad}', which is not a configuration label",
                     s.path.display()
-                ));
+                )));
             }
         }
         Ok(())
@@ -229,15 +283,15 @@ impl Suite {
 }
 
 /// Budgets must be positive, finite and at most a day.
-pub fn check_budgets(budgets: &[f64]) -> Result<(), String> {
+pub fn check_budgets(budgets: &[f64]) -> Result<(), SuiteError> {
     if budgets.is_empty() {
-        return Err("no time budgets".into());
+        return Err(SuiteError::rule("no time budgets"));
     }
     for &b in budgets {
         if !(b.is_finite() && b > 0.0 && b <= 86_400.0) {
-            return Err(format!(
+            return Err(SuiteError::rule(format!(
                 "time budget {b}: expected a positive number of seconds (at most 86400)"
-            ));
+            )));
         }
     }
     Ok(())
@@ -268,17 +322,24 @@ mod tests {
     #[test]
     fn errors_name_file_and_line() {
         let bad = GOOD.replace("budgets", "\n budgetz");
-        let e = Suite::parse(&bad, Path::new("s.ron")).unwrap_err();
+        let e = Suite::parse(&bad, Path::new("s.ron"))
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("s.ron:6:2:"), "{e}");
-        let e = Suite::parse(&GOOD.replace("0.5", "-1.0"), Path::new("s.ron")).unwrap_err();
+        let e = Suite::parse(&GOOD.replace("0.5", "-1.0"), Path::new("s.ron"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("time budget -1"), "{e}");
-        let e = Suite::parse(&GOOD.replace("\"di\"", "\"path\""), Path::new("s.ron")).unwrap_err();
+        let e = Suite::parse(&GOOD.replace("\"di\"", "\"path\""), Path::new("s.ron"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("used twice"), "{e}");
         let only = GOOD.replace("height: Some(16)", "height: 16, integrators: [\"di\"]");
         let s = Suite::parse(&only, Path::new("s.ron")).unwrap();
         assert!(s.scenes[0].runs("di") && !s.scenes[0].runs("path"));
-        let e =
-            Suite::parse(&only.replace("[\"di\"]", "[\"dj\"]"), Path::new("s.ron")).unwrap_err();
+        let e = Suite::parse(&only.replace("[\"di\"]", "[\"dj\"]"), Path::new("s.ron"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("'dj'"), "{e}");
     }
 }

@@ -1,11 +1,17 @@
-//! Pixel filters, importance-sampled: each camera ray is offset from the pixel centre by a sample
-//! of the filter, and the pixel value is the plain average of its samples. The expected value is
-//! the filter-weighted average of radiance over the footprint, the same as Mitsuba's splatting
-//! film away from the image border, and every integrator sees the same footprint.
+//! The film: the pixel filter and the accumulation of passes into an image.
+//!
+//! Pixel filters are importance-sampled: each camera ray is offset from the pixel centre by a
+//! sample of the filter, and the pixel value is the plain average of its samples. The expected
+//! value is the filter-weighted average of radiance over the footprint, the same as Mitsuba's
+//! splatting film away from the image border, and every integrator sees the same footprint.
+//! Because the filter is in the sampling, the [`Film`] keeps one sum per pixel (in `f64`, so that
+//! thousands of passes lose nothing) and its image is the sum divided by the number of passes.
 
-use glam::Vec2;
+use glam::{DVec3, Vec2};
 use restir_sampling::{Distribution1D, warp};
 use restir_scene::FilterDesc;
+
+use crate::Image;
 
 /// Table resolution for filters without an analytic inverse.
 const TABLE_SIZE: usize = 1024;
@@ -69,6 +75,62 @@ impl Filter {
     }
 }
 
+/// The film of one render: the pixel filter, and per pixel the sum of one estimate per pass.
+#[derive(Clone, Debug)]
+pub struct Film {
+    width: u32,
+    height: u32,
+    filter: Filter,
+    sums: Vec<DVec3>,
+    passes: u32,
+}
+
+impl Film {
+    /// An empty film of `width × height` pixels with the filter `filter`.
+    pub fn new(width: u32, height: u32, filter: FilterDesc) -> Self {
+        Self {
+            width,
+            height,
+            filter: Filter::new(filter),
+            sums: vec![DVec3::ZERO; width as usize * height as usize],
+            passes: 0,
+        }
+    }
+
+    /// `(width, height)` in pixels.
+    pub fn resolution(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// The pixel filter.
+    pub fn filter(&self) -> &Filter {
+        &self.filter
+    }
+
+    /// Passes added so far.
+    pub fn passes(&self) -> u32 {
+        self.passes
+    }
+
+    /// Adds one pass: `pass` gets the filter (for jittering camera rays) and the row-major
+    /// per-pixel sums, to which it adds one estimate per pixel; its result is returned.
+    pub fn add_pass<R>(&mut self, pass: impl FnOnce(&Filter, &mut [DVec3]) -> R) -> R {
+        let r = pass(&self.filter, &mut self.sums);
+        self.passes += 1;
+        r
+    }
+
+    /// The average of the passes (black before the first).
+    pub fn image(&self) -> Image {
+        let inv = 1.0 / self.passes.max(1) as f64;
+        Image {
+            width: self.width,
+            height: self.height,
+            pixels: self.sums.iter().map(|s| (*s * inv).as_vec3()).collect(),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -102,5 +164,23 @@ mod tests {
                 "{desc:?}: var {v} vs {var}"
             );
         }
+    }
+
+    /// The image is the per-pixel mean of the passes.
+    #[test]
+    fn film_averages_passes() {
+        let mut film = Film::new(2, 1, FilterDesc::Box);
+        assert_eq!(film.image().pixels, vec![glam::Vec3::ZERO; 2]);
+        for v in [1.0, 2.0, 6.0] {
+            film.add_pass(|_, sums| {
+                sums[0] += DVec3::splat(v);
+                sums[1] += DVec3::new(v, 0.0, -v);
+            });
+        }
+        assert_eq!(film.passes(), 3);
+        let image = film.image();
+        assert_eq!((image.width, image.height), (2, 1));
+        assert_eq!(image.pixels[0], glam::Vec3::splat(3.0));
+        assert_eq!(image.pixels[1], glam::Vec3::new(3.0, 0.0, -3.0));
     }
 }

@@ -2,19 +2,20 @@
 //! filters, image I/O and error metrics.
 //!
 //! The entry point for programs and tests is [`render`]: give it a built
-//! [`Scene`], an [`Integrator`] and [`RenderSettings`], and it returns the
+//! [`Scene`], an [`Integrator`] and a [`RenderJob`], and it returns the
 //! averaged image with statistics. A *pass* is one sample per pixel of the integrator's final
 //! estimator; images are bit-identical whatever the thread count, because every pixel's random
 //! numbers come from `(seed, pixel, pass)`.
 //!
 //! ```no_run
 //! use std::sync::atomic::AtomicBool;
-//! use restir_integrators::{make_integrator, render, IntegratorOptions, RenderSettings};
-//! let loaded = restir_scene::load_scene("scenes/cornell-box.xml".as_ref(), &[]).unwrap();
+//! use restir_integrators::{make_integrator, render, IntegratorOptions, RenderJob};
+//! use restir_scene::{LoadOptions, load_scene};
+//! let loaded = load_scene("scenes/cornell-box.xml".as_ref(), &LoadOptions::default()).unwrap();
 //! let options = IntegratorOptions { name: Some("restir-di".into()), ..Default::default() };
 //! let made = make_integrator(&loaded.scene, &options).unwrap();
-//! let settings = RenderSettings { spp: 16, time_limit: None, seed: 0 };
-//! let out = render(&loaded.scene, made.integrator.as_ref(), &settings, &AtomicBool::new(false), &mut |_, _| {});
+//! let job = RenderJob { spp: 16, ..RenderJob::from_desc(&loaded.desc) };
+//! let out = render(&loaded.scene, made.integrator.as_ref(), &job, &AtomicBool::new(false), &mut |_, _| {});
 //! out.image.write("cbox.exr".as_ref()).unwrap();
 //! ```
 
@@ -32,7 +33,7 @@ pub mod shadow;
 pub use image_io::{Image, ImageError};
 pub use metrics::{ErrorMetrics, compare};
 pub use params::{Param, ParamError, ParamSet, ParamSource, ParamValue};
-pub use render::{Integrator, PassContext, PathIntegrator, RenderOutput, RenderSettings, render};
+pub use render::{Integrator, PassContext, PathIntegrator, RenderJob, RenderOutput, render};
 pub use restir_di::{RestirDiIntegrator, RestirDiSettings};
 pub use restir_pt::{RestirPtIntegrator, RestirPtSettings};
 

@@ -1,16 +1,19 @@
-//! The render driver: passes over the image until the sample count, the time limit or a
-//! cancellation ends it. A pass is one sample per pixel of an integrator's final estimator.
+//! The render driver: a [`RenderJob`] (how many passes, how long, which seed, where to) run on a
+//! scene with an [`Integrator`], pass after pass into a [`Film`] until the sample count, the time
+//! limit or a cancellation ends it. A pass is one sample per pixel of an integrator's final
+//! estimator.
 
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use glam::{DVec3, Vec2, Vec3};
+use glam::{DVec3, Vec2};
 use rayon::prelude::*;
 use restir_sampling::Pcg32;
-use restir_scene::Scene;
+use restir_scene::{Scene, SceneDesc};
 
 use crate::Image;
-use crate::film::Filter;
+use crate::film::{Film, Filter};
 use crate::path::{PathSettings, trace_camera_path};
 
 /// Rows per parallel work item.
@@ -113,15 +116,44 @@ impl Integrator for PathIntegrator {
     }
 }
 
-/// How long and how much to render.
-#[derive(Clone, Copy, Debug)]
-pub struct RenderSettings {
+/// One render of a scene: what belongs to this render rather than to the scene. A scene
+/// description's sample count and output file name are the defaults ([`RenderJob::from_desc`]).
+/// The film size is not here: the camera is built for it when the scene is loaded
+/// (`restir_scene::LoadOptions`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderJob {
     /// Passes to render (at least one is always rendered).
     pub spp: u32,
     /// Stop starting new passes once this much time has passed.
     pub time_limit: Option<Duration>,
     /// Seed of every random stream.
     pub seed: u64,
+    /// Where the image is to be written; [`render`] does not write it.
+    pub output: Option<PathBuf>,
+}
+
+impl Default for RenderJob {
+    /// One pass, no time limit, seed 0, no output file.
+    fn default() -> Self {
+        Self {
+            spp: 1,
+            time_limit: None,
+            seed: 0,
+            output: None,
+        }
+    }
+}
+
+impl RenderJob {
+    /// The job a scene description asks for: its sample count (at least one) and its film's
+    /// file name; seed 0 and no time limit.
+    pub fn from_desc(desc: &SceneDesc) -> Self {
+        Self {
+            spp: desc.spp.max(1),
+            output: desc.film.filename.as_ref().map(PathBuf::from),
+            ..Self::default()
+        }
+    }
 }
 
 /// The result of a render.
@@ -144,48 +176,40 @@ pub struct RenderOutput {
 pub fn render(
     scene: &Scene,
     integrator: &dyn Integrator,
-    settings: &RenderSettings,
+    job: &RenderJob,
     cancel: &AtomicBool,
     progress: &mut dyn FnMut(u32, Duration),
 ) -> RenderOutput {
     let (w, h) = scene.camera.resolution();
-    let filter = Filter::new(scene.filter);
-    let mut accum = vec![DVec3::ZERO; w as usize * h as usize];
+    let mut film = Film::new(w, h, scene.filter);
     let start = Instant::now();
-    let mut passes = 0u32;
     let mut rays = 0u64;
-    let spp = settings.spp.max(1);
-    while passes < spp {
-        let ctx = PassContext {
-            seed: settings.seed,
-            pass: passes,
-            filter: &filter,
-        };
-        rays += integrator.render_pass(scene, &ctx, &mut accum);
-        passes += 1;
+    let spp = job.spp.max(1);
+    while film.passes() < spp {
+        let pass = film.passes();
+        rays += film.add_pass(|filter, sums| {
+            let ctx = PassContext {
+                seed: job.seed,
+                pass,
+                filter,
+            };
+            integrator.render_pass(scene, &ctx, sums)
+        });
         let elapsed = start.elapsed();
-        progress(passes, elapsed);
+        progress(film.passes(), elapsed);
         if cancel.load(Ordering::Relaxed) {
             break;
         }
-        if settings.time_limit.is_some_and(|t| elapsed >= t) {
+        if job.time_limit.is_some_and(|t| elapsed >= t) {
             break;
         }
     }
     let seconds = start.elapsed().as_secs_f64();
-    let inv = 1.0 / passes as f64;
-    let image = Image {
-        width: w,
-        height: h,
-        pixels: accum
-            .iter()
-            .map(|s| (*s * inv).as_vec3())
-            .collect::<Vec<Vec3>>(),
-    };
+    let image = film.image();
     let nonfinite_pixels = image.nonfinite_count();
     RenderOutput {
         image,
-        passes,
+        passes: film.passes(),
         seconds,
         rays,
         nonfinite_pixels,

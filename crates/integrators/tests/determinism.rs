@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
 use restir_integrators::{
-    Image, IntegratorOptions, RenderOutput, RenderSettings, make_integrator, render,
+    Image, IntegratorOptions, RenderJob, RenderOutput, make_integrator, render,
 };
 use restir_scene::{Scene, load_desc};
 
@@ -34,10 +34,10 @@ fn render_with_threads(scene: &Scene, threads: usize, seed: u64, spp: u32) -> Re
     let integrator = make_integrator(scene, &IntegratorOptions::default())
         .unwrap()
         .integrator;
-    let settings = RenderSettings {
+    let settings = RenderJob {
         spp,
-        time_limit: None,
         seed,
+        ..RenderJob::default()
     };
     pool.install(|| {
         render(

@@ -253,7 +253,7 @@ fn matpreview_renders() {
     let dir = temp_dir("matpreview");
     let path = dir.join("matpreview.xml");
     std::fs::write(&path, xml).unwrap();
-    let loaded = restir_scene::load_scene(&path, &[]).unwrap();
+    let loaded = restir_scene::load_scene(&path, &restir_scene::LoadOptions::default()).unwrap();
     let scene = loaded.scene;
     assert!(scene.features.has_environment);
     for name in ["path", "restir-di", "restir-pt"] {

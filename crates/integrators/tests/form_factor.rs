@@ -13,7 +13,7 @@
 
 use std::sync::atomic::AtomicBool;
 
-use restir_integrators::{IntegratorOptions, RenderSettings, make_integrator, render};
+use restir_integrators::{IntegratorOptions, RenderJob, make_integrator, render};
 use restir_scene::{Scene, parse_ron};
 
 /// Form factor from a differential element at the origin (normal towards the rectangle) to the
@@ -83,10 +83,10 @@ impl Setup {
             .integrator;
         let mut values: [Vec<f64>; 3] = Default::default();
         for seed in 0..seeds {
-            let settings = RenderSettings {
+            let settings = RenderJob {
                 spp,
-                time_limit: None,
                 seed: 1000 + seed,
+                ..RenderJob::default()
             };
             let out = render(
                 &scene,

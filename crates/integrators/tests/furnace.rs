@@ -12,7 +12,7 @@
 
 use std::sync::atomic::AtomicBool;
 
-use restir_integrators::{IntegratorOptions, RenderSettings, make_integrator, render};
+use restir_integrators::{IntegratorOptions, RenderJob, make_integrator, render};
 use restir_scene::{Scene, parse_ron};
 
 /// Mean and standard error over the pixels covered by a unit sphere of `material` (RON), seen
@@ -32,10 +32,10 @@ fn furnace(material: &str, max_depth: i32, seed: u64) -> (f64, f64) {
     let integrator = make_integrator(&scene, &IntegratorOptions::default())
         .unwrap()
         .integrator;
-    let settings = RenderSettings {
+    let settings = RenderJob {
         spp: 256,
-        time_limit: None,
         seed,
+        ..RenderJob::default()
     };
     let out = render(
         &scene,

@@ -17,7 +17,7 @@
 use std::sync::atomic::AtomicBool;
 
 use glam::{Vec2, Vec3};
-use restir_integrators::{IntegratorOptions, RenderSettings, make_integrator, render};
+use restir_integrators::{IntegratorOptions, RenderJob, make_integrator, render};
 use restir_scene::{Scene, parse_ron};
 
 const COLOR0: [f64; 3] = [0.8, 0.5, 0.2];
@@ -95,10 +95,10 @@ fn estimate(scene: &Scene, integrator: &str, seeds: u64, spp: u32) -> [[(f64, f6
     let made = make_integrator(scene, &options).unwrap();
     let mut seed_means: [[Vec<f64>; 3]; 2] = Default::default();
     for seed in 0..seeds {
-        let settings = RenderSettings {
+        let settings = RenderJob {
             spp,
-            time_limit: None,
             seed: 77 + seed,
+            ..RenderJob::default()
         };
         let out = render(
             scene,

@@ -385,9 +385,7 @@ impl Scene {
             lights: light_set,
             camera,
             filter: desc.film.filter,
-            spp: desc.spp.max(1),
             integrator: desc.integrator.clone(),
-            output: desc.film.filename.clone(),
             features,
         })
     }

@@ -24,16 +24,17 @@
 mod build;
 pub mod desc;
 mod error;
+pub mod generate;
+mod load;
 mod material;
 mod meshio;
 pub mod spectrum;
 pub mod texture;
 pub mod xml;
 
-use std::path::{Path, PathBuf};
-
 pub use desc::*;
 pub use error::{SceneError, SceneWarning};
+pub use load::{LoadOptions, LoadedScene, load_desc, load_scene, parse_ron};
 
 use glam::{Vec2, Vec3};
 use restir_geometry::{Accel, Camera, Hit, Ray, Shape, SurfaceInteraction};
@@ -78,14 +79,10 @@ pub struct Scene {
     pub lights: LightSet,
     /// The camera (its resolution is the film's).
     pub camera: Camera,
-    /// Reconstruction filter.
+    /// Reconstruction filter (how camera rays are jittered within a pixel).
     pub filter: FilterDesc,
-    /// Samples per pixel the scene asks for.
-    pub spp: u32,
     /// The scene's integrator settings.
     pub integrator: IntegratorDesc,
-    /// Output file name the scene asks for.
-    pub output: Option<String>,
     /// What the scene contains.
     pub features: SceneFeatures,
 }
@@ -155,89 +152,4 @@ impl TexturedParams {
             nonlinear: self.base.nonlinear,
         }
     }
-}
-
-/// A loaded scene and what the loader noticed.
-#[derive(Debug)]
-pub struct LoadedScene {
-    /// The built scene.
-    pub scene: Scene,
-    /// Warnings (ignored properties, fallbacks), each with `file:line`.
-    pub warnings: Vec<SceneWarning>,
-    /// The description it was built from.
-    pub desc: SceneDesc,
-}
-
-/// Parses the project's RON scene format.
-pub fn parse_ron(text: &str, file: &Path) -> Result<SceneDesc, SceneError> {
-    ron::Options::default()
-        .from_str::<SceneDesc>(text)
-        .map_err(|e| {
-            SceneError::new(
-                Location {
-                    file: file.to_path_buf(),
-                    line: e.span.start.line as u32,
-                },
-                e.code.to_string(),
-            )
-        })
-}
-
-/// Reads a scene description from a `.ron` or `.xml` file. `defines` set XML `<default>` values
-/// (`-D name=value` on the command line); they are an error for RON files, which have none.
-pub fn load_desc(
-    path: &Path,
-    defines: &[(String, String)],
-) -> Result<(SceneDesc, Vec<SceneWarning>), SceneError> {
-    let whole = |msg: String| {
-        SceneError::new(
-            Location {
-                file: path.to_path_buf(),
-                line: 0,
-            },
-            msg,
-        )
-    };
-    let text =
-        std::fs::read_to_string(path).map_err(|e| whole(format!("cannot read scene: {e}")))?;
-    match path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .as_deref()
-    {
-        Some("ron") => {
-            if let Some((name, _)) = defines.first() {
-                return Err(whole(format!(
-                    "-D {name}=…: RON scenes have no <default> variables to set"
-                )));
-            }
-            Ok((parse_ron(&text, path)?, Vec::new()))
-        }
-        Some("xml") => xml::parse_xml(&text, path, defines),
-        _ => Err(whole(
-            "unknown scene format: expected a .ron or .xml file".into(),
-        )),
-    }
-}
-
-/// Loads and builds a scene file.
-pub fn load_scene(path: &Path, defines: &[(String, String)]) -> Result<LoadedScene, SceneError> {
-    let (desc, mut warnings) = load_desc(path, defines)?;
-    let base: PathBuf = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let scene = Scene::build(&desc, &base, path)?;
-    if scene.lights.is_empty() {
-        warnings.push(SceneWarning {
-            location: Location {
-                file: path.to_path_buf(),
-                line: 0,
-            },
-            message: "the scene has no light sources (no emitter with positive radiance): the image will be black".into(),
-        });
-    }
-    Ok(LoadedScene {
-        scene,
-        warnings,
-        desc,
-    })
 }

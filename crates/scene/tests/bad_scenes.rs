@@ -58,7 +58,7 @@ fn load(path: &Path) -> Result<Result<Vec<String>, String>, String> {
     let (tx, rx) = mpsc::channel();
     let p = path.to_path_buf();
     let handle = std::thread::spawn(move || {
-        let r = restir_scene::load_scene(&p, &[])
+        let r = restir_scene::load_scene(&p, &restir_scene::LoadOptions::default())
             .map(|l| l.warnings.iter().map(ToString::to_string).collect())
             .map_err(|e| e.to_string());
         let _ = tx.send(r);

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use restir_scene::texture::{Texture, TextureDesc, UvTransform};
-use restir_scene::{LoadedScene, load_scene};
+use restir_scene::{LoadOptions, LoadedScene, load_scene};
 
 fn corpus() -> Option<PathBuf> {
     let dir = Path::new(concat!(
@@ -27,7 +27,7 @@ fn corpus() -> Option<PathBuf> {
 
 fn load(dir: &Path, rel: &str) -> LoadedScene {
     let path = dir.join(rel);
-    load_scene(&path, &[]).unwrap_or_else(|e| panic!("{rel} should load: {e}"))
+    load_scene(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{rel} should load: {e}"))
 }
 
 #[test]
@@ -146,7 +146,7 @@ fn serialized_meshes_of_the_corpus() {
         sp.display()
     );
     let path = shape_scene("serialized.xml", &shapes);
-    let s = load_scene(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
+    let s = load_scene(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(s.scene.shapes.len(), 4);
 
     // An index past the file's shapes: an error at the shape's line.
@@ -154,7 +154,7 @@ fn serialized_meshes_of_the_corpus() {
         "<shape type=\"serialized\">\n<string name=\"filename\" value=\"{}\"/><integer name=\"shape_index\" value=\"99\"/></shape>",
         mp.display()
     );
-    let e = load_scene(&shape_scene("bad-index.xml", &bad), &[])
+    let e = load_scene(&shape_scene("bad-index.xml", &bad), &LoadOptions::default())
         .unwrap_err()
         .to_string();
     assert!(
@@ -167,7 +167,7 @@ fn serialized_meshes_of_the_corpus() {
             "missing.xml",
             "<shape type=\"ply\"><string name=\"filename\" value=\"nope.ply\"/></shape>",
         ),
-        &[],
+        &LoadOptions::default(),
     )
     .unwrap_err()
     .to_string();

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use restir_scene::load_scene;
+use restir_scene::{LoadOptions, load_scene};
 
 /// A fresh directory per test (tests run in parallel and each removes its own).
 fn temp_dir(test: &str) -> PathBuf {
@@ -64,7 +64,8 @@ fn envmap_formats_orientation_and_scale() {
                 r#"    <emitter type="envmap"><string name="filename" value="{file}"/><float name="scale" value="2"/></emitter>"#
             ),
         );
-        let s = load_scene(&path, &[]).unwrap_or_else(|e| panic!("{file}: {e}"));
+        let s =
+            load_scene(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{file}: {e}"));
         assert!(s.scene.features.has_environment);
         let lights = &s.scene.lights;
         // +Y is the top row (row 0 → g = 1); −Y the bottom row (g = 3). Column x sits at
@@ -89,7 +90,7 @@ fn envmap_formats_orientation_and_scale() {
         r#"    <emitter type="envmap"><string name="filename" value="map.exr"/>
         <transform name="to_world"><rotate y="1" angle="90"/></transform></emitter>"#,
     );
-    let s = load_scene(&path, &[]).unwrap();
+    let s = load_scene(&path, &LoadOptions::default()).unwrap();
     let r = glam::Mat3::from_rotation_y(90f32.to_radians());
     let got = s.scene.lights.environment_radiance(r * -Vec3::Z);
     assert!((got.x - 2.5).abs() < 1e-3, "{got}");
@@ -104,7 +105,7 @@ fn envmap_formats_orientation_and_scale() {
         "p.xml",
         r#"    <emitter type="envmap"><string name="filename" value="map.png"/></emitter>"#,
     );
-    let s = load_scene(&path, &[]).unwrap();
+    let s = load_scene(&path, &LoadOptions::default()).unwrap();
     let l = s.scene.lights.environment_radiance(Vec3::Z);
     assert!((l.x - 0.5029).abs() < 1e-3, "{l}");
     let _ = std::fs::remove_dir_all(&dir);
@@ -158,7 +159,7 @@ fn envmap_bad_input_names_file_and_line() {
     ];
     for (name, emitter, want) in cases {
         let path = scene(&dir, name, emitter);
-        let e = match load_scene(&path, &[]) {
+        let e = match load_scene(&path, &LoadOptions::default()) {
             Ok(_) => panic!("{name} loads"),
             Err(e) => e.to_string(),
         };

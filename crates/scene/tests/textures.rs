@@ -8,7 +8,8 @@ use glam::Vec3;
 use restir_geometry::Ray;
 use restir_materials::BsdfKind;
 use restir_scene::{
-    ColorParam, MaterialDesc, Scene, TextureDesc, load_scene, parse_ron, xml::parse_xml,
+    ColorParam, LoadOptions, MaterialDesc, Scene, TextureDesc, load_scene, parse_ron,
+    xml::parse_xml,
 };
 
 /// A fresh directory with a 2×2 raw PNG: row 0 (top) red, green; row 1 blue, white.
@@ -66,7 +67,7 @@ fn xml_nested_and_referenced_textures() {
     <shape type="rectangle"><ref id="by_ref"/></shape>
     <shape type="rectangle"><transform name="to_world"><translate x="3"/></transform><ref id="nested"/></shape>"#,
     );
-    let loaded = load_scene(&path, &[]).unwrap();
+    let loaded = load_scene(&path, &LoadOptions::default()).unwrap();
     let scene = &loaded.scene;
     assert!(scene.features.has_textures);
     assert_eq!(scene.textures.len(), 2);
@@ -114,7 +115,7 @@ fn untextured_scenes_take_the_constant_path() {
     <bsdf type="diffuse" id="unused"><ref name="reflectance" id="quad"/></bsdf>
     <shape type="rectangle"><bsdf type="diffuse"><rgb name="reflectance" value="0.25"/></bsdf></shape>"#,
     );
-    let scene = load_scene(&path, &[]).unwrap().scene;
+    let scene = load_scene(&path, &LoadOptions::default()).unwrap().scene;
     assert!(!scene.features.has_textures);
     assert_eq!(
         diffuse_reflectance(seen_at(&scene, 0.3, 0.2)),
@@ -138,7 +139,7 @@ fn obj_texture_coordinates_count_v_from_the_bottom() {
         <bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="quad.png"/><boolean name="raw" value="true"/></texture></bsdf>
     </shape>"#,
     );
-    let scene = load_scene(&path, &[]).unwrap().scene;
+    let scene = load_scene(&path, &LoadOptions::default()).unwrap().scene;
     // Mitsuba 3 reads this OBJ's (vt 0 0) corner as uv (0, 1): the image's bottom-left texel.
     assert_eq!(diffuse_reflectance(seen_at(&scene, -0.5, -0.5)), Vec3::Z);
     assert_eq!(diffuse_reflectance(seen_at(&scene, -0.5, 0.5)), Vec3::X);

@@ -40,7 +40,7 @@ pub struct BenchArgs {
 
 /// Runs `restir bench`.
 pub fn run(args: BenchArgs) -> Result<(), String> {
-    let mut suite = Suite::load(&args.suite)?;
+    let mut suite = Suite::load(&args.suite).map_err(|e| e.to_string())?;
     if let Some(b) = &args.budgets {
         suite::check_budgets(b).map_err(|e| format!("--budgets: {e}"))?;
         suite.budgets = b.clone();
@@ -59,7 +59,7 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         .validate()
         .map_err(|e| format!("{}: {e}", args.suite.display()))?;
     if let Some(doc) = &args.update_doc {
-        check_doc(doc)?;
+        check_doc(doc).map_err(|e| e.to_string())?;
     }
     let threads = args.threads.unwrap_or(0);
     if threads > 1024 {
@@ -99,10 +99,10 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let results = results?;
-    write_outputs(&results, &args.out)?;
+    let results = results.map_err(|e| e.to_string())?;
+    write_outputs(&results, &args.out).map_err(|e| e.to_string())?;
     if let Some(doc) = &args.update_doc {
-        update_doc(&results, &args.out, doc)?;
+        update_doc(&results, &args.out, doc).map_err(|e| e.to_string())?;
     }
     if !args.quiet {
         println!(

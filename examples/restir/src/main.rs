@@ -11,10 +11,10 @@ use std::time::{Duration, Instant};
 use clap::{Parser, Subcommand};
 use restir_geometry::Shape;
 use restir_integrators::{
-    Image, IntegratorOptions, Param, ParamSet, ParamValue, RenderSettings, compare,
-    make_integrator, render,
+    Image, IntegratorOptions, Param, ParamSet, ParamValue, RenderJob, compare, make_integrator,
+    render,
 };
-use restir_scene::{Scene, load_desc};
+use restir_scene::{LoadOptions, load_scene};
 
 mod bench;
 mod generate;
@@ -215,28 +215,23 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
             .ok_or_else(|| format!("-D {d}: expected NAME=VALUE"))?;
         defines.push((k.trim().to_string(), v.trim().to_string()));
     }
-    let (mut desc, warnings) = load_desc(&args.scene, &defines).map_err(|e| e.to_string())?;
+    let options = LoadOptions {
+        defines,
+        width: args.width,
+        height: args.height,
+        // The command line has never warned about unlit scenes.
+        warn_no_lights: false,
+    };
+    let loaded = load_scene(&args.scene, &options).map_err(|e| e.to_string())?;
     if !args.quiet {
-        for w in &warnings {
+        for w in &loaded.warnings {
             eprintln!("{w}");
         }
     }
-    if let Some(w) = args.width {
-        desc.film.width = w;
-    }
-    if let Some(h) = args.height {
-        desc.film.height = h;
-    }
-    let base = args
-        .scene
-        .parent()
-        .map(Path::to_path_buf)
-        .unwrap_or_default();
-    let mut scene = Scene::build(&desc, &base, &args.scene).map_err(|e| e.to_string())?;
-    if scene.integrator.location.file.as_os_str().is_empty() {
-        // RON scenes carry no line numbers; errors in their parameters still name the file.
-        scene.integrator.location.file = args.scene.clone();
-    }
+    let scene = loaded.scene;
+    // The scene's sample count and file name are the job's defaults.
+    let mut job = RenderJob::from_desc(&loaded.desc);
+    job.seed = args.seed;
     let load_seconds = load_start.elapsed().as_secs_f64();
 
     let options = IntegratorOptions {
@@ -255,7 +250,7 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         }
     }
     let integrator = made.integrator;
-    let spp = args.spp.unwrap_or(scene.spp);
+    let spp = args.spp.unwrap_or(job.spp);
     if spp == 0 {
         return Err("--spp must be at least 1".into());
     }
@@ -271,24 +266,24 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         None => None,
     };
     // With only a time limit, keep rendering until it runs out.
-    let spp = if args.time_limit.is_some() && args.spp.is_none() {
+    job.spp = if args.time_limit.is_some() && args.spp.is_none() {
         u32::MAX
     } else {
         spp
     };
-    let output = match &args.output {
-        Some(o) => o.clone(),
-        None => match &scene.output {
-            Some(f) => PathBuf::from(f),
-            None => PathBuf::from(format!(
-                "{}.exr",
-                args.scene
-                    .file_stem()
-                    .and_then(|s| s.to_str())
-                    .unwrap_or("render")
-            )),
-        },
+    job.time_limit = time_limit;
+    let spp = job.spp;
+    let output = match args.output.clone().or(job.output.take()) {
+        Some(o) => o,
+        None => PathBuf::from(format!(
+            "{}.exr",
+            args.scene
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("render")
+        )),
     };
+    job.output = Some(output.clone());
     match output
         .extension()
         .and_then(|e| e.to_str())
@@ -361,16 +356,11 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         None
     };
 
-    let settings = RenderSettings {
-        spp,
-        time_limit,
-        seed: args.seed,
-    };
     let out = pool.install(|| {
         render(
             &scene,
             integrator.as_ref(),
-            &settings,
+            &job,
             &cancel,
             &mut |passes, elapsed| {
                 if let Some(b) = &bar {

@@ -5,7 +5,7 @@
 use std::sync::atomic::AtomicBool;
 
 use restir_integrators::{
-    Image, IntegratorOptions, Param, ParamSource, RenderSettings, make_integrator, render,
+    Image, IntegratorOptions, Param, ParamSource, RenderJob, make_integrator, render,
 };
 use restir_scene::Scene;
 
@@ -34,10 +34,10 @@ pub fn render_image(
     };
     let made = make_integrator(scene, &options).unwrap();
     assert!(made.unused_params.is_empty());
-    let settings = RenderSettings {
+    let settings = RenderJob {
         spp,
-        time_limit: None,
         seed,
+        ..RenderJob::default()
     };
     let out = render(
         scene,

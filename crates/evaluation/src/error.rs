@@ -1,0 +1,166 @@
+//! The errors of a benchmark run ([`BenchError`]): a bad suite, a scene that does not load, an
+//! integrator configuration that does not build, a file that cannot be read or written. Each
+//! names the file or the configuration it is about.
+
+use std::path::PathBuf;
+
+use restir_integrators::ImageError;
+use restir_scene::SceneError;
+
+use crate::suite::SuiteError;
+
+/// Why a benchmark run, or writing its outputs, failed.
+#[derive(Debug)]
+pub enum BenchError {
+    /// The suite breaks a rule.
+    Suite(SuiteError),
+    /// A scene of the suite does not load.
+    Scene(SceneError),
+    /// An integrator configuration does not build for a scene.
+    Integrator {
+        /// The configuration's label.
+        label: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A file or directory cannot be read, written or created.
+    Io {
+        /// The file or directory.
+        path: PathBuf,
+        /// What was being done, as a message prefix (`"cannot read scene: "`), possibly empty.
+        doing: &'static str,
+        /// The system's error.
+        source: std::io::Error,
+    },
+    /// An image cannot be read or written.
+    Image(ImageError),
+    /// A plot cannot be drawn.
+    Plot {
+        /// The SVG file.
+        path: PathBuf,
+        /// The plotting library's message.
+        message: String,
+    },
+    /// A scene's crop rectangle does not fit in its image.
+    Crop {
+        /// The scene file, as given in the suite.
+        scene: PathBuf,
+        /// The rectangle `(x, y, width, height)`.
+        rect: (u32, u32, u32, u32),
+        /// The image size.
+        size: (u32, u32),
+    },
+    /// A given reference image is not the size the scene renders.
+    ReferenceSize {
+        /// The reference file.
+        path: PathBuf,
+        /// Its size.
+        reference: (u32, u32),
+        /// The scene's.
+        scene: (u32, u32),
+    },
+    /// A render and the reference differ in size.
+    ReferenceMismatch,
+    /// A Markdown document lacks a results marker.
+    Marker {
+        /// The document.
+        doc: PathBuf,
+        /// Which marker is missing: `true` for the begin marker.
+        begin: bool,
+    },
+}
+
+impl BenchError {
+    /// An I/O error on `path` while `doing` (a message prefix such as `"cannot read: "`).
+    pub(crate) fn io(
+        path: impl Into<PathBuf>,
+        doing: &'static str,
+    ) -> impl FnOnce(std::io::Error) -> Self {
+        let path = path.into();
+        move |source| Self::Io {
+            path,
+            doing,
+            source,
+        }
+    }
+}
+
+impl std::fmt::Display for BenchError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Suite(e) => e.fmt(f),
+            Self::Scene(e) => e.fmt(f),
+            Self::Integrator { label, message } => write!(f, "integrator '{label}': {message}"),
+            Self::Io {
+                path,
+                doing,
+                source,
+            } => write!(f, "{}: {doing}{source}", path.display()),
+            Self::Image(e) => e.fmt(f),
+            Self::Plot { path, message } => {
+                write!(f, "{}: cannot draw plot: {message}", path.display())
+            }
+            Self::Crop {
+                scene,
+                rect: (x, y, w, h),
+                size: (width, height),
+            } => write!(
+                f,
+                "{}: crop ({x}, {y}, {w}, {h}) does not fit in {width}×{height}",
+                scene.display()
+            ),
+            Self::ReferenceSize {
+                path,
+                reference: (rw, rh),
+                scene: (w, h),
+            } => write!(
+                f,
+                "{}: reference is {rw}×{rh} but the scene renders {w}×{h}",
+                path.display()
+            ),
+            Self::ReferenceMismatch => f.write_str("reference size mismatch"),
+            Self::Marker { doc, begin: true } => write!(
+                f,
+                "{}: no '{}' marker: add the markers where the results belong",
+                doc.display(),
+                crate::BEGIN_MARKER
+            ),
+            Self::Marker { doc, begin: false } => write!(
+                f,
+                "{}: no '{}' after the begin marker",
+                doc.display(),
+                crate::END_MARKER
+            ),
+        }
+    }
+}
+
+impl std::error::Error for BenchError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Self::Suite(e) => Some(e),
+            Self::Scene(e) => Some(e),
+            Self::Io { source, .. } => Some(source),
+            Self::Image(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+impl From<SuiteError> for BenchError {
+    fn from(e: SuiteError) -> Self {
+        Self::Suite(e)
+    }
+}
+
+impl From<SceneError> for BenchError {
+    fn from(e: SceneError) -> Self {
+        Self::Scene(e)
+    }
+}
+
+impl From<ImageError> for BenchError {
+    fn from(e: ImageError) -> Self {
+        Self::Image(e)
+    }
+}
