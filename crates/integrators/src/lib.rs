@@ -20,8 +20,6 @@
 
 pub mod film;
 pub mod gbuffer;
-mod image_io;
-pub mod metrics;
 pub mod neighbors;
 mod params;
 pub mod path;
@@ -29,8 +27,7 @@ mod render;
 pub mod restir_di;
 pub mod restir_pt;
 
-pub use image_io::{Image, ImageError};
-pub use metrics::{ErrorMetrics, compare};
+pub use restir_image::{ErrorMetrics, Image, ImageError, compare};
 pub use render::{Integrator, PassContext, PathIntegrator, RenderOutput, RenderSettings, render};
 pub use restir_di::{RestirDiIntegrator, RestirDiSettings};
 pub use restir_pt::{RestirPtIntegrator, RestirPtSettings};
