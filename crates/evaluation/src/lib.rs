@@ -32,9 +32,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-use restir_integrators::{
-    Image, IntegratorOptions, RenderSettings, compare, make_integrator, render,
-};
+use restir_image::{Image, compare};
+use restir_integrators::{IntegratorOptions, RenderSettings, make_integrator, render};
 use restir_scene::{Scene, load_desc};
 
 mod plot;

@@ -27,9 +27,9 @@ mod render;
 pub mod restir_di;
 pub mod restir_pt;
 
-pub use restir_image::{ErrorMetrics, Image, ImageError, compare};
 pub use render::{Integrator, PassContext, PathIntegrator, RenderOutput, RenderSettings, render};
 pub use restir_di::{RestirDiIntegrator, RestirDiSettings};
+pub use restir_image::{ErrorMetrics, Image, ImageError, compare};
 pub use restir_pt::{RestirPtIntegrator, RestirPtSettings};
 
 use restir_scene::Scene;

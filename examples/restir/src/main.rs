@@ -10,9 +10,8 @@ use std::time::{Duration, Instant};
 
 use clap::{Parser, Subcommand};
 use restir_geometry::Shape;
-use restir_integrators::{
-    Image, IntegratorOptions, RenderSettings, compare, make_integrator, render,
-};
+use restir_image::{Image, compare};
+use restir_integrators::{IntegratorOptions, RenderSettings, make_integrator, render};
 use restir_scene::{Scene, load_desc};
 
 mod bench;
