@@ -13,25 +13,14 @@ use restir_gris::{
     GrisInput, GrisResampler, MisScheme, Reservoir, ShiftMap, Shifted, StreamingReservoir, mis,
     resample,
 };
+// SplitMix64 from the test kit, for reproducible inputs.
+use restir_testkit::SplitMix64 as Rng;
 
 fn main() {
     divan::main();
 }
 
 const BATCH: usize = 1024;
-
-/// SplitMix64, for reproducible inputs.
-struct Rng(u64);
-
-impl Rng {
-    fn next_f32(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
 
 /// A light-sample-sized payload (`light` is carried, as in a renderer, but not read here).
 #[derive(Clone, Copy, Debug)]
@@ -42,7 +31,7 @@ struct LightSample {
 }
 
 fn candidates(seed: u64) -> Vec<(LightSample, f32, f32)> {
-    let mut rng = Rng(seed);
+    let mut rng = Rng::new(seed);
     (0..BATCH)
         .map(|i| {
             let s = LightSample {
@@ -68,7 +57,7 @@ fn add(bencher: Bencher) {
 
 #[divan::bench(name = "merge (per 1024 streams)")]
 fn merge(bencher: Bencher) {
-    let mut rng = Rng(2);
+    let mut rng = Rng::new(2);
     let streams: Vec<StreamingReservoir<LightSample>> = candidates(3)
         .chunks(4)
         .cycle()
@@ -129,7 +118,7 @@ type Scene = (
 );
 
 fn scene(k: usize) -> Scene {
-    let mut rng = Rng(10 + k as u64);
+    let mut rng = Rng::new(10 + k as u64);
     let pixel = |rng: &mut Rng| Pixel {
         normal: [0.0, 0.0, 1.0],
         offset: [rng.next_f32() * 0.1, rng.next_f32() * 0.1, -1.0],
@@ -162,7 +151,7 @@ fn bench_scheme(bencher: Bencher, k: usize, scheme: MisScheme) {
     let (c, rc, neighbors) = scene(k);
     let list: Vec<(&Pixel, &Reservoir<LightSample>)> =
         neighbors.iter().map(|(p, r)| (p, r)).collect();
-    let mut rng = Rng(99);
+    let mut rng = Rng::new(99);
     bencher.bench_local(|| {
         black_box(resample(
             &AreaIdentity,
@@ -203,7 +192,7 @@ fn resample_constant_biased(bencher: Bencher, k: usize) {
 /// The bare resampling arithmetic: k + 1 pre-shifted inputs with caller-computed balance weights.
 #[divan::bench(args = [3, 5])]
 fn gris_resampler_step(bencher: Bencher, k: usize) {
-    let mut rng = Rng(7);
+    let mut rng = Rng::new(7);
     let inputs: Vec<GrisInput<LightSample>> = (0..=k)
         .map(|i| GrisInput {
             sample: LightSample {

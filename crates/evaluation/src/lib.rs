@@ -32,7 +32,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-use restir_integrators::{Image, IntegratorOptions, RenderJob, compare, make_integrator, render};
+use restir_image::{Image, compare};
+use restir_integrators::{IntegratorOptions, RenderJob, make_integrator, render};
 use restir_scene::{LoadOptions, Scene, load_scene};
 
 mod error;

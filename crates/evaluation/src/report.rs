@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 use std::path::{Component, Path, PathBuf};
 
 use glam::Vec3;
-use restir_integrators::Image;
+use restir_image::Image;
 
 use crate::plot::{Series, relmse_plot};
 use crate::{BenchError, BenchResults, RunRecord, Strip};

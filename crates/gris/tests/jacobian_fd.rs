@@ -8,10 +8,8 @@
 // Uses `reconnection_jacobian_from_points`, which needs the `std` feature (square roots).
 #![cfg(feature = "std")]
 
-mod support;
-
 use restir_gris::jacobian::{reconnection_jacobian_from_points, reconnection_jacobian_solid_angle};
-use support::Rng;
+use restir_testkit::SplitMix64 as Rng;
 
 type V = [f64; 3];
 

@@ -4,8 +4,6 @@
 // Uses `reconnection_jacobian_from_points`, which needs the `std` feature (square roots).
 #![cfg(feature = "std")]
 
-mod support;
-
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use restir_gris::jacobian::{
@@ -17,7 +15,7 @@ use restir_gris::{
     GrisInput, GrisResampler, PairwiseNeighbor, PairwiseResampler, PairwiseVariant, Reservoir,
     Shifted, StreamingReservoir, mis,
 };
-use support::Rng;
+use restir_testkit::SplitMix64 as Rng;
 
 fn config(cases: u32) -> ProptestConfig {
     ProptestConfig {

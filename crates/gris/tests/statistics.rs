@@ -12,9 +12,11 @@ use restir_gris::{
     GrisInput, GrisResampler, MisScheme, PairwiseNeighbor, PairwiseResampler, PairwiseVariant,
     Reservoir, ShiftMap, StreamingReservoir, mis, resample,
 };
+use restir_testkit::{
+    RunningStats as Stats, SplitMix64 as Rng, chi_square, chi_square_critical, trials,
+};
 use support::{
-    PowerShift, Rng, Stats, TOY_INTEGRAL, TOY_UNCOVERED_INTEGRAL, ToyDomain, chi_square,
-    chi_square_critical, toy_domains, toy_integrand, trials,
+    PowerShift, TOY_INTEGRAL, TOY_UNCOVERED_INTEGRAL, ToyDomain, toy_domains, toy_integrand,
 };
 
 // ------------------------------------------------------------------------------------------

@@ -7,7 +7,8 @@ use restir_gris::jacobian::{inverse_jacobian, reconnection_jacobian_solid_angle}
 use restir_gris::{
     GrisInput, GrisResampler, MisScheme, Reservoir, StreamingReservoir, mis, resample,
 };
-use support::{PowerShift, Rng, Stats, TOY_INTEGRAL, toy_domains, toy_integrand, trials};
+use restir_testkit::{RunningStats as Stats, SplitMix64 as Rng, trials};
+use support::{PowerShift, TOY_INTEGRAL, toy_domains, toy_integrand};
 
 /// Kahan-compensated reference sum.
 fn kahan(values: impl Iterator<Item = f64>) -> f64 {

@@ -20,8 +20,6 @@
 //! ```
 
 pub mod film;
-mod image_io;
-pub mod metrics;
 pub mod params;
 pub mod path;
 mod render;
@@ -30,11 +28,10 @@ pub mod restir_pt;
 pub mod reuse;
 pub mod shadow;
 
-pub use image_io::{Image, ImageError};
-pub use metrics::{ErrorMetrics, compare};
 pub use params::{Param, ParamError, ParamSet, ParamSource, ParamValue};
 pub use render::{Integrator, PassContext, PathIntegrator, RenderJob, RenderOutput, render};
 pub use restir_di::{RestirDiIntegrator, RestirDiSettings};
+pub use restir_image::{ErrorMetrics, Image, ImageError, compare};
 pub use restir_pt::{RestirPtIntegrator, RestirPtSettings};
 
 use restir_scene::Scene;

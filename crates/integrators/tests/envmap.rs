@@ -13,6 +13,8 @@
 
 use std::path::{Path, PathBuf};
 
+use glam::Vec3;
+use restir_integrators::Image;
 use restir_scene::{Scene, parse_ron};
 
 mod common;
@@ -26,12 +28,14 @@ fn temp_dir(test: &str) -> PathBuf {
 }
 
 /// Writes a `w × h` EXR with texel `f(x, y)` (row 0 at the top).
-fn write_exr(path: &Path, w: usize, h: usize, f: impl Fn(usize, usize) -> [f32; 3] + Sync) {
-    exr::prelude::write_rgb_file(path, w, h, |x, y| {
-        let p = f(x, y);
-        (p[0], p[1], p[2])
-    })
-    .unwrap();
+fn write_exr(path: &Path, w: usize, h: usize, f: impl Fn(usize, usize) -> [f32; 3]) {
+    let mut img = Image::new(w as u32, h as u32);
+    for y in 0..h {
+        for x in 0..w {
+            img.pixels[y * w + x] = Vec3::from(f(x, y));
+        }
+    }
+    img.write(path).unwrap();
 }
 
 fn build(ron: &str) -> Scene {

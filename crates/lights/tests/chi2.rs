@@ -1,4 +1,4 @@
-//! Chi-square tests of light sampling (`restir_sampling::stats`, after Mitsuba 3's chi-square
+//! Chi-square tests of light sampling (`restir_testkit`, after Mitsuba 3's chi-square
 //! test) on a small scene of area lights (rectangles, a sphere, a cube) and a point light.
 //!
 //! - **Selection**: the light index [`LightSet::sample`] picks follows [`LightSet::pmf`], and the
@@ -20,10 +20,8 @@ use core::f32::consts::PI;
 use glam::{Affine3A, Quat, Vec2, Vec3};
 use restir_geometry::{Shape, Sphere, TriangleMesh};
 use restir_lights::{Light, LightSet};
-use restir_sampling::stats::{
-    Chi2Error, Chi2Outcome, Histogram, Quadrature, SphereGrid, sidak_level,
-};
 use restir_sampling::{Pcg32, luminance};
+use restir_testkit::{Chi2Error, Chi2Outcome, Histogram, Quadrature, SphereGrid, sidak_level};
 
 /// Chi-square hypothesis tests in this file (negative controls excluded).
 const CHI2_TESTS: usize = 6;

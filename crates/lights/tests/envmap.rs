@@ -1,5 +1,5 @@
 //! Environment-map light: chi-square test of its direction sampling against the density it
-//! reports (`restir_sampling::stats`, binned on a `(cos θ, φ)` grid), through [`LightSet`] as the
+//! reports (`restir_testkit`, binned on a `(cos θ, φ)` grid), through [`LightSet`] as the
 //! integrators use it, with two negative controls (the map turned by one texel: samples land
 //! where that density is zero; the sun 20 % dimmer: same support, p < 1e-6); and its power,
 //! which must be consistent with the constant environment's.
@@ -7,7 +7,7 @@
 use glam::{Mat3, Vec3};
 use restir_lights::{EnvMap, Light, LightSet};
 use restir_sampling::Pcg32;
-use restir_sampling::stats::{Histogram, Quadrature, SphereGrid, sidak_level};
+use restir_testkit::{Histogram, Quadrature, SphereGrid, sidak_level};
 
 /// A 32×16 map with a bright sun, a coloured band and a dark quadrant, rotated off the axes.
 fn map(scale: f32) -> EnvMap {

@@ -4,7 +4,7 @@
 //! Every check runs over the table [`cases`] × the directions [`wos`]; a new BSDF is tested by
 //! adding one [`Case`] to the table.
 //!
-//! - **Chi-square** (`restir_sampling::stats`, after Mitsuba 3): sampled `wi` are binned on a
+//! - **Chi-square** (`restir_testkit`, after Mitsuba 3): sampled `wi` are binned on a
 //!   10 × 20 `(cos θ, φ)` grid over the whole sphere, `pdf_sa(wo, ·)` is integrated over the same
 //!   cells; failed and delta-lobe samples are tested as one more cell whose expected count is
 //!   `N · (1 − ∫ pdf_sa)`. A test fails when `p < sidak_level(0.01, m)` with `m` the number of
@@ -26,10 +26,8 @@
 
 use glam::Vec3;
 use restir_materials::{Bsdf, Distribution, LobeFlags, Microfacet, ior};
-use restir_sampling::stats::{
-    Chi2Error, Chi2Outcome, Histogram, Quadrature, SphereGrid, sidak_level,
-};
 use restir_sampling::{Pcg32, warp};
+use restir_testkit::{Chi2Error, Chi2Outcome, Histogram, Quadrature, SphereGrid, sidak_level};
 
 /// How much of `pdf_sa`'s mass a BSDF has from the side `wo` is on.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -14,8 +14,8 @@
 
 use glam::{Vec2, Vec3};
 use restir_materials::{Bsdf, Distribution, LobeFlags, Microfacet, fresnel, ior};
-use restir_sampling::stats::{Histogram, Quadrature, SphereGrid};
 use restir_sampling::{Pcg32, warp};
+use restir_testkit::{Histogram, Quadrature, SphereGrid};
 
 fn sph(theta_deg: f32, phi_deg: f32) -> Vec3 {
     let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());

@@ -26,7 +26,6 @@
 mod distribution;
 mod rng;
 pub mod sequences;
-pub mod stats;
 pub mod warp;
 
 pub use distribution::{AliasTable, Distribution1D, Distribution2D};

@@ -1,5 +1,5 @@
 //! Chi-square goodness-of-fit tests of every warp and distribution against the density it claims
-//! (`restir_sampling::stats`, after Mitsuba 3's chi-square test).
+//! (`restir_testkit`, after Mitsuba 3's chi-square test).
 //!
 //! Each test draws samples from a fixed seed, bins them, integrates the claimed pdf/pmf over the
 //! same cells and runs Pearson's test. A test fails when its p-value is below
@@ -9,10 +9,10 @@
 //! must be rejected with p < 1e-6, so a pass above means something.
 
 use glam::{Vec2, Vec3};
-use restir_sampling::stats::{
+use restir_sampling::{AliasTable, Distribution1D, Distribution2D, Pcg32, warp};
+use restir_testkit::{
     Chi2Error, Chi2Outcome, Grid2D, Histogram, Quadrature, SphereGrid, sidak_level,
 };
-use restir_sampling::{AliasTable, Distribution1D, Distribution2D, Pcg32, warp};
 
 /// Number of chi-square hypothesis tests in this file (negative controls excluded), for the
 /// Šidák correction.
@@ -332,4 +332,36 @@ fn control_sample_where_pdf_is_zero() {
         hist.chi2(&p),
         Err(Chi2Error::SampleInZeroBin { .. })
     ));
+}
+
+/// The chi-square recipe end to end on the cosine-weighted hemisphere (formerly the example of
+/// `restir_sampling::stats`, whose code now lives in `restir_testkit`): accepted against its own
+/// density at the single-test level, rejected against the uniform hemisphere.
+#[test]
+fn recipe_example_cosine_hemisphere() {
+    let grid = SphereGrid::default(); // 10 cos θ bins × 20 φ bins over the whole sphere
+    let mut hist = Histogram::new(grid.len());
+    let mut rng = Pcg32::new(1, 0);
+    for _ in 0..20_000 {
+        hist.record(grid.bin(warp::sample_cosine_hemisphere(rng.next_2d())));
+    }
+    let probabilities = grid.integrate(
+        |w| warp::cosine_hemisphere_pdf(w.z) as f64,
+        &Quadrature::default(),
+    );
+    let outcome = hist.chi2(&probabilities).unwrap();
+    assert!(outcome.p_value >= sidak_level(0.01, 1), "{outcome}");
+
+    // The same samples against the wrong density are rejected.
+    let wrong = grid.integrate(
+        |w| {
+            if w.z >= 0.0 {
+                warp::UNIFORM_HEMISPHERE_PDF as f64
+            } else {
+                0.0
+            }
+        },
+        &Quadrature::default(),
+    );
+    assert!(hist.chi2(&wrong).unwrap().p_value < 1e-6);
 }

@@ -9,6 +9,7 @@
 use std::path::Path;
 
 use glam::{Vec2, Vec3};
+use restir_image::{Image, IntegerEncoding};
 use serde::{Deserialize, Serialize};
 
 /// The `uv` transform of a texture: `uv' = uv · scale + offset` (Mitsuba 0.6 `uscale`/`vscale`/
@@ -102,15 +103,6 @@ pub enum Texture {
     },
 }
 
-/// sRGB transfer function → linear.
-fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 impl Texture {
     /// Reads the files a description names; `base_dir` resolves relative paths.
     pub fn load(desc: &TextureDesc, base_dir: &Path) -> Result<Texture, String> {
@@ -202,66 +194,23 @@ impl Texture {
     }
 }
 
-/// Reads PNG/JPEG (8- or 16-bit, sRGB-decoded unless `raw`), EXR or Radiance HDR (linear) as
-/// linear RGB, the first row at the top. Also used for environment maps.
+/// Reads an image file as linear RGB texels, the first row at the top
+/// ([`restir_image::Image::read`]: PNG/JPEG sRGB-decoded unless `raw`, EXR and Radiance HDR linear).
+/// Also used for environment maps.
 pub(crate) fn read_image(path: &Path, raw: bool) -> Result<(usize, usize, Vec<Vec3>), String> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .unwrap_or_default();
-    let fail = |e: &dyn core::fmt::Display| format!("cannot read image '{}': {e}", path.display());
-    let (w, h, texels) = if ext == "exr" {
-        let img = exr::prelude::read_first_rgba_layer_from_file(
-            path,
-            |res, _| (res.width(), vec![Vec3::ZERO; res.width() * res.height()]),
-            |(w, px): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-                if let Some(t) = px.get_mut(pos.y() * *w + pos.x()) {
-                    *t = Vec3::new(r, g, b);
-                }
-            },
-        )
-        .map_err(|e| fail(&e))?;
-        let size = img.layer_data.size;
-        (
-            size.width(),
-            size.height(),
-            img.layer_data.channel_data.pixels.1,
-        )
+    let encoding = if raw {
+        IntegerEncoding::Raw
     } else {
-        let img = image::ImageReader::open(path)
-            .map_err(|e| fail(&e))?
-            .with_guessed_format()
-            .map_err(|e| fail(&e))?
-            .decode()
-            .map_err(|e| fail(&e))?;
-        let (w, h) = (img.width() as usize, img.height() as usize);
-        // Float formats (Radiance HDR) hold linear values already.
-        let linear = raw
-            || matches!(
-                img,
-                image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
-            );
-        let rgb = img.to_rgb32f();
-        let decode = |c: f32| if linear { c } else { srgb_to_linear(c) };
-        let texels = rgb
-            .pixels()
-            .map(|p| Vec3::new(decode(p.0[0]), decode(p.0[1]), decode(p.0[2])))
-            .collect();
-        (w, h, texels)
+        IntegerEncoding::Srgb
     };
-    if w == 0 || h == 0 || texels.len() != w * h {
-        return Err(fail(&"empty or inconsistent image"));
-    }
-    if texels.iter().any(|t| !t.is_finite()) {
-        return Err(fail(&"non-finite texel values"));
-    }
-    Ok((w, h, texels))
+    let img = Image::read(path, encoding).map_err(|e| e.to_string())?;
+    Ok((img.width as usize, img.height as usize, img.pixels))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use restir_image::srgb::decode as srgb_to_linear;
 
     #[test]
     fn checkerboard_pattern_and_scale() {

@@ -10,9 +10,9 @@ use std::time::{Duration, Instant};
 
 use clap::{Parser, Subcommand};
 use restir_geometry::Shape;
+use restir_image::{Image, compare};
 use restir_integrators::{
-    Image, IntegratorOptions, Param, ParamSet, ParamValue, RenderJob, compare, make_integrator,
-    render,
+    IntegratorOptions, Param, ParamSet, ParamValue, RenderJob, make_integrator, render,
 };
 use restir_scene::{LoadOptions, load_scene};
 

@@ -1,5 +1,6 @@
-//! Helpers shared by the integrators' statistical tests: render a scene with an estimator and
-//! compare per-block means of independent renders by their standard errors.
+//! Helpers shared by the integrators' statistical tests: render a scene with an estimator, and
+//! the test kit's block statistics (per-block means of independent renders and their standard
+//! errors) applied to [`Image`]s.
 #![allow(dead_code)] // each test file uses a different subset
 
 use std::sync::atomic::AtomicBool;
@@ -55,43 +56,18 @@ pub fn render_image(
 
 /// Mean RGB-average of each `block`×`block` block of the image (row-major blocks).
 pub fn block_means(img: &Image, block: u32) -> Vec<f64> {
-    let (bx, by) = (img.width / block, img.height / block);
-    let mut out = vec![0.0; (bx * by) as usize];
-    for y in 0..by * block {
-        for x in 0..bx * block {
-            let p = img.pixels[(y * img.width + x) as usize];
-            out[((y / block) * bx + x / block) as usize] +=
-                f64::from(p.x + p.y + p.z) / 3.0 / f64::from(block * block);
-        }
-    }
-    out
+    restir_testkit::block_means(img.width, img.height, &img.pixels, block)
 }
 
 /// Per block: mean and standard error of the mean over `seeds` independent renders with seeds
-/// `seed_base`, `seed_base + 1`, ….
+/// `seed_base`, `seed_base + 1`, … (the test kit's block statistics of [`block_means`]).
 pub fn block_statistics(
     render_one: impl Fn(u64) -> Image,
     seeds: u64,
     seed_base: u64,
     block: u32,
 ) -> Vec<(f64, f64)> {
-    let samples: Vec<Vec<f64>> = (0..seeds)
-        .map(|s| block_means(&render_one(seed_base + s), block))
-        .collect();
-    let n = seeds as f64;
-    (0..samples[0].len())
-        .map(|b| {
-            let mean = samples.iter().map(|v| v[b]).sum::<f64>() / n;
-            let var = samples.iter().map(|v| (v[b] - mean).powi(2)).sum::<f64>() / (n - 1.0);
-            (mean, (var / n).sqrt())
-        })
-        .collect()
+    restir_testkit::block_statistics(|s| block_means(&render_one(s), block), seeds, seed_base)
 }
 
-/// The largest |z| over blocks between two sets of block statistics.
-pub fn max_z(a: &[(f64, f64)], b: &[(f64, f64)]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(&(ma, sa), &(mb, sb))| (ma - mb).abs() / (sa * sa + sb * sb).sqrt().max(1e-12))
-        .fold(0.0, f64::max)
-}
+pub use restir_testkit::max_z;

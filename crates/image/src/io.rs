@@ -1,0 +1,241 @@
+//! Reading and writing image files: EXR (linear float32), PNG (8-bit sRGB) output; EXR, Radiance
+//! HDR, PNG and JPEG input. The one EXR decoder of the workspace is [`read_exr_pixels`].
+
+use std::path::Path;
+
+use glam::Vec3;
+
+use crate::{Image, ImageError, ReadFailure, srgb};
+
+/// How [`Image::read`] interprets the integer (8- or 16-bit) channels of PNG and JPEG files.
+/// Float formats (EXR, Radiance HDR) hold linear values and are never decoded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum IntegerEncoding {
+    /// sRGB-encoded: decoded with [`srgb::decode`] (colour images).
+    #[default]
+    Srgb,
+    /// Used as they are, divided by the largest code (data such as roughness maps: Mitsuba's
+    /// `raw = true`).
+    Raw,
+}
+
+/// The file name's extension, lower case.
+fn extension(path: &Path) -> Option<String> {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+}
+
+/// Decodes the first RGB(A) layer of an EXR file (alpha is ignored): `(width, height, pixels)`.
+fn read_exr_pixels(path: &Path) -> Result<(usize, usize, Vec<Vec3>), exr::error::Error> {
+    let img = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |res, _| (res.width(), vec![Vec3::ZERO; res.width() * res.height()]),
+        |(w, px): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            if let Some(t) = px.get_mut(pos.y() * *w + pos.x()) {
+                *t = Vec3::new(r, g, b);
+            }
+        },
+    )?;
+    let size = img.layer_data.size;
+    Ok((
+        size.width(),
+        size.height(),
+        img.layer_data.channel_data.pixels.1,
+    ))
+}
+
+impl Image {
+    /// Writes the image; the format follows the extension: `.exr` is linear float32 RGB, `.png`
+    /// 8-bit sRGB (clamped to [0, 1]).
+    pub fn write(&self, path: &Path) -> Result<(), ImageError> {
+        match extension(path).as_deref() {
+            Some("exr") => {
+                let w = self.width as usize;
+                exr::prelude::write_rgb_file(path, w, self.height as usize, |x, y| {
+                    let p = self.pixels[y * w + x];
+                    (p.x, p.y, p.z)
+                })
+                .map_err(|source| ImageError::WriteExr {
+                    path: path.to_path_buf(),
+                    source,
+                })
+            }
+            Some("png") => {
+                let bytes: Vec<u8> = self
+                    .pixels
+                    .iter()
+                    .flat_map(|p| {
+                        [
+                            srgb::encode_u8(p.x),
+                            srgb::encode_u8(p.y),
+                            srgb::encode_u8(p.z),
+                        ]
+                    })
+                    .collect();
+                image::save_buffer(
+                    path,
+                    &bytes,
+                    self.width,
+                    self.height,
+                    image::ExtendedColorType::Rgb8,
+                )
+                .map_err(|source| ImageError::WritePng {
+                    path: path.to_path_buf(),
+                    source,
+                })
+            }
+            _ => Err(ImageError::UnknownFormat {
+                path: path.to_path_buf(),
+            }),
+        }
+    }
+
+    /// Reads the first RGB(A) layer of an EXR file (alpha is ignored), as written by
+    /// [`Image::write`].
+    pub fn read_exr(path: &Path) -> Result<Self, ImageError> {
+        let (w, h, pixels) = read_exr_pixels(path).map_err(|source| ImageError::ReadExr {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Ok(Self {
+            width: w as u32,
+            height: h as u32,
+            pixels,
+        })
+    }
+
+    /// Reads an image a scene refers to as linear RGB, the first row at the top: EXR (by
+    /// extension) and Radiance HDR hold linear values; PNG/JPEG (8- or 16-bit, format guessed from
+    /// the contents) are decoded as `encoding` says. Empty images and non-finite values are errors.
+    /// Used for bitmap textures and environment maps.
+    pub fn read(path: &Path, encoding: IntegerEncoding) -> Result<Self, ImageError> {
+        let fail = |reason| ImageError::Read {
+            path: path.to_path_buf(),
+            reason,
+        };
+        let (w, h, texels) = if extension(path).as_deref() == Some("exr") {
+            read_exr_pixels(path).map_err(|e| fail(ReadFailure::Exr(e)))?
+        } else {
+            let img = image::ImageReader::open(path)
+                .map_err(|e| fail(ReadFailure::Io(e)))?
+                .with_guessed_format()
+                .map_err(|e| fail(ReadFailure::Io(e)))?
+                .decode()
+                .map_err(|e| fail(ReadFailure::Decode(e)))?;
+            let (w, h) = (img.width() as usize, img.height() as usize);
+            // Float formats (Radiance HDR) hold linear values already.
+            let linear = encoding == IntegerEncoding::Raw
+                || matches!(
+                    img,
+                    image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+                );
+            let rgb = img.to_rgb32f();
+            let decode = |c: f32| if linear { c } else { srgb::decode(c) };
+            let texels = rgb
+                .pixels()
+                .map(|p| Vec3::new(decode(p.0[0]), decode(p.0[1]), decode(p.0[2])))
+                .collect();
+            (w, h, texels)
+        };
+        if w == 0 || h == 0 || texels.len() != w * h {
+            return Err(fail(ReadFailure::Empty));
+        }
+        if texels.iter().any(|t| !t.is_finite()) {
+            return Err(fail(ReadFailure::NonFinite));
+        }
+        Ok(Self {
+            width: w as u32,
+            height: h as u32,
+            pixels: texels,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn temp_dir(tag: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("restir-image-{tag}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    #[test]
+    fn exr_roundtrip() {
+        let mut img = Image::new(3, 2);
+        for (i, p) in img.pixels.iter_mut().enumerate() {
+            *p = Vec3::new(i as f32, 0.5 * i as f32, 1e-3);
+        }
+        let dir = temp_dir("exr");
+        let path = dir.join("t.exr");
+        img.write(&path).unwrap();
+        let back = Image::read_exr(&path).unwrap();
+        assert_eq!(back, img);
+        assert_eq!(Image::read(&path, IntegerEncoding::Srgb).unwrap(), img);
+        img.write(&dir.join("t.png")).unwrap();
+        assert!(img.write(&dir.join("t.bmp")).is_err());
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// PNG output is 8-bit sRGB; reading it back decodes it (or not, when raw).
+    #[test]
+    fn png_roundtrip_through_srgb() {
+        let mut img = Image::new(2, 1);
+        img.pixels = vec![Vec3::new(0.0, 0.5, 1.0), Vec3::new(2.0, f32::NAN, 0.25)];
+        let dir = temp_dir("png");
+        let path = dir.join("t.png");
+        img.write(&path).unwrap();
+        let raw = Image::read(&path, IntegerEncoding::Raw).unwrap();
+        assert_eq!(raw.pixels[0], Vec3::new(0.0, 188.0 / 255.0, 1.0));
+        assert_eq!(raw.pixels[1].y, 0.0);
+        let back = Image::read(&path, IntegerEncoding::Srgb).unwrap();
+        assert!(
+            (back.pixels[0] - Vec3::new(0.0, 0.5, 1.0))
+                .abs()
+                .max_element()
+                < 0.01
+        );
+        assert!(
+            (back.pixels[1] - Vec3::new(1.0, 0.0, 0.25))
+                .abs()
+                .max_element()
+                < 0.01
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// The messages name the file, as the scene loader and the command line report them.
+    #[test]
+    fn error_messages() {
+        let dir = temp_dir("err");
+        let missing = dir.join("nope.exr");
+        let e = Image::read_exr(&missing).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with(&format!("{}: cannot read EXR: ", missing.display())),
+            "{e}"
+        );
+        assert_eq!(e.path(), missing);
+        let e = Image::read(&dir.join("nope.png"), IntegerEncoding::Srgb).unwrap_err();
+        assert!(
+            e.to_string().starts_with(&format!(
+                "cannot read image '{}': ",
+                dir.join("nope.png").display()
+            )),
+            "{e}"
+        );
+        let bmp = dir.join("t.bmp");
+        assert_eq!(
+            Image::new(1, 1).write(&bmp).unwrap_err().to_string(),
+            format!(
+                "{}: unknown image format: use a .exr or .png file name",
+                bmp.display()
+            )
+        );
+        std::fs::write(dir.join("bad.png"), b"not a png").unwrap();
+        assert!(Image::read(&dir.join("bad.png"), IntegerEncoding::Srgb).is_err());
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
