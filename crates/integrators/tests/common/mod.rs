@@ -70,4 +70,7 @@ pub fn block_statistics(
     restir_testkit::block_statistics(|s| block_means(&render_one(s), block), seeds, seed_base)
 }
 
-pub use restir_testkit::max_z;
+/// The largest |z| over blocks between two sets of block statistics (the test kit's).
+pub fn max_z(a: &[(f64, f64)], b: &[(f64, f64)]) -> f64 {
+    restir_testkit::max_z(a, b)
+}
