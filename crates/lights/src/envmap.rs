@@ -103,6 +103,47 @@ pub struct EnvMap {
     luminance_integral: f32,
 }
 
+/// Why [`EnvMap::new`] refused its input.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EnvMapError {
+    /// The texel count is not `width × height` (or the image is empty).
+    TexelCount {
+        /// Width in texels.
+        width: usize,
+        /// Height in texels.
+        height: usize,
+        /// Texels given.
+        texels: usize,
+    },
+    /// The radiance scale is negative or not finite.
+    Scale(f32),
+    /// A texel is negative or not finite.
+    Texels,
+    /// `to_world` scales, shears or projects.
+    NotRotation,
+}
+
+impl std::fmt::Display for EnvMapError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            EnvMapError::TexelCount {
+                width,
+                height,
+                texels,
+            } => write!(f, "envmap image of {width}×{height} has {texels} texels"),
+            EnvMapError::Scale(scale) => {
+                write!(f, "envmap scale {scale} must be finite and non-negative")
+            }
+            EnvMapError::Texels => f.write_str("envmap image has negative or non-finite texels"),
+            EnvMapError::NotRotation => {
+                f.write_str("envmap to_world must be a rotation (no scale, shear or projection)")
+            }
+        }
+    }
+}
+
+impl std::error::Error for EnvMapError {}
+
 impl EnvMap {
     /// Builds from `width × height` linear RGB texels (first row at the top), a radiance `scale`
     /// and the rotation `to_world` (an orthogonal matrix: the map's local frame in world space).
@@ -112,31 +153,28 @@ impl EnvMap {
         texels: Vec<Vec3>,
         scale: f32,
         to_world: Mat3,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, EnvMapError> {
         if width == 0 || height == 0 || texels.len() != width * height {
-            return Err(format!(
-                "envmap image of {width}×{height} has {} texels",
-                texels.len()
-            ));
+            return Err(EnvMapError::TexelCount {
+                width,
+                height,
+                texels: texels.len(),
+            });
         }
         if !(scale.is_finite() && scale >= 0.0) {
-            return Err(format!(
-                "envmap scale {scale} must be finite and non-negative"
-            ));
+            return Err(EnvMapError::Scale(scale));
         }
         if texels
             .iter()
             .any(|t| !t.is_finite() || t.min_element() < 0.0)
         {
-            return Err("envmap image has negative or non-finite texels".into());
+            return Err(EnvMapError::Texels);
         }
         // Only rotations (and reflections) keep directions unit length and the density's
         // Jacobian 1; reject scale and shear.
         let gram = to_world.transpose() * to_world;
         if !to_world.is_finite() || !gram.abs_diff_eq(Mat3::IDENTITY, 1e-3) {
-            return Err(
-                "envmap to_world must be a rotation (no scale, shear or projection)".into(),
-            );
+            return Err(EnvMapError::NotRotation);
         }
         let mut texels: Vec<Vec3> = texels.into_iter().map(|t| t * scale).collect();
         let height = if height == 1 {

@@ -13,7 +13,7 @@
 
 mod envmap;
 
-pub use envmap::EnvMap;
+pub use envmap::{EnvMap, EnvMapError};
 
 use core::f32::consts::PI;
 use glam::{Vec2, Vec3};

@@ -43,7 +43,7 @@ impl TextureCache {
         if let Some(i) = self.descs.iter().position(|e| e == d) {
             return Ok(i as u32);
         }
-        let t = Texture::load(d, base_dir)?;
+        let t = Texture::load(d, base_dir).map_err(|e| e.to_string())?;
         self.descs.push(d.clone());
         self.textures.push(t);
         Ok(self.textures.len() as u32 - 1)
@@ -86,8 +86,9 @@ fn build_envmap(
     base_dir: &Path,
 ) -> Result<EnvMap, String> {
     let m = transform_matrix(to_world).map_err(|e| e.to_string())?;
-    let (w, h, texels) = crate::texture::read_image(&base_dir.join(filename), false)?;
-    EnvMap::new(w, h, texels, scale, glam::Mat3::from_mat4(m))
+    let (w, h, texels) =
+        crate::texture::read_image(&base_dir.join(filename), false).map_err(|e| e.to_string())?;
+    EnvMap::new(w, h, texels, scale, glam::Mat3::from_mat4(m)).map_err(|e| e.to_string())
 }
 
 fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<Shape, String> {

@@ -103,22 +103,60 @@ pub enum Texture {
     },
 }
 
+/// Why a texture could not be made.
+#[derive(Debug)]
+pub enum TextureError {
+    /// The uv transform has a non-finite scale or offset.
+    UvNotFinite {
+        /// The scale given.
+        scale: Vec2,
+        /// The offset given.
+        offset: Vec2,
+    },
+    /// A checkerboard colour leaves `[0, 1]`.
+    CheckerColor {
+        /// `color0` or `color1`.
+        name: &'static str,
+        /// The colour given.
+        color: [f32; 3],
+    },
+    /// The bitmap's file could not be read.
+    Image(restir_image::ImageError),
+}
+
+impl std::fmt::Display for TextureError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TextureError::UvNotFinite { scale, offset } => write!(
+                f,
+                "texture uv transform (scale {scale}, offset {offset}) is not finite"
+            ),
+            TextureError::CheckerColor { name, color } => {
+                write!(f, "checkerboard {name} {color:?} must lie in [0, 1]")
+            }
+            TextureError::Image(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for TextureError {}
+
 impl Texture {
     /// Reads the files a description names; `base_dir` resolves relative paths.
-    pub fn load(desc: &TextureDesc, base_dir: &Path) -> Result<Texture, String> {
+    pub fn load(desc: &TextureDesc, base_dir: &Path) -> Result<Texture, TextureError> {
         let uv = match desc {
             TextureDesc::Bitmap { uv, .. } | TextureDesc::Checkerboard { uv, .. } => uv,
         };
         if !(uv.scale.is_finite() && uv.offset.is_finite()) {
-            return Err(format!(
-                "texture uv transform (scale {}, offset {}) is not finite",
-                uv.scale, uv.offset
-            ));
+            return Err(TextureError::UvNotFinite {
+                scale: uv.scale,
+                offset: uv.offset,
+            });
         }
         if let TextureDesc::Checkerboard { color0, color1, .. } = desc {
             for (name, c) in [("color0", color0), ("color1", color1)] {
                 if !c.iter().all(|x| (0.0..=1.0).contains(x)) {
-                    return Err(format!("checkerboard {name} {c:?} must lie in [0, 1]"));
+                    return Err(TextureError::CheckerColor { name, color: *c });
                 }
             }
         }
@@ -130,7 +168,8 @@ impl Texture {
             }),
             TextureDesc::Bitmap { filename, raw, uv } => {
                 let path = base_dir.join(filename);
-                let (width, height, texels) = read_image(&path, *raw)?;
+                let (width, height, texels) =
+                    read_image(&path, *raw).map_err(TextureError::Image)?;
                 Ok(Texture::Bitmap {
                     width,
                     height,
@@ -197,13 +236,16 @@ impl Texture {
 /// Reads an image file as linear RGB texels, the first row at the top
 /// ([`restir_image::Image::read`]: PNG/JPEG sRGB-decoded unless `raw`, EXR and Radiance HDR linear).
 /// Also used for environment maps.
-pub(crate) fn read_image(path: &Path, raw: bool) -> Result<(usize, usize, Vec<Vec3>), String> {
+pub(crate) fn read_image(
+    path: &Path,
+    raw: bool,
+) -> Result<(usize, usize, Vec<Vec3>), restir_image::ImageError> {
     let encoding = if raw {
         IntegerEncoding::Raw
     } else {
         IntegerEncoding::Srgb
     };
-    let img = Image::read(path, encoding).map_err(|e| e.to_string())?;
+    let img = Image::read(path, encoding)?;
     Ok((img.width as usize, img.height as usize, img.pixels))
 }
 

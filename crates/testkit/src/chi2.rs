@@ -1,6 +1,6 @@
 //! Pearson's chi-square test on histograms: [`Histogram`] counts samples per cell,
 //! [`chi2_test`] (or [`Histogram::chi2`]) pools sparse cells and turns the statistic into a
-//! p-value with [`chi2_sf`](crate::chi2_sf).
+//! p-value with [`chi2_sf`].
 
 use crate::special::chi2_sf;
 

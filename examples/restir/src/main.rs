@@ -1,6 +1,10 @@
 //! `restir`: the command-line front end. Parsing arguments, a progress bar and writing files;
 //! everything else lives in the library crates.
 
+// The argument structs' doc comments are clap's `--help` text, where `<scene>` is a placeholder
+// for the user, not an HTML tag.
+#![allow(rustdoc::invalid_html_tags)]
+
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

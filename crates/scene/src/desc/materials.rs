@@ -243,7 +243,7 @@ pub struct TextureBinding {
 /// A shape's material: by name or inline.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum MaterialRef {
-    /// A material from [`SceneDesc::materials`].
+    /// A material from [`SceneDesc::materials`](super::SceneDesc::materials).
     Ref(String),
     /// An inline material.
     Inline(MaterialDesc),
