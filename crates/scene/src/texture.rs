@@ -396,6 +396,7 @@ mod tests {
         assert!(
             Texture::load(&bad, Path::new("."))
                 .unwrap_err()
+                .to_string()
                 .contains("color0")
         );
         let bad = TextureDesc::Checkerboard {
@@ -409,6 +410,7 @@ mod tests {
         assert!(
             Texture::load(&bad, Path::new("."))
                 .unwrap_err()
+                .to_string()
                 .contains("not finite")
         );
     }
@@ -450,6 +452,7 @@ mod tests {
         assert!(
             Texture::load(&missing, &dir)
                 .unwrap_err()
+                .to_string()
                 .contains("nope.png")
         );
         std::fs::write(dir.join("bad.png"), b"not a png").unwrap();
