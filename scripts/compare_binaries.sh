@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Interleaved CPU-time comparison of two restir binaries (1 thread, 160x120, user CPU seconds,
 # medians). Usage: scripts/compare_binaries.sh OLD_BINARY NEW_BINARY [ROUNDS]
-OLD=$1; NEW=$2; R=${3:-3}
+OLD=$(realpath "$1"); NEW=$(realpath "$2"); R=${3:-3}
 cd "$(dirname "$0")/.."
 cases=("scenes/cornell-box.xml --integrator path --spp 32"
        "scenes/many-lights.ron --integrator restir-di --spp 8"
