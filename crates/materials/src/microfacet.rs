@@ -259,7 +259,7 @@ fn sample_slopes_beckmann(cos_theta: f32, u: Vec2) -> Vec2 {
 /// The inverse error function in `f32` for `|x| < 1`: Giles' single-precision approximation
 /// ("Approximating the erfinv function", GPU Computing Gems, 2011) without refinement (relative
 /// error about 1e-6; `erfinv_f32_matches_erfinv` checks it).
-// Giles' published coefficients, as in `erfinv`; each rounds to the nearest `f32`.
+// Giles' published coefficients; each rounds to the nearest `f32`.
 #[allow(clippy::excessive_precision)]
 #[inline]
 fn erfinv_f32(x: f32) -> f32 {
@@ -290,56 +290,30 @@ fn erfinv_f32(x: f32) -> f32 {
     p * x
 }
 
-/// The inverse error function on `(−1, 1)` (±∞ at ±1): Giles' single-precision approximation
-/// ("Approximating the erfinv function", GPU Computing Gems, 2011) refined by two Newton steps
-/// on `libm::erf`, accurate to about 1e-14 away from the end points.
-pub fn erfinv(x: f64) -> f64 {
-    if x <= -1.0 {
-        return f64::NEG_INFINITY;
-    }
-    if x >= 1.0 {
-        return f64::INFINITY;
-    }
-    let w = -((1.0 - x) * (1.0 + x)).ln();
-    let mut p;
-    if w < 5.0 {
-        let w = w - 2.5;
-        p = 2.810_226_36e-08;
-        p = 3.432_739_39e-07 + p * w;
-        p = -3.523_387_7e-06 + p * w;
-        p = -4.391_506_54e-06 + p * w;
-        p = 0.000_218_580_87 + p * w;
-        p = -0.001_253_725_03 + p * w;
-        p = -0.004_177_681_64 + p * w;
-        p = 0.246_640_727 + p * w;
-        p = 1.501_409_41 + p * w;
-    } else {
-        let w = w.sqrt() - 3.0;
-        p = -0.000_200_214_257;
-        p = 0.000_100_950_558 + p * w;
-        p = 0.001_349_343_22 + p * w;
-        p = -0.003_673_428_44 + p * w;
-        p = 0.005_739_507_73 + p * w;
-        p = -0.007_622_461_3 + p * w;
-        p = 0.009_438_870_47 + p * w;
-        p = 1.001_674_06 + p * w;
-        p = 2.832_976_82 + p * w;
-    }
-    let mut y = p * x;
-    // Newton on erf(y) = x: y ← y − (erf(y) − x) / (2/√π · e^(−y²)).
-    for _ in 0..2 {
-        let d = 2.0 * INV_SQRT_PI * (-y * y).exp();
-        if d <= 0.0 {
-            break;
-        }
-        y -= (libm::erf(y) - x) / d;
-    }
-    y
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The reference inverse error function on `(−1, 1)` (±∞ at ±1): [`erfinv_f32`]'s estimate
+    /// refined by Newton steps on `libm::erf` to about 1e-14 away from the end points.
+    fn erfinv(x: f64) -> f64 {
+        if x <= -1.0 {
+            return f64::NEG_INFINITY;
+        }
+        if x >= 1.0 {
+            return f64::INFINITY;
+        }
+        let mut y = f64::from(erfinv_f32(x as f32));
+        // Newton on erf(y) = x: y ← y − (erf(y) − x) / (2/√π · e^(−y²)).
+        for _ in 0..3 {
+            let d = 2.0 * INV_SQRT_PI * (-y * y).exp();
+            if d <= 0.0 {
+                break;
+            }
+            y -= (libm::erf(y) - x) / d;
+        }
+        y
+    }
 
     #[test]
     fn erfinv_inverts_erf() {
