@@ -19,6 +19,7 @@
 //! out.image.write("cbox.exr".as_ref()).unwrap();
 //! ```
 
+mod bands;
 pub mod film;
 pub mod params;
 pub mod path;

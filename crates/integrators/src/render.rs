@@ -13,11 +13,9 @@ use restir_sampling::Pcg32;
 use restir_scene::{Scene, SceneDesc};
 
 use crate::Image;
+use crate::bands::Bands;
 use crate::film::{Film, Filter};
 use crate::path::{PathSettings, trace_camera_path};
-
-/// Rows per parallel work item.
-pub(crate) const BAND_ROWS: usize = 2;
 
 /// What an integrator needs to know about the current pass.
 #[derive(Debug)]
@@ -96,13 +94,14 @@ impl Integrator for PathIntegrator {
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
         let (w, _) = scene.camera.resolution();
         let w = w as usize;
+        let bands = Bands::new(w);
         accum
-            .par_chunks_mut(w * BAND_ROWS)
+            .par_chunks_mut(bands.pixels())
             .enumerate()
             .map(|(band, chunk)| {
                 let mut rays = 0;
                 for (i, px) in chunk.iter_mut().enumerate() {
-                    let index = band * w * BAND_ROWS + i;
+                    let index = bands.first(band) + i;
                     let (x, y) = ((index % w) as u32, (index / w) as u32);
                     let mut rng = ctx.pixel_rng(index);
                     let film = ctx.film_position(x, y, &mut rng);

@@ -33,9 +33,9 @@ use restir_scene::Scene;
 
 pub use settings::{LightSampler, RestirDiSettings};
 
+use crate::bands::Bands;
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
 use crate::render::{Integrator, PassContext};
-use crate::reuse::bands::Bands;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::light_point::{Contact, LightPoint, Resolved, contact, resolve};
 use crate::reuse::neighbors::NeighborPattern;

@@ -37,7 +37,7 @@ pub use settings::{DirectLight, RestirPtSettings, SHIFT_NAMES};
 use shift::PtReuse;
 pub use shift::PtShift;
 
-use crate::reuse::bands::Bands;
+use crate::bands::Bands;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::neighbors::NeighborPattern;
 use crate::reuse::passes::{self, HistorySlot};

@@ -8,8 +8,8 @@ use restir_geometry::Frame;
 use restir_materials::Bsdf;
 use restir_scene::Scene;
 
+use crate::bands::Bands;
 use crate::render::PassContext;
-use crate::reuse::bands::Bands;
 
 /// What a reuse pass needs to know about a pixel's primary hit: the shading point, its frame,
 /// its material and texture coordinates, the direction to the camera and what the

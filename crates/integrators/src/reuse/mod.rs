@@ -5,7 +5,6 @@
 //! over the estimator's sample and shift map, as pbrt-v4's `ImageTileIntegrator` is over its
 //! `RayIntegrator`).
 
-pub(crate) mod bands;
 pub mod gbuffer;
 pub mod light_point;
 pub mod neighbors;

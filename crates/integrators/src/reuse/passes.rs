@@ -15,8 +15,8 @@ use std::borrow::Borrow;
 
 use restir_gris::{Reservoir, ShiftMap, resample};
 
+use crate::bands::Bands;
 use crate::render::PassContext;
-use crate::reuse::bands::Bands;
 use crate::reuse::gbuffer::GBuffer;
 use crate::reuse::neighbors::NeighborPattern;
 use crate::reuse::settings::ReuseSettings;

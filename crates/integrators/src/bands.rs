@@ -1,7 +1,9 @@
-//! The parallel work items of a per-pixel pass: bands of [`BAND_ROWS`] image rows, and the
+//! The parallel work items of a per-pixel pass (every estimator's loops over the image): bands of [`BAND_ROWS`] image rows, and the
 //! arithmetic from a band and a position in it to the pixel index.
 
-use crate::render::BAND_ROWS;
+/// Image rows per parallel work item: small enough to balance the threads, large enough to
+/// amortise the per-item setup.
+pub(crate) const BAND_ROWS: usize = 2;
 
 /// The bands of an image `width` pixels wide.
 #[derive(Clone, Copy, Debug)]
