@@ -12,13 +12,16 @@
 //! directional) it is the discrete selection probability and `delta` is set.
 
 mod envmap;
+mod table;
 
 pub use envmap::{EnvMap, EnvMapError};
 
 use core::f32::consts::PI;
 use glam::{Vec2, Vec3};
 use restir_geometry::Shape;
-use restir_sampling::{AliasTable, luminance, warp};
+use restir_geometry::area_to_solid_angle;
+use restir_sampling::{luminance, warp};
+use table::{Emitter, EmitterTable};
 use std::sync::Arc;
 
 /// An emitter.
@@ -117,59 +120,24 @@ impl core::fmt::Display for LightError {
 
 impl std::error::Error for LightError {}
 
-/// How a light is picked, decided once when the set is built: a scene with one light (with
-/// power) skips the alias table, and a scene without lights has nothing to pick.
-#[derive(Clone, Debug)]
-enum Selection {
-    /// No light has power.
-    Empty,
-    /// Exactly one light has power: it is always picked, with probability 1.
-    Single(usize),
-    /// Power-proportional alias table.
-    Alias(AliasTable),
-}
-
-impl Selection {
-    fn new(powers: &[f32]) -> Self {
-        let mut with_power = powers.iter().enumerate().filter(|(_, p)| **p > 0.0);
-        match (with_power.next(), with_power.next()) {
-            (None, _) => Self::Empty,
-            (Some((i, _)), None) => Self::Single(i),
-            _ => AliasTable::new(powers).map_or(Self::Empty, Self::Alias),
-        }
-    }
-
-    /// `(index, pmf, u_remapped)` as [`AliasTable::sample`]; a single light passes `u` through.
-    #[inline]
-    fn sample(&self, u: f32) -> Option<(usize, f32, f32)> {
-        match self {
-            Self::Empty => None,
-            Self::Single(i) => Some((*i, 1.0, u)),
-            Self::Alias(t) => Some(t.sample(u)),
-        }
-    }
-
-    #[inline]
-    fn pmf(&self, i: usize) -> f32 {
-        match self {
-            Self::Empty => 0.0,
-            Self::Single(j) => f32::from(u8::from(i == *j)),
-            Self::Alias(t) => t.pmf(i),
-        }
-    }
-}
-
 /// All lights of a scene with power-proportional selection.
 #[derive(Clone, Debug)]
 pub struct LightSet {
     lights: Vec<Light>,
-    sampler: Selection,
+    /// What a selection picks: every emissive triangle and every other light, and the
+    /// environment with its share.
+    table: EmitterTable,
+    /// Per light: for area lights on meshes the area density of a selected point,
+    /// `pmf / area`; zero otherwise.
+    area_pdf: Vec<f32>,
     /// Each light's power (the selection weights).
     powers: Vec<f32>,
     /// Each light's bounding sphere; `None` for lights at infinity.
     spheres: Vec<Option<(Vec3, f32)>>,
     /// For each shape, the area light on it.
     shape_light: Vec<Option<u32>>,
+    /// Per light, the area of its mesh (area lights on meshes; zero otherwise).
+    mesh_areas: Vec<f32>,
     environment: Option<u32>,
     /// The image of the `Envmap` light, if there is one.
     envmap: Option<Arc<EnvMap>>,
@@ -213,6 +181,7 @@ impl LightSet {
         let mut environment = None;
         let mut powers = Vec::with_capacity(lights.len());
         let mut spheres = Vec::with_capacity(lights.len());
+        let mut mesh_areas = vec![0.0; lights.len()];
         for (i, l) in lights.iter().enumerate() {
             spheres.push(match *l {
                 Light::Area { shape, .. } => shapes.get(shape as usize).map(bounding_sphere),
@@ -228,6 +197,9 @@ impl LightSet {
                         return Err(LightError::BadParameter(i, "radiance"));
                     }
                     shape_light[shape as usize] = Some(i as u32);
+                    if let Shape::Mesh(m) = s {
+                        mesh_areas[i] = m.area();
+                    }
                     PI * s.area() * luminance(radiance)
                 }
                 Light::Point {
@@ -268,7 +240,7 @@ impl LightSet {
             };
             powers.push(if power.is_finite() { power } else { 0.0 });
         }
-        let lights = lights
+        let lights: Vec<Light> = lights
             .into_iter()
             .map(|l| match l {
                 Light::Directional {
@@ -281,16 +253,58 @@ impl LightSet {
                 l => l,
             })
             .collect();
-        Ok(Self {
+        let table = EmitterTable::new(&lights, shapes, &powers, environment);
+        let mut set = Self {
+            area_pdf: vec![0.0; lights.len()],
             lights,
-            sampler: Selection::new(&powers),
+            table,
             powers,
             spheres,
             shape_light,
             environment,
             envmap: envmap.map(Arc::new),
             scene_radius,
-        })
+            mesh_areas,
+        };
+        set.update_area_pdfs();
+        Ok(set)
+    }
+
+    fn update_area_pdfs(&mut self) {
+        for (i, pdf) in self.area_pdf.iter_mut().enumerate() {
+            let area = self.mesh_areas[i];
+            *pdf = if area > 0.0 {
+                self.table.pmf(i as u32) / area
+            } else {
+                0.0
+            };
+        }
+    }
+
+    /// Sets the share of light selections that go to the environment (constant or image
+    /// environment light), the rest going to the local emitters by power. The default is the
+    /// environment's power share, which overrates an environment that walls block; a scene
+    /// builder that can see what receivers get decides a better share once. Ignored without an
+    /// environment or without local lights.
+    pub fn set_environment_share(&mut self, share: f32) {
+        self.table.set_env_share(share);
+        self.update_area_pdfs();
+    }
+
+    /// The share of light selections that go to the environment.
+    pub fn environment_share(&self) -> f32 {
+        self.table.env_share()
+    }
+
+    /// The environment's share of the lights' power (the default environment share).
+    pub fn environment_power_share(&self) -> f32 {
+        self.table.env_power_share()
+    }
+
+    /// Number of entries a selection picks from besides the environment: one per emissive
+    /// triangle and one per other light with power.
+    pub fn emitter_count(&self) -> usize {
+        self.table.len()
     }
 
     /// The lights.
@@ -305,7 +319,7 @@ impl LightSet {
 
     /// Whether there are no lights (or none with power).
     pub fn is_empty(&self) -> bool {
-        matches!(self.sampler, Selection::Empty)
+        self.table.is_empty()
     }
 
     /// The area light on shape `shape`, if any.
@@ -329,11 +343,14 @@ impl LightSet {
         self.scene_radius
     }
 
-    /// Picks a light by power: `(index, probability)`.
+    /// Picks a light: `(index, probability)`, the probability being [`LightSet::pmf`].
     #[inline]
     pub fn select(&self, u: f32) -> Option<(u32, f32)> {
-        let (index, pmf, _) = self.sampler.sample(u)?;
-        Some((index as u32, pmf))
+        let light = match self.table.pick(u)? {
+            Ok(e) => e.light(),
+            Err(env) => env,
+        };
+        Some((light, self.table.pmf(light)))
     }
 
     /// The power (selection weight) of light `light`: `π·A·lum(L)` for area lights, `4π·lum(I)`
@@ -348,10 +365,11 @@ impl LightSet {
         self.spheres[light as usize]
     }
 
-    /// Probability that [`LightSet::sample`] picks light `light`.
+    /// Probability that [`LightSet::sample`] picks light `light` (for a mesh, any of its
+    /// triangles).
     #[inline]
     pub fn pmf(&self, light: u32) -> f32 {
-        self.sampler.pmf(light as usize)
+        self.table.pmf(light)
     }
 
     /// Radiance leaving an area light's surface point with shading normal `n` towards unit `w`
@@ -384,10 +402,64 @@ impl LightSet {
         u_select: f32,
         u: Vec2,
     ) -> Option<LightSample> {
-        let (index, pmf, _) = self.sampler.sample(u_select)?;
-        let mut s = self.sample_light(shapes, index as u32, ref_p, u)?;
-        s.pdf_sa *= pmf;
+        let light = match self.table.pick(u_select)? {
+            Ok(&Emitter::Triangle {
+                light,
+                prim,
+                ref p,
+                ng,
+                smooth,
+            }) => return self.sample_triangle(shapes, light, prim, p, ng, smooth, ref_p, u),
+            Ok(&Emitter::Whole { light }) => light,
+            Err(env) => env,
+        };
+        let mut s = self.sample_light(shapes, light, ref_p, u)?;
+        s.pdf_sa *= self.table.pmf(light);
         Some(s)
+    }
+
+    /// A uniform point on an emissive triangle the table picked, with the selection in its
+    /// density.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn sample_triangle(
+        &self,
+        shapes: &[Shape],
+        light: u32,
+        prim: u32,
+        corners: &[Vec3; 3],
+        ng: Vec3,
+        smooth: bool,
+        ref_p: Vec3,
+        u: Vec2,
+    ) -> Option<LightSample> {
+        let Light::Area { shape, radiance } = self.lights[light as usize] else {
+            return None;
+        };
+        let tp = Emitter::triangle_point(corners, ng, smooth, &shapes[shape as usize], prim, u);
+        let to = tp.p - ref_p;
+        let dist = to.length();
+        if dist <= 0.0 {
+            return None;
+        }
+        let wi = to / dist;
+        if tp.n.dot(wi) >= 0.0 {
+            return None; // back of a one-sided emitter
+        }
+        let pdf_sa = area_to_solid_angle(self.area_pdf[light as usize], ref_p, tp.p, tp.ng)?;
+        Some(LightSample {
+            light,
+            p: tp.p,
+            n: tp.n,
+            ng: tp.ng,
+            wi,
+            dist,
+            le: radiance,
+            pdf_sa,
+            delta: false,
+            prim,
+            param: tp.param,
+        })
     }
 
     /// Samples a point on light `light` as seen from `ref_p`, with `pdf_sa` *not* including the
@@ -512,7 +584,12 @@ impl LightSet {
             return 0.0;
         }
         match self.lights[light as usize] {
-            Light::Area { shape, .. } => pmf * shapes[shape as usize].pdf_sa_from(ref_p, p, n),
+            Light::Area { shape, .. } => match &shapes[shape as usize] {
+                Shape::Mesh(_) => {
+                    area_to_solid_angle(self.area_pdf[light as usize], ref_p, p, n).unwrap_or(0.0)
+                }
+                s => pmf * s.pdf_sa_from(ref_p, p, n),
+            },
             Light::Constant { .. } => pmf * warp::UNIFORM_SPHERE_PDF,
             Light::Envmap => self
                 .envmap
@@ -594,7 +671,7 @@ mod tests {
             },
         ];
         let set = LightSet::new(lights, &shapes, (Vec3::splat(-3.0), Vec3::splat(3.0))).unwrap();
-        assert!(matches!(set.sampler, Selection::Single(1)));
+        assert_eq!(set.emitter_count(), 1);
         assert_eq!((set.pmf(0), set.pmf(1)), (0.0, 1.0));
         let mut rng = Pcg32::new(5, 0);
         for _ in 0..1000 {
@@ -623,9 +700,10 @@ mod tests {
         let mut counts = [0u32; 3];
         for _ in 0..n {
             let (us, u) = (rng.next_f32(), rng.next_2d());
-            let Some((index, _, _)) = set.sampler.sample(us) else {
+            let Some((index, _)) = set.select(us) else {
                 panic!()
             };
+            let index = index as usize;
             counts[index] += 1;
             if let Some(s) = set.sample(&shapes, Vec3::ZERO, us, u) {
                 assert_eq!(s.light as usize, index);

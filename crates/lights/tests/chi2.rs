@@ -306,16 +306,22 @@ fn light_selection_follows_pmf() {
     }
     assert!((pmf.iter().sum::<f64>() - 1.0).abs() < 1e-5);
 
-    // The index is a function of `u_select` alone; a sample that fails (a back face of the cube)
-    // is retried with another `u`.
+    // The light is a function of `u_select` alone (which of a mesh's triangles, too: a back face
+    // of the cube fails whatever the point), and `sample` picks what `select` picks.
     let mut rng = Pcg32::new(21, 0);
     let mut hist = Histogram::new(n_lights);
+    let mut sampled = 0;
     for _ in 0..1_000_000 {
         let u_select = rng.next_f32();
-        let light = (0..64).find_map(|_| set.sample(&shapes, REF_P, u_select, rng.next_2d()));
-        let s = light.expect("some point on every light faces the reference point");
-        hist.record(Some(s.light as usize));
+        let (light, p) = set.select(u_select).expect("the set has lights");
+        assert_eq!(p, set.pmf(light));
+        if let Some(s) = set.sample(&shapes, REF_P, u_select, rng.next_2d()) {
+            assert_eq!(s.light, light);
+            sampled += 1;
+        }
+        hist.record(Some(light as usize));
     }
+    assert!(sampled > 500_000, "{sampled} samples succeeded");
     assert_accepted("light selection vs pmf", hist.chi2(&pmf));
 }
 

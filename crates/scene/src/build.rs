@@ -374,9 +374,10 @@ impl Scene {
                 .iter()
                 .any(|l| matches!(l, Light::Point { .. } | Light::Directional { .. })),
             light_count: light_set.len(),
+            environment_share: None,
         };
 
-        Ok(Scene {
+        let mut scene = Scene {
             shapes,
             shape_bsdf,
             bsdfs,
@@ -388,6 +389,8 @@ impl Scene {
             filter: desc.film.filter,
             integrator: desc.integrator.clone(),
             features,
-        })
+        };
+        scene.features.environment_share = scene.decide_environment_share();
+        Ok(scene)
     }
 }

@@ -25,6 +25,7 @@ mod build;
 pub mod desc;
 mod error;
 pub mod generate;
+mod light_share;
 mod load;
 mod material;
 mod meshio;
@@ -34,6 +35,7 @@ pub mod xml;
 
 pub use desc::*;
 pub use error::{SceneError, SceneWarning};
+pub use light_share::EnvironmentShare;
 pub use load::{LoadOptions, LoadedScene, load_desc, load_scene, parse_ron};
 
 use glam::{Vec2, Vec3};
@@ -44,7 +46,7 @@ use texture::Texture;
 
 /// What a scene contains, decided once at build time so that integrators can pick cheaper code
 /// paths instead of testing inside their loops.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SceneFeatures {
     /// Some material has a delta lobe (mirror, smooth glass).
     pub has_delta_lobes: bool,
@@ -58,6 +60,9 @@ pub struct SceneFeatures {
     pub has_delta_lights: bool,
     /// Number of lights.
     pub light_count: usize,
+    /// The environment's share of light samples, when there is an environment beside local
+    /// lights (decided from a pilot at the camera's primary hits).
+    pub environment_share: Option<EnvironmentShare>,
 }
 
 /// The runtime scene.
