@@ -139,7 +139,12 @@ const BLOCK: u32 = 8;
 
 /// A floor, a wall and a cube lit only by a strongly varying envmap.
 fn sky_scene(map: &Path, scale: f32, max_depth: i32) -> Scene {
-    build(&format!(
+    build(&sky_scene_text(map, scale, max_depth))
+}
+
+/// The RON text of [`sky_scene`].
+fn sky_scene_text(map: &Path, scale: f32, max_depth: i32) -> String {
+    format!(
         r#"(
         camera: (fov: 50, to_world: [LookAt(origin: (0, 4, 3), target: (0, 0, 0), up: (0, 1, 0))]),
         film: (width: {SIZE}, height: {SIZE}, filter: Box),
@@ -155,7 +160,7 @@ fn sky_scene(map: &Path, scale: f32, max_depth: i32) -> Scene {
         lights: [Envmap(filename: "{}", scale: {scale}, to_world: [Rotate(axis: (0, 1, 0), angle: 40)])],
     )"#,
         map.display()
-    ))
+    )
 }
 
 fn sky_map(dir: &Path) -> PathBuf {
@@ -212,6 +217,50 @@ fn restir_di_and_pt_with_envmap_match_path_tracer() {
     let z = max_z(&pt, &reference);
     eprintln!("restir-pt: max |z| = {z:.2}");
     assert!(z < Z_MAX, "restir-pt: max |z| = {z:.2}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The sky scene with two small bright area lights beside the envmap: the scene build picks the
+/// environment's share of light samples from a pilot. Whatever the share, every estimator
+/// converges to the same image: the path tracer, ReSTIR DI and ReSTIR PT at the pilot's share
+/// match the path tracer at a share of one half.
+#[test]
+fn environment_share_beside_area_lights_is_unbiased() {
+    let dir = temp_dir("sky-lights");
+    let map = sky_map(&dir);
+    let lit = |max_depth: i32| {
+        let base = sky_scene_text(&map, 1.0, max_depth);
+        let lights = r#"
+            (geometry: Rectangle, to_world: [Scale((0.1, 0.1, 1)), Rotate(axis: (1, 0, 0), angle: 90),
+             Translate((-0.8, 1.2, -0.6))], emission: Some((60, 50, 40))),
+            (geometry: Rectangle, to_world: [Scale((0.05, 0.05, 1)), Rotate(axis: (1, 0, 0), angle: 90),
+             Translate((0.6, 0.9, 0.8))], emission: Some((40, 60, 80))),
+        ],
+        lights: ["#;
+        build(&base.replacen("],\n        lights: [", lights, 1))
+    };
+    for (max_depth, name, params, seeds) in [
+        (2, "path", vec![], 24),
+        (2, "restir-di", vec![("candidates", "8")], 120),
+        (4, "restir-pt", vec![], 120),
+    ] {
+        let scene = lit(max_depth);
+        let decided = scene.features.environment_share.expect("a share is decided");
+        assert!(decided.receivers > 0);
+        assert!(
+            (decided.share - decided.power_share).abs() > 0.01,
+            "the pilot moved the share: {decided:?}"
+        );
+        let mut half = lit(max_depth);
+        half.lights.set_environment_share(0.5);
+        let reference = statistics(&half, "path", &[], 64, 24);
+        let spp = if name == "path" { 64 } else { 1 };
+        let test = statistics(&scene, name, &params, spp, seeds);
+        let z = max_z(&test, &reference);
+        eprintln!("{name} at share {:.3} (power share {:.3}) vs path at 0.5: max |z| = {z:.2}",
+            decided.share, decided.power_share);
+        assert!(z < Z_MAX, "{name}: max |z| = {z:.2}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -403,13 +403,7 @@ impl LightSet {
         u: Vec2,
     ) -> Option<LightSample> {
         let light = match self.table.pick(u_select)? {
-            Ok(&Emitter::Triangle {
-                light,
-                prim,
-                ref p,
-                ng,
-                smooth,
-            }) => return self.sample_triangle(shapes, light, prim, p, ng, smooth, ref_p, u),
+            Ok(e @ Emitter::Triangle { .. }) => return self.sample_triangle(shapes, e, ref_p, u),
             Ok(&Emitter::Whole { light }) => light,
             Err(env) => env,
         };
@@ -420,23 +414,29 @@ impl LightSet {
 
     /// A uniform point on an emissive triangle the table picked, with the selection in its
     /// density.
-    #[allow(clippy::too_many_arguments)]
     #[inline]
     fn sample_triangle(
         &self,
         shapes: &[Shape],
-        light: u32,
-        prim: u32,
-        corners: &[Vec3; 3],
-        ng: Vec3,
-        smooth: bool,
+        e: &Emitter,
         ref_p: Vec3,
         u: Vec2,
     ) -> Option<LightSample> {
+        let Emitter::Triangle {
+            light,
+            prim,
+            ref p,
+            ng,
+            n,
+            smooth,
+        } = *e
+        else {
+            return None;
+        };
         let Light::Area { shape, radiance } = self.lights[light as usize] else {
             return None;
         };
-        let tp = Emitter::triangle_point(corners, ng, smooth, &shapes[shape as usize], prim, u);
+        let tp = Emitter::triangle_point(p, ng, n, smooth, &shapes[shape as usize], prim, u);
         let to = tp.p - ref_p;
         let dist = to.length();
         if dist <= 0.0 {
@@ -726,6 +726,62 @@ mod tests {
         }
         let total: f32 = (0..3).map(|i| set.pmf(i)).sum();
         assert!((total - 1.0).abs() < 1e-5);
+    }
+
+    /// With an environment beside local lights, the environment takes exactly its share of
+    /// selections and the local lights split the rest by power; `pmf`, `select`, `sample` and
+    /// `pdf_sa` agree whatever the share, and a triangle of a mesh light is picked with the
+    /// mesh's pmf times its area fraction.
+    #[test]
+    fn environment_share_splits_selection() {
+        let (shapes, _) = setup();
+        let lights = vec![
+            Light::Area {
+                shape: 0,
+                radiance: Vec3::splat(1.0),
+            },
+            Light::Constant {
+                radiance: Vec3::splat(0.2),
+            },
+            Light::Area {
+                shape: 1,
+                radiance: Vec3::new(5.0, 1.0, 1.0),
+            },
+        ];
+        let mut set =
+            LightSet::new(lights, &shapes, (Vec3::splat(-3.0), Vec3::splat(3.0))).unwrap();
+        let power_share = set.environment_power_share();
+        assert!((set.pmf(1) - power_share).abs() < 1e-6);
+        assert_eq!(set.emitter_count(), 3, "two triangles and a sphere");
+        for share in [0.3f32, 0.01, 0.99] {
+            set.set_environment_share(share);
+            assert_eq!(set.environment_share(), share);
+            assert!((set.pmf(1) - share).abs() < 1e-7);
+            let local = set.pmf(0) + set.pmf(2);
+            assert!((local - (1.0 - share)).abs() < 1e-6, "{local}");
+            let ratio = set.pmf(0) / set.pmf(2);
+            let want = set.power(0) / set.power(2);
+            assert!((ratio - want).abs() < 1e-4 * want, "{ratio} vs {want}");
+            let mut rng = Pcg32::new(31, 0);
+            let n = 100_000;
+            let mut counts = [0u32; 3];
+            for _ in 0..n {
+                let (us, u) = (rng.next_f32(), rng.next_2d());
+                let (light, pmf) = set.select(us).unwrap();
+                assert_eq!(pmf, set.pmf(light));
+                counts[light as usize] += 1;
+                if let Some(s) = set.sample(&shapes, Vec3::ZERO, us, u) {
+                    assert_eq!(s.light, light);
+                    let pdf = set.pdf_sa(&shapes, s.light, Vec3::ZERO, s.p, s.ng);
+                    assert!((pdf - s.pdf_sa).abs() <= 1e-3 * pdf, "{pdf} vs {}", s.pdf_sa);
+                }
+            }
+            for (i, c) in counts.iter().enumerate() {
+                let p = set.pmf(i as u32) as f64;
+                let se = (p * (1.0 - p) / n as f64).sqrt().max(1e-9);
+                assert!((*c as f64 / n as f64 - p).abs() < 4.0 * se, "light {i} at share {share}");
+            }
+        }
     }
 
     /// ∫ over the light of Le·cos/pdf estimates the irradiance of a unit-radiance quad seen head-on,

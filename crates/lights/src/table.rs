@@ -34,7 +34,10 @@ pub(crate) enum Emitter {
         p: [Vec3; 3],
         /// Unit geometric normal, oriented as the mesh orients it.
         ng: Vec3,
-        /// Whether the mesh has vertex normals (then the shading normal is interpolated).
+        /// The shading normal where it is the same over the whole triangle (no vertex normals,
+        /// or three equal ones: a rectangle's).
+        n: Vec3,
+        /// Whether the shading normal varies over the triangle (then it is interpolated).
         smooth: bool,
     },
     /// A light sampled as a whole (sphere, point and directional lights).
@@ -69,6 +72,7 @@ impl Emitter {
     pub fn triangle_point(
         p: &[Vec3; 3],
         ng: Vec3,
+        n: Vec3,
         smooth: bool,
         shape: &Shape,
         prim: u32,
@@ -79,7 +83,7 @@ impl Emitter {
         let point = b0 * p[0] + b.x * p[1] + b.y * p[2];
         let n = match (smooth, shape) {
             (true, Shape::Mesh(m)) => m.point_at(prim as usize, b).2,
-            _ => ng,
+            _ => n,
         };
         TrianglePoint {
             p: point,
@@ -87,6 +91,26 @@ impl Emitter {
             n,
             param: b,
         }
+    }
+}
+
+/// Triangle `t`'s shading normal if it is the same everywhere on it (`(n, false)`), as
+/// [`restir_geometry::TriangleMesh::point_at`] orients it, else `(ng, true)`.
+fn constant_shading_normal(m: &restir_geometry::TriangleMesh, t: usize, ng: Vec3) -> (Vec3, bool) {
+    let Some(normals) = m.normals() else {
+        return (ng, false);
+    };
+    let [a, b, c] = m.indices()[t].map(|i| normals[i as usize]);
+    if a != b || a != c {
+        return (ng, true);
+    }
+    let n = a.normalize_or_zero();
+    if n == Vec3::ZERO {
+        (ng, false)
+    } else if m.flip_normals() {
+        (-n, false)
+    } else {
+        (n, false)
     }
 }
 
@@ -146,12 +170,15 @@ impl EmitterTable {
                         if !(w > 0.0 && w.is_finite()) {
                             continue;
                         }
+                        let ng = m.face_normal(t);
+                        let (n, smooth) = constant_shading_normal(m, t, ng);
                         entries.push(Emitter::Triangle {
                             light,
                             prim: t as u32,
                             p,
-                            ng: m.face_normal(t),
-                            smooth: m.normals().is_some(),
+                            ng,
+                            n,
+                            smooth,
                         });
                         weights.push(w);
                     }

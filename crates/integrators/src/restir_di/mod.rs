@@ -233,7 +233,7 @@ impl RestirDiIntegrator {
                 delta: ls.delta,
                 ng: ls.ng,
             };
-            let e = evaluate(scene, r, &sample, &c, Some(power_pdf_sa), self.counts);
+            let e = evaluate(scene, r, bsdf, &sample, &c, Some(power_pdf_sa), self.counts);
             // The source density in the sample's measure (the light sampler's is solid angle).
             let light_pdf = if ls.delta {
                 source_pdf_sa
@@ -274,10 +274,11 @@ impl RestirDiIntegrator {
     ) -> (Vec3, u64) {
         let mut l = Vec3::ZERO;
         let mut rays = 0;
+        let bsdf = &r.resolve_bsdf(scene);
         if let Some(y) = &res.sample
             && let Some(c) = contact(scene, y, r.p)
         {
-            let e = evaluate(scene, r, y, &c, None, self.counts);
+            let e = evaluate(scene, r, bsdf, y, &c, None, self.counts);
             if e.target > 0.0 {
                 rays += 1;
                 if visible(scene, r, ng, &c) {
@@ -291,7 +292,6 @@ impl RestirDiIntegrator {
         let max_depth = settings.max_segments();
         let continues = max_depth > 2 || scene.features.has_delta_lobes;
         let samples = self.settings.bsdf_candidates.max(u32::from(continues));
-        let bsdf = &r.resolve_bsdf(scene);
         // BSDF samples after the first only look for emitters at their first hit.
         let direct_only = PathSettings {
             max_depth: 2,

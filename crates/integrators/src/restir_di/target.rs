@@ -15,6 +15,7 @@
 //! reservoirs without that (their density on a light is zero wherever the light is occluded).
 
 use glam::Vec3;
+use restir_materials::Bsdf;
 use restir_sampling::luminance;
 use restir_scene::Scene;
 
@@ -46,19 +47,20 @@ impl Evaluated {
     };
 }
 
-/// Evaluates `sample` at receiver `r` seen as `c` (from [`contact`](crate::reuse::light_point::contact)). `known_light_pdf_sa` is
+/// Evaluates `sample` at receiver `r` (whose BSDF, textures resolved, is `bsdf`) seen as `c`
+/// (from [`contact`](crate::reuse::light_point::contact)). `known_light_pdf_sa` is
 /// the light-sampling density at `r` if the caller has it (selection included; the pmf for
 /// delta lights); otherwise it is computed when the light/BSDF split needs it (`N_B > 0`).
 #[inline]
 pub fn evaluate(
     scene: &Scene,
     r: &Receiver,
+    bsdf: &Bsdf,
     sample: &LightPoint,
     c: &Contact,
     known_light_pdf_sa: Option<f32>,
     counts: StrategyCounts,
 ) -> Evaluated {
-    let bsdf = &r.resolve_bsdf(scene);
     let wi = r.frame().to_local(c.wi);
     let f = bsdf.eval(r.wo, wi);
     if f == Vec3::ZERO {
@@ -99,5 +101,7 @@ pub fn target(
 ) -> f32 {
     resolved
         .contact(r.p)
-        .map_or(0.0, |c| evaluate(scene, r, sample, &c, None, counts).target)
+        .map_or(0.0, |c| {
+            evaluate(scene, r, &r.resolve_bsdf(scene), sample, &c, None, counts).target
+        })
 }
