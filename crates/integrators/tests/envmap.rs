@@ -245,7 +245,10 @@ fn environment_share_beside_area_lights_is_unbiased() {
         (4, "restir-pt", vec![], 120),
     ] {
         let scene = lit(max_depth);
-        let decided = scene.features.environment_share.expect("a share is decided");
+        let decided = scene
+            .features
+            .environment_share
+            .expect("a share is decided");
         assert!(decided.receivers > 0);
         assert!(
             (decided.share - decided.power_share).abs() > 0.01,
@@ -257,8 +260,10 @@ fn environment_share_beside_area_lights_is_unbiased() {
         let spp = if name == "path" { 64 } else { 1 };
         let test = statistics(&scene, name, &params, spp, seeds);
         let z = max_z(&test, &reference);
-        eprintln!("{name} at share {:.3} (power share {:.3}) vs path at 0.5: max |z| = {z:.2}",
-            decided.share, decided.power_share);
+        eprintln!(
+            "{name} at share {:.3} (power share {:.3}) vs path at 0.5: max |z| = {z:.2}",
+            decided.share, decided.power_share
+        );
         assert!(z < Z_MAX, "{name}: max |z| = {z:.2}");
     }
     let _ = std::fs::remove_dir_all(&dir);

@@ -21,8 +21,8 @@ use glam::{Vec2, Vec3};
 use restir_geometry::Shape;
 use restir_geometry::area_to_solid_angle;
 use restir_sampling::{luminance, warp};
-use table::{Emitter, EmitterTable};
 use std::sync::Arc;
+use table::{Emitter, EmitterTable};
 
 /// An emitter.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -773,13 +773,20 @@ mod tests {
                 if let Some(s) = set.sample(&shapes, Vec3::ZERO, us, u) {
                     assert_eq!(s.light, light);
                     let pdf = set.pdf_sa(&shapes, s.light, Vec3::ZERO, s.p, s.ng);
-                    assert!((pdf - s.pdf_sa).abs() <= 1e-3 * pdf, "{pdf} vs {}", s.pdf_sa);
+                    assert!(
+                        (pdf - s.pdf_sa).abs() <= 1e-3 * pdf,
+                        "{pdf} vs {}",
+                        s.pdf_sa
+                    );
                 }
             }
             for (i, c) in counts.iter().enumerate() {
                 let p = set.pmf(i as u32) as f64;
                 let se = (p * (1.0 - p) / n as f64).sqrt().max(1e-9);
-                assert!((*c as f64 / n as f64 - p).abs() < 4.0 * se, "light {i} at share {share}");
+                assert!(
+                    (*c as f64 / n as f64 - p).abs() < 4.0 * se,
+                    "light {i} at share {share}"
+                );
             }
         }
     }

@@ -466,6 +466,8 @@ fn run_compare(test: &Path, reference: &Path) -> Result<(), String> {
 }
 
 fn main() -> ExitCode {
+    // Rough-plastic tables are kept between runs (`RESTIR_CACHE_DIR=` turns this off).
+    restir_materials::table_cache::set_cache_dir(restir_materials::table_cache::default_cache_dir());
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {

@@ -99,9 +99,7 @@ pub fn target(
     resolved: &Resolved,
     counts: StrategyCounts,
 ) -> f32 {
-    resolved
-        .contact(r.p)
-        .map_or(0.0, |c| {
-            evaluate(scene, r, &r.resolve_bsdf(scene), sample, &c, None, counts).target
-        })
+    resolved.contact(r.p).map_or(0.0, |c| {
+        evaluate(scene, r, &r.resolve_bsdf(scene), sample, &c, None, counts).target
+    })
 }

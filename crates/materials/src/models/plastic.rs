@@ -15,6 +15,7 @@ use crate::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, reflect};
 use crate::lobe::{REFLECT_DELTA, REFLECT_DIFFUSE, REFLECT_GLOSSY};
 use crate::microfacet::{Distribution, Microfacet};
 
+pub mod cache;
 pub mod tables;
 
 use tables::{RoughPlasticTable, rough_plastic_table};

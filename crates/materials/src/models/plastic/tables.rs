@@ -5,7 +5,8 @@
 //!
 //! The tables depend on (distribution, α, η) only. They are built once per distinct triple and
 //! kept for the life of the process in a small registry, so that [`crate::Bsdf`] stays `Copy`
-//! and holds a `&'static` reference.
+//! and holds a `&'static` reference; a program may also keep them on disk between runs
+//! ([`super::cache`]).
 
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
@@ -157,7 +158,12 @@ pub fn rough_plastic_table(
         return t;
     }
     // Built outside the lock (it takes a moment); a racing thread may build it twice.
-    let table: &'static RoughPlasticTable = Box::leak(Box::new(build(distribution, alpha, eta)));
+    let table = super::cache::load(distribution, alpha, eta).unwrap_or_else(|| {
+        let t = build(distribution, alpha, eta);
+        super::cache::store(distribution, alpha, eta, &t);
+        t
+    });
+    let table: &'static RoughPlasticTable = Box::leak(Box::new(table));
     let mut guard = tables.lock().unwrap_or_else(|e| e.into_inner());
     let stored: &&'static RoughPlasticTable = guard.entry(key).or_insert(table);
     stored
