@@ -6,7 +6,7 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use restir_integrators::Image;
 use restir_scene::{Scene, load_desc};

@@ -219,13 +219,19 @@ fn nan_in_a_parameter() {
 #[test]
 fn unknown_flag() {
     for (args, needle) in [
-        (&["render", s(&cornell()), "--frobnicate"][..], "--frobnicate"),
+        (
+            &["render", s(&cornell()), "--frobnicate"][..],
+            "--frobnicate",
+        ),
         (&["frobnicate"][..], "frobnicate"),
     ] {
         let out = restir(args);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
-        assert!(stderr.starts_with("error: ") && stderr.contains(needle), "{stderr}");
+        assert!(
+            stderr.starts_with("error: ") && stderr.contains(needle),
+            "{stderr}"
+        );
         assert!(stderr.contains("Usage: restir"), "{stderr}");
     }
 }

@@ -75,8 +75,15 @@ fn a_failed_write_is_an_error_and_keeps_the_old_image() {
             "{ext}: {stderr}"
         );
         assert!(stderr.contains("too large"), "{ext}: {stderr}");
-        assert!(o.stdout.is_empty(), "{ext}: no summary after a failed write");
-        assert_eq!(std::fs::read(&out).unwrap(), before, "{ext}: old image kept");
+        assert!(
+            o.stdout.is_empty(),
+            "{ext}: no summary after a failed write"
+        );
+        assert_eq!(
+            std::fs::read(&out).unwrap(),
+            before,
+            "{ext}: old image kept"
+        );
         assert_eq!(entries(&dir.0).len(), if ext == "exr" { 1 } else { 2 });
     }
 }
@@ -117,13 +124,26 @@ fn a_closed_stdout_is_no_panic() {
 fn a_closed_stderr_is_no_panic() {
     let dir = temp_dir("stderr");
     let scene = dir.0.join("warns.xml");
-    let text = std::fs::read_to_string(cornell())
-        .unwrap()
-        .replace("<float name=\"fov\"", "<float name=\"near_clip\" value=\"1\"/><float name=\"fov\"");
+    let text = std::fs::read_to_string(cornell()).unwrap().replace(
+        "<float name=\"fov\"",
+        "<float name=\"near_clip\" value=\"1\"/><float name=\"fov\"",
+    );
     std::fs::write(&scene, text).unwrap();
     let out = dir.0.join("o.exr");
     for (args, code) in [
-        (vec!["render", s(&scene), "-o", s(&out), "--spp", "1", "--width", "8"], 0),
+        (
+            vec![
+                "render",
+                s(&scene),
+                "-o",
+                s(&out),
+                "--spp",
+                "1",
+                "--width",
+                "8",
+            ],
+            0,
+        ),
         (vec!["render", s(&scene), "-o", s(&out), "--spp", "0"], 1),
     ] {
         let mut child = Command::new(RESTIR)
@@ -151,7 +171,14 @@ fn interrupt(out: &Path, size: &str, signals: &[&str], wait: Duration) -> std::p
     std::thread::sleep(wait);
     for sig in signals {
         let kill = format!("kill -{sig} {}", child.id());
-        assert!(Command::new("sh").arg("-c").arg(&kill).status().unwrap().success());
+        assert!(
+            Command::new("sh")
+                .arg("-c")
+                .arg(&kill)
+                .status()
+                .unwrap()
+                .success()
+        );
         std::thread::sleep(Duration::from_millis(50));
     }
     child.wait_with_output().unwrap()
@@ -175,7 +202,10 @@ fn an_interrupt_writes_what_was_rendered_and_exits_130() {
         );
         let img = restir_image::Image::read_exr(&out).unwrap();
         assert_eq!((img.width, img.height), (32, 32));
-        assert!(img.mean().max_element() > 0.0, "{sig}: the image has the passes");
+        assert!(
+            img.mean().max_element() > 0.0,
+            "{sig}: the image has the passes"
+        );
     }
 }
 
