@@ -30,7 +30,7 @@ pub fn corpus_dir() -> PathBuf {
 /// [`CORPUS_IGNORE_REASON`]) when the corpus was absent at build time outside CI, a normal test
 /// otherwise. The body gets the corpus directory from [`corpus_dir`].
 ///
-/// ```ignore
+/// ```text
 /// restir_testkit::corpus_test! {
 ///     /// Loads a corpus scene.
 ///     fn a_corpus_scene_loads() {
