@@ -10,7 +10,8 @@
 //!   ([`chi_square`], [`chi_square_critical`]), trial counts that shrink in debug builds
 //!   ([`trials`]).
 //! - [`corpus`]: the shared scene corpus beside the clone ([`corpus_dir`]) and
-//!   [`corpus_test!`], which ignores a test that needs it when it is absent (outside CI).
+//!   [`corpus_test!`](crate::corpus_test), which ignores a test that needs it when it is absent
+//!   (outside CI).
 //! - [`blocks`]: per-block means of images and their mean and standard error over independent
 //!   renders ([`block_statistics`], [`max_z`]), for comparing two estimators of the same image.
 //!
