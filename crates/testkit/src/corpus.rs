@@ -1,8 +1,8 @@
 //! The shared scene corpus (`../shared/corpus` beside the clone): where it is, and
 //! [`corpus_test!`](crate::corpus_test), which declares a test that reads it. A test that needs
-//! the corpus must not report `ok` without it: when the corpus was absent at build time (and `CI` unset) such tests
-//! are `#[ignore]`d with the reason; under CI, or when run with `--ignored`, they run and
-//! [`corpus_dir`] fails with the path it looked for.
+//! the corpus must not report `ok` without it: when the corpus was absent at build time (and
+//! `CI` unset) such tests are `#[ignore]`d with the reason; under CI, or when run with
+//! `--ignored`, they run and [`corpus_dir`] fails with the path it looked for.
 
 use std::path::PathBuf;
 
