@@ -48,7 +48,7 @@ def render(a, scene, flags, spp, seed, out, threads):
     _, cpu = run(cmd)
     with open(stats) as f:
         s = json.load(f)
-    return cpu - s["load_seconds"] * 1.0, s
+    return cpu, s
 
 
 def relmse(a, test, ref):
@@ -83,18 +83,23 @@ def main():
         ref = os.path.join(a.refs, f"{os.path.basename(scene)}-{key}.exr")
         if not os.path.exists(ref):
             render(a, scene, a.ref_flags, a.ref_spp, 999, ref, 0)
-        # Calibrate each configuration's CPU time per pass (and load-free fixed cost).
-        spp = {}
+        # Calibrate each configuration's CPU time per pass and its fixed cost (loading the
+        # scene, building tables): CPU(n passes) = fixed + n · per pass. The fixed cost is
+        # subtracted from every render's CPU time (the wall-clock load time is no measure of CPU
+        # on a loaded machine).
+        spp, fixed = {}, {}
         for name, flags in configs:
             c1, _ = render(a, scene, flags, 2, 1000, os.path.join(work, "cal.exr"), a.threads)
-            c2, _ = render(a, scene, flags, 6, 1000, os.path.join(work, "cal.exr"), a.threads)
-            per_pass = max((c2 - c1) / 4, 1e-4)
+            c2, _ = render(a, scene, flags, 10, 1000, os.path.join(work, "cal.exr"), a.threads)
+            per_pass = max((c2 - c1) / 8, 1e-4)
+            fixed[name] = max(c1 - 2 * per_pass, 0.0)
             spp[name] = max(1, round(a.budget / per_pass))
         rows = {name: [] for name, _ in configs}
         for seed in range(a.seeds):
             for name, flags in configs:
                 out = os.path.join(work, f"{name}.exr")
                 cpu, _ = render(a, scene, flags, spp[name], seed, out, a.threads)
+                cpu = max(cpu - fixed[name], 0.1 * cpu)
                 e = relmse(a, out, ref)
                 rows[name].append((e, cpu))
         table[scene] = {}

@@ -1,58 +1,132 @@
 #!/usr/bin/env python3
-"""Mitsuba 3's path tracer on the bench suite's XML scene, for the time-to-error table.
+"""Equal-CPU-time efficiency of `restir`'s path tracer against Mitsuba 3's, on Mitsuba XML scenes.
 
-Development tool (needs `pip install mitsuba`; `llvm_ad_rgb` also needs Debian's libllvm19),
-never part of CI or of the project's dependencies. Run from the repository root after
-`restir bench` has cached its references:
+Development tool: needs `pip install mitsuba numpy` (`llvm_ad_rgb` also needs Debian's
+libllvm19); never part of CI or of the project's dependencies.
 
-    python3 scripts/mitsuba_equal_time.py [--scene scenes/cornell-box.xml] [--size 128]
-        [--reference docs/bench/references/cornell-box-<hash>.exr] [--variant llvm_ad_rgb]
+For each scene both renderers render at the same size and maximum depth, single-threaded, and
+each render is timed by the CPU time it uses (ours: the child process's user+system time minus
+its load time; Mitsuba: this process's CPU time around `mi.render` after a warm-up render that
+compiles its kernels), because the machines this runs on are shared and noisy. The sample
+counts are calibrated so that each render takes about `--budget` CPU seconds; relMSE is measured
+by `restir compare` against a converged reference rendered by `restir` (cached in `--refs`).
+Renders are interleaved (seed-major). Prints per scene the medians and
+efficiency = 1 / (relMSE · seconds), and ours / Mitsuba.
 
-For each pass count it renders once to compile the kernels, then `--seeds` times with different
-seeds, and prints the median wall time of `mi.render` (all cores, as `restir bench`) and the
-mean relMSE against the same reference `restir bench` uses, with the same metric
-(mean over pixels and channels of (x − r)² / (r² + 0.01)).
+    python3 scripts/mitsuba_equal_time.py --bin target/release/restir --size 256x256 \\
+        --max-depth 6 scenes/cornell-box.xml
 """
 
 import argparse
-import glob
+import hashlib
+import json
+import os
+import re
+import resource
 import statistics
-import time
+import subprocess
+import sys
+import tempfile
 
-import numpy as np
+
+def child_cpu(cmd):
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    _, status, usage = os.wait4(p.pid, 0)
+    out, err = p.stdout.read(), p.stderr.read()
+    if os.waitstatus_to_exitcode(status) != 0:
+        sys.exit(f"failed: {' '.join(cmd)}\n{err}")
+    return out, usage.ru_utime + usage.ru_stime
+
+
+def ours(a, scene, spp, seed, out, threads, flags=()):
+    w, h = a.size.split("x")
+    stats = out + ".json"
+    cmd = [a.bin, "render", scene, "--integrator", "path", "--spp", str(spp), "--seed",
+           str(seed), "--width", w, "--height", h, "--threads", str(threads), "--quiet",
+           "--max-depth", str(a.max_depth), "-o", out, "--stats", stats, *flags]
+    _, cpu = child_cpu(cmd)
+    with open(stats) as f:
+        load = json.load(f)["load_seconds"]
+    return cpu - load
+
+
+def relmse(a, test, ref):
+    out, _ = child_cpu([a.bin, "compare", test, ref])
+    return float(re.search(r"relmse=([0-9.eE+-]+)", out).group(1))
+
+
+def self_cpu():
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--scene", default="scenes/cornell-box.xml")
-    ap.add_argument("--size", type=int, default=128)
-    ap.add_argument("--reference", default=None)
-    ap.add_argument("--variant", default="llvm_ad_rgb")
+    ap.add_argument("scenes", nargs="+")
+    ap.add_argument("--bin", default="target/release/restir")
+    ap.add_argument("--size", default="256x256")
+    ap.add_argument("--max-depth", type=int, default=6)
+    ap.add_argument("--budget", type=float, default=4.0, help="CPU seconds per render")
     ap.add_argument("--seeds", type=int, default=3)
-    ap.add_argument("--spp", default="4,8,16,32,64,128,256,512")
+    ap.add_argument("--ref-spp", type=int, default=4096)
+    ap.add_argument("--refs", default="/tmp/restir-refs")
+    ap.add_argument("--variant", default="llvm_ad_rgb")
     a = ap.parse_args()
 
+    import drjit as dr
     import mitsuba as mi
-    mi.set_variant(a.variant)
-    ref_path = a.reference or sorted(glob.glob("docs/bench/references/cornell-box-*.exr"))[0]
-    ref = np.array(mi.Bitmap(ref_path))[..., :3].astype(np.float64)
-    scene = mi.load_file(a.scene, resx=a.size, resy=a.size)
+    import numpy as np
 
-    print(f"# Mitsuba {mi.__version__} {a.variant}, {a.scene} at {a.size}x{a.size}, "
-          f"reference {ref_path}")
-    print("| spp | seconds (median) | relMSE (mean of seeds) | relMSE × seconds |")
-    print("|---|---|---|---|")
-    for spp in [int(s) for s in a.spp.split(",")]:
-        mi.render(scene, spp=spp, seed=10_000)  # compile the kernels for this spp
-        times, errs = [], []
+    mi.set_variant(a.variant)
+    dr.set_thread_count(1)
+    w, h = (int(v) for v in a.size.split("x"))
+    os.makedirs(a.refs, exist_ok=True)
+    work = tempfile.mkdtemp(prefix="mitsuba-et-")
+    print(f"# Mitsuba {mi.__version__} {a.variant} vs restir, {a.size}, max depth "
+          f"{a.max_depth}, ~{a.budget} CPU s per render, 1 thread, {a.seeds} seeds")
+    print("| scene | renderer | spp | CPU s | relMSE | efficiency | ours / Mitsuba |")
+    print("|---|---|---|---|---|---|---|")
+    for scene in a.scenes:
+        key = hashlib.sha1((open(scene, "rb").read().hex() + a.size + str(a.max_depth)
+                            + str(a.ref_spp)).encode()).hexdigest()[:12]
+        ref = os.path.join(a.refs, f"{os.path.basename(scene)}-{key}.exr")
+        if not os.path.exists(ref):
+            ours(a, scene, a.ref_spp, 999, ref, 0)
+
+        ms = mi.load_file(scene, resx=w, resy=h, max_depth=a.max_depth)
+
+        def mitsuba(spp, seed, out):
+            t = self_cpu()
+            img = mi.render(ms, spp=spp, seed=seed)
+            arr = np.array(img)  # forces evaluation
+            cpu = self_cpu() - t
+            mi.Bitmap(arr[..., :3].astype(np.float32)).write(out)
+            return cpu
+
+        # Calibrate CPU seconds per sample (Mitsuba: after compiling for that spp).
+        o1 = ours(a, scene, 4, 1000, os.path.join(work, "cal.exr"), 1)
+        o2 = ours(a, scene, 12, 1000, os.path.join(work, "cal.exr"), 1)
+        spp_ours = max(1, round(a.budget / max((o2 - o1) / 8, 1e-5)))
+        mitsuba(4, 10_000, os.path.join(work, "cal.exr"))
+        m1 = mitsuba(4, 10_001, os.path.join(work, "cal.exr"))
+        spp_mi = max(1, round(a.budget / max(m1 / 4, 1e-5)))
+        mitsuba(spp_mi, 10_002, os.path.join(work, "cal.exr"))  # compile for this spp
+        res = {"restir": [], "mitsuba": []}
         for seed in range(a.seeds):
-            t = time.perf_counter()
-            img = mi.render(scene, spp=spp, seed=seed)
-            img = np.array(img)[..., :3].astype(np.float64)  # forces evaluation
-            times.append(time.perf_counter() - t)
-            errs.append(float(np.mean((img - ref) ** 2 / (ref ** 2 + 0.01))))
-        t, e = statistics.median(times), statistics.mean(errs)
-        print(f"| {spp} | {t:.3f} | {e:.3e} | {t * e:.4f} |")
+            out = os.path.join(work, "ours.exr")
+            cpu = ours(a, scene, spp_ours, seed, out, 1)
+            res["restir"].append((cpu, relmse(a, out, ref)))
+            out = os.path.join(work, "mi.exr")
+            cpu = mitsuba(spp_mi, seed, out)
+            res["mitsuba"].append((cpu, relmse(a, out, ref)))
+        eff = {}
+        for name, spp in (("restir", spp_ours), ("mitsuba", spp_mi)):
+            cpu = statistics.median(r[0] for r in res[name])
+            err = statistics.median(r[1] for r in res[name])
+            eff[name] = statistics.median(1 / (r[0] * r[1]) for r in res[name])
+            ratio = f"{eff['restir'] / eff['mitsuba']:.2f}" if name == "mitsuba" else ""
+            print(f"| {os.path.basename(scene)} | {name} | {spp} | {cpu:.2f} | {err:.4e} | "
+                  f"{eff[name]:.3f} | {ratio} |", flush=True)
 
 
 if __name__ == "__main__":

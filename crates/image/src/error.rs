@@ -39,6 +39,15 @@ pub enum ImageError {
         /// The file.
         path: PathBuf,
     },
+    /// Creating, writing, flushing, syncing or renaming an output file failed.
+    Io {
+        /// The target file.
+        path: PathBuf,
+        /// What could not be done ("cannot write", "cannot create a file beside it", …).
+        what: &'static str,
+        /// The system's error.
+        source: std::io::Error,
+    },
 }
 
 /// What went wrong in [`Image::read`](crate::Image::read).
@@ -88,7 +97,8 @@ impl ImageError {
             | ImageError::Read { path, .. }
             | ImageError::WriteExr { path, .. }
             | ImageError::WritePng { path, .. }
-            | ImageError::UnknownFormat { path } => path,
+            | ImageError::UnknownFormat { path }
+            | ImageError::Io { path, .. } => path,
         }
     }
 }
@@ -113,6 +123,9 @@ impl core::fmt::Display for ImageError {
                 "{}: unknown image format: use a .exr or .png file name",
                 path.display()
             ),
+            ImageError::Io { path, what, source } => {
+                write!(f, "{}: {what}: {source}", path.display())
+            }
         }
     }
 }
@@ -125,6 +138,7 @@ impl std::error::Error for ImageError {
             }
             ImageError::Read { reason, .. } => Some(reason),
             ImageError::WritePng { source, .. } => Some(source),
+            ImageError::Io { source, .. } => Some(source),
             ImageError::UnknownFormat { .. } => None,
         }
     }

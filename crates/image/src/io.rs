@@ -46,20 +46,40 @@ fn read_exr_pixels(path: &Path) -> Result<(usize, usize, Vec<Vec3>), exr::error:
 }
 
 impl Image {
+    /// Checks before rendering that [`Image::write`] can write `path`: a known extension, and
+    /// [`check_writable`](crate::check_writable) (not a directory, a file can be created beside
+    /// it).
+    pub fn check_output(path: &Path) -> Result<(), ImageError> {
+        match extension(path).as_deref() {
+            Some("exr") | Some("png") => crate::check_writable(path),
+            _ => Err(ImageError::UnknownFormat {
+                path: path.to_path_buf(),
+            }),
+        }
+    }
+
     /// Writes the image; the format follows the extension: `.exr` is linear float32 RGB, `.png`
-    /// 8-bit sRGB (clamped to [0, 1]).
+    /// 8-bit sRGB (clamped to [0, 1]). The file is written beside the target and renamed onto it
+    /// ([`write_atomically`](crate::write_atomically)): a failed write (a full disk included)
+    /// is an error and leaves an existing file as it was.
     pub fn write(&self, path: &Path) -> Result<(), ImageError> {
         match extension(path).as_deref() {
             Some("exr") => {
+                use exr::prelude::{SpecificChannels, Vec2, WritableImage};
                 let w = self.width as usize;
-                exr::prelude::write_rgb_file(path, w, self.height as usize, |x, y| {
+                let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
                     let p = self.pixels[y * w + x];
                     (p.x, p.y, p.z)
-                })
-                .map_err(|source| ImageError::WriteExr {
-                    path: path.to_path_buf(),
-                    source,
-                })
+                });
+                let image = exr::prelude::Image::from_channels((w, self.height as usize), channels);
+                crate::write_atomically(
+                    path,
+                    |out| image.write().to_buffered(out),
+                    |source| ImageError::WriteExr {
+                        path: path.to_path_buf(),
+                        source,
+                    },
+                )
             }
             Some("png") => {
                 let bytes: Vec<u8> = self
@@ -73,17 +93,22 @@ impl Image {
                         ]
                     })
                     .collect();
-                image::save_buffer(
+                use image::ImageEncoder;
+                crate::write_atomically(
                     path,
-                    &bytes,
-                    self.width,
-                    self.height,
-                    image::ExtendedColorType::Rgb8,
+                    |out| {
+                        image::codecs::png::PngEncoder::new(out).write_image(
+                            &bytes,
+                            self.width,
+                            self.height,
+                            image::ExtendedColorType::Rgb8,
+                        )
+                    },
+                    |source| ImageError::WritePng {
+                        path: path.to_path_buf(),
+                        source,
+                    },
                 )
-                .map_err(|source| ImageError::WritePng {
-                    path: path.to_path_buf(),
-                    source,
-                })
             }
             _ => Err(ImageError::UnknownFormat {
                 path: path.to_path_buf(),

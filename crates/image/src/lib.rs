@@ -1,7 +1,9 @@
 //! Linear RGB images for the `restir` renderer, in one place:
 //!
 //! - [`Image`]: a linear RGB image, row-major from the top-left pixel.
-//! - Files: [`Image::write`] writes `.exr` (linear float32 RGB) or `.png` (8-bit sRGB);
+//! - Files: [`Image::write`] writes `.exr` (linear float32 RGB) or `.png` (8-bit sRGB), through a
+//!   temporary file renamed onto the target ([`write_atomically`]: never a half-written file,
+//!   every error reported, flush included; [`Image::check_output`] checks a path before a render);
 //!   [`Image::read_exr`] reads a rendered EXR back; [`Image::read`] reads what a scene refers to
 //!   (PNG/JPEG, sRGB-decoded unless told otherwise, EXR and Radiance HDR as linear values) for
 //!   textures and environment maps. Failures are an [`ImageError`] naming the file.
@@ -24,11 +26,13 @@
 mod error;
 mod io;
 mod metrics;
+mod output;
 pub mod srgb;
 
 pub use error::{ImageError, ReadFailure};
 pub use io::IntegerEncoding;
 pub use metrics::{ErrorMetrics, compare};
+pub use output::{check_writable, temp_path, write_atomically, write_file_atomically};
 
 use glam::Vec3;
 

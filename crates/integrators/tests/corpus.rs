@@ -1,34 +1,17 @@
 //! Renders every scene of the shared corpus (`../shared/corpus` beside the workspace) at a small
 //! size with the path tracer and checks the images: finite, not black, not flat, and (for the
 //! Cornell box) the colours where they belong. The scene's own integrator settings are used
-//! except the resolution and the sample count. When the corpus is absent the test fails under CI
-//! (`CI` set) and is skipped otherwise.
+//! except the resolution and the sample count. When the corpus was absent at build time the test is
+//! ignored (`restir_testkit::corpus_test!`); under CI (`CI` set) it runs and fails without it.
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use restir_integrators::Image;
 use restir_scene::{Scene, load_desc};
 
 const SIZE: u32 = 24;
-
-fn corpus() -> Option<PathBuf> {
-    let dir = Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/corpus"
-    ));
-    if dir.is_dir() {
-        return Some(dir.to_path_buf());
-    }
-    assert!(
-        std::env::var_os("CI").is_none(),
-        "the scene corpus is missing at {} (required when CI is set)",
-        dir.display()
-    );
-    eprintln!("skipped: no scene corpus at {}", dir.display());
-    None
-}
 
 /// Loads `rel` with its film set to `SIZE`×`SIZE` (keeping the aspect ratio's orientation is not
 /// needed for these checks).
@@ -53,9 +36,9 @@ fn mean_std(img: &Image) -> (f64, f64) {
     (mean, var.sqrt())
 }
 
-#[test]
+restir_testkit::corpus_test! {
 fn every_corpus_scene_renders() {
-    let Some(dir) = corpus() else { return };
+    let dir = restir_testkit::corpus_dir();
     for rel in [
         "lajolla/cbox/cbox.xml",
         "lajolla/veach_mi/mi.xml",
@@ -93,4 +76,5 @@ fn every_corpus_scene_renders() {
             );
         }
     }
+}
 }

@@ -273,24 +273,12 @@ fn environment_share_beside_area_lights_is_unbiased() {
 // Corpus
 // ------------------------------------------------------------------------------------------
 
+restir_testkit::corpus_test! {
 /// The corpus's matpreview with its envmap, glass and meshes (the plane's checkerboard replaced
 /// by a grey reflectance, file paths made absolute) renders at 32×24 without non-finite pixels
 /// in every estimator.
-#[test]
 fn matpreview_renders() {
-    let corpus = Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/corpus/lajolla/matpreview"
-    ));
-    if !corpus.is_dir() {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "the scene corpus is missing at {}",
-            corpus.display()
-        );
-        eprintln!("skipped: no scene corpus at {}", corpus.display());
-        return;
-    }
+    let corpus = restir_testkit::corpus_dir().join("lajolla/matpreview");
     let xml = std::fs::read_to_string(corpus.join("matpreview.xml")).unwrap();
     let abs = |f: &str| corpus.join(f).display().to_string();
     let xml = xml
@@ -320,4 +308,5 @@ fn matpreview_renders() {
         assert!(mean > 0.0, "{name}: black image");
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
 }

@@ -1,38 +1,21 @@
 //! Loads every scene of the shared corpus (`../shared/corpus` beside the workspace): the ones the
 //! importer supports must load, the others must fail with a clear `file:line` message. When the
-//! corpus is absent the test fails under CI (`CI` set) and is skipped otherwise.
+//! corpus was absent at build time the tests are ignored (`restir_testkit::corpus_test!`); under
+//! CI (`CI` set) they run and fail without it.
 
 use std::path::{Path, PathBuf};
 
 use restir_scene::texture::{Texture, TextureDesc, UvTransform};
 use restir_scene::{LoadOptions, LoadedScene, load_scene};
 
-fn corpus() -> Option<PathBuf> {
-    let dir = Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/corpus"
-    ));
-    if dir.is_dir() {
-        return Some(dir.to_path_buf());
-    }
-    if std::env::var_os("CI").is_some() {
-        panic!(
-            "the scene corpus is missing at {} (required when CI is set)",
-            dir.display()
-        );
-    }
-    eprintln!("skipped: no scene corpus at {}", dir.display());
-    None
-}
-
 fn load(dir: &Path, rel: &str) -> LoadedScene {
     let path = dir.join(rel);
     load_scene(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{rel} should load: {e}"))
 }
 
-#[test]
+restir_testkit::corpus_test! {
 fn supported_corpus_scenes_load() {
-    let Some(dir) = corpus() else { return };
+    let dir = restir_testkit::corpus_dir();
 
     // Cornell box: OBJ meshes, measured reflectance spectra, a spectral area light.
     let cbox = load(&dir, "lajolla/cbox/cbox.xml");
@@ -66,11 +49,12 @@ fn supported_corpus_scenes_load() {
         restir_scene::GeometryDesc::Ply { filename } if filename.contains("bunny")
     )));
 }
+}
 
+restir_testkit::corpus_test! {
 /// The textured scenes load, and their materials vary over the surface as their textures do.
-#[test]
 fn textured_corpus_scenes_load() {
-    let Some(dir) = corpus() else { return };
+    let dir = restir_testkit::corpus_dir();
     let centre_hit = |scene: &restir_scene::Scene| {
         let (w, h) = scene.camera.resolution();
         let film = glam::Vec2::new(w as f32 / 2.0, h as f32 * 0.9);
@@ -110,6 +94,7 @@ fn textured_corpus_scenes_load() {
     let r1 = reflectance(sponza.bsdf(&si));
     assert!(r0 != r1 && r0.max_element() <= 1.0, "{r0} {r1}");
 }
+}
 
 /// A scene around one shape, written next to the test's temporary files.
 fn shape_scene(name: &str, shape: &str) -> PathBuf {
@@ -129,9 +114,9 @@ fn shape_scene(name: &str, shape: &str) -> PathBuf {
     path
 }
 
-#[test]
+restir_testkit::corpus_test! {
 fn serialized_meshes_of_the_corpus() {
-    let Some(dir) = corpus() else { return };
+    let dir = restir_testkit::corpus_dir();
     let mp = dir.join("lajolla/matpreview/matpreview.serialized");
     let sp = dir.join("lajolla/sponza/sponza.serialized");
     let mut shapes = String::new();
@@ -176,10 +161,11 @@ fn serialized_meshes_of_the_corpus() {
         "{e}"
     );
 }
+}
 
-#[test]
+restir_testkit::corpus_test! {
 fn corpus_exr_and_jpeg_decode() {
-    let Some(dir) = corpus() else { return };
+    let dir = restir_testkit::corpus_dir();
     let desc = TextureDesc::Bitmap {
         filename: "envmap.exr".into(),
         raw: false,
@@ -197,4 +183,5 @@ fn corpus_exr_and_jpeg_decode() {
     let t = Texture::load(&jpeg, &dir.join("lajolla/sponza")).unwrap();
     let m = t.mean();
     assert!(m.max_element() <= 1.0 && m.min_element() > 0.0, "{m:?}");
+}
 }

@@ -9,6 +9,9 @@
 //!   and an unbiasedness check ([`RunningStats`]), a quick fixed-level chi-square check
 //!   ([`chi_square`], [`chi_square_critical`]), trial counts that shrink in debug builds
 //!   ([`trials`]).
+//! - [`corpus`]: the shared scene corpus beside the clone ([`corpus_dir`]) and
+//!   [`corpus_test!`](crate::corpus_test), which ignores a test that needs it when it is absent
+//!   (outside CI).
 //! - [`blocks`]: per-block means of images and their mean and standard error over independent
 //!   renders ([`block_statistics`], [`max_z`]), for comparing two estimators of the same image.
 //!
@@ -60,6 +63,7 @@
 
 pub mod blocks;
 pub mod chi2;
+pub mod corpus;
 pub mod grid;
 pub mod running;
 pub mod special;
@@ -69,6 +73,7 @@ pub use chi2::{
     Chi2Error, Chi2Outcome, Histogram, POOL_THRESHOLD, WorstCell, chi_square, chi_square_critical,
     chi2_test,
 };
+pub use corpus::{CORPUS_IGNORE_REASON, corpus_dir};
 pub use grid::{Grid2D, Quadrature, SphereGrid};
 pub use running::{RunningStats, SplitMix64, trials};
 pub use special::{chi2_sf, gamma_p, gamma_q, ln_gamma, sidak_level};

@@ -4,6 +4,7 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
+use crate::say::say;
 use restir_evaluation::{
     Progress, RunOptions, Suite, check_doc, run_suite, suite, update_doc, write_outputs,
 };
@@ -27,7 +28,7 @@ pub struct BenchArgs {
     /// Reference passes; overrides the suite's (and every scene's) reference_spp.
     #[arg(long)]
     reference_spp: Option<u32>,
-    /// Worker threads (default: all cores).
+    /// Worker threads, 1 to 256 (0 or absent: one per core).
     #[arg(long)]
     threads: Option<usize>,
     /// Also rewrite the marked results section of this Markdown file (e.g. docs/BENCHMARKS.md).
@@ -61,14 +62,7 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
     if let Some(doc) = &args.update_doc {
         check_doc(doc).map_err(|e| e.to_string())?;
     }
-    let threads = args.threads.unwrap_or(0);
-    if threads > 1024 {
-        return Err(format!("--threads {threads}: at most 1024 (0 = all cores)"));
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| format!("cannot start {threads} threads: {e}"))?;
+    let pool = crate::strict::thread_pool(args.threads)?;
     let opts = RunOptions {
         suite_dir: args.suite.parent().map(PathBuf::from).unwrap_or_default(),
         out: args.out.clone(),
@@ -105,7 +99,7 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         update_doc(&results, &args.out, doc).map_err(|e| e.to_string())?;
     }
     if !args.quiet {
-        println!(
+        say!(
             "{} renders in {:.1} min -> {}",
             results.records.len(),
             results.wall_seconds / 60.0,

@@ -8,8 +8,7 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 use clap::{Parser, Subcommand};
@@ -22,6 +21,12 @@ use restir_scene::{LoadOptions, load_scene};
 
 mod bench;
 mod generate;
+mod interrupt;
+mod progress;
+mod say;
+mod strict;
+
+use say::{say, say_err};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -76,9 +81,13 @@ struct RenderArgs {
     /// Random seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Worker threads (default: all cores).
+    /// Worker threads, 1 to 256 (0 or absent: one per core).
     #[arg(long)]
     threads: Option<usize>,
+    /// Refuse films whose estimated memory (film, images and the estimator's per-pixel
+    /// buffers) exceeds this many GiB, before allocating anything [default: 8].
+    #[arg(long, value_name = "GIB")]
+    max_memory: Option<f64>,
     /// Image width; overrides the scene.
     #[arg(long)]
     width: Option<u32>,
@@ -184,9 +193,6 @@ impl RestirArgs {
     }
 }
 
-/// More worker threads than this is a typo, not a machine.
-const MAX_THREADS: usize = 1024;
-
 #[derive(serde::Serialize)]
 struct Stats<'a> {
     scene: String,
@@ -209,7 +215,13 @@ struct Stats<'a> {
     threads: usize,
 }
 
-fn run_render(args: RenderArgs) -> Result<(), String> {
+/// How a render ended: completely, or stopped by an interrupt (the partial image written).
+enum Rendered {
+    Complete,
+    Interrupted,
+}
+
+fn run_render(args: RenderArgs) -> Result<Rendered, String> {
     let load_start = Instant::now();
     let mut defines = Vec::new();
     for d in &args.defines {
@@ -226,10 +238,15 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         // The command line has never warned about unlit scenes.
         warn_no_lights: false,
     };
-    let loaded = load_scene(&args.scene, &options).map_err(|e| e.to_string())?;
+    let spinner = progress::load_spinner(&args.scene, args.quiet);
+    let loaded = load_scene(&args.scene, &options);
+    if let Some(s) = spinner {
+        s.finish_and_clear();
+    }
+    let loaded = loaded.map_err(|e| e.to_string())?;
     if !args.quiet {
         for w in &loaded.warnings {
-            eprintln!("{w}");
+            say_err!("{w}");
         }
     }
     let scene = loaded.scene;
@@ -244,9 +261,10 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         params: args.restir.params(),
     };
     let made = make_integrator(&scene, &options).map_err(|e| e.to_string())?;
+    strict::check_flags_used(&scene, &made)?;
     if !args.quiet {
         for p in &made.unused_params {
-            eprintln!(
+            say_err!(
                 "warning: integrator '{}' does not use the parameter '{}'",
                 made.integrator.name(),
                 p.name
@@ -302,6 +320,13 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
             ));
         }
     }
+    let (width, height) = scene.camera.resolution();
+    strict::check_memory(
+        width,
+        height,
+        integrator.as_ref(),
+        strict::max_memory(args.max_memory)?,
+    )?;
 
     // Fail before rendering, not after, when the output cannot be written.
     if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -311,25 +336,16 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
     if output.is_dir() {
         return Err(format!("{}: is a directory", output.display()));
     }
-
-    let threads = args.threads.unwrap_or(0);
-    if threads > MAX_THREADS {
-        return Err(format!(
-            "--threads {threads}: at most {MAX_THREADS} (0 = all cores)"
-        ));
+    Image::check_output(&output).map_err(|e| e.to_string())?;
+    if let Some(stats) = &args.stats {
+        restir_image::check_writable(stats).map_err(|e| e.to_string())?;
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| format!("cannot start {threads} threads: {e}"))?;
+
+    let pool = strict::thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
 
-    let cancel = Arc::new(AtomicBool::new(false));
-    {
-        let cancel = cancel.clone();
-        // Ctrl-C finishes the current pass and still writes the image.
-        let _ = ctrlc::set_handler(move || cancel.store(true, Ordering::Relaxed));
-    }
+    // Ctrl-C finishes the current pass and still writes the image; a second one aborts.
+    let cancel = interrupt::install(output.clone(), args.quiet);
 
     let show_bar = !args.quiet && std::io::stderr().is_terminal();
     let bar = if show_bar {
@@ -417,15 +433,21 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
             threads,
         };
         let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
-        std::fs::write(path, json + "\n").map_err(|e| format!("{}: {e}", path.display()))?;
+        restir_image::write_file_atomically(path, (json + "\n").as_bytes())
+            .map_err(|e| e.to_string())?;
+    }
+    let interrupted = cancel.load(Ordering::SeqCst);
+    if interrupted {
+        // Said even with --quiet: the exit code alone does not tell what was written.
+        say_err!(
+            "interrupted after {} passes: wrote what was rendered -> {}",
+            out.passes,
+            output.display()
+        );
     }
     if !args.quiet {
-        let stopped = if cancel.load(Ordering::Relaxed) {
-            " (interrupted)"
-        } else {
-            ""
-        };
-        println!(
+        let stopped = if interrupted { " (interrupted)" } else { "" };
+        say!(
             "{}: {} passes in {:.2} s{stopped}, {:.1} Mrays/s, {} threads, loaded in {:.2} s -> {}",
             integrator.describe(),
             out.passes,
@@ -436,13 +458,17 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
             output.display()
         );
         if out.nonfinite_pixels > 0 {
-            eprintln!(
+            say_err!(
                 "warning: {} pixels are NaN or infinite",
                 out.nonfinite_pixels
             );
         }
     }
-    Ok(())
+    Ok(if interrupted {
+        Rendered::Interrupted
+    } else {
+        Rendered::Complete
+    })
 }
 
 fn run_compare(test: &Path, reference: &Path) -> Result<(), String> {
@@ -458,9 +484,12 @@ fn run_compare(test: &Path, reference: &Path) -> Result<(), String> {
             r.height
         )
     })?;
-    println!(
+    say!(
         "relmse={:.6e} mse={:.6e} mean_ratio={:.6} nonfinite={}",
-        m.relmse, m.mse, m.mean_ratio, m.nonfinite
+        m.relmse,
+        m.mse,
+        m.mean_ratio,
+        m.nonfinite
     );
     Ok(())
 }
@@ -485,22 +514,25 @@ fn main() -> ExitCode {
                     ExitCode::SUCCESS
                 };
             }
-            let text = e.render().to_string();
-            let first = text.lines().next().unwrap_or("invalid arguments");
-            eprintln!("{} (see restir --help)", first.trim());
+            // clap's whole message: the error, its hints ("a similar argument exists") and the
+            // usage line.
+            let _ = e.print();
             return ExitCode::FAILURE;
         }
     };
     let result = match cli.command {
         Command::Render(args) => run_render(*args),
-        Command::Compare { test, reference } => run_compare(&test, &reference),
-        Command::Generate(what) => generate::run(what),
-        Command::Bench(args) => bench::run(*args),
+        Command::Compare { test, reference } => {
+            run_compare(&test, &reference).map(|()| Rendered::Complete)
+        }
+        Command::Generate(what) => generate::run(what).map(|()| Rendered::Complete),
+        Command::Bench(args) => bench::run(*args).map(|()| Rendered::Complete),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(Rendered::Complete) => ExitCode::SUCCESS,
+        Ok(Rendered::Interrupted) => ExitCode::from(interrupt::EXIT_INTERRUPTED),
         Err(e) => {
-            eprintln!("error: {e}");
+            say_err!("error: {e}");
             ExitCode::FAILURE
         }
     }

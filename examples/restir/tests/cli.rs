@@ -215,13 +215,25 @@ fn nan_in_a_parameter() {
     );
 }
 
+/// clap's whole message (error, hints, usage) on stderr, exit code 1.
 #[test]
 fn unknown_flag() {
-    fails(
-        &["render", s(&cornell()), "--frobnicate"],
-        &["--frobnicate"],
-    );
-    fails(&["frobnicate"], &["frobnicate"]);
+    for (args, needle) in [
+        (
+            &["render", s(&cornell()), "--frobnicate"][..],
+            "--frobnicate",
+        ),
+        (&["frobnicate"][..], "frobnicate"),
+    ] {
+        let out = restir(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(
+            stderr.starts_with("error: ") && stderr.contains(needle),
+            "{stderr}"
+        );
+        assert!(stderr.contains("Usage: restir"), "{stderr}");
+    }
 }
 
 #[test]

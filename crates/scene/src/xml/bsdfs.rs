@@ -7,6 +7,19 @@ use super::props::{ColorUse, PROPERTY_TAGS, Props, Value};
 use super::{Importer, Result, elements, snake_case};
 use crate::desc::*;
 
+/// The `<bsdf>` types the importer reads.
+const BSDF_TYPES: &[&str] = &[
+    "diffuse",
+    "twosided",
+    "conductor",
+    "roughconductor",
+    "dielectric",
+    "roughdielectric",
+    "plastic",
+    "roughplastic",
+    "null",
+];
+
 impl<'a> Importer<'a> {
     /// A `<bsdf>` element (top-level, nested in a shape or wrapped by `twosided`).
     pub(super) fn bsdf<'i>(&self, node: Node<'a, 'i>) -> Result<MaterialDesc> {
@@ -30,7 +43,7 @@ impl<'a> Importer<'a> {
                     "bsdf 'thindielectric' is not supported yet (use 'dielectric' on a closed shape)",
                 ));
             }
-            other => return Err(self.err(node, format!("unknown bsdf type '{other}'"))),
+            other => return Err(self.unknown_type(node, "bsdf", other, BSDF_TYPES)),
         };
         let m = self.bind_textures(&ty, m, textured)?;
         // Everything the builder would reject, reported here with this bsdf's line.

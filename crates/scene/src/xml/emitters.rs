@@ -77,7 +77,20 @@ impl<'a> Importer<'a> {
                 }
             }
             "area" => return Err(self.err(node, "an area emitter must be inside a <shape>")),
-            other => return Err(self.err(node, format!("unknown emitter type '{other}'"))),
+            other => {
+                return Err(self.unknown_type(
+                    node,
+                    "emitter",
+                    other,
+                    &[
+                        "point",
+                        "directional",
+                        "constant",
+                        "envmap",
+                        "area (inside a shape)",
+                    ],
+                ));
+            }
         };
         props.finish();
         Ok(light)

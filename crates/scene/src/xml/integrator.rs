@@ -1,10 +1,26 @@
 //! `<integrator>`: the estimator, its depth settings, and the ReSTIR parameters passed through.
+//! An unknown type is an error listing the known ones (never a fallback to the path tracer).
 
 use roxmltree::Node;
 
 use super::props::Value;
 use super::{Importer, Result};
 use crate::desc::*;
+
+/// The `<integrator>` types the importer reads: Mitsuba's `path`, `volpath` (read as `path`) and
+/// `direct` (`path` with max_depth 2), and this renderer's estimators under their spellings.
+const INTEGRATOR_TYPES: &[&str] = &[
+    "path",
+    "volpath",
+    "direct",
+    "restir-di",
+    "restir_di",
+    "restir",
+    "restirdi",
+    "restir-pt",
+    "restir_pt",
+    "restirpt",
+];
 
 impl<'a> Importer<'a> {
     pub(super) fn integrator<'i>(&self, node: Node<'a, 'i>, desc: &mut SceneDesc) -> Result<()> {
@@ -18,7 +34,7 @@ impl<'a> Importer<'a> {
                 integ.kind = "path".into();
                 integ.max_depth = 2;
             }
-            "restir" | "restir_di" | "restir-di" => {
+            "restir" | "restir_di" | "restir-di" | "restirdi" => {
                 integ.kind = "restir-di".into();
                 keep_params = true;
             }
@@ -27,11 +43,7 @@ impl<'a> Importer<'a> {
                 keep_params = true;
             }
             other => {
-                self.warn(
-                    node,
-                    format!("unknown integrator type '{other}': using the path tracer"),
-                );
-                integ.kind = "path".into();
+                return Err(self.unknown_type(node, "integrator", other, INTEGRATOR_TYPES));
             }
         }
         if keep_params {

@@ -201,7 +201,14 @@ pub fn parse_xml(
             t if PROPERTY_TAGS.contains(&t) => {
                 imp.warn(c, format!("ignored <{t}> directly inside <scene>"))
             }
-            t => return Err(imp.err(c, format!("unsupported element <{t}>"))),
+            t => {
+                return Err(imp.err(
+                    c,
+                    format!(
+                        "unsupported element <{t}> (known: integrator, sensor, bsdf, texture, shape, emitter, default, and properties)"
+                    ),
+                ));
+            }
         }
     }
     if !saw_sensor {

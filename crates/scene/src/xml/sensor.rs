@@ -11,7 +11,7 @@ impl<'a> Importer<'a> {
     pub(super) fn sensor<'i>(&self, node: Node<'a, 'i>, desc: &mut SceneDesc) -> Result<()> {
         let ty = self.plugin_type(node)?;
         if ty != "perspective" && ty != "thinlens" {
-            return Err(self.err(node, format!("unknown sensor type '{ty}'")));
+            return Err(self.unknown_type(node, "sensor", &ty, &["perspective", "thinlens"]));
         }
         let props = self.props(node, format!("sensor '{ty}'"))?;
         let fov = props.float("fov")?.unwrap_or(defaults::FOV);
@@ -55,6 +55,20 @@ impl<'a> Importer<'a> {
                 "film" => self.film(c, &mut desc.film)?,
                 "sampler" => {
                     let sty = self.plugin_type(c)?;
+                    // Mitsuba's samplers (0.6 and 3): all stand for this renderer's own.
+                    const SAMPLERS: &[&str] = &[
+                        "independent",
+                        "stratified",
+                        "multijitter",
+                        "orthogonal",
+                        "ldsampler",
+                        "halton",
+                        "hammersley",
+                        "sobol",
+                    ];
+                    if !SAMPLERS.contains(&sty.as_str()) {
+                        return Err(self.unknown_type(c, "sampler", &sty, SAMPLERS));
+                    }
                     let sp = self.props(c, format!("sampler '{sty}'"))?;
                     if let Some(n) = sp.int("sample_count")? {
                         if !(1..=1 << 24).contains(&n) {
@@ -111,11 +125,9 @@ impl<'a> Importer<'a> {
         let ty = self.plugin_type(node)?;
         // Mitsuba 3's hdrfilm and specfilm, Mitsuba 0.6's ldrfilm and tiledhdrfilm: all give an
         // image; the output format comes from the output file name.
-        if !matches!(
-            ty.as_str(),
-            "hdrfilm" | "ldrfilm" | "tiledhdrfilm" | "specfilm"
-        ) {
-            return Err(self.err(node, format!("unknown film type '{ty}'")));
+        const FILMS: &[&str] = &["hdrfilm", "ldrfilm", "tiledhdrfilm", "specfilm"];
+        if !FILMS.contains(&ty.as_str()) {
+            return Err(self.unknown_type(node, "film", &ty, FILMS));
         }
         let props = self.props(node, format!("film '{ty}'"))?;
         let dim = |what: &str, d: u32| -> Result<u32> {
@@ -174,7 +186,14 @@ impl<'a> Importer<'a> {
                             }
                             FilterDesc::Gaussian { stddev: s }
                         }
-                        other => return Err(self.err(c, format!("unknown rfilter type '{other}'"))),
+                        other => {
+                            return Err(self.unknown_type(
+                                c,
+                                "rfilter",
+                                other,
+                                &["box", "tent", "gaussian"],
+                            ));
+                        }
                     };
                     fp.finish();
                 }

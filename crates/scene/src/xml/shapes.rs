@@ -51,7 +51,22 @@ impl<'a> Importer<'a> {
                     shape_index,
                 }
             }
-            other => return Err(self.err(node, format!("unknown shape type '{other}'"))),
+            other => {
+                return Err(self.unknown_type(
+                    node,
+                    "shape",
+                    other,
+                    &[
+                        "rectangle",
+                        "cube",
+                        "disk",
+                        "sphere",
+                        "obj",
+                        "ply",
+                        "serialized",
+                    ],
+                ));
+            }
         };
         let to_world = props.transform("to_world")?;
         let flip_normals = props.bool("flip_normals")?.unwrap_or(false);

@@ -48,6 +48,20 @@ impl<'a> Source<'a> {
         SceneError::new(self.loc(node), msg)
     }
 
+    /// "unknown `family` type 'ty' (known: a, b, …)", at `node`.
+    pub(super) fn unknown_type(
+        &self,
+        node: Node,
+        family: &str,
+        ty: &str,
+        known: &[&str],
+    ) -> SceneError {
+        self.err(
+            node,
+            format!("unknown {family} type '{ty}' (known: {})", known.join(", ")),
+        )
+    }
+
     /// Records a warning at `node`.
     pub(super) fn warn(&self, node: Node, msg: impl Into<String>) {
         let location = self.loc(node);

@@ -73,7 +73,9 @@ impl<'a> Importer<'a> {
                     .unwrap_or(defaults::CHECKER_COLOR1),
                 uv,
             },
-            other => return Err(self.err(node, format!("unknown texture type '{other}'"))),
+            other => {
+                return Err(self.unknown_type(node, "texture", other, &["bitmap", "checkerboard"]));
+            }
         };
         for c in elements(node) {
             let tag = c.tag_name().name();

@@ -1,0 +1,227 @@
+//! Outputs that are never half-written and a command that never panics on its streams
+//! (issue 17, "output"; issue 16 §2, Ctrl-C): a write that fails (here a file-size limit, as a
+//! full disk would) is exit code 1 with the file named and the old file kept; a closed stdout
+//! or stderr is no panic; an interrupt writes what was rendered and exits 130, a second one
+//! aborts at once without writing.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
+
+fn cornell() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml")
+}
+
+/// A fresh directory for one test, removed when dropped.
+struct TempDir(PathBuf);
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn temp_dir(tag: &str) -> TempDir {
+    let dir = std::env::temp_dir().join(format!("restir-output-{}-{tag}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    TempDir(dir)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// The names of the files in `dir`.
+fn entries(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// A write that fails part-way (the file-size limit `ulimit -f` with SIGXFSZ ignored, so the
+/// write returns EFBIG as on a full disk) is exit code 1 naming the file; the previous image
+/// stays whole and no temporary file is left. Both formats.
+#[test]
+fn a_failed_write_is_an_error_and_keeps_the_old_image() {
+    let dir = temp_dir("efbig");
+    for ext in ["exr", "png"] {
+        let out = dir.0.join(format!("o.{ext}"));
+        let small = ["--width", "64", "--height", "48", "--spp", "1", "--quiet"];
+        let good = Command::new(RESTIR)
+            .args(["render", s(&cornell()), "-o", s(&out)])
+            .args(small)
+            .output()
+            .unwrap();
+        assert!(good.status.success());
+        let before = std::fs::read(&out).unwrap();
+        // 8 blocks (4 or 8 KiB depending on the shell) is smaller than either image.
+        let o = Command::new("sh")
+            .arg("-c")
+            .arg("trap '' XFSZ; ulimit -f 8; exec \"$0\" \"$@\"")
+            .arg(RESTIR)
+            .args(["render", s(&cornell()), "-o", s(&out), "--seed", "3"])
+            .args(["--width", "64", "--height", "48", "--spp", "1"])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{ext}: {stderr}");
+        assert!(
+            stderr.starts_with(&format!("error: {}: cannot write", s(&out))),
+            "{ext}: {stderr}"
+        );
+        assert!(stderr.contains("too large"), "{ext}: {stderr}");
+        assert!(
+            o.stdout.is_empty(),
+            "{ext}: no summary after a failed write"
+        );
+        assert_eq!(
+            std::fs::read(&out).unwrap(),
+            before,
+            "{ext}: old image kept"
+        );
+        assert_eq!(entries(&dir.0).len(), if ext == "exr" { 1 } else { 2 });
+    }
+}
+
+/// `restir render … | head -0`: the summary goes to a closed pipe; no panic, exit code 0.
+#[test]
+fn a_closed_stdout_is_no_panic() {
+    let dir = temp_dir("stdout");
+    let out = dir.0.join("o.exr");
+    let mut child = Command::new(RESTIR)
+        .args(["render", s(&cornell()), "-o", s(&out)])
+        .args(["--width", "16", "--height", "16", "--spp", "1"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert!(out.is_file());
+    // compare's one line, too.
+    let mut child = Command::new(RESTIR)
+        .args(["compare", s(&out), s(&out)])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    assert!(o.stderr.is_empty());
+}
+
+/// Warnings and errors to a closed stderr: no panic, the exit code unchanged.
+#[test]
+fn a_closed_stderr_is_no_panic() {
+    let dir = temp_dir("stderr");
+    let scene = dir.0.join("warns.xml");
+    let text = std::fs::read_to_string(cornell()).unwrap().replace(
+        "<float name=\"fov\"",
+        "<float name=\"near_clip\" value=\"1\"/><float name=\"fov\"",
+    );
+    std::fs::write(&scene, text).unwrap();
+    let out = dir.0.join("o.exr");
+    for (args, code) in [
+        (
+            vec![
+                "render",
+                s(&scene),
+                "-o",
+                s(&out),
+                "--spp",
+                "1",
+                "--width",
+                "8",
+            ],
+            0,
+        ),
+        (vec!["render", s(&scene), "-o", s(&out), "--spp", "0"], 1),
+    ] {
+        let mut child = Command::new(RESTIR)
+            .args(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stderr.take());
+        let o = child.wait_with_output().unwrap();
+        assert_eq!(o.status.code(), Some(code), "{args:?}");
+    }
+}
+
+/// Starts a render of `passes` passes of `size`² pixels into `out` and sends it `signals`
+/// (`sh`'s `kill -SIG`), the first after `wait`, the others 50 ms apart.
+fn interrupt(out: &Path, size: &str, signals: &[&str], wait: Duration) -> std::process::Output {
+    let child = Command::new(RESTIR)
+        .args(["render", s(&cornell()), "-o", s(out), "--spp", "100000"])
+        .args(["--width", size, "--height", size, "--quiet"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(wait);
+    for sig in signals {
+        let kill = format!("kill -{sig} {}", child.id());
+        assert!(
+            Command::new("sh")
+                .arg("-c")
+                .arg(&kill)
+                .status()
+                .unwrap()
+                .success()
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// One interrupt (SIGINT, as Ctrl-C, or SIGTERM): the passes done so far are written, stderr
+/// says so, exit code 130.
+#[test]
+fn an_interrupt_writes_what_was_rendered_and_exits_130() {
+    let dir = temp_dir("sigint");
+    for sig in ["INT", "TERM"] {
+        let out = dir.0.join(format!("{sig}.exr"));
+        let o = interrupt(&out, "32", &[sig], Duration::from_millis(1500));
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(130), "{sig}: {stderr}");
+        let line = stderr.lines().last().unwrap_or("");
+        assert!(
+            line.starts_with("interrupted after ")
+                && line.ends_with(&format!("passes: wrote what was rendered -> {}", s(&out))),
+            "{sig}: {stderr}"
+        );
+        let img = restir_image::Image::read_exr(&out).unwrap();
+        assert_eq!((img.width, img.height), (32, 32));
+        assert!(
+            img.mean().max_element() > 0.0,
+            "{sig}: the image has the passes"
+        );
+    }
+}
+
+/// A second interrupt aborts the current pass at once: exit 130 within a fraction of a pass,
+/// nothing written.
+#[test]
+fn a_second_interrupt_aborts_at_once() {
+    let dir = temp_dir("abort");
+    let out = dir.0.join("o.exr");
+    // 2048² pixels: one pass takes seconds, the abort must not wait for it.
+    let start = Instant::now();
+    let o = interrupt(&out, "2048", &["INT", "INT"], Duration::from_millis(1500));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{stderr}");
+    assert!(stderr.ends_with("aborted\n"), "{stderr}");
+    assert!(!out.exists(), "nothing written");
+    assert!(entries(&dir.0).is_empty(), "no temporary file left");
+    assert!(start.elapsed() < Duration::from_secs(30));
+}
