@@ -2,7 +2,9 @@
 //!
 //! - [`Image`]: a linear RGB image, row-major from the top-left pixel.
 //! - Files: [`Image::write`] writes `.exr` (linear float32 RGB) or `.png` (8-bit sRGB);
-//!   [`Image::read_exr`] reads a rendered EXR back; [`Image::read`] reads what a scene refers to
+//!   [`Image::read_exr`] reads a rendered EXR back; [`Image::write_exr_part`] /
+//!   [`Image::read_exr_part`] an EXR of one part of a render ([`ExrPart`]: its place in the film
+//!   and text attributes); [`Image::read`] reads what a scene refers to
 //!   (PNG/JPEG, sRGB-decoded unless told otherwise, EXR and Radiance HDR as linear values) for
 //!   textures and environment maps. Failures are an [`ImageError`] naming the file.
 //! - [`srgb`]: the sRGB transfer function both ways.
@@ -24,11 +26,13 @@
 mod error;
 mod io;
 mod metrics;
+mod part;
 pub mod srgb;
 
 pub use error::{ImageError, ReadFailure};
 pub use io::IntegerEncoding;
 pub use metrics::{ErrorMetrics, compare};
+pub use part::ExrPart;
 
 use glam::Vec3;
 

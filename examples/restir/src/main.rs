@@ -16,12 +16,14 @@ use clap::{Parser, Subcommand};
 use restir_geometry::Shape;
 use restir_image::{Image, compare};
 use restir_integrators::{
-    IntegratorOptions, Param, ParamSet, ParamValue, RenderJob, make_integrator, render,
+    IntegratorOptions, Param, ParamSet, ParamValue, RenderJob, make_integrator,
 };
 use restir_scene::{LoadOptions, load_scene};
 
 mod bench;
+mod cluster;
 mod generate;
+mod merge;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -51,6 +53,8 @@ enum Command {
     /// Equal-time evaluation: render a suite of scenes × integrators × time budgets × seeds,
     /// compare with references, write a CSV, relMSE-versus-time plots, crops and a report.
     Bench(Box<bench::BenchArgs>),
+    /// Merge the parts of a split render (--chain/--crop) into one image (docs/CLUSTER.md).
+    Merge(merge::MergeArgs),
 }
 
 #[derive(clap::Args, Debug)]
@@ -96,6 +100,8 @@ struct RenderArgs {
     quiet: bool,
     #[command(flatten)]
     restir: RestirArgs,
+    #[command(flatten)]
+    cluster: cluster::ClusterArgs,
 }
 
 /// ReSTIR settings; each overrides the scene's `<integrator>` parameter of the same name.
@@ -207,6 +213,9 @@ struct Stats<'a> {
     nonfinite_pixels: usize,
     seed: u64,
     threads: usize,
+    /// The part of a split render this process rendered (--chain, --crop).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    part: Option<cluster::PartStats>,
 }
 
 fn run_render(args: RenderArgs) -> Result<(), String> {
@@ -288,6 +297,15 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         )),
     };
     job.output = Some(output.clone());
+    let plan = args.cluster.plan(
+        spp,
+        time_limit.is_some(),
+        &output,
+        scene.camera.resolution(),
+    )?;
+    if let Some(plan) = &plan {
+        job.spp = plan.passes.len() as u32;
+    }
     match output
         .extension()
         .and_then(|e| e.to_str())
@@ -361,10 +379,11 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
     };
 
     let out = pool.install(|| {
-        render(
+        cluster::render(
             &scene,
             integrator.as_ref(),
             &job,
+            plan.as_ref(),
             &cancel,
             &mut |passes, elapsed| {
                 if let Some(b) = &bar {
@@ -382,7 +401,17 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         b.finish_and_clear();
     }
 
-    out.image.write(&output).map_err(|e| e.to_string())?;
+    match &plan {
+        Some(p) => p.write(
+            &out.image,
+            &output,
+            &args.scene,
+            &loaded.desc,
+            integrator.as_ref(),
+            args.seed,
+        )?,
+        None => out.image.write(&output).map_err(|e| e.to_string())?,
+    }
 
     let mrays = out.rays as f64 / out.seconds.max(1e-9) / 1e6;
     if let Some(path) = &args.stats {
@@ -415,6 +444,7 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
             nonfinite_pixels: out.nonfinite_pixels,
             seed: args.seed,
             threads,
+            part: plan.as_ref().map(|p| p.stats(integrator.as_ref())),
         };
         let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
         std::fs::write(path, json + "\n").map_err(|e| format!("{}: {e}", path.display()))?;
@@ -494,6 +524,7 @@ fn main() -> ExitCode {
         Command::Compare { test, reference } => run_compare(&test, &reference),
         Command::Generate(what) => generate::run(what),
         Command::Bench(args) => bench::run(*args),
+        Command::Merge(args) => merge::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
