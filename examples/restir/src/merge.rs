@@ -318,7 +318,7 @@ mod tests {
         assert_eq!(m.pixels[0], Vec3::new(want, 0.0, 1.0));
         assert_eq!(
             m.pixels[5],
-            Vec3::new(want, (3.0 + 7.0 * 2.0 * 5.0) / 10.0, 1.0)
+            Vec3::new(want, (3.0 * 5.0 + 7.0 * 10.0) / 10.0, 1.0)
         );
         // Two tiles, the right one in two chains.
         let parts = [
