@@ -214,7 +214,7 @@ fn parts_of_different_renders_do_not_merge() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("(scene differs"));
     fails(
         &["merge", &merged, &a],
-        &format!("error: window 0,0,48,32: passes 1..2 of 2 are missing"),
+        "error: window 0,0,48,32: passes 1..2 of 2 are missing",
     );
     fails(
         &["merge", &merged, &a, &a],
