@@ -403,3 +403,61 @@ pub fn render_part(
         nonfinite_pixels,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reuse::settings::ReuseSettings;
+
+    fn win(x0: u32, y0: u32, x1: u32, y1: u32) -> PixelWindow {
+        PixelWindow {
+            x0,
+            y0,
+            width: x1 - x0,
+            height: y1 - y0,
+        }
+    }
+
+    /// The halo is `rounds × ⌈radius⌉`, none without neighbours.
+    #[test]
+    fn reuse_halo() {
+        let mut s = ReuseSettings::default();
+        assert_eq!(s.halo(), 30);
+        s.radius = 2.5;
+        s.spatial_rounds = 3;
+        assert_eq!(s.halo(), 9);
+        s.neighbors = 0;
+        assert_eq!(s.halo(), 0);
+    }
+
+    /// The region grows by the halo, moves out to multiples of 16 and stops at the film.
+    #[test]
+    fn region_with_halo() {
+        let film = (100, 70);
+        assert_eq!(win(20, 40, 50, 50).with_halo(0, film), win(16, 32, 64, 64));
+        assert_eq!(win(20, 40, 50, 50).with_halo(5, film), win(0, 32, 64, 64));
+        assert_eq!(win(32, 32, 48, 48).with_halo(0, film), win(32, 32, 48, 48));
+        assert_eq!(win(32, 32, 48, 48).with_halo(1, film), win(16, 16, 64, 64));
+        assert_eq!(
+            win(90, 60, 100, 70).with_halo(8, film),
+            win(80, 48, 100, 70)
+        );
+        assert_eq!(win(0, 0, 100, 70).with_halo(30, film), win(0, 0, 100, 70));
+        assert!(win(0, 0, 100, 70).fits(film) && !win(1, 0, 101, 70).fits(film));
+    }
+
+    /// `extract` cuts an inner window out of a region's pixels.
+    #[test]
+    fn extract_window() {
+        let region = win(2, 3, 6, 6);
+        let image = Image {
+            width: 4,
+            height: 3,
+            pixels: (0..12).map(|i| glam::Vec3::splat(i as f32)).collect(),
+        };
+        let inner = region.extract(&image, &win(3, 4, 5, 6));
+        assert_eq!((inner.width, inner.height), (2, 2));
+        let v: Vec<f32> = inner.pixels.iter().map(|p| p.x).collect();
+        assert_eq!(v, [5.0, 6.0, 9.0, 10.0]);
+    }
+}

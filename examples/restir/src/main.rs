@@ -306,6 +306,7 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
     if let Some(plan) = &plan {
         job.spp = plan.passes.len() as u32;
     }
+    let spp = job.spp;
     match output
         .extension()
         .and_then(|e| e.to_str())
