@@ -126,6 +126,25 @@ fn chains_and_tiles_merge_into_the_single_render() {
         std::fs::read(&merged).unwrap() == std::fs::read(p(d, "full.exr")).unwrap(),
         "merged chains and tiles differ from the single render"
     );
+    // With temporal reuse each chain's history starts afresh, and the stats say so.
+    let temporal = p(d, "temporal.json");
+    let args = [
+        &di[..],
+        &[
+            "--temporal",
+            "--chain",
+            "2",
+            "--chains",
+            "3",
+            "--stats",
+            &temporal,
+        ],
+    ]
+    .concat();
+    render(&scene, &args, &p(d, "temporal.exr"));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&temporal).unwrap()).unwrap();
+    assert_eq!(json["part"]["temporal_restarts"], true);
     // A plain render has no stats part.
     let plain = p(d, "plain.json");
     render(
