@@ -428,6 +428,7 @@ mod lights {
             seed: 0,
             pass: 0,
             filter: &filter,
+            crop: None,
         };
         let (w, h) = scene.camera.resolution();
         let mut radiance = vec![Vec3::ZERO; (w * h) as usize];

@@ -50,6 +50,7 @@ fn measure(scene: &Scene, integrator: &dyn Integrator, budget: f64) -> Measureme
             seed: 0,
             pass,
             filter: &filter,
+            crop: None,
         };
         pass += 1;
         let start = Instant::now();

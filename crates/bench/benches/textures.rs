@@ -143,6 +143,7 @@ fn cornell_flag(budget: f64) {
             seed: 0,
             pass: pass / 2,
             filter: &filter,
+            crop: None,
         };
         pass += 1;
         integrator.render_pass(&scene, &ctx, &mut accum)
@@ -195,6 +196,7 @@ fn sponza(budget: f64) {
             seed: 0,
             pass: pass / 2,
             filter: &filter,
+            crop: None,
         };
         pass += 1;
         integrator.render_pass(&scene, &ctx, &mut accum)

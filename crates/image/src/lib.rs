@@ -4,7 +4,9 @@
 //! - Files: [`Image::write`] writes `.exr` (linear float32 RGB) or `.png` (8-bit sRGB), through a
 //!   temporary file renamed onto the target ([`write_atomically`]: never a half-written file,
 //!   every error reported, flush included; [`Image::check_output`] checks a path before a render);
-//!   [`Image::read_exr`] reads a rendered EXR back; [`Image::read`] reads what a scene refers to
+//!   [`Image::read_exr`] reads a rendered EXR back; [`Image::write_exr_part`] /
+//!   [`Image::read_exr_part`] an EXR of one part of a render ([`ExrPart`]: its place in the film
+//!   and text attributes); [`Image::read`] reads what a scene refers to
 //!   (PNG/JPEG, sRGB-decoded unless told otherwise, EXR and Radiance HDR as linear values) for
 //!   textures and environment maps. Failures are an [`ImageError`] naming the file.
 //! - [`srgb`]: the sRGB transfer function both ways.
@@ -27,12 +29,14 @@ mod error;
 mod io;
 mod metrics;
 mod output;
+mod part;
 pub mod srgb;
 
 pub use error::{ImageError, ReadFailure};
 pub use io::IntegerEncoding;
 pub use metrics::{ErrorMetrics, compare};
 pub use output::{check_writable, temp_path, write_atomically, write_file_atomically};
+pub use part::ExrPart;
 
 use glam::Vec3;
 

@@ -30,7 +30,10 @@ pub mod reuse;
 pub mod shadow;
 
 pub use params::{Param, ParamError, ParamSet, ParamSource, ParamValue};
-pub use render::{Integrator, PassContext, PathIntegrator, RenderJob, RenderOutput, render};
+pub use render::{
+    CROP_ALIGN, Crop, Integrator, PassContext, PathIntegrator, PixelWindow, RenderJob,
+    RenderOutput, RenderPart, render, render_part,
+};
 pub use restir_di::{RestirDiIntegrator, RestirDiSettings};
 pub use restir_image::{ErrorMetrics, Image, ImageError, compare};
 pub use restir_pt::{RestirPtIntegrator, RestirPtSettings};

@@ -1,7 +1,9 @@
 //! The render driver: a [`RenderJob`] (how many passes, how long, which seed, where to) run on a
 //! scene with an [`Integrator`], pass after pass into a [`Film`] until the sample count, the time
 //! limit or a cancellation ends it. A pass is one sample per pixel of an integrator's final
-//! estimator.
+//! estimator. [`render_part`] renders one part of a render, for splitting it across machines: a
+//! range of its passes (the same `(seed, pixel, pass)` streams), and optionally a window of the
+//! film ([`PixelWindow`]) rendered with a halo wide enough for the estimator's spatial reuse.
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -26,13 +28,139 @@ pub struct PassContext<'a> {
     pub pass: u32,
     /// The pixel filter, for jittering camera rays.
     pub filter: &'a Filter,
+    /// The part of the film this pass renders, if not all of it: pixel indices and coordinates
+    /// the integrator sees are then the region's, and the random streams and camera rays are
+    /// those of the same pixels in the whole film.
+    pub crop: Option<Crop>,
+}
+
+/// A rectangle of film pixels: columns `x0..x0 + width`, rows `y0..y0 + height`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PixelWindow {
+    /// First column.
+    pub x0: u32,
+    /// First row.
+    pub y0: u32,
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+}
+
+/// Rendered regions of a cropped render start and end on multiples of this many pixels (or at
+/// the film's edge), so that ReSTIR DI's 16×16 light tiles are the whole film's tiles.
+pub const CROP_ALIGN: u32 = 16;
+
+impl PixelWindow {
+    /// The whole of a `width × height` film.
+    pub fn full((width, height): (u32, u32)) -> Self {
+        Self {
+            x0: 0,
+            y0: 0,
+            width,
+            height,
+        }
+    }
+
+    /// One past the last column and row.
+    pub fn end(&self) -> (u32, u32) {
+        (self.x0 + self.width, self.y0 + self.height)
+    }
+
+    /// Pixels in the window.
+    pub fn pixels(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+
+    /// Whether the window is non-empty and lies inside a film of `(width, height)`.
+    pub fn fits(&self, (width, height): (u32, u32)) -> bool {
+        self.width > 0
+            && self.height > 0
+            && u64::from(self.x0) + u64::from(self.width) <= u64::from(width)
+            && u64::from(self.y0) + u64::from(self.height) <= u64::from(height)
+    }
+
+    /// The region to render for this window: grown by `halo` pixels on every side, its edges
+    /// then moved out to multiples of [`CROP_ALIGN`], all clipped to the `film`.
+    pub fn with_halo(&self, halo: u32, film: (u32, u32)) -> Self {
+        let (x1, y1) = self.end();
+        let down = |v: u32| v.saturating_sub(halo) / CROP_ALIGN * CROP_ALIGN;
+        let up = |v: u32, max: u32| {
+            v.saturating_add(halo)
+                .div_ceil(CROP_ALIGN)
+                .saturating_mul(CROP_ALIGN)
+                .min(max)
+        };
+        let (x0, y0) = (down(self.x0), down(self.y0));
+        let (x1, y1) = (up(x1, film.0), up(y1, film.1));
+        Self {
+            x0,
+            y0,
+            width: x1 - x0,
+            height: y1 - y0,
+        }
+    }
+
+    /// The pixels of `inner` (a window inside this one, both in film coordinates) out of
+    /// `image`, this window's pixels, row-major.
+    pub fn extract(&self, image: &Image, inner: &PixelWindow) -> Image {
+        let (dx, dy) = ((inner.x0 - self.x0) as usize, (inner.y0 - self.y0) as usize);
+        let w = self.width as usize;
+        let pixels = (0..inner.height as usize)
+            .flat_map(|y| {
+                let row = (dy + y) * w + dx;
+                image.pixels[row..row + inner.width as usize]
+                    .iter()
+                    .copied()
+            })
+            .collect();
+        Image {
+            width: inner.width,
+            height: inner.height,
+            pixels,
+        }
+    }
+}
+
+/// Where a cropped pass sits in the film.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Crop {
+    /// The region rendered.
+    pub region: PixelWindow,
+    /// The whole film's width.
+    pub film_width: u32,
 }
 
 impl PassContext<'_> {
+    /// The `(width, height)` of the pixels this pass renders: the film's, or the crop region's.
+    #[inline]
+    pub fn resolution(&self, scene: &Scene) -> (u32, u32) {
+        match &self.crop {
+            None => scene.camera.resolution(),
+            Some(c) => (c.region.width, c.region.height),
+        }
+    }
+
+    /// The film's index of pixel `index` of this pass.
+    #[inline]
+    fn film_index(&self, index: usize) -> u64 {
+        match &self.crop {
+            None => index as u64,
+            Some(c) => {
+                let w = c.region.width as usize;
+                let (x, y) = (
+                    index % w + c.region.x0 as usize,
+                    index / w + c.region.y0 as usize,
+                );
+                (y * c.film_width as usize + x) as u64
+            }
+        }
+    }
+
     /// The random stream of pixel `index` in this pass, the same whatever thread renders it.
     #[inline]
     pub fn pixel_rng(&self, index: usize) -> Pcg32 {
-        Pcg32::for_pixel_sample(self.seed, index as u64, self.pass as u64)
+        Pcg32::for_pixel_sample(self.seed, self.film_index(index), self.pass as u64)
     }
 
     /// A second, independent stream of pixel `index` in this pass, for estimator stage `stage`
@@ -44,12 +172,17 @@ impl PassContext<'_> {
         } else {
             restir_sampling::mix64(self.seed ^ stage.wrapping_mul(0xa076_1d64_78bd_642f))
         };
-        Pcg32::for_pixel_sample(seed, index as u64, self.pass as u64)
+        Pcg32::for_pixel_sample(seed, self.film_index(index), self.pass as u64)
     }
 
-    /// The film position (pixel units) of a filter-jittered camera ray through pixel `(x, y)`.
+    /// The film position (pixel units) of a filter-jittered camera ray through pixel `(x, y)`
+    /// of this pass.
     #[inline]
     pub fn film_position(&self, x: u32, y: u32, rng: &mut Pcg32) -> Vec2 {
+        let (x, y) = match &self.crop {
+            None => (x, y),
+            Some(c) => (x + c.region.x0, y + c.region.y0),
+        };
         Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + self.filter.sample(rng.next_2d())
     }
 }
@@ -68,6 +201,11 @@ pub trait Integrator: Sync + Send + std::fmt::Debug {
     /// Bytes per pixel of the per-pass buffers the estimator keeps besides the image (reservoirs,
     /// primary hits).
     fn buffer_bytes_per_pixel(&self) -> usize {
+        0
+    }
+    /// How far, in pixels, a pixel's estimate in one pass reaches for other pixels' samples
+    /// (spatial reuse: rounds × radius): the halo a cropped render needs around its window.
+    fn halo(&self) -> u32 {
         0
     }
 }
@@ -92,7 +230,7 @@ impl Integrator for PathIntegrator {
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
-        let (w, _) = scene.camera.resolution();
+        let (w, _) = ctx.resolution(scene);
         let w = w as usize;
         let bands = Bands::new(w);
         accum
@@ -179,18 +317,66 @@ pub fn render(
     cancel: &AtomicBool,
     progress: &mut dyn FnMut(u32, Duration),
 ) -> RenderOutput {
-    let (w, h) = scene.camera.resolution();
-    let mut film = Film::new(w, h, scene.filter);
+    render_part(
+        scene,
+        integrator,
+        job,
+        &RenderPart::default(),
+        cancel,
+        progress,
+    )
+}
+
+/// Which part of a render this process makes: passes `first_pass..first_pass + job.spp` of the
+/// same random streams, over the whole film or a window of it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RenderPart {
+    /// Index of the first pass.
+    pub first_pass: u32,
+    /// The window of the film to render, or `None` for all of it.
+    pub window: Option<PixelWindow>,
+}
+
+impl RenderPart {
+    /// The region rendered for the window: the window with the integrator's halo, aligned
+    /// ([`PixelWindow::with_halo`]); the whole film without a window.
+    pub fn region(&self, integrator: &dyn Integrator, film: (u32, u32)) -> PixelWindow {
+        match &self.window {
+            None => PixelWindow::full(film),
+            Some(w) => w.with_halo(integrator.halo(), film),
+        }
+    }
+}
+
+/// [`render`] for one part of a render: passes from `part.first_pass` on, and with a window only
+/// its region (the window plus halo) is rendered and the image is the window's. Temporal reuse
+/// starts afresh at the part's first pass. `part.window` must fit the film.
+pub fn render_part(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    job: &RenderJob,
+    part: &RenderPart,
+    cancel: &AtomicBool,
+    progress: &mut dyn FnMut(u32, Duration),
+) -> RenderOutput {
+    let film_size = scene.camera.resolution();
+    let region = part.region(integrator, film_size);
+    let crop = part.window.map(|_| Crop {
+        region,
+        film_width: film_size.0,
+    });
+    let mut film = Film::new(region.width, region.height, scene.filter);
     let start = Instant::now();
     let mut rays = 0u64;
     let spp = job.spp.max(1);
     while film.passes() < spp {
-        let pass = film.passes();
+        let pass = part.first_pass + film.passes();
         rays += film.add_pass(|filter, sums| {
             let ctx = PassContext {
                 seed: job.seed,
                 pass,
                 filter,
+                crop,
             };
             integrator.render_pass(scene, &ctx, sums)
         });
@@ -204,7 +390,10 @@ pub fn render(
         }
     }
     let seconds = start.elapsed().as_secs_f64();
-    let image = film.image();
+    let image = match &part.window {
+        None => film.image(),
+        Some(window) => region.extract(&film.image(), window),
+    };
     let nonfinite_pixels = image.nonfinite_count();
     RenderOutput {
         image,
@@ -212,5 +401,63 @@ pub fn render(
         seconds,
         rays,
         nonfinite_pixels,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reuse::settings::ReuseSettings;
+
+    fn win(x0: u32, y0: u32, x1: u32, y1: u32) -> PixelWindow {
+        PixelWindow {
+            x0,
+            y0,
+            width: x1 - x0,
+            height: y1 - y0,
+        }
+    }
+
+    /// The halo is `rounds × ⌈radius⌉`, none without neighbours.
+    #[test]
+    fn reuse_halo() {
+        let mut s = ReuseSettings::default();
+        assert_eq!(s.halo(), 30);
+        s.radius = 2.5;
+        s.spatial_rounds = 3;
+        assert_eq!(s.halo(), 9);
+        s.neighbors = 0;
+        assert_eq!(s.halo(), 0);
+    }
+
+    /// The region grows by the halo, moves out to multiples of 16 and stops at the film.
+    #[test]
+    fn region_with_halo() {
+        let film = (100, 70);
+        assert_eq!(win(20, 40, 50, 50).with_halo(0, film), win(16, 32, 64, 64));
+        assert_eq!(win(20, 40, 50, 50).with_halo(5, film), win(0, 32, 64, 64));
+        assert_eq!(win(32, 32, 48, 48).with_halo(0, film), win(32, 32, 48, 48));
+        assert_eq!(win(32, 32, 48, 48).with_halo(1, film), win(16, 16, 64, 64));
+        assert_eq!(
+            win(90, 60, 100, 70).with_halo(8, film),
+            win(80, 48, 100, 70)
+        );
+        assert_eq!(win(0, 0, 100, 70).with_halo(30, film), win(0, 0, 100, 70));
+        assert!(win(0, 0, 100, 70).fits(film) && !win(1, 0, 101, 70).fits(film));
+    }
+
+    /// `extract` cuts an inner window out of a region's pixels.
+    #[test]
+    fn extract_window() {
+        let region = win(2, 3, 6, 6);
+        let image = Image {
+            width: 4,
+            height: 3,
+            pixels: (0..12).map(|i| glam::Vec3::splat(i as f32)).collect(),
+        };
+        let inner = region.extract(&image, &win(3, 4, 5, 6));
+        assert_eq!((inner.width, inner.height), (2, 2));
+        let v: Vec<f32> = inner.pixels.iter().map(|p| p.x).collect();
+        assert_eq!(v, [5.0, 6.0, 9.0, 10.0]);
     }
 }

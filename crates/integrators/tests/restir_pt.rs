@@ -164,6 +164,7 @@ fn check_shifts(scene: &Scene, pt: &RestirPtIntegrator) -> ShiftStats {
             seed: 7,
             pass,
             filter: &filter,
+            crop: None,
         };
         let (gbuf, reservoirs, _, _) = pt.initial_reservoirs(scene, &ctx);
         let shift = pt.shift_map(scene, &gbuf);

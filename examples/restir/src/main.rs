@@ -15,13 +15,15 @@ use clap::{Parser, Subcommand};
 use restir_geometry::Shape;
 use restir_image::{Image, compare};
 use restir_integrators::{
-    IntegratorOptions, Param, ParamSet, ParamValue, RenderJob, make_integrator, render,
+    IntegratorOptions, Param, ParamSet, ParamValue, RenderJob, make_integrator,
 };
 use restir_scene::{LoadOptions, load_scene};
 
 mod bench;
+mod cluster;
 mod generate;
 mod interrupt;
+mod merge;
 mod progress;
 mod say;
 mod strict;
@@ -56,6 +58,8 @@ enum Command {
     /// Equal-time evaluation: render a suite of scenes × integrators × time budgets × seeds,
     /// compare with references, write a CSV, relMSE-versus-time plots, crops and a report.
     Bench(Box<bench::BenchArgs>),
+    /// Merge the parts of a split render (--chain/--crop) into one image (docs/CLUSTER.md).
+    Merge(merge::MergeArgs),
 }
 
 #[derive(clap::Args, Debug)]
@@ -105,6 +109,8 @@ struct RenderArgs {
     quiet: bool,
     #[command(flatten)]
     restir: RestirArgs,
+    #[command(flatten)]
+    cluster: cluster::ClusterArgs,
 }
 
 /// ReSTIR settings; each overrides the scene's `<integrator>` parameter of the same name.
@@ -213,6 +219,9 @@ struct Stats<'a> {
     nonfinite_pixels: usize,
     seed: u64,
     threads: usize,
+    /// The part of a split render this process rendered (--chain, --crop).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    part: Option<cluster::PartStats>,
 }
 
 /// How a render ended: completely, or stopped by an interrupt (the partial image written).
@@ -306,6 +315,16 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
         )),
     };
     job.output = Some(output.clone());
+    let plan = args.cluster.plan(
+        spp,
+        time_limit.is_some(),
+        &output,
+        scene.camera.resolution(),
+    )?;
+    if let Some(plan) = &plan {
+        job.spp = plan.passes.len() as u32;
+    }
+    let spp = job.spp;
     match output
         .extension()
         .and_then(|e| e.to_str())
@@ -377,10 +396,11 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
     };
 
     let out = pool.install(|| {
-        render(
+        cluster::render(
             &scene,
             integrator.as_ref(),
             &job,
+            plan.as_ref(),
             &cancel,
             &mut |passes, elapsed| {
                 if let Some(b) = &bar {
@@ -398,7 +418,17 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
         b.finish_and_clear();
     }
 
-    out.image.write(&output).map_err(|e| e.to_string())?;
+    match &plan {
+        Some(p) => p.write(
+            &out.image,
+            &output,
+            &args.scene,
+            &loaded.desc,
+            integrator.as_ref(),
+            args.seed,
+        )?,
+        None => out.image.write(&output).map_err(|e| e.to_string())?,
+    }
 
     let mrays = out.rays as f64 / out.seconds.max(1e-9) / 1e6;
     if let Some(path) = &args.stats {
@@ -431,6 +461,7 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
             nonfinite_pixels: out.nonfinite_pixels,
             seed: args.seed,
             threads,
+            part: plan.as_ref().map(|p| p.stats(integrator.as_ref())),
         };
         let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
         restir_image::write_file_atomically(path, (json + "\n").as_bytes())
@@ -527,6 +558,7 @@ fn main() -> ExitCode {
         }
         Command::Generate(what) => generate::run(what).map(|()| Rendered::Complete),
         Command::Bench(args) => bench::run(*args).map(|()| Rendered::Complete),
+        Command::Merge(args) => merge::run(args).map(|()| Rendered::Complete),
     };
     match result {
         Ok(Rendered::Complete) => ExitCode::SUCCESS,

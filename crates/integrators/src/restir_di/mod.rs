@@ -374,6 +374,10 @@ impl Integrator for RestirDiIntegrator {
         )
     }
 
+    fn halo(&self) -> u32 {
+        self.settings.reuse.halo()
+    }
+
     fn buffer_bytes_per_pixel(&self) -> usize {
         let reservoirs = if self.settings.reuse.temporal { 3 } else { 2 };
         let hits = if self.settings.reuse.temporal { 2 } else { 1 };

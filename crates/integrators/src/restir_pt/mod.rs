@@ -145,7 +145,7 @@ impl RestirPtIntegrator {
         ctx: &PassContext,
     ) -> (GBuffer, Vec<PtReservoir>, Vec<Vec3>, u64) {
         let s = &self.settings;
-        let (w, h) = scene.camera.resolution();
+        let (w, h) = ctx.resolution(scene);
         let n = w as usize * h as usize;
         let mut radiance = vec![Vec3::ZERO; n];
         let keep = self.max_depth() >= 2;
@@ -288,6 +288,10 @@ impl Integrator for RestirPtIntegrator {
             s.direct.name(),
             if s.is_unbiased() { "" } else { " (biased)" }
         )
+    }
+
+    fn halo(&self) -> u32 {
+        self.settings.reuse.halo()
     }
 
     fn buffer_bytes_per_pixel(&self) -> usize {

@@ -124,7 +124,7 @@ impl GBuffer {
         keep_hits: bool,
         radiance: &mut [Vec3],
     ) -> (Self, u64) {
-        let (w, h) = scene.camera.resolution();
+        let (w, h) = ctx.resolution(scene);
         let (w, h) = (w as usize, h as usize);
         let mut receivers = vec![Receiver::EMPTY; w * h];
         let mut ng = vec![Vec3::ZERO; w * h];

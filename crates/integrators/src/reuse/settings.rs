@@ -78,6 +78,17 @@ impl ReuseSettings {
         self.mis.is_unbiased()
     }
 
+    /// How many pixels from a pixel the spatial rounds of one pass reach: `rounds × ⌈radius⌉`
+    /// (neighbours lie in a disk of `radius`, rounded to the nearest pixel), 0 without spatial
+    /// reuse. A cropped render renders this halo around its window.
+    pub fn halo(&self) -> u32 {
+        if self.neighbors == 0 {
+            return 0;
+        }
+        self.spatial_rounds
+            .saturating_mul(self.radius.ceil().min(u32::MAX as f32) as u32)
+    }
+
     /// The neighbour rule of the spatial rounds.
     pub fn neighbor_rule(&self) -> NeighborRule {
         NeighborRule {

@@ -1,0 +1,250 @@
+//! `restir render --chain/--chains/--crop` and `restir merge` from the command line: parts merge
+//! into the single-process image (tiles to the same bytes), the parts' `--stats` say which passes
+//! and window they hold, and bad splits or mismatched parts are one-line errors.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
+
+fn cornell() -> String {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes/cornell-box.xml")
+        .display()
+        .to_string()
+}
+
+/// A fresh directory, removed when dropped.
+struct TempDir(PathBuf);
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn temp_dir(tag: &str) -> TempDir {
+    let dir = std::env::temp_dir().join(format!("restir-cluster-{}-{tag}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    TempDir(dir)
+}
+
+fn restir(args: &[&str]) -> Output {
+    Command::new(RESTIR).args(args).output().unwrap()
+}
+
+fn ok(args: &[&str]) {
+    let out = restir(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// Expects exit code 1 and one stderr line equal to `want`.
+fn fails(args: &[&str], want: &str) {
+    let out = restir(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+    assert_eq!(stderr.trim_end(), want, "{args:?}");
+}
+
+fn p(dir: &Path, name: &str) -> String {
+    dir.join(name).display().to_string()
+}
+
+const SMALL: [&str; 7] = [
+    "--width",
+    "48",
+    "--height",
+    "32",
+    "--quiet",
+    "--threads",
+    "2",
+];
+
+fn render(scene: &str, extra: &[&str], out: &str) {
+    let mut args = vec!["render", scene, "-o", out];
+    args.extend(SMALL);
+    args.extend(extra);
+    ok(&args);
+}
+
+#[test]
+fn chains_and_tiles_merge_into_the_single_render() {
+    let dir = temp_dir("merge");
+    let d = &dir.0;
+    let scene = cornell();
+    let di = ["--integrator", "restir-di", "--radius", "3", "--spp", "3"];
+    render(&scene, &di, &p(d, "full.exr"));
+    // Tiles of rows, plus chains inside the last tile.
+    render(
+        &scene,
+        &[&di[..], &["--crop", "0,0,48,20"]].concat(),
+        &p(d, "t0.exr"),
+    );
+    for (i, name) in ["c0.exr", "c1.exr", "c2.exr"].iter().enumerate() {
+        let i = i.to_string();
+        let args = [
+            &di[..],
+            &["--crop", "0,20,48,32", "--chain", &i, "--chains", "3"],
+        ]
+        .concat();
+        render(&scene, &args, &p(d, name));
+    }
+    let stats = p(d, "c1.json");
+    let args = [
+        &di[..],
+        &["--crop", "0,20,48,32", "--chain", "1", "--chains", "3"],
+    ]
+    .concat();
+    render(
+        &scene,
+        &[&args[..], &["--stats", &stats]].concat(),
+        &p(d, "c1.exr"),
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    let part = &json["part"];
+    assert_eq!(part["passes"], serde_json::json!([1, 2]));
+    assert_eq!(part["spp_total"], 3);
+    assert_eq!(part["chain"], serde_json::json!([1, 3]));
+    assert_eq!(part["window"], serde_json::json!([0, 20, 48, 32]));
+    assert_eq!(part["region"], serde_json::json!([0, 16, 48, 32]));
+    assert_eq!(part["halo"], 3);
+    assert_eq!(part["temporal_restarts"], false);
+    assert_eq!(json["spp"], 1);
+    let merged = p(d, "merged.exr");
+    let parts = ["t0.exr", "c0.exr", "c1.exr", "c2.exr"].map(|n| p(d, n));
+    let mut args = vec!["merge", &merged];
+    args.extend(parts.iter().map(String::as_str));
+    ok(&args);
+    // One-pass chains: the merge is exact, so the file has the same bytes.
+    assert!(
+        std::fs::read(&merged).unwrap() == std::fs::read(p(d, "full.exr")).unwrap(),
+        "merged chains and tiles differ from the single render"
+    );
+    // With temporal reuse each chain's history starts afresh, and the stats say so.
+    let temporal = p(d, "temporal.json");
+    let args = [
+        &di[..],
+        &[
+            "--temporal",
+            "--chain",
+            "2",
+            "--chains",
+            "3",
+            "--stats",
+            &temporal,
+        ],
+    ]
+    .concat();
+    render(&scene, &args, &p(d, "temporal.exr"));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&temporal).unwrap()).unwrap();
+    assert_eq!(json["part"]["temporal_restarts"], true);
+    // A plain render has no stats part.
+    let plain = p(d, "plain.json");
+    render(
+        &scene,
+        &["--spp", "1", "--stats", &plain],
+        &p(d, "plain.exr"),
+    );
+    assert!(
+        !std::fs::read_to_string(&plain)
+            .unwrap()
+            .contains("\"part\"")
+    );
+}
+
+#[test]
+fn bad_splits_are_errors() {
+    let dir = temp_dir("bad");
+    let out = p(&dir.0, "x.exr");
+    let scene = cornell();
+    let base = [
+        "render", &scene, "-o", &out, "--width", "48", "--height", "32",
+    ];
+    let run = |extra: &[&str], want: &str| fails(&[&base[..], extra].concat(), want);
+    run(
+        &["--spp", "4", "--chain", "4", "--chains", "4"],
+        "error: --chain 4: expected 0 to 3 (--chains 4)",
+    );
+    run(
+        &["--spp", "4", "--chain", "0", "--chains", "5"],
+        "error: --chains 5: expected 1 to 4 (the render's passes)",
+    );
+    run(
+        &["--crop", "0,0,49,32"],
+        "error: --crop 0,0,49,32: outside the 48×32 film",
+    );
+    run(
+        &["--crop", "5,0,5,32"],
+        "error: --crop 5,0,5,32: expected x0,y0,x1,y1 (pixels, x0 < x1 <= width, y0 < y1 <= height)",
+    );
+    run(
+        &["--time-limit", "1", "--crop", "0,0,8,8"],
+        "error: --time-limit cannot be combined with --chain or --crop: a part's passes must be fixed for merge",
+    );
+    let png = p(&dir.0, "x.png");
+    fails(
+        &["render", &scene, "-o", &png, "--crop", "0,0,8,8"],
+        &format!("error: {png}: a part of a render (--chain, --crop) must be written as .exr"),
+    );
+    let out = restir(&[&base[..], &["--chain", "1"]].concat());
+    assert_eq!(out.status.code(), Some(1));
+    // clap's message; the front end prints its first line.
+    assert!(String::from_utf8_lossy(&out.stderr).contains("required arguments were not provided"));
+}
+
+#[test]
+fn parts_of_different_renders_do_not_merge() {
+    let dir = temp_dir("mismatch");
+    let d = &dir.0;
+    let scene = cornell();
+    let chain = |i: &str, extra: &[&str], name: &str| {
+        let args = [&["--spp", "2", "--chain", i, "--chains", "2"][..], extra].concat();
+        render(&scene, &args, &p(d, name));
+    };
+    chain("0", &[], "a.exr");
+    chain("1", &["--seed", "9"], "seed.exr");
+    chain("1", &["--max-depth", "2"], "depth.exr");
+    let merged = p(d, "m.exr");
+    let (a, seed, depth) = (p(d, "a.exr"), p(d, "seed.exr"), p(d, "depth.exr"));
+    fails(
+        &["merge", &merged, &a, &seed],
+        &format!(
+            "error: {a} and {seed}: parts of different renders (seed differs: restir:seed '0' vs '9')"
+        ),
+    );
+    let out = restir(&["merge", &merged, &a, &depth]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr.contains("integrator settings differs"), "{stderr}");
+    // Another film size is another scene description.
+    let other = p(d, "size.exr");
+    ok(&[
+        "render", &scene, "-o", &other, "--width", "40", "--height", "32", "--quiet", "--spp", "2",
+        "--chain", "1", "--chains", "2",
+    ]);
+    let out = restir(&["merge", &merged, &a, &other]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("(scene differs"));
+    fails(
+        &["merge", &merged, &a],
+        "error: window 0,0,48,32: passes 1..2 of 2 are missing",
+    );
+    fails(
+        &["merge", &merged, &a, &a],
+        &format!("error: {a} (passes 0..1) and {a} (passes 0..1): passes overlap"),
+    );
+    let plain = p(d, "plain.exr");
+    render(&scene, &["--spp", "1"], &plain);
+    fails(
+        &["merge", &merged, &plain],
+        &format!(
+            "error: {plain}: not a part of a split render (no restir:passes attribute): render parts with --chain/--crop"
+        ),
+    );
+}
