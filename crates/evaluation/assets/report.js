@@ -398,6 +398,29 @@ $('plot').addEventListener('click', (ev) => {
   if (idx > 0) select('a', idx);
 });
 
+// ---- a view given in the address: #scene=1&a=3&b=0&mode=relerr&ev=1.5&split=0.3&zoom=4&px=40,60
+function applyHash() {
+  const h = new URLSearchParams(location.hash.slice(1)), s = () => scene();
+  const num = (k) => (h.has(k) && Number.isFinite(Number(h.get(k))) ? Number(h.get(k)) : null);
+  if (num('scene') != null && DATA.scenes[num('scene')]) { state.scene = num('scene'); buildScene(); }
+  for (const k of ['a', 'b']) if (num(k) != null && s().images[num(k)]) select(k, num(k));
+  if (['image', 'relerr', 'flip'].includes(h.get('mode'))) { state.mode = h.get('mode'); $('mode').value = state.mode; }
+  if (num('ev') != null) { $('exposure').value = num('ev'); $('exposure').dispatchEvent(new Event('input')); }
+  if (num('split') != null) { state.split = Math.max(0, Math.min(1, num('split'))); $('split').value = state.split; }
+  const px = (h.get('px') || '').split(',').map(Number);
+  if (num('zoom') != null) {
+    const v = state.view, k = num('zoom') / v.scale;
+    const [cx, cy] = px.length === 2 ? [v.ox + (px[0] + 0.5) * v.scale, v.oy + (px[1] + 0.5) * v.scale] : [view.width / 2, view.height / 2];
+    v.scale *= k; v.ox = view.width / 2 - (cx - v.ox) * k; v.oy = view.height / 2 - (cy - v.oy) * k;
+  }
+  drawThumbs(); draw();
+  if (px.length === 2 && px.every(Number.isInteger)) {
+    state.hover = px; draw();
+    inspect({ inside: px[0] >= 0 && px[1] >= 0 && px[0] < s().width && px[1] < s().height, x: px[0], y: px[1] });
+    state.pinned = true;
+  }
+}
+
 // ---- start ----------------------------------------------------------------------------------
 function nonblank(canvas) {
   const d = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;
@@ -426,11 +449,14 @@ async function start() {
     });
   }
   buildScene();
+  applyHash();
   // The pixel inspector on the first pixel: a header line, A, B (the reference).
   inspect({ inside: true, x: 0, y: 0 });
   STATUS.inspectorLines = $('inspector').textContent.split('\n').length;
-  inspect(null);
+  if (state.pinned) applyHash(); else inspect(null);
   STATUS.viewerNonblank = nonblank(view);
+  STATUS.mode = state.mode;
+  STATUS.scale = state.view.scale;
   STATUS.plotNonblank = scene().plot ? nonblank($('plot')) : null;
   writeStatus('ready');
 }

@@ -60,7 +60,15 @@ fn temp_dir(tag: &str) -> TempDir {
 /// Runs headless Chromium on `page` with `extra` arguments (a fresh profile each time), killing
 /// it after two minutes; returns its stdout (through a file: the DOM outgrows a pipe's buffer).
 fn run_chromium(page: &Path, profile: &Path, extra: &[String]) -> String {
-    let url = format!("file://{}", page.canonicalize().unwrap().display());
+    run_chromium_at(page, "", profile, extra)
+}
+
+/// [`run_chromium`] on `page` with a `#fragment` (a view given in the address).
+fn run_chromium_at(page: &Path, fragment: &str, profile: &Path, extra: &[String]) -> String {
+    let url = format!(
+        "file://{}{fragment}",
+        page.canonicalize().unwrap().display()
+    );
     let stdout_path = profile.with_extension("stdout");
     let stdout = std::fs::File::create(&stdout_path).unwrap();
     let mut child = Command::new(chromium())
@@ -99,7 +107,16 @@ fn run_chromium(page: &Path, profile: &Path, extra: &[String]) -> String {
 
 /// The page's `#status`: its `data-state` and the JSON it holds; and the DOM.
 fn page_status(page: &Path, profile: &Path) -> (String, serde_json::Value, String) {
-    let dom = run_chromium(page, profile, &["--dump-dom".into()]);
+    page_status_at(page, "", profile)
+}
+
+/// [`page_status`] with a `#fragment`.
+fn page_status_at(
+    page: &Path,
+    fragment: &str,
+    profile: &Path,
+) -> (String, serde_json::Value, String) {
+    let dom = run_chromium_at(page, fragment, profile, &["--dump-dom".into()]);
     let start = dom.find("<pre id=\"status\"").unwrap_or_else(|| {
         panic!(
             "no #status in the page's DOM:\n{}",
@@ -392,6 +409,24 @@ fn compare_page_draws_in_chromium() {
     let page = dir.0.join("compare.html");
     std::fs::write(&page, &html).unwrap();
     assert_ready(&page, &dir.0.join("profile"), 2, false);
+    // A view given in the address: the FLIP map, zoomed, the inspector pinned on a pixel.
+    let (state, status, dom) = page_status_at(
+        &page,
+        "#mode=flip&a=1&b=0&zoom=8&px=12,20",
+        &dir.0.join("profile-hash"),
+    );
+    assert_eq!(state, "ready", "{status}");
+    assert_eq!(status["viewerNonblank"], true, "{status}");
+    assert!(
+        dom.contains("pixel (12, 20)"),
+        "the inspector is not pinned"
+    );
+    assert!(
+        dom.contains("FLIP 0."),
+        "the inspector lacks the FLIP value"
+    );
+    assert_eq!(status["mode"], "flip", "{status}");
+    assert_eq!(status["scale"], 8.0, "{status}");
 }
 
 /// Negative control: corrupted image data must show up as an error in the status, not "ready".
