@@ -10,6 +10,12 @@ function writeStatus(state) {
   const el = document.getElementById('status');
   el.dataset.state = STATUS.errors.length ? 'error' : state;
   el.textContent = JSON.stringify(STATUS);
+  if (STATUS.errors.length) {
+    const shown = document.getElementById('page-error');
+    shown.hidden = false;
+    shown.textContent = 'This page failed to draw (it needs a browser with DecompressionStream: ' +
+      'Chromium 80, Firefox 113, Safari 16.4 or later): ' + STATUS.errors.join('; ');
+  }
 }
 window.addEventListener('error', (e) => { STATUS.errors.push(String(e.message || e)); writeStatus('error'); });
 window.addEventListener('unhandledrejection', (e) => {

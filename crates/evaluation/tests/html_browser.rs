@@ -440,7 +440,9 @@ fn corrupted_page_reports_an_error() {
     let broken = format!("{}AAAA{}", &html[..at], &html[at + 8..]);
     let page = dir.0.join("broken.html");
     std::fs::write(&page, broken).unwrap();
-    let (state, status, _) = page_status(&page, &dir.0.join("profile"));
+    let (state, status, dom) = page_status(&page, &dir.0.join("profile"));
     assert_eq!(state, "error", "{status}");
     assert_ne!(status["errors"], serde_json::json!([]), "{status}");
+    // The reader is told too, not only the test.
+    assert!(dom.contains("This page failed to draw"), "no visible error");
 }
