@@ -213,6 +213,7 @@ view.addEventListener('mousemove', (ev) => {
 });
 view.addEventListener('mouseleave', () => { state.hover = null; inspect(null); draw(); });
 view.addEventListener('dblclick', () => { fit(); draw(); });
+window.addEventListener('resize', () => { if (state.view) { fit(); draw(); } });
 
 // ---- controls, grid and table ---------------------------------------------------------------
 function select(which, idx) {
