@@ -61,6 +61,8 @@ pub enum BenchError {
     },
     /// A render and the reference differ in size.
     ReferenceMismatch,
+    /// The HTML page cannot be made.
+    Page(crate::html::PageError),
     /// A Markdown document lacks a results marker.
     Marker {
         /// The document.
@@ -119,6 +121,7 @@ impl std::fmt::Display for BenchError {
                 path.display()
             ),
             Self::ReferenceMismatch => f.write_str("reference size mismatch"),
+            Self::Page(e) => e.fmt(f),
             Self::Marker { doc, begin: true } => write!(
                 f,
                 "{}: no '{}' marker: add the markers where the results belong",
@@ -142,6 +145,7 @@ impl std::error::Error for BenchError {
             Self::Scene(e) => Some(e),
             Self::Io { source, .. } => Some(source),
             Self::Image(e) => Some(e),
+            Self::Page(e) => Some(e),
             _ => None,
         }
     }
@@ -156,6 +160,12 @@ impl From<SuiteError> for BenchError {
 impl From<SceneError> for BenchError {
     fn from(e: SceneError) -> Self {
         Self::Scene(e)
+    }
+}
+
+impl From<crate::html::PageError> for BenchError {
+    fn from(e: crate::html::PageError) -> Self {
+        Self::Page(e)
     }
 }
 

@@ -4,8 +4,9 @@
 //! renders every combination with the library [`render`] (`spp: u32::MAX`, the budget as time
 //! limit), compares each image with a reference and records time, passes, rays, errors and peak
 //! memory. [`write_outputs`] then writes the CSV, one log-log relMSE-versus-time plot per scene
-//! (SVG), one strip of crops per scene (PNG) and a Markdown report; [`update_doc`] puts the report
-//! into a marked section of another Markdown file.
+//! (SVG), one strip of crops per scene (PNG), a Markdown report and an interactive HTML page
+//! ([`html`]); [`update_doc`] puts the report into a marked section of another Markdown file.
+//! Besides relMSE every run records MAPE and FLIP ([`metrics`]).
 //!
 //! **References.** A scene's `reference` EXR is used as given (its noise is unknown). Otherwise
 //! the path tracer renders the scene at the suite's `reference_spp`, as two halves of
@@ -33,10 +34,14 @@ use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 use restir_image::{Image, compare};
+
+use crate::metrics::evaluate;
 use restir_integrators::{IntegratorOptions, RenderJob, make_integrator, render};
 use restir_scene::{LoadOptions, Scene, load_scene};
 
 mod error;
+pub mod html;
+pub mod metrics;
 mod plot;
 mod report;
 pub mod suite;
@@ -78,6 +83,10 @@ pub struct RunRecord {
     pub relmse: f64,
     /// MSE against the reference.
     pub mse: f64,
+    /// MAPE against the reference ([`metrics`]).
+    pub mape: f64,
+    /// Mean FLIP error of the tone-mapped image against the tone-mapped reference ([`metrics`]).
+    pub flip: f64,
     /// Mean of the image over mean of the reference.
     pub mean_ratio: f64,
     /// Pixels with NaN or infinite values.
@@ -127,6 +136,18 @@ pub struct Strip {
     pub labels: Vec<String>,
 }
 
+/// A scene's full images for the HTML report: the reference, then seed 0 of every configuration
+/// at every budget.
+#[derive(Clone, Debug)]
+pub struct SceneImages {
+    /// Scene name.
+    pub scene: String,
+    /// The reference.
+    pub reference: Image,
+    /// `(configuration label, budget, image)` in suite order, budgets ascending.
+    pub renders: Vec<(String, f64, Image)>,
+}
+
 /// The machine the suite ran on.
 #[derive(Clone, Debug)]
 pub struct Machine {
@@ -155,6 +176,8 @@ pub struct BenchResults {
     pub references: Vec<ReferenceInfo>,
     /// One per scene.
     pub strips: Vec<Strip>,
+    /// One per scene (seed 0 only).
+    pub images: Vec<SceneImages>,
     /// Where it ran.
     pub machine: Machine,
     /// The command that ran it.
@@ -498,6 +521,7 @@ pub fn run_suite(
     let mut records = Vec::new();
     let mut references = Vec::new();
     let mut strips = Vec::new();
+    let mut images = Vec::new();
     for (entry, loaded, rect) in &scenes {
         let (w, h) = loaded.scene.camera.resolution();
         progress(&Progress {
@@ -509,6 +533,7 @@ pub fn run_suite(
         done += 1;
         references.push(info);
         let mut strip_crops: Vec<Option<Image>> = vec![None; suite.integrators.len()];
+        let mut renders: Vec<(usize, String, f64, Image)> = Vec::new();
         let integrators = suite
             .integrators
             .iter()
@@ -545,7 +570,8 @@ pub fn run_suite(
                     let before = vm_hwm_kib();
                     let out = render_once(&loaded.scene, integrator, &job);
                     let after = vm_hwm_kib();
-                    let m = compare(&out.image, &reference).ok_or(BenchError::ReferenceMismatch)?;
+                    let m =
+                        evaluate(&out.image, &reference).ok_or(BenchError::ReferenceMismatch)?;
                     if seed == 0 && budget == strip_budget {
                         strip_crops[ci] = Some(crop(&out.image, *rect));
                     }
@@ -562,11 +588,16 @@ pub fn run_suite(
                         rays: out.rays,
                         relmse: m.relmse,
                         mse: m.mse,
+                        mape: m.mape,
+                        flip: m.flip,
                         mean_ratio: m.mean_ratio,
                         nonfinite: m.nonfinite,
                         rss_before_mib: mib(before),
                         peak_rss_mib: mib(after),
                     });
+                    if seed == 0 {
+                        renders.push((ci, config.label.clone(), budget, out.image));
+                    }
                     done += 1;
                 }
             }
@@ -586,6 +617,12 @@ pub fn run_suite(
             crops,
             labels,
         });
+        renders.sort_by(|a, b| a.0.cmp(&b.0).then(a.2.total_cmp(&b.2)));
+        images.push(SceneImages {
+            scene: loaded.name.clone(),
+            reference,
+            renders: renders.into_iter().map(|(_, l, b, i)| (l, b, i)).collect(),
+        });
     }
     progress(&Progress {
         done,
@@ -597,6 +634,7 @@ pub fn run_suite(
         records,
         references,
         strips,
+        images,
         machine: Machine {
             cpu,
             cores,

@@ -40,6 +40,10 @@ pub struct Summary {
     pub relmse_max: f64,
     /// Median MSE.
     pub mse: f64,
+    /// Median MAPE.
+    pub mape: f64,
+    /// Median mean FLIP.
+    pub flip: f64,
     /// Median mean ratio.
     pub mean_ratio: f64,
     /// Non-finite pixels over all runs.
@@ -92,6 +96,8 @@ pub fn summarize(results: &BenchResults) -> Vec<Summary> {
                     relmse_min: runs.iter().map(|x| x.relmse).fold(f64::INFINITY, f64::min),
                     relmse_max: runs.iter().map(|x| x.relmse).fold(0.0, f64::max),
                     mse: col(|x| x.mse),
+                    mape: col(|x| x.mape),
+                    flip: col(|x| x.flip),
                     mean_ratio: col(|x| x.mean_ratio),
                     nonfinite: runs.iter().map(|x| x.nonfinite).sum(),
                     peak_rss_mib: runs.iter().map(|x| x.peak_rss_mib).fold(0.0, f64::max),
@@ -158,7 +164,7 @@ fn csv_field(s: &str) -> String {
 }
 
 /// The CSV header.
-pub const CSV_HEADER: &str = "scene,label,integrator_settings,width,height,budget_s,seed,seconds,passes,rays,mrays_per_s,relmse,mse,mean_ratio,nonfinite_pixels,rss_before_mib,peak_rss_mib,reference_noise_relmse";
+pub const CSV_HEADER: &str = "scene,label,integrator_settings,width,height,budget_s,seed,seconds,passes,rays,mrays_per_s,relmse,mse,mape,flip,mean_ratio,nonfinite_pixels,rss_before_mib,peak_rss_mib,reference_noise_relmse";
 
 fn csv(results: &BenchResults) -> String {
     let mut s = String::from(CSV_HEADER);
@@ -167,7 +173,7 @@ fn csv(results: &BenchResults) -> String {
         let noise = reference_noise(results, &r.scene).map_or(String::new(), |n| format!("{n:e}"));
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{:.4},{},{},{:.3},{:e},{:e},{:.6},{},{:.1},{:.1},{}",
+            "{},{},{},{},{},{},{},{:.4},{},{},{:.3},{:e},{:e},{:e},{:.6},{:.6},{},{:.1},{:.1},{}",
             csv_field(&r.scene),
             csv_field(&r.label),
             csv_field(&r.describe),
@@ -181,6 +187,8 @@ fn csv(results: &BenchResults) -> String {
             r.mrays_per_second(),
             r.relmse,
             r.mse,
+            r.mape,
+            r.flip,
             r.mean_ratio,
             r.nonfinite,
             r.rss_before_mib,
@@ -228,7 +236,7 @@ fn strip_image(strip: &Strip) -> Image {
     out
 }
 
-fn utc(unix: u64) -> String {
+pub(crate) fn utc(unix: u64) -> String {
     // Days since 1970-01-01 to a proleptic Gregorian date (era-based civil calendar arithmetic).
     let days = (unix / 86_400) as i64;
     let secs = unix % 86_400;
@@ -292,7 +300,10 @@ pub fn report_markdown(results: &BenchResults, h: &str, link: &str) -> String {
     );
     let _ = writeln!(
         s,
-        "**Definitions.** relMSE is the mean over pixels and channels of (x − r)² / (r² + 0.01). \
+        "**Definitions.** relMSE is the mean over pixels and channels of (x − r)² / (r² + 0.01), \
+         MAPE the mean of |x − r| / (|r| + 0.01), FLIP the mean LDR-FLIP error (Andersson et al. \
+         2020, NVIDIA's implementation) of the images clamped to [0, 1] and sRGB-encoded to 8 \
+         bits. \
          Curves are medians over seeds; bars span the smallest to largest relMSE, dots are single \
          runs. *Equal-time ratio*: the path tracer's median relMSE over the configuration's, at \
          the largest budget (> 1: the configuration is better). *Time to path's error*: the time \
@@ -301,7 +312,8 @@ pub fn report_markdown(results: &BenchResults, h: &str, link: &str) -> String {
          extrapolated assuming relMSE ∝ 1/time); *speed-up* is the path tracer's time over it. \
          The reference's own relMSE, estimated as relMSE(half A, half B)/4 from two independent \
          halves, adds to every measured relMSE in expectation: errors within a few times it are \
-         not meaningful.\n"
+         not meaningful. [`report.html`]({link}report.html) shows every image of seed 0 with a \
+         split view, zoom, pixel values, exposure and error maps.\n"
     );
     let _ = writeln!(
         s,
@@ -378,12 +390,12 @@ pub fn report_markdown(results: &BenchResults, h: &str, link: &str) -> String {
         );
         let _ = writeln!(
             s,
-            "| configuration | budget (s) | median time (s) | passes | Mrays/s | relMSE median [min, max] | MSE | mean ratio | non-finite | peak MiB |\n|---|---|---|---|---|---|---|---|---|---|"
+            "| configuration | budget (s) | median time (s) | passes | Mrays/s | relMSE median [min, max] | MSE | MAPE | FLIP | mean ratio | non-finite | peak MiB |\n|---|---|---|---|---|---|---|---|---|---|---|---|"
         );
         for x in &rows {
             let _ = writeln!(
                 s,
-                "| {} | {} | {:.2} | {:.0} | {:.2} | {} [{}, {}] | {} | {:.4} | {} | {:.0} |",
+                "| {} | {} | {:.2} | {:.0} | {:.2} | {} [{}, {}] | {} | {:.4} | {:.4} | {:.4} | {} | {:.0} |",
                 x.label,
                 x.budget,
                 x.seconds,
@@ -393,6 +405,8 @@ pub fn report_markdown(results: &BenchResults, h: &str, link: &str) -> String {
                 sci(x.relmse_min),
                 sci(x.relmse_max),
                 sci(x.mse),
+                x.mape,
+                x.flip,
                 x.mean_ratio,
                 x.nonfinite,
                 x.peak_rss_mib
@@ -474,7 +488,8 @@ fn write_file(path: &Path, bytes: &[u8]) -> Result<(), BenchError> {
     std::fs::write(path, bytes).map_err(BenchError::io(path, ""))
 }
 
-/// Writes `results.csv`, `relmse-<scene>.svg`, `strip-<scene>.png` and `report.md` into `out`.
+/// Writes `results.csv`, `relmse-<scene>.svg`, `strip-<scene>.png`, `report.md` and the
+/// interactive `report.html` ([`crate::html`]) into `out`.
 pub fn write_outputs(results: &BenchResults, out: &Path) -> Result<(), BenchError> {
     std::fs::create_dir_all(out).map_err(BenchError::io(out, "cannot create directory: "))?;
     write_file(&out.join("results.csv"), csv(results).as_bytes())?;
@@ -516,6 +531,10 @@ pub fn write_outputs(results: &BenchResults, out: &Path) -> Result<(), BenchErro
     write_file(
         &out.join("report.md"),
         report_markdown(results, "#", "").as_bytes(),
+    )?;
+    write_file(
+        &out.join("report.html"),
+        crate::html::bench_page(results)?.as_bytes(),
     )
 }
 

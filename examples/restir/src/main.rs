@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 
 use clap::{Parser, Subcommand};
 use restir_geometry::Shape;
-use restir_image::{Image, compare};
+use restir_image::Image;
 use restir_integrators::{
     IntegratorOptions, Param, ParamSet, ParamValue, RenderJob, make_integrator,
 };
@@ -45,12 +45,17 @@ struct Cli {
 enum Command {
     /// Render a scene (.xml in Mitsuba format, or .ron) to an image.
     Render(Box<RenderArgs>),
-    /// Compare a rendered EXR with a reference EXR: relMSE, MSE, mean ratio, non-finite pixels.
+    /// Compare a rendered EXR with a reference EXR: relMSE, MSE, mean ratio, non-finite pixels,
+    /// MAPE and FLIP.
     Compare {
         /// The image to judge.
         test: PathBuf,
         /// The reference.
         reference: PathBuf,
+        /// Also write an interactive comparison page (split view, zoom, pixel values, exposure,
+        /// error maps): one self-contained HTML file.
+        #[arg(long, value_name = "OUT.html")]
+        html: Option<PathBuf>,
     },
     /// Write a procedurally generated scene (RON).
     #[command(subcommand)]
@@ -502,10 +507,10 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
     })
 }
 
-fn run_compare(test: &Path, reference: &Path) -> Result<(), String> {
+fn run_compare(test: &Path, reference: &Path, html: Option<&Path>) -> Result<(), String> {
     let t = Image::read_exr(test).map_err(|e| e.to_string())?;
     let r = Image::read_exr(reference).map_err(|e| e.to_string())?;
-    let m = compare(&t, &r).ok_or_else(|| {
+    let m = restir_evaluation::metrics::evaluate(&t, &r).ok_or_else(|| {
         format!(
             "{}: size {}×{} differs from the reference's {}×{}",
             test.display(),
@@ -515,12 +520,18 @@ fn run_compare(test: &Path, reference: &Path) -> Result<(), String> {
             r.height
         )
     })?;
+    if let Some(out) = html {
+        let name = |p: &Path| {
+            p.file_name()
+                .map_or(p.display().to_string(), |n| n.to_string_lossy().into())
+        };
+        let page = restir_evaluation::html::compare_page(&name(test), &t, &name(reference), &r)
+            .map_err(|e| e.to_string())?;
+        restir_image::write_file_atomically(out, page.as_bytes()).map_err(|e| e.to_string())?;
+    }
     say!(
-        "relmse={:.6e} mse={:.6e} mean_ratio={:.6} nonfinite={}",
-        m.relmse,
-        m.mse,
-        m.mean_ratio,
-        m.nonfinite
+        "relmse={:.6e} mse={:.6e} mean_ratio={:.6} nonfinite={} mape={:.6e} flip={:.6}",
+        m.relmse, m.mse, m.mean_ratio, m.nonfinite, m.mape, m.flip
     );
     Ok(())
 }
@@ -553,9 +564,11 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Render(args) => run_render(*args),
-        Command::Compare { test, reference } => {
-            run_compare(&test, &reference).map(|()| Rendered::Complete)
-        }
+        Command::Compare {
+            test,
+            reference,
+            html,
+        } => run_compare(&test, &reference, html.as_deref()).map(|()| Rendered::Complete),
         Command::Generate(what) => generate::run(what).map(|()| Rendered::Complete),
         Command::Bench(args) => bench::run(*args).map(|()| Rendered::Complete),
         Command::Merge(args) => merge::run(args).map(|()| Rendered::Complete),

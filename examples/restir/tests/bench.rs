@@ -119,6 +119,8 @@ fn smoke_suite_end_to_end() {
         assert!(num("passes") >= 1.0 && num("rays") > 0.0, "{r:?}");
         assert!((num("mean_ratio") - 1.0).abs() < 0.5, "{r:?}");
         assert!(num("reference_noise_relmse") > 0.0, "{r:?}");
+        assert!(num("mape") > 0.0 && num("mape").is_finite(), "{r:?}");
+        assert!(num("flip") > 0.0 && num("flip") < 1.0, "{r:?}");
         assert_eq!(num("nonfinite_pixels"), 0.0);
         assert_eq!(num("budget_s"), 0.2);
     }
@@ -147,12 +149,27 @@ fn smoke_suite_end_to_end() {
         "Crops, left to right: reference, path, restir-pt.",
         "equal-time ratio",
         "own relMSE",
+        "| MSE | MAPE | FLIP |",
+        "(report.html)",
     ] {
         assert!(
             report.contains(needle),
             "report lacks {needle:?}:\n{report}"
         );
     }
+
+    // The interactive page: one self-contained file with every scene's reference and seed-0
+    // render (the browser test in crates/evaluation/tests/html_browser.rs draws such a page).
+    let html = std::fs::read_to_string(out_dir.join("report.html")).unwrap();
+    assert!(html.starts_with("<!DOCTYPE html>") && html.trim_end().ends_with("</html>"));
+    assert_eq!(
+        html.matches("\"hdr_f16\"").count(),
+        (1 + 3) + (1 + 3) + (1 + 2)
+    );
+    for scene in ["cornell-box", "many-lights", "indirect-room"] {
+        assert!(html.contains(&format!("\"name\":\"{scene}\"")), "{scene}");
+    }
+    assert!(!html.contains("src=\"http") && !html.contains("href=\"http"));
 
     // The document keeps its hand-written parts and links into the output directory.
     let text = std::fs::read_to_string(&doc).unwrap();

@@ -414,7 +414,7 @@ fn tiny_render_writes_images_stats_and_compares() {
     assert!(json["rays"].as_u64().unwrap() >= 16 * 16 * 2);
     assert!(json["seconds"].as_f64().unwrap() >= 0.0);
 
-    // compare: one line `relmse=… mse=… mean_ratio=… nonfinite=…`.
+    // compare: one line `relmse=… mse=… mean_ratio=… nonfinite=… mape=… flip=…`.
     let o = restir(&["compare", s(&exr), s(&exr2)]);
     assert!(o.status.success());
     let stdout = String::from_utf8(o.stdout).unwrap();
@@ -424,16 +424,34 @@ fn tiny_render_writes_images_stats_and_compares() {
         .map(|f| f.split_once('=').unwrap())
         .collect();
     let names: Vec<&str> = fields.iter().map(|f| f.0).collect();
-    assert_eq!(names, ["relmse", "mse", "mean_ratio", "nonfinite"]);
+    assert_eq!(
+        names,
+        ["relmse", "mse", "mean_ratio", "nonfinite", "mape", "flip"]
+    );
     let relmse: f64 = fields[0].1.parse().unwrap();
     let ratio: f64 = fields[2].1.parse().unwrap();
     assert!(relmse > 0.0 && relmse.is_finite(), "{stdout}");
     assert!(ratio > 0.5 && ratio < 2.0, "{stdout}");
     assert_eq!(fields[3].1, "0");
-    // An image against itself.
-    let o = restir(&["compare", s(&exr), s(&exr)]);
+    let mape: f64 = fields[4].1.parse().unwrap();
+    let flip: f64 = fields[5].1.parse().unwrap();
+    assert!(mape > 0.0 && mape.is_finite(), "{stdout}");
+    assert!(flip > 0.0 && flip < 1.0, "{stdout}");
+    // An image against itself, with the comparison page.
+    let page = dir.join("cmp.html");
+    let o = restir(&["compare", s(&exr), s(&exr), "--html", s(&page)]);
     let stdout = String::from_utf8(o.stdout).unwrap();
-    assert!(stdout.starts_with("relmse=0.000000e0 mse=0.000000e0 mean_ratio=1.000000"));
+    assert_eq!(
+        stdout,
+        "relmse=0.000000e0 mse=0.000000e0 mean_ratio=1.000000 nonfinite=0 mape=0.000000e0 \
+         flip=0.000000\n"
+    );
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(html.starts_with("<!DOCTYPE html>") && html.contains("\"hdr_f16\""));
+    fails(
+        &["compare", s(&exr), s(&exr), "--html", "/proc/nope/x.html"],
+        &["/proc/nope/x.html"],
+    );
     // Different sizes are an error, not a panic.
     let small = dir.join("small.exr");
     let mut args = vec!["render", s(&c), "-o", s(&small), "--width", "8"];
