@@ -39,6 +39,28 @@ pub struct EnvironmentShare {
 }
 
 impl Scene {
+    /// How light samples are drawn, in one line for `--stats`: the emitter table's size and the
+    /// environment's share, with what decided it.
+    pub fn light_selection(&self) -> String {
+        let lights = &self.lights;
+        let table = format!(
+            "{} lights, {} entries in one alias table (one per emissive triangle or other light)",
+            lights.len(),
+            lights.emitter_count()
+        );
+        match (lights.environment(), self.features.environment_share) {
+            (None, _) => table,
+            (Some(_), Some(d)) => format!(
+                "{table}; environment share {:.4} from a pilot at {} camera hits (power share {:.4})",
+                d.share, d.receivers, d.power_share
+            ),
+            (Some(env), None) => format!(
+                "{table}; environment share {:.4} (power share)",
+                lights.pmf(env)
+            ),
+        }
+    }
+
     /// Estimates the variance-optimal environment share at the camera's primary hits and sets
     /// it on the light set. `None` (nothing changed) without both an environment and local
     /// lights, or when no camera ray hits a surface.

@@ -224,6 +224,8 @@ struct Stats<'a> {
     nonfinite_pixels: usize,
     seed: u64,
     threads: usize,
+    /// How light samples are drawn, as the scene build decided it.
+    light_selection: String,
     /// The part of a split render this process rendered (--chain, --crop).
     #[serde(skip_serializing_if = "Option::is_none")]
     part: Option<cluster::PartStats>,
@@ -466,6 +468,7 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
             nonfinite_pixels: out.nonfinite_pixels,
             seed: args.seed,
             threads,
+            light_selection: scene.light_selection(),
             part: plan.as_ref().map(|p| p.stats(integrator.as_ref())),
         };
         let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
