@@ -172,10 +172,10 @@
 //!   stale value.
 //! * **Random numbers come in as arguments** (`u ∈ [0, 1)`, or a `FnMut() -> f32` source for
 //!   whole steps), so results are repeatable and replayable. No RNG lives in this crate.
-//! * **Precision.** Stored values are `f32`; running sums (`weight_sum`) and products of weights
-//!   are `f64`. Zero, negative, NaN and infinite candidates count towards confidence but are never
-//!   selected and never enter `weight_sum`; no public function returns NaN or infinity (see
-//!   *Saturation* above).
+//! * **Precision.** Stored values are `f32`; running sums (`weight_sum`, confidence) and
+//!   products of weights are `f64`. Zero, negative, NaN and infinite candidates count towards
+//!   confidence but are never selected and never enter `weight_sum`; no public function returns
+//!   NaN or infinity (see *Saturation* above).
 //!
 //! # What the caller must guarantee for unbiasedness (Lin et al. 2022; `docs/GRIS.md` §3.1)
 //!
