@@ -132,7 +132,7 @@ fn scene(k: usize) -> Scene {
             sample: Some(sample),
             ucw: 0.5 + rng.next_f32(),
             confidence: 1.0 + rng.next_f32() * 10.0,
-            target_pdf: p.target_pdf(&sample),
+            own_target: p.target_pdf(&sample),
         }
     };
     let c = pixel(&mut rng);
@@ -199,14 +199,14 @@ fn gris_resampler_step(bencher: Bencher, k: usize) {
                 position: [rng.next_f32(), rng.next_f32(), rng.next_f32()],
                 light: i as u32,
             },
-            target_pdf: rng.next_f32(),
+            receiver_target: rng.next_f32(),
             ucw: rng.next_f32() + 0.5,
             jacobian: 1.0,
             confidence: 1.0 + rng.next_f32(),
         })
         .collect();
     let confidences: Vec<f32> = inputs.iter().map(|i| i.confidence).collect();
-    let targets: Vec<f32> = inputs.iter().map(|i| i.target_pdf).collect();
+    let targets: Vec<f32> = inputs.iter().map(|i| i.receiver_target).collect();
     bencher.bench_local(|| {
         let mut step = GrisResampler::new();
         for (i, input) in black_box(&inputs).iter().enumerate() {

@@ -4,10 +4,29 @@
 //! streaming RIS (weighted reservoir sampling), GRIS resampling of reservoirs across domains,
 //! the resampling MIS weights, confidence (M) capping, the shift-map contract and the standard
 //! shift Jacobians. It is generic over the sample payload (a light sample, a path descriptor,
-//! anything), has no dependencies and is `no_std`: the default `std` feature only adds the two
-//! helpers that need a square root, `jacobian::reconnection_jacobian_from_points` and
-//! `jacobian::geometry_term`.
+//! anything) and has no dependencies.
 //!
+//! # `no_std`
+//!
+//! The crate is `no_std` **only with `default-features = false`**: the default `std` feature
+//! links `std` and adds the two helpers that need a square root,
+#![cfg_attr(
+    feature = "std",
+    doc = "[`jacobian::reconnection_jacobian_from_points`] and [`jacobian::geometry_term`]."
+)]
+#![cfg_attr(
+    not(feature = "std"),
+    doc = "`jacobian::reconnection_jacobian_from_points` and `jacobian::geometry_term` (not built here)."
+)]
+//! For a `no_std` target depend on it as
+//!
+//! ```toml
+//! restir-gris = { version = "0.1", default-features = false }
+//! ```
+//!
+//! Everything else (reservoirs, resampling, MIS weights, the other Jacobians) is available
+//! either way.
+
 //! # Example: RIS on a 1-D integral, then reuse across two domains with GRIS
 //!
 //! ```
@@ -61,7 +80,7 @@
 //!     }
 //!     if let Some(x) = b.sample {
 //!         // Shift B → A (identity here): the receiver's target at the shifted sample, J = 1.
-//!         let input = GrisInput { sample: x, target_pdf: target_a(x), ucw: b.ucw,
+//!         let input = GrisInput { sample: x, receiver_target: target_a(x), ucw: b.ucw,
 //!                                 jacobian: 1.0, confidence: b.confidence };
 //!         let m = mis::generalized_balance(1, &confidences, &[target_a(x), target_b(x)]);
 //!         step.add(input, m, rng.next_f32());
@@ -78,7 +97,68 @@
 //! ```
 //!
 //! With a [`ShiftMap`] implementation, [`resample`] does the whole GRIS step for any
-//! [`MisScheme`]; [`PairwiseResampler`] is the streaming form a spatial-reuse pass uses.
+//! [`MisScheme`]; [`PairwiseResampler`] is the streaming form a spatial-reuse pass uses (a
+//! runnable spatial-reuse example: `cargo run -p restir-gris --example pairwise`, source in
+//! `crates/gris/examples/pairwise.rs`).
+//!
+//! # Which target is which
+//!
+//! Four different target values meet in a GRIS step; each has its own name, saying whose target
+//! it is and at which sample (all are in the measure of the domain they belong to):
+//!
+//! | name | value | where |
+//! |---|---|---|
+//! | [`Reservoir::own_target`] | `p̂_i(X_i)`: the owning domain's target at its own sample | stored reservoirs, [`StreamingReservoir::add_candidate`] |
+//! | [`Shifted::destination_target`] | `p̂_j(T_{i→j}(x))`: the destination's target at the shifted sample | what a [`ShiftMap`] returns |
+//! | [`GrisInput::receiver_target`] | `p̂_c(Y_i)`: the receiver's target at a shifted input | [`GrisResampler`] inputs (= the forward shift's `destination_target`) |
+//! | `pulled_back_target_at_canonical` ([`PairwiseNeighbor::new`]) | `p̂_{←i}(X_c) = p̂_i(T_{c→i}(X_c))·J_{c→i}`: a neighbour's target pulled back to the canonical sample | [`Shifted::pulled_back_target_pdf`], [`ShiftMap::pulled_back_target_pdf`] |
+//!
+//! # Common mistakes, and what catches them
+//!
+//! Each is exercised by a test in `tests/mistakes.rs`.
+//!
+//! 1. **The receiver's target where the neighbour's own target belongs** (pairwise MIS then
+//!    weights the wrong pair and is biased by several percent with no other symptom).
+//!    [`PairwiseNeighbor`] has private fields and is built by [`PairwiseNeighbor::new`] from the
+//!    neighbour's [`Reservoir`]: its own target, `W` and confidence come from there, the
+//!    receiver's target from the [`Shifted`] forward shift, and only the pulled-back value is a
+//!    bare number, so the two cannot be exchanged. Likewise [`GrisInput::from_shift`] takes the
+//!    source [`Reservoir`] rather than loose `ucw` and `confidence` numbers.
+//! 2. **[`StreamingReservoir::add`] followed by [`StreamingReservoir::finalize_recorded`]**:
+//!    `add` records no target, so there is nothing to divide by. A `debug_assert!` fails in
+//!    debug builds (release builds return an empty reservoir, as documented). Use
+//!    [`StreamingReservoir::add_candidate`], or [`StreamingReservoir::finalize`] with the target.
+//! 3. **A uniform outside `[0, 1)`** (a raw `u32`, or `u = 1`): only `f32` and `f64` are
+//!    accepted ([`Uniform`] is sealed), and a `debug_assert!` checks the range.
+//! 4. **A 24-bit uniform for a stream whose weights span many decades**: candidates lighter than
+//!    `2^-24` of the running sum are then over-selected. Pass an `f64` uniform
+//!    ([`uniform_f64`]); see [`Uniform`].
+//! 5. **Skipping empty or failed neighbours** in a pairwise step: their canonical share is then
+//!    missing and the weights no longer sum to one. Add them with a `None` shift (this cannot be
+//!    detected; the statistical tests show the bias).
+//!
+//! Mistakes 1 and 3 do not compile:
+//!
+//! ```compile_fail,E0451
+//! use restir_gris::PairwiseNeighbor;
+//! // The fields are private: a neighbour cannot be assembled from loose (swappable) numbers.
+//! let n: PairwiseNeighbor<f32> = PairwiseNeighbor {
+//!     shifted: None, ucw: 1.0, confidence: 1.0, own_target: 0.5,
+//!     pulled_back_target_at_canonical: 0.2,
+//! };
+//! ```
+//!
+//! ```compile_fail,E0277
+//! let mut s = restir_gris::StreamingReservoir::new();
+//! s.add(0u8, 1.0, 12345u32); // a raw integer is not a uniform in [0, 1)
+//! ```
+//!
+//! # Saturation
+//!
+//! Confidences are accumulated in `f64` (unit increments are counted exactly far beyond `2^24`)
+//! and stored as `f32` saturated at `f32::MAX`, never infinite; an infinite increment saturates
+//! too. Targets and weights that would not be finite are rejected (the sample is dropped, the
+//! confidence kept): no public function returns NaN or infinity for finite inputs.
 //!
 //! # Conventions (stated once, used everywhere)
 //!
@@ -92,9 +172,10 @@
 //!   stale value.
 //! * **Random numbers come in as arguments** (`u ∈ [0, 1)`, or a `FnMut() -> f32` source for
 //!   whole steps), so results are repeatable and replayable. No RNG lives in this crate.
-//! * **Precision.** Stored values are `f32`; running sums (`weight_sum`) and products of weights
-//!   are `f64`. Zero, negative, NaN and infinite candidates count towards confidence but are never
-//!   selected and never enter `weight_sum`; no public function returns NaN or infinity.
+//! * **Precision.** Stored values are `f32`; running sums (`weight_sum`, confidence) and
+//!   products of weights are `f64`. Zero, negative, NaN and infinite candidates count towards
+//!   confidence but are never selected and never enter `weight_sum`; no public function returns
+//!   NaN or infinity (see *Saturation* above).
 //!
 //! # What the caller must guarantee for unbiasedness (Lin et al. 2022; `docs/GRIS.md` §3.1)
 //!
@@ -158,7 +239,7 @@ pub use mis::MisScheme;
 pub use resampling::{
     GrisInput, GrisResampler, PairwiseNeighbor, PairwiseResampler, PairwiseVariant, resample,
 };
-pub use reservoir::{Reservoir, StreamingReservoir};
+pub use reservoir::{Reservoir, StreamingReservoir, Uniform, uniform_f64};
 pub use shift::{ShiftMap, Shifted};
 
 // Runs the README's example as a doc test.

@@ -114,7 +114,8 @@ pub fn constant_biased(confidence_i: f32, confidence_sum: f32) -> f32 {
 /// `docs/GRIS.md` §4.2).
 ///
 /// `confidences[j]` and `target_pdfs[j]` describe the same technique; extra entries of the
-/// longer slice are ignored.
+/// longer slice are ignored. When `Z > 0` is so small that `1/Z` overflows `f32`, the result
+/// saturates at `f32::MAX` (it is never 0 for `Z > 0`, never infinite).
 pub fn one_over_z(confidences: &[f32], target_pdfs: &[f32]) -> f32 {
     let z: f64 = confidences
         .iter()
@@ -122,11 +123,16 @@ pub fn one_over_z(confidences: &[f32], target_pdfs: &[f32]) -> f32 {
         .filter(|&(_, &p)| clean(p) > 0.0)
         .map(|(&c, _)| clean(c))
         .sum();
-    if z > 0.0 {
-        let r = (1.0 / z) as f32;
-        if r.is_finite() { r } else { 0.0 }
+    if z > 0.0 { saturate(1.0 / z) } else { 0.0 }
+}
+
+/// `f64 → f32` for a positive finite ratio: saturates at `f32::MAX` instead of overflowing.
+#[inline]
+fn saturate(r: f64) -> f32 {
+    if r < f64::from(f32::MAX) {
+        r as f32
     } else {
-        0.0
+        f32::MAX
     }
 }
 
@@ -162,7 +168,8 @@ pub fn contribution(selected: usize, confidences: &[f32], target_pdfs: &[f32]) -
 ///
 /// With resampling weights `w_i = c_i·p̂_c(Y_i)·W_i·J_i`, finalise the selected `y` (from
 /// technique `s`) with `W = weight_sum · factor / p̂_c(y)`, i.e. pass it as `scale` to
-/// [`crate::StreamingReservoir::finalize_scaled`]. Returns 0 if the denominator is 0.
+/// [`crate::StreamingReservoir::finalize_scaled`]. Returns 0 if the denominator is 0; saturates
+/// at `f32::MAX` when the factor overflows `f32`.
 pub fn contribution_scale(selected: usize, confidences: &[f32], target_pdfs: &[f32]) -> f32 {
     let Some(&ps) = target_pdfs.get(selected) else {
         return 0.0;
@@ -173,9 +180,8 @@ pub fn contribution_scale(selected: usize, confidences: &[f32], target_pdfs: &[f
         .map(|(&c, &p)| technique(c, p))
         .sum();
     let num = clean(ps);
-    if den > 0.0 && num > 0.0 {
-        let r = (num / den) as f32;
-        if r.is_finite() { r } else { 0.0 }
+    if den > 0.0 && num > 0.0 && den.is_finite() {
+        saturate(num / den)
     } else {
         0.0
     }

@@ -23,8 +23,9 @@
 //! * **Symmetric failure:** the forward shift of `x` succeeds iff the inverse shift of its result
 //!   succeeds (every acceptance test — roughness, distance, Jacobian bound, visibility — must be
 //!   symmetric; see [`crate::jacobian::reject_jacobian`]).
-//! * **Consistent targets:** the target returned for domain `j` is the same function that domain
-//!   `j` uses for its own reservoirs (`Reservoir::target_pdf`), evaluated with domain `j`'s data.
+//! * **Consistent targets:** the target returned for domain `j` ([`Shifted::destination_target`])
+//!   is the same function that domain `j` uses for its own reservoirs
+//!   ([`Reservoir::own_target`](crate::Reservoir::own_target)), evaluated with domain `j`'s data.
 
 /// A successfully shifted sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -34,17 +35,18 @@ pub struct Shifted<S> {
     /// Jacobian determinant `|∂T/∂x|` of this shift at `x` (destination measure per source
     /// measure). Must be finite and positive.
     pub jacobian: f32,
-    /// Target function of the **destination** domain at `y`, `p̂_dst(y) ≥ 0`.
-    pub target_pdf: f32,
+    /// Target function of the **destination** domain at `y`, `p̂_dst(y) ≥ 0`, evaluated with the
+    /// destination's data (in the destination's measure). Not the source domain's target.
+    pub destination_target: f32,
 }
 
 impl<S> Shifted<S> {
     /// The identity shift (a domain's own sample): `J = 1`.
-    pub fn identity(sample: S, target_pdf: f32) -> Self {
+    pub fn identity(sample: S, destination_target: f32) -> Self {
         Self {
             sample,
             jacobian: 1.0,
-            target_pdf,
+            destination_target,
         }
     }
 
@@ -53,8 +55,8 @@ impl<S> Shifted<S> {
     pub fn is_valid(&self) -> bool {
         self.jacobian > 0.0
             && self.jacobian.is_finite()
-            && self.target_pdf >= 0.0
-            && self.target_pdf.is_finite()
+            && self.destination_target >= 0.0
+            && self.destination_target.is_finite()
     }
 
     /// For a shift **from the receiving domain `c` into domain `j`**, the pulled-back target
@@ -64,7 +66,7 @@ impl<S> Shifted<S> {
         if !self.is_valid() {
             return 0.0;
         }
-        let p = (f64::from(self.target_pdf) * f64::from(self.jacobian)) as f32;
+        let p = (f64::from(self.destination_target) * f64::from(self.jacobian)) as f32;
         if p.is_finite() { p } else { 0.0 }
     }
 
@@ -101,8 +103,8 @@ impl<S> Shifted<S> {
 ///         let a = from.exponent / to.exponent;
 ///         let y = x.powf(a);
 ///         let jacobian = (a * x.powf(a - 1.0)) as f32;
-///         let target_pdf = y as f32; // this toy's target is p̂_j(y) = y in every domain
-///         let s = Shifted { sample: y, jacobian, target_pdf };
+///         let destination_target = y as f32; // this toy's target is p̂_j(y) = y in every domain
+///         let s = Shifted { sample: y, jacobian, destination_target };
 ///         s.is_valid().then_some(s)
 ///     }
 /// }

@@ -146,7 +146,7 @@ proptest! {
         let (cc, pc) = (c[0], p[0]);
         let (nc, np) = (&c[1..], &p[1..]);
         let k = nc.len();
-        let canonical = Reservoir { sample: Some(0u8), ucw: 1.0, confidence: cc, target_pdf: pc };
+        let canonical = Reservoir { sample: Some(0u8), ucw: 1.0, confidence: cc, own_target: pc };
         let cn: f32 = nc.iter().sum();
         for variant in [
             PairwiseVariant::Plain,
@@ -155,13 +155,8 @@ proptest! {
         ] {
             let mut step = PairwiseResampler::new(variant, k, canonical);
             for i in 0..k {
-                step.add_neighbor(PairwiseNeighbor {
-                    shifted: None,
-                    ucw: 0.0,
-                    confidence: nc[i],
-                    target_pdf: 0.0,
-                    canonical_sample_target_pdf: np[i],
-                }, 0.5);
+                let empty = Reservoir { confidence: nc[i], ..Reservoir::empty() };
+                step.add_neighbor(PairwiseNeighbor::new(&empty, None, np[i]), 0.5);
             }
             let (expected, normaliser) = match variant {
                 PairwiseVariant::Plain if k == 0 => (1.0, 1.0),
@@ -193,7 +188,7 @@ proptest! {
             if fail {
                 gris.add_failed(c);
             } else {
-                gris.add(GrisInput { sample: i, target_pdf: 1.0, ucw: w, jacobian: 1.0, confidence: c }, 1.0, rng.next_f32());
+                gris.add(GrisInput { sample: i, receiver_target: 1.0, ucw: w, jacobian: 1.0, confidence: c }, 1.0, rng.next_f32());
             }
         }
         let mut half = StreamingReservoir::new();
@@ -217,10 +212,10 @@ proptest! {
         let mut gris = GrisResampler::new();
         for (i, &(t, w, j, c, m)) in inputs.iter().enumerate() {
             stream.add_candidate(i, t, w, c, rng.next_f32());
-            gris.add(GrisInput { sample: i, target_pdf: t, ucw: w, jacobian: j, confidence: c }, m, rng.next_f32());
+            gris.add(GrisInput { sample: i, receiver_target: t, ucw: w, jacobian: j, confidence: c }, m, rng.next_f32());
         }
         let (cu, ct, cc) = canonical;
-        let canonical = Reservoir { sample: Some(99usize), ucw: cu, confidence: cc, target_pdf: ct };
+        let canonical = Reservoir { sample: Some(99usize), ucw: cu, confidence: cc, own_target: ct };
         let mut pairs = [
             PairwiseResampler::new(PairwiseVariant::Plain, inputs.len(), canonical),
             PairwiseResampler::new(PairwiseVariant::Defensive, inputs.len(), canonical),
@@ -228,19 +223,15 @@ proptest! {
         ];
         for pair in &mut pairs {
             for (i, &(t, w, j, c, m)) in inputs.iter().enumerate() {
-                pair.add_neighbor(PairwiseNeighbor {
-                    shifted: Some(Shifted { sample: i, jacobian: j, target_pdf: t }),
-                    ucw: w,
-                    confidence: c,
-                    target_pdf: m,
-                    canonical_sample_target_pdf: scale,
-                }, rng.next_f32());
+                let own = Reservoir { sample: Some(i), ucw: w, confidence: c, own_target: m };
+                let shifted = Shifted { sample: i, jacobian: j, destination_target: t };
+                pair.add_neighbor(PairwiseNeighbor::new(&own, Some(shifted), scale), rng.next_f32());
             }
         }
         let mut outs = vec![
             stream.finalize_recorded(),
             stream.finalize(scale),
-            stream.finalize_scaled(canonical.target_pdf, scale),
+            stream.finalize_scaled(canonical.own_target, scale),
             gris.finalize(),
             gris.finalize_scaled(scale),
         ];

@@ -350,10 +350,10 @@ fn manual_step(
         .map(|(i, (r, d))| {
             let x = r.sample?;
             if i == 0 {
-                return Some((x, 1.0, r.target_pdf));
+                return Some((x, 1.0, r.own_target));
             }
             map.shift(d, c, &x)
-                .map(|s| (s.sample, s.jacobian, s.target_pdf))
+                .map(|s| (s.sample, s.jacobian, s.destination_target))
         })
         .collect();
     // Pulled-back targets of every technique at a canonical point y.
@@ -374,17 +374,15 @@ fn manual_step(
     if let Manual::StreamingDefensive = scheme {
         let mut step = PairwiseResampler::new(PairwiseVariant::Defensive, k, reservoirs[0]);
         for i in 1..domains.len() {
-            let neighbor = PairwiseNeighbor {
-                shifted: reservoirs[i]
+            let neighbor = PairwiseNeighbor::new(
+                &reservoirs[i],
+                reservoirs[i]
                     .sample
                     .and_then(|x| map.shift(&domains[i], c, &x)),
-                ucw: reservoirs[i].ucw,
-                confidence: reservoirs[i].confidence,
-                target_pdf: reservoirs[i].target_pdf,
-                canonical_sample_target_pdf: reservoirs[0]
+                reservoirs[0]
                     .sample
                     .map_or(0.0, |xc| map.pulled_back_target_pdf(c, &domains[i], &xc)),
-            };
+            );
             step.add_neighbor(neighbor, rng.next_f32());
         }
         return step.finalize(rng.next_f32());
@@ -393,7 +391,7 @@ fn manual_step(
     let mut step = GrisResampler::new();
     let c_sum: f32 = confidences.iter().sum();
     for (i, s) in shifted.iter().enumerate() {
-        let Some((y, jacobian, target_pdf)) = *s else {
+        let Some((y, jacobian, receiver_target)) = *s else {
             step.add_failed(confidences[i]);
             continue;
         };
@@ -424,7 +422,7 @@ fn manual_step(
         };
         let input = GrisInput {
             sample: y,
-            target_pdf,
+            receiver_target,
             ucw: reservoirs[i].ucw,
             jacobian,
             confidence: confidences[i],

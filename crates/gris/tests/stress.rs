@@ -206,7 +206,7 @@ fn grazing_angles_and_tiny_distances() {
                     resampler.add(
                         GrisInput {
                             sample: (cy, dy, cx, dx),
-                            target_pdf: dy,
+                            receiver_target: dy,
                             ucw: dx,
                             jacobian: fwd,
                             confidence: 1.0,

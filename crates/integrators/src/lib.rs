@@ -1,9 +1,23 @@
 //! Estimators for the `restir` renderer and the code around them: the render driver, pixel
 //! filters, image I/O and error metrics.
 //!
-//! The entry point for programs and tests is [`render`]: give it a built
-//! [`Scene`], an [`Integrator`] and a [`RenderJob`], and it returns the
-//! averaged image with statistics. A *pass* is one sample per pixel of the integrator's final
+//! The simplest render is one line with [`Renderer`]:
+//!
+//! ```no_run
+//! use restir_integrators::Renderer;
+//! use restir_scene::{LoadOptions, load_scene};
+//! let loaded = load_scene("scenes/cornell-box.xml".as_ref(), &LoadOptions::default())?;
+//! let out = Renderer::new(&loaded.scene).spp(16).integrator("restir-di").render()?;
+//! out.image.write("cbox.exr".as_ref())?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! Images are `Vec<glam::Vec3>`; this crate re-exports [`glam`] so a caller need not depend on
+//! a matching version. A complete program: `examples/library-render` in the repository.
+//!
+//! The full form, which the command line uses, is [`render`]: give it a built
+//! [`Scene`], an [`Integrator`], a [`RenderJob`], a cancel flag and a progress callback, and it
+//! returns the averaged image with statistics. A *pass* is one sample per pixel of the integrator's final
 //! estimator; images are bit-identical whatever the thread count, because every pixel's random
 //! numbers come from `(seed, pixel, pass)`.
 //!
@@ -24,16 +38,20 @@ pub mod film;
 pub mod params;
 pub mod path;
 mod render;
+mod renderer;
 pub mod restir_di;
 pub mod restir_pt;
 pub mod reuse;
 pub mod shadow;
 
+/// The vector types of images and scenes (`Image::pixels` is a `Vec<glam::Vec3>`).
+pub use glam;
 pub use params::{Param, ParamError, ParamSet, ParamSource, ParamValue};
 pub use render::{
     CROP_ALIGN, Crop, Integrator, PassContext, PathIntegrator, PixelWindow, RenderJob,
     RenderOutput, RenderPart, render, render_part,
 };
+pub use renderer::{RenderError, Renderer};
 pub use restir_di::{RestirDiIntegrator, RestirDiSettings};
 pub use restir_image::{ErrorMetrics, Image, ImageError, compare};
 pub use restir_pt::{RestirPtIntegrator, RestirPtSettings};

@@ -184,7 +184,7 @@ fn check_shifts(scene: &Scene, pt: &RestirPtIntegrator) -> ShiftStats {
                     y.value, x.value,
                     "pixel {i}: self-shift contribution ({x:?})"
                 );
-                assert_eq!(t, res.target_pdf, "pixel {i}: self-shift target");
+                assert_eq!(t, res.own_target, "pixel {i}: self-shift target");
                 identity += 1;
             }
             for _ in 0..8 {
@@ -202,7 +202,7 @@ fn check_shifts(scene: &Scene, pt: &RestirPtIntegrator) -> ShiftStats {
                 });
                 let prod = f64::from(f.jacobian) * f64::from(b.jacobian);
                 assert!((prod - 1.0).abs() < 1e-4, "pixels {i}->{k}: J·J⁻¹ = {prod}");
-                if f.target_pdf > 0.0 && b.target_pdf > 0.0 {
+                if f.destination_target > 0.0 && b.destination_target > 0.0 {
                     visible += 1;
                     let err =
                         (b.sample.value - x.value).abs().max_element() / x.value.max_element();

@@ -27,7 +27,7 @@ pub use pairwise::{PairwiseNeighbor, PairwiseResampler, PairwiseVariant};
 pub use step::resample;
 
 use crate::mis::clean;
-use crate::reservoir::{Reservoir, StreamingReservoir};
+use crate::reservoir::{Reservoir, StreamingReservoir, Uniform};
 use crate::shift::Shifted;
 
 /// One input of a GRIS step, already shifted into the receiving domain.
@@ -35,8 +35,10 @@ use crate::shift::Shifted;
 pub struct GrisInput<S> {
     /// The shifted sample `Y_i = T_{i→c}(X_i)`.
     pub sample: S,
-    /// Receiving domain's target at the shifted sample, `p̂_c(Y_i)`.
-    pub target_pdf: f32,
+    /// The **receiving** domain's target at the shifted sample, `p̂_c(Y_i)` (receiver's measure;
+    /// [`Shifted::destination_target`] of the shift into the receiver). Not the input
+    /// reservoir's own target `p̂_i(X_i)`.
+    pub receiver_target: f32,
     /// The input reservoir's unbiased contribution weight `W_i` (in its own domain's measure).
     pub ucw: f32,
     /// Jacobian `|∂T_{i→c}/∂x|` at `X_i` (1 for the canonical input).
@@ -46,36 +48,40 @@ pub struct GrisInput<S> {
 }
 
 impl<S> GrisInput<S> {
-    /// The canonical input: the receiving domain's own reservoir (identity shift, `J = 1`).
-    /// `None` if the reservoir is empty.
+    /// The canonical input: the receiving domain's own reservoir (identity shift, `J = 1`; its
+    /// own target is the receiver's target). `None` if the reservoir is empty.
     pub fn canonical(reservoir: Reservoir<S>) -> Option<Self> {
-        let target_pdf = reservoir.target_pdf;
+        let receiver_target = reservoir.own_target;
         let (ucw, confidence) = (reservoir.ucw, reservoir.confidence);
         reservoir.sample.map(|sample| Self {
             sample,
-            target_pdf,
+            receiver_target,
             ucw,
             jacobian: 1.0,
             confidence,
         })
     }
 
-    /// An input from a successful shift of a reservoir with weight `ucw` and confidence
-    /// `confidence`.
-    pub fn from_shift(shifted: Shifted<S>, ucw: f32, confidence: f32) -> Self {
+    /// An input from a successful shift `shifted` (into the receiver) of the reservoir `source`:
+    /// the receiver's target and the Jacobian come from the shift, `W_i` and `c_i` from the
+    /// reservoir, so none of them can take another's place.
+    pub fn from_shift(shifted: Shifted<S>, source: &Reservoir<S>) -> Self {
         Self {
             sample: shifted.sample,
-            target_pdf: shifted.target_pdf,
-            ucw,
+            receiver_target: shifted.destination_target,
+            ucw: source.ucw,
             jacobian: shifted.jacobian,
-            confidence,
+            confidence: source.confidence,
         }
     }
 
     /// `w_i = m_i · p̂_c(Y_i) · W_i · J_i` in `f64`. Negative, NaN and infinite factors give 0.
     #[inline]
     pub fn resampling_weight(&self, mis_weight: f32) -> f64 {
-        let w = clean(mis_weight) * clean(self.target_pdf) * clean(self.ucw) * clean(self.jacobian);
+        let w = clean(mis_weight)
+            * clean(self.receiver_target)
+            * clean(self.ucw)
+            * clean(self.jacobian);
         if w.is_finite() { w } else { 0.0 }
     }
 }
@@ -89,8 +95,8 @@ impl<S> GrisInput<S> {
 /// ```
 /// use restir_gris::{GrisInput, GrisResampler, Reservoir, mis};
 ///
-/// let canonical = Reservoir { sample: Some(0.5f32), ucw: 2.0, confidence: 1.0, target_pdf: 0.5 };
-/// let neighbor = GrisInput { sample: 0.8f32, target_pdf: 0.8, ucw: 1.5, jacobian: 1.0, confidence: 1.0 };
+/// let canonical = Reservoir { sample: Some(0.5f32), ucw: 2.0, confidence: 1.0, own_target: 0.5 };
+/// let neighbor = GrisInput { sample: 0.8f32, receiver_target: 0.8, ucw: 1.5, jacobian: 1.0, confidence: 1.0 };
 /// // Constant MIS with two equally confident inputs: m = 1/2 each.
 /// let mut r = GrisResampler::new();
 /// r.add(GrisInput::canonical(canonical).unwrap(), 0.5, 0.3);
@@ -122,16 +128,21 @@ impl<S> GrisResampler<S> {
         }
     }
 
-    /// Streams one input with MIS weight `mis_weight = m_i(Y_i)` and uniform `u ∈ [0, 1)`.
-    /// Adds `input.confidence` to the output confidence. Returns `true` if it was selected.
+    /// Streams one input with MIS weight `mis_weight = m_i(Y_i)` and uniform `u ∈ [0, 1)`
+    /// (`f32` or `f64`, see [`Uniform`]). Adds `input.confidence` to the output confidence.
+    /// Returns `true` if it was selected.
     #[inline]
-    pub fn add(&mut self, input: GrisInput<S>, mis_weight: f32, u: f32) -> bool {
+    pub fn add(&mut self, input: GrisInput<S>, mis_weight: f32, u: impl Uniform) -> bool {
         let w = input.resampling_weight(mis_weight);
         let index = self.inputs;
         self.inputs += 1;
-        let taken = self
-            .stream
-            .push(input.sample, input.target_pdf, w, input.confidence, u);
+        let taken = self.stream.push(
+            input.sample,
+            input.receiver_target,
+            w,
+            input.confidence,
+            u.to_f64(),
+        );
         if taken {
             self.selected_input = Some(index);
         }
@@ -156,9 +167,9 @@ impl<S> GrisResampler<S> {
         self.selected_input
     }
 
-    /// `p̂_c` at the selected sample.
-    pub fn selected_target_pdf(&self) -> f32 {
-        self.stream.selected_target_pdf()
+    /// The receiver's target `p̂_c` at the selected sample.
+    pub fn selected_receiver_target(&self) -> f32 {
+        self.stream.selected_target()
     }
 
     /// Running `Σ w_i` in `f64`.
@@ -181,7 +192,7 @@ impl<S> GrisResampler<S> {
     /// after selection (`1/Σc` for constant MIS, [`crate::mis::one_over_z`],
     /// [`crate::mis::contribution_scale`], `1/n` or `1/(n+1)` for pairwise).
     pub fn finalize_scaled(self, scale: f32) -> Reservoir<S> {
-        let t = self.stream.selected_target_pdf();
+        let t = self.stream.selected_target();
         self.stream.finalize_scaled(t, scale)
     }
 }

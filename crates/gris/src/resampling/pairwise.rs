@@ -6,7 +6,7 @@
 
 use super::{GrisInput, GrisResampler};
 use crate::mis::{self, PairTerms, clean};
-use crate::reservoir::Reservoir;
+use crate::reservoir::{Reservoir, Uniform};
 use crate::shift::Shifted;
 
 /// Which pairwise MIS variant a [`PairwiseResampler`] uses (`docs/GRIS.md` §4.5–4.7).
@@ -26,23 +26,62 @@ pub enum PairwiseVariant {
     },
 }
 
-/// What a [`PairwiseResampler`] needs to know about one neighbour.
+/// What a [`PairwiseResampler`] needs to know about one neighbour `i`, built with
+/// [`PairwiseNeighbor::new`] from the neighbour's own reservoir.
+///
+/// Three targets of three different domains/points meet in one pairwise step; each has one
+/// source here, so none can silently take another's place:
+///
+/// * `p̂_i(X_i)`, the neighbour's target at its own sample: the reservoir's
+///   [`own_target`](Reservoir::own_target);
+/// * `p̂_c(Y_i)`, the canonical target at the shifted neighbour sample: the forward shift's
+///   [`destination_target`](Shifted::destination_target);
+/// * `p̂_{←i}(X_c)`, the neighbour's target pulled back to the canonical sample: the one number
+///   passed explicitly.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PairwiseNeighbor<S> {
-    /// Forward shift `T_{i→c}(X_i)` of the neighbour's sample into the canonical domain, or
-    /// `None` if the neighbour's reservoir is empty or the shift failed.
-    pub shifted: Option<Shifted<S>>,
-    /// Neighbour's `W_i`.
-    pub ucw: f32,
-    /// Neighbour's confidence `c_i`.
-    pub confidence: f32,
-    /// Neighbour's target at its own sample, `p̂_i(X_i)` (its `Reservoir::target_pdf`).
-    pub target_pdf: f32,
-    /// Inverse direction: the canonical sample shifted into the neighbour's domain and pulled
-    /// back, `p̂_{←i}(X_c) = p̂_i(T_{c→i}(X_c)) · J_{c→i}(X_c)`
-    /// ([`Shifted::pulled_back_target_pdf`]); 0 if that shift fails or there is no canonical
-    /// sample.
-    pub canonical_sample_target_pdf: f32,
+    shifted: Option<Shifted<S>>,
+    ucw: f32,
+    confidence: f32,
+    own_target: f32,
+    pulled_back_target_at_canonical: f32,
+}
+
+impl<S> PairwiseNeighbor<S> {
+    /// Neighbour `i` of a pairwise step:
+    ///
+    /// * `reservoir`: the neighbour's own reservoir (its `W_i`, `c_i` and own target `p̂_i(X_i)`
+    ///   are taken from it); empty reservoirs are allowed and must still be added;
+    /// * `shifted`: the forward shift `T_{i→c}(X_i)` of its sample into the canonical domain, or
+    ///   `None` if the reservoir is empty or the shift failed;
+    /// * `pulled_back_target_at_canonical`: the canonical sample shifted into the neighbour's
+    ///   domain and pulled back, `p̂_{←i}(X_c) = p̂_i(T_{c→i}(X_c)) · J_{c→i}(X_c)`
+    ///   ([`Shifted::pulled_back_target_pdf`] of the inverse shift, or
+    ///   [`ShiftMap::pulled_back_target_pdf`](crate::ShiftMap::pulled_back_target_pdf)); 0 if that
+    ///   shift fails or there is no canonical sample.
+    pub fn new(
+        reservoir: &Reservoir<S>,
+        shifted: Option<Shifted<S>>,
+        pulled_back_target_at_canonical: f32,
+    ) -> Self {
+        Self {
+            shifted,
+            ucw: reservoir.ucw,
+            confidence: reservoir.confidence,
+            own_target: reservoir.own_target,
+            pulled_back_target_at_canonical,
+        }
+    }
+
+    /// The forward shift of the neighbour's sample into the canonical domain, if any.
+    pub fn shifted(&self) -> Option<&Shifted<S>> {
+        self.shifted.as_ref()
+    }
+
+    /// `p̂_{←i}(X_c)`, as given to [`Self::new`].
+    pub fn pulled_back_target_at_canonical(&self) -> f32 {
+        self.pulled_back_target_at_canonical
+    }
 }
 
 /// Streaming pairwise-MIS GRIS step (Bitterli 2022, PhD thesis §9.1; Lin et al. 2022;
@@ -67,7 +106,7 @@ pub struct PairwiseResampler<S> {
 }
 
 impl<S> PairwiseResampler<S> {
-    /// Starts a step for the canonical reservoir `canonical` (whose `target_pdf` must be
+    /// Starts a step for the canonical reservoir `canonical` (whose `own_target` is
     /// `p̂_c(X_c)`) with `neighbor_count` configured neighbours.
     pub fn new(variant: PairwiseVariant, neighbor_count: usize, canonical: Reservoir<S>) -> Self {
         let canonical_weight = match variant {
@@ -97,13 +136,13 @@ impl<S> PairwiseResampler<S> {
     }
 
     /// Adds one neighbour with uniform `u ∈ [0, 1)`; returns `true` if its sample was selected.
-    pub fn add_neighbor(&mut self, neighbor: PairwiseNeighbor<S>, u: f32) -> bool {
+    pub fn add_neighbor(&mut self, neighbor: PairwiseNeighbor<S>, u: impl Uniform) -> bool {
         self.added += 1;
         let cc = self.canonical.confidence;
-        let pc = self.canonical.target_pdf;
+        let pc = self.canonical.own_target;
         let ci = neighbor.confidence;
         // Canonical share at the canonical sample X_c.
-        let p_ic = neighbor.canonical_sample_target_pdf;
+        let p_ic = neighbor.pulled_back_target_at_canonical;
         match self.variant {
             PairwiseVariant::Plain | PairwiseVariant::Defensive => {
                 let pair = PairTerms {
@@ -133,8 +172,8 @@ impl<S> PairwiseResampler<S> {
             self.stream.add_failed(ci);
             return false;
         };
-        let p_i = shifted.source_target_pdf_at_receiver(neighbor.target_pdf);
-        let p_c = shifted.target_pdf;
+        let p_i = shifted.source_target_pdf_at_receiver(neighbor.own_target);
+        let p_c = shifted.destination_target;
         let pair = PairTerms {
             neighbor_confidence: ci,
             neighbor_target_pdf: p_i,
@@ -149,7 +188,13 @@ impl<S> PairwiseResampler<S> {
                 neighbor_confidence_sum,
             } => mis::confidence_weighted_pairwise_neighbor(pair, neighbor_confidence_sum),
         };
-        let input = GrisInput::from_shift(shifted, neighbor.ucw, ci);
+        let input = GrisInput {
+            sample: shifted.sample,
+            receiver_target: p_c,
+            ucw: neighbor.ucw,
+            jacobian: shifted.jacobian,
+            confidence: ci,
+        };
         self.stream.add(input, m, u)
     }
 
@@ -162,7 +207,7 @@ impl<S> PairwiseResampler<S> {
     /// Streams the canonical sample last (with uniform `u ∈ [0, 1)`) and finalises:
     /// `W = Σ w_i · scale / p̂_c(Y)` with `scale = 1/n` (plain, 1 if `n = 0`), `1/(n+1)`
     /// (defensive) or 1 (confidence-weighted), `n` = neighbours added.
-    pub fn finalize(self, u: f32) -> Reservoir<S> {
+    pub fn finalize(self, u: impl Uniform) -> Reservoir<S> {
         let n = self.added as f32;
         let (canonical_mis, scale) = match self.variant {
             PairwiseVariant::Plain if self.added == 0 => (1.0, 1.0),

@@ -9,7 +9,7 @@ use core::borrow::Borrow;
 
 use super::{GrisInput, GrisResampler, PairwiseNeighbor, PairwiseResampler, PairwiseVariant};
 use crate::mis::{MisScheme, clean};
-use crate::reservoir::{Reservoir, sanitize_non_negative};
+use crate::reservoir::{Reservoir, Uniform, sanitize_non_negative};
 use crate::shift::{ShiftMap, Shifted};
 
 /// Shifts a neighbour's reservoir into the receiver, or `None` if it is empty or the shift fails.
@@ -28,14 +28,15 @@ fn shift_in<S, M: ShiftMap<S>>(
 
 /// One complete GRIS step at `canonical_domain` with the MIS scheme `scheme`.
 ///
-/// * `canonical` is the receiving domain's own reservoir; its `target_pdf` must be `p̂_c(X_c)`.
-/// * `neighbors` lists each neighbour's domain and reservoir (`target_pdf = p̂_i(X_i)`); empty
+/// * `canonical` is the receiving domain's own reservoir; its `own_target` is `p̂_c(X_c)`.
+/// * `neighbors` lists each neighbour's domain and reservoir (`own_target = p̂_i(X_i)`); empty
 ///   reservoirs are allowed and still count as techniques. A domain is anything that borrows as
 ///   `M::Domain`: a reference (`&Receiver`) or, for a small `Copy` domain such as a pixel index,
 ///   the value itself (`(usize, &Reservoir<S>)`), so the caller does not have to keep the domains
 ///   alive elsewhere just to lend them. An empty list needs its element type spelled out, e.g.
 ///   `let none: &[(&Domain, &Reservoir<S>)] = &[];`.
-/// * `next_u` supplies independent uniform numbers in `[0, 1)` (one per input).
+/// * `next_u` supplies independent uniform numbers in `[0, 1)` (one per input), `f32` or `f64`
+///   (see [`Uniform`]: `f64` with 53 bits when weights may span more than ~7 decades).
 ///
 /// Shift cost per scheme (k neighbours): constant O(k); 1/Z and contribution O(k) + O(k) inverse
 /// shifts of the selected sample; pairwise variants 2k; generalized balance O(k²). The output
@@ -56,26 +57,27 @@ fn shift_in<S, M: ShiftMap<S>>(
 ///     }
 /// }
 /// let (a, b) = (Domain { slope: 1.0 }, Domain { slope: 3.0 });
-/// let ra = Reservoir { sample: Some(0.25f32), ucw: 0.9, confidence: 1.0, target_pdf: 1.25 };
-/// let rb = Reservoir { sample: Some(0.75f32), ucw: 0.6, confidence: 2.0, target_pdf: 3.25 };
+/// let ra = Reservoir { sample: Some(0.25f32), ucw: 0.9, confidence: 1.0, own_target: 1.25 };
+/// let rb = Reservoir { sample: Some(0.75f32), ucw: 0.6, confidence: 2.0, own_target: 3.25 };
 /// let mut us = [0.1f32, 0.9].into_iter();
 /// let out = resample(&Identity, MisScheme::DefensivePairwise, &a, &ra, &[(&b, &rb)],
 ///                    || us.next().unwrap_or(0.5));
 /// assert_eq!(out.confidence, 3.0);
 /// assert!(out.sample.is_some() && out.ucw > 0.0);
 /// ```
-pub fn resample<S, M, D>(
+pub fn resample<S, M, D, U>(
     map: &M,
     scheme: MisScheme,
     canonical_domain: &M::Domain,
     canonical: &Reservoir<S>,
     neighbors: &[(D, &Reservoir<S>)],
-    next_u: impl FnMut() -> f32,
+    next_u: impl FnMut() -> U,
 ) -> Reservoir<S>
 where
     S: Clone,
     M: ShiftMap<S>,
     D: Borrow<M::Domain>,
+    U: Uniform,
 {
     match scheme {
         MisScheme::Pairwise => pairwise(
@@ -114,18 +116,19 @@ where
 
 /// The pairwise family: every neighbour streams through a [`PairwiseResampler`] with its forward
 /// shift and the inverse shift of the canonical sample (2k shifts), the canonical sample last.
-fn pairwise<S, M, D>(
+fn pairwise<S, M, D, U>(
     map: &M,
     variant: PairwiseVariant,
     canonical_domain: &M::Domain,
     canonical: &Reservoir<S>,
     neighbors: &[(D, &Reservoir<S>)],
-    mut next_u: impl FnMut() -> f32,
+    mut next_u: impl FnMut() -> U,
 ) -> Reservoir<S>
 where
     S: Clone,
     M: ShiftMap<S>,
     D: Borrow<M::Domain>,
+    U: Uniform,
 {
     let mut step = PairwiseResampler::new(variant, neighbors.len(), canonical.clone());
     for (domain, reservoir) in neighbors {
@@ -133,13 +136,11 @@ where
         let canonical_sample_target_pdf = canonical.sample.as_ref().map_or(0.0, |xc| {
             map.pulled_back_target_pdf(canonical_domain, domain, xc)
         });
-        let neighbor = PairwiseNeighbor {
-            shifted: shift_in(map, domain, canonical_domain, reservoir),
-            ucw: reservoir.ucw,
-            confidence: reservoir.confidence,
-            target_pdf: reservoir.target_pdf,
+        let neighbor = PairwiseNeighbor::new(
+            reservoir,
+            shift_in(map, domain, canonical_domain, reservoir),
             canonical_sample_target_pdf,
-        };
+        );
         step.add_neighbor(neighbor, next_u());
     }
     step.finalize(next_u())
@@ -148,20 +149,21 @@ where
 /// The generalized balance heuristic: each candidate (canonical first) is weighted by
 /// `m_i = P_i / Σ_j P_j` at its shifted sample, with inverse shifts into every other domain
 /// (O(k²) shifts); the weights are normalised, so the step finalises with `W = Σ w_i / p̂_c(Y)`.
-fn generalized_balance<S, M, D>(
+fn generalized_balance<S, M, D, U>(
     map: &M,
     canonical_domain: &M::Domain,
     canonical: &Reservoir<S>,
     neighbors: &[(D, &Reservoir<S>)],
-    mut next_u: impl FnMut() -> f32,
+    mut next_u: impl FnMut() -> U,
 ) -> Reservoir<S>
 where
     S: Clone,
     M: ShiftMap<S>,
     D: Borrow<M::Domain>,
+    U: Uniform,
 {
     let cc = sanitize_non_negative(canonical.confidence);
-    let pc_own = canonical.target_pdf;
+    let pc_own = canonical.own_target;
     // Σ_j P_j(y) over the neighbours j ≠ skip, by inverse shifts of y.
     let others = |y: &S, skip: Option<usize>| -> f64 {
         neighbors
@@ -189,10 +191,11 @@ where
             continue;
         };
         let own = clean(reservoir.confidence)
-            * clean(shifted.source_target_pdf_at_receiver(reservoir.target_pdf));
-        let den = own + clean(cc) * clean(shifted.target_pdf) + others(&shifted.sample, Some(i));
+            * clean(shifted.source_target_pdf_at_receiver(reservoir.own_target));
+        let den =
+            own + clean(cc) * clean(shifted.destination_target) + others(&shifted.sample, Some(i));
         let m = balance(own, den);
-        let input = GrisInput::from_shift(shifted, reservoir.ucw, reservoir.confidence);
+        let input = GrisInput::from_shift(shifted, reservoir);
         stream.add(input, m, next_u());
     }
     stream.finalize()
@@ -202,21 +205,22 @@ where
 /// resampled with their confidences as weights (O(k) shifts); the MIS normalisation (`1/Σc`,
 /// `1/Z(y)` or the contribution factor) is applied to the selected sample `y` only, with O(k)
 /// inverse shifts of `y` for the unbiased two.
-fn constant_weights<S, M, D>(
+fn constant_weights<S, M, D, U>(
     map: &M,
     scheme: MisScheme,
     canonical_domain: &M::Domain,
     canonical: &Reservoir<S>,
     neighbors: &[(D, &Reservoir<S>)],
-    mut next_u: impl FnMut() -> f32,
+    mut next_u: impl FnMut() -> U,
 ) -> Reservoir<S>
 where
     S: Clone,
     M: ShiftMap<S>,
     D: Borrow<M::Domain>,
+    U: Uniform,
 {
     let cc = sanitize_non_negative(canonical.confidence);
-    let pc_own = canonical.target_pdf;
+    let pc_own = canonical.own_target;
     // Constant resampling weights c_i; the normalisation is applied after selection.
     // Input 0 is the canonical, input i + 1 is neighbour i.
     let mut stream = GrisResampler::new();
@@ -231,9 +235,9 @@ where
     for (domain, reservoir) in neighbors {
         match shift_in(map, domain.borrow(), canonical_domain, reservoir) {
             Some(shifted) => {
-                let (j, t) = (shifted.jacobian, reservoir.target_pdf);
+                let (j, t) = (shifted.jacobian, reservoir.own_target);
                 let c = sanitize_non_negative(reservoir.confidence);
-                let input = GrisInput::from_shift(shifted, reservoir.ucw, c);
+                let input = GrisInput::from_shift(shifted, reservoir);
                 if stream.add(input, c, next_u()) {
                     selected_jacobian = j;
                     selected_source_target = t;
@@ -256,7 +260,7 @@ where
         }
         _ => {
             // P_j(y) for every technique, without allocating: canonical, then neighbours.
-            let pc_y = stream.selected_target_pdf();
+            let pc_y = stream.selected_receiver_target();
             let pulled = |j: usize| -> f32 {
                 if j == 0 {
                     pc_y

@@ -98,7 +98,7 @@ impl ShiftMap<f64> for PowerShift {
         let s = Shifted {
             sample: y,
             jacobian,
-            target_pdf: to.target_pdf(y) as f32,
+            destination_target: to.target_pdf(y) as f32,
         };
         s.is_valid().then_some(s)
     }

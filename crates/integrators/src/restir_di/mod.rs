@@ -256,7 +256,7 @@ impl RestirDiIntegrator {
             if !visible {
                 res.sample = None;
                 res.ucw = 0.0;
-                res.target_pdf = 0.0;
+                res.own_target = 0.0;
             }
         }
         (res, rays)

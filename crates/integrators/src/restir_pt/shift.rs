@@ -148,11 +148,11 @@ impl ShiftMap<PathSample> for PtShift<'_> {
 
     #[inline]
     fn shift(&self, from: &usize, to: &usize, x: &PathSample) -> Option<Shifted<PathSample>> {
-        let (target_pdf, jacobian, sample) = self.shift_full(*from, *to, x)?;
+        let (destination_target, jacobian, sample) = self.shift_full(*from, *to, x)?;
         Some(Shifted {
             sample,
             jacobian,
-            target_pdf,
+            destination_target,
         })
     }
 }
