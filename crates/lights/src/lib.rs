@@ -21,8 +21,8 @@ use glam::{Vec2, Vec3};
 use restir_geometry::Shape;
 use restir_geometry::area_to_solid_angle;
 use restir_sampling::{luminance, warp};
-use table::{Emitter, EmitterTable};
 use std::sync::Arc;
+use table::{Emitter, EmitterTable};
 
 /// An emitter.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -66,7 +66,11 @@ impl Scene {
                 };
                 receivers += 1;
                 // The side of the surface the camera sees.
-                let n = if si.ng.dot(ray.d) < 0.0 { si.ng } else { -si.ng };
+                let n = if si.ng.dot(ray.d) < 0.0 {
+                    si.ng
+                } else {
+                    -si.ng
+                };
                 for k in 0..2 * SAMPLES {
                     let u = rng.next_2d();
                     let s = if k < SAMPLES {
