@@ -10,8 +10,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use restir_scene::generate::{
-    DiOptions, Generated, Glass, Issue, Kind, Params, Receivers, RoomOptions, Split, family,
-    generate,
+    AssetContents, DiOptions, Generated, Glass, Issue, Kind, Params, Receivers, RoomOptions, Split,
+    family, generate,
 };
 use restir_scene::{LoadOptions, Scene, load_scene};
 
@@ -33,6 +33,31 @@ fn load(generated: &Generated, name: &str, width: u32, height: u32) -> (Scene, P
     };
     let scene = load_scene(&path, &options).unwrap().scene;
     (scene, dir)
+}
+
+/// Emissive rectangles, spheres or triangles of a generated many-light scene: the emissive
+/// shapes, or for meshes the faces of their OBJ files.
+fn emissive_primitives(generated: &Generated) -> usize {
+    let objs: usize = generated
+        .assets
+        .iter()
+        .filter_map(|a| match &a.contents {
+            AssetContents::Text(text) if a.filename.ends_with(".obj") => {
+                Some(text.lines().filter(|l| l.starts_with("f ")).count())
+            }
+            _ => None,
+        })
+        .sum();
+    if objs > 0 {
+        objs
+    } else {
+        generated
+            .desc
+            .shapes
+            .iter()
+            .filter(|s| s.emission.is_some())
+            .count()
+    }
 }
 
 fn di(kind: Kind, lights: u32, receivers: Receivers, envmap: bool) -> Params {
@@ -78,10 +103,19 @@ fn every_kind_builds_and_renders_finite_and_lit() {
             let generated = generate(&params, seed).unwrap();
             let (scene, dir) = load(&generated, &format!("{name}-{seed}"), 32, 24);
             if let Params::Di(_, options) = &params {
-                // Every light is an entry: two triangles per rectangle, one per sphere or triangle,
-                // plus the environment.
-                let per_light = if params.kind() == Kind::Rects { 2 } else { 1 };
-                let expected = per_light * options.lights as usize + usize::from(options.envmap);
+                assert_eq!(
+                    emissive_primitives(&generated),
+                    options.lights as usize,
+                    "{name}"
+                );
+                // The light set has an entry per emissive shape, plus the environment.
+                let shapes = generated
+                    .desc
+                    .shapes
+                    .iter()
+                    .filter(|s| s.emission.is_some())
+                    .count();
+                let expected = shapes + usize::from(options.envmap);
                 assert_eq!(scene.features.light_count, expected, "{name} seed {seed}");
                 assert_eq!(scene.integrator.max_depth, 2, "{name}: direct light only");
             } else {
@@ -198,13 +232,19 @@ fn hundred_thousand_light_members_build() {
         let (scene, dir) = load(&generated, &member.name(), 32, 24);
         let loaded = start.elapsed();
         eprintln!(
-            "{}: generated in {:.2} s, written, parsed and built in {:.2} s, {} lights",
+            "{}: generated in {:.2} s, written, parsed and built in {:.2} s, {} light-set entries",
             member.name(),
             made.as_secs_f64(),
             loaded.as_secs_f64(),
             scene.features.light_count
         );
-        assert!(scene.features.light_count >= 100_000, "{}", member.name());
+        assert_eq!(
+            emissive_primitives(&generated),
+            100_000,
+            "{}",
+            member.name()
+        );
+        assert!(scene.features.light_count >= 8, "{}", member.name());
         let _ = std::fs::remove_dir_all(dir);
     }
 }
