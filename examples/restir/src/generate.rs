@@ -15,6 +15,16 @@ use crate::say::say;
 pub enum Generate {
     /// A floor with boxes and pillars lit only by many small coloured sphere lights.
     ManyLights(ManyLightsArgs),
+    /// Small one-sided emissive rectangles hanging over receivers (direct light only).
+    Rects(DiArgs),
+    /// Small emissive spheres hanging over receivers (direct light only).
+    Spheres(DiArgs),
+    /// A few emissive OBJ meshes of thousands of small triangles over receivers (direct light only).
+    Meshes(DiArgs),
+    /// A glossy room lit mostly indirectly by one hidden area light.
+    Room(RoomArgs),
+    /// Every scene of a training or test family (issue 14: di, issue 15: pt) with an index.
+    Family(FamilyArgs),
     /// A latitude-longitude environment map (EXR): a sky with a sun over a dark ground, the map
     /// of scenes/envmap-spheres.xml.
     Envmap(EnvmapArgs),
@@ -81,6 +91,11 @@ pub fn run(what: Generate) -> Result<(), String> {
             );
             Ok(())
         }
+        Generate::Rects(args) => write_di(Kind::Rects, args),
+        Generate::Spheres(args) => write_di(Kind::Spheres, args),
+        Generate::Meshes(args) => write_di(Kind::Meshes, args),
+        Generate::Room(args) => write_room(args),
+        Generate::Family(args) => write_family(&args),
         Generate::Envmap(args) => {
             if !(4..=8192).contains(&args.width) || args.width % 2 != 0 {
                 return Err(format!(
@@ -191,4 +206,241 @@ pub fn sky(width: u32, height: u32) -> Image {
         }
     }
     img
+}
+
+// ---- the scene families' kinds (issues 14 and 15) ----
+
+use restir_scene::generate::{
+    DiOptions, FamilyMember, Generated, Glass, Issue, Kind, Params, Receivers, RoomOptions, Split,
+    family,
+};
+
+/// Options of `restir generate rects|spheres|meshes`.
+#[derive(clap::Args, Debug)]
+pub struct DiArgs {
+    /// Seed of the layout, materials and lights.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Number of lights (rectangles, spheres or emissive triangles).
+    #[arg(long, default_value_t = 1000)]
+    lights: u32,
+    /// Receiver materials.
+    #[arg(long, default_value = "mixed", value_parser = ["diffuse", "textured", "glossy", "mixed"])]
+    receivers: String,
+    /// Brightest over dimmest light radiance.
+    #[arg(long, default_value_t = 1000.0)]
+    power_ratio: f32,
+    /// Leave out the slats and pillars between lights and receivers.
+    #[arg(long)]
+    no_occluders: bool,
+    /// A dim sky (EXR written beside the scene) besides the lights.
+    #[arg(long)]
+    envmap: bool,
+    /// Output RON file; assets go beside it. Default: <kind>-<options>-s<seed>.ron.
+    #[arg(short = 'o', long = "output")]
+    output: Option<PathBuf>,
+}
+
+/// Options of `restir generate room`.
+#[derive(clap::Args, Debug)]
+pub struct RoomArgs {
+    /// Seed of the layout, materials and light.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// A glass object.
+    #[arg(long, default_value = "none", value_parser = ["none", "smooth", "rough"])]
+    glass: String,
+    /// A window in the right wall with a sky (EXR written beside the scene) outside.
+    #[arg(long)]
+    window: bool,
+    /// Output RON file; assets go beside it. Default: room-<options>-s<seed>.ron.
+    #[arg(short = 'o', long = "output")]
+    output: Option<PathBuf>,
+}
+
+/// Options of `restir generate family`.
+#[derive(clap::Args, Debug)]
+pub struct FamilyArgs {
+    /// Which study: di (ReSTIR DI, many lights, direct light) or pt (ReSTIR PT, glossy rooms).
+    #[arg(long, value_parser = ["di", "pt"])]
+    issue: String,
+    /// train (seeds 1..) or test (seeds 101..).
+    #[arg(long, value_parser = ["train", "test"])]
+    split: String,
+    /// Directory for the scenes, their assets and the index family.txt.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+fn di_params(kind: Kind, args: &DiArgs) -> Result<Params, String> {
+    if !(1..=1_000_000).contains(&args.lights) {
+        return Err(format!(
+            "--lights {}: expected 1 to 1000000 lights",
+            args.lights
+        ));
+    }
+    if !(args.power_ratio.is_finite() && args.power_ratio >= 1.0) {
+        return Err(format!(
+            "--power-ratio {}: expected a ratio of at least 1",
+            args.power_ratio
+        ));
+    }
+    let receivers = Receivers::ALL
+        .into_iter()
+        .find(|r| r.name() == args.receivers)
+        .ok_or_else(|| {
+            format!(
+                "--receivers {}: expected diffuse, textured, glossy or mixed",
+                args.receivers
+            )
+        })?;
+    Ok(Params::Di(
+        kind,
+        DiOptions {
+            lights: args.lights,
+            power_ratio: args.power_ratio,
+            receivers,
+            occluders: !args.no_occluders,
+            envmap: args.envmap,
+        },
+    ))
+}
+
+/// A one-line description of a scene's parameters.
+fn describe(params: &Params) -> String {
+    match params {
+        Params::Di(kind, o) => format!(
+            "{}: {} lights, power ratio {}, {} receivers, {}occluders, {}",
+            kind.name(),
+            o.lights,
+            o.power_ratio,
+            o.receivers.name(),
+            if o.occluders { "" } else { "no " },
+            if o.envmap {
+                "sky beside the lights"
+            } else {
+                "no environment"
+            }
+        ),
+        Params::Room(o) => format!(
+            "room: glass {}, {}",
+            o.glass.name(),
+            if o.window {
+                "window with a sky"
+            } else {
+                "closed"
+            }
+        ),
+    }
+}
+
+fn tag(params: &Params) -> String {
+    match params {
+        Params::Di(_, o) => o.tag(),
+        Params::Room(o) => o.tag(),
+    }
+}
+
+/// Writes one generated scene to `output` (or its default name) and says so.
+fn write_one(params: &Params, seed: u64, output: Option<PathBuf>) -> Result<(), String> {
+    let generated: Generated =
+        restir_scene::generate::generate(params, seed).map_err(|e| e.to_string())?;
+    let output = output.unwrap_or_else(|| {
+        PathBuf::from(format!(
+            "{}-{}-s{seed}.ron",
+            params.kind().name(),
+            tag(params)
+        ))
+    });
+    let dir = output
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(".".as_ref());
+    let stem = output
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .ok_or_else(|| format!("{}: expected a file name ending in .ron", output.display()))?;
+    if output.extension().and_then(|e| e.to_str()) != Some("ron") {
+        return Err(format!(
+            "{}: expected a file name ending in .ron",
+            output.display()
+        ));
+    }
+    let path = generated.write(dir, stem).map_err(|e| e.to_string())?;
+    println!(
+        "{}, seed {seed} -> {} (+{} assets)",
+        describe(params),
+        path.display(),
+        generated.assets.len()
+    );
+    Ok(())
+}
+
+/// Writes every member of a family and the index `family.txt`.
+fn write_family(args: &FamilyArgs) -> Result<(), String> {
+    let issue = if args.issue == "di" {
+        Issue::Di
+    } else {
+        Issue::Pt
+    };
+    let split = if args.split == "train" {
+        Split::Train
+    } else {
+        Split::Test
+    };
+    let members: Vec<FamilyMember> = family(issue, split);
+    let mut index = format!(
+        "# The {} {} family: written by `restir generate family --issue {} --split {} --out DIR`.\n\
+         # Regenerate rather than edit. One line per scene: file, seed, kind and parameters.\n\
+         # Training seeds start at 1, test seeds at 101 (the splits never share a scene).\n",
+        issue.name(),
+        split.name(),
+        issue.name(),
+        split.name()
+    );
+    for member in &members {
+        let generated = member.generate().map_err(|e| e.to_string())?;
+        let path = generated
+            .write(&args.out, &member.name())
+            .map_err(|e| e.to_string())?;
+        let assets: Vec<&str> = generated
+            .assets
+            .iter()
+            .map(|a| a.filename.as_str())
+            .collect();
+        index.push_str(&format!(
+            "{}.ron\tseed {}\t{}{}\n",
+            member.name(),
+            member.seed,
+            describe(&member.params),
+            if assets.is_empty() {
+                String::new()
+            } else {
+                format!("\tassets: {}", assets.join(" "))
+            }
+        ));
+        println!("{}", path.display());
+    }
+    let path = args.out.join("family.txt");
+    std::fs::write(&path, index).map_err(|e| format!("{}: {e}", path.display()))?;
+    println!("{} scenes, index {}", members.len(), path.display());
+    Ok(())
+}
+
+/// Writes one many-light scene (`restir generate rects|spheres|meshes`).
+fn write_di(kind: Kind, args: DiArgs) -> Result<(), String> {
+    write_one(&di_params(kind, &args)?, args.seed, args.output)
+}
+
+/// Writes one glossy room (`restir generate room`).
+fn write_room(args: RoomArgs) -> Result<(), String> {
+    let glass = Glass::ALL
+        .into_iter()
+        .find(|g| g.name() == args.glass)
+        .ok_or_else(|| format!("--glass {}: expected none, smooth or rough", args.glass))?;
+    let params = Params::Room(RoomOptions {
+        glass,
+        window: args.window,
+    });
+    write_one(&params, args.seed, args.output)
 }

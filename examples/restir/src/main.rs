@@ -534,7 +534,12 @@ fn run_compare(test: &Path, reference: &Path, html: Option<&Path>) -> Result<(),
     }
     say!(
         "relmse={:.6e} mse={:.6e} mean_ratio={:.6} nonfinite={} mape={:.6e} flip={:.6}",
-        m.relmse, m.mse, m.mean_ratio, m.nonfinite, m.mape, m.flip
+        m.relmse,
+        m.mse,
+        m.mean_ratio,
+        m.nonfinite,
+        m.mape,
+        m.flip
     );
     Ok(())
 }

@@ -1,5 +1,4 @@
-//! Procedural scenes: [`SceneDesc`] values computed from a seed, for tests and benchmarks
-//! (`restir generate` writes them as RON files).
+//! The shipped many-lights scene (`scenes/many-lights.ron`).
 //!
 //! [`many_lights`] is the direct-lighting test scene for ReSTIR DI: a floor with diffuse boxes and
 //! pillars (for shadow edges), lit only by many small emissive spheres whose radiance is
@@ -13,6 +12,7 @@
 
 use restir_sampling::Pcg32;
 
+use super::util::{hue_colour, round, uniform};
 use crate::{
     CameraDesc, FilmDesc, FilterDesc, GeometryDesc, IntegratorDesc, MaterialDesc, MaterialRef,
     NamedMaterial, SceneDesc, ShapeDesc, TransformOp,
@@ -28,27 +28,6 @@ const HEIGHT: (f32, f32) = (0.2, 2.0);
 const TINT: f32 = 0.35;
 /// The dimmest radiance (luminance-ish scale) for the default 400 lights; the brightest is 1000×.
 const BASE_RADIANCE: f32 = 0.1;
-
-/// Rounds to `digits` decimals so that the file stays short and readable.
-fn round(x: f32, digits: i32) -> f32 {
-    let s = 10f32.powi(digits);
-    (x * s).round() / s
-}
-
-fn uniform(rng: &mut Pcg32, lo: f32, hi: f32) -> f32 {
-    lo + (hi - lo) * rng.next_f32()
-}
-
-/// A colour with maximum component 1 from a hue in `[0, 1)` and a saturation (0 is white).
-fn hue_colour(h: f32, s: f32) -> [f32; 3] {
-    let channel = |offset: f32| {
-        let x = (h + offset).fract() * 6.0;
-        let v = (x - 3.0).abs() - 1.0; // a triangle wave: 1 at x = 0 and 6, 0 on [2, 4]
-        v.clamp(0.0, 1.0)
-    };
-    let rgb = [channel(0.0), channel(2.0 / 3.0), channel(1.0 / 3.0)];
-    rgb.map(|c| 1.0 - s + s * c)
-}
 
 /// An axis-aligned footprint (x, z half sizes after rotation, conservatively) of an occluder.
 struct Footprint {

@@ -1,0 +1,250 @@
+//! The generated scene kinds of `restir_scene::generate` (the issue 14 and 15 families): every
+//! kind builds, renders a tiny image with the path tracer and its ReSTIR estimator without a
+//! non-finite pixel and not black, the same seed gives the same scene, the families' splits are
+//! disjoint and cover every kind and light count, and the 10⁵-light members build (the time is
+//! printed: `cargo test --release -p restir-integrators --test generated_scenes -- --nocapture`).
+
+mod common;
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use restir_scene::generate::{
+    AssetContents, DiOptions, Generated, Glass, Issue, Kind, Params, Receivers, RoomOptions, Split,
+    family, generate,
+};
+use restir_scene::{LoadOptions, Scene, load_scene};
+
+/// A fresh directory for one test's files.
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("restir-generated-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+/// Writes `generated` into a fresh directory and loads it at `width`×`height`.
+fn load(generated: &Generated, name: &str, width: u32, height: u32) -> (Scene, PathBuf) {
+    let dir = temp_dir(name);
+    let path = generated.write(&dir, name).unwrap();
+    let options = LoadOptions {
+        width: Some(width),
+        height: Some(height),
+        ..LoadOptions::default()
+    };
+    let scene = load_scene(&path, &options).unwrap().scene;
+    (scene, dir)
+}
+
+/// Emissive rectangles, spheres or triangles of a generated many-light scene: the emissive
+/// shapes, or for meshes the faces of their OBJ files.
+fn emissive_primitives(generated: &Generated) -> usize {
+    let objs: usize = generated
+        .assets
+        .iter()
+        .filter_map(|a| match &a.contents {
+            AssetContents::Text(text) if a.filename.ends_with(".obj") => {
+                Some(text.lines().filter(|l| l.starts_with("f ")).count())
+            }
+            _ => None,
+        })
+        .sum();
+    if objs > 0 {
+        objs
+    } else {
+        generated
+            .desc
+            .shapes
+            .iter()
+            .filter(|s| s.emission.is_some())
+            .count()
+    }
+}
+
+fn di(kind: Kind, lights: u32, receivers: Receivers, envmap: bool) -> Params {
+    Params::Di(
+        kind,
+        DiOptions {
+            lights,
+            receivers,
+            envmap,
+            ..DiOptions::default()
+        },
+    )
+}
+
+fn room(glass: Glass, window: bool) -> Params {
+    Params::Room(RoomOptions { glass, window })
+}
+
+#[test]
+fn every_kind_builds_and_renders_finite_and_lit() {
+    let cases = [
+        (
+            "rects",
+            di(Kind::Rects, 300, Receivers::Mixed, true),
+            "restir-di",
+        ),
+        (
+            "spheres",
+            di(Kind::Spheres, 300, Receivers::Glossy, false),
+            "restir-di",
+        ),
+        (
+            "meshes",
+            di(Kind::Meshes, 2000, Receivers::Textured, true),
+            "restir-di",
+        ),
+        ("room", room(Glass::None, false), "restir-pt"),
+        ("room-smooth-window", room(Glass::Smooth, true), "restir-pt"),
+        ("room-rough", room(Glass::Rough, false), "restir-pt"),
+    ];
+    for (name, params, restir) in cases {
+        for seed in [1, 2] {
+            let generated = generate(&params, seed).unwrap();
+            let (scene, dir) = load(&generated, &format!("{name}-{seed}"), 32, 24);
+            if let Params::Di(_, options) = &params {
+                assert_eq!(
+                    emissive_primitives(&generated),
+                    options.lights as usize,
+                    "{name}"
+                );
+                // The light set has an entry per emissive shape, plus the environment.
+                let shapes = generated
+                    .desc
+                    .shapes
+                    .iter()
+                    .filter(|s| s.emission.is_some())
+                    .count();
+                let expected = shapes + usize::from(options.envmap);
+                assert_eq!(scene.features.light_count, expected, "{name} seed {seed}");
+                assert_eq!(scene.integrator.max_depth, 2, "{name}: direct light only");
+            } else {
+                assert_eq!(scene.integrator.max_depth, 8, "{name}");
+            }
+            for estimator in ["path", restir] {
+                let image = common::render_image(&scene, estimator, &[], 4, 7);
+                let mean = image.mean();
+                assert!(
+                    mean.max_element() > 1e-3,
+                    "{name} seed {seed} {estimator}: black image (mean {mean})"
+                );
+            }
+            let _ = std::fs::remove_dir_all(dir);
+        }
+    }
+}
+
+#[test]
+fn same_seed_same_scene_other_seed_other_scene() {
+    for params in [
+        di(Kind::Rects, 50, Receivers::Mixed, true),
+        di(Kind::Spheres, 50, Receivers::Diffuse, false),
+        di(Kind::Meshes, 500, Receivers::Glossy, false),
+        room(Glass::Rough, true),
+    ] {
+        let a = generate(&params, 5).unwrap();
+        assert_eq!(a, generate(&params, 5).unwrap(), "{params:?}");
+        assert_eq!(
+            a.ron().unwrap(),
+            generate(&params, 5).unwrap().ron().unwrap()
+        );
+        assert_ne!(a.desc, generate(&params, 6).unwrap().desc, "{params:?}");
+        // The RON text reads back as the same description.
+        let back = restir_scene::parse_ron(&a.ron().unwrap(), "gen.ron".as_ref()).unwrap();
+        assert_eq!(back, a.desc, "{params:?}");
+    }
+}
+
+#[test]
+fn families_are_disjoint_and_cover_every_kind_and_light_count() {
+    for issue in [Issue::Di, Issue::Pt] {
+        let train = family(issue, Split::Train);
+        let test = family(issue, Split::Test);
+        assert!(
+            (8..=12).contains(&train.len()),
+            "{issue:?}: {} members",
+            train.len()
+        );
+        assert_eq!(train.len(), test.len());
+        for t in &train {
+            assert!(
+                test.iter().all(|s| s.seed != t.seed),
+                "{issue:?}: seed {} shared",
+                t.seed
+            );
+        }
+        let mut names: Vec<String> = train.iter().chain(&test).map(|m| m.name()).collect();
+        names.sort();
+        names.dedup();
+        assert_eq!(
+            names.len(),
+            2 * train.len(),
+            "{issue:?}: member names collide"
+        );
+    }
+    let di = family(Issue::Di, Split::Test);
+    for kind in [Kind::Rects, Kind::Spheres, Kind::Meshes] {
+        for lights in [1_000, 10_000, 100_000] {
+            assert!(
+                di.iter().any(
+                    |m| matches!(&m.params, Params::Di(k, o) if *k == kind && o.lights == lights)
+                ),
+                "no {kind:?} member with {lights} lights"
+            );
+        }
+    }
+    for receivers in Receivers::ALL {
+        assert!(
+            di.iter()
+                .any(|m| matches!(&m.params, Params::Di(_, o) if o.receivers == receivers))
+        );
+    }
+    assert!(
+        di.iter()
+            .any(|m| matches!(&m.params, Params::Di(_, o) if o.envmap))
+    );
+    assert!(
+        di.iter().all(
+            |m| matches!(&m.params, Params::Di(_, o) if o.occluders && o.power_ratio == 1000.0)
+        )
+    );
+    let pt = family(Issue::Pt, Split::Test);
+    for glass in Glass::ALL {
+        for window in [false, true] {
+            assert!(
+                pt.iter().any(|m| m.params == room(glass, window)),
+                "{glass:?} window {window}"
+            );
+        }
+    }
+}
+
+#[test]
+fn hundred_thousand_light_members_build() {
+    for member in family(Issue::Di, Split::Test)
+        .into_iter()
+        .filter(|m| matches!(&m.params, Params::Di(_, o) if o.lights == 100_000))
+    {
+        let start = Instant::now();
+        let generated = member.generate().unwrap();
+        let made = start.elapsed();
+        let start = Instant::now();
+        let (scene, dir) = load(&generated, &member.name(), 32, 24);
+        let loaded = start.elapsed();
+        eprintln!(
+            "{}: generated in {:.2} s, written, parsed and built in {:.2} s, {} light-set entries",
+            member.name(),
+            made.as_secs_f64(),
+            loaded.as_secs_f64(),
+            scene.features.light_count
+        );
+        assert_eq!(
+            emissive_primitives(&generated),
+            100_000,
+            "{}",
+            member.name()
+        );
+        assert!(scene.features.light_count >= 8, "{}", member.name());
+        let _ = std::fs::remove_dir_all(dir);
+    }
+}

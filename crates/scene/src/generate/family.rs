@@ -1,0 +1,160 @@
+//! The scene families of the equal-time studies: for each issue a fixed list of kinds and
+//! parameters, and for each split its own seeds (training `1..`, test `101..`), so a family is a
+//! list of seeds and the two splits never share a scene. Defaults are chosen on the training
+//! family and gains reported on the test family.
+//!
+//! - [`Issue::Di`] (ReSTIR DI, direct light only): rectangles, spheres and emissive meshes at
+//!   10³, 10⁴ and 10⁵ lights, radiances spread over 1000×, occluders between lights and receivers,
+//!   diffuse, checkerboard, glossy and mixed receivers, four members with a sky beside the lights.
+//! - [`Issue::Pt`] (ReSTIR PT): glossy rooms without glass, with smooth and with rough glass,
+//!   each with and without a window to a sky.
+
+use super::{DiOptions, GenerateError, Generated, Glass, Kind, Params, Receivers, RoomOptions};
+
+/// Which study a family serves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Issue {
+    /// ReSTIR DI against the path tracer at max depth 2.
+    Di,
+    /// ReSTIR PT against the path tracer in glossy rooms.
+    Pt,
+}
+
+impl Issue {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Issue::Di => "di",
+            Issue::Pt => "pt",
+        }
+    }
+}
+
+/// Training (to choose defaults) or test (to report on).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Split {
+    /// Seeds `1..`.
+    Train,
+    /// Seeds `101..`.
+    Test,
+}
+
+impl Split {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Split::Train => "train",
+            Split::Test => "test",
+        }
+    }
+
+    /// The first seed; member `i` has seed `first_seed + i`.
+    pub fn first_seed(self) -> u64 {
+        match self {
+            Split::Train => 1,
+            Split::Test => 101,
+        }
+    }
+}
+
+/// One scene of a family.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FamilyMember {
+    /// The study.
+    pub issue: Issue,
+    /// The split.
+    pub split: Split,
+    /// Position in the family (the same parameters in both splits).
+    pub index: usize,
+    /// Kind and options.
+    pub params: Params,
+    /// The seed.
+    pub seed: u64,
+}
+
+impl FamilyMember {
+    /// The file stem: `di-test-03-spheres-n1000-glossy-occ-env-s104`.
+    pub fn name(&self) -> String {
+        let tag = match &self.params {
+            Params::Di(_, options) => options.tag(),
+            Params::Room(options) => options.tag(),
+        };
+        format!(
+            "{}-{}-{:02}-{}-{tag}-s{}",
+            self.issue.name(),
+            self.split.name(),
+            self.index,
+            self.params.kind().name(),
+            self.seed
+        )
+    }
+
+    /// The scene.
+    pub fn generate(&self) -> Result<Generated, GenerateError> {
+        super::generate(&self.params, self.seed)
+    }
+}
+
+/// The DI family's parameters: every kind at every light count, every receiver choice, sky in four.
+fn di_params() -> Vec<Params> {
+    let di = |kind, lights, receivers, envmap| {
+        Params::Di(
+            kind,
+            DiOptions {
+                lights,
+                power_ratio: 1000.0,
+                receivers,
+                occluders: true,
+                envmap,
+            },
+        )
+    };
+    use Kind::{Meshes, Rects, Spheres};
+    use Receivers::{Diffuse, Glossy, Mixed, Textured};
+    vec![
+        di(Rects, 1_000, Diffuse, false),
+        di(Rects, 10_000, Textured, false),
+        di(Rects, 100_000, Glossy, false),
+        di(Spheres, 1_000, Glossy, true),
+        di(Spheres, 10_000, Mixed, false),
+        di(Spheres, 100_000, Textured, false),
+        di(Meshes, 1_000, Textured, true),
+        di(Meshes, 10_000, Glossy, true),
+        di(Meshes, 100_000, Mixed, false),
+        di(Rects, 1_000, Mixed, true),
+    ]
+}
+
+/// The PT family's parameters: each glass choice with and without a window, two more plain ones.
+fn pt_params() -> Vec<Params> {
+    let room = |glass, window| Params::Room(RoomOptions { glass, window });
+    vec![
+        room(Glass::None, false),
+        room(Glass::None, true),
+        room(Glass::Smooth, false),
+        room(Glass::Smooth, true),
+        room(Glass::Rough, false),
+        room(Glass::Rough, true),
+        room(Glass::None, false),
+        room(Glass::Rough, true),
+    ]
+}
+
+/// The family of `issue` for `split`.
+pub fn family(issue: Issue, split: Split) -> Vec<FamilyMember> {
+    let params = match issue {
+        Issue::Di => di_params(),
+        Issue::Pt => pt_params(),
+    };
+    params
+        .into_iter()
+        .enumerate()
+        .map(|(index, params)| FamilyMember {
+            issue,
+            split,
+            index,
+            params,
+            seed: split.first_seed() + index as u64,
+        })
+        .collect()
+}

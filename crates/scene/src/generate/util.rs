@@ -1,0 +1,177 @@
+//! Helpers every generator shares: rounding for short files, uniform and log-uniform draws, light
+//! tints, shape and material constructors, and RON serialisation.
+
+use restir_sampling::Pcg32;
+
+use crate::{
+    GeometryDesc, MaterialDesc, MaterialRef, MicrofacetDesc, RoughnessDesc, SceneDesc, ShapeDesc,
+    TransformOp, V3,
+};
+
+/// Rounds to `digits` decimals so that the file stays short and readable.
+pub(super) fn round(x: f32, digits: i32) -> f32 {
+    let s = 10f32.powi(digits);
+    (x * s).round() / s
+}
+
+/// Rounds every component of a vector.
+pub(super) fn round3(v: V3, digits: i32) -> V3 {
+    v.map(|x| round(x, digits))
+}
+
+/// Uniform in `[lo, hi)`.
+pub(super) fn uniform(rng: &mut Pcg32, lo: f32, hi: f32) -> f32 {
+    lo + (hi - lo) * rng.next_f32()
+}
+
+/// Log-uniform in `[1, ratio)`: the power spread of the many-light scenes.
+pub(super) fn log_uniform(rng: &mut Pcg32, ratio: f32) -> f32 {
+    ratio.powf(rng.next_f32())
+}
+
+/// A colour with maximum component 1 from a hue in `[0, 1)` and a saturation (0 is white).
+pub(super) fn hue_colour(h: f32, s: f32) -> [f32; 3] {
+    let channel = |offset: f32| {
+        let x = (h + offset).fract() * 6.0;
+        let v = (x - 3.0).abs() - 1.0; // a triangle wave: 1 at x = 0 and 6, 0 on [2, 4]
+        v.clamp(0.0, 1.0)
+    };
+    let rgb = [channel(0.0), channel(2.0 / 3.0), channel(1.0 / 3.0)];
+    rgb.map(|c| 1.0 - s + s * c)
+}
+
+/// A shape with a material and a transform, not emitting.
+pub(super) fn shape(
+    geometry: GeometryDesc,
+    to_world: Vec<TransformOp>,
+    material: MaterialRef,
+) -> ShapeDesc {
+    ShapeDesc {
+        geometry,
+        to_world,
+        material: Some(material),
+        emission: None,
+        flip_normals: false,
+        face_normals: false,
+        location: Default::default(),
+    }
+}
+
+/// An emitter without a material (black apart from its emission).
+pub(super) fn emitter(
+    geometry: GeometryDesc,
+    to_world: Vec<TransformOp>,
+    radiance: V3,
+) -> ShapeDesc {
+    ShapeDesc {
+        geometry,
+        to_world,
+        material: None,
+        emission: Some(radiance),
+        flip_normals: false,
+        face_normals: false,
+        location: Default::default(),
+    }
+}
+
+/// A reference to a named material.
+pub(super) fn named(name: &str) -> MaterialRef {
+    MaterialRef::Ref(name.into())
+}
+
+/// A rectangle `[-sx, sx] × [-sy, sy]` rotated about `axis` by `angle` degrees, then moved to `at`.
+pub(super) fn rect_transform(sx: f32, sy: f32, axis: V3, angle: f32, at: V3) -> Vec<TransformOp> {
+    vec![
+        TransformOp::Scale([sx, sy, 1.0]),
+        TransformOp::Rotate { axis, angle },
+        TransformOp::Translate(at),
+    ]
+}
+
+/// Roughness with one α.
+pub(super) fn roughness(distribution: MicrofacetDesc, alpha: f32) -> RoughnessDesc {
+    RoughnessDesc {
+        distribution,
+        alpha,
+        alpha_u: None,
+        alpha_v: None,
+    }
+}
+
+/// Beckmann or GGX, one each with probability ½.
+pub(super) fn distribution(rng: &mut Pcg32) -> MicrofacetDesc {
+    if rng.next_bounded(2) == 0 {
+        MicrofacetDesc::Beckmann
+    } else {
+        MicrofacetDesc::Ggx
+    }
+}
+
+/// A rough conductor of a named metal.
+pub(super) fn rough_conductor(
+    metal: &str,
+    distribution: MicrofacetDesc,
+    alpha: f32,
+) -> MaterialDesc {
+    MaterialDesc::RoughConductor {
+        ior: crate::ConductorIorDesc {
+            material: Some(metal.into()),
+            eta: None,
+            k: None,
+        },
+        specular_reflectance: [1.0; 3],
+        roughness: roughness(distribution, alpha),
+    }
+}
+
+/// A rough plastic (polypropylene coat) over a diffuse base.
+pub(super) fn rough_plastic(diffuse: V3, distribution: MicrofacetDesc, alpha: f32) -> MaterialDesc {
+    MaterialDesc::RoughPlastic {
+        int_ior: crate::POLYPROPYLENE_IOR,
+        ext_ior: crate::AIR_IOR,
+        diffuse_reflectance: diffuse,
+        specular_reflectance: [1.0; 3],
+        nonlinear: false,
+        roughness: roughness(distribution, alpha),
+    }
+}
+
+/// A diffuse material with a checkerboard bound to its reflectance, `tiles` squares per unit uv.
+pub(super) fn checkerboard(color0: V3, color1: V3, tiles: f32) -> MaterialDesc {
+    MaterialDesc::Textured {
+        material: Box::new(MaterialDesc::Diffuse {
+            reflectance: color0,
+        }),
+        textures: vec![crate::TextureBinding {
+            param: crate::ColorParam::Reflectance,
+            texture: crate::TextureDesc::Checkerboard {
+                color0,
+                color1,
+                uv: crate::UvTransform {
+                    scale: glam::Vec2::splat(tiles),
+                    offset: glam::Vec2::ZERO,
+                },
+            },
+        }],
+    }
+}
+
+/// The metals the glossy materials draw from (named IORs of `restir_materials::ior`).
+pub(super) const METALS: [&str; 4] = ["Au", "Cu", "Al", "Ag"];
+
+/// A scene description as pretty RON (one shape per line) after a header of `//` comments.
+pub(super) fn to_ron(desc: &SceneDesc, header: &str) -> Result<String, ron::Error> {
+    let config = ron::ser::PrettyConfig::new()
+        .depth_limit(2)
+        .struct_names(false);
+    let body = ron::ser::to_string_pretty(desc, config)?;
+    let mut text = String::new();
+    for line in header.lines() {
+        text.push_str("// ");
+        text.push_str(line);
+        text.push('\n');
+    }
+    text.push_str(&body);
+    text.push('\n');
+    Ok(text)
+}
