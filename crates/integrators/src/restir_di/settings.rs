@@ -39,7 +39,8 @@ pub struct RestirDiSettings {
     pub path: PathSettings,
     /// Spatial and temporal reuse.
     pub reuse: ReuseSettings,
-    /// Light candidates per pixel in initial resampling, `N_L` (default 32).
+    /// Light candidates per pixel in initial resampling, `N_L` (default 8, chosen by an
+    /// equal-CPU-time sweep on a training family of generated scenes; `docs/BENCHMARKS.md`).
     pub candidates: u32,
     /// Where candidates' lights come from (default the power sampler).
     pub light_sampler: LightSampler,
@@ -51,12 +52,13 @@ pub struct RestirDiSettings {
 }
 
 impl RestirDiSettings {
-    /// The defaults (Bitterli et al. 2020's unbiased configuration; `docs/RESTIR_DI.md`).
+    /// The defaults (Bitterli et al. 2020's unbiased configuration with 8 candidates instead of
+    /// the paper's 32, which cost more than they gain on a CPU; `docs/RESTIR_DI.md`).
     pub fn new(path: PathSettings) -> Self {
         Self {
             path,
             reuse: ReuseSettings::default(),
-            candidates: 32,
+            candidates: 8,
             light_sampler: LightSampler::Power,
             bsdf_candidates: 1,
             visibility_reuse: false,
