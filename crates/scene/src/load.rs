@@ -112,7 +112,8 @@ pub fn load_scene(path: &Path, options: &LoadOptions) -> Result<LoadedScene, Sce
         desc.integrator.location.file = path.to_path_buf();
     }
     let base: PathBuf = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let scene = Scene::build(&desc, &base, path)?;
+    let (scene, noted) = Scene::build_noting(&desc, &base, path)?;
+    warnings.extend(noted);
     if options.warn_no_lights && scene.lights.is_empty() {
         warnings.push(SceneWarning {
             location: Location {
