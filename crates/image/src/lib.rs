@@ -22,6 +22,7 @@
 //! ```
 
 mod error;
+pub mod input;
 mod io;
 mod metrics;
 pub mod srgb;

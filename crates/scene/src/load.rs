@@ -74,8 +74,10 @@ pub fn load_desc(
             msg,
         )
     };
-    let text =
-        std::fs::read_to_string(path).map_err(|e| whole(format!("cannot read scene: {e}")))?;
+    let bytes = restir_image::input::read_regular(path)
+        .map_err(|e| whole(format!("cannot read scene: {e}")))?;
+    let text = String::from_utf8(bytes)
+        .map_err(|_| whole("cannot read scene: stream did not contain valid UTF-8".into()))?;
     match path
         .extension()
         .and_then(|e| e.to_str())
