@@ -103,7 +103,7 @@ fn extent_problem(shape: &Shape) -> Option<String> {
         ),
         Shape::Sphere(s) => ("the sphere", s.center.abs().max_element() + s.radius),
     };
-    (!(v <= limits::MAX_COORDINATE)).then(|| {
+    (v.is_nan() || v > limits::MAX_COORDINATE).then(|| {
         format!(
             "{what} reaches {v:e} in world space, beyond the coordinate limit ±{:e}",
             limits::MAX_COORDINATE
