@@ -34,6 +34,11 @@ pub enum MeshError {
     },
     /// The mesh has no triangles.
     Empty,
+    /// Every triangle of the mesh has zero area (see [`TriangleMesh::drop_degenerate`]).
+    AllDegenerate {
+        /// How many triangles there were.
+        count: usize,
+    },
 }
 
 impl core::fmt::Display for MeshError {
@@ -59,6 +64,10 @@ impl core::fmt::Display for MeshError {
                 "the mesh has {count} {attribute} for {vertex_count} vertices"
             ),
             MeshError::Empty => write!(f, "the mesh has no triangles"),
+            MeshError::AllDegenerate { count } => write!(
+                f,
+                "all {count} triangles of the mesh have zero area (collinear or coincident corners)"
+            ),
         }
     }
 }
@@ -183,6 +192,27 @@ impl TriangleMesh {
             }
         }
         self.update_areas();
+    }
+
+    /// Removes the triangles of zero area (collinear or coincident corners: they can never be
+    /// sampled and are hit only through rounding), returning how many there were. Called on
+    /// world-space meshes, after [`TriangleMesh::transform`]; a mesh with nothing else is an error.
+    /// Nothing changes, not even the area table, when every triangle has an area.
+    pub fn drop_degenerate(&mut self) -> Result<usize, MeshError> {
+        let keep: Vec<bool> = (0..self.indices.len())
+            .map(|i| self.triangle_area(i) > 0.0)
+            .collect();
+        let dropped = keep.iter().filter(|&&k| !k).count();
+        if dropped == 0 {
+            return Ok(0);
+        }
+        if dropped == self.indices.len() {
+            return Err(MeshError::AllDegenerate { count: dropped });
+        }
+        let mut k = keep.iter();
+        self.indices.retain(|_| *k.next().unwrap_or(&true));
+        self.update_areas();
+        Ok(dropped)
     }
 
     /// Vertex positions.

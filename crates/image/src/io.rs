@@ -5,7 +5,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use crate::{Image, ImageError, ReadFailure, srgb};
+use crate::{Image, ImageError, ReadFailure, input, srgb};
 
 /// How [`Image::read`] interprets the integer (8- or 16-bit) channels of PNG and JPEG files.
 /// Float formats (EXR, Radiance HDR) hold linear values and are never decoded.
@@ -27,16 +27,34 @@ fn extension(path: &Path) -> Option<String> {
 }
 
 /// Decodes the first RGB(A) layer of an EXR file (alpha is ignored): `(width, height, pixels)`.
+/// Only a regular file is opened, and every layer's size is checked against
+/// [`input::MAX_IMAGE_PIXELS`] from the header before the pixels are allocated.
 fn read_exr_pixels(path: &Path) -> Result<(usize, usize, Vec<Vec3>), exr::error::Error> {
-    let img = exr::prelude::read_first_rgba_layer_from_file(
-        path,
-        |res, _| (res.width(), vec![Vec3::ZERO; res.width() * res.height()]),
-        |(w, px): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            if let Some(t) = px.get_mut(pos.y() * *w + pos.x()) {
-                *t = Vec3::new(r, g, b);
-            }
-        },
-    )?;
+    use exr::prelude::*;
+    use std::io::Seek;
+    let mut file = std::io::BufReader::new(input::open_regular(path)?);
+    let meta = MetaData::read_from_buffered(&mut file, false)?;
+    for header in meta.headers.iter() {
+        let size = header.layer_size;
+        if let Some(problem) = input::size_problem(size.width(), size.height()) {
+            return Err(exr::error::Error::Invalid(problem.into()));
+        }
+    }
+    file.rewind()?;
+    let img = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |res, _| (res.width(), vec![Vec3::ZERO; res.width() * res.height()]),
+            |(w, px): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                if let Some(t) = px.get_mut(pos.y() * *w + pos.x()) {
+                    *t = Vec3::new(r, g, b);
+                }
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(file)?;
     let size = img.layer_data.size;
     Ok((
         size.width(),
@@ -142,12 +160,20 @@ impl Image {
         let (w, h, texels) = if extension(path).as_deref() == Some("exr") {
             read_exr_pixels(path).map_err(|e| fail(ReadFailure::Exr(e)))?
         } else {
-            let img = image::ImageReader::open(path)
-                .map_err(|e| fail(ReadFailure::Io(e)))?
+            let file = input::open_regular(path).map_err(|e| fail(ReadFailure::Io(e)))?;
+            let mut limits = image::Limits::default();
+            limits.max_image_width = Some(input::MAX_IMAGE_SIDE as u32);
+            limits.max_image_height = Some(input::MAX_IMAGE_SIDE as u32);
+            // As `ImageReader::open`: the format from the extension unless the contents say.
+            let mut reader = image::ImageReader::new(std::io::BufReader::new(file));
+            if let Ok(format) = image::ImageFormat::from_path(path) {
+                reader.set_format(format);
+            }
+            let mut reader = reader
                 .with_guessed_format()
-                .map_err(|e| fail(ReadFailure::Io(e)))?
-                .decode()
-                .map_err(|e| fail(ReadFailure::Decode(e)))?;
+                .map_err(|e| fail(ReadFailure::Io(e)))?;
+            reader.limits(limits);
+            let img = reader.decode().map_err(|e| fail(ReadFailure::Decode(e)))?;
             let (w, h) = (img.width() as usize, img.height() as usize);
             // Float formats (Radiance HDR) hold linear values already.
             let linear = encoding == IntegerEncoding::Raw
@@ -228,6 +254,30 @@ mod tests {
                 .max_element()
                 < 0.01
         );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// An EXR whose header claims 65536×65536 pixels (a few hundred bytes on disk) is refused
+    /// from the header, by both readers, instead of allocating 51 GB.
+    #[test]
+    fn a_lying_exr_header_is_refused_before_allocating() {
+        let dir = temp_dir("huge");
+        let path = dir.join("huge.exr");
+        Image::new(1, 1).write(&path).unwrap();
+        let mut bytes = std::fs::read(&path).unwrap();
+        let tag = b"dataWindow\0box2i\0";
+        let at = bytes.windows(tag.len()).position(|w| w == tag).unwrap() + tag.len() + 4;
+        for (i, v) in [0i32, 0, 65535, 65535].into_iter().enumerate() {
+            bytes[at + 4 * i..at + 4 * i + 4].copy_from_slice(&v.to_le_bytes());
+        }
+        std::fs::write(&path, &bytes).unwrap();
+        let want = "the image is 65536×65536 pixels, beyond the limit";
+        let e = Image::read_exr(&path).unwrap_err().to_string();
+        assert!(e.contains(want), "{e}");
+        let e = Image::read(&path, IntegerEncoding::Srgb)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(want), "{e}");
         std::fs::remove_dir_all(&dir).ok();
     }
 

@@ -26,6 +26,7 @@
 //! ```
 
 mod error;
+pub mod input;
 mod io;
 mod metrics;
 mod output;

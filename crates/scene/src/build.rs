@@ -12,7 +12,7 @@ use crate::desc::*;
 use crate::material::v3;
 use crate::texture::Texture;
 use crate::transform_matrix;
-use crate::{Scene, SceneError, SceneFeatures, TexturedParams};
+use crate::{Scene, SceneError, SceneFeatures, SceneWarning, TexturedParams};
 
 fn affine(m: Mat4) -> Result<Affine3A, String> {
     let row3 = m.row(3);
@@ -91,10 +91,33 @@ fn build_envmap(
     EnvMap::new(w, h, texels, scale, glam::Mat3::from_mat4(m)).map_err(|e| e.to_string())
 }
 
-fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<Shape, String> {
+/// Why a world-space shape lies beyond [`limits::MAX_COORDINATE`], or `None`.
+fn extent_problem(shape: &Shape) -> Option<String> {
+    let (what, v) = match shape {
+        Shape::Mesh(m) => (
+            "a vertex",
+            m.positions()
+                .iter()
+                .map(|p| p.abs().max_element())
+                .fold(0.0, f32::max),
+        ),
+        Shape::Sphere(s) => ("the sphere", s.center.abs().max_element() + s.radius),
+    };
+    (v.is_nan() || v > limits::MAX_COORDINATE).then(|| {
+        format!(
+            "{what} reaches {v:e} in world space, beyond the coordinate limit ±{:e}",
+            limits::MAX_COORDINATE
+        )
+    })
+}
+
+/// A shape in world space and how many zero-area triangles were dropped from it.
+fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<(Shape, usize), String> {
     let m = transform_matrix(&desc.to_world).map_err(|e| e.to_string())?;
+    let dropped = std::cell::Cell::new(0);
     let mesh = |mut mesh: TriangleMesh| -> Result<Shape, String> {
         mesh.transform(&affine(m)?);
+        dropped.set(mesh.drop_degenerate().map_err(|e| e.to_string())?);
         Ok(Shape::Mesh(mesh))
     };
     let mut shape = match &desc.geometry {
@@ -193,13 +216,26 @@ fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<Shape, String> {
         )
         .map_err(|e| e.to_string())?;
     }
-    Ok(shape)
+    if let Some(problem) = extent_problem(&shape) {
+        return Err(problem);
+    }
+    Ok((shape, dropped.get()))
 }
 
 impl Scene {
     /// Builds the runtime scene. `base_dir` resolves relative mesh paths; `source` names the scene
     /// file in errors.
     pub fn build(desc: &SceneDesc, base_dir: &Path, source: &Path) -> Result<Scene, SceneError> {
+        Self::build_noting(desc, base_dir, source).map(|(scene, _)| scene)
+    }
+
+    /// [`Scene::build`], also returning what the builder noticed (zero-area triangles dropped).
+    pub fn build_noting(
+        desc: &SceneDesc,
+        base_dir: &Path,
+        source: &Path,
+    ) -> Result<(Scene, Vec<SceneWarning>), SceneError> {
+        let mut warnings = Vec::new();
         let at = |loc: &Location, msg: String| {
             let location = if loc.file.as_os_str().is_empty() {
                 Location {
@@ -240,9 +276,17 @@ impl Scene {
         .map_err(|e| whole(format!("camera: {e}")))?;
         match desc.film.filter {
             FilterDesc::Box => {}
-            FilterDesc::Tent { radius } if radius.is_finite() && radius > 0.0 => {}
-            FilterDesc::Gaussian { stddev } if stddev.is_finite() && stddev > 0.0 => {}
-            f => return Err(whole(format!("filter {f:?} needs a positive width"))),
+            FilterDesc::Tent { radius: w } | FilterDesc::Gaussian { stddev: w } => {
+                if w.is_nan() || w <= 0.0 {
+                    return Err(whole(format!(
+                        "filter {:?} needs a positive width",
+                        desc.film.filter
+                    )));
+                }
+                if let Some(p) = limits::filter_width_problem(w) {
+                    return Err(whole(format!("filter {:?}: width {p}", desc.film.filter)));
+                }
+            }
         }
         if desc.integrator.max_depth < -1 {
             return Err(whole(format!(
@@ -275,8 +319,18 @@ impl Scene {
         let mut shape_bsdf = Vec::with_capacity(desc.shapes.len());
         let mut lights = Vec::new();
         for (i, sd) in desc.shapes.iter().enumerate() {
-            let shape = build_shape(sd, base_dir)
+            let (shape, dropped) = build_shape(sd, base_dir)
                 .map_err(|e| at(&sd.location, format!("shape {i}: {e}")))?;
+            if dropped > 0 {
+                let location = at(&sd.location, String::new()).location;
+                warnings.push(SceneWarning {
+                    location,
+                    message: format!(
+                        "shape {i}: {dropped} zero-area triangle{} dropped",
+                        if dropped == 1 { "" } else { "s" }
+                    ),
+                });
+            }
             let bsdf = match &sd.material {
                 Some(MaterialRef::Ref(name)) => *names.get(name).ok_or_else(|| {
                     at(
@@ -391,6 +445,6 @@ impl Scene {
             features,
         };
         scene.features.environment_share = scene.decide_environment_share();
-        Ok(scene)
+        Ok((scene, warnings))
     }
 }

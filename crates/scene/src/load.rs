@@ -74,8 +74,10 @@ pub fn load_desc(
             msg,
         )
     };
-    let text =
-        std::fs::read_to_string(path).map_err(|e| whole(format!("cannot read scene: {e}")))?;
+    let bytes = restir_image::input::read_regular(path)
+        .map_err(|e| whole(format!("cannot read scene: {e}")))?;
+    let text = String::from_utf8(bytes)
+        .map_err(|_| whole("cannot read scene: stream did not contain valid UTF-8".into()))?;
     match path
         .extension()
         .and_then(|e| e.to_str())
@@ -112,7 +114,8 @@ pub fn load_scene(path: &Path, options: &LoadOptions) -> Result<LoadedScene, Sce
         desc.integrator.location.file = path.to_path_buf();
     }
     let base: PathBuf = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let scene = Scene::build(&desc, &base, path)?;
+    let (scene, noted) = Scene::build_noting(&desc, &base, path)?;
+    warnings.extend(noted);
     if options.warn_no_lights && scene.lights.is_empty() {
         warnings.push(SceneWarning {
             location: Location {

@@ -203,7 +203,7 @@ fn nan_in_a_parameter() {
         &["render", s(&scene), "-o", s(&out)],
         &[&format!("{}:{line}:", s(&scene)), "nan", "finite"],
     );
-    // And a NaN in a RON scene, caught when the scene is built.
+    // And a NaN in a RON scene, caught while deserialising, at its line.
     let scene = write(
         &dir,
         "nan.ron",
@@ -211,7 +211,7 @@ fn nan_in_a_parameter() {
     );
     fails(
         &["render", s(&scene), "-o", s(&out)],
-        &[s(&scene), "radius NaN"],
+        &[&format!("{}:1:", s(&scene)), "NaN is not a finite number"],
     );
 }
 

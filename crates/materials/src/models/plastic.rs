@@ -63,14 +63,51 @@ fn specular_weight(diffuse: Vec3, specular: Vec3) -> f32 {
 
 /// A plastic's `ρ' / η²`: the base reflectance `ρd` after the internal-reflection series
 /// (`ρd / (1 − R_int)`, or `ρd / (1 − ρd R_int)` if `nonlinear`) times the radiance scale `1/η²`.
+///
+/// With `r_int` `None` (or outside `[0, 1)`), `R_int` is the value reciprocity gives,
+/// `1 − (1 − R_ext(η))/η²`, used in `f64` in the form `(1 − R_int) η² = 1 − R_ext(η)` so that the
+/// result stays finite for any legal `η` (it rounds to 1 in `f32` for large `η`). The result is
+/// never negative.
 #[inline]
-fn plastic_diffuse_scaled(eta: f32, diffuse: Vec3, r_int: f32, nonlinear: bool) -> Vec3 {
-    let rho = if nonlinear {
-        diffuse / (Vec3::ONE - diffuse * r_int)
-    } else {
-        diffuse / (1.0 - r_int)
+fn plastic_diffuse_scaled(eta: f32, diffuse: Vec3, r_int: Option<f32>, nonlinear: bool) -> Vec3 {
+    if let Some(r_int) = r_int.filter(|r| (0.0..1.0).contains(r)) {
+        let rho = if nonlinear {
+            diffuse / (Vec3::ONE - diffuse * r_int)
+        } else {
+            diffuse / (1.0 - r_int)
+        };
+        return (rho / (eta * eta)).max(Vec3::ZERO);
+    }
+    let eta2 = f64::from(eta) * f64::from(eta);
+    // (1 − R_int) η², from reciprocity.
+    let t_scaled = (1.0 - f64::from(fresnel_diffuse_reflectance(eta).clamp(0.0, 1.0))).max(1e-30);
+    let channel = |rho: f32| {
+        let rho = f64::from(rho);
+        // ρ / ((1 − ρ R_int) η²) with 1 − ρ R_int = (1 − ρ) + ρ (1 − R_int).
+        let denom = if nonlinear {
+            (1.0 - rho) * eta2 + rho * t_scaled
+        } else {
+            t_scaled
+        };
+        let v = rho / denom;
+        if v.is_finite() {
+            v.max(0.0) as f32
+        } else {
+            0.0
+        }
     };
-    rho / (eta * eta)
+    Vec3::new(channel(diffuse.x), channel(diffuse.y), channel(diffuse.z))
+}
+
+/// The smooth plastic's internal diffuse reflectance: Mitsuba's fit `R_ext(1/η)`, unless it
+/// strays more than 5 % from reciprocity in `(1 − R_int) η²` (it does above `η` ≈ 2.5, and
+/// exceeds 1 above 3.9, which made the diffuse part negative); then `None`, reciprocity's value.
+fn smooth_internal_reflectance(eta: f32) -> Option<f32> {
+    let fit = fresnel_diffuse_reflectance(1.0 / eta);
+    let eta2 = f64::from(eta) * f64::from(eta);
+    let from_fit = (1.0 - f64::from(fit)) * eta2;
+    let from_reciprocity = 1.0 - f64::from(fresnel_diffuse_reflectance(eta));
+    ((from_fit - from_reciprocity).abs() <= 0.05 * from_reciprocity.abs()).then_some(fit)
 }
 
 /// Normalised lobe probabilities `(a, b) / (a + b)` (`(1, 0)` when both vanish).
@@ -84,7 +121,7 @@ impl Plastic {
     /// Mitsuba's precomputation for coating IOR `eta`, base `diffuse` and specular multiplier
     /// `specular` (the internal reflectance is the fitted diffuse Fresnel reflectance).
     pub(crate) fn new(eta: f32, diffuse: Vec3, specular: Vec3, nonlinear: bool) -> Self {
-        let fdr_int = fresnel_diffuse_reflectance(1.0 / eta);
+        let fdr_int = smooth_internal_reflectance(eta);
         Plastic {
             eta,
             diffuse_scaled: plastic_diffuse_scaled(eta, diffuse, fdr_int, nonlinear),
@@ -117,7 +154,7 @@ impl RoughPlastic {
             diffuse_scaled: plastic_diffuse_scaled(
                 eta,
                 diffuse,
-                table.internal_reflectance,
+                Some(table.internal_reflectance),
                 nonlinear,
             ),
             specular_reflectance: specular,
@@ -133,7 +170,7 @@ impl RoughPlastic {
             diffuse_scaled: plastic_diffuse_scaled(
                 self.eta,
                 diffuse,
-                self.table.internal_reflectance,
+                Some(self.table.internal_reflectance),
                 nonlinear,
             ),
             specular_reflectance: specular,
@@ -150,7 +187,8 @@ pub(crate) fn eval_smooth(p: &Plastic, v: Vec3, l: Vec3) -> Vec3 {
     if v.z > 0.0 && l.z > 0.0 {
         let fi = fresnel_dielectric(v.z, p.eta).r;
         let fo = fresnel_dielectric(l.z, p.eta).r;
-        p.diffuse_scaled * ((1.0 - fi) * (1.0 - fo) * FRAC_1_PI * l.z)
+        // Rounding can put F a hair above 1 for huge IORs.
+        p.diffuse_scaled * ((1.0 - fi).max(0.0) * (1.0 - fo).max(0.0) * FRAC_1_PI * l.z)
     } else {
         Vec3::ZERO
     }
@@ -281,6 +319,57 @@ mod tests {
 
     /// Mitsuba 3.9.1 `eval` values (MATERIALS.md §4.3), ρd = (0.2, 0.5, 0.8), η = 1.49/1.000277.
     /// Mitsuba's `wi` (viewer) is our `wo`.
+    /// Every legal IOR (up to 1e6) gives finite, non-negative values, diffuse albedo at most 1
+    /// (before the fix, IORs above about 3.9 made the diffuse part negative).
+    #[test]
+    fn plastics_stay_non_negative_for_any_ior() {
+        let rho = Vec3::new(0.2, 0.5, 1.0);
+        for eta in [1.5f32, 3.0, 4.0, 1e3, 1e6] {
+            for nonlinear in [false, true] {
+                let models = [
+                    Bsdf::plastic(eta, rho, Vec3::ONE, nonlinear),
+                    Bsdf::rough_plastic(
+                        eta,
+                        rho,
+                        Vec3::ONE,
+                        nonlinear,
+                        Distribution::Beckmann,
+                        0.1,
+                    ),
+                    Bsdf::rough_plastic(eta, rho, Vec3::ONE, nonlinear, Distribution::Ggx, 0.5),
+                ];
+                for (m, b) in models.iter().enumerate() {
+                    let mut rng = restir_sampling::Pcg32::new(eta.to_bits() as u64, m as u64);
+                    let mut albedo = Vec3::ZERO;
+                    let n = 2000;
+                    let wo = sph(40.0, 0.0);
+                    for _ in 0..n {
+                        let wi = sph(rng.next_f32() * 90.0, rng.next_f32() * 360.0);
+                        let f = b.eval(wo, wi);
+                        assert!(
+                            f.is_finite() && f.min_element() >= 0.0,
+                            "η {eta}, model {m}: {f}"
+                        );
+                        if let Some(s) = b.sample(wo, rng.next_f32(), rng.next_2d()) {
+                            assert!(
+                                s.f.is_finite() && s.f.min_element() >= 0.0,
+                                "η {eta}, model {m}: sampled {}",
+                                s.f
+                            );
+                            if s.pdf_sa > 0.0 {
+                                albedo += s.f / s.pdf_sa / n as f32;
+                            }
+                        }
+                    }
+                    assert!(
+                        albedo.max_element() < 1.05,
+                        "η {eta}, model {m}: albedo {albedo}"
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn plastics_match_mitsuba_eval() {
         let eta = 1.49 / 1.000_277;

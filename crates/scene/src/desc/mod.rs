@@ -6,6 +6,7 @@
 //! [`materials`](self) (re-exported), and every default value is in [`defaults`].
 
 pub mod defaults;
+pub mod limits;
 mod materials;
 mod transform;
 
@@ -96,10 +97,13 @@ pub struct CameraDesc {
     #[serde(default)]
     pub to_world: Vec<TransformOp>,
     /// Lens radius; 0 is a pinhole.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "limits::coordinate")]
     pub aperture_radius: f32,
     /// Distance of the plane in focus (thin lens only).
-    #[serde(default = "defaults::focus_distance")]
+    #[serde(
+        default = "defaults::focus_distance",
+        deserialize_with = "limits::coordinate"
+    )]
     pub focus_distance: f32,
 }
 
@@ -124,11 +128,13 @@ pub enum FilterDesc {
     /// `max(0, 1 − |x|/radius)` per axis.
     Tent {
         /// Radius in pixels (default 1).
+        #[serde(deserialize_with = "limits::filter_width")]
         radius: f32,
     },
     /// `max(0, exp(−x²/2σ²) − exp(−8))` per axis, truncated at 4σ (Mitsuba's default filter).
     Gaussian {
         /// Standard deviation in pixels (default 0.5).
+        #[serde(deserialize_with = "limits::filter_width")]
         stddev: f32,
     },
 }
@@ -218,8 +224,10 @@ pub enum GeometryDesc {
     /// A sphere (its transform may translate, rotate and scale uniformly).
     Sphere {
         /// Centre.
+        #[serde(deserialize_with = "limits::coordinates")]
         center: V3,
         /// Radius.
+        #[serde(deserialize_with = "limits::coordinate")]
         radius: f32,
     },
     /// A Wavefront OBJ file, relative to the scene file.
@@ -243,6 +251,7 @@ pub enum GeometryDesc {
     /// Triangles given inline.
     Mesh {
         /// Vertex positions.
+        #[serde(deserialize_with = "limits::point_list")]
         positions: Vec<V3>,
         /// Triangles as index triples.
         indices: Vec<[u32; 3]>,
@@ -285,6 +294,7 @@ pub enum LightDesc {
     /// Isotropic point light.
     Point {
         /// Position.
+        #[serde(deserialize_with = "limits::coordinates")]
         position: V3,
         /// Intensity (W/sr).
         intensity: V3,

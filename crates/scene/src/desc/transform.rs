@@ -4,7 +4,7 @@
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
 
-use super::V3;
+use super::{V3, limits};
 
 /// One step of a transform; steps apply in order (the first is applied to the object first),
 /// as in Mitsuba's `<transform>`.
@@ -12,27 +12,32 @@ use super::V3;
 #[serde(deny_unknown_fields)]
 pub enum TransformOp {
     /// Translation.
-    Translate(V3),
+    Translate(#[serde(deserialize_with = "limits::coordinates")] V3),
     /// Per-axis scale.
-    Scale(V3),
+    Scale(#[serde(deserialize_with = "limits::coordinates")] V3),
     /// Rotation by `angle` degrees about `axis` (counter-clockwise looking down the axis).
     Rotate {
         /// Rotation axis (need not be unit length).
+        #[serde(deserialize_with = "limits::finite3")]
         axis: V3,
         /// Angle in degrees.
+        #[serde(deserialize_with = "limits::finite")]
         angle: f32,
     },
     /// Camera-style look-at: `+z` towards `target`, `+y` towards `up`, `+x = up × z`.
     LookAt {
         /// Eye position.
+        #[serde(deserialize_with = "limits::coordinates")]
         origin: V3,
         /// Point looked at.
+        #[serde(deserialize_with = "limits::coordinates")]
         target: V3,
         /// Up vector.
+        #[serde(deserialize_with = "limits::finite3")]
         up: V3,
     },
     /// A row-major 4×4 matrix.
-    Matrix([f32; 16]),
+    Matrix(#[serde(deserialize_with = "limits::matrix")] [f32; 16]),
 }
 
 /// Why transform steps do not compose into a usable matrix.

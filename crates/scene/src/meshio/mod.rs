@@ -84,9 +84,9 @@ pub(crate) fn load_serialized(path: &Path, index: usize) -> Result<MeshData, Mes
         .map_err(|problem| malformed(path, problem))
 }
 
-/// Reads a whole mesh file.
+/// Reads a whole mesh file (a regular file of at most 2 GiB).
 fn read_file(path: &Path) -> Result<Vec<u8>, MeshError> {
-    std::fs::read(path).map_err(|e| MeshError::Read {
+    restir_image::input::read_regular(path).map_err(|e| MeshError::Read {
         path: path.to_path_buf(),
         reason: e.to_string(),
     })

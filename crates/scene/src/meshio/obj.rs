@@ -1,5 +1,6 @@
 //! Wavefront OBJ meshes, read with `tobj`: every model of the file in one mesh, triangulated,
-//! with normals and uvs kept only when every model has them.
+//! with normals and uvs kept only when every model has them. Materials come from the scene, so
+//! an `mtllib` line is never followed (its file is not opened).
 
 use std::path::Path;
 
@@ -20,8 +21,14 @@ pub(crate) fn load_obj(path: &Path) -> Result<MeshData, MeshError> {
         path: path.to_path_buf(),
         reason,
     };
-    std::fs::File::open(path).map_err(|e| read_error(e.to_string()))?;
-    let (models, _) = tobj::load_obj(path, &opts).map_err(|e| read_error(e.to_string()))?;
+    let file = restir_image::input::open_regular(path).map_err(|e| read_error(e.to_string()))?;
+    let mut reader = std::io::BufReader::new(std::io::Read::take(
+        file,
+        restir_image::input::MAX_INPUT_BYTES,
+    ));
+    let (models, _) =
+        tobj::load_obj_buf(&mut reader, &opts, |_| Err(tobj::LoadError::OpenFileFailed))
+            .map_err(|e| read_error(e.to_string()))?;
     let mut positions = Vec::new();
     let mut normals = Vec::new();
     let mut uvs = Vec::new();

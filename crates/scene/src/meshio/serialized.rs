@@ -95,6 +95,15 @@ pub(crate) fn read_serialized(bytes: &[u8], index: usize) -> Result<MeshData, St
     }
     let nv = z.u64()?;
     let nt = z.u64()?;
+    let cap = crate::desc::limits::MAX_MESH_ELEMENTS;
+    let real = if flags & DOUBLE != 0 { 8 } else { 4 };
+    z.check(nv.saturating_mul(3 * real))?;
+    if nv > cap || nt > cap {
+        // Checked before inflating: a small file can claim (and hold) gigabytes.
+        return Err(format!(
+            "shape {index}: {nv} vertices and {nt} triangles exceed the limit of {cap} each"
+        ));
+    }
     let double = flags & DOUBLE != 0;
     if double == (flags & SINGLE != 0) {
         return Err(format!(
@@ -173,13 +182,18 @@ struct Inflate<'a> {
 }
 
 impl Inflate<'_> {
-    fn bytes(&mut self, n: u64) -> Result<Vec<u8>, String> {
+    /// An error unless `n` more bytes fit the budget.
+    fn check(&self, n: u64) -> Result<(), String> {
         if n > self.budget {
             return Err(format!(
                 "shape {}: the file claims more data than it holds (truncated or damaged)",
                 self.index
             ));
         }
+        Ok(())
+    }
+    fn bytes(&mut self, n: u64) -> Result<Vec<u8>, String> {
+        self.check(n)?;
         self.budget -= n;
         // Grows with the data actually decompressed, so a lying count cannot allocate much.
         let mut v = Vec::new();
@@ -291,6 +305,33 @@ mod tests {
             let e = read_serialized(&f, 2).unwrap_err();
             assert!(e.contains("out of range"), "{e}");
         }
+    }
+
+    /// A small file that really inflates to more vertices than the limit (1.5 MB inflating to
+    /// 100 M vertices took 3.5 GB before the limit): refused from its counts, before inflating.
+    #[test]
+    fn a_decompression_bomb_is_refused_from_its_counts() {
+        let nv = crate::desc::limits::MAX_MESH_ELEMENTS + 1;
+        let mut raw = Vec::new();
+        raw.extend(SINGLE.to_le_bytes());
+        raw.extend(nv.to_le_bytes());
+        raw.extend(1u64.to_le_bytes());
+        let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::best());
+        z.write_all(&raw).unwrap();
+        let zeros = vec![0u8; 1 << 20];
+        for _ in 0..(nv * 12 + 12) >> 20 {
+            z.write_all(&zeros).unwrap();
+        }
+        let mut shape = SERIALIZED_ID.to_le_bytes().to_vec();
+        shape.extend(3u16.to_le_bytes());
+        shape.extend(z.finish().unwrap());
+        let f = file(3, &[shape]);
+        assert!(f.len() < 1 << 20, "{} bytes", f.len());
+        let e = read_serialized(&f, 0).unwrap_err();
+        assert_eq!(
+            e,
+            "shape 0: 33554433 vertices and 1 triangles exceed the limit of 33554432 each"
+        );
     }
 
     #[test]

@@ -16,7 +16,7 @@ impl<'a> Importer<'a> {
                 let intensity = props
                     .color("intensity", ColorUse::Emission)?
                     .unwrap_or(defaults::EMISSION);
-                let position = match props.point("position")? {
+                let position = match props.position("position")? {
                     Some(p) => p,
                     None => {
                         let m = crate::desc::transform_matrix(&props.transform("to_world")?)

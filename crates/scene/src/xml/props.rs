@@ -10,7 +10,7 @@ use roxmltree::Node;
 use super::source::Source;
 use super::{Result, snake_case};
 use crate::SceneError;
-use crate::desc::TransformOp;
+use crate::desc::{TransformOp, limits};
 use crate::spectrum::{self, SpectrumUse};
 
 /// The element names that are properties (everything else inside a plugin is a nested plugin).
@@ -256,6 +256,28 @@ impl<'a, 'i> Props<'a, 'i> {
                 _ => Err(self.type_err(p, "a point or vector")),
             },
         }
+    }
+
+    /// A point within the coordinate limit ([`crate::desc::limits::MAX_COORDINATE`]).
+    pub(super) fn position(&self, name: &str) -> Result<Option<[f32; 3]>> {
+        let v = self.point(name)?;
+        if let (Some(p), Some(v)) = (self.get(name), v)
+            && let Some(problem) = v.iter().find_map(|&x| limits::coordinate_problem(x))
+        {
+            return Err(self.err(p, format!("{}: '{}': {problem}", self.what, p.name)));
+        }
+        Ok(v)
+    }
+
+    /// A length (radius) within the coordinate limit.
+    pub(super) fn length(&self, name: &str) -> Result<Option<f32>> {
+        let v = self.float(name)?;
+        if let (Some(p), Some(v)) = (self.get(name), v)
+            && let Some(problem) = limits::coordinate_problem(v)
+        {
+            return Err(self.err(p, format!("{}: '{}': {problem}", self.what, p.name)));
+        }
+        Ok(v)
     }
 
     pub(super) fn transform(&self, name: &str) -> Result<Vec<TransformOp>> {

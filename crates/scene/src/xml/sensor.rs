@@ -177,12 +177,18 @@ impl<'a> Importer<'a> {
                             if r <= 0.0 {
                                 return Err(self.err(c, "tent radius must be positive"));
                             }
+                            if let Some(p) = limits::filter_width_problem(r) {
+                                return Err(self.err(c, format!("tent radius {p}")));
+                            }
                             FilterDesc::Tent { radius: r }
                         }
                         "gaussian" => {
                             let s = fp.float("stddev")?.unwrap_or(defaults::GAUSSIAN_STDDEV);
                             if s <= 0.0 {
                                 return Err(self.err(c, "gaussian stddev must be positive"));
+                            }
+                            if let Some(p) = limits::filter_width_problem(s) {
+                                return Err(self.err(c, format!("gaussian stddev {p}")));
                             }
                             FilterDesc::Gaussian { stddev: s }
                         }

@@ -16,8 +16,8 @@ impl<'a> Importer<'a> {
             "cube" => GeometryDesc::Cube,
             "disk" => GeometryDesc::Disk,
             "sphere" => {
-                let center = props.point("center")?.unwrap_or(defaults::SPHERE_CENTER);
-                let radius = props.float("radius")?.unwrap_or(defaults::SPHERE_RADIUS);
+                let center = props.position("center")?.unwrap_or(defaults::SPHERE_CENTER);
+                let radius = props.length("radius")?.unwrap_or(defaults::SPHERE_RADIUS);
                 if radius <= 0.0 {
                     return Err(self.err(node, format!("sphere radius {radius} must be positive")));
                 }

@@ -11,6 +11,7 @@ use std::path::Path;
 use roxmltree::Node;
 
 use super::{Result, snake_case};
+use crate::desc::limits;
 use crate::{Location, SceneError, SceneWarning};
 
 /// One XML scene file while it is imported.
@@ -95,6 +96,15 @@ impl<'a> Source<'a> {
                 )
             })?;
             out.push_str(value);
+            if out.len() > limits::MAX_SUBSTITUTED_BYTES {
+                return Err(self.err(
+                    node,
+                    format!(
+                        "the value grows beyond {} bytes through <default> substitution",
+                        limits::MAX_SUBSTITUTED_BYTES
+                    ),
+                ));
+            }
             rest = &after[len..];
         }
         out.push_str(rest);

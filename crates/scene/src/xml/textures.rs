@@ -39,6 +39,12 @@ impl<'a> Importer<'a> {
                     .string("filename")?
                     .ok_or_else(|| self.err(node, "bitmap texture needs a 'filename'"))?;
                 let path = self.file.parent().unwrap_or(Path::new("")).join(&filename);
+                if path.exists() && !path.is_file() {
+                    return Err(self.err(
+                        node,
+                        format!("bitmap texture: '{}' is not a regular file", path.display()),
+                    ));
+                }
                 if !path.is_file() {
                     return Err(self.err(
                         node,

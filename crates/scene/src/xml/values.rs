@@ -5,7 +5,7 @@ use roxmltree::Node;
 
 use super::source::Source;
 use super::{Result, snake_case};
-use crate::desc::TransformOp;
+use crate::desc::{TransformOp, limits};
 
 /// Numbers separated by commas and/or whitespace.
 pub(super) fn parse_numbers(s: &str) -> Option<Vec<f64>> {
@@ -27,6 +27,14 @@ impl Source<'_> {
             ))
         } else {
             Ok(v)
+        }
+    }
+
+    /// `v` unless it lies beyond the coordinate limit ([`limits::MAX_COORDINATE`]).
+    fn within_limit(&self, node: Node, v: [f32; 3], what: &str) -> Result<[f32; 3]> {
+        match v.iter().find_map(|&x| limits::coordinate_problem(x)) {
+            Some(problem) => Err(self.err(node, format!("{what}: {problem}"))),
+            None => Ok(v),
         }
     }
 
@@ -73,8 +81,10 @@ impl Source<'_> {
         for c in node.children().filter(Node::is_element) {
             let tag = snake_case(c.tag_name().name()).replace('_', "");
             let op = match tag.as_str() {
-                "translate" => TransformOp::Translate(self.xyz(c, 0.0)?),
-                "scale" => TransformOp::Scale(self.xyz(c, 1.0)?),
+                "translate" => {
+                    TransformOp::Translate(self.within_limit(c, self.xyz(c, 0.0)?, "translate")?)
+                }
+                "scale" => TransformOp::Scale(self.within_limit(c, self.xyz(c, 1.0)?, "scale")?),
                 "rotate" => {
                     let axis = match self.attr(c, "axis")? {
                         Some(a) => self.parse_vec3(c, &a)?,
@@ -88,7 +98,9 @@ impl Source<'_> {
                 }
                 "lookat" => {
                     let origin = self.parse_vec3(c, &self.req_attr(c, "origin")?)?;
+                    let origin = self.within_limit(c, origin, "lookat origin")?;
                     let target = self.parse_vec3(c, &self.req_attr(c, "target")?)?;
+                    let target = self.within_limit(c, target, "lookat target")?;
                     let up = match self.attr(c, "up")? {
                         Some(u) => self.parse_vec3(c, &u)?,
                         None => [0.0, 1.0, 0.0],
@@ -104,6 +116,7 @@ impl Source<'_> {
                         .ok_or_else(|| self.err(c, format!("cannot parse matrix \"{s}\"")))?;
                     for x in &v {
                         self.finite(c, *x, "matrix entry")?;
+                        self.within_limit(c, [*x as f32; 3], "matrix entry")?;
                     }
                     let m: [f32; 16] = match v.len() {
                         16 => core::array::from_fn(|i| v[i] as f32),
