@@ -60,6 +60,22 @@ def self_cpu():
     return r.ru_utime + r.ru_stime
 
 
+def load_mitsuba(mi, scene, w, h, max_depth):
+    """The scene in Mitsuba at this size and depth: the XML with its film size and the path
+    integrator's max_depth rewritten, in a temporary copy beside it (relative paths hold)."""
+    text = open(scene).read()
+    for name, value in (("width", w), ("height", h), ("max_depth", max_depth)):
+        text = re.sub(rf'(name="{name}"\s+value=")[^"]*(")', rf"\g<1>{value}\g<2>", text)
+    tmp = os.path.join(os.path.dirname(os.path.abspath(scene)),
+                       f".mitsuba-et-{os.getpid()}.xml")
+    with open(tmp, "w") as f:
+        f.write(text)
+    try:
+        return mi.load_file(tmp)
+    finally:
+        os.remove(tmp)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("scenes", nargs="+")
@@ -93,7 +109,7 @@ def main():
         if not os.path.exists(ref):
             ours(a, scene, a.ref_spp, 999, ref, 0)
 
-        ms = mi.load_file(scene, resx=w, resy=h, max_depth=a.max_depth)
+        ms = load_mitsuba(mi, scene, w, h, a.max_depth)
 
         def mitsuba(spp, seed, out):
             t = self_cpu()
