@@ -5,9 +5,10 @@ Development tool: needs `pip install mitsuba numpy` (`llvm_ad_rgb` also needs De
 libllvm19); never part of CI or of the project's dependencies.
 
 For each scene both renderers render at the same size and maximum depth, single-threaded, and
-each render is timed by the CPU time it uses (ours: the child process's user+system time minus
-its load time; Mitsuba: this process's CPU time around `mi.render` after a warm-up render that
-compiles its kernels), because the machines this runs on are shared and noisy. The sample
+each render is timed by the CPU time it uses (ours, on one thread: the child process's
+user+system time minus its load time; Mitsuba, on its own thread pool: this process's CPU time of
+all threads around `mi.render`, after a warm-up render that compiles its kernels; with
+`dr.set_thread_count(1)` Mitsuba 3.9.1 hung here), because the machines this runs on are shared and noisy. The sample
 counts are calibrated so that each render takes about `--budget` CPU seconds; relMSE is measured
 by `restir compare` against a converged reference rendered by `restir` (cached in `--refs`).
 Renders are interleaved (seed-major). Prints per scene the medians and
@@ -64,7 +65,7 @@ def load_mitsuba(mi, scene, w, h, max_depth):
     """The scene in Mitsuba at this size and depth: the XML with its film size and the path
     integrator's max_depth rewritten, in a temporary copy beside it (relative paths hold)."""
     text = open(scene).read()
-    for name, value in (("width", w), ("height", h), ("max_depth", max_depth)):
+    for name, value in (("width", w), ("height", h), ("max_depth", max_depth), ("maxDepth", max_depth)):
         text = re.sub(rf'(name="{name}"\s+value=")[^"]*(")', rf"\g<1>{value}\g<2>", text)
     tmp = os.path.join(os.path.dirname(os.path.abspath(scene)),
                        f".mitsuba-et-{os.getpid()}.xml")
@@ -87,6 +88,8 @@ def main():
     ap.add_argument("--ref-spp", type=int, default=4096)
     ap.add_argument("--refs", default="/tmp/restir-refs")
     ap.add_argument("--variant", default="llvm_ad_rgb")
+    ap.add_argument("--mi-threads", type=int, default=0,
+                    help="Mitsuba's threads (0: its default; 1 hung here)")
     a = ap.parse_args()
 
     import drjit as dr
@@ -94,12 +97,14 @@ def main():
     import numpy as np
 
     mi.set_variant(a.variant)
-    dr.set_thread_count(1)
+    if a.mi_threads:
+        dr.set_thread_count(a.mi_threads)
     w, h = (int(v) for v in a.size.split("x"))
     os.makedirs(a.refs, exist_ok=True)
     work = tempfile.mkdtemp(prefix="mitsuba-et-")
-    print(f"# Mitsuba {mi.__version__} {a.variant} vs restir, {a.size}, max depth "
-          f"{a.max_depth}, ~{a.budget} CPU s per render, 1 thread, {a.seeds} seeds")
+    print(f"# Mitsuba {mi.__version__} {a.variant} ({a.mi_threads or 'all'} threads) vs restir "
+          f"(1 thread), {a.size}, max depth {a.max_depth}, ~{a.budget} CPU s per render "
+          f"(process CPU time), {a.seeds} seeds")
     print("| scene | renderer | spp | CPU s | relMSE | efficiency | ours / Mitsuba |")
     print("|---|---|---|---|---|---|---|")
     for scene in a.scenes:
