@@ -82,6 +82,19 @@ fn elements<'a, 'i>(node: Node<'a, 'i>) -> impl Iterator<Item = Node<'a, 'i>> {
     node.children().filter(Node::is_element)
 }
 
+/// `s` with control characters escaped (`\n`, `\t`, `\u{1b}`), so an error stays on one line.
+fn escape_controls(s: &str) -> String {
+    s.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_debug().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
 /// Parses a Mitsuba-style XML scene. `defines` override `<default>` values.
 pub fn parse_xml(
     text: &str,
@@ -94,7 +107,8 @@ pub fn parse_xml(
                 file: file.to_path_buf(),
                 line: e.pos().row,
             },
-            format!("malformed XML: {e}"),
+            // One line whatever the parser quotes: a newline it did not expect is shown as `\n`.
+            format!("malformed XML: {}", escape_controls(&e.to_string())),
         )
     })?;
     let root = doc.root_element();
