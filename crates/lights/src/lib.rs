@@ -18,8 +18,8 @@ pub use envmap::{EnvMap, EnvMapError};
 
 use core::f32::consts::PI;
 use glam::{Vec2, Vec3};
-use restir_geometry::Shape;
 use restir_geometry::area_to_solid_angle;
+use restir_geometry::{PositionSample, Shape};
 use restir_sampling::{luminance, warp};
 use std::sync::Arc;
 use table::{Emitter, EmitterTable};
@@ -436,30 +436,9 @@ impl LightSet {
         let Light::Area { shape, radiance } = self.lights[light as usize] else {
             return None;
         };
-        let tp = Emitter::triangle_point(p, ng, n, smooth, &shapes[shape as usize], prim, u);
-        let to = tp.p - ref_p;
-        let dist = to.length();
-        if dist <= 0.0 {
-            return None;
-        }
-        let wi = to / dist;
-        if tp.n.dot(wi) >= 0.0 {
-            return None; // back of a one-sided emitter
-        }
-        let pdf_sa = area_to_solid_angle(self.area_pdf[light as usize], ref_p, tp.p, tp.ng)?;
-        Some(LightSample {
-            light,
-            p: tp.p,
-            n: tp.n,
-            ng: tp.ng,
-            wi,
-            dist,
-            le: radiance,
-            pdf_sa,
-            delta: false,
-            prim,
-            param: tp.param,
-        })
+        let ps = Emitter::triangle_point(p, ng, n, smooth, &shapes[shape as usize], prim, u);
+        let pdf_sa = area_to_solid_angle(self.area_pdf[light as usize], ref_p, ps.p, ps.ng)?;
+        area_light_sample(light, radiance, ref_p, ps, pdf_sa)
     }
 
     /// Samples a point on light `light` as seen from `ref_p`, with `pdf_sa` *not* including the
@@ -475,28 +454,7 @@ impl LightSet {
         match self.lights[light as usize] {
             Light::Area { shape, radiance } => {
                 let (ps, pdf_sa) = shapes[shape as usize].sample_from(ref_p, u)?;
-                let to = ps.p - ref_p;
-                let dist = to.length();
-                if dist <= 0.0 {
-                    return None;
-                }
-                let wi = to / dist;
-                if ps.n.dot(wi) >= 0.0 {
-                    return None; // back of a one-sided emitter
-                }
-                Some(LightSample {
-                    light,
-                    p: ps.p,
-                    n: ps.n,
-                    ng: ps.ng,
-                    wi,
-                    dist,
-                    le: radiance,
-                    pdf_sa,
-                    delta: false,
-                    prim: ps.prim,
-                    param: ps.param,
-                })
+                area_light_sample(light, radiance, ref_p, ps, pdf_sa)
             }
             Light::Point {
                 position,
@@ -598,6 +556,40 @@ impl LightSet {
             Light::Point { .. } | Light::Directional { .. } => 0.0,
         }
     }
+}
+
+/// The sample of area light `light` (radiance `radiance`) at point `ps` seen from `ref_p`, with
+/// solid-angle density `pdf_sa`; `None` at the receiver itself or behind the one-sided emitter.
+#[inline]
+fn area_light_sample(
+    light: u32,
+    radiance: Vec3,
+    ref_p: Vec3,
+    ps: PositionSample,
+    pdf_sa: f32,
+) -> Option<LightSample> {
+    let to = ps.p - ref_p;
+    let dist = to.length();
+    if dist <= 0.0 {
+        return None;
+    }
+    let wi = to / dist;
+    if ps.n.dot(wi) >= 0.0 {
+        return None; // back of a one-sided emitter
+    }
+    Some(LightSample {
+        light,
+        p: ps.p,
+        n: ps.n,
+        ng: ps.ng,
+        wi,
+        dist,
+        le: radiance,
+        pdf_sa,
+        delta: false,
+        prim: ps.prim,
+        param: ps.param,
+    })
 }
 
 /// A sphere around a shape (for meshes, around its bounding box).

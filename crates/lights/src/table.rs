@@ -18,7 +18,7 @@
 //! ([`crate::LightSet::set_environment_share`]); the default is the power share.
 
 use glam::{Vec2, Vec3};
-use restir_geometry::Shape;
+use restir_geometry::{PositionSample, Shape};
 use restir_sampling::{AliasTable, warp};
 
 /// One entry of the table.
@@ -47,15 +47,6 @@ pub(crate) enum Emitter {
     },
 }
 
-/// A point on an emissive triangle.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct TrianglePoint {
-    pub p: Vec3,
-    pub ng: Vec3,
-    pub n: Vec3,
-    pub param: Vec2,
-}
-
 impl Emitter {
     /// The light the entry belongs to.
     #[inline]
@@ -77,7 +68,7 @@ impl Emitter {
         shape: &Shape,
         prim: u32,
         u: Vec2,
-    ) -> TrianglePoint {
+    ) -> PositionSample {
         let b = warp::sample_uniform_triangle(u);
         let b0 = 1.0 - b.x - b.y;
         let point = b0 * p[0] + b.x * p[1] + b.y * p[2];
@@ -85,10 +76,11 @@ impl Emitter {
             (true, Shape::Mesh(m)) => m.point_at(prim as usize, b).2,
             _ => n,
         };
-        TrianglePoint {
+        PositionSample {
             p: point,
-            ng,
             n,
+            ng,
+            prim,
             param: b,
         }
     }
