@@ -43,6 +43,7 @@ pub mod restir_di;
 pub mod restir_pt;
 pub mod reuse;
 pub mod shadow;
+pub mod stages;
 
 /// The vector types of images and scenes (`Image::pixels` is a `Vec<glam::Vec3>`).
 pub use glam;

@@ -208,6 +208,11 @@ pub trait Integrator: Sync + Send + std::fmt::Debug {
     fn halo(&self) -> u32 {
         0
     }
+    /// Wall seconds spent in each stage of the passes so far, in the order the stages run
+    /// (empty for an estimator without stages, like the path tracer).
+    fn stage_seconds(&self) -> Vec<(&'static str, f64)> {
+        Vec::new()
+    }
 }
 
 /// The path tracer as an [`Integrator`].

@@ -122,7 +122,7 @@ struct RenderArgs {
 #[derive(clap::Args, Debug)]
 #[command(next_help_heading = "ReSTIR")]
 struct RestirArgs {
-    /// Initial candidates per pixel: light samples for restir-di [default: 32], paths for
+    /// Initial candidates per pixel: light samples for restir-di [default: 8], paths for
     /// restir-pt [default: 1].
     #[arg(long)]
     candidates: Option<u32>,
@@ -226,9 +226,20 @@ struct Stats<'a> {
     threads: usize,
     /// How light samples are drawn, as the scene build decided it.
     light_selection: String,
+    /// Wall seconds per stage of the estimator's passes, summed over the passes (empty for
+    /// the path tracer).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    stage_seconds: Vec<StageSeconds>,
     /// The part of a split render this process rendered (--chain, --crop).
     #[serde(skip_serializing_if = "Option::is_none")]
     part: Option<cluster::PartStats>,
+}
+
+/// One stage's summed wall time in `--stats`.
+#[derive(serde::Serialize)]
+struct StageSeconds {
+    stage: &'static str,
+    seconds: f64,
 }
 
 /// How a render ended: completely, or stopped by an interrupt (the partial image written).
@@ -469,6 +480,11 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
             seed: args.seed,
             threads,
             light_selection: scene.light_selection(),
+            stage_seconds: integrator
+                .stage_seconds()
+                .into_iter()
+                .map(|(stage, seconds)| StageSeconds { stage, seconds })
+                .collect(),
             part: plan.as_ref().map(|p| p.stats(integrator.as_ref())),
         };
         let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;

@@ -42,6 +42,7 @@ use crate::reuse::neighbors::NeighborPattern;
 use crate::reuse::passes::{self, HistorySlot, ReuseShift};
 use crate::reuse::settings::mis_name;
 use crate::shadow::{self, ShadowTarget};
+use crate::stages::StageClock;
 use target::{StrategyCounts, evaluate, target};
 
 /// Random-stream stages (see [`PassContext::stage_rng`]).
@@ -60,6 +61,7 @@ pub struct RestirDiIntegrator {
     counts: StrategyCounts,
     pattern: NeighborPattern,
     history: HistorySlot<LightPoint>,
+    clock: StageClock,
 }
 
 /// The identity shift between pixels: the sample stays on the light, `J = 1`; only the target
@@ -155,6 +157,7 @@ impl RestirDiIntegrator {
             settings,
             pattern: NeighborPattern::new(),
             history: HistorySlot::default(),
+            clock: StageClock::default(),
         }
     }
 
@@ -374,6 +377,10 @@ impl Integrator for RestirDiIntegrator {
         )
     }
 
+    fn stage_seconds(&self) -> Vec<(&'static str, f64)> {
+        self.clock.seconds()
+    }
+
     fn halo(&self) -> u32 {
         self.settings.reuse.halo()
     }
@@ -391,12 +398,14 @@ impl Integrator for RestirDiIntegrator {
         let n = accum.len();
         let mut radiance = vec![Vec3::ZERO; n];
         let keep = s.path.max_segments() >= 2;
-        let (gbuf, mut rays) =
-            GBuffer::trace(scene, ctx, s.path.hide_emitters, keep, &mut radiance);
+        let (gbuf, mut rays) = self.clock.time("primary", || {
+            GBuffer::trace(scene, ctx, s.path.hide_emitters, keep, &mut radiance)
+        });
         let w = gbuf.width;
         let bands = Bands::new(w);
         if keep {
             // Initial resampling.
+            let start = std::time::Instant::now();
             let light_tiles = match s.light_sampler {
                 LightSampler::Power => None,
                 LightSampler::Tiles => tiles::LightTiles::build(scene, &gbuf),
@@ -422,6 +431,7 @@ impl Integrator for RestirDiIntegrator {
                     rays
                 })
                 .sum::<u64>();
+            self.clock.add("initial", start.elapsed());
 
             // Temporal and spatial reuse.
             let history = self.history.take(reuse, n);
@@ -432,27 +442,32 @@ impl Integrator for RestirDiIntegrator {
                 prev: history.as_ref().map(|h| &h.gbuffer),
             };
             if let Some(history) = &history {
-                rays += passes::temporal(
+                rays += self.clock.time("temporal", || {
+                    passes::temporal(
+                        &shift,
+                        reuse,
+                        ctx,
+                        &gbuf,
+                        history,
+                        STAGE_TEMPORAL,
+                        &mut current,
+                    )
+                });
+            }
+            rays += self.clock.time("spatial", || {
+                passes::spatial(
                     &shift,
                     reuse,
+                    &self.pattern,
                     ctx,
                     &gbuf,
-                    history,
-                    STAGE_TEMPORAL,
+                    STAGE_SPATIAL,
                     &mut current,
-                );
-            }
-            rays += passes::spatial(
-                &shift,
-                reuse,
-                &self.pattern,
-                ctx,
-                &gbuf,
-                STAGE_SPATIAL,
-                &mut current,
-            );
+                )
+            });
 
             // Shading.
+            let start = std::time::Instant::now();
             rays += radiance
                 .par_chunks_mut(bands.pixels())
                 .enumerate()
@@ -471,6 +486,7 @@ impl Integrator for RestirDiIntegrator {
                     rays
                 })
                 .sum::<u64>();
+            self.clock.add("shade", start.elapsed());
 
             self.history.store(reuse, gbuf, current);
         }

@@ -46,6 +46,7 @@ use crate::path::PathSettings;
 use crate::render::{Integrator, PassContext};
 use crate::restir_di::{RestirDiIntegrator, RestirDiSettings};
 use crate::reuse::settings::mis_name;
+use crate::stages::StageClock;
 use sample::connectible;
 use walk::{ScatterVertex, Walker};
 
@@ -65,6 +66,7 @@ pub struct RestirPtIntegrator {
     di: Option<RestirDiIntegrator>,
     pattern: NeighborPattern,
     history: HistorySlot<PathSample>,
+    clock: StageClock,
 }
 
 impl RestirPtIntegrator {
@@ -86,6 +88,7 @@ impl RestirPtIntegrator {
             di,
             pattern: NeighborPattern::new(),
             history: HistorySlot::default(),
+            clock: StageClock::default(),
         }
     }
 
@@ -149,7 +152,7 @@ impl RestirPtIntegrator {
         let n = w as usize * h as usize;
         let mut radiance = vec![Vec3::ZERO; n];
         let keep = self.max_depth() >= 2;
-        let (gbuf, mut rays) =
+        let (gbuf, mut rays) = self.clock.time("primary", || {
             // With `direct = restir-di` the ReSTIR DI pass adds the emitters the camera sees.
             GBuffer::trace(
                 scene,
@@ -157,10 +160,12 @@ impl RestirPtIntegrator {
                 s.path.hide_emitters || s.direct == DirectLight::RestirDi,
                 keep,
                 &mut radiance,
-            );
+            )
+        });
         let mut current = vec![PtReservoir::empty(); n];
         if keep {
             let bands = Bands::new(gbuf.width);
+            let start = std::time::Instant::now();
             rays += current
                 .par_chunks_mut(bands.pixels())
                 .zip(radiance.par_chunks_mut(bands.pixels()))
@@ -181,6 +186,7 @@ impl RestirPtIntegrator {
                     rays
                 })
                 .sum::<u64>();
+            self.clock.add("initial", start.elapsed());
         }
         (gbuf, current, radiance, rays)
     }
@@ -294,6 +300,10 @@ impl Integrator for RestirPtIntegrator {
         self.settings.reuse.halo()
     }
 
+    fn stage_seconds(&self) -> Vec<(&'static str, f64)> {
+        self.clock.seconds()
+    }
+
     fn buffer_bytes_per_pixel(&self) -> usize {
         let hit_bytes = std::mem::size_of::<Receiver>() + std::mem::size_of::<Vec3>();
         let (reservoirs, hits) = if self.settings.reuse.temporal {
@@ -312,10 +322,10 @@ impl Integrator for RestirPtIntegrator {
         let n = accum.len();
         // Emitters seen by the camera and the direct light at the primary hit (paths of one and
         // two segments) from ReSTIR DI; the reservoirs below carry the longer paths.
-        let mut rays = self
-            .di
-            .as_ref()
-            .map_or(0, |di| di.render_pass(scene, ctx, accum));
+        let mut rays = self.di.as_ref().map_or(0, |di| {
+            self.clock
+                .time("direct (restir-di)", || di.render_pass(scene, ctx, accum))
+        });
         let (gbuf, mut current, mut radiance, nr) = self.initial_reservoirs(scene, ctx);
         rays += nr;
         if self.max_depth() >= 2 {
@@ -329,22 +339,27 @@ impl Integrator for RestirPtIntegrator {
                 pixels: n,
             };
             if let Some(history) = &history {
-                rays +=
-                    passes::temporal(&shift, s, ctx, &gbuf, history, STAGE_TEMPORAL, &mut current);
+                rays += self.clock.time("temporal", || {
+                    passes::temporal(&shift, s, ctx, &gbuf, history, STAGE_TEMPORAL, &mut current)
+                });
             }
-            rays += passes::spatial(
-                &shift,
-                s,
-                &self.pattern,
-                ctx,
-                &gbuf,
-                STAGE_SPATIAL,
-                &mut current,
-            );
-            radiance
-                .par_iter_mut()
-                .zip(current.par_iter())
-                .for_each(|(l, res)| *l += Self::shade(res));
+            rays += self.clock.time("spatial", || {
+                passes::spatial(
+                    &shift,
+                    s,
+                    &self.pattern,
+                    ctx,
+                    &gbuf,
+                    STAGE_SPATIAL,
+                    &mut current,
+                )
+            });
+            self.clock.time("shade", || {
+                radiance
+                    .par_iter_mut()
+                    .zip(current.par_iter())
+                    .for_each(|(l, res)| *l += Self::shade(res))
+            });
             self.history.store(s, gbuf, current);
         }
         accum
