@@ -175,6 +175,14 @@ impl PassContext<'_> {
         Pcg32::for_pixel_sample(seed, self.film_index(index), self.pass as u64)
     }
 
+    /// A stream of the whole pass for estimator stage `stage`: the same for every pixel, and for
+    /// every crop of the film (choices made once per pass, like shared neighbour offsets).
+    #[inline]
+    pub fn pass_rng(&self, stage: u64) -> Pcg32 {
+        let seed = restir_sampling::mix64(self.seed ^ stage.wrapping_mul(0xe703_7ed1_a0b4_28db));
+        Pcg32::for_pixel_sample(seed, u64::MAX, self.pass as u64)
+    }
+
     /// The film position (pixel units) of a filter-jittered camera ray through pixel `(x, y)`
     /// of this pass.
     #[inline]

@@ -132,6 +132,30 @@ fn unbiased_for_every_unbiased_mis_scheme() {
     );
     eprintln!("tiles: max |z| = {z:.2}");
     assert!(z < Z_MAX, "tiles: max |z| = {z:.2}");
+    // Reciprocal neighbour pairs sharing their shifts, and their negative control (each pixel
+    // reading the other target of its pair).
+    let reciprocal = [
+        ("spatial_rounds", "2"),
+        ("neighbors", "4"),
+        ("radius", "3"),
+        ("reciprocal", "true"),
+    ];
+    let z = max_z(
+        &statistics(&scene, "restir-di", &reciprocal, 1, 200),
+        &reference,
+    );
+    eprintln!("reciprocal pairs: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "reciprocal: max |z| = {z:.2}");
+    let params = [&reciprocal[..], &[("reciprocal_mismatched", "true")]].concat();
+    let z = max_z(
+        &statistics(&scene, "restir-di", &params, 1, 400),
+        &reference,
+    );
+    eprintln!("reciprocal pairs reading the wrong shift: max |z| = {z:.2}");
+    assert!(
+        z > Z_MAX,
+        "mismatched reciprocal shifts should be biased: {z:.2}"
+    );
     let z = max_z(
         &statistics(&scene, "restir-di", &[("temporal", "true")], 4, 100),
         &reference,

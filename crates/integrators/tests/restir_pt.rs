@@ -77,11 +77,19 @@ fn scene_with(extra: &str) -> Scene {
 }
 
 fn render_image(scene: &Scene, name: &str, params: &[(&str, &str)], spp: u32, seed: u64) -> Image {
-    // Neighbours within a third of this small image (the default 30 px would mostly miss); a
-    // radius given in `params` comes later and wins.
-    let mut all = Vec::with_capacity(params.len() + 1);
+    // The reuse these tests were written for (one candidate, one round of three neighbours
+    // within 8 pixels, independent neighbours: cheaper than the defaults, so each test affords
+    // more renders); parameters given in `params` come later and win, and
+    // `unbiased_at_the_defaults` checks the defaults themselves.
+    let mut all = Vec::with_capacity(params.len() + 5);
     if name == "restir-pt" {
-        all.push(("radius", "8"));
+        all.extend_from_slice(&[
+            ("radius", "8"),
+            ("candidates", "1"),
+            ("spatial_rounds", "1"),
+            ("neighbors", "3"),
+            ("reciprocal", "false"),
+        ]);
     }
     all.extend_from_slice(params);
     common::render_image(scene, name, &all, spp, seed)
@@ -261,6 +269,30 @@ fn unbiased_against_the_path_tracer() {
     );
     eprintln!("max_depth 4, 2 rounds × 5 neighbours, 2 candidates: max |z| = {z:.2}");
     assert!(z < Z_MAX, "2 rounds: max |z| = {z:.2}");
+    // Reciprocal neighbour pairs sharing their shifts (3 rounds of 2 pairs), and their negative
+    // control: each pixel reading the other shift of its pair.
+    let reciprocal = [
+        ("spatial_rounds", "3"),
+        ("neighbors", "4"),
+        ("radius", "3"),
+        ("reciprocal", "true"),
+    ];
+    let z = max_z(
+        &statistics(&scene, "restir-pt", &reciprocal, 1, 300),
+        &reference,
+    );
+    eprintln!("max_depth 4, reciprocal pairs, 3 rounds × 4 neighbours: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "reciprocal: max |z| = {z:.2}");
+    let params = [&reciprocal[..], &[("reciprocal_mismatched", "true")]].concat();
+    let z = max_z(
+        &statistics(&scene, "restir-pt", &params, 1, 600),
+        &reference,
+    );
+    eprintln!("reciprocal pairs reading the wrong shift: max |z| = {z:.2}");
+    assert!(
+        z > Z_MAX,
+        "mismatched reciprocal shifts should be biased: {z:.2}"
+    );
     // Direct light path traced per pixel, the reservoirs carrying the rest.
     let z = max_z(
         &statistics(&scene, "restir-pt", &[("direct", "path")], 1, 400),
@@ -303,6 +335,38 @@ fn unbiased_against_the_path_tracer() {
     let z = max_z(&nojac, &reference);
     eprintln!("Jacobian omitted: max |z| = {z:.2}");
     assert!(z > Z_MAX, "J = 1 should be biased: {z:.2}");
+}
+
+/// The defaults (two candidates, three rounds of two reciprocal pairs within 3 pixels).
+#[test]
+fn unbiased_at_the_defaults() {
+    let scene = scene();
+    let reference = statistics(&scene, "path", &[], 128, 64);
+    let defaults = [
+        ("radius", "3"),
+        ("candidates", "2"),
+        ("spatial_rounds", "3"),
+        ("neighbors", "4"),
+        ("reciprocal", "true"),
+    ];
+    let settings = *integrator(4).settings();
+    assert_eq!(
+        (
+            settings.reuse.radius,
+            settings.candidates,
+            settings.reuse.spatial_rounds,
+            settings.reuse.neighbors,
+            settings.reuse.reciprocal
+        ),
+        (3.0, 2, 3, 4, true),
+        "the defaults changed: update this test's parameters"
+    );
+    let z = max_z(
+        &statistics(&scene, "restir-pt", &defaults, 1, 200),
+        &reference,
+    );
+    eprintln!("max_depth 4, the defaults: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "defaults: max |z| = {z:.2}");
 }
 
 #[test]
@@ -412,6 +476,20 @@ fn shifts_unbiased_with_glass_and_near_specular() {
             );
             eprintln!("{label}, hybrid, direct = restir-di: max |z| = {z:.2}");
             assert!(z < Z_MAX, "{label}, direct = restir-di: max |z| = {z:.2}");
+            // Reciprocal pairs with the hybrid shift (replayed prefixes shared by a pair).
+            let params = [
+                depth,
+                ("spatial_rounds", "3"),
+                ("neighbors", "4"),
+                ("radius", "3"),
+                ("reciprocal", "true"),
+            ];
+            let z = max_z(
+                &statistics(&scene, "restir-pt", &params, 1, 300),
+                &reference,
+            );
+            eprintln!("{label}, hybrid, reciprocal pairs: max |z| = {z:.2}");
+            assert!(z < Z_MAX, "{label}, reciprocal: max |z| = {z:.2}");
             continue;
         }
         // Negative controls, with more reuse (3 rounds of 6 neighbours) to make bias visible.

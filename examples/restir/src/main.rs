@@ -123,7 +123,7 @@ struct RenderArgs {
 #[command(next_help_heading = "ReSTIR")]
 struct RestirArgs {
     /// Initial candidates per pixel: light samples for restir-di [default: 8], paths for
-    /// restir-pt [default: 1].
+    /// restir-pt [default: 2].
     #[arg(long)]
     candidates: Option<u32>,
     /// Where candidates' lights come from: power (the power-based sampler) or tiles (per
@@ -133,13 +133,13 @@ struct RestirArgs {
     /// BSDF samples per pixel, MIS-combined with the reservoirs [default: 1].
     #[arg(long)]
     bsdf_candidates: Option<u32>,
-    /// Spatial neighbours per round [default: 3].
+    /// Spatial neighbours per round [default: 3 for restir-di, 4 for restir-pt].
     #[arg(long, alias = "neighbours")]
     neighbors: Option<u32>,
-    /// Spatial reuse radius in pixels [default: 30].
+    /// Spatial reuse radius in pixels [default: 30 for restir-di, 3 for restir-pt].
     #[arg(long)]
     radius: Option<f32>,
-    /// Spatial reuse rounds [default: 1].
+    /// Spatial reuse rounds [default: 1 for restir-di, 3 for restir-pt].
     #[arg(long)]
     spatial_rounds: Option<u32>,
     /// Reuse MIS: defensive-pairwise, pairwise, confidence-pairwise, balance, contribution,
@@ -155,6 +155,10 @@ struct RestirArgs {
     /// Drop occluded initial candidates (biased at shadow edges).
     #[arg(long)]
     visibility_reuse: bool,
+    /// Spatial neighbours in reciprocal pairs that share their shifts (pairwise MIS):
+    /// true or false [default: false for restir-di, true for restir-pt].
+    #[arg(long)]
+    reciprocal: Option<bool>,
     /// restir-pt shift map: reconnection, replay or hybrid [default: hybrid; reconnection in
     /// scenes without delta or near-specular materials].
     #[arg(long)]
@@ -193,6 +197,7 @@ impl RestirArgs {
         put("mis", self.mis.clone().map(ParamValue::Text));
         put("mcap", self.mcap.map(ParamValue::Number));
         put("temporal", self.temporal.then_some(ParamValue::Bool(true)));
+        put("reciprocal", self.reciprocal.map(ParamValue::Bool));
         put(
             "visibility_reuse",
             self.visibility_reuse.then_some(ParamValue::Bool(true)),

@@ -40,6 +40,7 @@ use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::light_point::{Contact, LightPoint, Resolved, contact, resolve};
 use crate::reuse::neighbors::NeighborPattern;
 use crate::reuse::passes::{self, HistorySlot, ReuseShift};
+use crate::reuse::reciprocal;
 use crate::reuse::settings::mis_name;
 use crate::shadow::{self, ShadowTarget};
 use crate::stages::StageClock;
@@ -361,7 +362,8 @@ impl Integrator for RestirDiIntegrator {
         let s = &self.settings;
         format!(
             "restir-di max_depth={} candidates={} light_sampler={} bsdf_candidates={} neighbors={} \
-             radius={} spatial_rounds={} mis={} mcap={} temporal={} visibility_reuse={}{}",
+             radius={} spatial_rounds={} reciprocal={} mis={} mcap={} temporal={} \
+             visibility_reuse={}{}",
             s.path.max_depth,
             s.candidates,
             s.light_sampler.name(),
@@ -369,6 +371,7 @@ impl Integrator for RestirDiIntegrator {
             s.reuse.neighbors,
             s.reuse.radius,
             s.reuse.spatial_rounds,
+            s.reuse.reciprocal,
             mis_name(s.reuse.mis),
             s.reuse.mcap,
             s.reuse.temporal,
@@ -389,7 +392,10 @@ impl Integrator for RestirDiIntegrator {
         let reservoirs = if self.settings.reuse.temporal { 3 } else { 2 };
         let hits = if self.settings.reuse.temporal { 2 } else { 1 };
         let hit_bytes = std::mem::size_of::<Receiver>() + std::mem::size_of::<Vec3>();
-        reservoirs * Self::RESERVOIR_BYTES + hits * hit_bytes + std::mem::size_of::<Vec3>()
+        reservoirs * Self::RESERVOIR_BYTES
+            + hits * hit_bytes
+            + std::mem::size_of::<Vec3>()
+            + reciprocal::table_bytes_per_pixel::<LightPoint>(&self.settings.reuse)
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {

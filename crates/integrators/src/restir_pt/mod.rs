@@ -41,6 +41,7 @@ use crate::bands::Bands;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::neighbors::NeighborPattern;
 use crate::reuse::passes::{self, HistorySlot};
+use crate::reuse::reciprocal;
 
 use crate::path::PathSettings;
 use crate::render::{Integrator, PassContext};
@@ -279,12 +280,14 @@ impl Integrator for RestirPtIntegrator {
         let s = &self.settings;
         format!(
             "restir-pt max_depth={} candidates={} neighbors={} radius={} spatial_rounds={} \
-             mis={} mcap={} temporal={} shift={} near_distance={} max_jacobian={} direct={}{}",
+             reciprocal={} mis={} mcap={} temporal={} shift={} near_distance={} max_jacobian={} \
+             direct={}{}",
             s.path.max_depth,
             s.candidates,
             s.reuse.neighbors,
             s.reuse.radius,
             s.reuse.spatial_rounds,
+            s.reuse.reciprocal,
             mis_name(s.reuse.mis),
             s.reuse.mcap,
             s.reuse.temporal,
@@ -314,6 +317,7 @@ impl Integrator for RestirPtIntegrator {
         reservoirs * Self::RESERVOIR_BYTES
             + hits * hit_bytes
             + std::mem::size_of::<Vec3>()
+            + reciprocal::table_bytes_per_pixel::<PathSample>(&self.settings.reuse)
             + self.di.as_ref().map_or(0, |d| d.buffer_bytes_per_pixel())
     }
 

@@ -61,7 +61,7 @@ pub struct RestirPtSettings {
     pub path: PathSettings,
     /// Spatial and temporal reuse.
     pub reuse: ReuseSettings,
-    /// Candidate paths per pixel in initial sampling (default 1).
+    /// Candidate paths per pixel in initial sampling (default 2).
     pub candidates: u32,
     /// Shortest reconnection segment, as a fraction of the scene's bounding-sphere radius
     /// (default 0.01).
@@ -81,12 +81,20 @@ pub struct RestirPtSettings {
 }
 
 impl RestirPtSettings {
-    /// The defaults (one candidate path, one round of three neighbours, defensive pairwise MIS).
+    /// The defaults: two candidate paths, three spatial rounds of four neighbours within 3
+    /// pixels in two reciprocal pairs, defensive pairwise MIS. Chosen on the training family
+    /// of `restir generate family --issue pt` (docs/BENCHMARKS.md, "ReSTIR PT defaults").
     pub fn new(path: PathSettings) -> Self {
         Self {
             path,
-            reuse: ReuseSettings::default(),
-            candidates: 1,
+            reuse: ReuseSettings {
+                neighbors: 4,
+                radius: 3.0,
+                spatial_rounds: 3,
+                reciprocal: true,
+                ..ReuseSettings::default()
+            },
+            candidates: 2,
             near_distance: 0.01,
             max_jacobian: 0.0,
             direct: DirectLight::Reservoir,

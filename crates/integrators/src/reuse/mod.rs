@@ -3,12 +3,14 @@
 //! the light-point sample ([`light_point`]), the reuse settings ([`settings`]) and the reuse
 //! passes themselves ([`passes`]: temporal reuse, the spatial rounds and the history, generic
 //! over the estimator's sample and shift map, as pbrt-v4's `ImageTileIntegrator` is over its
-//! `RayIntegrator`).
+//! `RayIntegrator`; [`reciprocal`]: spatial rounds over reciprocal neighbour pairs, which share
+//! their shifts).
 
 pub mod gbuffer;
 pub mod light_point;
 pub mod neighbors;
 pub mod passes;
+pub mod reciprocal;
 pub mod settings;
 
 pub use settings::{MIS_NAMES, ReuseSettings, mis_name};

@@ -19,6 +19,7 @@ use crate::bands::Bands;
 use crate::render::PassContext;
 use crate::reuse::gbuffer::GBuffer;
 use crate::reuse::neighbors::NeighborPattern;
+use crate::reuse::reciprocal;
 use crate::reuse::settings::ReuseSettings;
 
 /// What an estimator's reuse needs for one pass: its shift map between the pixels of this pass
@@ -160,6 +161,9 @@ pub fn spatial<R: ReuseShift>(
 ) -> u64 {
     if settings.neighbors == 0 || settings.spatial_rounds == 0 {
         return 0;
+    }
+    if settings.reciprocal && reciprocal::shares_pair_shifts(settings.mis) {
+        return reciprocal::spatial(reuse, settings, ctx, gbuf, first_stage, current);
     }
     let rule = settings.neighbor_rule();
     let bands = Bands::new(gbuf.width);

@@ -53,6 +53,12 @@ pub struct ReuseSettings {
     pub normal_cos: f32,
     /// Largest relative difference of camera distances (default 0.1).
     pub depth_tolerance: f32,
+    /// Spatial neighbours in reciprocal pairs that share their shifts ([`super::reciprocal`];
+    /// pairwise MIS only, default off).
+    pub reciprocal: bool,
+    /// Negative control only: reciprocal pairs read the wrong one of a pair's two shifts
+    /// (biased).
+    pub reciprocal_mismatched: bool,
 }
 
 impl Default for ReuseSettings {
@@ -68,6 +74,8 @@ impl Default for ReuseSettings {
             temporal: false,
             normal_cos: 25f32.to_radians().cos(),
             depth_tolerance: 0.1,
+            reciprocal: false,
+            reciprocal_mismatched: false,
         }
     }
 }
@@ -75,7 +83,7 @@ impl Default for ReuseSettings {
 impl ReuseSettings {
     /// Whether reuse is unbiased with these settings.
     pub fn is_unbiased(&self) -> bool {
-        self.mis.is_unbiased()
+        self.mis.is_unbiased() && !(self.reciprocal && self.reciprocal_mismatched)
     }
 
     /// How many pixels from a pixel the spatial rounds of one pass reach: `rounds × ⌈radius⌉`
@@ -130,6 +138,8 @@ impl ReuseSettings {
             "mis" | "bias_correction" => self.mis = p.mis()?,
             "mcap" | "m_cap" | "m_capping" | "max_history" => self.mcap = p.positive()?,
             "temporal" | "temporal_reuse" => self.temporal = p.boolean()?,
+            "reciprocal" | "reciprocal_neighbors" => self.reciprocal = p.boolean()?,
+            "reciprocal_mismatched" => self.reciprocal_mismatched = p.boolean()?,
             "normal_threshold" => {
                 let deg = p.positive()?;
                 if deg > 180.0 {

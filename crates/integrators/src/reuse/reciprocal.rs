@@ -1,0 +1,291 @@
+//! Reciprocal spatial reuse: neighbours chosen in pairs, so one pair of shifts serves both
+//! pixels of a pair.
+//!
+//! Pairwise MIS at pixel `p` with neighbour `q` needs two shifts: `q`'s sample into `p`
+//! (the candidate) and `p`'s sample into `q` (the canonical sample's weight). At `q` with
+//! neighbour `p` it needs the same two. When the neighbour relation is symmetric each pair's
+//! shifts are therefore computed once and read by both pixels, halving the shifts (and their
+//! shadow rays and replayed segments) of a round. The idea of sharing one shift between the
+//! two pixels of a reciprocal pair is from Lin, Kettunen and Wyman ("ReSTIR PT Enhanced").
+//!
+//! Each round draws `⌈k/2⌉` offsets `o_j` in the disk of the reuse radius, the same for every
+//! pixel of the pass (from a stream of the pass and round alone, so a cropped render draws the
+//! same ones); pixel `p`'s neighbours are `p + o_j` and `p − o_j` that exist, have a primary hit
+//! and pass the similarity test (which is symmetric). The choice depends on the G-buffer and the
+//! pass's stream only, never on reservoirs, so the reuse stays unbiased. A round runs in two
+//! phases: the shifts of every pair `(p, p + o_j)`, stored per pixel and offset, then each
+//! pixel's resampling with a [`ShiftMap`] that reads them.
+
+use std::borrow::Borrow;
+
+use rayon::prelude::*;
+use restir_gris::{MisScheme, Reservoir, ShiftMap, Shifted, resample};
+use restir_sampling::Pcg32;
+
+use crate::bands::Bands;
+use crate::render::PassContext;
+use crate::reuse::gbuffer::GBuffer;
+use crate::reuse::passes::ReuseShift;
+use crate::reuse::settings::ReuseSettings;
+
+/// Whether `scheme` uses only shifts between the canonical pixel and each neighbour (the
+/// pairwise family), the shifts a reciprocal pair shares.
+pub fn shares_pair_shifts(scheme: MisScheme) -> bool {
+    matches!(
+        scheme,
+        MisScheme::Pairwise | MisScheme::DefensivePairwise | MisScheme::ConfidenceWeightedPairwise
+    )
+}
+
+/// Bytes per pixel of the shift table the reciprocal rounds of `settings` keep (0 when they do
+/// not run), for an estimator's `buffer_bytes_per_pixel`.
+pub fn table_bytes_per_pixel<S>(settings: &ReuseSettings) -> usize {
+    let runs = settings.reciprocal
+        && shares_pair_shifts(settings.mis)
+        && settings.neighbors > 0
+        && settings.spatial_rounds > 0;
+    if runs {
+        (settings.neighbors as usize).div_ceil(2) * std::mem::size_of::<Option<PairShifts<S>>>()
+    } else {
+        0
+    }
+}
+
+/// The two shifts of a pair `(a, b = a + o_j)`: `a`'s sample into `b` and `b`'s into `a`.
+#[derive(Clone, Copy, Debug)]
+struct PairShifts<S> {
+    a_into_b: Option<Shifted<S>>,
+    b_into_a: Option<Shifted<S>>,
+}
+
+/// A domain as the cached map sees it: the pixel being resampled, or one of its neighbours
+/// named by the pair entry that holds their shifts.
+#[derive(Clone, Copy, Debug)]
+enum Slot {
+    Canonical,
+    /// The pair's entry in the table and whether the canonical pixel is the pair's first
+    /// pixel `a` (neighbour `p + o_j`) or its second `b` (neighbour `p − o_j`).
+    Neighbor {
+        entry: usize,
+        canonical_is_a: bool,
+    },
+}
+
+/// The shift map of one pixel's resampling: every shift is read from the round's table.
+struct CachedShifts<'t, S> {
+    table: &'t [Option<PairShifts<S>>],
+    /// Negative control: read the other shift of the pair.
+    mismatched: bool,
+}
+
+impl<S: Copy> ShiftMap<S> for CachedShifts<'_, S> {
+    type Domain = Slot;
+
+    fn shift(&self, from: &Slot, to: &Slot, _sample: &S) -> Option<Shifted<S>> {
+        let (entry, canonical_is_a, into_neighbor) = match (*from, *to) {
+            (
+                Slot::Canonical,
+                Slot::Neighbor {
+                    entry,
+                    canonical_is_a,
+                },
+            ) => (entry, canonical_is_a, true),
+            (
+                Slot::Neighbor {
+                    entry,
+                    canonical_is_a,
+                },
+                Slot::Canonical,
+            ) => (entry, canonical_is_a, false),
+            // Pairwise MIS shifts only between the canonical pixel and a neighbour.
+            _ => {
+                debug_assert!(false, "a reciprocal pair has no shift {from:?} → {to:?}");
+                return None;
+            }
+        };
+        let pair = self.table[entry].as_ref()?;
+        // canonical = a: into the neighbour is a→b; canonical = b: into the neighbour is b→a.
+        if (into_neighbor == canonical_is_a) != self.mismatched {
+            pair.a_into_b
+        } else {
+            pair.b_into_a
+        }
+    }
+}
+
+/// Offsets of one round: `count` distinct integer offsets in the disk of `radius` pixels, none
+/// zero and none the negation of another.
+fn round_offsets(radius: f32, count: usize, rng: &mut Pcg32) -> Vec<(i64, i64)> {
+    let mut out: Vec<(i64, i64)> = Vec::with_capacity(count);
+    let r = radius.max(1.0);
+    // Distinct offsets of the disk, up to sign: about 1.5 r² of them; ask for no more.
+    let wanted = count.min((1.5 * r * r) as usize).max(1);
+    let mut tries = 0;
+    while out.len() < wanted && tries < 1000 {
+        tries += 1;
+        let (u, v) = (2.0 * rng.next_f32() - 1.0, 2.0 * rng.next_f32() - 1.0);
+        if u * u + v * v > 1.0 {
+            continue;
+        }
+        let o = ((u * r).round() as i64, (v * r).round() as i64);
+        if o == (0, 0) || out.iter().any(|&q| q == o || q == (-o.0, -o.1)) {
+            continue;
+        }
+        out.push(o);
+    }
+    out
+}
+
+/// `R` reciprocal spatial rounds (see the module docs); the settings must use a pairwise MIS
+/// ([`shares_pair_shifts`]). Returns the rays traced.
+pub fn spatial<R: ReuseShift>(
+    reuse: &R,
+    settings: &ReuseSettings,
+    ctx: &PassContext,
+    gbuf: &GBuffer,
+    first_stage: u64,
+    current: &mut Vec<Reservoir<R::Sample>>,
+) -> u64 {
+    debug_assert!(shares_pair_shifts(settings.mis));
+    let (w, h) = (gbuf.width as i64, gbuf.height as i64);
+    let bands = Bands::new(gbuf.width);
+    let n = current.len();
+    let mut next = vec![Reservoir::empty(); n];
+    let mut rays = 0;
+    let pairs_per_round = (settings.neighbors as usize).div_ceil(2);
+    let mut table: Vec<Option<PairShifts<R::Sample>>> = Vec::new();
+    for round in 0..settings.spatial_rounds {
+        let stage = first_stage + u64::from(round);
+        let offsets = round_offsets(
+            settings.radius,
+            pairs_per_round,
+            &mut ctx.pass_rng(stage ^ 0x5eed_0ff5),
+        );
+        let m = offsets.len();
+        if m == 0 {
+            break;
+        }
+        let input = &*current;
+        // The pixel at offset `o` from `a`, if it is on the film.
+        let step = |a: usize, (ox, oy): (i64, i64)| -> Option<usize> {
+            let (x, y) = (a as i64 % w + ox, a as i64 / w + oy);
+            (x >= 0 && y >= 0 && x < w && y < h).then_some((y * w + x) as usize)
+        };
+        // The partner `a + o` of pixel `a`, when the pair exists (both hit, similar).
+        let partner = |a: usize, o: (i64, i64)| -> Option<usize> {
+            let b = step(a, o)?;
+            let (ra, rb) = (gbuf.receiver(a)?, gbuf.receiver(b)?);
+            ra.is_similar(rb, settings.normal_cos, settings.depth_tolerance)
+                .then_some(b)
+        };
+
+        // Phase 1: the shifts of every pair (a, a + o_j), at entry a·m + j.
+        table.clear();
+        table.resize(n * m, None);
+        rays += table
+            .par_chunks_mut(bands.pixels() * m)
+            .enumerate()
+            .map(|(band, out)| {
+                let mut rays = 0;
+                for (i, entries) in out.chunks_mut(m).enumerate() {
+                    let a = bands.first(band) + i;
+                    for (entry, &o) in entries.iter_mut().zip(&offsets) {
+                        let Some(b) = partner(a, o) else {
+                            continue;
+                        };
+                        let (da, db) = (reuse.domain(a, false), reuse.domain(b, false));
+                        let (ra, rb) = (&input[a], &input[b]);
+                        let map_a = reuse.map(ra);
+                        let a_into_b = ra
+                            .sample
+                            .as_ref()
+                            .and_then(|y| map_a.shift(da.borrow(), db.borrow(), y));
+                        rays += R::rays(&map_a);
+                        let map_b = reuse.map(rb);
+                        let b_into_a = rb
+                            .sample
+                            .as_ref()
+                            .and_then(|y| map_b.shift(db.borrow(), da.borrow(), y));
+                        rays += R::rays(&map_b);
+                        *entry = Some(PairShifts { a_into_b, b_into_a });
+                    }
+                }
+                rays
+            })
+            .sum::<u64>();
+
+        // Phase 2: every pixel resamples with its neighbours p + o_j and p − o_j.
+        let table = &table;
+        next.par_chunks_mut(bands.pixels())
+            .enumerate()
+            .for_each(|(band, out)| {
+                let mut neighbors = Vec::with_capacity(2 * m);
+                for (i, res) in out.iter_mut().enumerate() {
+                    let p = bands.first(band) + i;
+                    let canonical = &input[p];
+                    if gbuf.receiver(p).is_none() {
+                        *res = *canonical;
+                        continue;
+                    }
+                    neighbors.clear();
+                    for (j, &(ox, oy)) in offsets.iter().enumerate() {
+                        // Pair (p, p + o_j), entered at p; pair (p − o_j, p), entered at p − o_j.
+                        if table[p * m + j].is_some()
+                            && let Some(q) = step(p, (ox, oy))
+                        {
+                            let slot = Slot::Neighbor {
+                                entry: p * m + j,
+                                canonical_is_a: true,
+                            };
+                            neighbors.push((slot, &input[q]));
+                        }
+                        if let Some(q) = step(p, (-ox, -oy))
+                            && table[q * m + j].is_some()
+                        {
+                            let slot = Slot::Neighbor {
+                                entry: q * m + j,
+                                canonical_is_a: false,
+                            };
+                            neighbors.push((slot, &input[q]));
+                        }
+                    }
+                    let mut rng = ctx.stage_rng(p, stage);
+                    *res = resample(
+                        &CachedShifts {
+                            table,
+                            mismatched: settings.reciprocal_mismatched,
+                        },
+                        settings.mis,
+                        &Slot::Canonical,
+                        canonical,
+                        &neighbors,
+                        || rng.next_f32(),
+                    )
+                    .with_confidence_cap(settings.mcap);
+                }
+            });
+        std::mem::swap(current, &mut next);
+    }
+    rays
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offsets_are_distinct_up_to_sign_and_inside_the_disk() {
+        let mut rng = Pcg32::new(3, 5);
+        for radius in [1.0f32, 2.0, 3.0, 10.0, 30.0] {
+            let o = round_offsets(radius, 4, &mut rng);
+            assert!(!o.is_empty() && o.len() <= 4, "{radius}: {o:?}");
+            for (i, &(x, y)) in o.iter().enumerate() {
+                assert!((x, y) != (0, 0));
+                assert!(((x * x + y * y) as f32).sqrt() <= radius.max(1.0) + 0.75);
+                for &(x2, y2) in &o[..i] {
+                    assert!((x2, y2) != (x, y) && (x2, y2) != (-x, -y));
+                }
+            }
+        }
+    }
+}
