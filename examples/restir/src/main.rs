@@ -128,8 +128,8 @@ struct RestirArgs {
     candidates: Option<u32>,
     /// Where candidates' lights come from: power (the power-based sampler), tiles (per
     /// 16×16-pixel tile, mixed with a distance-aware table), bvh (the light hierarchy: per
-    /// receiver, by power, distance and orientation) or auto (bvh from 1000 emitters on, else
-    /// power) [default: auto].
+    /// receiver, by power, distance and orientation) or auto (decided from the scene; power at
+    /// every light count measured so far) [default: auto].
     #[arg(long)]
     light_sampler: Option<String>,
     /// restir-di: auto hands a scene of a few emitters with one dominant light to the path

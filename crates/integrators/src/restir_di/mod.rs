@@ -4,9 +4,10 @@
 //! One pass, for every pixel at once (`docs/RESTIR_DI.md`):
 //!
 //! 1. **Primary hits** ([`GBuffer`]), adding what the camera sees directly.
-//! 2. **Initial resampling**: `N_L` light candidates from the power-based light sampler or, from
-//!    [`settings::HIERARCHY_MIN_EMITTERS`] emitters on, the light hierarchy (a receiver-aware
-//!    descent with its exact probability; stratified selection either way), streamed into a
+//! 2. **Initial resampling**: `N_L` light candidates from the power-based light sampler or the
+//!    light hierarchy (a receiver-aware descent with its exact probability; from
+//!    [`settings::HIERARCHY_MIN_EMITTERS`] emitters on by default; stratified selection either
+//!    way), streamed into a
 //!    reservoir with weights `p̂/(N_L·p_L)`; the result
 //!    counts as confidence 1. Optional visibility reuse drops an occluded selection (biased).
 //! 3. **Temporal reuse** (optional): the same pixel's reservoir from the previous pass.
