@@ -192,7 +192,7 @@ impl LightBvh {
         let mut unbounded = Vec::new();
         let (mut bounded_power, mut unbounded_power) = (0.0f64, 0.0f64);
         for (i, (e, &w)) in entries.iter().zip(weights).enumerate() {
-            if !(w > 0.0) {
+            if w.is_nan() || w <= 0.0 {
                 continue;
             }
             let entry = i as u32;
