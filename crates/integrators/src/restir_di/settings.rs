@@ -15,9 +15,9 @@ use crate::reuse::settings::ReuseSettings;
 /// is the default candidate source. On the training family (10², 10³ and 10⁴ lights, equal CPU
 /// time, `docs/BENCHMARKS.md`, "Light hierarchy") a hierarchy pass costs 1.6–3.0× a power-table
 /// pass and its candidates make a pass only 1.3–1.7× better, so no measured light count
-/// qualifies: `auto` is the power table everywhere until the descent gets cheaper, and this
-/// bound is where the rule lives.
-pub const HIERARCHY_MIN_EMITTERS: usize = usize::MAX;
+/// qualifies (`None`): `auto` is the power table everywhere until the descent gets cheaper,
+/// and this bound is where the rule lives.
+pub const HIERARCHY_MIN_EMITTERS: Option<usize> = None;
 
 /// The share of light selections one light must hold for ReSTIR DI to hand the scene to the
 /// path tracer at its defaults (`fallback = auto`), when the emitter table also holds at most
@@ -139,11 +139,12 @@ impl RestirDiSettings {
     /// [`DOMINANT_LIGHT_SHARE`] of the light selections.
     pub fn resolve(&mut self, features: &SceneFeatures) -> Option<String> {
         if self.light_sampler == LightSampler::Auto {
-            self.light_sampler = if features.emitter_count >= HIERARCHY_MIN_EMITTERS {
-                LightSampler::Bvh
-            } else {
-                LightSampler::Power
-            };
+            self.light_sampler =
+                if HIERARCHY_MIN_EMITTERS.is_some_and(|m| features.emitter_count >= m) {
+                    LightSampler::Bvh
+                } else {
+                    LightSampler::Power
+                };
         }
         let share = features.largest_light_share;
         let applies = self.fallback == Fallback::Auto && !self.configured;
