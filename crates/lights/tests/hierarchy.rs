@@ -152,7 +152,7 @@ fn back_facing_lights_get_no_probability() {
     let mut back = 0;
     for e in 0..set.emitter_count() {
         let light = set.entry_light(e) as usize;
-        if light < 300 && light % 3 == 0 {
+        if light < 300 && light.is_multiple_of(3) {
             assert_eq!(set.hierarchy_pmf(&shapes, p, n, e), 0.0, "entry {e}");
             back += 1;
         }
@@ -217,9 +217,9 @@ fn pmf_sums_to_one_over_omnidirectional_lights() {
     let mut rng = Pcg32::new(5, 5);
     let mut shapes = Vec::new();
     let mut lights = Vec::new();
-    for i in 0..257 {
+    for i in 0..257u32 {
         let c = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 6.0 - 3.0;
-        if i % 4 == 0 {
+        if i.is_multiple_of(4) {
             lights.push(Light::Point {
                 position: c,
                 intensity: Vec3::splat(1.0 + 100.0 * rng.next_f32()),
