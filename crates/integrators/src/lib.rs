@@ -80,6 +80,9 @@ pub struct MadeIntegrator {
     pub integrator: Box<dyn Integrator>,
     /// Scene or command-line parameters the estimator does not use, with where they were given.
     pub unused_params: Vec<Param>,
+    /// What was decided from the scene summary that a user should hear about (one line each;
+    /// the binary prints them unless `--quiet`).
+    pub notes: Vec<String>,
 }
 
 /// Why [`make_integrator`] failed.
@@ -138,6 +141,7 @@ pub fn make_integrator(
         ParamSet::new()
     };
     params.extend(&options.params);
+    let mut notes = Vec::new();
     let (integrator, unused_params): (Box<dyn Integrator>, _) = match name {
         "path" => (
             Box::new(PathIntegrator { settings }),
@@ -146,7 +150,14 @@ pub fn make_integrator(
         "restir-di" => {
             let mut s = RestirDiSettings::new(settings);
             let unused = s.apply(&params)?;
-            (Box::new(RestirDiIntegrator::new(s)), unused)
+            let fallback = s.resolve(&scene.features);
+            if let Some(why) = &fallback {
+                notes.push(format!("restir-di: {why}"));
+            }
+            (
+                Box::new(RestirDiIntegrator::new(s).with_fallback(fallback)),
+                unused,
+            )
         }
         "restir-pt" => {
             let mut s = RestirPtSettings::new(settings);
@@ -158,6 +169,7 @@ pub fn make_integrator(
     Ok(MadeIntegrator {
         integrator,
         unused_params,
+        notes,
     })
 }
 

@@ -3,10 +3,18 @@
 //! light and a dim environment), the average of many independent renders matches the path
 //! tracer for every unbiased MIS scheme, block by block, within the standard error measured
 //! *across seeds* (spatial reuse correlates the pixels of one render). The biased options
-//! (constant 1/M weights, visibility reuse) must fail the same test.
+//! (constant 1/M weights, visibility reuse) must fail the same test. The light hierarchy as
+//! the candidate source (`light_sampler = bvh`) passes it, and its negative control (the
+//! hierarchy's candidates weighted by the power table's pmf) fails it. The fallback to the path
+//! tracer (one dominant light, ReSTIR DI at its defaults) passes it too.
 
+use std::sync::atomic::AtomicBool;
+
+use restir_integrators::restir_di::LightSampler;
 use restir_integrators::reuse::MIS_NAMES;
-use restir_integrators::{IntegratorOptions, make_integrator};
+use restir_integrators::{
+    IntegratorOptions, RenderJob, RestirDiIntegrator, RestirDiSettings, make_integrator, render,
+};
 use restir_scene::{Scene, parse_ron};
 
 mod common;
@@ -284,4 +292,89 @@ fn xml_restir_integrator_and_parameters() {
         make_integrator(&scene, &options).unwrap().integrator.name(),
         "path"
     );
+}
+
+/// The light hierarchy as the candidate source is unbiased (alone and with two rounds of reuse);
+/// weighting its candidates by the power table's pmf instead of the hierarchy's (the wrong
+/// density) is caught by the same test.
+#[test]
+fn light_hierarchy_is_unbiased_and_a_wrong_pmf_is_caught() {
+    let scene = scene();
+    let reference = direct_reference(&scene);
+    for params in [
+        &[("light_sampler", "bvh"), ("candidates", "4")][..],
+        &[("light_sampler", "bvh"), ("spatial_rounds", "2")][..],
+    ] {
+        let z = max_z(&statistics(&scene, "restir-di", params, 1, 200), &reference);
+        eprintln!("{params:?}: max |z| = {z:.2}");
+        assert!(z < Z_MAX, "{params:?}: max |z| = {z:.2}");
+    }
+    let mut wrong =
+        RestirDiSettings::new(restir_integrators::path::PathSettings::from_scene(&scene));
+    wrong.light_sampler = LightSampler::BvhWithPowerPmf;
+    wrong.candidates = 4;
+    let render_one = |seed| {
+        let integrator = RestirDiIntegrator::new(wrong);
+        let job = RenderJob {
+            spp: 1,
+            seed,
+            ..RenderJob::default()
+        };
+        render(
+            &scene,
+            &integrator,
+            &job,
+            &AtomicBool::new(false),
+            &mut |_, _| {},
+        )
+        .image
+    };
+    let z = max_z(
+        &block_statistics(render_one, 200, seed_base(), BLOCK),
+        &reference,
+    );
+    eprintln!("hierarchy with the power pmf: max |z| = {z:.2}");
+    assert!(
+        z > 2.0 * Z_MAX,
+        "the wrong pmf should be visibly biased, max |z| = {z:.2}"
+    );
+}
+
+/// At its defaults on this scene (the small bright sphere takes more than half of the light
+/// selections) ReSTIR DI hands the scene to the path tracer, says so, and stays unbiased;
+/// any ReSTIR DI parameter, or `fallback = off`, keeps ReSTIR DI.
+#[test]
+fn dominant_light_falls_back_to_the_path_tracer() {
+    let scene = scene();
+    assert!(
+        scene.features.largest_light_share >= 0.5,
+        "{:?}",
+        scene.features
+    );
+    let made = |params: &[(&str, &str)]| {
+        let options = IntegratorOptions {
+            params: params.into(),
+            name: Some("restir-di".into()),
+            ..Default::default()
+        };
+        make_integrator(&scene, &options).unwrap()
+    };
+    let m = made(&[]);
+    let d = m.integrator.describe();
+    assert!(d.contains("; estimator: path max_depth=2"), "{d}");
+    assert_eq!(m.notes.len(), 1, "{:?}", m.notes);
+    assert!(
+        m.notes[0].contains("the path tracer renders it"),
+        "{:?}",
+        m.notes
+    );
+    for params in [&[("fallback", "off")][..], &[("candidates", "8")][..]] {
+        let m = made(params);
+        assert!(m.notes.is_empty(), "{params:?}: {:?}", m.notes);
+        assert!(!m.integrator.describe().contains("estimator:"));
+    }
+    let reference = direct_reference(&scene);
+    let z = max_z(&statistics(&scene, "restir-di", &[], 1, 200), &reference);
+    eprintln!("fallback: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "fallback: max |z| = {z:.2}");
 }

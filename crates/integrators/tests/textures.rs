@@ -88,8 +88,15 @@ fn estimate(scene: &Scene, integrator: &str, seeds: u64, spp: u32) -> [[(f64, f6
         let n = checks.iter().filter(|c| **c == Some(k)).count();
         assert!(n >= 40, "region {k} has only {n} whole pixels");
     }
+    // ReSTIR DI itself, not the path tracer it hands a one-light scene to at its defaults.
+    let params: &[(&str, &str)] = if integrator == "restir-di" {
+        &[("fallback", "off")]
+    } else {
+        &[]
+    };
     let options = IntegratorOptions {
         name: Some(integrator.into()),
+        params: params.into(),
         ..Default::default()
     };
     let made = make_integrator(scene, &options).unwrap();

@@ -8,20 +8,26 @@
 //!   the selection probability; [`LightSet::pdf_sa`] returns exactly that density for a point
 //!   reached another way (by BSDF sampling), and [`LightSet::pmf`] the selection probability.
 //!
+//! - [`LightSet::sample_hierarchy`]: the same lights picked for one receiver by a light hierarchy
+//!   (`bvh.rs`, built on first use) with receiver-aware importance; its exact probabilities
+//!   are [`LightSet::hierarchy_pmf`].
+//!
 //! Measures: `pdf_sa` is per unit solid angle at the receiving point; for delta lights (point,
 //! directional) it is the discrete selection probability and `delta` is set.
 
+mod bvh;
 mod envmap;
 mod table;
 
 pub use envmap::{EnvMap, EnvMapError};
 
+use bvh::LightBvh;
 use core::f32::consts::PI;
 use glam::{Vec2, Vec3};
 use restir_geometry::area_to_solid_angle;
 use restir_geometry::{PositionSample, Shape};
 use restir_sampling::{luminance, warp};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 use table::{Emitter, EmitterTable};
 
 /// An emitter.
@@ -142,6 +148,8 @@ pub struct LightSet {
     /// The image of the `Envmap` light, if there is one.
     envmap: Option<Arc<EnvMap>>,
     scene_radius: f32,
+    /// The light hierarchy over the table's entries, built on first use.
+    hierarchy: OnceLock<LightBvh>,
 }
 
 fn valid(v: Vec3) -> bool {
@@ -265,6 +273,7 @@ impl LightSet {
             envmap: envmap.map(Arc::new),
             scene_radius,
             mesh_areas,
+            hierarchy: OnceLock::new(),
         };
         set.update_area_pdfs();
         Ok(set)
@@ -529,6 +538,141 @@ impl LightSet {
                 })
             }
         }
+    }
+
+    /// The light hierarchy over the table's entries (built on the first call; `shapes` are the
+    /// scene's, as for every other call).
+    fn hierarchy(&self, shapes: &[Shape]) -> &LightBvh {
+        self.hierarchy.get_or_init(|| {
+            LightBvh::new(
+                &self.lights,
+                shapes,
+                self.table.entries(),
+                self.table.weights(),
+            )
+        })
+    }
+
+    /// Builds the light hierarchy now (else the first [`LightSet::sample_hierarchy`] does);
+    /// returns its node count.
+    pub fn build_hierarchy(&self, shapes: &[Shape]) -> usize {
+        self.hierarchy(shapes).node_count()
+    }
+
+    /// Picks a light for a receiver at `ref_p` with normal `ref_n` (zero if unknown) by the
+    /// light hierarchy (`u_select ∈ [0, 1)`, the environment keeping its share), and a point on
+    /// it (`u`). Returns the sample, whose `pdf_sa` includes the hierarchy's selection
+    /// probability, and the density [`LightSet::sample`] (power selection) would give the same
+    /// point. `None` if nothing can light the receiver or the point is on a back face.
+    #[inline]
+    pub fn sample_hierarchy(
+        &self,
+        shapes: &[Shape],
+        ref_p: Vec3,
+        ref_n: Vec3,
+        u_select: f64,
+        u: Vec2,
+    ) -> Option<(LightSample, f32)> {
+        let share = self.table.env_share() as f64;
+        if let Some(env) = self.environment
+            && u_select < share
+        {
+            let s = self.sample_light(shapes, env, ref_p, u)?;
+            let pdf = s.pdf_sa * self.table.pmf(env);
+            return Some((LightSample { pdf_sa: pdf, ..s }, pdf));
+        }
+        let v = if share > 0.0 {
+            ((u_select - share) / (1.0 - share)).clamp(0.0, 1.0 - f64::EPSILON)
+        } else {
+            u_select
+        };
+        let (entry, pmf) = self.hierarchy(shapes).sample(ref_p, ref_n, v)?;
+        let pmf = pmf * (1.0 - self.table.env_share());
+        match self.table.entries()[entry as usize] {
+            Emitter::Triangle {
+                light,
+                prim,
+                ref p,
+                ng,
+                n,
+                smooth,
+            } => {
+                let Light::Area { shape, radiance } = self.lights[light as usize] else {
+                    return None;
+                };
+                let ps =
+                    Emitter::triangle_point(p, ng, n, smooth, &shapes[shape as usize], prim, u);
+                let area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
+                let pdf_sa = area_to_solid_angle(pmf / area, ref_p, ps.p, ps.ng)?;
+                let power_pdf =
+                    area_to_solid_angle(self.area_pdf[light as usize], ref_p, ps.p, ps.ng)?;
+                Some((
+                    area_light_sample(light, radiance, ref_p, ps, pdf_sa)?,
+                    power_pdf,
+                ))
+            }
+            Emitter::Whole { light } => {
+                let s = self.sample_light(shapes, light, ref_p, u)?;
+                let power_pdf = s.pdf_sa * self.table.pmf(light);
+                Some((
+                    LightSample {
+                        pdf_sa: s.pdf_sa * pmf,
+                        ..s
+                    },
+                    power_pdf,
+                ))
+            }
+        }
+    }
+
+    /// Picks a local entry (an emissive triangle or another light; the environment aside) for a
+    /// receiver at `ref_p` with normal `ref_n` by the light hierarchy: `(entry, probability)`,
+    /// the probability among local entries. The entries are numbered `0..emitter_count()`.
+    pub fn hierarchy_select(
+        &self,
+        shapes: &[Shape],
+        ref_p: Vec3,
+        ref_n: Vec3,
+        u: f64,
+    ) -> Option<(usize, f32)> {
+        let (e, pmf) = self.hierarchy(shapes).sample(ref_p, ref_n, u)?;
+        Some((e as usize, pmf))
+    }
+
+    /// The probability that [`LightSet::hierarchy_select`] picks local entry `entry` for a
+    /// receiver at `ref_p` with normal `ref_n` (a second descent of the hierarchy, exact: the
+    /// same factors as the sampling descent multiplies).
+    pub fn hierarchy_pmf(&self, shapes: &[Shape], ref_p: Vec3, ref_n: Vec3, entry: usize) -> f32 {
+        self.hierarchy(shapes).pmf(ref_p, ref_n, entry as u32)
+    }
+
+    /// The probability that the power table picks local entry `entry` among the local entries.
+    pub fn entry_power_pmf(&self, entry: usize) -> f32 {
+        let w = self.table.weights();
+        let total: f64 = w.iter().map(|&x| x as f64).sum();
+        w.get(entry).map_or(0.0, |&x| (x as f64 / total) as f32)
+    }
+
+    /// The light local entry `entry` belongs to.
+    pub fn entry_light(&self, entry: usize) -> u32 {
+        self.table.entries()[entry].light()
+    }
+
+    /// The local entry of light `light`'s primitive `prim` (a triangle of a mesh light; `prim`
+    /// is ignored for other lights): entries are ordered by light, then by triangle.
+    pub fn entry_of(&self, light: u32, prim: u32) -> Option<usize> {
+        let key = |e: &Emitter| match *e {
+            Emitter::Triangle { light, prim, .. } => (light, prim),
+            Emitter::Whole { light } => (light, 0),
+        };
+        let prim = match self.table.entries().iter().find(|e| e.light() == light)? {
+            Emitter::Triangle { .. } => prim,
+            Emitter::Whole { .. } => 0,
+        };
+        self.table
+            .entries()
+            .binary_search_by(|e| key(e).cmp(&(light, prim)))
+            .ok()
     }
 
     /// The solid-angle density, including the selection probability, with which

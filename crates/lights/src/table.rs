@@ -119,6 +119,8 @@ enum Selection {
 #[derive(Clone, Debug)]
 pub(crate) struct EmitterTable {
     entries: Vec<Emitter>,
+    /// Each entry's selection weight (its power).
+    weights: Vec<f32>,
     selection: Selection,
     /// Per light, the probability that a local selection picks one of its entries.
     local_pmf: Vec<f32>,
@@ -207,6 +209,7 @@ impl EmitterTable {
         };
         let mut table = Self {
             entries,
+            weights,
             selection,
             local_pmf,
             environment,
@@ -249,6 +252,16 @@ impl EmitterTable {
     /// Number of local entries.
     pub fn len(&self) -> usize {
         self.entries.len()
+    }
+
+    /// The local entries.
+    pub fn entries(&self) -> &[Emitter] {
+        &self.entries
+    }
+
+    /// Each local entry's selection weight (its power).
+    pub fn weights(&self) -> &[f32] {
+        &self.weights
     }
 
     /// Probability that a selection picks light `light` (any of its entries).

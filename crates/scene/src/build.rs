@@ -428,6 +428,8 @@ impl Scene {
                 .iter()
                 .any(|l| matches!(l, Light::Point { .. } | Light::Directional { .. })),
             light_count: light_set.len(),
+            emitter_count: light_set.emitter_count(),
+            largest_light_share: 0.0,
             environment_share: None,
         };
 
@@ -445,6 +447,9 @@ impl Scene {
             features,
         };
         scene.features.environment_share = scene.decide_environment_share();
+        scene.features.largest_light_share = (0..scene.lights.len() as u32)
+            .map(|l| scene.lights.pmf(l))
+            .fold(0.0, f32::max);
         Ok((scene, warnings))
     }
 }

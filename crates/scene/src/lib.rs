@@ -60,6 +60,13 @@ pub struct SceneFeatures {
     pub has_delta_lights: bool,
     /// Number of lights.
     pub light_count: usize,
+    /// Entries of the emitter table (one per emissive triangle, one per other light with
+    /// power; the environment aside): what a light selection chooses among.
+    pub emitter_count: usize,
+    /// The largest probability with which a light selection picks one light (a mesh light with
+    /// all its triangles; the environment with its share), after the environment share is
+    /// decided; 0 without lights.
+    pub largest_light_share: f32,
     /// The environment's share of light samples, when there is an environment beside local
     /// lights (decided from a pilot at the camera's primary hits).
     pub environment_share: Option<EnvironmentShare>,

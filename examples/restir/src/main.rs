@@ -126,10 +126,16 @@ struct RestirArgs {
     /// restir-pt [default: 2].
     #[arg(long)]
     candidates: Option<u32>,
-    /// Where candidates' lights come from: power (the power-based sampler) or tiles (per
-    /// 16×16-pixel tile, mixed with a distance-aware table) [default: power].
+    /// Where candidates' lights come from: power (the power-based sampler), tiles (per
+    /// 16×16-pixel tile, mixed with a distance-aware table), bvh (the light hierarchy: per
+    /// receiver, by power, distance and orientation) or auto (decided from the scene; power at
+    /// every light count measured so far) [default: auto].
     #[arg(long)]
     light_sampler: Option<String>,
+    /// restir-di: auto hands a scene of a few emitters with one dominant light to the path
+    /// tracer when no other ReSTIR DI option is given; off never does [default: auto].
+    #[arg(long)]
+    fallback: Option<String>,
     /// BSDF samples per pixel, MIS-combined with the reservoirs [default: 1].
     #[arg(long)]
     bsdf_candidates: Option<u32>,
@@ -187,6 +193,7 @@ impl RestirArgs {
             "light_sampler",
             self.light_sampler.clone().map(ParamValue::Text),
         );
+        put("fallback", self.fallback.clone().map(ParamValue::Text));
         put(
             "bsdf_candidates",
             self.bsdf_candidates.map(ParamValue::Count),
@@ -295,6 +302,9 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
     let made = make_integrator(&scene, &options).map_err(|e| e.to_string())?;
     strict::check_flags_used(&scene, &made)?;
     if !args.quiet {
+        for note in &made.notes {
+            say_err!("{note}");
+        }
         for p in &made.unused_params {
             say_err!(
                 "warning: integrator '{}' does not use the parameter '{}'",

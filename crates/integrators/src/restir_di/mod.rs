@@ -4,8 +4,11 @@
 //! One pass, for every pixel at once (`docs/RESTIR_DI.md`):
 //!
 //! 1. **Primary hits** ([`GBuffer`]), adding what the camera sees directly.
-//! 2. **Initial resampling**: `N_L` light candidates from the power-based light sampler
-//!    (stratified selection), streamed into a reservoir with weights `p̂/(N_L·p_L)`; the result
+//! 2. **Initial resampling**: `N_L` light candidates from the power-based light sampler or the
+//!    light hierarchy (a receiver-aware descent with its exact probability; from
+//!    [`settings::HIERARCHY_MIN_EMITTERS`] emitters on by default; stratified selection either
+//!    way), streamed into a
+//!    reservoir with weights `p̂/(N_L·p_L)`; the result
 //!    counts as confidence 1. Optional visibility reuse drops an occluded selection (biased).
 //! 3. **Temporal reuse** (optional): the same pixel's reservoir from the previous pass.
 //! 4. **Spatial reuse**: `R` rounds of `k` neighbours from a low-discrepancy disk pattern with a
@@ -19,6 +22,10 @@
 //!    weighted by the balance heuristic against the light strategy (the exact split is explained
 //!    in [`mod@target`]); the first BSDF sample continues as a path-traced path when
 //!    `max_depth > 2` (indirect light) or when it followed a delta lobe.
+//!
+//! A scene of a few emitters where one light takes most light selections goes to the path
+//! tracer instead (`fallback = auto`, [`RestirDiSettings::resolve`]): the estimator is then
+//! exactly the path tracer's, and `describe` (hence `--stats`) says so.
 
 mod settings;
 pub mod target;
@@ -31,11 +38,14 @@ use restir_gris::{Reservoir, ShiftMap, Shifted, StreamingReservoir};
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
-pub use settings::{LightSampler, RestirDiSettings};
+pub use settings::{
+    DOMINANT_LIGHT_SHARE, FEW_EMITTERS, Fallback, HIERARCHY_MIN_EMITTERS, LightSampler,
+    RestirDiSettings,
+};
 
 use crate::bands::Bands;
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
-use crate::render::{Integrator, PassContext};
+use crate::render::{Integrator, PassContext, PathIntegrator};
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::light_point::{Contact, LightPoint, Resolved, contact, resolve};
 use crate::reuse::neighbors::NeighborPattern;
@@ -63,6 +73,8 @@ pub struct RestirDiIntegrator {
     pattern: NeighborPattern,
     history: HistorySlot<LightPoint>,
     clock: StageClock,
+    /// The path tracer that renders instead, and why (a scene with one dominant light).
+    fallback: Option<(PathIntegrator, String)>,
 }
 
 /// The identity shift between pixels: the sample stays on the light, `J = 1`; only the target
@@ -159,7 +171,27 @@ impl RestirDiIntegrator {
             pattern: NeighborPattern::new(),
             history: HistorySlot::default(),
             clock: StageClock::default(),
+            fallback: None,
         }
+    }
+
+    /// The same integrator rendering with the path tracer instead when `why` says so (what
+    /// [`RestirDiSettings::resolve`] returned).
+    pub fn with_fallback(mut self, why: Option<String>) -> Self {
+        self.fallback = why.map(|why| {
+            (
+                PathIntegrator {
+                    settings: self.settings.path,
+                },
+                why,
+            )
+        });
+        self
+    }
+
+    /// Whether the path tracer renders in place of ReSTIR DI.
+    pub fn falls_back(&self) -> bool {
+        self.fallback.is_some()
     }
 
     /// The settings.
@@ -201,12 +233,32 @@ impl RestirDiIntegrator {
             // The candidate, its solid-angle source density (selection included) and the
             // power sampler's density (which the light/BSDF split uses, whatever picked it).
             let (ls, source_pdf_sa, power_pdf_sa) = match tile {
-                None => {
+                None if !self.settings.light_sampler.is_hierarchy() => {
                     let Some(ls) = scene.lights.sample(&scene.shapes, r.p, u_select, u_light)
                     else {
                         continue;
                     };
                     (ls, ls.pdf_sa, ls.pdf_sa)
+                }
+                None => {
+                    // 48 bits for the descent: the stratified number and 24 more random ones.
+                    let u =
+                        (i as f64 + u0 as f64 + rng.next_f32() as f64 / 16_777_216.0) / n as f64;
+                    let Some((ls, power_pdf_sa)) = scene.lights.sample_hierarchy(
+                        &scene.shapes,
+                        r.p,
+                        r.n,
+                        u.min(1.0 - f64::EPSILON),
+                        u_light,
+                    ) else {
+                        continue;
+                    };
+                    let source = if self.settings.light_sampler == LightSampler::Bvh {
+                        ls.pdf_sa
+                    } else {
+                        power_pdf_sa // the negative control's wrong density
+                    };
+                    (ls, source, power_pdf_sa)
                 }
                 Some(table) => {
                     let Some((light, pmf, power_pmf)) = tiles::select(scene, table, u_select)
@@ -377,7 +429,9 @@ impl Integrator for RestirDiIntegrator {
             s.reuse.temporal,
             s.visibility_reuse,
             if s.is_unbiased() { "" } else { " (biased)" }
-        )
+        ) + &self.fallback.as_ref().map_or(String::new(), |(p, why)| {
+            format!("; estimator: {} ({why})", p.describe())
+        })
     }
 
     fn stage_seconds(&self) -> Vec<(&'static str, f64)> {
@@ -385,10 +439,16 @@ impl Integrator for RestirDiIntegrator {
     }
 
     fn halo(&self) -> u32 {
+        if self.fallback.is_some() {
+            return 0;
+        }
         self.settings.reuse.halo()
     }
 
     fn buffer_bytes_per_pixel(&self) -> usize {
+        if self.fallback.is_some() {
+            return 0;
+        }
         let reservoirs = if self.settings.reuse.temporal { 3 } else { 2 };
         let hits = if self.settings.reuse.temporal { 2 } else { 1 };
         let hit_bytes = std::mem::size_of::<Receiver>() + std::mem::size_of::<Vec3>();
@@ -399,6 +459,9 @@ impl Integrator for RestirDiIntegrator {
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
+        if let Some((path, _)) = &self.fallback {
+            return path.render_pass(scene, ctx, accum);
+        }
         let s = &self.settings;
         let reuse = &s.reuse;
         let n = accum.len();
@@ -413,9 +476,12 @@ impl Integrator for RestirDiIntegrator {
             // Initial resampling.
             let start = std::time::Instant::now();
             let light_tiles = match s.light_sampler {
-                LightSampler::Power => None,
                 LightSampler::Tiles => tiles::LightTiles::build(scene, &gbuf),
+                _ => None,
             };
+            if s.light_sampler.is_hierarchy() {
+                scene.lights.build_hierarchy(&scene.shapes);
+            }
             let mut current = vec![DiReservoir::empty(); n];
             rays += current
                 .par_chunks_mut(bands.pixels())

@@ -1,35 +1,94 @@
 //! ReSTIR DI settings and their parsing from named parameters (XML scenes and the command line
 //! use the same names; the names Lajolla ReSTIR ports use are accepted too). The reuse settings
-//! are [`ReuseSettings`].
+//! are [`ReuseSettings`]. Two defaults are rules of the scene summary, decided once when the
+//! integrator is made ([`RestirDiSettings::resolve`]): the candidate source (the light hierarchy
+//! above [`HIERARCHY_MIN_EMITTERS`] emitters) and the path tracer in place of ReSTIR DI when one
+//! light dominates ([`DOMINANT_LIGHT_SHARE`]).
+
+use restir_scene::SceneFeatures;
 
 use crate::params::{Param, ParamError, ParamSet};
 use crate::path::PathSettings;
 use crate::reuse::settings::ReuseSettings;
 
+/// Emitter-table entries (emissive triangles and other lights) from which the light hierarchy
+/// is the default candidate source. On the training family (10², 10³ and 10⁴ lights, equal CPU
+/// time, `docs/BENCHMARKS.md`, "Light hierarchy") a hierarchy pass costs 1.6–3.0× a power-table
+/// pass and its candidates make a pass only 1.3–1.7× better, so no measured light count
+/// qualifies (`None`): `auto` is the power table everywhere until the descent gets cheaper,
+/// and this bound is where the rule lives.
+pub const HIERARCHY_MIN_EMITTERS: Option<usize> = None;
+
+/// The share of light selections one light must hold for ReSTIR DI to hand the scene to the
+/// path tracer at its defaults (`fallback = auto`), when the emitter table also holds at most
+/// [`FEW_EMITTERS`] entries: with one dominant light made of a few surfaces the reservoirs have
+/// little to choose from and their cost is not repaid (`docs/BENCHMARKS.md`, "Never worse").
+/// A dominant mesh light of thousands of small triangles is a many-light problem and keeps
+/// ReSTIR DI.
+pub const DOMINANT_LIGHT_SHARE: f32 = 0.5;
+
+/// At most this many emitter-table entries for the fallback ([`DOMINANT_LIGHT_SHARE`]).
+pub const FEW_EMITTERS: usize = 64;
+
 /// Where initial candidates' lights come from (`--light-sampler`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LightSampler {
-    /// The power-based light sampler (the paper's choice; default).
+    /// Decided from the scene: [`LightSampler::Bvh`] from [`HIERARCHY_MIN_EMITTERS`] emitters
+    /// on, else [`LightSampler::Power`] (the default; [`RestirDiSettings::resolve`]).
+    Auto,
+    /// The power-based light sampler (the paper's choice).
     Power,
     /// Per 16×16-pixel tile, a mixture of a distance-aware table and the power sampler
     /// (see [`super::tiles`]).
     Tiles,
+    /// The light hierarchy: per receiver, a descent of a light BVH by power, distance and
+    /// orientation, with its exact probability (`restir_lights::LightSet::sample_hierarchy`).
+    Bvh,
+    /// A negative control for the tests, never a choice: candidates from the hierarchy weighted
+    /// as if the power table had drawn them (biased).
+    #[doc(hidden)]
+    BvhWithPowerPmf,
 }
 
 impl LightSampler {
     /// The names `--light-sampler` takes.
     pub const NAMES: &[(&str, LightSampler)] = &[
+        ("auto", LightSampler::Auto),
         ("power", LightSampler::Power),
         ("tiles", LightSampler::Tiles),
+        ("bvh", LightSampler::Bvh),
     ];
+
+    /// Whether candidates come from the light hierarchy.
+    pub fn is_hierarchy(self) -> bool {
+        matches!(self, LightSampler::Bvh | LightSampler::BvhWithPowerPmf)
+    }
 
     /// The name `--light-sampler` takes.
     pub fn name(self) -> &'static str {
         match self {
+            LightSampler::Auto => "auto",
             LightSampler::Power => "power",
             LightSampler::Tiles => "tiles",
+            LightSampler::Bvh => "bvh",
+            LightSampler::BvhWithPowerPmf => "bvh-with-power-pmf",
         }
     }
+}
+
+/// Whether ReSTIR DI may hand a scene that does not suit it to the path tracer (`fallback`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fallback {
+    /// When one light holds at least [`DOMINANT_LIGHT_SHARE`] of the selections among at most
+    /// [`FEW_EMITTERS`] emitters and no other ReSTIR DI parameter is given (default).
+    Auto,
+    /// Never: ReSTIR DI whatever the scene.
+    Off,
+}
+
+impl Fallback {
+    /// The names `fallback` takes.
+    pub const NAMES: &[(&str, Fallback)] = &[("auto", Fallback::Auto), ("off", Fallback::Off)];
 }
 
 /// Everything ReSTIR DI can be told.
@@ -49,6 +108,11 @@ pub struct RestirDiSettings {
     pub bsdf_candidates: u32,
     /// Zero an occluded initial candidate, keeping its confidence. Biased at shadow edges.
     pub visibility_reuse: bool,
+    /// Whether a scene with one dominant light goes to the path tracer (default auto).
+    pub fallback: Fallback,
+    /// Whether some ReSTIR DI parameter was given ([`RestirDiSettings::apply`]): then
+    /// `fallback = auto` keeps ReSTIR DI (the user asked for a configured ReSTIR DI).
+    pub configured: bool,
 }
 
 impl RestirDiSettings {
@@ -59,32 +123,83 @@ impl RestirDiSettings {
             path,
             reuse: ReuseSettings::default(),
             candidates: 8,
-            light_sampler: LightSampler::Power,
+            light_sampler: LightSampler::Auto,
             bsdf_candidates: 1,
             visibility_reuse: false,
+            fallback: Fallback::Auto,
+            configured: false,
         }
+    }
+
+    /// Decides the scene-dependent defaults from the scene summary: an `auto` light sampler
+    /// becomes the hierarchy from [`HIERARCHY_MIN_EMITTERS`] emitters on (else the power
+    /// table). Returns why the path tracer should render the scene instead: when `fallback` is
+    /// auto, no other ReSTIR DI parameter was given (ReSTIR DI at its defaults), the emitter
+    /// table holds at most [`FEW_EMITTERS`] entries and one light holds at least
+    /// [`DOMINANT_LIGHT_SHARE`] of the light selections.
+    pub fn resolve(&mut self, features: &SceneFeatures) -> Option<String> {
+        if self.light_sampler == LightSampler::Auto {
+            self.light_sampler =
+                if HIERARCHY_MIN_EMITTERS.is_some_and(|m| features.emitter_count >= m) {
+                    LightSampler::Bvh
+                } else {
+                    LightSampler::Power
+                };
+        }
+        let share = features.largest_light_share;
+        let applies = self.fallback == Fallback::Auto && !self.configured;
+        let few = features.emitter_count <= FEW_EMITTERS;
+        (applies && few && share >= DOMINANT_LIGHT_SHARE).then(|| {
+            format!(
+                "one light takes {:.0}% of the light selections (>= {:.0}%, {} emitters <= {}): \
+                 the path tracer renders it (fallback = off keeps ReSTIR DI)",
+                100.0 * share,
+                100.0 * DOMINANT_LIGHT_SHARE,
+                features.emitter_count,
+                FEW_EMITTERS
+            )
+        })
     }
 
     /// Whether the estimator is unbiased with these settings.
     pub fn is_unbiased(&self) -> bool {
-        self.reuse.is_unbiased() && !self.visibility_reuse
+        self.reuse.is_unbiased()
+            && !self.visibility_reuse
+            && self.light_sampler != LightSampler::BvhWithPowerPmf
     }
 
     /// Applies `params` in order (later ones win). Names are case-insensitive, `-` and `_` are
     /// the same. Returns the parameters it did not know, for the caller to warn about.
     pub fn apply(&mut self, params: &ParamSet) -> Result<Vec<Param>, ParamError> {
         params.apply(|key, p| {
-            match key {
+            let used = match key {
                 "candidates" | "light_candidates" | "initial_candidates" | "num_candidates"
-                | "reservoir_size" | "reservior_size" => self.candidates = p.count(1)?,
-                "light_sampler" => {
-                    self.light_sampler = p.choice(LightSampler::NAMES, "power or tiles")?;
+                | "reservoir_size" | "reservior_size" => {
+                    self.candidates = p.count(1)?;
+                    true
                 }
-                "bsdf_candidates" | "brdf_candidates" => self.bsdf_candidates = p.count(0)?,
-                "visibility_reuse" => self.visibility_reuse = p.boolean()?,
-                _ => return self.reuse.apply(key, p),
-            }
-            Ok(true)
+                "light_sampler" => {
+                    self.light_sampler =
+                        p.choice(LightSampler::NAMES, "auto, power, tiles or bvh")?;
+                    true
+                }
+                "fallback" => {
+                    self.fallback = p.choice(Fallback::NAMES, "auto or off")?;
+                    return Ok(true);
+                }
+                "bsdf_candidates" | "brdf_candidates" => {
+                    self.bsdf_candidates = p.count(0)?;
+                    true
+                }
+                "visibility_reuse" => {
+                    self.visibility_reuse = p.boolean()?;
+                    true
+                }
+                _ => self.reuse.apply(key, p)?,
+            };
+            // A ReSTIR DI parameter given: the user configured ReSTIR DI, keep it.
+            self.configured |= used;
+            Ok(used)
         })
     }
 }
@@ -139,7 +254,7 @@ mod tests {
             s.apply(&p("light_sampler", "near"))
                 .unwrap_err()
                 .to_string(),
-            "light_sampler = 'near': expected power or tiles"
+            "light_sampler = 'near': expected auto, power, tiles or bvh"
         );
     }
 }

@@ -1,0 +1,246 @@
+//! The light hierarchy (`LightSet::sample_hierarchy`, `hierarchy_select`, `hierarchy_pmf`):
+//!
+//! - its descent picks local entries with the probabilities `hierarchy_pmf` reports, by a
+//!   chi-square test at several receivers (above, below and beside the lights, with normals
+//!   towards and away from them);
+//! - `hierarchy_pmf` sums to 1 over the entries wherever some light can reach the receiver,
+//!   and the probability the descent reports with a pick equals it bit for bit;
+//! - a point sampled through the hierarchy carries the density `pmf(entry) / area` (times the
+//!   local share), and the power density it reports is what `LightSet::pdf_sa` says;
+//! - the negative control: the same descent tested against the power table's pmf is rejected.
+//!
+//! The scene: 300 one-sided emissive rectangles (600 triangle entries) of powers spread over
+//! three decades, facing up, down and sideways, two emissive spheres, a point light and a
+//! directional light (kept beside the tree).
+
+use glam::{Affine3A, Quat, Vec3};
+use restir_geometry::{Shape, Sphere};
+use restir_lights::{Light, LightSet};
+use restir_sampling::Pcg32;
+use restir_testkit::{Histogram, sidak_level};
+
+fn scene() -> (Vec<Shape>, LightSet) {
+    let mut rng = Pcg32::new(7, 3);
+    let mut shapes = Vec::new();
+    let mut lights = Vec::new();
+    for i in 0..300 {
+        let mut quad = Shape::rectangle();
+        let rotation = match i % 3 {
+            0 => Quat::from_rotation_x(std::f32::consts::PI), // facing down
+            1 => Quat::IDENTITY,                              // facing up
+            _ => Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
+        };
+        let p = Vec3::new(
+            8.0 * rng.next_f32() - 4.0,
+            8.0 * rng.next_f32() - 4.0,
+            3.0 * rng.next_f32(),
+        );
+        quad.transform(&Affine3A::from_scale_rotation_translation(
+            Vec3::splat(0.05 + 0.1 * rng.next_f32()),
+            rotation,
+            p,
+        ));
+        shapes.push(Shape::Mesh(quad));
+        let scale = 10f32.powf(3.0 * rng.next_f32());
+        lights.push(Light::Area {
+            shape: i,
+            radiance: Vec3::new(1.0, 0.8, 0.6) * scale,
+        });
+    }
+    for (c, r) in [
+        (Vec3::new(1.0, 1.0, 1.5), 0.2),
+        (Vec3::new(-2.0, 3.0, 0.5), 0.05),
+    ] {
+        shapes.push(Shape::Sphere(Sphere::new(c, r, false)));
+        lights.push(Light::Area {
+            shape: shapes.len() as u32 - 1,
+            radiance: Vec3::splat(20.0),
+        });
+    }
+    lights.push(Light::Point {
+        position: Vec3::new(0.5, -1.0, 2.0),
+        intensity: Vec3::splat(4.0),
+    });
+    lights.push(Light::Directional {
+        direction: Vec3::new(0.2, 0.1, -1.0),
+        irradiance: Vec3::splat(0.05),
+    });
+    let set = LightSet::new(lights, &shapes, (Vec3::splat(-5.0), Vec3::splat(5.0))).unwrap();
+    (shapes, set)
+}
+
+/// Receivers: (point, normal).
+const RECEIVERS: [(Vec3, Vec3); 5] = [
+    (Vec3::new(0.0, 0.0, -0.5), Vec3::Z),
+    (Vec3::new(3.0, -2.0, 1.0), Vec3::X),
+    (Vec3::new(-1.0, 1.0, 1.2), Vec3::new(0.0, 0.6, 0.8)),
+    (Vec3::new(0.0, 0.0, 4.0), Vec3::Z), // above everything, facing away from the down-facing lights
+    (Vec3::new(0.2, 0.3, 1.0), Vec3::ZERO), // no receiver normal
+];
+
+const SAMPLES: usize = 400_000;
+
+fn seed_offset() -> u64 {
+    std::env::var("HIERARCHY_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0)
+}
+
+fn pmfs(shapes: &[Shape], set: &LightSet, p: Vec3, n: Vec3) -> Vec<f64> {
+    (0..set.emitter_count())
+        .map(|e| set.hierarchy_pmf(shapes, p, n, e) as f64)
+        .collect()
+}
+
+/// Picks of the descent; `misses` counts the descents that found no light as the remainder
+/// (else they are left out).
+fn histogram(
+    shapes: &[Shape],
+    set: &LightSet,
+    p: Vec3,
+    n: Vec3,
+    seed: u64,
+    misses: bool,
+) -> Histogram {
+    let mut rng = Pcg32::new(seed, 1);
+    let mut hist = Histogram::new(set.emitter_count());
+    for _ in 0..SAMPLES {
+        let u = rng.next_f32() as f64 + rng.next_f32() as f64 * (1.0 / 16_777_216.0);
+        match set.hierarchy_select(shapes, p, n, u.min(1.0 - f64::EPSILON)) {
+            Some((e, pmf)) => {
+                assert_eq!(pmf, set.hierarchy_pmf(shapes, p, n, e), "entry {e}");
+                assert!(pmf > 0.0);
+                hist.record(Some(e));
+            }
+            None if misses => hist.record_remainder(),
+            None => {}
+        }
+    }
+    hist
+}
+
+#[test]
+fn descent_follows_its_pmf() {
+    let (shapes, set) = scene();
+    assert_eq!(set.emitter_count(), 600 + 4);
+    let level = sidak_level(0.01, RECEIVERS.len());
+    for (i, &(p, n)) in RECEIVERS.iter().enumerate() {
+        // Σ pmf ≤ 1: the rest is the probability that the descent reaches a node none of whose
+        // children can light the receiver (then no light is picked), tested as one more cell.
+        let pmf = pmfs(&shapes, &set, p, n);
+        let total: f64 = pmf.iter().sum();
+        assert!(
+            total <= 1.0 + 1e-4 && total > 0.5,
+            "receiver {i}: Σ pmf = {total}"
+        );
+        let outcome = histogram(&shapes, &set, p, n, 100 + i as u64 + seed_offset(), true)
+            .chi2(&pmf)
+            .unwrap();
+        eprintln!("receiver {i}: {outcome}");
+        assert!(outcome.accepts(level), "receiver {i}: {outcome}");
+    }
+}
+
+/// Lights that face away from a receiver get nothing: the down-facing rectangles all lie below
+/// the receiver above everything, so they have probability 0 there (and the chi-square test
+/// above shows the other lights share the whole mass).
+#[test]
+fn back_facing_lights_get_no_probability() {
+    let (shapes, set) = scene();
+    let (p, n) = RECEIVERS[3];
+    let mut back = 0;
+    for e in 0..set.emitter_count() {
+        let light = set.entry_light(e) as usize;
+        if light < 300 && light.is_multiple_of(3) {
+            assert_eq!(set.hierarchy_pmf(&shapes, p, n, e), 0.0, "entry {e}");
+            back += 1;
+        }
+    }
+    assert_eq!(back, 200);
+}
+
+/// A sample's density is the hierarchy's entry probability over the triangle's area, converted
+/// to solid angle; the power density beside it is `LightSet::pdf_sa`'s.
+#[test]
+fn sample_densities_agree() {
+    let (shapes, set) = scene();
+    let mut rng = Pcg32::new(9, 0);
+    for &(p, n) in &RECEIVERS {
+        let mut checked = 0;
+        for _ in 0..20_000 {
+            let u = rng.next_f32() as f64;
+            let Some((s, power_pdf)) = set.sample_hierarchy(&shapes, p, n, u, rng.next_2d()) else {
+                continue;
+            };
+            if s.delta {
+                continue;
+            }
+            let want_power = set.pdf_sa(&shapes, s.light, p, s.p, s.ng);
+            assert!(
+                (power_pdf - want_power).abs() <= 1e-3 * want_power,
+                "{power_pdf} vs {want_power}"
+            );
+            // Hierarchy density / power density = hierarchy pmf / power pmf of the entry (a
+            // triangle's power weight is its area's share of its mesh's).
+            let e = set.entry_of(s.light, s.prim).unwrap();
+            let ratio = s.pdf_sa / power_pdf;
+            let want = set.hierarchy_pmf(&shapes, p, n, e) / set.entry_power_pmf(e);
+            assert!((ratio - want).abs() <= 1e-3 * want, "{ratio} vs {want}");
+            checked += 1;
+        }
+        assert!(checked > 1000, "{checked}");
+    }
+}
+
+/// Negative control: the descent is far from the power table's probabilities, and the test
+/// says so.
+#[test]
+fn negative_control_power_pmf_is_rejected() {
+    let (shapes, set) = scene();
+    let (p, n) = RECEIVERS[0];
+    let power: Vec<f64> = (0..set.emitter_count())
+        .map(|e| set.entry_power_pmf(e) as f64)
+        .collect();
+    assert!((power.iter().sum::<f64>() - 1.0).abs() < 1e-4);
+    let outcome = histogram(&shapes, &set, p, n, 77, false)
+        .chi2(&power)
+        .unwrap();
+    eprintln!("power pmf: {outcome}");
+    assert!(outcome.p_value < 1e-6, "{outcome}");
+}
+
+/// Where no light can be ruled out (lights that radiate all around, a receiver without a
+/// normal) the descent never fails and `hierarchy_pmf` sums to 1 over the entries.
+#[test]
+fn pmf_sums_to_one_over_omnidirectional_lights() {
+    let mut rng = Pcg32::new(5, 5);
+    let mut shapes = Vec::new();
+    let mut lights = Vec::new();
+    for i in 0..257u32 {
+        let c = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 6.0 - 3.0;
+        if i.is_multiple_of(4) {
+            lights.push(Light::Point {
+                position: c,
+                intensity: Vec3::splat(1.0 + 100.0 * rng.next_f32()),
+            });
+        } else {
+            shapes.push(Shape::Sphere(Sphere::new(
+                c,
+                0.01 + 0.1 * rng.next_f32(),
+                false,
+            )));
+            lights.push(Light::Area {
+                shape: shapes.len() as u32 - 1,
+                radiance: Vec3::splat(1.0 + 1000.0 * rng.next_f32()),
+            });
+        }
+    }
+    let set = LightSet::new(lights, &shapes, (Vec3::splat(-4.0), Vec3::splat(4.0))).unwrap();
+    for p in [Vec3::ZERO, Vec3::new(2.0, -1.0, 0.5), Vec3::splat(10.0)] {
+        let total: f64 = pmfs(&shapes, &set, p, Vec3::ZERO).iter().sum();
+        assert!((total - 1.0).abs() < 1e-5, "at {p}: Σ pmf = {total}");
+        let hist = histogram(&shapes, &set, p, Vec3::ZERO, 3, true);
+        assert_eq!(hist.remainder(), 0);
+    }
+}
