@@ -1,0 +1,174 @@
+//! The AVX2 kernel: a node's eight child boxes and a block's eight triangles tested in one
+//! 256-bit pass each, with exactly the scalar kernel's float operations (multiply then add, no
+//! FMA; the same min/max operand order), so both give the same bits. Used only when the CPU
+//! reports AVX2, checked once when the [`super::Accel`] is built.
+//!
+//! The entry points are `#[target_feature(enable = "avx2")]` functions around the generic
+//! traversal, so the whole loop is compiled for AVX2 and the kernel's intrinsics inline into it.
+#![allow(unsafe_code)]
+
+#[cfg(target_arch = "x86_64")]
+use std::arch::x86_64::*;
+
+use super::wide::{Entries, Kernel, Node, TRay, TriBlock, Wide, any, closest};
+
+/// The AVX2 kernel (x86-64 only).
+#[derive(Debug)]
+pub(super) struct Avx2;
+
+#[inline(always)]
+fn splat(x: f32) -> __m256 {
+    // SAFETY: AVX is implied by AVX2, which the callers' `target_feature` guarantees.
+    unsafe { _mm256_set1_ps(x) }
+}
+
+/// Eight `u8` grid coordinates as `f32` lanes.
+#[inline(always)]
+fn load_q(q: &[u8; 8]) -> __m256 {
+    // SAFETY: reads exactly the 8 bytes of `q`; AVX2 is guaranteed by the callers.
+    unsafe {
+        let b = _mm_loadl_epi64(q.as_ptr().cast());
+        _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(b))
+    }
+}
+
+#[inline(always)]
+fn load(x: &[f32; 8]) -> __m256 {
+    // SAFETY: `TriBlock` rows are 32-byte aligned arrays of eight floats.
+    unsafe { _mm256_load_ps(x.as_ptr()) }
+}
+
+/// The triangle distances of a block (Möller–Trumbore, the scalar test's operations lane by
+/// lane) and the mask of lanes hit with `0 < t < t_max`.
+#[inline(always)]
+fn block_t(b: &TriBlock, r: &TRay, t_max: f32) -> (__m256, i32) {
+    // SAFETY: arithmetic intrinsics only; AVX2 is guaranteed by the callers.
+    unsafe {
+        let (ox, oy, oz) = (splat(r.o.x), splat(r.o.y), splat(r.o.z));
+        let (dx, dy, dz) = (splat(r.d.x), splat(r.d.y), splat(r.d.z));
+        let v = &b.v;
+        let (v0x, v0y, v0z) = (load(&v[0]), load(&v[1]), load(&v[2]));
+        let (e1x, e1y, e1z) = (load(&v[3]), load(&v[4]), load(&v[5]));
+        let (e2x, e2y, e2z) = (load(&v[6]), load(&v[7]), load(&v[8]));
+        // (Plain `_mm256_*` calls or `#[inline(always)]` functions: a closure would be compiled
+        // without AVX2 and every intrinsic in it would become a call.)
+        use {_mm256_add_ps as add, _mm256_mul_ps as mul, _mm256_sub_ps as sub};
+        // glam's `a.cross(b)`: (a.y·b.z − b.y·a.z, a.z·b.x − b.z·a.x, a.x·b.y − b.x·a.y);
+        // `a.dot(b)`: (a.x·b.x + a.y·b.y) + a.z·b.z.
+        let px = sub(mul(dy, e2z), mul(e2y, dz));
+        let py = sub(mul(dz, e2x), mul(e2z, dx));
+        let pz = sub(mul(dx, e2y), mul(e2x, dy));
+        let det = add(add(mul(e1x, px), mul(e1y, py)), mul(e1z, pz));
+        let abs = _mm256_andnot_ps(splat(-0.0), det);
+        let mut ok = _mm256_cmp_ps::<_CMP_NLT_UQ>(abs, splat(1e-20));
+        let inv_det = _mm256_div_ps(splat(1.0), det);
+        let (tx, ty, tz) = (sub(ox, v0x), sub(oy, v0y), sub(oz, v0z));
+        let u = mul(add(add(mul(tx, px), mul(ty, py)), mul(tz, pz)), inv_det);
+        ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_GE_OQ>(u, splat(0.0)));
+        ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_LE_OQ>(u, splat(1.0)));
+        let qx = sub(mul(ty, e1z), mul(e1y, tz));
+        let qy = sub(mul(tz, e1x), mul(e1z, tx));
+        let qz = sub(mul(tx, e1y), mul(e1x, ty));
+        let vv = mul(add(add(mul(dx, qx), mul(dy, qy)), mul(dz, qz)), inv_det);
+        let out = _mm256_or_ps(
+            _mm256_cmp_ps::<_CMP_LT_OQ>(vv, splat(0.0)),
+            _mm256_cmp_ps::<_CMP_GT_OQ>(add(u, vv), splat(1.0)),
+        );
+        ok = _mm256_andnot_ps(out, ok);
+        let t = mul(add(add(mul(e2x, qx), mul(e2y, qy)), mul(e2z, qz)), inv_det);
+        ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_GT_OQ>(t, splat(0.0)));
+        ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_LT_OQ>(t, splat(t_max)));
+        (t, _mm256_movemask_ps(ok))
+    }
+}
+
+/// The entry and exit distances of the eight child slabs along `axis`.
+#[inline(always)]
+fn slab(n: &Node, r: &TRay, axis: usize, scale: f32, offset: f32) -> (__m256, __m256) {
+    let (lo, hi) = (load_q(&n.q[2 * axis]), load_q(&n.q[2 * axis + 1]));
+    let (near, far) = if r.neg[axis] { (hi, lo) } else { (lo, hi) };
+    let (s, o) = (splat(scale), splat(offset));
+    // SAFETY: arithmetic intrinsics only; AVX2 is guaranteed by the callers.
+    unsafe {
+        (
+            _mm256_add_ps(_mm256_mul_ps(near, s), o),
+            _mm256_add_ps(_mm256_mul_ps(far, s), o),
+        )
+    }
+}
+
+impl Kernel for Avx2 {
+    #[inline(always)]
+    fn node_hits(n: &Node, r: &TRay, t_max: f32) -> u32 {
+        let adj_inv = glam::Vec3A::from(n.extent) * r.inv_d;
+        let adj_o = (glam::Vec3A::from(n.p) - r.o) * r.inv_d;
+        let (ai, ao) = (adj_inv.to_array(), adj_o.to_array());
+        let (x0, x1) = slab(n, r, 0, ai[0], ao[0]);
+        let (y0, y1) = slab(n, r, 1, ai[1], ao[1]);
+        let (z0, z1) = slab(n, r, 2, ai[2], ao[2]);
+        // SAFETY: arithmetic intrinsics only; AVX2 is guaranteed by the callers.
+        unsafe {
+            let tmin = _mm256_max_ps(_mm256_max_ps(x0, _mm256_max_ps(y0, z0)), splat(1e-4));
+            let tmax = _mm256_min_ps(_mm256_min_ps(x1, _mm256_min_ps(y1, z1)), splat(t_max));
+            _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tmin, tmax)) as u32
+        }
+    }
+
+    #[inline(always)]
+    fn block_closest(b: &TriBlock, r: &TRay, t_max: f32, lanes: u32) -> Option<(f32, u32)> {
+        let (t, hit) = block_t(b, r, t_max);
+        let hit = hit as u32 & lanes;
+        if hit == 0 {
+            return None;
+        }
+        let mut ts = [0.0f32; 8];
+        // SAFETY: stores eight floats into an eight-float array.
+        unsafe { _mm256_storeu_ps(ts.as_mut_ptr(), t) };
+        // Highest lane first, strict `<`: ties go to the highest lane.
+        let mut rest = hit;
+        let mut best = (f32::INFINITY, 0);
+        while rest != 0 {
+            let j = 31 - rest.leading_zeros();
+            rest &= !(1 << j);
+            if ts[j as usize] < best.0 {
+                best = (ts[j as usize], j);
+            }
+        }
+        Some(best)
+    }
+
+    #[inline(always)]
+    fn block_any(b: &TriBlock, r: &TRay, t_max: f32, lanes: u32) -> bool {
+        block_t(b, r, t_max).1 as u32 & lanes != 0
+    }
+}
+
+/// [`closest`] with the AVX2 kernel.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[target_feature(enable = "avx2")]
+pub(super) unsafe fn closest_avx2(
+    w: &Wide,
+    r: &TRay,
+    t_max: f32,
+    stack: &mut [(u32, u32)],
+    entries: &impl Entries,
+) -> Option<(f32, u32, u32)> {
+    closest::<Avx2>(w, r, t_max, stack, entries)
+}
+
+/// [`any`] with the AVX2 kernel.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[target_feature(enable = "avx2")]
+pub(super) unsafe fn any_avx2(
+    w: &Wide,
+    r: &TRay,
+    t_max: f32,
+    stack: &mut [(u32, u32)],
+    entries: &impl Entries,
+) -> bool {
+    any::<Avx2>(w, r, t_max, stack, entries)
+}

@@ -1,0 +1,387 @@
+//! The acceleration structure: one `obvhs` CWBVH (8-wide, compressed nodes) over every triangle
+//! and sphere of the scene. Spheres are analytic primitives intersected in the traversal closure.
+//!
+//! obvhs's PLOC builder pairs clusters only when both prefer each other; among many primitives
+//! with bit-identical bounds every choice ties, almost nothing pairs per sweep, and the build turns
+//! quadratic (20 000 coincident triangles: 22 s). When more than [`MAX_SHARED_BOUNDS`] primitives
+//! share their bounds, those primitives become one BVH entry (a *group*, tested in a loop, exact
+//! duplicates once); scenes without such pile-ups get the plain one-primitive-per-entry BVH.
+
+use std::time::Duration;
+
+use glam::{Vec2, Vec3, Vec3A};
+use obvhs::{BvhBuildParams, aabb::Aabb, cwbvh::builder::build_cwbvh};
+
+use crate::{Frame, Ray, Shape};
+
+#[cfg(target_arch = "x86_64")]
+mod avx2;
+mod prims;
+mod wide;
+
+use prims::{Prim, group_entries};
+use wide::{Entries, STACK, Scalar, TRay, Wide};
+
+/// A closest hit: distance and which primitive.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Ray parameter of the hit.
+    pub t: f32,
+    /// The shape that was hit (index into the slice given to [`Accel::build`]).
+    pub shape: u32,
+    /// The triangle within the shape (0 for spheres).
+    pub prim: u32,
+}
+
+/// Everything about a surface point that shading needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceInteraction {
+    /// Position.
+    pub p: Vec3,
+    /// Geometric normal (unit; follows winding and `flip_normals`).
+    pub ng: Vec3,
+    /// Shading frame; `shading.n` is the interpolated shading normal.
+    pub shading: Frame,
+    /// Texture coordinates.
+    pub uv: Vec2,
+    /// Shape index.
+    pub shape: u32,
+    /// Primitive within the shape.
+    pub prim: u32,
+    /// Barycentrics (meshes) or [`crate::Sphere::param_of`] parameters (spheres) of the point on its primitive;
+    /// with `shape` and `prim` this names the point without storing it.
+    pub param: Vec2,
+    /// Distance from the ray origin.
+    pub t: f32,
+}
+
+/// The most primitives that may share bit-identical bounds before they are grouped into one BVH
+/// entry (a quad's two triangles share theirs; only degenerate input piles up more).
+pub const MAX_SHARED_BOUNDS: usize = 8;
+
+/// A BVH over a list of shapes.
+#[derive(Debug)]
+pub struct Accel {
+    /// The decoded CWBVH with the triangles inline; `None` for an empty scene.
+    wide: Option<Wide>,
+    prims: Vec<Prim>,
+    /// (shape, primitive within shape) of each BVH-ordered primitive.
+    ids: Vec<(u32, u32)>,
+    /// With groups, BVH entry `e` holds `prims[groups[e]..groups[e + 1]]`; without, entry `e` is
+    /// primitive `e`.
+    groups: Option<Vec<u32>>,
+    bounds: (Vec3, Vec3),
+    /// Whether the AVX2 kernel is used (the CPU was checked once, at build).
+    avx2: bool,
+    /// obvhs's tree, kept by the tests to run obvhs's own traversal as the reference.
+    #[cfg(test)]
+    reference: Option<obvhs::cwbvh::CwBvh>,
+}
+
+/// Whether this CPU runs the AVX2 kernel.
+fn detect_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+impl Entries for Accel {
+    #[inline(always)]
+    fn entry(&self, e: usize, r: &TRay, t_max: f32) -> (f32, u32) {
+        self.intersect_entry(e, r, t_max)
+    }
+}
+
+impl Accel {
+    /// Builds the BVH over all shapes.
+    pub fn build(shapes: &[Shape]) -> Self {
+        let mut prims = Vec::new();
+        let mut ids = Vec::new();
+        let mut aabbs = Vec::new();
+        for (si, shape) in shapes.iter().enumerate() {
+            match shape {
+                Shape::Mesh(m) => {
+                    for ti in 0..m.triangle_count() {
+                        let [a, b, c] = m.triangle(ti);
+                        prims.push(Prim::Triangle {
+                            v0: a.into(),
+                            e1: (b - a).into(),
+                            e2: (c - a).into(),
+                        });
+                        ids.push((si as u32, ti as u32));
+                        aabbs.push(Aabb::from_points(&[a.into(), b.into(), c.into()]));
+                    }
+                }
+                Shape::Sphere(s) => {
+                    prims.push(Prim::Sphere {
+                        center: s.center.into(),
+                        radius: s.radius,
+                    });
+                    ids.push((si as u32, 0));
+                    let r = Vec3A::splat(s.radius);
+                    aabbs.push(Aabb::new(
+                        Vec3A::from(s.center) - r,
+                        Vec3A::from(s.center) + r,
+                    ));
+                }
+            }
+        }
+        let mut bounds = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for b in &aabbs {
+            bounds.0 = bounds.0.min(b.min.into());
+            bounds.1 = bounds.1.max(b.max.into());
+        }
+        let avx2 = detect_avx2();
+        if prims.is_empty() {
+            return Self {
+                wide: None,
+                prims,
+                ids,
+                groups: None,
+                bounds: (Vec3::ZERO, Vec3::ZERO),
+                avx2,
+                #[cfg(test)]
+                reference: None,
+            };
+        }
+        let (bvh, prims, ids, groups) = match group_entries(&prims, &aabbs) {
+            Some((entries, boxes)) => {
+                let bvh = build_cwbvh(
+                    &boxes,
+                    BvhBuildParams::medium_build(),
+                    &mut Duration::default(),
+                );
+                let mut starts = vec![0];
+                let (mut out_prims, mut out_ids) = (Vec::new(), Vec::new());
+                for &e in &bvh.primitive_indices {
+                    for &i in &entries[e as usize] {
+                        out_prims.push(prims[i]);
+                        out_ids.push(ids[i]);
+                    }
+                    starts.push(out_prims.len() as u32);
+                }
+                (bvh, out_prims, out_ids, Some(starts))
+            }
+            None => {
+                let bvh = build_cwbvh(
+                    &aabbs,
+                    BvhBuildParams::medium_build(),
+                    &mut Duration::default(),
+                );
+                // Lay primitives out in BVH order so the traversal indexes them directly.
+                let order = &bvh.primitive_indices;
+                let p = order.iter().map(|&i| prims[i as usize]).collect();
+                let d = order.iter().map(|&i| ids[i as usize]).collect();
+                (bvh, p, d, None)
+            }
+        };
+        let wide = Wide::build(&bvh, |e| {
+            let members = match &groups {
+                Some(s) => s[e] as usize..s[e + 1] as usize,
+                None => e..e + 1,
+            };
+            match (members.len(), prims[members.start]) {
+                (1, Prim::Triangle { v0, e1, e2 }) => Some([v0, e1, e2]),
+                _ => None,
+            }
+        });
+        Self {
+            wide: Some(wide),
+            prims,
+            ids,
+            groups,
+            bounds,
+            avx2,
+            #[cfg(test)]
+            reference: Some(bvh),
+        }
+    }
+
+    /// The scene's axis-aligned bounds `(min, max)`.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.bounds
+    }
+
+    /// Number of primitives (triangles and spheres).
+    pub fn primitive_count(&self) -> usize {
+        self.prims.len()
+    }
+
+    /// Whether traversal uses the AVX2 kernel (decided by the CPU at build).
+    pub fn uses_avx2(&self) -> bool {
+        self.avx2
+    }
+
+    /// The scalar kernel from now on, whatever the CPU (to compare kernels).
+    #[doc(hidden)]
+    pub fn force_scalar(&mut self) {
+        self.avx2 = false;
+    }
+
+    /// Primitive `id`'s distance along `r` if below `t_max`, else infinity.
+    #[inline(always)]
+    fn intersect_prim(&self, id: usize, r: &TRay, t_max: f32) -> f32 {
+        self.prims[id].intersect(r.o, r.d, t_max)
+    }
+
+    /// BVH entry `e` tested member by member: the closest distance below `t_max` (infinity if
+    /// none) and its primitive, the first of equals.
+    #[inline(always)]
+    fn intersect_entry(&self, e: usize, r: &TRay, t_max: f32) -> (f32, u32) {
+        let Some(starts) = &self.groups else {
+            return (self.intersect_prim(e, r, t_max), e as u32);
+        };
+        let mut best = (f32::INFINITY, 0);
+        for id in starts[e] as usize..starts[e + 1] as usize {
+            let t = self.intersect_prim(id, r, t_max);
+            if t < best.0 && t < t_max {
+                best = (t, id as u32);
+            }
+        }
+        best
+    }
+
+    /// The closest hit along `ray` with `t < t_max`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        let w = self.wide.as_ref()?;
+        let r = TRay::new(ray.o.into(), ray.d.into());
+        let mut small = [(0, 0); STACK];
+        let mut big = Vec::new();
+        let stack = if w.depth <= STACK {
+            &mut small[..]
+        } else {
+            big.resize(w.depth, (0, 0));
+            &mut big[..]
+        };
+        #[cfg(target_arch = "x86_64")]
+        let found = if self.avx2 {
+            // SAFETY: `avx2` is set only when the CPU reported AVX2 (`detect_avx2`).
+            #[allow(unsafe_code)]
+            unsafe {
+                avx2::closest_avx2(w, &r, t_max, stack, self)
+            }
+        } else {
+            wide::closest::<Scalar>(w, &r, t_max, stack, self)
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        let found = wide::closest::<Scalar>(w, &r, t_max, stack, self);
+        let (t, entry, member) = found?;
+        let id = match (member, &self.groups) {
+            (u32::MAX, Some(starts)) => starts[entry as usize],
+            (u32::MAX, None) => entry,
+            (m, _) => m,
+        };
+        let (shape, prim) = self.ids[id as usize];
+        Some(Hit { t, shape, prim })
+    }
+
+    /// Whether anything blocks `ray` before `t_max`.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        let Some(w) = self.wide.as_ref() else {
+            return false;
+        };
+        let r = TRay::new(ray.o.into(), ray.d.into());
+        let mut small = [(0, 0); STACK];
+        let mut big = Vec::new();
+        let stack = if w.depth <= STACK {
+            &mut small[..]
+        } else {
+            big.resize(w.depth, (0, 0));
+            &mut big[..]
+        };
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only when the CPU reported AVX2 (`detect_avx2`).
+            #[allow(unsafe_code)]
+            return unsafe { avx2::any_avx2(w, &r, t_max, stack, self) };
+        }
+        wide::any::<Scalar>(w, &r, t_max, stack, self)
+    }
+
+    /// Surface details of a hit returned by [`Accel::intersect`] for the same `ray`.
+    #[inline]
+    pub fn surface_interaction(
+        &self,
+        shapes: &[Shape],
+        hit: &Hit,
+        ray: &Ray,
+    ) -> SurfaceInteraction {
+        let shape = &shapes[hit.shape as usize];
+        let param = match shape {
+            Shape::Mesh(m) => {
+                // Barycentrics of the hit point, recomputed on the original vertices.
+                let [p0, p1, p2] = m.triangle(hit.prim as usize);
+                let (e1, e2) = (p1 - p0, p2 - p0);
+                let pvec = ray.d.cross(e2);
+                let inv_det = 1.0 / e1.dot(pvec);
+                let tvec = ray.o - p0;
+                let u = tvec.dot(pvec) * inv_det;
+                let v = ray.d.dot(tvec.cross(e1)) * inv_det;
+                let u = u.clamp(0.0, 1.0);
+                let v = v.clamp(0.0, 1.0 - u);
+                Vec2::new(u, v)
+            }
+            Shape::Sphere(s) => {
+                let n = (ray.at(hit.t) - s.center).normalize();
+                crate::Sphere::param_of(n)
+            }
+        };
+        let mut si = surface_at(shapes, hit.shape, hit.prim, param);
+        si.t = hit.t;
+        if let Shape::Sphere(s) = shape {
+            // Reproject onto the sphere for accuracy.
+            let n = (ray.at(hit.t) - s.center).normalize();
+            si.p = s.center + s.radius * n;
+        }
+        si
+    }
+}
+
+/// The surface interaction at a point named by `(shape, prim, param)` (see
+/// [`SurfaceInteraction::param`]); `t` is left at 0.
+#[inline]
+pub fn surface_at(shapes: &[Shape], shape: u32, prim: u32, param: Vec2) -> SurfaceInteraction {
+    match &shapes[shape as usize] {
+        Shape::Mesh(m) => {
+            let (p, ng, ns, uv, dpdu) = m.surface_at(prim as usize, param);
+            SurfaceInteraction {
+                p,
+                ng,
+                shading: Frame::from_normal_tangent(ns, dpdu),
+                uv,
+                shape,
+                prim,
+                param,
+                t: 0.0,
+            }
+        }
+        Shape::Sphere(s) => {
+            let (p, n) = s.point_at(param);
+            let n = if s.flip_normals { -n } else { n };
+            // Tangent along increasing φ.
+            let dpdu = Vec3::new(-(p.y - s.center.y), p.x - s.center.x, 0.0);
+            SurfaceInteraction {
+                p,
+                ng: n,
+                shading: Frame::from_normal_tangent(n, dpdu),
+                uv: crate::Sphere::uv_of(if s.flip_normals { -n } else { n }),
+                shape,
+                prim,
+                param,
+                t: 0.0,
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod proptests;
+#[cfg(test)]
+mod tests;

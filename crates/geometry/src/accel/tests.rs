@@ -1,0 +1,151 @@
+//! Tests of the acceleration structure: hits against brute force, self-intersection, grouping.
+
+use super::prims::intersect_triangle;
+use super::*;
+use crate::{Sphere, offset_ray_origin};
+use restir_sampling::Pcg32;
+
+fn scene() -> Vec<Shape> {
+    let mut floor = Shape::rectangle();
+    floor.transform(&glam::Affine3A::from_scale(Vec3::splat(10.0)));
+    let mut cube = Shape::cube();
+    cube.transform(&glam::Affine3A::from_translation(Vec3::new(0.0, 0.0, 2.0)));
+    vec![
+        Shape::Mesh(floor),
+        Shape::Mesh(cube),
+        Shape::Sphere(Sphere::new(Vec3::new(3.0, 0.0, 1.5), 0.5, false)),
+    ]
+}
+
+/// Every hit the BVH reports is the brute-force closest hit.
+#[test]
+fn bvh_matches_brute_force() {
+    let shapes = scene();
+    let accel = Accel::build(&shapes);
+    let mut rng = Pcg32::new(3, 4);
+    for _ in 0..2000 {
+        let o = Vec3::new(
+            rng.next_f32() * 12.0 - 6.0,
+            rng.next_f32() * 12.0 - 6.0,
+            rng.next_f32() * 6.0 + 0.1,
+        );
+        let d = restir_sampling::warp::sample_uniform_sphere(rng.next_2d());
+        let ray = Ray::new(o, d);
+        let got = accel.intersect(&ray, f32::INFINITY);
+        let r = TRay::new(o.into(), d.into());
+        let mut best = f32::INFINITY;
+        for i in 0..accel.prims.len() {
+            best = best.min(accel.intersect_prim(i, &r, f32::INFINITY));
+        }
+        match got {
+            Some(h) => assert!((h.t - best).abs() <= 1e-4 * best.max(1.0)),
+            None => assert!(best.is_infinite()),
+        }
+        assert_eq!(accel.occluded(&ray, f32::INFINITY), best.is_finite());
+    }
+}
+
+/// Rays leaving a surface through the offset origin never hit that surface again.
+#[test]
+fn no_self_intersection() {
+    let shapes = scene();
+    let accel = Accel::build(&shapes);
+    let mut rng = Pcg32::new(5, 6);
+    let mut checked = 0;
+    for _ in 0..5000 {
+        let o = Vec3::new(rng.next_f32() * 8.0 - 4.0, rng.next_f32() * 8.0 - 4.0, 5.0);
+        let target = Vec3::new(rng.next_f32() * 8.0 - 4.0, rng.next_f32() * 8.0 - 4.0, 0.0);
+        let ray = Ray::new(o, (target - o).normalize());
+        let Some(hit) = accel.intersect(&ray, f32::INFINITY) else {
+            continue;
+        };
+        let si = accel.surface_interaction(&shapes, &hit, &ray);
+        // Reflect off the surface into the hemisphere the ray came from.
+        let frame = Frame::from_normal(si.ng * -si.ng.dot(ray.d).signum());
+        let d = frame.to_world(restir_sampling::warp::sample_cosine_hemisphere(
+            rng.next_2d(),
+        ));
+        let o2 = offset_ray_origin(si.p, si.ng, d);
+        if let Some(h2) = accel.intersect(&Ray::new(o2, d), f32::INFINITY) {
+            assert!(
+                !(h2.shape == hit.shape && h2.prim == hit.prim && h2.t < 1e-3),
+                "self-intersection at t = {}",
+                h2.t
+            );
+        }
+        checked += 1;
+    }
+    assert!(checked > 1000);
+}
+
+/// Coincident triangles build in linear time and still give the brute-force closest hit
+/// (beside a scene that is not grouped).
+#[test]
+fn coincident_triangles_are_grouped() {
+    let n = 20_000;
+    let pile = crate::TriangleMesh::new(
+        vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(0.0, 0.0, 0.5)],
+        None,
+        None,
+        (0..n)
+            .map(|i| if i % 2 == 0 { [0, 1, 2] } else { [1, 2, 3] })
+            .collect(),
+        false,
+    )
+    .unwrap();
+    let mut shapes = scene();
+    shapes.push(Shape::Mesh(pile));
+    let start = std::time::Instant::now();
+    let accel = Accel::build(&shapes);
+    let took = start.elapsed();
+    assert!(took.as_secs_f32() < 2.0, "build took {took:?}");
+    assert!(accel.groups.is_some());
+    // Exact duplicates are kept once.
+    assert!(accel.primitive_count() < 100, "{}", accel.primitive_count());
+    let plain = Accel::build(&scene());
+    assert!(plain.groups.is_none());
+    let mut rng = Pcg32::new(7, 8);
+    for _ in 0..2000 {
+        let o = Vec3::new(
+            rng.next_f32() * 4.0 - 2.0,
+            rng.next_f32() * 4.0 - 2.0,
+            rng.next_f32() * 4.0 + 0.1,
+        );
+        let d = restir_sampling::warp::sample_uniform_sphere(rng.next_2d());
+        let ray = Ray::new(o, d);
+        let r = TRay::new(o.into(), d.into());
+        let best = (0..accel.prims.len())
+            .map(|i| accel.intersect_prim(i, &r, f32::INFINITY))
+            .fold(f32::INFINITY, f32::min);
+        match accel.intersect(&ray, f32::INFINITY) {
+            Some(h) => {
+                assert_eq!(h.t, best);
+                let s = &shapes[h.shape as usize];
+                if let Shape::Mesh(m) = s {
+                    let [a, b, c] = m.triangle(h.prim as usize);
+                    let t = intersect_triangle(
+                        a.into(),
+                        (b - a).into(),
+                        (c - a).into(),
+                        o.into(),
+                        d.into(),
+                        f32::INFINITY,
+                    );
+                    assert_eq!(t, h.t, "the hit names the primitive it hit");
+                }
+            }
+            None => assert!(best.is_infinite()),
+        }
+        assert_eq!(accel.occluded(&ray, f32::INFINITY), best.is_finite());
+    }
+}
+
+#[test]
+fn sphere_hit_from_inside() {
+    let shapes = vec![Shape::Sphere(Sphere::new(Vec3::ZERO, 2.0, false))];
+    let accel = Accel::build(&shapes);
+    let h = accel
+        .intersect(&Ray::new(Vec3::ZERO, Vec3::X), f32::INFINITY)
+        .unwrap();
+    assert!((h.t - 2.0).abs() < 1e-5);
+}

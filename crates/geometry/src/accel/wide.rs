@@ -1,0 +1,498 @@
+//! Our traversal of obvhs's CWBVH: the node and leaf layout we build once from the `CwBvh`, the
+//! closest-hit and any-hit loops (generic over the kernel that tests a node's eight children and
+//! eight triangles at once), and the scalar kernel.
+//!
+//! The results are bit-for-bit those of obvhs's own `ray_traverse` / `ray_traverse_miss` with our
+//! triangle and sphere tests in the closure: the node test does the same float operations on the
+//! same quantized child boxes, children are visited in the same order (the CWBVH's octant order:
+//! child slot `s` has priority `s ^ octant`, so the slots laid out towards the ray come first),
+//! and a node's leaf primitives are tested right after the node, the closest one kept with ties
+//! going to the highest primitive offset, as obvhs's sequential highest-bit-first loop does.
+//! What changes is the layout: the triangles of a node sit inline in 8-wide SoA blocks
+//! (`v0`, `e1`, `e2` precomputed) in the node's own order, so a leaf test does no index
+//! indirection and one block test covers up to eight triangles.
+
+use glam::Vec3A;
+use obvhs::cwbvh::CwBvh;
+
+use super::prims::intersect_triangle;
+
+/// obvhs's lower bound on a child box's entry distance.
+const NODE_EPSILON: f32 = 0.0001;
+
+/// The deepest tree the fixed traversal stack holds; deeper trees use a heap stack.
+pub(super) const STACK: usize = 24;
+
+/// One CWBVH node, decoded for traversal.
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(64))]
+pub(super) struct Node {
+    /// The quantization grid's origin.
+    pub p: [f32; 3],
+    /// The grid's cell size per axis (a power of two).
+    pub extent: [f32; 3],
+    /// Child box bounds on the grid: min x, max x, min y, max y, min z, max z, per child slot.
+    pub q: [[u8; 8]; 6],
+    /// Per child slot: the slot's leaf entries as a mask of offsets from `first` (0 for inner
+    /// and empty slots).
+    pub leaf: [u32; 8],
+    /// Index of the first child node.
+    pub child_base: u32,
+    /// BVH entry at offset 0.
+    pub first: u32,
+    /// First of this node's triangle blocks (offset `o` is lane `o % 8` of block `block + o / 8`).
+    pub block: u32,
+    /// Offsets of the entries tested one at a time (spheres, groups of coincident primitives).
+    pub scalar: u32,
+    /// Which child slots are inner nodes (obvhs's `imask`).
+    pub imask: u8,
+}
+
+/// Eight triangles in SoA: `v[0..3]` the first vertex, `v[3..6]` edge 1, `v[6..9]` edge 2, each an
+/// axis across the eight lanes. Unused lanes are zero (a zero edge never hits).
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(32))]
+pub(super) struct TriBlock {
+    pub v: [[f32; 8]; 9],
+}
+
+impl TriBlock {
+    #[inline(always)]
+    pub fn lane(&self, j: usize) -> (Vec3A, Vec3A, Vec3A) {
+        let v = &self.v;
+        (
+            Vec3A::new(v[0][j], v[1][j], v[2][j]),
+            Vec3A::new(v[3][j], v[4][j], v[5][j]),
+            Vec3A::new(v[6][j], v[7][j], v[8][j]),
+        )
+    }
+}
+
+/// A ray prepared for traversal (obvhs's conventions: no negative zeros in the direction, a
+/// clamped reciprocal).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct TRay {
+    pub o: Vec3A,
+    pub d: Vec3A,
+    pub inv_d: Vec3A,
+    /// Per axis: whether the direction is negative (the near plane is the box's max).
+    pub neg: [bool; 3],
+    /// Octant code (`4·[d.x ≥ 0] + 2·[d.y ≥ 0] + [d.z ≥ 0]`), the child-order key.
+    pub oct: u32,
+}
+
+/// obvhs's reciprocal: `±1/ε` for components within machine epsilon of zero.
+#[inline(always)]
+fn safe_inverse(x: f32) -> f32 {
+    if x.abs() <= f32::EPSILON {
+        x.signum() / f32::EPSILON
+    } else {
+        1.0 / x
+    }
+}
+
+impl TRay {
+    #[inline(always)]
+    pub fn new(o: Vec3A, d: Vec3A) -> Self {
+        let d = d + Vec3A::ZERO;
+        let neg = [d.x < 0.0, d.y < 0.0, d.z < 0.0];
+        let oct = (!neg[0] as u32) << 2 | (!neg[1] as u32) << 1 | !neg[2] as u32;
+        TRay {
+            o,
+            d,
+            inv_d: Vec3A::new(safe_inverse(d.x), safe_inverse(d.y), safe_inverse(d.z)),
+            neg,
+            oct,
+        }
+    }
+}
+
+/// `_mm_max_ps` / `_mm_min_ps` semantics (the second operand when either is NaN).
+#[inline(always)]
+fn max_ps(a: f32, b: f32) -> f32 {
+    if a > b { a } else { b }
+}
+#[inline(always)]
+fn min_ps(a: f32, b: f32) -> f32 {
+    if a < b { a } else { b }
+}
+
+/// What a traversal needs from the hardware: a node's child hit mask and a triangle block's
+/// closest / any hit. Implementations must agree bit for bit.
+pub(super) trait Kernel {
+    /// Bit `s` set when child slot `s`'s box is entered before `t_max`.
+    fn node_hits(node: &Node, ray: &TRay, t_max: f32) -> u32;
+    /// The closest hit among `lanes` (a mask) with `t < t_max`: `(t, lane)`, ties to the highest
+    /// lane.
+    fn block_closest(block: &TriBlock, ray: &TRay, t_max: f32, lanes: u32) -> Option<(f32, u32)>;
+    /// Whether any of `lanes` is hit with `t < t_max`.
+    fn block_any(block: &TriBlock, ray: &TRay, t_max: f32, lanes: u32) -> bool;
+}
+
+/// The scalar kernel (every target; the reference the SIMD kernels match).
+#[derive(Debug)]
+pub(super) struct Scalar;
+
+impl Kernel for Scalar {
+    #[inline(always)]
+    fn node_hits(n: &Node, r: &TRay, t_max: f32) -> u32 {
+        let adj_inv = Vec3A::from(n.extent) * r.inv_d;
+        let adj_o = (Vec3A::from(n.p) - r.o) * r.inv_d;
+        let (ai, ao) = (adj_inv.to_array(), adj_o.to_array());
+        let mut mask = 0;
+        for s in 0..8 {
+            let mut t0 = [0.0; 3];
+            let mut t1 = [0.0; 3];
+            for a in 0..3 {
+                let (lo, hi) = (n.q[2 * a][s] as f32, n.q[2 * a + 1][s] as f32);
+                let (near, far) = if r.neg[a] { (hi, lo) } else { (lo, hi) };
+                t0[a] = near * ai[a] + ao[a];
+                t1[a] = far * ai[a] + ao[a];
+            }
+            let tmin = max_ps(max_ps(t0[0], max_ps(t0[1], t0[2])), NODE_EPSILON);
+            let tmax = min_ps(min_ps(t1[0], min_ps(t1[1], t1[2])), t_max);
+            if tmin <= tmax {
+                mask |= 1 << s;
+            }
+        }
+        mask
+    }
+
+    #[inline(always)]
+    fn block_closest(b: &TriBlock, r: &TRay, t_max: f32, mut lanes: u32) -> Option<(f32, u32)> {
+        let mut best: Option<(f32, u32)> = None;
+        let mut t_max = t_max;
+        while lanes != 0 {
+            let j = 31 - lanes.leading_zeros();
+            lanes &= !(1 << j);
+            let (v0, e1, e2) = b.lane(j as usize);
+            let t = intersect_triangle(v0, e1, e2, r.o, r.d, t_max);
+            if t < t_max {
+                t_max = t;
+                best = Some((t, j));
+            }
+        }
+        best
+    }
+
+    #[inline(always)]
+    fn block_any(b: &TriBlock, r: &TRay, t_max: f32, mut lanes: u32) -> bool {
+        while lanes != 0 {
+            let j = lanes.trailing_zeros();
+            lanes &= lanes - 1;
+            let (v0, e1, e2) = b.lane(j as usize);
+            if intersect_triangle(v0, e1, e2, r.o, r.d, t_max) < t_max {
+                return true;
+            }
+        }
+        false
+    }
+}
+
+/// `PERM[oct][m]`: child hit mask `m` (bit = slot) re-indexed by priority (bit `s ^ oct`).
+static PERM: [[u8; 256]; 8] = {
+    let mut t = [[0u8; 256]; 8];
+    let mut oct = 0;
+    while oct < 8 {
+        let mut m = 0;
+        while m < 256 {
+            let mut s = 0;
+            let mut out = 0u8;
+            while s < 8 {
+                if m & (1 << s) != 0 {
+                    out |= 1 << (s ^ oct);
+                }
+                s += 1;
+            }
+            t[oct][m] = out;
+            m += 1;
+        }
+        oct += 1;
+    }
+    t
+};
+
+/// The decoded tree and its inline triangles.
+#[derive(Debug, Default)]
+pub(super) struct Wide {
+    pub nodes: Vec<Node>,
+    pub blocks: Vec<TriBlock>,
+    /// Tree depth (nodes on the longest root-to-leaf path).
+    pub depth: usize,
+}
+
+impl Wide {
+    /// Decodes `bvh`; `tri(e)` is BVH entry `e`'s triangle `(v0, e1, e2)` when the entry is a
+    /// single triangle, `None` for entries tested one at a time.
+    pub fn build(bvh: &CwBvh, tri: impl Fn(usize) -> Option<[Vec3A; 3]>) -> Self {
+        let mut nodes = Vec::with_capacity(bvh.nodes.len());
+        let mut blocks = Vec::new();
+        for n in &bvh.nodes {
+            let mut node = Node {
+                p: n.p.to_array(),
+                extent: n.e.map(|e| f32::from_bits((e as u32) << 23)),
+                q: [
+                    n.child_min_x,
+                    n.child_max_x,
+                    n.child_min_y,
+                    n.child_max_y,
+                    n.child_min_z,
+                    n.child_max_z,
+                ],
+                child_base: n.child_base_idx,
+                first: n.primitive_base_idx,
+                block: blocks.len() as u32,
+                imask: n.imask,
+                ..Node::default()
+            };
+            let mut span = 0;
+            for s in 0..8 {
+                let meta = n.child_meta[s] as u32;
+                let inner = meta & (meta << 1) & 0b1_0000 != 0;
+                if !inner {
+                    let (off, bits) = (meta & 0b1_1111, (meta >> 5) & 0b111);
+                    node.leaf[s] = bits << off;
+                    if bits != 0 {
+                        span = span.max(off + 32 - bits.leading_zeros());
+                    }
+                }
+            }
+            let first = blocks.len();
+            blocks.resize(first + span.div_ceil(8) as usize, TriBlock::default());
+            for off in 0..span as usize {
+                let e = n.primitive_base_idx as usize + off;
+                match tri(e) {
+                    Some(v) => {
+                        let b = &mut blocks[first + off / 8];
+                        for (axis, x) in v.iter().flat_map(|v| v.to_array()).enumerate() {
+                            b.v[axis][off % 8] = x;
+                        }
+                    }
+                    None => node.scalar |= 1 << off,
+                }
+            }
+            nodes.push(node);
+        }
+        let depth = depth_of(&nodes, 0);
+        Wide {
+            nodes,
+            blocks,
+            depth,
+        }
+    }
+}
+
+/// Nodes on the longest path down from `n`.
+fn depth_of(nodes: &[Node], n: usize) -> usize {
+    let node = &nodes[n];
+    let inner = node.imask.count_ones() as usize;
+    (0..inner)
+        .map(|k| depth_of(nodes, node.child_base as usize + k))
+        .max()
+        .unwrap_or(0)
+        + 1
+}
+
+/// The child node in slot `slot` of a node with these `child_base` and `imask`.
+#[inline(always)]
+fn child(child_base: u32, imask: u32, slot: u32) -> usize {
+    (child_base + (imask & !(u32::MAX << slot)).count_ones()) as usize
+}
+
+/// The mask of leaf entries (offsets from `node.first`) in the slots of `leaves`.
+#[inline(always)]
+fn leaf_entries(node: &Node, mut leaves: u32) -> u32 {
+    let mut pm = 0;
+    while leaves != 0 {
+        pm |= node.leaf[leaves.trailing_zeros() as usize];
+        leaves &= leaves - 1;
+    }
+    pm
+}
+
+/// Tests the BVH entries that are not inline triangles (spheres, groups): entry `e`'s closest
+/// distance below `t_max` (infinity if none) and the primitive it names.
+pub(super) trait Entries {
+    fn entry(&self, e: usize, r: &TRay, t_max: f32) -> (f32, u32);
+}
+
+/// What a traversal does at a node's hit leaf entries: `Some(new t_max)` to go on, `None` to stop.
+/// (A trait with `#[inline(always)]` methods rather than a closure: a closure would be compiled
+/// without the kernel's target features, and every intrinsic in it would become a call.)
+trait Visit {
+    fn visit(&mut self, node: &Node, entries: u32, t_max: f32) -> Option<f32>;
+}
+
+/// Visits the tree depth first in obvhs's order, calling `v` at each node with hit leaves.
+#[inline(always)]
+fn walk<K: Kernel>(
+    w: &Wide,
+    r: &TRay,
+    mut t_max: f32,
+    stack: &mut [(u32, u32)],
+    v: &mut impl Visit,
+) {
+    let perm = &PERM[r.oct as usize];
+    let mut sp = 0;
+    let mut n = 0;
+    loop {
+        let node = &w.nodes[n];
+        let m = K::node_hits(node, r, t_max);
+        let imask = node.imask as u32;
+        let leaves = m & !imask;
+        if leaves != 0 {
+            match v.visit(node, leaf_entries(node, leaves), t_max) {
+                Some(t) => t_max = t,
+                None => return,
+            }
+        }
+        let inner = perm[(m & imask) as usize] as u32;
+        if inner != 0 {
+            stack[sp] = (node.child_base, imask << 8 | inner);
+            sp += 1;
+        }
+        if sp == 0 {
+            return;
+        }
+        let (base, packed) = stack[sp - 1];
+        let order = packed & 0xff;
+        let k = 31 - order.leading_zeros();
+        let rest = order & !(1 << k);
+        if rest == 0 {
+            sp -= 1;
+        } else {
+            stack[sp - 1].1 = (packed & !0xff) | rest;
+        }
+        n = child(base, packed >> 8, k ^ r.oct);
+    }
+}
+
+struct Closest<'a, K, E> {
+    w: &'a Wide,
+    r: &'a TRay,
+    entries: &'a E,
+    best: Option<(f32, u32, u32)>,
+    kernel: std::marker::PhantomData<K>,
+}
+
+impl<K: Kernel, E: Entries> Visit for Closest<'_, K, E> {
+    #[inline(always)]
+    fn visit(&mut self, node: &Node, entries: u32, t_max: f32) -> Option<f32> {
+        let mut bt = t_max;
+        let mut found: Option<(u32, u32)> = None;
+        let tris = entries & !node.scalar;
+        for c in (0..3).rev() {
+            let lanes = (tris >> (8 * c)) & 0xff;
+            if lanes != 0 {
+                let b = &self.w.blocks[(node.block + c) as usize];
+                if let Some((t, j)) = K::block_closest(b, self.r, bt, lanes) {
+                    bt = t;
+                    found = Some((8 * c + j, u32::MAX));
+                }
+            }
+        }
+        let mut sc = entries & node.scalar;
+        while sc != 0 {
+            let off = 31 - sc.leading_zeros();
+            sc &= !(1 << off);
+            let (t, member) = self
+                .entries
+                .entry((node.first + off) as usize, self.r, t_max);
+            // Sequentially (highest offset first, strict `<`), equal distances go to the
+            // highest offset.
+            if t < bt || (t == bt && found.is_some_and(|(o, _)| off > o)) {
+                bt = t;
+                found = Some((off, member));
+            }
+        }
+        if let Some((off, member)) = found {
+            self.best = Some((bt, node.first + off, member));
+        }
+        Some(bt)
+    }
+}
+
+struct Any<'a, K, E> {
+    w: &'a Wide,
+    r: &'a TRay,
+    entries: &'a E,
+    hit: bool,
+    kernel: std::marker::PhantomData<K>,
+}
+
+impl<K: Kernel, E: Entries> Visit for Any<'_, K, E> {
+    #[inline(always)]
+    fn visit(&mut self, node: &Node, entries: u32, t_max: f32) -> Option<f32> {
+        let tris = entries & !node.scalar;
+        for c in 0..3 {
+            let lanes = (tris >> (8 * c)) & 0xff;
+            if lanes != 0
+                && K::block_any(
+                    &self.w.blocks[(node.block + c) as usize],
+                    self.r,
+                    t_max,
+                    lanes,
+                )
+            {
+                self.hit = true;
+                return None;
+            }
+        }
+        let mut sc = entries & node.scalar;
+        while sc != 0 {
+            let off = sc.trailing_zeros();
+            sc &= sc - 1;
+            if self
+                .entries
+                .entry((node.first + off) as usize, self.r, t_max)
+                .0
+                < t_max
+            {
+                self.hit = true;
+                return None;
+            }
+        }
+        Some(t_max)
+    }
+}
+
+/// The closest entry hit before `t_max`: `(t, entry, member)` where `member` is what
+/// [`Entries::entry`] returned for a scalar entry (`u32::MAX` for an inline triangle).
+#[inline(always)]
+pub(super) fn closest<K: Kernel>(
+    w: &Wide,
+    r: &TRay,
+    t_max: f32,
+    stack: &mut [(u32, u32)],
+    entries: &impl Entries,
+) -> Option<(f32, u32, u32)> {
+    let mut v = Closest::<K, _> {
+        w,
+        r,
+        entries,
+        best: None,
+        kernel: std::marker::PhantomData,
+    };
+    walk::<K>(w, r, t_max, stack, &mut v);
+    v.best
+}
+
+/// Whether any entry is hit before `t_max`.
+#[inline(always)]
+pub(super) fn any<K: Kernel>(
+    w: &Wide,
+    r: &TRay,
+    t_max: f32,
+    stack: &mut [(u32, u32)],
+    entries: &impl Entries,
+) -> bool {
+    let mut v = Any::<K, _> {
+        w,
+        r,
+        entries,
+        hit: false,
+        kernel: std::marker::PhantomData,
+    };
+    walk::<K>(w, r, t_max, stack, &mut v);
+    v.hit
+}
