@@ -369,6 +369,10 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
         None => output,
     };
     if let Some(p) = frame_plan.as_ref().and_then(|f| f.preview.as_ref()) {
+        if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| format!("{}: cannot create output directory: {e}", dir.display()))?;
+        }
         restir_image::check_writable(p).map_err(|e| e.to_string())?;
     }
     if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
