@@ -42,6 +42,17 @@ pub fn parse_animation(text: &str, file: &Path) -> Result<AnimationDesc, SceneEr
     Ok(anim)
 }
 
+/// The byte offset of a RON scene's `animation:` field (the first `animation` followed by a
+/// colon outside a `//` comment), or 0.
+pub(crate) fn section_start(text: &str) -> usize {
+    text.match_indices("animation")
+        .find(|&(i, w)| {
+            let line_start = text[..i].rfind('\n').map_or(0, |n| n + 1);
+            !text[line_start..i].contains("//") && text[i + w.len()..].trim_start().starts_with(':')
+        })
+        .map_or(0, |(i, _)| i)
+}
+
 /// The 1-based line of the `nth` occurrence (0-based) of `needle` in `text` at or after byte
 /// `from`, or 0.
 fn line_of(text: &str, needle: &str, from: usize, nth: usize) -> u32 {

@@ -103,7 +103,7 @@ pub fn load_desc(
             let mut desc = parse_ron(&text, path)?;
             if let Some(mut anim) = desc.animation.take() {
                 anim.location.file = path.to_path_buf();
-                let from = text.find("animation").unwrap_or(0);
+                let from = animation::section_start(&text);
                 animation::attach(&mut desc, anim, &text, from)?;
             }
             Ok((desc, Vec::new()))
