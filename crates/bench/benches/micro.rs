@@ -353,6 +353,7 @@ mod lights {
             ];
             let l = 0.1 * 1000f32.powf(rng.next_f32());
             desc.shapes.push(ShapeDesc {
+                id: None,
                 geometry: GeometryDesc::Sphere {
                     center: c,
                     radius: 0.03 + 0.03 * rng.next_f32(),

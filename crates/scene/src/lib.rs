@@ -21,6 +21,7 @@
 //! assert_eq!(scene.camera.resolution(), (32, 32));
 //! ```
 
+pub mod animation;
 mod build;
 pub mod desc;
 mod error;
@@ -36,7 +37,7 @@ pub mod xml;
 pub use desc::*;
 pub use error::{SceneError, SceneWarning};
 pub use light_share::EnvironmentShare;
-pub use load::{LoadOptions, LoadedScene, load_desc, load_scene, parse_ron};
+pub use load::{LoadOptions, LoadedScene, load_desc, load_scene, parse_ron, sidecar_path};
 
 use glam::{Vec2, Vec3};
 use restir_geometry::{Accel, Camera, Hit, Ray, Shape, SurfaceInteraction};

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::{Location, Scene, SceneDesc, SceneError, SceneWarning, xml};
+use crate::{Location, Scene, SceneDesc, SceneError, SceneWarning, animation, xml};
 
 /// What a caller may change about a scene file while loading it. The film size is here and not
 /// in a render job because the camera's projection is built for it.
@@ -59,7 +59,17 @@ pub fn parse_ron(text: &str, file: &Path) -> Result<SceneDesc, SceneError> {
         })
 }
 
-/// Reads a scene description from a `.ron` or `.xml` file. `defines` set XML `<default>` values
+/// Where an XML scene's animation is looked for: `<name>.anim.ron` beside `<name>.xml`.
+pub fn sidecar_path(scene: &Path) -> PathBuf {
+    let stem = scene
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("scene");
+    scene.with_file_name(format!("{stem}.anim.ron"))
+}
+
+/// Reads a scene description from a `.ron` or `.xml` file (with its animation: a RON scene's
+/// `animation` section, or an XML scene's sidecar, [`sidecar_path`]). `defines` set XML `<default>` values
 /// (`-D name=value` on the command line); they are an error for RON files, which have none.
 pub fn load_desc(
     path: &Path,
@@ -90,9 +100,22 @@ pub fn load_desc(
                     "-D {name}=…: RON scenes have no <default> variables to set"
                 )));
             }
-            Ok((parse_ron(&text, path)?, Vec::new()))
+            let mut desc = parse_ron(&text, path)?;
+            if let Some(mut anim) = desc.animation.take() {
+                anim.location.file = path.to_path_buf();
+                let from = animation::section_start(&text);
+                animation::attach(&mut desc, anim, &text, from)?;
+            }
+            Ok((desc, Vec::new()))
         }
-        Some("xml") => xml::parse_xml(&text, path, defines),
+        Some("xml") => {
+            let (mut desc, warnings) = xml::parse_xml(&text, path, defines)?;
+            let sidecar = sidecar_path(path);
+            if sidecar.is_file() {
+                animation::load_animation(&mut desc, &sidecar)?;
+            }
+            Ok((desc, warnings))
+        }
         _ => Err(whole(
             "unknown scene format: expected a .ron or .xml file".into(),
         )),

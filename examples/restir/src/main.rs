@@ -21,6 +21,7 @@ use restir_scene::{LoadOptions, load_scene};
 
 mod bench;
 mod cluster;
+mod frames;
 mod generate;
 mod interrupt;
 mod merge;
@@ -116,6 +117,8 @@ struct RenderArgs {
     restir: RestirArgs,
     #[command(flatten)]
     cluster: cluster::ClusterArgs,
+    #[command(flatten)]
+    frames: frames::FrameArgs,
 }
 
 /// ReSTIR settings; each overrides the scene's `<integrator>` parameter of the same name.
@@ -282,7 +285,13 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
     if let Some(s) = spinner {
         s.finish_and_clear();
     }
-    let loaded = loaded.map_err(|e| e.to_string())?;
+    let mut loaded = loaded.map_err(|e| e.to_string())?;
+    args.frames.check_needs_frames()?;
+    if let Some(a) = &args.frames.animation {
+        restir_scene::animation::load_animation(&mut loaded.desc, a).map_err(|e| e.to_string())?;
+    }
+    let split = args.cluster.chain.is_some() || args.cluster.crop.is_some();
+    let frame_plan = args.frames.plan(&args.scene, &loaded.desc, split)?;
     if !args.quiet {
         for w in &loaded.warnings {
             say_err!("{w}");
@@ -381,6 +390,17 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
     )?;
 
     // Fail before rendering, not after, when the output cannot be written.
+    let output = match &frame_plan {
+        Some(f) => frames::frame_path(&output, f.first),
+        None => output,
+    };
+    if let Some(p) = frame_plan.as_ref().and_then(|f| f.preview.as_ref()) {
+        if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| format!("{}: cannot create output directory: {e}", dir.display()))?;
+        }
+        restir_image::check_writable(p).map_err(|e| e.to_string())?;
+    }
     if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)
             .map_err(|e| format!("{}: cannot create output directory: {e}", dir.display()))?;
@@ -398,6 +418,26 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
 
     // Ctrl-C finishes the current pass and still writes the image; a second one aborts.
     let cancel = interrupt::install(output.clone(), args.quiet);
+
+    if let Some(plan) = &frame_plan {
+        let stopped = pool.install(|| {
+            frames::run(
+                &args.scene,
+                &loaded.desc,
+                &options,
+                &job,
+                plan,
+                &cancel,
+                args.quiet,
+                args.stats.as_deref(),
+            )
+        })?;
+        return Ok(if stopped {
+            Rendered::Interrupted
+        } else {
+            Rendered::Complete
+        });
+    }
 
     let show_bar = !args.quiet && std::io::stderr().is_terminal();
     let bar = if show_bar {

@@ -91,6 +91,7 @@ fn every_shipped_scene_loads_from_the_repository_alone() {
 
     let mut scenes = 0;
     let mut suites = 0;
+    let mut animated = 0;
     for file in files(&copy) {
         let rel = file.strip_prefix(&copy).unwrap().to_path_buf();
         let ext = file.extension().and_then(|e| e.to_str()).unwrap_or("");
@@ -114,6 +115,20 @@ fn every_shipped_scene_loads_from_the_repository_alone() {
         if ext != "xml" && ext != "ron" {
             continue;
         }
+        if rel.to_string_lossy().ends_with(".anim.ron") {
+            // An XML scene's animation: read with its scene, which must be beside it.
+            let name = file
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .replace(".anim.ron", ".xml");
+            assert!(
+                file.with_file_name(&name).is_file(),
+                "{}: no scene {name} beside it",
+                rel.display()
+            );
+            continue;
+        }
         let options = restir_scene::LoadOptions {
             width: Some(8),
             height: Some(8),
@@ -121,6 +136,17 @@ fn every_shipped_scene_loads_from_the_repository_alone() {
         };
         let loaded = restir_scene::load_scene(&file, &options)
             .unwrap_or_else(|e| panic!("{} does not load from scenes/ alone: {e}", rel.display()));
+        if restir_scene::sidecar_path(&file).is_file() {
+            assert!(loaded.desc.animation.is_some(), "{}", rel.display());
+        }
+        // An animated scene builds at its first and a later time.
+        if loaded.desc.animation.is_some() {
+            for t in [0.0, 1.5] {
+                restir_scene::animation::build_at(&loaded.desc, &file, t)
+                    .unwrap_or_else(|e| panic!("{}: {e}", rel.display()));
+            }
+            animated += 1;
+        }
         let json = serde_json::to_value(&loaded.desc).unwrap();
         let mut names = Vec::new();
         filenames(&json, &mut names);
@@ -136,6 +162,7 @@ fn every_shipped_scene_loads_from_the_repository_alone() {
     let _ = std::fs::remove_dir_all(&sandbox);
     assert!(scenes >= 8, "only {scenes} scenes found");
     assert!(suites >= 2, "only {suites} suites found");
+    assert!(animated >= 2, "only {animated} animated scenes found");
 }
 
 /// The path check itself: relative paths that stay inside pass, the corpus path of old fails.

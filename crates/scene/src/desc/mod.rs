@@ -5,11 +5,13 @@
 //! The scene, camera, film, integrator, shapes and lights are here; materials are in
 //! [`materials`](self) (re-exported), and every default value is in [`defaults`].
 
+mod animation;
 pub mod defaults;
 pub mod limits;
 mod materials;
 mod transform;
 
+pub use animation::*;
 pub use defaults::{AIR_IOR, BK7_IOR, POLYPROPYLENE_IOR};
 pub use materials::*;
 pub use transform::{TransformError, TransformOp, transform_matrix};
@@ -62,6 +64,9 @@ pub struct SceneDesc {
     /// Lights that are not attached to a shape.
     #[serde(default)]
     pub lights: Vec<LightDesc>,
+    /// What moves over time, if anything (docs/ANIMATION.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub animation: Option<AnimationDesc>,
 }
 
 /// A 3-vector `(x, y, z)` or colour `(r, g, b)`.
@@ -265,6 +270,9 @@ pub enum GeometryDesc {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShapeDesc {
+    /// A name an animation refers to the shape by (XML: the `id` attribute).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub id: Option<String>,
     /// What it is.
     pub geometry: GeometryDesc,
     /// Object-to-world transform.

@@ -74,6 +74,7 @@ pub fn many_lights(lights: u32, seed: u64) -> SceneDesc {
     }
 
     let mut shapes = vec![ShapeDesc {
+        id: None,
         geometry: GeometryDesc::Rectangle,
         to_world: vec![
             TransformOp::Scale([10.0, 10.0, 1.0]),
@@ -121,6 +122,7 @@ pub fn many_lights(lights: u32, seed: u64) -> SceneDesc {
             );
             let colour = rng.next_bounded(occluder_colours.len() as u32);
             shapes.push(ShapeDesc {
+                id: None,
                 geometry: GeometryDesc::Cube,
                 to_world: vec![
                     TransformOp::Scale([sx, sy, sz]),
@@ -165,6 +167,7 @@ pub fn many_lights(lights: u32, seed: u64) -> SceneDesc {
         }
         let radiance = colour.map(|c| round(c * level * scale, 4));
         shapes.push(ShapeDesc {
+            id: None,
             geometry: GeometryDesc::Sphere {
                 center: [round(x, 3), round(y, 3), round(z, 3)],
                 radius: round(r, 4),
@@ -204,6 +207,7 @@ pub fn many_lights(lights: u32, seed: u64) -> SceneDesc {
         materials,
         shapes,
         lights: Vec::new(),
+        animation: None,
     }
 }
 

@@ -386,6 +386,7 @@ pub fn room(seed: u64, options: &RoomOptions) -> Generated {
             .collect(),
         shapes,
         lights,
+        animation: None,
     };
     Generated {
         desc,

@@ -339,6 +339,7 @@ pub(super) fn stage(seed: u64, options: &DiOptions) -> Stage {
         materials,
         shapes,
         lights,
+        animation: None,
     };
     Stage {
         desc,

@@ -47,6 +47,7 @@ pub(super) fn shape(
     material: MaterialRef,
 ) -> ShapeDesc {
     ShapeDesc {
+        id: None,
         geometry,
         to_world,
         material: Some(material),
@@ -64,6 +65,7 @@ pub(super) fn emitter(
     radiance: V3,
 ) -> ShapeDesc {
     ShapeDesc {
+        id: None,
         geometry,
         to_world,
         material: None,

@@ -114,6 +114,7 @@ impl<'a> Importer<'a> {
         }
         props.finish();
         Ok(ShapeDesc {
+            id: self.attr(node, "id")?,
             geometry,
             to_world,
             material,

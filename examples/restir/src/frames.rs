@@ -1,0 +1,380 @@
+//! `restir render SCENE --frames A..B`: an animated scene rendered frame by frame. Each frame is
+//! the scene at time `frame / fps` (`restir_scene::animation::build_at`, a whole new scene per
+//! frame), rendered with the job's passes or time limit and written as `NAME_0001.exr` (or
+//! `.png`) through the atomic writer; `--preview OUT.png` also writes an animated PNG of the
+//! frames. The flags are checked before anything renders.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use restir_image::Image;
+use restir_integrators::{IntegratorOptions, RenderJob, make_integrator, render};
+use restir_scene::SceneDesc;
+use restir_scene::animation::{FRAME_REBUILDS, build_at, frame_time};
+
+/// The frames to render, checked.
+#[derive(Clone, Debug)]
+pub struct FramePlan {
+    /// First frame number.
+    pub first: u32,
+    /// Last frame number (inclusive).
+    pub last: u32,
+    /// Frames per second.
+    pub fps: f32,
+    /// Where the animated preview goes.
+    pub preview: Option<PathBuf>,
+}
+
+/// The flags of an animation render.
+#[derive(clap::Args, Debug)]
+#[command(next_help_heading = "Animation")]
+pub struct FrameArgs {
+    /// Render frames A to B (inclusive) of an animated scene, one image per frame
+    /// (NAME_0001.exr, …); frame N shows time N / fps.
+    #[arg(long, value_name = "A..B")]
+    pub frames: Option<String>,
+    /// Frames per second [default: the animation's, else 24].
+    #[arg(long, value_name = "F")]
+    pub fps: Option<f32>,
+    /// The scene's animation from this RON file (for XML scenes, instead of NAME.anim.ron
+    /// beside the scene).
+    #[arg(long, value_name = "FILE")]
+    pub animation: Option<PathBuf>,
+    /// Also write the frames as one animated PNG (8-bit sRGB), played at the frame rate.
+    #[arg(long, value_name = "OUT.png")]
+    pub preview: Option<PathBuf>,
+}
+
+impl FrameArgs {
+    /// The flags that mean nothing without `--frames` are refused without it.
+    pub fn check_needs_frames(&self) -> Result<(), String> {
+        if self.frames.is_some() {
+            return Ok(());
+        }
+        if let Some(f) = self.fps {
+            return Err(format!("--fps {f}: needs --frames A..B"));
+        }
+        if let Some(p) = &self.preview {
+            return Err(format!("--preview {}: needs --frames A..B", p.display()));
+        }
+        if let Some(a) = &self.animation {
+            return Err(format!("--animation {}: needs --frames A..B", a.display()));
+        }
+        Ok(())
+    }
+
+    /// Checks the flags against the scene; `None` without `--frames`. `split` says whether
+    /// `--chain` or `--crop` was given.
+    pub fn plan(
+        &self,
+        scene: &Path,
+        desc: &SceneDesc,
+        split: bool,
+    ) -> Result<Option<FramePlan>, String> {
+        self.check_needs_frames()?;
+        let Some(range) = &self.frames else {
+            return Ok(None);
+        };
+        let bad = || {
+            format!(
+                "--frames {range}: expected A..B, the first and last frame numbers with A <= B (e.g. 1..48)"
+            )
+        };
+        let (a, b) = range.split_once("..").ok_or_else(bad)?;
+        let first: u32 = a.trim().parse().map_err(|_| bad())?;
+        let last: u32 = b.trim().parse().map_err(|_| bad())?;
+        if first > last {
+            return Err(bad());
+        }
+        if split {
+            return Err("--frames cannot be combined with --chain or --crop".into());
+        }
+        let Some(anim) = &desc.animation else {
+            return Err(format!(
+                "{}: --frames: the scene has no animation (give it an `animation` section, a sidecar {}, or --animation FILE)",
+                scene.display(),
+                restir_scene::sidecar_path(scene).display()
+            ));
+        };
+        let fps = match self.fps {
+            Some(f) if f.is_finite() && f > 0.0 && f <= 1e6 => f,
+            Some(f) => {
+                return Err(format!(
+                    "--fps {f}: expected a positive number of frames per second (at most 1e6)"
+                ));
+            }
+            None => anim.fps,
+        };
+        if let Some(p) = &self.preview
+            && !p
+                .extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+        {
+            return Err(format!(
+                "{}: --preview must end in .png (an animated PNG)",
+                p.display()
+            ));
+        }
+        Ok(Some(FramePlan {
+            first,
+            last,
+            fps,
+            preview: self.preview.clone(),
+        }))
+    }
+}
+
+/// The file of frame `frame` for output `output`: `NAME_0001.EXT`.
+pub fn frame_path(output: &Path, frame: u32) -> PathBuf {
+    let stem = output
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("frame");
+    let ext = output.extension().and_then(|e| e.to_str()).unwrap_or("exr");
+    output.with_file_name(format!("{stem}_{frame:04}.{ext}"))
+}
+
+/// What one frame took.
+#[derive(serde::Serialize, Debug)]
+pub struct FrameStats {
+    /// Frame number.
+    pub frame: u32,
+    /// The time it shows, in seconds.
+    pub time: f32,
+    /// Building the frame's scene.
+    pub build_seconds: f64,
+    /// Rendering it.
+    pub seconds: f64,
+    /// Passes rendered.
+    pub passes: u32,
+    /// Rays traced.
+    pub rays: u64,
+    /// The image written.
+    pub output: String,
+}
+
+/// `--stats` of an animation render.
+#[derive(serde::Serialize, Debug)]
+pub struct SequenceStats {
+    /// The scene file.
+    pub scene: String,
+    /// The estimator's settings.
+    pub integrator_settings: String,
+    /// What was rebuilt for each frame.
+    pub rebuilt: &'static str,
+    /// Frames per second.
+    pub fps: f32,
+    /// Seed of the render (frame `n` renders with its own streams derived from it).
+    pub seed: u64,
+    /// Per frame.
+    pub frames: Vec<FrameStats>,
+}
+
+/// The seed of frame `frame`: its own random streams, so noise does not repeat across frames.
+pub fn frame_seed(seed: u64, frame: u32) -> u64 {
+    seed ^ u64::from(frame).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+}
+
+/// Renders the frames of `plan`: per frame, the scene at its time, a fresh estimator from
+/// `options` (no history crosses frames), `job`'s passes or time limit, and the image at
+/// [`frame_path`]. `progress` gets `(frame index, frames, passes of this frame)`. Stops after
+/// the current frame when `cancel` is set; returns the statistics and whether it was stopped.
+#[allow(clippy::too_many_arguments)]
+pub fn render_frames(
+    scene_path: &Path,
+    desc: &SceneDesc,
+    options: &IntegratorOptions,
+    job: &RenderJob,
+    output: &Path,
+    plan: &FramePlan,
+    cancel: &AtomicBool,
+    progress: &mut dyn FnMut(u32, u32, u32),
+) -> Result<(SequenceStats, bool), String> {
+    let count = plan.last - plan.first + 1;
+    let mut frames = Vec::with_capacity(count as usize);
+    let mut preview = Vec::new();
+    let mut settings = String::new();
+    let mut stopped = false;
+    for (i, frame) in (plan.first..=plan.last).enumerate() {
+        let time = frame_time(frame, plan.fps);
+        let build = Instant::now();
+        let scene = build_at(desc, scene_path, time).map_err(|e| e.to_string())?;
+        let build_seconds = build.elapsed().as_secs_f64();
+        let made = make_integrator(&scene, options).map_err(|e| e.to_string())?;
+        settings = made.integrator.describe();
+        let frame_job = RenderJob {
+            seed: frame_seed(job.seed, frame),
+            ..job.clone()
+        };
+        let out = render(
+            &scene,
+            made.integrator.as_ref(),
+            &frame_job,
+            cancel,
+            &mut |passes, _| progress(i as u32, count, passes),
+        );
+        let path = frame_path(output, frame);
+        out.image.write(&path).map_err(|e| e.to_string())?;
+        if plan.preview.is_some() {
+            preview.push(out.image);
+        }
+        frames.push(FrameStats {
+            frame,
+            time,
+            build_seconds,
+            seconds: out.seconds,
+            passes: out.passes,
+            rays: out.rays,
+            output: path.display().to_string(),
+        });
+        if cancel.load(Ordering::SeqCst) {
+            stopped = true;
+            break;
+        }
+    }
+    if let Some(p) = &plan.preview {
+        write_apng(p, &preview, plan.fps)?;
+    }
+    Ok((
+        SequenceStats {
+            scene: scene_path.display().to_string(),
+            integrator_settings: settings,
+            rebuilt: FRAME_REBUILDS,
+            fps: plan.fps,
+            seed: job.seed,
+            frames,
+        },
+        stopped,
+    ))
+}
+
+/// Writes `frames` as an animated PNG (8-bit sRGB, looping) at `fps`, atomically.
+pub fn write_apng(path: &Path, frames: &[Image], fps: f32) -> Result<(), String> {
+    let Some(first) = frames.first() else {
+        return Ok(());
+    };
+    let fail =
+        |e: png::EncodingError| format!("{}: cannot encode the preview: {e}", path.display());
+    let mut bytes = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut bytes, first.width, first.height);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        enc.set_animated(frames.len() as u32, 0).map_err(fail)?;
+        // The delay in seconds as a fraction: 100 / (100 fps).
+        let den = (fps * 100.0).round().clamp(1.0, 65535.0) as u16;
+        enc.set_frame_delay(100, den).map_err(fail)?;
+        let mut w = enc.write_header().map_err(fail)?;
+        for img in frames {
+            let data: Vec<u8> = img
+                .pixels
+                .iter()
+                .flat_map(|p| p.to_array().map(restir_image::srgb::encode_u8))
+                .collect();
+            w.write_image_data(&data).map_err(fail)?;
+        }
+        w.finish().map_err(fail)?;
+    }
+    restir_image::write_file_atomically(path, &bytes).map_err(|e| e.to_string())
+}
+
+/// The command's side of [`render_frames`]: a progress bar (frame and pass), the statistics
+/// file and the summary. Returns whether an interrupt stopped the sequence.
+#[allow(clippy::too_many_arguments)]
+pub fn run(
+    scene_path: &Path,
+    desc: &SceneDesc,
+    options: &IntegratorOptions,
+    job: &RenderJob,
+    plan: &FramePlan,
+    cancel: &AtomicBool,
+    quiet: bool,
+    stats: Option<&Path>,
+) -> Result<bool, String> {
+    use std::io::IsTerminal;
+    let output = job
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("frame.exr"));
+    let count = plan.last - plan.first + 1;
+    let by_passes = job.spp != u32::MAX;
+    let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
+        let len = if by_passes {
+            u64::from(count) * u64::from(job.spp)
+        } else {
+            u64::from(count)
+        };
+        let b = indicatif::ProgressBar::new(len);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:40} {msg}, {elapsed_precise} elapsed, ETA {eta_precise}",
+            )
+            .expect("valid template"),
+        );
+        b
+    });
+    let start = Instant::now();
+    let (stats_out, stopped) = render_frames(
+        scene_path,
+        desc,
+        options,
+        job,
+        &output,
+        plan,
+        cancel,
+        &mut |i, n, passes| {
+            if let Some(b) = &bar {
+                let done = if by_passes {
+                    u64::from(i) * u64::from(job.spp) + u64::from(passes)
+                } else {
+                    u64::from(i)
+                };
+                b.set_position(done);
+                let of = if by_passes {
+                    format!("/{}", job.spp)
+                } else {
+                    String::new()
+                };
+                b.set_message(format!(
+                    "frame {} ({}/{n}), pass {passes}{of}",
+                    plan.first + i,
+                    i + 1
+                ));
+            }
+        },
+    )?;
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    if let Some(path) = stats {
+        let json = serde_json::to_string_pretty(&stats_out).map_err(|e| e.to_string())?;
+        restir_image::write_file_atomically(path, (json + "\n").as_bytes())
+            .map_err(|e| e.to_string())?;
+    }
+    let written = stats_out.frames.len();
+    if stopped {
+        crate::say::say_err!(
+            "interrupted after {written} of {count} frames: wrote the frames rendered -> {}",
+            frame_path(&output, plan.first).display()
+        );
+    }
+    if !quiet {
+        let passes: u32 = stats_out.frames.iter().map(|f| f.passes).sum();
+        crate::say::say!(
+            "{}: {written} frames ({} to {}) at {} fps, {passes} passes in {:.2} s -> {} …{}",
+            stats_out.integrator_settings,
+            plan.first,
+            plan.first + written.saturating_sub(1) as u32,
+            plan.fps,
+            start.elapsed().as_secs_f64(),
+            frame_path(&output, plan.first).display(),
+            match &plan.preview {
+                Some(p) => format!(", preview {}", p.display()),
+                None => String::new(),
+            }
+        );
+    }
+    Ok(stopped)
+}

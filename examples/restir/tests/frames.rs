@@ -1,0 +1,242 @@
+//! `restir render SCENE --frames A..B`: one image per frame through the atomic writer, the
+//! animated PNG preview and the statistics, and every bad flag refused before rendering with
+//! exit code 1 and exactly the message checked here.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
+
+/// A fresh directory for one test, removed when dropped.
+struct TempDir(PathBuf);
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn temp_dir(tag: &str) -> TempDir {
+    let dir = std::env::temp_dir().join(format!("restir-frames-{}-{tag}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    TempDir(dir)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn restir(args: &[&str]) -> Output {
+    Command::new(RESTIR).args(args).output().unwrap()
+}
+
+fn fails_with(args: &[&str], expected: &str) {
+    let out = restir(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+    assert_eq!(stderr, format!("{expected}\n"), "{args:?}");
+    assert!(out.stdout.is_empty(), "{args:?} printed a summary");
+}
+
+const ANIMATED: &str = r#"(
+    camera: (fov: 40, to_world: [LookAt(origin: (0, 0, 4), target: (0, 0, 0), up: (0, 1, 0))]),
+    film: (width: 8, height: 8, filter: Box),
+    shapes: [
+        (geometry: Rectangle),
+        (id: Some("lamp"), geometry: Sphere(center: (0, 0, 1), radius: 0.2), emission: Some((5, 5, 5))),
+    ],
+    animation: Some((
+        fps: 2,
+        camera: Some((keys: [
+            (time: 0, position: (0, 0, 4), target: (0, 0, 0)),
+            (time: 1, position: (1, 0, 4), target: (0, 0, 0)),
+        ])),
+        shapes: [(id: "lamp", motion: Some([(time: 0), (time: 1, translate: (0.5, 0, 0))]))],
+    )),
+)"#;
+
+fn animated(dir: &TempDir) -> PathBuf {
+    let p = dir.0.join("anim.ron");
+    std::fs::write(&p, ANIMATED).unwrap();
+    p
+}
+
+fn static_scene(dir: &TempDir) -> PathBuf {
+    let p = dir.0.join("still.ron");
+    let text = ANIMATED.split("    animation:").next().unwrap().to_string() + ")";
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn frames_are_written_one_file_each_with_a_preview_and_stats() {
+    let dir = temp_dir("ok");
+    let scene = animated(&dir);
+    let out = dir.0.join("out/seq.exr");
+    let preview = dir.0.join("seq.png");
+    let stats = dir.0.join("stats.json");
+    let run = restir(&[
+        "render",
+        s(&scene),
+        "--frames",
+        "0..2",
+        "--spp",
+        "2",
+        "--integrator",
+        "restir-di",
+        "-o",
+        s(&out),
+        "--preview",
+        s(&preview),
+        "--stats",
+        s(&stats),
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    let mut frames = Vec::new();
+    for f in 0..3 {
+        let p = dir.0.join(format!("out/seq_{f:04}.exr"));
+        frames.push(restir_image::Image::read_exr(&p).unwrap());
+    }
+    assert!(!dir.0.join("out/seq.exr").exists());
+    // The camera and the lamp move: consecutive frames differ.
+    assert_ne!(frames[0].pixels, frames[1].pixels);
+    // An animated PNG: its acTL chunk says 3 frames, looping.
+    let bytes = std::fs::read(&preview).unwrap();
+    let at = bytes
+        .windows(4)
+        .position(|w| w == b"acTL")
+        .expect("an acTL chunk");
+    assert_eq!(&bytes[at + 4..at + 8], &3u32.to_be_bytes());
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    let fr = json["frames"].as_array().unwrap();
+    assert_eq!(fr.len(), 3);
+    assert_eq!(fr[1]["frame"], 1);
+    assert_eq!(fr[1]["time"], 0.5);
+    assert_eq!(fr[2]["passes"], 2);
+    assert!(json["rebuilt"].as_str().unwrap().contains("BVH"));
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(stdout.contains("3 frames (0 to 2) at 2 fps"), "{stdout}");
+}
+
+#[test]
+fn bad_frame_flags_are_refused_before_rendering() {
+    let dir = temp_dir("bad");
+    let scene = animated(&dir);
+    let still = static_scene(&dir);
+    let out = dir.0.join("o.exr");
+    let o = s(&out);
+    let range = "error: --frames 5..2: expected A..B, the first and last frame numbers with A <= B (e.g. 1..48)";
+    fails_with(&["render", s(&scene), "-o", o, "--frames", "5..2"], range);
+    fails_with(
+        &["render", s(&scene), "-o", o, "--frames", "three"],
+        "error: --frames three: expected A..B, the first and last frame numbers with A <= B (e.g. 1..48)",
+    );
+    fails_with(
+        &["render", s(&scene), "-o", o, "--frames", "1..-4"],
+        "error: --frames 1..-4: expected A..B, the first and last frame numbers with A <= B (e.g. 1..48)",
+    );
+    fails_with(
+        &["render", s(&still), "-o", o, "--frames", "1..3"],
+        &format!(
+            "error: {}: --frames: the scene has no animation (give it an `animation` section, a sidecar {}, or --animation FILE)",
+            s(&still),
+            s(&dir.0.join("still.anim.ron"))
+        ),
+    );
+    fails_with(
+        &[
+            "render",
+            s(&scene),
+            "-o",
+            o,
+            "--frames",
+            "1..3",
+            "--fps",
+            "0",
+        ],
+        "error: --fps 0: expected a positive number of frames per second (at most 1e6)",
+    );
+    fails_with(
+        &["render", s(&scene), "-o", o, "--fps", "24"],
+        "error: --fps 24: needs --frames A..B",
+    );
+    fails_with(
+        &["render", s(&scene), "-o", o, "--preview", "p.png"],
+        "error: --preview p.png: needs --frames A..B",
+    );
+    fails_with(
+        &[
+            "render",
+            s(&scene),
+            "-o",
+            o,
+            "--frames",
+            "1..3",
+            "--preview",
+            "p.gif",
+        ],
+        "error: p.gif: --preview must end in .png (an animated PNG)",
+    );
+    fails_with(
+        &[
+            "render",
+            s(&scene),
+            "-o",
+            o,
+            "--frames",
+            "1..3",
+            "--crop",
+            "0,0,4,4",
+        ],
+        "error: --frames cannot be combined with --chain or --crop",
+    );
+    let missing = dir.0.join("missing.anim.ron");
+    let out = restir(&[
+        "render",
+        s(&still),
+        "-o",
+        o,
+        "--frames",
+        "1..3",
+        "--animation",
+        s(&missing),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr.starts_with(&format!("error: {}: cannot read animation: ", s(&missing))),
+        "{stderr}"
+    );
+    fails_with(
+        &["render", s(&still), "-o", o, "--animation", s(&missing)],
+        &format!("error: --animation {}: needs --frames A..B", s(&missing)),
+    );
+    // A second animation beside the scene's own.
+    let side = dir.0.join("side.anim.ron");
+    std::fs::write(&side, "(fps: 3)").unwrap();
+    fails_with(
+        &[
+            "render",
+            s(&scene),
+            "-o",
+            o,
+            "--frames",
+            "0..1",
+            "--animation",
+            s(&side),
+        ],
+        &format!(
+            "error: {}: the scene already has an animation (from {}): give one animation",
+            s(&side),
+            s(&scene)
+        ),
+    );
+    assert!(!out_exists(&dir), "nothing was rendered");
+}
+
+fn out_exists(dir: &TempDir) -> bool {
+    std::fs::read_dir(&dir.0)
+        .unwrap()
+        .any(|e| e.unwrap().file_name().to_string_lossy().starts_with("o"))
+}
