@@ -151,7 +151,7 @@ impl RestirDiSettings {
         let few = features.emitter_count <= FEW_EMITTERS;
         (applies && few && share >= DOMINANT_LIGHT_SHARE).then(|| {
             format!(
-                "one light takes {:.0}% of the light selections (>= {:.0}%, {} emitters <= {}): \
+                "one light takes {:.0}% of the light selections (>= {:.0}% with {} emitters <= {}): \
                  the path tracer renders it (fallback = off keeps ReSTIR DI)",
                 100.0 * share,
                 100.0 * DOMINANT_LIGHT_SHARE,
