@@ -20,7 +20,7 @@ mod prims;
 mod wide;
 
 use prims::{Prim, group_entries};
-use wide::{Entries, STACK, Scalar, TRay, Wide};
+use wide::{Entries, Scalar, TRay, Wide};
 
 /// A closest hit: distance and which primitive.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -251,26 +251,15 @@ impl Accel {
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         let w = self.wide.as_ref()?;
         let r = TRay::new(ray.o.into(), ray.d.into());
-        let mut small = [(0, 0); STACK];
-        let mut big = Vec::new();
-        let stack = if w.depth <= STACK {
-            &mut small[..]
-        } else {
-            big.resize(w.depth, (0, 0));
-            &mut big[..]
-        };
-        #[cfg(target_arch = "x86_64")]
-        let found = if self.avx2 {
-            // SAFETY: `avx2` is set only when the CPU reported AVX2 (`detect_avx2`).
-            #[allow(unsafe_code)]
-            unsafe {
-                avx2::closest_avx2(w, &r, t_max, stack, self)
+        let found = wide::with_stack(w.depth, |stack| {
+            #[cfg(target_arch = "x86_64")]
+            if self.avx2 {
+                // SAFETY: `avx2` is set only when the CPU reported AVX2 (`detect_avx2`).
+                #[allow(unsafe_code)]
+                return unsafe { avx2::closest_avx2(w, &r, t_max, stack, self) };
             }
-        } else {
             wide::closest::<Scalar>(w, &r, t_max, stack, self)
-        };
-        #[cfg(not(target_arch = "x86_64"))]
-        let found = wide::closest::<Scalar>(w, &r, t_max, stack, self);
+        });
         let (t, entry, member) = found?;
         let id = match (member, &self.groups) {
             (u32::MAX, Some(starts)) => starts[entry as usize],
@@ -288,21 +277,15 @@ impl Accel {
             return false;
         };
         let r = TRay::new(ray.o.into(), ray.d.into());
-        let mut small = [(0, 0); STACK];
-        let mut big = Vec::new();
-        let stack = if w.depth <= STACK {
-            &mut small[..]
-        } else {
-            big.resize(w.depth, (0, 0));
-            &mut big[..]
-        };
-        #[cfg(target_arch = "x86_64")]
-        if self.avx2 {
-            // SAFETY: `avx2` is set only when the CPU reported AVX2 (`detect_avx2`).
-            #[allow(unsafe_code)]
-            return unsafe { avx2::any_avx2(w, &r, t_max, stack, self) };
-        }
-        wide::any::<Scalar>(w, &r, t_max, stack, self)
+        wide::with_stack(w.depth, |stack| {
+            #[cfg(target_arch = "x86_64")]
+            if self.avx2 {
+                // SAFETY: `avx2` is set only when the CPU reported AVX2 (`detect_avx2`).
+                #[allow(unsafe_code)]
+                return unsafe { avx2::any_avx2(w, &r, t_max, stack, self) };
+            }
+            wide::any::<Scalar>(w, &r, t_max, stack, self)
+        })
     }
 
     /// Surface details of a hit returned by [`Accel::intersect`] for the same `ray`.

@@ -23,6 +23,17 @@ const NODE_EPSILON: f32 = 0.0001;
 /// The deepest tree the fixed traversal stack holds; deeper trees use a heap stack.
 pub(super) const STACK: usize = 24;
 
+/// Runs a traversal `f` with a stack for a tree `depth` levels deep: on the call stack up to
+/// [`STACK`] levels, on the heap beyond.
+#[inline(always)]
+pub(super) fn with_stack<T>(depth: usize, f: impl FnOnce(&mut [(u32, u32)]) -> T) -> T {
+    if depth <= STACK {
+        f(&mut [(0, 0); STACK])
+    } else {
+        f(&mut vec![(0, 0); depth])
+    }
+}
+
 /// One CWBVH node, decoded for traversal.
 #[derive(Clone, Copy, Debug, Default)]
 #[repr(C, align(64))]
