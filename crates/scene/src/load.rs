@@ -44,9 +44,10 @@ pub struct LoadedScene {
     pub desc: SceneDesc,
 }
 
-/// Parses the project's RON scene format.
+/// Parses the project's RON scene format, an `animation` section included (its tracks'
+/// shape ids resolved to shape indices; an unknown id is an error).
 pub fn parse_ron(text: &str, file: &Path) -> Result<SceneDesc, SceneError> {
-    ron::Options::default()
+    let mut desc = ron::Options::default()
         .from_str::<SceneDesc>(text)
         .map_err(|e| {
             SceneError::new(
@@ -56,7 +57,13 @@ pub fn parse_ron(text: &str, file: &Path) -> Result<SceneDesc, SceneError> {
                 },
                 e.code.to_string(),
             )
-        })
+        })?;
+    if let Some(mut anim) = desc.animation.take() {
+        anim.location.file = file.to_path_buf();
+        let from = animation::section_start(text);
+        animation::attach(&mut desc, anim, text, from)?;
+    }
+    Ok(desc)
 }
 
 /// Where an XML scene's animation is looked for: `<name>.anim.ron` beside `<name>.xml`.
@@ -100,13 +107,7 @@ pub fn load_desc(
                     "-D {name}=…: RON scenes have no <default> variables to set"
                 )));
             }
-            let mut desc = parse_ron(&text, path)?;
-            if let Some(mut anim) = desc.animation.take() {
-                anim.location.file = path.to_path_buf();
-                let from = animation::section_start(&text);
-                animation::attach(&mut desc, anim, &text, from)?;
-            }
-            Ok((desc, Vec::new()))
+            Ok((parse_ron(&text, path)?, Vec::new()))
         }
         Some("xml") => {
             let (mut desc, warnings) = xml::parse_xml(&text, path, defines)?;
