@@ -53,6 +53,7 @@ impl std::error::Error for CameraError {}
 #[derive(Clone, Copy, Debug)]
 pub struct Camera {
     to_world: Mat4,
+    from_world: Mat4,
     origin: Vec3,
     tan_half: Vec2,
     resolution: (u32, u32),
@@ -116,6 +117,7 @@ impl Camera {
         };
         Ok(Self {
             to_world,
+            from_world: to_world.inverse(),
             origin: to_world.transform_point3(Vec3::ZERO),
             tan_half,
             resolution,
@@ -137,6 +139,25 @@ impl Camera {
     /// The camera-to-world matrix.
     pub fn to_world(&self) -> Mat4 {
         self.to_world
+    }
+
+    /// Where the camera sees world point `p`: the film position (in pixels, `(0, 0)` at the
+    /// top-left corner, possibly outside the film) of the ray through the lens centre towards
+    /// `p`, the inverse of [`Camera::generate_ray`] for a pinhole (for a thin lens, the
+    /// position where `p` is in focus at its depth). `None` for points not in front of the
+    /// camera. Motion vectors use it: where a point seen now was seen by the previous frame's
+    /// camera.
+    #[inline]
+    pub fn film_position_of(&self, p: Vec3) -> Option<Vec2> {
+        let local = self.from_world.transform_point3(p);
+        if local.z.is_nan() || local.z <= 0.0 {
+            return None;
+        }
+        let (w, h) = self.resolution;
+        let x = local.x / (local.z * self.tan_half.x);
+        let y = local.y / (local.z * self.tan_half.y);
+        let film = Vec2::new((1.0 - x) * 0.5 * w as f32, (1.0 - y) * 0.5 * h as f32);
+        film.is_finite().then_some(film)
     }
 
     /// The primary ray through film position `film` (in pixels, `(0, 0)` at the top-left corner),
@@ -189,6 +210,29 @@ mod tests {
         // Top edge looks up; vertical half-extent is tan(45°)/aspect.
         let t = cam.generate_ray(Vec2::new(50.0, 0.0), Vec2::ZERO);
         assert!(t.d.y > 0.0 && (t.d.y / -t.d.z - 0.5).abs() < 1e-5);
+    }
+
+    #[test]
+    fn film_position_inverts_generate_ray() {
+        let m = Mat4::from_rotation_translation(
+            glam::Quat::from_euler(glam::EulerRot::YXZ, 0.4, -0.3, 0.1),
+            Vec3::new(1.0, 2.0, 5.0),
+        );
+        for axis in [FovAxis::X, FovAxis::Y, FovAxis::Diagonal] {
+            let cam = Camera::perspective(m, 50.0, axis, (64, 48)).unwrap();
+            for film in [
+                Vec2::new(0.5, 0.5),
+                Vec2::new(31.2, 7.9),
+                Vec2::new(63.9, 47.1),
+            ] {
+                let ray = cam.generate_ray(film, Vec2::ZERO);
+                let back = cam.film_position_of(ray.o + 3.7 * ray.d).unwrap();
+                assert!((back - film).length() < 1e-3, "{film} -> {back}");
+            }
+            // Behind the camera: nowhere on the film.
+            let ray = cam.generate_ray(Vec2::new(10.0, 10.0), Vec2::ZERO);
+            assert!(cam.film_position_of(ray.o - ray.d).is_none());
+        }
     }
 
     #[test]
