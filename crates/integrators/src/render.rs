@@ -6,6 +6,7 @@
 //! film ([`PixelWindow`]) rendered with a halo wide enough for the estimator's spatial reuse.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
@@ -18,6 +19,7 @@ use crate::Image;
 use crate::bands::Bands;
 use crate::film::{Film, Filter};
 use crate::path::{PathSettings, trace_camera_path};
+use crate::reuse::motion::FrameMotion;
 
 /// What an integrator needs to know about the current pass.
 #[derive(Debug)]
@@ -220,6 +222,13 @@ pub trait Integrator: Sync + Send + std::fmt::Debug {
     /// (empty for an estimator without stages, like the path tracer).
     fn stage_seconds(&self) -> Vec<(&'static str, f64)> {
         Vec::new()
+    }
+    /// The passes that follow render the next frame of a sequence, which moved from the frame
+    /// of the passes before as `motion` says. An estimator that keeps samples between passes
+    /// (temporal reuse) shifts them across the frames with it, or forgets them; the default
+    /// keeps nothing, so it does nothing.
+    fn next_frame(&self, motion: Arc<FrameMotion>) {
+        let _ = motion;
     }
 }
 

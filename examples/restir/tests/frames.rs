@@ -119,6 +119,61 @@ fn frames_are_written_one_file_each_with_a_preview_and_stats() {
     assert!(stdout.contains("3 frames (0 to 2) at 2 fps"), "{stdout}");
 }
 
+/// With `--temporal`, ReSTIR DI's first pass of a frame reuses the previous frame (the frame
+/// differs from the one rendered without it, same seed; the first frame, with no history,
+/// does not); ReSTIR PT starts every frame afresh and renders too.
+#[test]
+fn temporal_reuse_crosses_frames() {
+    let dir = temp_dir("temporal");
+    let scene = animated(&dir);
+    let render = |tag: &str, extra: &[&str]| -> Vec<restir_image::Image> {
+        let out = dir.0.join(format!("{tag}/f.exr"));
+        let stats = dir.0.join(format!("{tag}.json"));
+        let mut args = vec![
+            "render",
+            s(&scene),
+            "--frames",
+            "0..2",
+            "--spp",
+            "1",
+            "-o",
+            s(&out),
+            "--stats",
+            s(&stats),
+        ];
+        args.extend_from_slice(extra);
+        let run = restir(&args);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let json: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+        let settings = json["integrator_settings"].as_str().unwrap();
+        assert_eq!(
+            settings.contains("temporal=true"),
+            extra.contains(&"--temporal"),
+            "{settings}"
+        );
+        (0..3)
+            .map(|f| {
+                let p = dir.0.join(format!("{tag}/f_{f:04}.exr"));
+                restir_image::Image::read_exr(&p).unwrap()
+            })
+            .collect()
+    };
+    let di = ["--integrator", "restir-di", "--fallback", "off"];
+    let spatial = render("di", &di);
+    let temporal = render("di-t", &[&di[..], &["--temporal"]].concat());
+    assert_eq!(spatial[0].pixels, temporal[0].pixels);
+    assert_ne!(spatial[1].pixels, temporal[1].pixels);
+    assert_ne!(spatial[2].pixels, temporal[2].pixels);
+    for img in render("pt-t", &["--integrator", "restir-pt", "--temporal"]) {
+        assert!(img.pixels.iter().all(|p| p.is_finite()));
+    }
+}
+
 #[test]
 fn bad_frame_flags_are_refused_before_rendering() {
     let dir = temp_dir("bad");

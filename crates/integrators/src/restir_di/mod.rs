@@ -48,6 +48,7 @@ use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
 use crate::render::{Integrator, PassContext, PathIntegrator};
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::light_point::{Contact, LightPoint, Resolved, contact, resolve};
+use crate::reuse::motion::FrameMotion;
 use crate::reuse::neighbors::NeighborPattern;
 use crate::reuse::passes::{self, HistorySlot, ReuseShift};
 use crate::reuse::reciprocal;
@@ -77,20 +78,40 @@ pub struct RestirDiIntegrator {
     fallback: Option<(PathIntegrator, String)>,
 }
 
+/// A receiver where ReSTIR DI's shift map works: a pixel's primary hit in this pass, or in the
+/// previous pass, which across frames lies in the previous frame's scene.
+#[derive(Clone, Copy)]
+struct DiDomain<'a> {
+    r: &'a Receiver,
+    /// The scene the receiver's target is evaluated in.
+    scene: &'a Scene,
+    /// Whether the receiver is the previous frame's (its light indices are that frame's).
+    earlier: bool,
+}
+
 /// The identity shift between pixels: the sample stays on the light, `J = 1`; only the target
-/// changes. It keeps the receiving pixel's own sample resolved, because pairwise MIS evaluates
-/// that sample at every neighbour.
+/// changes. Across frames the sample moves with its light, which the previous frame may name
+/// by another index ([`FrameMotion`]); a rigid motion keeps area, so `J = 1` still. It keeps
+/// the receiving pixel's own sample resolved, because pairwise MIS evaluates that sample at
+/// every neighbour.
 struct DiShift<'a> {
     scene: &'a Scene,
     counts: StrategyCounts,
+    motion: Option<&'a FrameMotion>,
     canonical: Option<(LightPoint, Resolved)>,
 }
 
 impl<'a> DiShift<'a> {
-    fn new(scene: &'a Scene, counts: StrategyCounts, canonical: &DiReservoir) -> Self {
+    fn new(
+        scene: &'a Scene,
+        counts: StrategyCounts,
+        motion: Option<&'a FrameMotion>,
+        canonical: &DiReservoir,
+    ) -> Self {
         Self {
             scene,
             counts,
+            motion,
             canonical: canonical.sample.map(|x| (x, resolve(scene, &x))),
         }
     }
@@ -104,58 +125,86 @@ impl<'a> DiShift<'a> {
     }
 }
 
-impl ShiftMap<LightPoint> for DiShift<'_> {
-    type Domain = Receiver;
+impl<'a> ShiftMap<LightPoint> for DiShift<'a> {
+    type Domain = DiDomain<'a>;
 
     #[inline(always)]
     fn shift(
         &self,
-        _from: &Receiver,
-        to: &Receiver,
+        from: &DiDomain<'a>,
+        to: &DiDomain<'a>,
         x: &LightPoint,
     ) -> Option<Shifted<LightPoint>> {
-        let resolved = self.resolved(x);
+        let mut y = *x;
+        if from.earlier != to.earlier
+            && let Some(m) = self.motion
+        {
+            y.light = if to.earlier {
+                m.light_to_prev(x.light)?
+            } else {
+                m.light_from_prev(x.light)?
+            };
+        }
+        let resolved = if std::ptr::eq(to.scene, self.scene) {
+            self.resolved(&y)
+        } else {
+            resolve(to.scene, &y)
+        };
         Some(Shifted::identity(
-            *x,
-            target(self.scene, to, x, &resolved, self.counts),
+            y,
+            target(to.scene, to.r, &y, &resolved, self.counts),
         ))
     }
 }
 
 /// ReSTIR DI's part in the reuse passes: the identity shift between receivers; a domain is a
-/// pixel's receiver in this pass or the previous one.
+/// pixel's receiver in this pass or the previous one (across frames, with the previous
+/// frame's scene, or with this frame's for the negative control `temporal_current_scene`).
 struct DiReuse<'p> {
     scene: &'p Scene,
     counts: StrategyCounts,
     gbuf: &'p GBuffer,
     prev: Option<&'p GBuffer>,
+    /// The previous pass's scene and the motion since, when it was the previous frame's.
+    motion: Option<&'p FrameMotion>,
+    prev_scene: &'p Scene,
 }
 
-impl ReuseShift for DiReuse<'_> {
+impl<'p> ReuseShift for DiReuse<'p> {
     type Sample = LightPoint;
-    type Domain = Receiver;
+    type Domain = DiDomain<'p>;
     type DomainRef<'d>
-        = &'d Receiver
+        = DiDomain<'p>
     where
         Self: 'd;
     type Map<'m>
-        = DiShift<'m>
+        = DiShift<'p>
     where
         Self: 'm;
 
     #[inline]
-    fn map(&self, canonical: &DiReservoir) -> DiShift<'_> {
-        DiShift::new(self.scene, self.counts, canonical)
+    fn map(&self, canonical: &DiReservoir) -> DiShift<'p> {
+        DiShift::new(self.scene, self.counts, self.motion, canonical)
     }
 
     #[inline]
-    fn domain(&self, index: usize, previous: bool) -> &Receiver {
-        let gbuf = if previous {
-            self.prev.expect("temporal reuse has a previous pass")
+    fn domain(&self, index: usize, previous: bool) -> DiDomain<'p> {
+        if previous {
+            DiDomain {
+                r: &self
+                    .prev
+                    .expect("temporal reuse has a previous pass")
+                    .receivers[index],
+                scene: self.prev_scene,
+                earlier: self.motion.is_some(),
+            }
         } else {
-            self.gbuf
-        };
-        &gbuf.receivers[index]
+            DiDomain {
+                r: &self.gbuf.receivers[index],
+                scene: self.scene,
+                earlier: false,
+            }
+        }
     }
 }
 
@@ -438,6 +487,13 @@ impl Integrator for RestirDiIntegrator {
         self.clock.seconds()
     }
 
+    /// The previous frame's reservoirs are reused with the motion: light samples move with
+    /// their lights, receivers are found by motion vectors, targets of previous domains are
+    /// evaluated in the previous frame's scene.
+    fn next_frame(&self, motion: std::sync::Arc<FrameMotion>) {
+        self.history.next_frame(Some(motion));
+    }
+
     fn halo(&self) -> u32 {
         if self.fallback.is_some() {
             return 0;
@@ -451,7 +507,7 @@ impl Integrator for RestirDiIntegrator {
         }
         let reservoirs = if self.settings.reuse.temporal { 3 } else { 2 };
         let hits = if self.settings.reuse.temporal { 2 } else { 1 };
-        let hit_bytes = std::mem::size_of::<Receiver>() + std::mem::size_of::<Vec3>();
+        let hit_bytes = GBuffer::BYTES_PER_PIXEL;
         reservoirs * Self::RESERVOIR_BYTES
             + hits * hit_bytes
             + std::mem::size_of::<Vec3>()
@@ -507,11 +563,17 @@ impl Integrator for RestirDiIntegrator {
 
             // Temporal and spatial reuse.
             let history = self.history.take(reuse, n);
+            let motion = history.as_ref().and_then(|h| h.motion.as_deref());
             let shift = DiReuse {
                 scene,
                 counts: self.counts,
                 gbuf: &gbuf,
                 prev: history.as_ref().map(|h| &h.gbuffer),
+                motion,
+                prev_scene: match motion {
+                    Some(m) if !reuse.temporal_current_scene => &m.prev_scene,
+                    _ => scene,
+                },
             };
             if let Some(history) = &history {
                 rays += self.clock.time("temporal", || {

@@ -307,8 +307,15 @@ impl Integrator for RestirPtIntegrator {
         self.clock.seconds()
     }
 
+    /// Paths are not shifted across frames yet (their vertices would have to move with their
+    /// shapes and be replayed in the previous frame's scene): the history is dropped, and the
+    /// first pass of every frame starts afresh (`docs/ANIMATION.md`).
+    fn next_frame(&self, _motion: std::sync::Arc<crate::reuse::motion::FrameMotion>) {
+        self.history.next_frame(None);
+    }
+
     fn buffer_bytes_per_pixel(&self) -> usize {
-        let hit_bytes = std::mem::size_of::<Receiver>() + std::mem::size_of::<Vec3>();
+        let hit_bytes = GBuffer::BYTES_PER_PIXEL;
         let (reservoirs, hits) = if self.settings.reuse.temporal {
             (3, 2)
         } else {

@@ -103,9 +103,16 @@ pub struct GBuffer {
     pub receivers: Vec<Receiver>,
     /// Geometric normals (for ray offsets at shading).
     pub ng: Vec<Vec3>,
+    /// The shape each primary hit lies on (index into `Scene::shapes`; motion vectors move the
+    /// hit with its shape and reject a previous hit on another shape).
+    pub shape: Vec<u32>,
 }
 
 impl GBuffer {
+    /// Bytes per pixel of one G-buffer (receiver, geometric normal, shape).
+    pub const BYTES_PER_PIXEL: usize =
+        std::mem::size_of::<Receiver>() + std::mem::size_of::<Vec3>() + std::mem::size_of::<u32>();
+
     /// The primary hit of pixel `index`, if there is one.
     #[inline]
     pub fn receiver(&self, index: usize) -> Option<&Receiver> {
@@ -128,14 +135,16 @@ impl GBuffer {
         let (w, h) = (w as usize, h as usize);
         let mut receivers = vec![Receiver::EMPTY; w * h];
         let mut ng = vec![Vec3::ZERO; w * h];
+        let mut shape = vec![u32::MAX; w * h];
         let lights = &scene.lights;
         let bands = Bands::new(w);
         let rays = receivers
             .par_chunks_mut(bands.pixels())
             .zip(ng.par_chunks_mut(bands.pixels()))
+            .zip(shape.par_chunks_mut(bands.pixels()))
             .zip(radiance.par_chunks_mut(bands.pixels()))
             .enumerate()
-            .map(|(band, ((recv, ngs), rad))| {
+            .map(|(band, (((recv, ngs), shapes), rad))| {
                 for (i, l) in rad.iter_mut().enumerate() {
                     let index = bands.first(band) + i;
                     let (x, y) = ((index % w) as u32, (index / w) as u32);
@@ -161,6 +170,7 @@ impl GBuffer {
                             si.t,
                         );
                         ngs[i] = si.ng;
+                        shapes[i] = si.shape;
                     }
                 }
                 rad.len() as u64
@@ -172,6 +182,7 @@ impl GBuffer {
                 height: h,
                 receivers,
                 ng,
+                shape,
             },
             rays,
         )

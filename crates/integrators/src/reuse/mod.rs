@@ -4,10 +4,12 @@
 //! passes themselves ([`passes`]: temporal reuse, the spatial rounds and the history, generic
 //! over the estimator's sample and shift map, as pbrt-v4's `ImageTileIntegrator` is over its
 //! `RayIntegrator`; [`reciprocal`]: spatial rounds over reciprocal neighbour pairs, which share
-//! their shifts).
+//! their shifts; [`motion`]: the previous frame of a moving sequence, for temporal reuse across
+//! frames).
 
 pub mod gbuffer;
 pub mod light_point;
+pub mod motion;
 pub mod neighbors;
 pub mod passes;
 pub mod reciprocal;

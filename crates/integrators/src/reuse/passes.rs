@@ -8,7 +8,7 @@
 //! numbers come from its own stage stream ([`PassContext::stage_rng`]), drawn in the same order
 //! whatever the estimator: the neighbour pattern's start, then resampling.
 
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use rayon::prelude::*;
 use std::borrow::Borrow;
@@ -18,6 +18,7 @@ use restir_gris::{Reservoir, ShiftMap, resample};
 use crate::bands::Bands;
 use crate::render::PassContext;
 use crate::reuse::gbuffer::GBuffer;
+use crate::reuse::motion::FrameMotion;
 use crate::reuse::neighbors::NeighborPattern;
 use crate::reuse::reciprocal;
 use crate::reuse::settings::ReuseSettings;
@@ -61,6 +62,31 @@ pub struct History<S> {
     pub gbuffer: GBuffer,
     /// Its final reservoirs.
     pub reservoirs: Vec<Reservoir<S>>,
+    /// How the scene moved since that pass, if it was the previous frame's last pass (`None`:
+    /// a pass of this frame, in this scene).
+    pub motion: Option<Arc<FrameMotion>>,
+}
+
+impl<S> History<S> {
+    /// The previous pass's pixel that saw pixel `index`'s primary hit of `gbuf`, if it saw a
+    /// similar one: the same pixel in the same frame, or the motion vector's pixel in the
+    /// previous frame ([`FrameMotion::previous_pixel`]).
+    #[inline]
+    pub fn previous_pixel(
+        &self,
+        gbuf: &GBuffer,
+        index: usize,
+        settings: &ReuseSettings,
+    ) -> Option<usize> {
+        match &self.motion {
+            Some(m) => m.previous_pixel(gbuf, index, &self.gbuffer, settings),
+            None => {
+                let (r, prev) = (gbuf.receiver(index)?, self.gbuffer.receiver(index)?);
+                r.is_similar(prev, settings.normal_cos, settings.depth_tolerance)
+                    .then_some(index)
+            }
+        }
+    }
 }
 
 /// The history slot an integrator keeps between passes.
@@ -95,13 +121,29 @@ impl<S> HistorySlot<S> {
             *h = Some(History {
                 gbuffer,
                 reservoirs,
+                motion: None,
             });
+        }
+    }
+
+    /// The passes that follow render the next frame of a sequence: the history (the previous
+    /// frame's last pass) is kept with `motion`, how the scene moved since, or dropped when
+    /// `motion` is `None` (an estimator that cannot shift its samples across frames) or when
+    /// the history is older than one frame.
+    pub fn next_frame(&self, motion: Option<Arc<FrameMotion>>) {
+        if let Ok(mut h) = self.0.lock() {
+            match (h.as_mut(), motion) {
+                (Some(hist), Some(m)) if hist.motion.is_none() => hist.motion = Some(m),
+                _ => *h = None,
+            }
         }
     }
 }
 
-/// Temporal reuse: every pixel whose primary hit is similar to the previous pass's resamples
-/// its reservoir with the previous one (confidence capped at `mcap`). Returns the rays traced.
+/// Temporal reuse: every pixel whose primary hit was seen by a similar one in the previous pass
+/// ([`History::previous_pixel`]: the same pixel, or across frames the motion vector's)
+/// resamples its reservoir with that pixel's (confidence capped at `mcap`); the previous domain
+/// is `reuse.domain(previous pixel, true)`. Returns the rays traced.
 pub fn temporal<R: ReuseShift>(
     reuse: &R,
     settings: &ReuseSettings,
@@ -120,15 +162,10 @@ pub fn temporal<R: ReuseShift>(
             let mut rays = 0;
             for (i, res) in out.iter_mut().enumerate() {
                 let index = bands.first(band) + i;
-                let (Some(r), Some(prev_r)) =
-                    (gbuf.receiver(index), history.gbuffer.receiver(index))
-                else {
+                let Some(q) = history.previous_pixel(gbuf, index, settings) else {
                     continue;
                 };
-                if !r.is_similar(prev_r, settings.normal_cos, settings.depth_tolerance) {
-                    continue;
-                }
-                let prev = history.reservoirs[index].with_confidence_cap(settings.mcap);
+                let prev = history.reservoirs[q].with_confidence_cap(settings.mcap);
                 let mut rng = ctx.stage_rng(index, stage);
                 let map = reuse.map(res);
                 *res = resample(
@@ -136,7 +173,7 @@ pub fn temporal<R: ReuseShift>(
                     mis,
                     reuse.domain(index, false).borrow(),
                     res,
-                    &[(reuse.domain(index, true), &prev)],
+                    &[(reuse.domain(q, true), &prev)],
                     || rng.next_f32(),
                 )
                 .with_confidence_cap(settings.mcap);

@@ -59,6 +59,9 @@ pub struct ReuseSettings {
     /// Negative control only: reciprocal pairs read the wrong one of a pair's two shifts
     /// (biased).
     pub reciprocal_mismatched: bool,
+    /// Negative control only: temporal reuse across frames evaluates the previous frame's
+    /// domains in the current frame's scene (lights where they are now; biased).
+    pub temporal_current_scene: bool,
 }
 
 impl Default for ReuseSettings {
@@ -76,6 +79,7 @@ impl Default for ReuseSettings {
             depth_tolerance: 0.1,
             reciprocal: false,
             reciprocal_mismatched: false,
+            temporal_current_scene: false,
         }
     }
 }
@@ -83,7 +87,9 @@ impl Default for ReuseSettings {
 impl ReuseSettings {
     /// Whether reuse is unbiased with these settings.
     pub fn is_unbiased(&self) -> bool {
-        self.mis.is_unbiased() && !(self.reciprocal && self.reciprocal_mismatched)
+        self.mis.is_unbiased()
+            && !(self.reciprocal && self.reciprocal_mismatched)
+            && !(self.temporal && self.temporal_current_scene)
     }
 
     /// How many pixels from a pixel the spatial rounds of one pass reach: `rounds × ⌈radius⌉`
@@ -140,6 +146,7 @@ impl ReuseSettings {
             "temporal" | "temporal_reuse" => self.temporal = p.boolean()?,
             "reciprocal" | "reciprocal_neighbors" => self.reciprocal = p.boolean()?,
             "reciprocal_mismatched" => self.reciprocal_mismatched = p.boolean()?,
+            "temporal_current_scene" => self.temporal_current_scene = p.boolean()?,
             "normal_threshold" => {
                 let deg = p.positive()?;
                 if deg > 180.0 {
