@@ -22,6 +22,7 @@
 //! | 1/Z | [`one_over_z`] | yes | Bitterli et al. 2020 (unbiased ReSTIR) |
 //! | contribution MIS ("MIS-like") | [`contribution`], [`contribution_scale`] | yes | Bitterli et al. 2020; RTXDI `BASIC` |
 //! | generalized balance | [`generalized_balance`] | yes | Lin et al. 2022 (GRIS), balance heuristic |
+//! | generalized power (targets squared, confidences linear) | [`generalized_power`] | yes | Veach 1997 §9.2 (power heuristic), applied to GRIS's targets |
 //! | pairwise | [`pairwise_neighbor`], [`pairwise_canonical`] | yes | Bitterli 2022, PhD thesis §9.1; RTXDI `PAIRWISE` |
 //! | defensive pairwise | [`defensive_pairwise_neighbor`], [`defensive_pairwise_canonical`] | yes | Lin et al. 2022 (GRIS / ReSTIR PT) |
 //! | confidence-weighted defensive pairwise | [`confidence_weighted_pairwise_neighbor`], [`confidence_weighted_pairwise_canonical`] | yes | Wyman et al. 2023, "A Gentle Introduction to ReSTIR" course notes |
@@ -41,6 +42,11 @@ pub enum MisScheme {
     /// Generalized balance heuristic: `m_i = P_i / Σ_j P_j` for every candidate. Unbiased,
     /// O(k²) shifts.
     GeneralizedBalance,
+    /// Generalized power heuristic: `m_i = c_i·p̂_{←i}² / Σ_j c_j·p̂_{←j}²` for every candidate
+    /// ([`generalized_power`]). Unbiased, O(k²) shifts. Equal to the balance heuristic where
+    /// the domains' targets agree; where they disagree it bounds how much a high-confidence
+    /// domain whose target is far below the receiver's can weigh (temporal reuse under motion).
+    GeneralizedPower,
     /// Pairwise MIS (non-defensive). Unbiased, 2 shifts per neighbour.
     Pairwise,
     /// Defensive pairwise MIS: the canonical technique keeps at least `1/(k+1)`. Unbiased.
@@ -51,11 +57,12 @@ pub enum MisScheme {
 
 impl MisScheme {
     /// All schemes, in declaration order.
-    pub const ALL: [MisScheme; 7] = [
+    pub const ALL: [MisScheme; 8] = [
         MisScheme::ConstantBiased,
         MisScheme::OneOverZ,
         MisScheme::Contribution,
         MisScheme::GeneralizedBalance,
+        MisScheme::GeneralizedPower,
         MisScheme::Pairwise,
         MisScheme::DefensivePairwise,
         MisScheme::ConfidenceWeightedPairwise,
@@ -151,6 +158,36 @@ pub fn generalized_balance(i: usize, confidences: &[f32], target_pdfs: &[f32]) -
         .map(|(&c, &p)| technique(c, p))
         .sum();
     ratio(technique(ci, pi), den)
+}
+
+/// **(d′) Generalized power heuristic** `m_i(y) = c_i·p̂_{←i}(y)² / Σ_j c_j·p̂_{←j}(y)²`.
+///
+/// Veach's power heuristic (exponent 2) on the pulled-back targets, with the confidences kept
+/// linear: where every domain's target agrees (`p̂_{←j}(y)` all equal) the weights are the
+/// balance heuristic's `c_i/Σc`, so a history of confidence 20 weighs as 20 fresh samples, not
+/// 400. Where they disagree, weight moves to the larger target faster than with the balance
+/// heuristic, which bounds a reused sample's resampling weight `m_i·p̂_c·W_i`: with two domains
+/// of confidences `c_c`, `c_i` and ratio `r = p̂_c/p̂_{←i}`, it is at most `√(c_i/c_c)/2` times
+/// domain `i`'s own estimate `p̂_{←i}·W_i` (the balance heuristic allows `c_i/c_c` times).
+/// A partition of unity that is zero where `p̂_{←i} = 0`, hence unbiased under the same
+/// conditions as [`generalized_balance`] (`docs/GRIS.md` §4.4). Same cost: O((k+1)²) shifts.
+pub fn generalized_power(i: usize, confidences: &[f32], target_pdfs: &[f32]) -> f32 {
+    let (Some(&ci), Some(&pi)) = (confidences.get(i), target_pdfs.get(i)) else {
+        return 0.0;
+    };
+    let den: f64 = confidences
+        .iter()
+        .zip(target_pdfs)
+        .map(|(&c, &p)| power_technique(c, p))
+        .sum();
+    ratio(power_technique(ci, pi), den)
+}
+
+/// `c_j · p̂_{←j}²` in `f64`.
+#[inline]
+pub(crate) fn power_technique(confidence: f32, target_pdf: f32) -> f64 {
+    let p = clean(target_pdf);
+    clean(confidence) * p * p
 }
 
 /// **(c) Contribution MIS weight** ("MIS-like"): the balance heuristic applied to the
@@ -385,6 +422,31 @@ mod tests {
     }
 
     #[test]
+    fn power_partition_and_agreement_with_balance() {
+        let c = [1.0, 2.0, 0.5];
+        let p = [0.3, 0.0, 4.0];
+        let s: f32 = (0..3).map(|i| generalized_power(i, &c, &p)).sum();
+        assert!((s - 1.0).abs() < 1e-6);
+        assert_eq!(generalized_power(1, &c, &p), 0.0);
+        assert_eq!(generalized_power(7, &c, &p), 0.0);
+        // Equal targets: the balance heuristic's confidence shares.
+        let q = [0.7, 0.7, 0.7];
+        for i in 0..3 {
+            let (a, b) = (generalized_power(i, &c, &q), generalized_balance(i, &c, &q));
+            assert!((a - b).abs() < 1e-6, "{a} vs {b}");
+        }
+        // The bound on a reused sample's weight m_i·p̂_c (domain i's own estimate is 1).
+        let (cc, ci) = (1.0f32, 20.0f32);
+        let worst = (1..2000)
+            .map(|k| {
+                let r = k as f32 * 0.05;
+                generalized_power(1, &[cc, ci], &[r, 1.0]) * r
+            })
+            .fold(0.0f32, f32::max);
+        assert!((worst - (ci / cc).sqrt() / 2.0).abs() < 0.01, "{worst}");
+    }
+
+    #[test]
     fn pairwise_partition_with_zero_neighbours() {
         assert_eq!(pairwise_canonical(1.0, 1.0, &[], &[]), 1.0);
         assert_eq!(defensive_pairwise_canonical(1.0, 1.0, &[], &[]), 1.0);
@@ -419,7 +481,7 @@ mod tests {
     #[test]
     fn constant_is_labelled_biased() {
         assert!(!MisScheme::ConstantBiased.is_unbiased());
-        assert_eq!(MisScheme::ALL.iter().filter(|s| s.is_unbiased()).count(), 6);
+        assert_eq!(MisScheme::ALL.iter().filter(|s| s.is_unbiased()).count(), 7);
         assert_eq!(constant_biased(1.0, 4.0), 0.25);
     }
 }

@@ -3,7 +3,8 @@
 //! turns over (facing away from the floor in frame 0, towards it in frame 1) and a light turns
 //! on (it does not exist in frame 0's light list, so light indices differ between the frames),
 //! rendered by ReSTIR DI with the history of frame 0, averages to frame 1's path-traced
-//! reference block by block within the standard error across seeds. The negative control
+//! reference block by block within the standard error across seeds, with the balance and the
+//! power heuristic as temporal MIS. The negative control
 //! evaluates the previous frame's targets with the current frame's scene
 //! (`temporal_current_scene`): the turned-over light then looks reachable from the previous
 //! frame's receivers, which never sampled it, and its light is underestimated.
@@ -26,7 +27,7 @@ use common::{block_statistics, max_z, render_image};
 
 const SIZE: u32 = 32;
 const BLOCK: u32 = 8;
-/// 16 blocks, two comparisons that must pass: about 4 standard errors.
+/// 16 blocks, three comparisons that must pass: about 4 standard errors.
 const Z_MAX: f64 = 4.0;
 
 const T0: f32 = 0.0;
@@ -144,6 +145,13 @@ fn temporal_reuse_across_moving_frames_is_unbiased() {
     let z = max_z(&statistics(&frames, TEMPORAL), &reference);
     eprintln!("temporal across frames: max |z| = {z:.2}");
     assert!(z < Z_MAX, "temporal across frames: max |z| = {z:.2}");
+    let power = [TEMPORAL, &[("temporal_mis", "power")]].concat();
+    let z = max_z(&statistics(&frames, &power), &reference);
+    eprintln!("temporal across frames, power heuristic: max |z| = {z:.2}");
+    assert!(
+        z < Z_MAX,
+        "temporal across frames, power heuristic: max |z| = {z:.2}"
+    );
     // Spatial-only ReSTIR DI on the same frames, for comparison (no history is used).
     let z = max_z(&statistics(&frames, &[("candidates", "2")]), &reference);
     eprintln!("spatial only: max |z| = {z:.2}");

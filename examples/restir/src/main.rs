@@ -151,10 +151,14 @@ struct RestirArgs {
     /// Spatial reuse rounds [default: 1 for restir-di, 3 for restir-pt].
     #[arg(long)]
     spatial_rounds: Option<u32>,
-    /// Reuse MIS: defensive-pairwise, pairwise, confidence-pairwise, balance, contribution,
-    /// one-over-z, or uniform (biased) [default: defensive-pairwise].
+    /// Reuse MIS: defensive-pairwise, pairwise, confidence-pairwise, balance, power,
+    /// contribution, one-over-z, or uniform (biased) [default: defensive-pairwise].
     #[arg(long)]
     mis: Option<String>,
+    /// Temporal reuse's MIS between the pixel and its previous pixel: one of the --mis names
+    /// [default: balance, or the --mis scheme when it is biased].
+    #[arg(long)]
+    temporal_mis: Option<String>,
     /// Confidence cap after every reuse step [default: 20].
     #[arg(long)]
     mcap: Option<f32>,
@@ -205,6 +209,10 @@ impl RestirArgs {
         put("radius", self.radius.map(ParamValue::Number));
         put("spatial_rounds", self.spatial_rounds.map(ParamValue::Count));
         put("mis", self.mis.clone().map(ParamValue::Text));
+        put(
+            "temporal_mis",
+            self.temporal_mis.clone().map(ParamValue::Text),
+        );
         put("mcap", self.mcap.map(ParamValue::Number));
         put("temporal", self.temporal.then_some(ParamValue::Bool(true)));
         put("reciprocal", self.reciprocal.map(ParamValue::Bool));

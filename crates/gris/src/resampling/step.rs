@@ -105,9 +105,22 @@ where
             };
             pairwise(map, variant, canonical_domain, canonical, neighbors, next_u)
         }
-        MisScheme::GeneralizedBalance => {
-            generalized_balance(map, canonical_domain, canonical, neighbors, next_u)
-        }
+        MisScheme::GeneralizedBalance => generalized_balance(
+            map,
+            Heuristic::Balance,
+            canonical_domain,
+            canonical,
+            neighbors,
+            next_u,
+        ),
+        MisScheme::GeneralizedPower => generalized_balance(
+            map,
+            Heuristic::Power,
+            canonical_domain,
+            canonical,
+            neighbors,
+            next_u,
+        ),
         MisScheme::ConstantBiased | MisScheme::OneOverZ | MisScheme::Contribution => {
             constant_weights(map, scheme, canonical_domain, canonical, neighbors, next_u)
         }
@@ -146,11 +159,32 @@ where
     step.finalize(next_u())
 }
 
-/// The generalized balance heuristic: each candidate (canonical first) is weighted by
-/// `m_i = P_i / Σ_j P_j` at its shifted sample, with inverse shifts into every other domain
-/// (O(k²) shifts); the weights are normalised, so the step finalises with `W = Σ w_i / p̂_c(Y)`.
+/// What the generalized heuristics weigh a technique by at a sample.
+#[derive(Clone, Copy)]
+enum Heuristic {
+    /// `c · p̂` ([`MisScheme::GeneralizedBalance`]).
+    Balance,
+    /// `c · p̂²` ([`MisScheme::GeneralizedPower`]).
+    Power,
+}
+
+impl Heuristic {
+    #[inline]
+    fn term(self, confidence: f32, target: f32) -> f64 {
+        match self {
+            Heuristic::Balance => clean(confidence) * clean(target),
+            Heuristic::Power => crate::mis::power_technique(confidence, target),
+        }
+    }
+}
+
+/// The generalized balance (or power) heuristic: each candidate (canonical first) is weighted
+/// by `m_i = P_i / Σ_j P_j` at its shifted sample (`P_j = c_j·p̂_{←j}`, or `c_j·p̂_{←j}²` for the
+/// power heuristic), with inverse shifts into every other domain (O(k²) shifts); the weights
+/// are normalised, so the step finalises with `W = Σ w_i / p̂_c(Y)`.
 fn generalized_balance<S, M, D, U>(
     map: &M,
+    heuristic: Heuristic,
     canonical_domain: &M::Domain,
     canonical: &Reservoir<S>,
     neighbors: &[(D, &Reservoir<S>)],
@@ -171,15 +205,17 @@ where
             .enumerate()
             .filter(|&(j, _)| Some(j) != skip)
             .map(|(_, (d, r))| {
-                clean(r.confidence)
-                    * clean(map.pulled_back_target_pdf(canonical_domain, d.borrow(), y))
+                heuristic.term(
+                    r.confidence,
+                    map.pulled_back_target_pdf(canonical_domain, d.borrow(), y),
+                )
             })
             .sum()
     };
     let mut stream = GrisResampler::new();
     match GrisInput::canonical(canonical.clone()) {
         Some(input) => {
-            let own = clean(cc) * clean(pc_own);
+            let own = heuristic.term(cc, pc_own);
             let m = balance(own, own + others(&input.sample, None));
             stream.add(input, m, next_u());
         }
@@ -190,10 +226,12 @@ where
             stream.add_failed(reservoir.confidence);
             continue;
         };
-        let own = clean(reservoir.confidence)
-            * clean(shifted.source_target_pdf_at_receiver(reservoir.own_target));
+        let own = heuristic.term(
+            reservoir.confidence,
+            shifted.source_target_pdf_at_receiver(reservoir.own_target),
+        );
         let den =
-            own + clean(cc) * clean(shifted.destination_target) + others(&shifted.sample, Some(i));
+            own + heuristic.term(cc, shifted.destination_target) + others(&shifted.sample, Some(i));
         let m = balance(own, den);
         let input = GrisInput::from_shift(shifted, reservoir);
         stream.add(input, m, next_u());

@@ -463,7 +463,7 @@ impl Integrator for RestirDiIntegrator {
         let s = &self.settings;
         format!(
             "restir-di max_depth={} candidates={} light_sampler={} bsdf_candidates={} neighbors={} \
-             radius={} spatial_rounds={} reciprocal={} mis={} mcap={} temporal={} \
+             radius={} spatial_rounds={} reciprocal={} mis={} mcap={} {} \
              visibility_reuse={}{}",
             s.path.max_depth,
             s.candidates,
@@ -475,7 +475,7 @@ impl Integrator for RestirDiIntegrator {
             s.reuse.reciprocal,
             mis_name(s.reuse.mis),
             s.reuse.mcap,
-            s.reuse.temporal,
+            s.reuse.describe_temporal(),
             s.visibility_reuse,
             if s.is_unbiased() { "" } else { " (biased)" }
         ) + &self.fallback.as_ref().map_or(String::new(), |(p, why)| {

@@ -280,7 +280,7 @@ impl Integrator for RestirPtIntegrator {
         let s = &self.settings;
         format!(
             "restir-pt max_depth={} candidates={} neighbors={} radius={} spatial_rounds={} \
-             reciprocal={} mis={} mcap={} temporal={} shift={} near_distance={} max_jacobian={} \
+             reciprocal={} mis={} mcap={} {} shift={} near_distance={} max_jacobian={} \
              direct={}{}",
             s.path.max_depth,
             s.candidates,
@@ -290,7 +290,7 @@ impl Integrator for RestirPtIntegrator {
             s.reuse.reciprocal,
             mis_name(s.reuse.mis),
             s.reuse.mcap,
-            s.reuse.temporal,
+            s.reuse.describe_temporal(),
             s.shift.name(),
             s.near_distance,
             s.max_jacobian,

@@ -13,6 +13,7 @@ pub const MIS_NAMES: &[(&str, MisScheme)] = &[
     ("pairwise", MisScheme::Pairwise),
     ("confidence-pairwise", MisScheme::ConfidenceWeightedPairwise),
     ("balance", MisScheme::GeneralizedBalance),
+    ("power", MisScheme::GeneralizedPower),
     ("contribution", MisScheme::Contribution),
     ("one-over-z", MisScheme::OneOverZ),
     ("uniform", MisScheme::ConstantBiased),
@@ -49,6 +50,9 @@ pub struct ReuseSettings {
     pub mcap: f32,
     /// Reuse the previous pass's reservoirs (default off).
     pub temporal: bool,
+    /// The MIS of temporal reuse, when chosen (`temporal_mis`); else [`Self::temporal_mis`]
+    /// decides.
+    pub temporal_scheme: Option<MisScheme>,
     /// Largest angle between neighbour shading normals, as a cosine (default cos 25°).
     pub normal_cos: f32,
     /// Largest relative difference of camera distances (default 0.1).
@@ -75,6 +79,7 @@ impl Default for ReuseSettings {
             mis: MisScheme::DefensivePairwise,
             mcap: 20.0,
             temporal: false,
+            temporal_scheme: None,
             normal_cos: 25f32.to_radians().cos(),
             depth_tolerance: 0.1,
             reciprocal: false,
@@ -88,6 +93,7 @@ impl ReuseSettings {
     /// Whether reuse is unbiased with these settings.
     pub fn is_unbiased(&self) -> bool {
         self.mis.is_unbiased()
+            && (!self.temporal || self.temporal_mis().is_unbiased())
             && !(self.reciprocal && self.reciprocal_mismatched)
             && !(self.temporal && self.temporal_current_scene)
     }
@@ -113,15 +119,30 @@ impl ReuseSettings {
         }
     }
 
-    /// The MIS of temporal reuse. Two techniques, one of them carrying up to `mcap` passes of
+    /// The MIS of temporal reuse: `temporal_mis` when given, else: two techniques, one of them carrying up to `mcap` passes of
     /// history: the generalized balance heuristic (4 target evaluations) lets the history weigh
     /// by its confidence, where defensive pairwise would keep half the weight on the fresh
     /// sample (`docs/GRIS.md` §4.4). Biased schemes stay as chosen.
     pub fn temporal_mis(&self) -> MisScheme {
-        if self.mis.is_unbiased() {
+        if let Some(scheme) = self.temporal_scheme {
+            scheme
+        } else if self.mis.is_unbiased() {
             MisScheme::GeneralizedBalance
         } else {
             self.mis
+        }
+    }
+
+    /// `temporal=…` in an estimator's one-line description: `false`, or `true` with the
+    /// temporal MIS.
+    pub fn describe_temporal(&self) -> String {
+        if self.temporal {
+            format!(
+                "temporal=true temporal_mis={}",
+                mis_name(self.temporal_mis())
+            )
+        } else {
+            "temporal=false".into()
         }
     }
 
@@ -144,6 +165,7 @@ impl ReuseSettings {
             "mis" | "bias_correction" => self.mis = p.mis()?,
             "mcap" | "m_cap" | "m_capping" | "max_history" => self.mcap = p.positive()?,
             "temporal" | "temporal_reuse" => self.temporal = p.boolean()?,
+            "temporal_mis" => self.temporal_scheme = Some(p.mis()?),
             "reciprocal" | "reciprocal_neighbors" => self.reciprocal = p.boolean()?,
             "reciprocal_mismatched" => self.reciprocal_mismatched = p.boolean()?,
             "temporal_current_scene" => self.temporal_current_scene = p.boolean()?,
