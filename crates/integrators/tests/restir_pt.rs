@@ -84,10 +84,12 @@ fn scene_text(extra: &str) -> String {
 }
 
 /// The room with every surface diffuse (the rough plastics and the rough gold replaced by
-/// Lambertian reflectors), a smooth glass sphere in front, and the light's radiance `emission`
-/// (20 in the other scenes).
-fn diffuse_glass_scene(emission: &str) -> Scene {
-    let ron = scene_text(
+/// Lambertian reflectors) and a smooth glass sphere in front. With `ceiling_light` the light
+/// hangs under the ceiling facing down (the room lit mostly directly, as the Cornell box)
+/// instead of lying behind the partition facing up; its radiance is `emission` (20 in the other
+/// scenes).
+fn diffuse_glass_scene(ceiling_light: bool, emission: &str) -> Scene {
+    let mut ron = scene_text(
         r#"(geometry: Sphere(center: (-0.6, 0.45, 0.6), radius: 0.4),
              material: Some(Inline(Dielectric()))),"#,
     )
@@ -102,7 +104,14 @@ fn diffuse_glass_scene(emission: &str) -> Scene {
         "emission: Some((20, 20, 20))",
         &format!("emission: Some(({emission}, {emission}, {emission}))"),
     );
+    if ceiling_light {
+        ron = ron.replace(
+            "Translate((0, 0.05, -1.4))], emission",
+            "Rotate(axis: (1, 0, 0), angle: 180), Translate((0, 1.95, 0.3))], emission",
+        );
+    }
     assert!(!ron.contains("Rough") && ron.contains(emission), "{ron}");
+    assert_eq!(ron.contains("1.95, 0.3"), ceiling_light);
     build(&ron)
 }
 
@@ -630,12 +639,13 @@ fn xml_restir_pt_integrator_and_parameters() {
 }
 
 /// At its defaults in a room where the camera's paths reach only diffuse surfaces (directly or
-/// through smooth glass) ReSTIR PT hands the scene to the path tracer, says so, and stays
-/// unbiased (a 5 % brighter light is caught by the same statistic); any ReSTIR PT parameter, or
-/// `fallback = off`, keeps ReSTIR PT, and the glossy room keeps it at its defaults.
+/// through smooth glass) lit mostly directly, ReSTIR PT hands the scene to the path tracer, says
+/// so, and stays unbiased (a 5 % brighter light is caught by the same statistic); any ReSTIR PT
+/// parameter, or `fallback = off`, keeps ReSTIR PT. The glossy room, and the diffuse room lit
+/// mostly indirectly (its light behind the partition), keep it at their defaults.
 #[test]
 fn no_glossy_surface_in_view_falls_back_to_the_path_tracer() {
-    let scene = diffuse_glass_scene("20");
+    use restir_integrators::restir_pt::{GLOSSY_VIEW_MIN, INDIRECT_VIEW_MIN, view_pilot};
     let made = |scene: &Scene, params: &[(&str, &str)]| {
         let options = IntegratorOptions {
             params: params.into(),
@@ -644,8 +654,14 @@ fn no_glossy_surface_in_view_falls_back_to_the_path_tracer() {
         };
         make_integrator(scene, &options).unwrap()
     };
-    let view = restir_integrators::restir_pt::glossy_view(&scene);
+    let scene = diffuse_glass_scene(true, "20");
+    let view = view_pilot(&scene);
+    eprintln!(
+        "diffuse, lit directly: {view:?}, indirect share {:.3}",
+        view.indirect_share()
+    );
     assert!(view.reached > 500 && view.glossy == 0, "{view:?}");
+    assert!(view.indirect_share() < INDIRECT_VIEW_MIN, "{view:?}");
     let m = made(&scene, &[]);
     let d = m.integrator.describe();
     assert!(d.contains("; estimator: path max_depth=4"), "{d}");
@@ -660,16 +676,27 @@ fn no_glossy_surface_in_view_falls_back_to_the_path_tracer() {
         assert!(m.notes.is_empty(), "{params:?}: {:?}", m.notes);
         assert!(!m.integrator.describe().contains("estimator:"));
     }
-    // The glossy room: its rough plastic back wall and rough gold wall are in view.
+    // Kept: the glossy room (its rough plastic back wall and rough gold wall in view), and the
+    // diffuse room whose light shines at the ceiling from behind the partition.
     let glossy = scene_with("");
-    let view = restir_integrators::restir_pt::glossy_view(&glossy);
+    let view = view_pilot(&glossy);
+    eprintln!("glossy room: {view:?}");
+    assert!(view.glossy_share() >= GLOSSY_VIEW_MIN, "{view:?}");
+    let hidden = diffuse_glass_scene(false, "20");
+    let view = view_pilot(&hidden);
+    eprintln!(
+        "diffuse, lit indirectly: {view:?}, indirect share {:.3}",
+        view.indirect_share()
+    );
     assert!(
-        view.share() >= restir_integrators::restir_pt::GLOSSY_VIEW_MIN,
+        view.glossy == 0 && view.indirect_share() >= INDIRECT_VIEW_MIN,
         "{view:?}"
     );
-    let m = made(&glossy, &[]);
-    assert!(m.notes.is_empty(), "{:?}", m.notes);
-    assert!(!m.integrator.describe().contains("estimator:"));
+    for kept in [&glossy, &hidden] {
+        let m = made(kept, &[]);
+        assert!(m.notes.is_empty(), "{:?}", m.notes);
+        assert!(!m.integrator.describe().contains("estimator:"));
+    }
 
     // Unbiased: the fallback (defaults, no parameters) against the path tracer, on other seeds.
     let reference = statistics(&scene, "path", &[], 128, 64);
@@ -683,7 +710,7 @@ fn no_glossy_surface_in_view_falls_back_to_the_path_tracer() {
     eprintln!("fallback: max |z| = {z:.2}");
     assert!(z < Z_MAX, "fallback: max |z| = {z:.2}");
     // Negative control: the same statistic rejects a 5 % brighter light.
-    let brighter = statistics(&diffuse_glass_scene("21"), "path", &[], 128, 64);
+    let brighter = statistics(&diffuse_glass_scene(true, "21"), "path", &[], 128, 64);
     let z = max_z(&fallback, &brighter);
     eprintln!("fallback vs light × 1.05: max |z| = {z:.2}");
     assert!(z > Z_MAX, "a 5 % error went unnoticed: max |z| = {z:.2}");

@@ -19,8 +19,8 @@
 //!    are the shared [`crate::reuse::passes`].
 //! 5. **Shading**: the selected path's integrand at the pixel (kept in the sample) times `W`.
 //!
-//! A scene where too few of the camera's paths reconnect at a glossy surface goes to the path
-//! tracer instead (`fallback = auto`, [`RestirPtSettings::resolve`], [`fallback`]): the
+//! A scene where too few of the camera's paths reconnect at a glossy surface or at one lit
+//! mostly indirectly goes to the path tracer instead (`fallback = auto`, [`RestirPtSettings::resolve`], [`fallback`]): the
 //! estimator is then exactly the path tracer's, and `describe` (hence `--stats`) says so.
 
 mod candidate;
@@ -37,7 +37,7 @@ use restir_materials::LobeFlags;
 use restir_sampling::{Pcg32, luminance};
 use restir_scene::Scene;
 
-pub use fallback::{GLOSSY_VIEW_MIN, GlossyView, glossy_view};
+pub use fallback::{GLOSSY_VIEW_MIN, INDIRECT_VIEW_MIN, ViewPilot, view_pilot};
 pub use sample::{Kind, PathSample, ShiftKind};
 pub use settings::{DirectLight, Fallback, RestirPtSettings, SHIFT_NAMES};
 use shift::PtReuse;

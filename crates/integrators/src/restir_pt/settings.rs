@@ -2,7 +2,8 @@
 //! use the same names; the reuse settings are [`ReuseSettings`], shared with ReSTIR DI). One
 //! default is a rule of the scene, decided once when the integrator is made
 //! ([`RestirPtSettings::resolve`]): the path tracer in place of ReSTIR PT where the camera's
-//! paths reconnect at too few glossy surfaces ([`GLOSSY_VIEW_MIN`]).
+//! paths reconnect at too few glossy surfaces ([`GLOSSY_VIEW_MIN`]) and too little of the light
+//! there is indirect ([`INDIRECT_VIEW_MIN`]).
 
 use restir_scene::Scene;
 
@@ -10,7 +11,7 @@ use crate::params::{Param, ParamError, ParamProblem, ParamSet};
 use crate::path::PathSettings;
 use crate::reuse::settings::ReuseSettings;
 
-use super::fallback::{GLOSSY_VIEW_MIN, glossy_view};
+use super::fallback::{GLOSSY_VIEW_MIN, INDIRECT_VIEW_MIN, view_pilot};
 use super::sample::ShiftKind;
 
 /// The shifts `--shift` accepts.
@@ -64,7 +65,8 @@ impl DirectLight {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Fallback {
     /// When fewer than [`GLOSSY_VIEW_MIN`] of the camera's paths first reach a glossy surface
-    /// a path can reconnect at and no other ReSTIR PT parameter is given (default).
+    /// a path can reconnect at, the indirect share of the light there is below
+    /// [`INDIRECT_VIEW_MIN`], and no other ReSTIR PT parameter is given (default).
     Auto,
     /// Never: ReSTIR PT whatever the scene.
     Off,
@@ -99,7 +101,8 @@ pub struct RestirPtSettings {
     pub shift: ShiftKind,
     /// Negative control only: skip the hybrid shift's invertibility checks (biased).
     pub skip_invertibility: bool,
-    /// Whether a scene without glossy surfaces in view goes to the path tracer (default auto).
+    /// Whether a scene without glossy or indirectly lit surfaces in view goes to the path tracer
+    /// (default auto).
     pub fallback: Fallback,
     /// Whether some ReSTIR PT parameter was given ([`RestirPtSettings::apply`]): then
     /// `fallback = auto` keeps ReSTIR PT (the user asked for a configured ReSTIR PT).
@@ -133,24 +136,26 @@ impl RestirPtSettings {
     }
 
     /// Returns why the path tracer should render `scene` instead of ReSTIR PT: when `fallback`
-    /// is auto, no other ReSTIR PT parameter was given (ReSTIR PT at its defaults) and fewer
-    /// than [`GLOSSY_VIEW_MIN`] of the camera's paths first reconnect at a glossy surface (a
-    /// pilot of 1024 camera rays, [`super::fallback`]; not run otherwise).
+    /// is auto, no other ReSTIR PT parameter was given (ReSTIR PT at its defaults) and the
+    /// camera's paths reach too few glossy surfaces ([`GLOSSY_VIEW_MIN`]) and the light there is
+    /// too little indirect ([`INDIRECT_VIEW_MIN`]), as a pilot of 1024 camera paths sees them
+    /// ([`super::fallback`]; not run otherwise).
     pub fn resolve(&self, scene: &Scene) -> Option<String> {
         if self.fallback != Fallback::Auto || self.configured {
             return None;
         }
-        let view = glossy_view(scene);
-        let share = view.share();
+        let view = view_pilot(scene);
         // No commas: the bench CSV's settings column is split on them.
-        (share < GLOSSY_VIEW_MIN).then(|| {
+        (!view.keeps_restir_pt()).then(|| {
             format!(
-                "{} of {} camera paths ({:.1}% < {:.0}%) first reconnect at a glossy surface: \
-                 the path tracer renders it (fallback = off keeps ReSTIR PT)",
-                view.glossy,
+                "of {} camera paths {:.1}% first reconnect at a glossy surface (< {:.0}%) and \
+                 {:.0}% of their light is indirect (< {:.0}%): the path tracer renders it \
+                 (fallback = off keeps ReSTIR PT)",
                 view.reached,
-                100.0 * share,
-                100.0 * GLOSSY_VIEW_MIN
+                100.0 * view.glossy_share(),
+                100.0 * GLOSSY_VIEW_MIN,
+                100.0 * view.indirect_share(),
+                100.0 * INDIRECT_VIEW_MIN
             )
         })
     }
