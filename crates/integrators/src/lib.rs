@@ -162,7 +162,14 @@ pub fn make_integrator(
         "restir-pt" => {
             let mut s = RestirPtSettings::new(settings);
             let unused = s.apply(&params)?;
-            (Box::new(RestirPtIntegrator::new(s)), unused)
+            let fallback = s.resolve(scene);
+            if let Some(why) = &fallback {
+                notes.push(format!("restir-pt: {why}"));
+            }
+            (
+                Box::new(RestirPtIntegrator::new(s).with_fallback(fallback)),
+                unused,
+            )
         }
         other => return Err(IntegratorError::Unknown(other.to_string())),
     };

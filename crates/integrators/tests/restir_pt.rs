@@ -38,7 +38,16 @@ fn glass_scene() -> Scene {
 }
 
 fn scene_with(extra: &str) -> Scene {
-    let ron = format!(
+    build(&scene_text(extra))
+}
+
+fn build(ron: &str) -> Scene {
+    let desc = parse_ron(ron, "pt-test.ron".as_ref()).unwrap();
+    Scene::build(&desc, ".".as_ref(), "pt-test.ron".as_ref()).unwrap()
+}
+
+fn scene_text(extra: &str) -> String {
+    format!(
         r#"(
         camera: (fov: 55, to_world: [LookAt(origin: (0, 1, 4.5), target: (0, 0.7, 0), up: (0, 1, 0))]),
         film: (width: {SIZE}, height: {SIZE}, filter: Box),
@@ -71,9 +80,39 @@ fn scene_with(extra: &str) -> Scene {
             Constant(radiance: (0.02, 0.03, 0.05)),
         ],
     )"#
+    )
+}
+
+/// The room with every surface diffuse (the rough plastics and the rough gold replaced by
+/// Lambertian reflectors) and a smooth glass sphere in front. With `ceiling_light` the light
+/// hangs under the ceiling facing down (the room lit mostly directly, as the Cornell box)
+/// instead of lying behind the partition facing up; its radiance is `emission` (20 in the other
+/// scenes).
+fn diffuse_glass_scene(ceiling_light: bool, emission: &str) -> Scene {
+    let mut ron = scene_text(
+        r#"(geometry: Sphere(center: (-0.6, 0.45, 0.6), radius: 0.4),
+             material: Some(Inline(Dielectric()))),"#,
+    )
+    .replace("RoughPlastic(diffuse_reflectance:", "Diffuse(reflectance:")
+    .replace(",\n             roughness: (alpha: 0.15)", "")
+    .replace(",\n             roughness: (alpha: 0.1)", "")
+    .replace(
+        "RoughConductor(ior: (material: Some(\"Au\")),\n             roughness: (alpha: 0.25))",
+        "Diffuse(reflectance: (0.8, 0.6, 0.3))",
+    )
+    .replace(
+        "emission: Some((20, 20, 20))",
+        &format!("emission: Some(({emission}, {emission}, {emission}))"),
     );
-    let desc = parse_ron(&ron, "pt-test.ron".as_ref()).unwrap();
-    Scene::build(&desc, ".".as_ref(), "pt-test.ron".as_ref()).unwrap()
+    if ceiling_light {
+        ron = ron.replace(
+            "Translate((0, 0.05, -1.4))], emission",
+            "Rotate(axis: (1, 0, 0), angle: 180), Translate((0, 1.95, 0.3))], emission",
+        );
+    }
+    assert!(!ron.contains("Rough") && ron.contains(emission), "{ron}");
+    assert_eq!(ron.contains("1.95, 0.3"), ceiling_light);
+    build(&ron)
 }
 
 fn render_image(scene: &Scene, name: &str, params: &[(&str, &str)], spp: u32, seed: u64) -> Image {
@@ -597,4 +636,82 @@ fn xml_restir_pt_integrator_and_parameters() {
         err.to_string().contains("reconnection, replay, hybrid"),
         "{err}"
     );
+}
+
+/// At its defaults in a room where the camera's paths reach only diffuse surfaces (directly or
+/// through smooth glass) lit mostly directly, ReSTIR PT hands the scene to the path tracer, says
+/// so, and stays unbiased (a 5 % brighter light is caught by the same statistic); any ReSTIR PT
+/// parameter, or `fallback = off`, keeps ReSTIR PT. The glossy room, and the diffuse room lit
+/// mostly indirectly (its light behind the partition), keep it at their defaults.
+#[test]
+fn no_glossy_surface_in_view_falls_back_to_the_path_tracer() {
+    use restir_integrators::restir_pt::{GLOSSY_VIEW_MIN, INDIRECT_VIEW_MIN, view_pilot};
+    let made = |scene: &Scene, params: &[(&str, &str)]| {
+        let options = IntegratorOptions {
+            params: params.into(),
+            name: Some("restir-pt".into()),
+            ..Default::default()
+        };
+        make_integrator(scene, &options).unwrap()
+    };
+    let scene = diffuse_glass_scene(true, "20");
+    let view = view_pilot(&scene);
+    eprintln!(
+        "diffuse, lit directly: {view:?}, indirect share {:.3}",
+        view.indirect_share()
+    );
+    assert!(view.reached > 500 && view.glossy == 0, "{view:?}");
+    assert!(view.indirect_share() < INDIRECT_VIEW_MIN, "{view:?}");
+    let m = made(&scene, &[]);
+    let d = m.integrator.describe();
+    assert!(d.contains("; estimator: path max_depth=4"), "{d}");
+    assert_eq!(m.notes.len(), 1, "{:?}", m.notes);
+    assert!(
+        m.notes[0].contains("the path tracer renders it"),
+        "{:?}",
+        m.notes
+    );
+    for params in [&[("fallback", "off")][..], &[("candidates", "2")][..]] {
+        let m = made(&scene, params);
+        assert!(m.notes.is_empty(), "{params:?}: {:?}", m.notes);
+        assert!(!m.integrator.describe().contains("estimator:"));
+    }
+    // Kept: the glossy room (its rough plastic back wall and rough gold wall in view), and the
+    // diffuse room whose light shines at the ceiling from behind the partition.
+    let glossy = scene_with("");
+    let view = view_pilot(&glossy);
+    eprintln!("glossy room: {view:?}");
+    assert!(view.glossy_share() >= GLOSSY_VIEW_MIN, "{view:?}");
+    let hidden = diffuse_glass_scene(false, "20");
+    let view = view_pilot(&hidden);
+    eprintln!(
+        "diffuse, lit indirectly: {view:?}, indirect share {:.3}",
+        view.indirect_share()
+    );
+    assert!(
+        view.glossy == 0 && view.indirect_share() >= INDIRECT_VIEW_MIN,
+        "{view:?}"
+    );
+    for kept in [&glossy, &hidden] {
+        let m = made(kept, &[]);
+        assert!(m.notes.is_empty(), "{:?}", m.notes);
+        assert!(!m.integrator.describe().contains("estimator:"));
+    }
+
+    // Unbiased: the fallback (defaults, no parameters) against the path tracer, on other seeds.
+    let reference = statistics(&scene, "path", &[], 128, 64);
+    let fallback = block_statistics(
+        |seed| common::render_image(&scene, "restir-pt", &[], 16, seed),
+        64,
+        5000,
+        BLOCK,
+    );
+    let z = max_z(&fallback, &reference);
+    eprintln!("fallback: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "fallback: max |z| = {z:.2}");
+    // Negative control: the same statistic rejects a 5 % brighter light.
+    let brighter = statistics(&diffuse_glass_scene(true, "21"), "path", &[], 128, 64);
+    let z = max_z(&fallback, &brighter);
+    eprintln!("fallback vs light × 1.05: max |z| = {z:.2}");
+    assert!(z > Z_MAX, "a 5 % error went unnoticed: max |z| = {z:.2}");
 }

@@ -88,11 +88,12 @@ fn estimate(scene: &Scene, integrator: &str, seeds: u64, spp: u32) -> [[(f64, f6
         let n = checks.iter().filter(|c| **c == Some(k)).count();
         assert!(n >= 40, "region {k} has only {n} whole pixels");
     }
-    // ReSTIR DI itself, not the path tracer it hands a one-light scene to at its defaults.
-    let params: &[(&str, &str)] = if integrator == "restir-di" {
-        &[("fallback", "off")]
-    } else {
+    // The ReSTIR estimators themselves, not the path tracer they hand this scene to at their
+    // defaults (one light; no glossy surface).
+    let params: &[(&str, &str)] = if integrator == "path" {
         &[]
+    } else {
+        &[("fallback", "off")]
     };
     let options = IntegratorOptions {
         name: Some(integrator.into()),

@@ -135,8 +135,10 @@ struct RestirArgs {
     /// every light count measured so far) [default: auto].
     #[arg(long)]
     light_sampler: Option<String>,
-    /// restir-di: auto hands a scene of a few emitters with one dominant light to the path
-    /// tracer when no other ReSTIR DI option is given; off never does [default: auto].
+    /// auto hands a scene that does not suit the estimator to the path tracer when no other
+    /// option of it is given (restir-di: a few emitters with one dominant light; restir-pt:
+    /// fewer than 5% of the camera's paths reconnect at a glossy surface); off never does
+    /// [default: auto].
     #[arg(long)]
     fallback: Option<String>,
     /// BSDF samples per pixel, MIS-combined with the reservoirs [default: 1].

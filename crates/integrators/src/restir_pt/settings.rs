@@ -1,10 +1,17 @@
 //! ReSTIR PT settings and their parsing from named parameters (XML scenes and the command line
-//! use the same names; the reuse settings are [`ReuseSettings`], shared with ReSTIR DI).
+//! use the same names; the reuse settings are [`ReuseSettings`], shared with ReSTIR DI). One
+//! default is a rule of the scene, decided once when the integrator is made
+//! ([`RestirPtSettings::resolve`]): the path tracer in place of ReSTIR PT where the camera's
+//! paths reconnect at too few glossy surfaces ([`GLOSSY_VIEW_MIN`]) and too little of the light
+//! there is indirect ([`INDIRECT_VIEW_MIN`]).
+
+use restir_scene::Scene;
 
 use crate::params::{Param, ParamError, ParamProblem, ParamSet};
 use crate::path::PathSettings;
 use crate::reuse::settings::ReuseSettings;
 
+use super::fallback::{GLOSSY_VIEW_MIN, INDIRECT_VIEW_MIN, view_pilot};
 use super::sample::ShiftKind;
 
 /// The shifts `--shift` accepts.
@@ -54,6 +61,22 @@ impl DirectLight {
     }
 }
 
+/// Whether ReSTIR PT may hand a scene that does not suit it to the path tracer (`fallback`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fallback {
+    /// When fewer than [`GLOSSY_VIEW_MIN`] of the camera's paths first reach a glossy surface
+    /// a path can reconnect at, the indirect share of the light there is below
+    /// [`INDIRECT_VIEW_MIN`], and no other ReSTIR PT parameter is given (default).
+    Auto,
+    /// Never: ReSTIR PT whatever the scene.
+    Off,
+}
+
+impl Fallback {
+    /// The names `fallback` takes.
+    pub const NAMES: &[(&str, Fallback)] = &[("auto", Fallback::Auto), ("off", Fallback::Off)];
+}
+
 /// Everything ReSTIR PT can be told.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RestirPtSettings {
@@ -78,6 +101,12 @@ pub struct RestirPtSettings {
     pub shift: ShiftKind,
     /// Negative control only: skip the hybrid shift's invertibility checks (biased).
     pub skip_invertibility: bool,
+    /// Whether a scene without glossy or indirectly lit surfaces in view goes to the path tracer
+    /// (default auto).
+    pub fallback: Fallback,
+    /// Whether some ReSTIR PT parameter was given ([`RestirPtSettings::apply`]): then
+    /// `fallback = auto` keeps ReSTIR PT (the user asked for a configured ReSTIR PT).
+    pub configured: bool,
 }
 
 impl RestirPtSettings {
@@ -101,7 +130,34 @@ impl RestirPtSettings {
             unit_jacobian: false,
             shift: ShiftKind::Hybrid,
             skip_invertibility: false,
+            fallback: Fallback::Auto,
+            configured: false,
         }
+    }
+
+    /// Returns why the path tracer should render `scene` instead of ReSTIR PT: when `fallback`
+    /// is auto, no other ReSTIR PT parameter was given (ReSTIR PT at its defaults) and the
+    /// camera's paths reach too few glossy surfaces ([`GLOSSY_VIEW_MIN`]) and the light there is
+    /// too little indirect ([`INDIRECT_VIEW_MIN`]), as a pilot of 1024 camera paths sees them
+    /// ([`super::fallback`]; not run otherwise).
+    pub fn resolve(&self, scene: &Scene) -> Option<String> {
+        if self.fallback != Fallback::Auto || self.configured {
+            return None;
+        }
+        let view = view_pilot(scene);
+        // No commas: the bench CSV's settings column is split on them.
+        (!view.keeps_restir_pt()).then(|| {
+            format!(
+                "of {} camera paths {:.1}% first reconnect at a glossy surface (< {:.0}%) and \
+                 {:.0}% of their light is indirect (< {:.0}%): the path tracer renders it \
+                 (fallback = off keeps ReSTIR PT)",
+                view.reached,
+                100.0 * view.glossy_share(),
+                100.0 * GLOSSY_VIEW_MIN,
+                100.0 * view.indirect_share(),
+                100.0 * INDIRECT_VIEW_MIN
+            )
+        })
     }
 
     /// Whether the estimator is unbiased with these settings.
@@ -113,31 +169,41 @@ impl RestirPtSettings {
     /// the same. Returns the parameters it did not know, for the caller to warn about.
     pub fn apply(&mut self, params: &ParamSet) -> Result<Vec<Param>, ParamError> {
         params.apply(|key, p| {
-            match key {
-                "candidates" | "path_candidates" | "initial_candidates" | "num_candidates" => {
-                    self.candidates = p.count(1)?;
-                }
-                "shift" | "shift_mapping" => {
-                    self.shift =
-                        p.choice(SHIFT_CHOICES, &format!("one of {}", SHIFT_NAMES.join(", ")))?;
-                }
-                "near_distance" | "distance_threshold" => self.near_distance = p.positive()?,
-                "max_jacobian" | "jacobian_threshold" => {
-                    let j = p.positive()?;
-                    if j <= 1.0 {
-                        return Err(p.error(ParamProblem::NotAboveOne));
-                    }
-                    self.max_jacobian = j;
-                }
-                "direct" => {
-                    self.direct = p.choice(DirectLight::CHOICES, "reservoir, path or restir-di")?;
-                }
-                "unit_jacobian" => self.unit_jacobian = p.boolean()?,
-                "skip_invertibility" => self.skip_invertibility = p.boolean()?,
-                _ => return self.reuse.apply(key, p),
-            }
-            Ok(true)
+            let used = self.apply_one(key, p)?;
+            // A ReSTIR PT parameter given (other than `fallback`): the user configured ReSTIR
+            // PT, keep it.
+            self.configured |= used && key != "fallback";
+            Ok(used)
         })
+    }
+
+    /// One parameter; whether it is one of ReSTIR PT's.
+    fn apply_one(&mut self, key: &str, p: &Param) -> Result<bool, ParamError> {
+        match key {
+            "candidates" | "path_candidates" | "initial_candidates" | "num_candidates" => {
+                self.candidates = p.count(1)?;
+            }
+            "shift" | "shift_mapping" => {
+                self.shift =
+                    p.choice(SHIFT_CHOICES, &format!("one of {}", SHIFT_NAMES.join(", ")))?;
+            }
+            "near_distance" | "distance_threshold" => self.near_distance = p.positive()?,
+            "max_jacobian" | "jacobian_threshold" => {
+                let j = p.positive()?;
+                if j <= 1.0 {
+                    return Err(p.error(ParamProblem::NotAboveOne));
+                }
+                self.max_jacobian = j;
+            }
+            "direct" => {
+                self.direct = p.choice(DirectLight::CHOICES, "reservoir, path or restir-di")?;
+            }
+            "unit_jacobian" => self.unit_jacobian = p.boolean()?,
+            "skip_invertibility" => self.skip_invertibility = p.boolean()?,
+            "fallback" => self.fallback = p.choice(Fallback::NAMES, "auto or off")?,
+            _ => return self.reuse.apply(key, p),
+        }
+        Ok(true)
     }
 }
 
@@ -187,5 +253,36 @@ mod tests {
         assert!(s.apply(&p("candidates", "0")).is_err());
         s.apply(&p("direct", "restir_di")).unwrap();
         assert_eq!(s.direct, DirectLight::RestirDi);
+    }
+
+    /// `fallback` takes auto or off and is the one parameter that does not count as
+    /// configuring ReSTIR PT; every other one does, including the shared reuse parameters.
+    #[test]
+    fn fallback_and_configured() {
+        let new = || {
+            RestirPtSettings::new(PathSettings {
+                max_depth: 4,
+                rr_depth: 5,
+                hide_emitters: false,
+            })
+        };
+        let p = |a: &str, b: &str| ParamSet::from(&[(a, b)][..]);
+        let mut s = new();
+        assert_eq!((s.fallback, s.configured), (Fallback::Auto, false));
+        s.apply(&p("fallback", "OFF")).unwrap();
+        assert_eq!((s.fallback, s.configured), (Fallback::Off, false));
+        assert_eq!(
+            s.apply(&p("fallback", "never")).unwrap_err().to_string(),
+            "fallback = 'never': expected auto or off"
+        );
+        for (name, value) in [("candidates", "2"), ("radius", "3"), ("shift", "hybrid")] {
+            let mut s = new();
+            s.apply(&p(name, value)).unwrap();
+            assert!(s.configured, "{name}");
+        }
+        let mut s = new();
+        let unknown = s.apply(&p("foo", "1")).unwrap();
+        assert_eq!(unknown.len(), 1);
+        assert!(!s.configured);
     }
 }
