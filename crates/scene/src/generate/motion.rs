@@ -21,7 +21,7 @@
 //!   A room has one hidden area light: it slides (`light0`, behind its partition or behind the
 //!   camera) and dims to 40–70 % and back; two small lamps are added (`lamp0`, `lamp1`, emissive
 //!   spheres of 2–4 W, about a tenth of the main light, floating in view in the back half of the room),
-//!   which move 0.6–1.2 m, and `lamp0` goes dark and back.
+//!   which move 0.6–1.2 m, and `lamp0` goes dark and back (dark, it is a small black sphere).
 //!
 //! Linear and Catmull-Rom tracks are both used. The animation is attached (shape ids resolved),
 //! so [`Generated::desc`] builds at any time with [`crate::animation::build_at`] and its RON text
