@@ -23,7 +23,9 @@ pub enum Generate {
     Meshes(DiArgs),
     /// A glossy room lit mostly indirectly by one hidden area light.
     Room(RoomArgs),
-    /// Every scene of a training or test family (issue 14: di, issue 15: pt) with an index.
+    /// Every scene of a training or test family with an index: issue 14 di, issue 15 pt, and
+    /// issue 19's moving di-motion and pt-motion (animated, 12 fps; render them with
+    /// `restir render DIR/NAME.ron --frames 0..23`).
     Family(FamilyArgs),
     /// A latitude-longitude environment map (EXR): a sky with a sun over a dark ground, the map
     /// of scenes/envmap-spheres.xml.
@@ -261,8 +263,10 @@ pub struct RoomArgs {
 /// Options of `restir generate family`.
 #[derive(clap::Args, Debug)]
 pub struct FamilyArgs {
-    /// Which study: di (ReSTIR DI, many lights, direct light) or pt (ReSTIR PT, glossy rooms).
-    #[arg(long, value_parser = ["di", "pt"])]
+    /// Which study: di (ReSTIR DI, many lights, direct light), pt (ReSTIR PT, glossy rooms), or
+    /// the same under motion, di-motion and pt-motion (camera, objects and lights move over 2 s
+    /// at 12 fps, frames 0..23).
+    #[arg(long, value_parser = ["di", "pt", "di-motion", "pt-motion"])]
     issue: String,
     /// train (seeds 1..) or test (seeds 101..).
     #[arg(long, value_parser = ["train", "test"])]
@@ -270,6 +274,9 @@ pub struct FamilyArgs {
     /// Directory for the scenes, their assets and the index family.txt.
     #[arg(long)]
     out: PathBuf,
+    /// Write only the member with this index (0-based; its scene and assets, no family.txt).
+    #[arg(long)]
+    index: Option<usize>,
 }
 
 fn di_params(kind: Kind, args: &DiArgs) -> Result<Params, String> {
@@ -334,6 +341,20 @@ fn describe(params: &Params) -> String {
     }
 }
 
+/// [`describe`], saying when the member is animated.
+fn describe_member(member: &FamilyMember) -> String {
+    if member.issue.animated() {
+        format!(
+            "{}, animated ({} fps, frames 0..{})",
+            describe(&member.params),
+            restir_scene::generate::FPS,
+            (restir_scene::generate::FPS * restir_scene::generate::DURATION) as u32 - 1
+        )
+    } else {
+        describe(&member.params)
+    }
+}
+
 fn tag(params: &Params) -> String {
     match params {
         Params::Di(_, o) => o.tag(),
@@ -378,17 +399,42 @@ fn write_one(params: &Params, seed: u64, output: Option<PathBuf>) -> Result<(), 
 
 /// Writes every member of a family and the index `family.txt`.
 fn write_family(args: &FamilyArgs) -> Result<(), String> {
-    let issue = if args.issue == "di" {
-        Issue::Di
-    } else {
-        Issue::Pt
-    };
+    let issue = Issue::ALL
+        .into_iter()
+        .find(|i| i.name() == args.issue)
+        .ok_or_else(|| {
+            format!(
+                "--issue {}: expected di, pt, di-motion or pt-motion",
+                args.issue
+            )
+        })?;
     let split = if args.split == "train" {
         Split::Train
     } else {
         Split::Test
     };
     let members: Vec<FamilyMember> = family(issue, split);
+    if let Some(i) = args.index {
+        let member = members.get(i).ok_or_else(|| {
+            format!(
+                "--index {i}: the {} family has members 0 to {}",
+                issue.name(),
+                members.len() - 1
+            )
+        })?;
+        let generated = member.generate().map_err(|e| e.to_string())?;
+        let path = generated
+            .write(&args.out, &member.name())
+            .map_err(|e| e.to_string())?;
+        println!(
+            "{}, seed {} -> {} (+{} assets)",
+            describe_member(member),
+            member.seed,
+            path.display(),
+            generated.assets.len()
+        );
+        return Ok(());
+    }
     let mut index = format!(
         "# The {} {} family: written by `restir generate family --issue {} --split {} --out DIR`.\n\
          # Regenerate rather than edit. One line per scene: file, seed, kind and parameters.\n\
@@ -412,7 +458,7 @@ fn write_family(args: &FamilyArgs) -> Result<(), String> {
             "{}.ron\tseed {}\t{}{}\n",
             member.name(),
             member.seed,
-            describe(&member.params),
+            describe_member(member),
             if assets.is_empty() {
                 String::new()
             } else {

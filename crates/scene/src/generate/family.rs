@@ -8,6 +8,16 @@
 //!   diffuse, checkerboard, glossy and mixed receivers, four members with a sky beside the lights.
 //! - [`Issue::Pt`] (ReSTIR PT): glossy rooms without glass, with smooth and with rough glass,
 //!   each with and without a window to a sky.
+//! - [`Issue::DiMotion`] (ReSTIR DI under motion, issue 19): rectangles, spheres and emissive
+//!   meshes at 10³ lights, two of each, with diffuse, glossy, mixed and textured receivers,
+//!   occluders everywhere and a sky in three, each animated by [`super::animate`] (camera,
+//!   receivers, slats and lights move, lights change radiance and one goes dark and back).
+//! - [`Issue::PtMotion`] (ReSTIR PT under motion): the six glossy rooms (each glass choice with
+//!   and without a window), animated likewise (camera, two objects, the hidden light, and two
+//!   added lamps move; one lamp goes dark and back).
+//!
+//! The moving families share the static families' seeds (training `1..`, test `101..`), so a
+//! moving member with the parameters of a static one is that scene in motion.
 
 use super::{DiOptions, GenerateError, Generated, Glass, Kind, Params, Receivers, RoomOptions};
 
@@ -18,15 +28,29 @@ pub enum Issue {
     Di,
     /// ReSTIR PT against the path tracer in glossy rooms.
     Pt,
+    /// ReSTIR DI under motion: animated many-light scenes at 10³ lights.
+    DiMotion,
+    /// ReSTIR PT under motion: animated glossy rooms.
+    PtMotion,
 }
 
 impl Issue {
+    /// Every study.
+    pub const ALL: [Issue; 4] = [Issue::Di, Issue::Pt, Issue::DiMotion, Issue::PtMotion];
+
     /// The name on the command line.
     pub fn name(self) -> &'static str {
         match self {
             Issue::Di => "di",
             Issue::Pt => "pt",
+            Issue::DiMotion => "di-motion",
+            Issue::PtMotion => "pt-motion",
         }
+    }
+
+    /// Whether the family's scenes are animated (render them with `--frames 0..23`).
+    pub fn animated(self) -> bool {
+        matches!(self, Issue::DiMotion | Issue::PtMotion)
     }
 }
 
@@ -89,9 +113,13 @@ impl FamilyMember {
         )
     }
 
-    /// The scene.
+    /// The scene (animated by [`super::animate`] in the moving families).
     pub fn generate(&self) -> Result<Generated, GenerateError> {
-        super::generate(&self.params, self.seed)
+        let mut generated = super::generate(&self.params, self.seed)?;
+        if self.issue.animated() {
+            super::animate(&mut generated, self.params.kind(), self.seed)?;
+        }
+        Ok(generated)
     }
 }
 
@@ -140,11 +168,47 @@ fn pt_params() -> Vec<Params> {
     ]
 }
 
+/// The moving DI family's parameters: each kind twice at 10³ lights, every receiver choice.
+fn di_motion_params() -> Vec<Params> {
+    let di = |kind, receivers, envmap| {
+        Params::Di(
+            kind,
+            DiOptions {
+                lights: 1_000,
+                power_ratio: 1000.0,
+                receivers,
+                occluders: true,
+                envmap,
+            },
+        )
+    };
+    use Kind::{Meshes, Rects, Spheres};
+    use Receivers::{Diffuse, Glossy, Mixed, Textured};
+    vec![
+        di(Rects, Diffuse, false),
+        di(Rects, Glossy, true),
+        di(Spheres, Mixed, false),
+        di(Spheres, Textured, true),
+        di(Meshes, Textured, false),
+        di(Meshes, Mixed, true),
+    ]
+}
+
+/// The moving PT family's parameters: each glass choice with and without a window.
+fn pt_motion_params() -> Vec<Params> {
+    Glass::ALL
+        .into_iter()
+        .flat_map(|glass| [false, true].map(|window| Params::Room(RoomOptions { glass, window })))
+        .collect()
+}
+
 /// The family of `issue` for `split`.
 pub fn family(issue: Issue, split: Split) -> Vec<FamilyMember> {
     let params = match issue {
         Issue::Di => di_params(),
         Issue::Pt => pt_params(),
+        Issue::DiMotion => di_motion_params(),
+        Issue::PtMotion => pt_motion_params(),
     };
     params
         .into_iter()

@@ -12,7 +12,9 @@
 //! The three many-light kinds share their stage (`stage.rs`: a floor, receivers, occluders
 //! between lights and receivers, an optional environment map) and are direct-light scenes (max
 //! depth 2). `envmap.rs` makes the environment images, `family.rs` the training and test
-//! families (lists of kinds, seeds and parameters), `util.rs` the shared helpers.
+//! families (lists of kinds, seeds and parameters), `motion.rs` the animations of the moving
+//! families ([`animate`]: camera, objects and lights in motion, from the seed), `util.rs` the
+//! shared helpers.
 //!
 //! A generated scene is a [`Generated`]: the description plus the files it names (OBJ meshes,
 //! EXR environment maps), which [`Generated::write`] puts beside the RON file. Asset names are a
@@ -23,6 +25,7 @@ pub mod envmap;
 mod family;
 mod many_lights;
 mod meshes;
+mod motion;
 mod rects;
 mod room;
 mod spheres;
@@ -37,6 +40,7 @@ use crate::SceneDesc;
 
 pub use family::{FamilyMember, Issue, Split, family};
 pub use many_lights::{many_lights, many_lights_ron};
+pub use motion::{DURATION, FPS, animate};
 pub use room::{Glass, RoomOptions, room};
 pub use stage::{DiOptions, Receivers};
 
@@ -105,6 +109,8 @@ pub enum GenerateError {
     },
     /// Writing an image failed.
     Image(ImageError),
+    /// A scene that [`animate`] cannot animate (not one of the generated kinds).
+    Animation(String),
 }
 
 impl core::fmt::Display for GenerateError {
@@ -121,6 +127,7 @@ impl core::fmt::Display for GenerateError {
             GenerateError::Ron(e) => write!(f, "serialising the scene: {e}"),
             GenerateError::Io { path, source } => write!(f, "{}: {source}", path.display()),
             GenerateError::Image(e) => write!(f, "{e}"),
+            GenerateError::Animation(why) => write!(f, "cannot animate the scene: {why}"),
         }
     }
 }

@@ -166,7 +166,31 @@ pub(super) fn to_ron(desc: &SceneDesc, header: &str) -> Result<String, ron::Erro
     let config = ron::ser::PrettyConfig::new()
         .depth_limit(2)
         .struct_names(false);
-    let body = ron::ser::to_string_pretty(desc, config)?;
+    let mut body = match &desc.animation {
+        None => ron::ser::to_string_pretty(desc, config.clone())?,
+        Some(_) => {
+            let still = SceneDesc {
+                animation: None,
+                ..desc.clone()
+            };
+            ron::ser::to_string_pretty(&still, config.clone())?
+        }
+    };
+    if let Some(anim) = &desc.animation {
+        // The animation one level deeper than the scene, so that every track and camera key
+        // gets its own line.
+        let anim = ron::ser::to_string_pretty(anim, config)?;
+        let close = body.rfind(')').unwrap_or(body.len());
+        body.truncate(close);
+        body.push_str("    animation: Some(");
+        for (i, line) in anim.lines().enumerate() {
+            if i > 0 {
+                body.push_str("\n    ");
+            }
+            body.push_str(line);
+        }
+        body.push_str("),\n)");
+    }
     let mut text = String::new();
     for line in header.lines() {
         text.push_str("// ");
