@@ -158,7 +158,7 @@ struct RestirArgs {
     #[arg(long)]
     mis: Option<String>,
     /// Temporal reuse's MIS between the pixel and its previous pixel: one of the --mis names
-    /// [default: balance, or the --mis scheme when it is biased].
+    /// [default: power, or the --mis scheme when it is biased].
     #[arg(long)]
     temporal_mis: Option<String>,
     /// Confidence cap after every reuse step [default: 20].

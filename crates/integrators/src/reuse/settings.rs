@@ -119,15 +119,19 @@ impl ReuseSettings {
         }
     }
 
-    /// The MIS of temporal reuse: `temporal_mis` when given, else: two techniques, one of them carrying up to `mcap` passes of
-    /// history: the generalized balance heuristic (4 target evaluations) lets the history weigh
-    /// by its confidence, where defensive pairwise would keep half the weight on the fresh
-    /// sample (`docs/GRIS.md` §4.4). Biased schemes stay as chosen.
+    /// The MIS of temporal reuse: `temporal_mis` when given; else, for an unbiased `mis`, the
+    /// generalized power heuristic over the two techniques (the pixel and its previous pixel,
+    /// which carries up to `mcap` passes of history): like the balance heuristic it lets the
+    /// history weigh by its confidence where the two targets agree (defensive pairwise would keep
+    /// half the weight on the fresh sample), and it bounds what a history sample brings where
+    /// the receiver's target has grown (motion; `docs/GRIS.md` §4.4′). Chosen over the balance
+    /// heuristic on the moving training family (docs/BENCHMARKS.md, "Temporal reuse across
+    /// frames"). Biased schemes stay as chosen.
     pub fn temporal_mis(&self) -> MisScheme {
         if let Some(scheme) = self.temporal_scheme {
             scheme
         } else if self.mis.is_unbiased() {
-            MisScheme::GeneralizedBalance
+            MisScheme::GeneralizedPower
         } else {
             self.mis
         }
