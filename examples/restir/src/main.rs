@@ -164,9 +164,11 @@ struct RestirArgs {
     /// Confidence cap after every reuse step [default: 20].
     #[arg(long)]
     mcap: Option<f32>,
-    /// Reuse the previous pass's reservoirs.
-    #[arg(long)]
-    temporal: bool,
+    /// Reuse the previous pass's reservoirs (and across the frames of a sequence, the
+    /// previous frame's): `--temporal` or `--temporal true`; `--temporal false` turns off what a
+    /// scene file turned on.
+    #[arg(long, value_name = "BOOL", num_args = 0..=1, default_missing_value = "true")]
+    temporal: Option<bool>,
     /// Drop occluded initial candidates (biased at shadow edges).
     #[arg(long)]
     visibility_reuse: bool,
@@ -216,7 +218,7 @@ impl RestirArgs {
             self.temporal_mis.clone().map(ParamValue::Text),
         );
         put("mcap", self.mcap.map(ParamValue::Number));
-        put("temporal", self.temporal.then_some(ParamValue::Bool(true)));
+        put("temporal", self.temporal.map(ParamValue::Bool));
         put("reciprocal", self.reciprocal.map(ParamValue::Bool));
         put(
             "visibility_reuse",

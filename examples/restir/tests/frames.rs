@@ -153,7 +153,7 @@ fn temporal_reuse_crosses_frames() {
         let settings = json["integrator_settings"].as_str().unwrap();
         assert_eq!(
             settings.contains("temporal=true"),
-            extra.contains(&"--temporal"),
+            extra.contains(&"--temporal") && !extra.contains(&"false"),
             "{settings}"
         );
         (0..3)
@@ -169,6 +169,9 @@ fn temporal_reuse_crosses_frames() {
     assert_eq!(spatial[0].pixels, temporal[0].pixels);
     assert_ne!(spatial[1].pixels, temporal[1].pixels);
     assert_ne!(spatial[2].pixels, temporal[2].pixels);
+    // `--temporal false` is spatial-only.
+    let off = render("di-f", &[&di[..], &["--temporal", "false"]].concat());
+    assert_eq!(spatial[2].pixels, off[2].pixels);
     for img in render("pt-t", &["--integrator", "restir-pt", "--temporal"]) {
         assert!(img.pixels.iter().all(|p| p.is_finite()));
     }
