@@ -69,17 +69,27 @@ fn desc() -> SceneDesc {
 }
 
 fn frames() -> (SceneDesc, Arc<Scene>, Scene) {
-    let desc = desc();
+    frames_of(desc())
+}
+
+/// The same sequence with only the camera moving.
+fn camera_only() -> (SceneDesc, Arc<Scene>, Scene) {
+    let mut d = desc();
+    d.animation.as_mut().unwrap().shapes.clear();
+    frames_of(d)
+}
+
+fn frames_of(desc: SceneDesc) -> (SceneDesc, Arc<Scene>, Scene) {
     let path = std::path::Path::new("motion-test.ron");
     let s0 = Arc::new(build_at(&desc, path, T0).unwrap());
     let s1 = build_at(&desc, path, T1).unwrap();
     (desc, s0, s1)
 }
 
-fn options(params: &[(&str, &str)]) -> IntegratorOptions {
+fn options(name: &str, max_depth: Option<i32>, params: &[(&str, &str)]) -> IntegratorOptions {
     IntegratorOptions {
-        name: Some("restir-di".into()),
-        max_depth: None,
+        name: Some(name.into()),
+        max_depth,
         params: params
             .iter()
             .map(|(k, v)| Param::new(*k, *v, ParamSource::Caller))
@@ -113,10 +123,11 @@ fn run(
 /// told of the motion in between.
 fn frame_one(
     (desc, s0, s1): &(SceneDesc, Arc<Scene>, Scene),
+    (name, max_depth): (&str, Option<i32>),
     params: &[(&str, &str)],
     seed: u64,
 ) -> Image {
-    let made = make_integrator(s0, &options(params)).unwrap();
+    let made = make_integrator(s0, &options(name, max_depth, params)).unwrap();
     assert!(made.unused_params.is_empty());
     let di = made.integrator;
     run(s0, di.as_ref(), 2, seed);
@@ -126,7 +137,62 @@ fn frame_one(
 }
 
 fn statistics(frames: &(SceneDesc, Arc<Scene>, Scene), params: &[(&str, &str)]) -> Vec<(f64, f64)> {
-    block_statistics(|s| frame_one(frames, params, s), 200, 3000, BLOCK)
+    block_statistics(|s| frame_one(frames, DI, params, s), 200, 3000, BLOCK)
+}
+
+const DI: (&str, Option<i32>) = ("restir-di", None);
+/// ReSTIR PT with paths of up to three segments (one bounce: reconnections).
+const PT: (&str, Option<i32>) = ("restir-pt", Some(3));
+
+/// ReSTIR PT across frames: where only the camera moved the previous frame's paths are reused
+/// (the frame differs from one rendered without history) and the average matches the
+/// reference; where shapes and lights moved the history is dropped, and keeping it anyway
+/// (`temporal_ignore_motion`, paths' cached suffixes and light indices gone stale) is biased.
+#[test]
+fn restir_pt_reuses_frames_where_only_the_camera_moved() {
+    let still = camera_only();
+    assert!(
+        FrameMotion::new(
+            still.1.clone(),
+            &still.2,
+            still.0.animation.as_ref().unwrap(),
+            T0,
+            T1
+        )
+        .scene_is_still()
+    );
+    let pt = |frames, params: &[(&str, &str)]| {
+        block_statistics(|s| frame_one(frames, PT, params, s), 200, 5000, BLOCK)
+    };
+    let temporal = [("temporal", "true")];
+    assert_ne!(
+        frame_one(&still, PT, &temporal, 1).pixels,
+        frame_one(&still, PT, &[("temporal", "false")], 1).pixels,
+        "frame 1 should reuse frame 0"
+    );
+    let reference = |frames: &(SceneDesc, Arc<Scene>, Scene)| {
+        block_statistics(
+            |s| render_image(&frames.2, "path", &[("max_depth", "3")], 256, s),
+            48,
+            1,
+            BLOCK,
+        )
+    };
+    let z = max_z(&pt(&still, &temporal), &reference(&still));
+    eprintln!("restir-pt, camera moving: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "restir-pt, camera moving: max |z| = {z:.2}");
+    let moving = frames();
+    let moving_reference = reference(&moving);
+    let z = max_z(&pt(&moving, &temporal), &moving_reference);
+    eprintln!("restir-pt, scene moving (history dropped): max |z| = {z:.2}");
+    assert!(z < Z_MAX, "restir-pt, scene moving: max |z| = {z:.2}");
+    let control = [("temporal", "true"), ("temporal_ignore_motion", "true")];
+    let z = max_z(&pt(&moving, &control), &moving_reference);
+    eprintln!("restir-pt keeping stale history: max |z| = {z:.2}");
+    assert!(
+        z > 2.0 * Z_MAX,
+        "stale paths should be biased: max |z| = {z:.2}"
+    );
 }
 
 const TEMPORAL: &[(&str, &str)] = &[("temporal", "true"), ("candidates", "2")];

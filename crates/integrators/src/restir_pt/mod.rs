@@ -340,11 +340,19 @@ impl Integrator for RestirPtIntegrator {
         self.clock.seconds()
     }
 
-    /// Paths are not shifted across frames yet (their vertices would have to move with their
-    /// shapes and be replayed in the previous frame's scene): the history is dropped, and the
-    /// first pass of every frame starts afresh (`docs/ANIMATION.md`).
-    fn next_frame(&self, _motion: std::sync::Arc<crate::reuse::motion::FrameMotion>) {
-        self.history.next_frame(None);
+    /// Across frames where only the camera moved, the previous frame's reservoirs are reused
+    /// through motion vectors: the scene is the same, so every vertex, light index and cached
+    /// suffix radiance of a path means the same in both frames and the shift is the one between
+    /// pixels. Where anything else moved or changed, a path's cached suffix (its radiance after
+    /// the reconnection vertex, its light index) may be stale, so the history is dropped and the
+    /// frame starts afresh (`docs/ANIMATION.md`); `temporal_ignore_motion` (negative control
+    /// only) keeps it anyway.
+    fn next_frame(&self, motion: std::sync::Arc<crate::reuse::motion::FrameMotion>) {
+        let keep = motion.scene_is_still() || self.settings.temporal_ignore_motion;
+        if let Some(di) = &self.di {
+            di.next_frame(motion.clone()); // its light samples move with their lights
+        }
+        self.history.next_frame(keep.then_some(motion));
     }
 
     fn buffer_bytes_per_pixel(&self) -> usize {

@@ -96,6 +96,9 @@ pub struct RestirPtSettings {
     pub direct: DirectLight,
     /// Negative control only: use Jacobian 1 in every shift (biased).
     pub unit_jacobian: bool,
+    /// Negative control only: keep the history across frames in which shapes or lights moved
+    /// (cached path suffixes go stale; biased).
+    pub temporal_ignore_motion: bool,
     /// The shift between pixels (default hybrid; plain reconnection in scenes without
     /// near-specular materials).
     pub shift: ShiftKind,
@@ -128,6 +131,7 @@ impl RestirPtSettings {
             max_jacobian: 0.0,
             direct: DirectLight::Reservoir,
             unit_jacobian: false,
+            temporal_ignore_motion: false,
             shift: ShiftKind::Hybrid,
             skip_invertibility: false,
             fallback: Fallback::Auto,
@@ -162,7 +166,10 @@ impl RestirPtSettings {
 
     /// Whether the estimator is unbiased with these settings.
     pub fn is_unbiased(&self) -> bool {
-        self.reuse.is_unbiased() && !self.unit_jacobian && !self.skip_invertibility
+        self.reuse.is_unbiased()
+            && !self.unit_jacobian
+            && !self.skip_invertibility
+            && (!self.reuse.temporal || !self.temporal_ignore_motion)
     }
 
     /// Applies `params` in order (later ones win). Names are case-insensitive, `-` and `_` are
@@ -199,6 +206,7 @@ impl RestirPtSettings {
                 self.direct = p.choice(DirectLight::CHOICES, "reservoir, path or restir-di")?;
             }
             "unit_jacobian" => self.unit_jacobian = p.boolean()?,
+            "temporal_ignore_motion" => self.temporal_ignore_motion = p.boolean()?,
             "skip_invertibility" => self.skip_invertibility = p.boolean()?,
             "fallback" => self.fallback = p.choice(Fallback::NAMES, "auto or off")?,
             _ => return self.reuse.apply(key, p),

@@ -34,6 +34,9 @@ pub struct FrameMotion {
     light_to_prev: Vec<Option<u32>>,
     /// Per light of the previous frame, the same light now.
     light_from_prev: Vec<Option<u32>>,
+    /// Whether only the camera moved: every shape in place, the same lights with the same
+    /// radiance (everything a sample names or caches is then the same in both frames).
+    scene_still: bool,
 }
 
 /// Which light a light is across frames: an area light by its shape, any other light by its
@@ -94,12 +97,20 @@ impl FrameMotion {
             "one motion per shape of the current frame"
         );
         let (now, then) = (scene.lights.lights(), prev_scene.lights.lights());
+        let scene_still = to_prev.iter().all(|m| *m == Mat4::IDENTITY) && now == then;
         Self {
+            scene_still,
             light_to_prev: light_map(now, then),
             light_from_prev: light_map(then, now),
             to_prev,
             prev_scene,
         }
+    }
+
+    /// Whether only the camera moved between the two frames (no shape moved, no light changed).
+    #[inline]
+    pub fn scene_is_still(&self) -> bool {
+        self.scene_still
     }
 
     /// The previous frame's index of light `light` of the current frame.
