@@ -34,6 +34,7 @@
 //! ```
 
 mod bands;
+pub mod fallback;
 pub mod film;
 pub mod params;
 pub mod path;

@@ -10,20 +10,19 @@
 //! frame's receivers, which never sampled it, and its light is underestimated.
 
 use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
 
 use restir_integrators::film::Filter;
 use restir_integrators::reuse::ReuseSettings;
 use restir_integrators::reuse::gbuffer::GBuffer;
 use restir_integrators::reuse::motion::FrameMotion;
 use restir_integrators::{
-    Image, IntegratorOptions, Param, ParamSource, PassContext, RenderJob, make_integrator, render,
+    Image, IntegratorOptions, Param, ParamSource, PassContext, make_integrator,
 };
 use restir_scene::animation::build_at;
 use restir_scene::{Scene, SceneDesc, parse_ron};
 
 mod common;
-use common::{block_statistics, max_z, render_image};
+use common::{block_statistics, max_z, render_image, render_with};
 
 const SIZE: u32 = 32;
 const BLOCK: u32 = 8;
@@ -97,28 +96,6 @@ fn options(name: &str, max_depth: Option<i32>, params: &[(&str, &str)]) -> Integ
     }
 }
 
-fn run(
-    scene: &Scene,
-    integrator: &dyn restir_integrators::Integrator,
-    spp: u32,
-    seed: u64,
-) -> Image {
-    let job = RenderJob {
-        spp,
-        seed,
-        ..RenderJob::default()
-    };
-    let out = render(
-        scene,
-        integrator,
-        &job,
-        &AtomicBool::new(false),
-        &mut |_, _| {},
-    );
-    assert_eq!(out.nonfinite_pixels, 0);
-    out.image
-}
-
 /// Frame 1 rendered with one pass after two passes of frame 0 (seed `seed`), the estimator
 /// told of the motion in between.
 fn frame_one(
@@ -130,10 +107,10 @@ fn frame_one(
     let made = make_integrator(s0, &options(name, max_depth, params)).unwrap();
     assert!(made.unused_params.is_empty());
     let di = made.integrator;
-    run(s0, di.as_ref(), 2, seed);
+    render_with(s0, di.as_ref(), 2, seed);
     let anim = desc.animation.as_ref().unwrap();
     di.next_frame(Arc::new(FrameMotion::new(s0.clone(), s1, anim, T0, T1)));
-    run(s1, di.as_ref(), 1, seed ^ 0x5555)
+    render_with(s1, di.as_ref(), 1, seed ^ 0x5555)
 }
 
 fn statistics(frames: &(SceneDesc, Arc<Scene>, Scene), params: &[(&str, &str)]) -> Vec<(f64, f64)> {

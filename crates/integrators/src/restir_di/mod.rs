@@ -44,8 +44,9 @@ pub use settings::{
 };
 
 use crate::bands::Bands;
+use crate::fallback::PathFallback;
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
-use crate::render::{Integrator, PassContext, PathIntegrator};
+use crate::render::{Integrator, PassContext};
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::light_point::{Contact, LightPoint, Resolved, contact, resolve};
 use crate::reuse::motion::FrameMotion;
@@ -75,7 +76,7 @@ pub struct RestirDiIntegrator {
     history: HistorySlot<LightPoint>,
     clock: StageClock,
     /// The path tracer that renders instead, and why (a scene with one dominant light).
-    fallback: Option<(PathIntegrator, String)>,
+    fallback: Option<PathFallback>,
 }
 
 /// A receiver where ReSTIR DI's shift map works: a pixel's primary hit in this pass, or in the
@@ -227,14 +228,7 @@ impl RestirDiIntegrator {
     /// The same integrator rendering with the path tracer instead when `why` says so (what
     /// [`RestirDiSettings::resolve`] returned).
     pub fn with_fallback(mut self, why: Option<String>) -> Self {
-        self.fallback = why.map(|why| {
-            (
-                PathIntegrator {
-                    settings: self.settings.path,
-                },
-                why,
-            )
-        });
+        self.fallback = PathFallback::new(self.settings.path, why);
         self
     }
 
@@ -478,9 +472,10 @@ impl Integrator for RestirDiIntegrator {
             s.reuse.describe_temporal(),
             s.visibility_reuse,
             if s.is_unbiased() { "" } else { " (biased)" }
-        ) + &self.fallback.as_ref().map_or(String::new(), |(p, why)| {
-            format!("; estimator: {} ({why})", p.describe())
-        })
+        ) + &self
+            .fallback
+            .as_ref()
+            .map_or(String::new(), PathFallback::describe)
     }
 
     fn stage_seconds(&self) -> Vec<(&'static str, f64)> {
@@ -515,7 +510,7 @@ impl Integrator for RestirDiIntegrator {
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
-        if let Some((path, _)) = &self.fallback {
+        if let Some(path) = &self.fallback {
             return path.render_pass(scene, ctx, accum);
         }
         let s = &self.settings;

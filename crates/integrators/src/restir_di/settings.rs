@@ -7,6 +7,7 @@
 
 use restir_scene::SceneFeatures;
 
+pub use crate::fallback::Fallback;
 use crate::params::{Param, ParamError, ParamSet};
 use crate::path::PathSettings;
 use crate::reuse::settings::ReuseSettings;
@@ -74,21 +75,6 @@ impl LightSampler {
             LightSampler::BvhWithPowerPmf => "bvh-with-power-pmf",
         }
     }
-}
-
-/// Whether ReSTIR DI may hand a scene that does not suit it to the path tracer (`fallback`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Fallback {
-    /// When one light holds at least [`DOMINANT_LIGHT_SHARE`] of the selections among at most
-    /// [`FEW_EMITTERS`] emitters and no other ReSTIR DI parameter is given (default).
-    Auto,
-    /// Never: ReSTIR DI whatever the scene.
-    Off,
-}
-
-impl Fallback {
-    /// The names `fallback` takes.
-    pub const NAMES: &[(&str, Fallback)] = &[("auto", Fallback::Auto), ("off", Fallback::Off)];
 }
 
 /// Everything ReSTIR DI can be told.

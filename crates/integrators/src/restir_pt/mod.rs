@@ -49,8 +49,9 @@ use crate::reuse::neighbors::NeighborPattern;
 use crate::reuse::passes::{self, HistorySlot};
 use crate::reuse::reciprocal;
 
+use crate::fallback::PathFallback;
 use crate::path::PathSettings;
-use crate::render::{Integrator, PassContext, PathIntegrator};
+use crate::render::{Integrator, PassContext};
 use crate::restir_di::{RestirDiIntegrator, RestirDiSettings};
 use crate::reuse::settings::mis_name;
 use crate::stages::StageClock;
@@ -75,7 +76,7 @@ pub struct RestirPtIntegrator {
     history: HistorySlot<PathSample>,
     clock: StageClock,
     /// The path tracer that renders instead, and why ([`RestirPtIntegrator::with_fallback`]).
-    fallback: Option<(PathIntegrator, String)>,
+    fallback: Option<PathFallback>,
 }
 
 impl RestirPtIntegrator {
@@ -105,14 +106,7 @@ impl RestirPtIntegrator {
     /// The same integrator rendering with the path tracer instead when `why` says so (what
     /// [`RestirPtSettings::resolve`] returned).
     pub fn with_fallback(mut self, why: Option<String>) -> Self {
-        self.fallback = why.map(|why| {
-            (
-                PathIntegrator {
-                    settings: self.settings.path,
-                },
-                why,
-            )
-        });
+        self.fallback = PathFallback::new(self.settings.path, why);
         self
     }
 
@@ -324,9 +318,10 @@ impl Integrator for RestirPtIntegrator {
             s.max_jacobian,
             s.direct.name(),
             if s.is_unbiased() { "" } else { " (biased)" }
-        ) + &self.fallback.as_ref().map_or(String::new(), |(p, why)| {
-            format!("; estimator: {} ({why})", p.describe())
-        })
+        ) + &self
+            .fallback
+            .as_ref()
+            .map_or(String::new(), PathFallback::describe)
     }
 
     fn halo(&self) -> u32 {
@@ -373,7 +368,7 @@ impl Integrator for RestirPtIntegrator {
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
-        if let Some((path, _)) = &self.fallback {
+        if let Some(path) = &self.fallback {
             return path.render_pass(scene, ctx, accum);
         }
         let s = &self.settings.reuse;

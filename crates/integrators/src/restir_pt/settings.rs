@@ -7,6 +7,7 @@
 
 use restir_scene::Scene;
 
+pub use crate::fallback::Fallback;
 use crate::params::{Param, ParamError, ParamProblem, ParamSet};
 use crate::path::PathSettings;
 use crate::reuse::settings::ReuseSettings;
@@ -59,22 +60,6 @@ impl DirectLight {
             DirectLight::RestirDi => "restir-di",
         }
     }
-}
-
-/// Whether ReSTIR PT may hand a scene that does not suit it to the path tracer (`fallback`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Fallback {
-    /// When fewer than [`GLOSSY_VIEW_MIN`] of the camera's paths first reach a glossy surface
-    /// a path can reconnect at, the indirect share of the light there is below
-    /// [`INDIRECT_VIEW_MIN`], and no other ReSTIR PT parameter is given (default).
-    Auto,
-    /// Never: ReSTIR PT whatever the scene.
-    Off,
-}
-
-impl Fallback {
-    /// The names `fallback` takes.
-    pub const NAMES: &[(&str, Fallback)] = &[("auto", Fallback::Auto), ("off", Fallback::Off)];
 }
 
 /// Everything ReSTIR PT can be told.

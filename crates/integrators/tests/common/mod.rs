@@ -6,7 +6,7 @@
 use std::sync::atomic::AtomicBool;
 
 use restir_integrators::{
-    Image, IntegratorOptions, Param, ParamSource, RenderJob, make_integrator, render,
+    Image, Integrator, IntegratorOptions, Param, ParamSource, RenderJob, make_integrator, render,
 };
 use restir_scene::Scene;
 
@@ -35,6 +35,12 @@ pub fn render_image(
     };
     let made = make_integrator(scene, &options).unwrap();
     assert!(made.unused_params.is_empty());
+    render_with(scene, made.integrator.as_ref(), spp, seed)
+}
+
+/// Renders `spp` passes of `scene` with `integrator` (which keeps whatever history it has
+/// between calls) and seed `seed`. Every pixel must be finite.
+pub fn render_with(scene: &Scene, integrator: &dyn Integrator, spp: u32, seed: u64) -> Image {
     let settings = RenderJob {
         spp,
         seed,
@@ -42,14 +48,16 @@ pub fn render_image(
     };
     let out = render(
         scene,
-        made.integrator.as_ref(),
+        integrator,
         &settings,
         &AtomicBool::new(false),
         &mut |_, _| {},
     );
     assert_eq!(
-        out.nonfinite_pixels, 0,
-        "{name} {params:?}: non-finite pixels"
+        out.nonfinite_pixels,
+        0,
+        "{}: non-finite pixels",
+        integrator.describe()
     );
     out.image
 }

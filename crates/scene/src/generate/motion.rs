@@ -248,6 +248,30 @@ fn track(
     }
 }
 
+/// A track that moves shape `shape` rigidly by `motion` ([`track`] with its motion keys).
+fn mover(
+    shapes: &mut [ShapeDesc],
+    shape: usize,
+    id: String,
+    interpolation: Interpolation,
+    pivot: Vec3,
+    motion: Keys<MotionKey>,
+) -> ShapeTrack {
+    ShapeTrack {
+        motion: Some(motion),
+        ..track(shapes, shape, id, interpolation, pivot)
+    }
+}
+
+/// Catmull-Rom for the even-numbered of a group of moving shapes, linear for the others.
+fn alternate(n: usize) -> Interpolation {
+    if n.is_multiple_of(2) {
+        Interpolation::CatmullRom
+    } else {
+        Interpolation::Linear
+    }
+}
+
 /// The camera's look-at (eye, target), or an error when the camera is not one look-at.
 fn look_at(desc: &SceneDesc) -> Result<(Vec3, Vec3), GenerateError> {
     match desc.camera.to_world.as_slice() {
@@ -327,30 +351,28 @@ fn many_lights(
         let size = 2.0 * h.x.max(h.z);
         let end = horizontal(rng, 0.4 * size, 0.8 * size);
         let turn = [0.0, sign(rng) * uniform(rng, 15.0, 45.0), 0.0];
-        let mut t = track(
+        tracks.push(mover(
             &mut generated.desc.shapes,
             i,
             format!("object{n}"),
             Interpolation::CatmullRom,
             c,
-        );
-        t.motion = Some(rigid(rng, end, turn));
-        tracks.push(t);
+            rigid(rng, end, turn),
+        ));
     }
     summary.0.push("three receivers move and turn".into());
     for (n, &i) in choose(rng, &slats, 2).iter().enumerate() {
         let (c, _) = box_of(i)?;
         let end = horizontal(rng, 0.3, 0.8);
         let turn = [0.0, sign(rng) * uniform(rng, 20.0, 60.0), 0.0];
-        let mut t = track(
+        tracks.push(mover(
             &mut generated.desc.shapes,
             i,
             format!("slat{n}"),
             Interpolation::Linear,
             c,
-        );
-        t.motion = Some(rigid(rng, end, turn));
-        tracks.push(t);
+            rigid(rng, end, turn),
+        ));
     }
     if !slats.is_empty() {
         summary.0.push("two slats move and turn".into());
@@ -369,20 +391,14 @@ fn many_lights(
                 sign(rng) * uniform(rng, 30.0, 90.0),
                 0.0,
             ];
-            let interpolation = if n % 2 == 0 {
-                Interpolation::CatmullRom
-            } else {
-                Interpolation::Linear
-            };
-            let mut t = track(
+            tracks.push(mover(
                 &mut generated.desc.shapes,
                 i,
                 format!("light{n}"),
-                interpolation,
+                alternate(n),
                 c,
-            );
-            t.motion = Some(rigid(rng, end, turn));
-            tracks.push(t);
+                rigid(rng, end, turn),
+            ));
         }
         summary.0.push(format!(
             "{} emissive meshes move whole (the brightest among them)",
@@ -436,20 +452,14 @@ fn many_lights(
             } else {
                 [0.0; 3]
             };
-            let interpolation = if n % 2 == 0 {
-                Interpolation::CatmullRom
-            } else {
-                Interpolation::Linear
-            };
-            let mut t = track(
+            tracks.push(mover(
                 &mut generated.desc.shapes,
                 i,
                 format!("light{n}"),
-                interpolation,
+                alternate(n),
                 c,
-            );
-            t.motion = Some(rigid(rng, end, turn));
-            tracks.push(t);
+                rigid(rng, end, turn),
+            ));
         }
         summary
             .0
@@ -533,15 +543,14 @@ fn room(
         let phi = uniform(rng, -60f32, 60.0).to_radians();
         let end = Vec3::new(phi.sin(), 0.0, phi.cos()) * uniform(rng, 0.2, 0.4);
         let turn = [0.0, sign(rng) * uniform(rng, 15.0, 45.0), 0.0];
-        let mut t = track(
+        tracks.push(mover(
             &mut generated.desc.shapes,
             i,
             format!("object{n}"),
             Interpolation::CatmullRom,
             c,
-        );
-        t.motion = Some(rigid(rng, end, turn));
-        tracks.push(t);
+            rigid(rng, end, turn),
+        ));
     }
     summary.0.push("two floor objects move and turn".into());
 
