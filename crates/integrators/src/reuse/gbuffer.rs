@@ -80,12 +80,57 @@ impl Receiver {
         }
     }
 
-    /// Whether `other` is similar enough to be a reuse neighbour: shading normals within
-    /// `normal_cos` (cosine of the largest angle) and camera distances within a relative
-    /// `depth_tolerance` (`docs/RESTIR_DI.md`, spatial reuse). These tests only pick participating domains;
-    /// the estimators stay unbiased whatever they decide.
+    /// Whether `other` is similar enough to be a reuse neighbour ([`SimilarityKey::is_similar`]).
     #[inline]
     pub fn is_similar(&self, other: &Receiver, normal_cos: f32, depth_tolerance: f32) -> bool {
+        self.key()
+            .is_similar(&other.key(), normal_cos, depth_tolerance)
+    }
+
+    /// What the similarity tests compare.
+    #[inline]
+    pub fn key(&self) -> SimilarityKey {
+        SimilarityKey {
+            n: self.n,
+            depth: if self.bsdf == Self::NO_HIT {
+                SimilarityKey::NO_HIT
+            } else {
+                self.depth
+            },
+        }
+    }
+}
+
+/// What the neighbour-similarity tests read of a primary hit, in 16 bytes: spatial reuse tries
+/// pixels at random within its radius, and testing this instead of the 64-byte [`Receiver`]
+/// touches a quarter of the memory (at 640×480 the receivers within a 30-pixel radius do not
+/// fit in a core's cache; the keys do).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(16))]
+pub struct SimilarityKey {
+    /// Shading normal.
+    pub n: Vec3,
+    /// Distance from the camera; [`SimilarityKey::NO_HIT`] without a primary hit.
+    pub depth: f32,
+}
+
+impl SimilarityKey {
+    /// `depth` of a pixel without a primary hit.
+    pub const NO_HIT: f32 = -1.0;
+
+    /// Whether the pixel has a primary hit.
+    #[inline]
+    pub fn hit(&self) -> bool {
+        self.depth >= 0.0
+    }
+
+    /// Whether `other` is similar enough to be a reuse neighbour: shading normals within
+    /// `normal_cos` (cosine of the largest angle) and camera distances within a relative
+    /// `depth_tolerance` (`docs/RESTIR_DI.md`, spatial reuse). These tests only pick
+    /// participating domains; the estimators stay unbiased whatever they decide. Both keys must
+    /// have a hit.
+    #[inline]
+    pub fn is_similar(&self, other: &SimilarityKey, normal_cos: f32, depth_tolerance: f32) -> bool {
         self.n.dot(other.n) >= normal_cos
             && (self.depth - other.depth).abs() <= depth_tolerance * self.depth.max(other.depth)
     }
@@ -106,18 +151,30 @@ pub struct GBuffer {
     /// The shape each primary hit lies on (index into `Scene::shapes`; motion vectors move the
     /// hit with its shape and reject a previous hit on another shape).
     pub shape: Vec<u32>,
+    /// Each receiver's [`SimilarityKey`], what neighbour selection tests.
+    pub keys: Vec<SimilarityKey>,
 }
 
 impl GBuffer {
     /// Bytes per pixel of one G-buffer (receiver, geometric normal, shape).
-    pub const BYTES_PER_PIXEL: usize =
-        std::mem::size_of::<Receiver>() + std::mem::size_of::<Vec3>() + std::mem::size_of::<u32>();
+    pub const BYTES_PER_PIXEL: usize = std::mem::size_of::<Receiver>()
+        + std::mem::size_of::<Vec3>()
+        + std::mem::size_of::<u32>()
+        + std::mem::size_of::<SimilarityKey>();
 
     /// The primary hit of pixel `index`, if there is one.
     #[inline]
     pub fn receiver(&self, index: usize) -> Option<&Receiver> {
         let r = &self.receivers[index];
         (r.bsdf != Receiver::NO_HIT).then_some(r)
+    }
+
+    /// Whether pixels `a` and `b` both have a primary hit and are similar enough to be reuse
+    /// neighbours ([`SimilarityKey::is_similar`]).
+    #[inline]
+    pub fn similar(&self, a: usize, b: usize, normal_cos: f32, depth_tolerance: f32) -> bool {
+        let (ka, kb) = (&self.keys[a], &self.keys[b]);
+        ka.hit() && kb.hit() && ka.is_similar(kb, normal_cos, depth_tolerance)
     }
 
     /// Traces the camera rays of pass `ctx`. Adds what the camera sees directly (emitters and
@@ -176,6 +233,7 @@ impl GBuffer {
                 rad.len() as u64
             })
             .sum();
+        let keys = receivers.par_iter().map(Receiver::key).collect();
         (
             Self {
                 width: w,
@@ -183,6 +241,7 @@ impl GBuffer {
                 receivers,
                 ng,
                 shape,
+                keys,
             },
             rays,
         )

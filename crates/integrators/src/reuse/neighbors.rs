@@ -68,9 +68,10 @@ impl NeighborPattern {
         out: &mut Vec<usize>,
     ) {
         out.clear();
-        let Some(r) = gbuf.receiver(index) else {
+        let r = &gbuf.keys[index];
+        if !r.hit() {
             return;
-        };
+        }
         let (w, h) = (gbuf.width as i64, gbuf.height as i64);
         let (x, y) = ((index as i64) % w, (index as i64) / w);
         let mask = self.offsets.len() - 1;
@@ -85,9 +86,8 @@ impl NeighborPattern {
                 continue;
             }
             let q = (ny * w + nx) as usize;
-            if let Some(rq) = gbuf.receiver(q)
-                && r.is_similar(rq, rule.normal_cos, rule.depth_tolerance)
-            {
+            let rq = &gbuf.keys[q];
+            if rq.hit() && r.is_similar(rq, rule.normal_cos, rule.depth_tolerance) {
                 out.push(q);
             }
         }

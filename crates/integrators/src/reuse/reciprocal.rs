@@ -174,8 +174,7 @@ pub fn spatial<R: ReuseShift>(
         // The partner `a + o` of pixel `a`, when the pair exists (both hit, similar).
         let partner = |a: usize, o: (i64, i64)| -> Option<usize> {
             let b = step(a, o)?;
-            let (ra, rb) = (gbuf.receiver(a)?, gbuf.receiver(b)?);
-            ra.is_similar(rb, settings.normal_cos, settings.depth_tolerance)
+            gbuf.similar(a, b, settings.normal_cos, settings.depth_tolerance)
                 .then_some(b)
         };
 
