@@ -93,6 +93,66 @@ pub struct LightSample {
     pub param: Vec2,
 }
 
+/// A light sample drawn without a receiver ([`LightSet::presample`]): what a pool of presampled
+/// candidates holds (RTXDI's presampled light tiles, Wyman and Panteleev 2021). Its density is
+/// the power sampler's ([`LightSet::sample`]) expressed in the sample's own measure, so it does
+/// not depend on where the sample will be seen from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Presampled {
+    /// A point on an emissive triangle.
+    Surface {
+        /// Index of the light.
+        light: u32,
+        /// The triangle in the light's mesh.
+        prim: u32,
+        /// Barycentrics of the point.
+        param: Vec2,
+        /// Position.
+        p: Vec3,
+        /// Shading normal (one-sided emission is judged against it).
+        n: Vec3,
+        /// Geometric normal.
+        ng: Vec3,
+        /// Emitted radiance.
+        le: Vec3,
+        /// Density per unit area, the selection included.
+        pdf_area: f32,
+    },
+    /// A point light.
+    Point {
+        /// Index of the light.
+        light: u32,
+        /// Position.
+        p: Vec3,
+        /// Radiant intensity.
+        intensity: Vec3,
+        /// Selection probability.
+        pmf: f32,
+    },
+    /// A direction towards a light at infinity (the environment, or a directional light).
+    Direction {
+        /// Index of the light.
+        light: u32,
+        /// Unit direction towards the light.
+        wi: Vec3,
+        /// Radiance (environment) or irradiance (directional light).
+        le: Vec3,
+        /// Density per unit solid angle, the selection included (the selection probability for a
+        /// directional light).
+        pdf: f32,
+        /// Whether the light is a delta light (directional).
+        delta: bool,
+    },
+    /// A light whose points are drawn per receiver ([`LightSet::sample_light`]: a sphere's by the
+    /// cone it subtends), with its selection probability.
+    Light {
+        /// Index of the light.
+        light: u32,
+        /// Selection probability.
+        pmf: f32,
+    },
+}
+
 /// Why a light set could not be built.
 #[derive(Clone, Debug, PartialEq)]
 pub enum LightError {
@@ -421,6 +481,63 @@ impl LightSet {
         Some(s)
     }
 
+    /// What [`LightSet::sample`] draws with the same numbers, as far as it does not depend on
+    /// the receiver ([`Presampled`]): the point of a triangle, a point light, the direction of a
+    /// light at infinity; a sphere light only picked. `None` where nothing can be sampled.
+    pub fn presample(&self, shapes: &[Shape], u_select: f32, u: Vec2) -> Option<Presampled> {
+        let light = match self.table.pick(u_select)? {
+            Ok(&Emitter::Triangle {
+                light,
+                prim,
+                ref p,
+                ng,
+                n,
+                smooth,
+            }) => {
+                let Light::Area { shape, radiance } = self.lights[light as usize] else {
+                    return None;
+                };
+                let ps =
+                    Emitter::triangle_point(p, ng, n, smooth, &shapes[shape as usize], prim, u);
+                return Some(Presampled::Surface {
+                    light,
+                    prim,
+                    param: ps.param,
+                    p: ps.p,
+                    n: ps.n,
+                    ng: ps.ng,
+                    le: radiance,
+                    pdf_area: self.area_pdf[light as usize],
+                });
+            }
+            Ok(&Emitter::Whole { light }) => light,
+            Err(env) => env,
+        };
+        let pmf = self.table.pmf(light);
+        match self.lights[light as usize] {
+            Light::Area { .. } => Some(Presampled::Light { light, pmf }),
+            Light::Point {
+                position,
+                intensity,
+            } => Some(Presampled::Point {
+                light,
+                p: position,
+                intensity,
+                pmf,
+            }),
+            Light::Directional { .. } | Light::Constant { .. } | Light::Envmap => {
+                let s = self.sample_light(shapes, light, Vec3::ZERO, u)?;
+                Some(Presampled::Direction {
+                    light,
+                    wi: s.wi,
+                    le: s.le,
+                    pdf: s.pdf_sa * pmf,
+                    delta: s.delta,
+                })
+            }
+        }
+    }
+
     /// A uniform point on an emissive triangle the table picked, with the selection in its
     /// density.
     #[inline]
@@ -448,6 +565,25 @@ impl LightSet {
         let ps = Emitter::triangle_point(p, ng, n, smooth, &shapes[shape as usize], prim, u);
         let pdf_sa = area_to_solid_angle(self.area_pdf[light as usize], ref_p, ps.p, ps.ng)?;
         area_light_sample(light, radiance, ref_p, ps, pdf_sa)
+    }
+
+    /// The point of area light `light`, whose shape is `shape`, named by primitive `prim` and
+    /// parameters `param` (barycentrics on a triangle, sphere parameters): the same bits as
+    /// [`Shape::position_at`]. A triangle of a light whose mesh is in the emitter table is read
+    /// from its table entry (corners and normals inline: one lookup instead of the chain shape →
+    /// indices → positions).
+    #[inline]
+    pub fn area_point(&self, shape: &Shape, light: u32, prim: u32, param: Vec2) -> PositionSample {
+        match self.table.triangle_entry(light, prim) {
+            Some(&Emitter::Triangle {
+                ref p,
+                ng,
+                n,
+                smooth,
+                ..
+            }) => Emitter::point_at(p, ng, n, smooth, shape, prim, param),
+            _ => shape.position_at(prim, param),
+        }
     }
 
     /// Samples a point on light `light` as seen from `ref_p`, with `pdf_sa` *not* including the

@@ -69,7 +69,29 @@ impl Emitter {
         prim: u32,
         u: Vec2,
     ) -> PositionSample {
-        let b = warp::sample_uniform_triangle(u);
+        Self::point_at(
+            p,
+            ng,
+            n,
+            smooth,
+            shape,
+            prim,
+            warp::sample_uniform_triangle(u),
+        )
+    }
+
+    /// The point of a triangle entry at barycentrics `b`, the same bits as
+    /// [`restir_geometry::TriangleMesh::point_at`]; `shape` is read only for smooth meshes.
+    #[inline]
+    pub fn point_at(
+        p: &[Vec3; 3],
+        ng: Vec3,
+        n: Vec3,
+        smooth: bool,
+        shape: &Shape,
+        prim: u32,
+        b: Vec2,
+    ) -> PositionSample {
         let b0 = 1.0 - b.x - b.y;
         let point = b0 * p[0] + b.x * p[1] + b.y * p[2];
         let n = match (smooth, shape) {
@@ -130,6 +152,9 @@ pub(crate) struct EmitterTable {
     env_share: f32,
     /// The power share of the environment, the default of `env_share`.
     env_power_share: f32,
+    /// Per light, the entry of its triangle 0 when every triangle of its mesh has an entry, in
+    /// order (so triangle `t` is entry `first + t`); [`EmitterTable::NO_ENTRIES`] otherwise.
+    first_triangle_entry: Vec<u32>,
 }
 
 impl EmitterTable {
@@ -143,6 +168,7 @@ impl EmitterTable {
     ) -> Self {
         let mut entries = Vec::new();
         let mut weights = Vec::new();
+        let mut first_triangle_entry = vec![Self::NO_ENTRIES; lights.len()];
         for (i, (l, &power)) in lights.iter().zip(powers).enumerate() {
             let light = i as u32;
             if power <= 0.0 || Some(light) == environment {
@@ -158,6 +184,7 @@ impl EmitterTable {
             match mesh {
                 Some((m, radiance)) => {
                     let per_area = core::f32::consts::PI * restir_sampling::luminance(radiance);
+                    let first = entries.len();
                     for t in 0..m.triangle_count() {
                         let p = m.triangle(t);
                         let w = per_area * m.triangle_area(t);
@@ -175,6 +202,9 @@ impl EmitterTable {
                             smooth,
                         });
                         weights.push(w);
+                    }
+                    if entries.len() - first == m.triangle_count() {
+                        first_triangle_entry[i] = first as u32;
                     }
                 }
                 None => {
@@ -215,9 +245,24 @@ impl EmitterTable {
             environment,
             env_share: 0.0,
             env_power_share,
+            first_triangle_entry,
         };
         table.set_env_share(env_power_share);
         table
+    }
+
+    /// `first_triangle_entry` of a light whose triangles are not all entries.
+    const NO_ENTRIES: u32 = u32::MAX;
+
+    /// The entry of triangle `prim` of area light `light`, when the table holds every triangle
+    /// of the light's mesh.
+    #[inline]
+    pub fn triangle_entry(&self, light: u32, prim: u32) -> Option<&Emitter> {
+        let first = *self.first_triangle_entry.get(light as usize)?;
+        if first == Self::NO_ENTRIES {
+            return None;
+        }
+        self.entries.get(first as usize + prim as usize)
     }
 
     /// Sets the environment's share of selections (clamped to what the table holds: 0 without

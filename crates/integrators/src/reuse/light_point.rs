@@ -110,7 +110,12 @@ pub enum Resolved {
 pub fn resolve(scene: &Scene, sample: &LightPoint) -> Resolved {
     match scene.lights.lights()[sample.light as usize] {
         Light::Area { shape, radiance } => {
-            let ps = scene.shapes[shape as usize].position_at(sample.prim, sample.param);
+            let ps = scene.lights.area_point(
+                &scene.shapes[shape as usize],
+                sample.light,
+                sample.prim,
+                sample.param,
+            );
             Resolved::Surface {
                 p: ps.p,
                 n: ps.n,
