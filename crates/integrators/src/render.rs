@@ -181,8 +181,27 @@ impl PassContext<'_> {
     /// every crop of the film (choices made once per pass, like shared neighbour offsets).
     #[inline]
     pub fn pass_rng(&self, stage: u64) -> Pcg32 {
+        self.pass_stream(stage, u64::MAX)
+    }
+
+    /// Stream `stream` of the whole pass for estimator stage `stage`, one of many (one per tile
+    /// of a pool drawn once per pass, say): like [`PassContext::pass_rng`], the same for every
+    /// pixel and every crop.
+    #[inline]
+    pub fn pass_stream(&self, stage: u64, stream: u64) -> Pcg32 {
         let seed = restir_sampling::mix64(self.seed ^ stage.wrapping_mul(0xe703_7ed1_a0b4_28db));
-        Pcg32::for_pixel_sample(seed, u64::MAX, self.pass as u64)
+        Pcg32::for_pixel_sample(seed, stream, self.pass as u64)
+    }
+
+    /// The film coordinates of pixel `index` of this pass's buffers, which are `width` pixels
+    /// wide (the film's, or the crop region's).
+    #[inline]
+    pub fn film_xy(&self, index: usize, width: usize) -> (u32, u32) {
+        let (x, y) = ((index % width) as u32, (index / width) as u32);
+        match &self.crop {
+            None => (x, y),
+            Some(c) => (x + c.region.x0, y + c.region.y0),
+        }
     }
 
     /// The film position (pixel units) of a filter-jittered camera ray through pixel `(x, y)`

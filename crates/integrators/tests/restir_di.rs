@@ -172,6 +172,73 @@ fn unbiased_for_every_unbiased_mis_scheme() {
     assert!(z < Z_MAX, "temporal: max |z| = {z:.2}");
 }
 
+/// The candidates come from the power sampler's pool of presampled lights (the default): the
+/// MIS loop above covers it; here the pool's negative control — whole lights' candidates
+/// (the sphere, the point light, the environment) weighted without their selection probability
+/// — must fail. Visibility in every target (`visibility = target`: a shadow ray per shift) is
+/// unbiased, alone, with reciprocal pairs and with temporal reuse; its biased sibling, the
+/// visibility of the initial selection alone (`visibility_reuse`), fails in
+/// `biased_options_show_their_bias`.
+#[test]
+fn light_pool_and_visible_targets() {
+    let scene = scene();
+    let reference = direct_reference(&scene);
+    for params in [
+        &[("visibility", "target")][..],
+        &[
+            ("visibility", "target"),
+            ("reciprocal", "true"),
+            ("neighbors", "4"),
+            ("radius", "3"),
+            ("spatial_rounds", "2"),
+        ][..],
+    ] {
+        let z = max_z(&statistics(&scene, "restir-di", params, 1, 200), &reference);
+        eprintln!("{params:?}: max |z| = {z:.2}");
+        assert!(z < Z_MAX, "{params:?}: max |z| = {z:.2}");
+    }
+    let z = max_z(
+        &statistics(
+            &scene,
+            "restir-di",
+            &[("visibility", "target"), ("temporal", "true")],
+            4,
+            100,
+        ),
+        &reference,
+    );
+    eprintln!("visibility target, temporal: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "visibility target, temporal: max |z| = {z:.2}");
+
+    let mut wrong =
+        RestirDiSettings::new(restir_integrators::path::PathSettings::from_scene(&scene));
+    wrong.light_sampler = LightSampler::PoolWithoutSelection;
+    let render_one = |seed| {
+        let job = RenderJob {
+            spp: 1,
+            seed,
+            ..RenderJob::default()
+        };
+        render(
+            &scene,
+            &RestirDiIntegrator::new(wrong),
+            &job,
+            &AtomicBool::new(false),
+            &mut |_, _| {},
+        )
+        .image
+    };
+    let z = max_z(
+        &block_statistics(render_one, 200, seed_base(), BLOCK),
+        &reference,
+    );
+    eprintln!("pool without the selection probability: max |z| = {z:.2}");
+    assert!(
+        z > 2.0 * Z_MAX,
+        "a pool entry weighted without its selection should be biased: {z:.2}"
+    );
+}
+
 /// Negative controls: the same test catches the biased options.
 #[test]
 fn biased_options_show_their_bias() {

@@ -169,7 +169,12 @@ struct RestirArgs {
     /// scene file turned on.
     #[arg(long, value_name = "BOOL", num_args = 0..=1, default_missing_value = "true")]
     temporal: Option<bool>,
-    /// Drop occluded initial candidates (biased at shadow edges).
+    /// restir-di: where light samples' visibility is tested: shading (once, for the selected
+    /// sample), target (in every target, a shadow ray per shift; unbiased) or reuse (the
+    /// initial selection only; biased) [default: shading].
+    #[arg(long)]
+    visibility: Option<String>,
+    /// restir-di: the same as --visibility reuse (biased at shadow edges).
     #[arg(long)]
     visibility_reuse: bool,
     /// Spatial neighbours in reciprocal pairs that share their shifts (pairwise MIS):
@@ -220,6 +225,7 @@ impl RestirArgs {
         put("mcap", self.mcap.map(ParamValue::Number));
         put("temporal", self.temporal.map(ParamValue::Bool));
         put("reciprocal", self.reciprocal.map(ParamValue::Bool));
+        put("visibility", self.visibility.clone().map(ParamValue::Text));
         put(
             "visibility_reuse",
             self.visibility_reuse.then_some(ParamValue::Bool(true)),

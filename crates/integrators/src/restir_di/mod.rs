@@ -27,6 +27,7 @@
 //! tracer instead (`fallback = auto`, [`RestirDiSettings::resolve`]): the estimator is then
 //! exactly the path tracer's, and `describe` (hence `--stats`) says so.
 
+pub mod pool;
 mod settings;
 pub mod target;
 pub mod tiles;
@@ -35,12 +36,13 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use restir_geometry::{Ray, offset_ray_origin};
 use restir_gris::{Reservoir, ShiftMap, Shifted, StreamingReservoir};
+use restir_lights::{LightSample, Presampled};
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
 pub use settings::{
     DOMINANT_LIGHT_SHARE, FEW_EMITTERS, Fallback, HIERARCHY_MIN_EMITTERS, LightSampler,
-    RestirDiSettings,
+    RestirDiSettings, Visibility,
 };
 
 use crate::bands::Bands;
@@ -56,13 +58,14 @@ use crate::reuse::reciprocal;
 use crate::reuse::settings::mis_name;
 use crate::shadow::{self, ShadowTarget};
 use crate::stages::StageClock;
-use target::{StrategyCounts, evaluate, target};
+use target::{StrategyCounts, evaluate};
 
 /// Random-stream stages (see [`PassContext::stage_rng`]).
 const STAGE_INITIAL: u64 = 1;
 const STAGE_TEMPORAL: u64 = 2;
 const STAGE_SHADE: u64 = 3;
 const STAGE_SPATIAL: u64 = 16;
+const STAGE_POOL: u64 = 4;
 
 /// The reservoir type: 16-byte sample, `W`, `M`, `p̂`.
 pub type DiReservoir = Reservoir<LightPoint>;
@@ -84,6 +87,8 @@ pub struct RestirDiIntegrator {
 #[derive(Clone, Copy)]
 struct DiDomain<'a> {
     r: &'a Receiver,
+    /// The receiver's geometric normal (shadow rays leave along it).
+    ng: Vec3,
     /// The scene the receiver's target is evaluated in.
     scene: &'a Scene,
     /// Whether the receiver is the previous frame's (its light indices are that frame's).
@@ -94,12 +99,16 @@ struct DiDomain<'a> {
 /// changes. Across frames the sample moves with its light, which the previous frame may name
 /// by another index ([`FrameMotion`]); a rigid motion keeps area, so `J = 1` still. It keeps
 /// the receiving pixel's own sample resolved, because pairwise MIS evaluates that sample at
-/// every neighbour.
+/// every neighbour. With [`Visibility::Target`] a target includes the visibility of the sample
+/// from the receiver it is evaluated at: one shadow ray per shift whose unshadowed target is
+/// positive, in the scene of the destination domain.
 struct DiShift<'a> {
     scene: &'a Scene,
     counts: StrategyCounts,
     motion: Option<&'a FrameMotion>,
     canonical: Option<(LightPoint, Resolved)>,
+    visibility: bool,
+    rays: std::cell::Cell<u64>,
 }
 
 impl<'a> DiShift<'a> {
@@ -108,12 +117,15 @@ impl<'a> DiShift<'a> {
         counts: StrategyCounts,
         motion: Option<&'a FrameMotion>,
         canonical: &DiReservoir,
+        visibility: bool,
     ) -> Self {
         Self {
             scene,
             counts,
             motion,
             canonical: canonical.sample.map(|x| (x, resolve(scene, &x))),
+            visibility,
+            rays: std::cell::Cell::new(0),
         }
     }
 
@@ -151,10 +163,18 @@ impl<'a> ShiftMap<LightPoint> for DiShift<'a> {
         } else {
             resolve(to.scene, &y)
         };
-        Some(Shifted::identity(
-            y,
-            target(to.scene, to.r, &y, &resolved, self.counts),
-        ))
+        let Some(c) = resolved.contact(to.r.p) else {
+            return Some(Shifted::identity(y, 0.0));
+        };
+        let bsdf = to.r.resolve_bsdf(to.scene);
+        let mut p = evaluate(to.scene, to.r, &bsdf, &y, &c, None, self.counts).target;
+        if self.visibility && p > 0.0 {
+            self.rays.set(self.rays.get() + 1);
+            if !shadow::visible(to.scene, to.r.p, to.ng, shadow_target(&c)) {
+                p = 0.0;
+            }
+        }
+        Some(Shifted::identity(y, p))
     }
 }
 
@@ -169,6 +189,8 @@ struct DiReuse<'p> {
     /// The previous pass's scene and the motion since, when it was the previous frame's.
     motion: Option<&'p FrameMotion>,
     prev_scene: &'p Scene,
+    /// Whether targets include visibility ([`Visibility::Target`]).
+    visibility: bool,
 }
 
 impl<'p> ReuseShift for DiReuse<'p> {
@@ -185,27 +207,161 @@ impl<'p> ReuseShift for DiReuse<'p> {
 
     #[inline]
     fn map(&self, canonical: &DiReservoir) -> DiShift<'p> {
-        DiShift::new(self.scene, self.counts, self.motion, canonical)
+        DiShift::new(
+            self.scene,
+            self.counts,
+            self.motion,
+            canonical,
+            self.visibility,
+        )
+    }
+
+    fn rays(map: &DiShift<'p>) -> u64 {
+        map.rays.get()
     }
 
     #[inline]
     fn domain(&self, index: usize, previous: bool) -> DiDomain<'p> {
         if previous {
+            let prev = self.prev.expect("temporal reuse has a previous pass");
             DiDomain {
-                r: &self
-                    .prev
-                    .expect("temporal reuse has a previous pass")
-                    .receivers[index],
+                r: &prev.receivers[index],
+                ng: prev.ng[index],
                 scene: self.prev_scene,
                 earlier: self.motion.is_some(),
             }
         } else {
             DiDomain {
                 r: &self.gbuf.receivers[index],
+                ng: self.gbuf.ng[index],
                 scene: self.scene,
                 earlier: false,
             }
         }
+    }
+}
+
+/// Where a pixel's initial candidates come from.
+#[derive(Clone, Copy)]
+enum Candidates<'a> {
+    /// The power sampler, drawn per pixel.
+    Power,
+    /// The power sampler's draws presampled for the pass: the tile of the pixel's block.
+    Pool(&'a [Option<Presampled>]),
+    /// The light hierarchy.
+    Hierarchy,
+    /// The pixel's 16×16 light tile (mixed with the power sampler).
+    Tile(&'a restir_sampling::AliasTable),
+}
+
+/// An initial candidate seen from a receiver.
+struct Candidate {
+    sample: LightPoint,
+    contact: Contact,
+    /// The density that drew it, in the sample's measure (area, counting or solid angle).
+    source_pdf: f32,
+    /// The power sampler's solid-angle density (the light/BSDF split's).
+    power_pdf_sa: f32,
+}
+
+impl Candidate {
+    /// A light sample with its source and power-sampler solid-angle densities.
+    #[inline]
+    fn from_sample(ls: &LightSample, source_pdf_sa: f32, power_pdf_sa: f32) -> Option<Self> {
+        let measure = if ls.delta || !ls.dist.is_finite() {
+            1.0
+        } else {
+            ls.ng.dot(ls.wi).abs() / (ls.dist * ls.dist)
+        };
+        Some(Self {
+            sample: LightPoint::from_light_sample(ls),
+            contact: Contact {
+                wi: ls.wi,
+                p: ls.p,
+                dist: ls.dist,
+                le: ls.le,
+                measure,
+                delta: ls.delta,
+                ng: ls.ng,
+            },
+            source_pdf: if ls.delta {
+                source_pdf_sa
+            } else {
+                source_pdf_sa * measure
+            },
+            power_pdf_sa,
+        })
+    }
+
+    /// A pool entry seen from `x` (a sphere light gets its point here, with `u`).
+    #[inline]
+    fn presampled(scene: &Scene, e: &Presampled, x: Vec3, u: glam::Vec2) -> Option<Self> {
+        let (sample, resolved, pdf) = match *e {
+            Presampled::Surface {
+                light,
+                prim,
+                param,
+                p,
+                n,
+                ng,
+                le,
+                pdf_area,
+            } => (
+                LightPoint { light, prim, param },
+                Resolved::Surface { p, n, ng, le },
+                pdf_area,
+            ),
+            Presampled::Point {
+                light,
+                p,
+                intensity,
+                pmf,
+            } => (
+                LightPoint {
+                    light,
+                    prim: 0,
+                    param: glam::Vec2::ZERO,
+                },
+                Resolved::Point { p, intensity },
+                pmf,
+            ),
+            Presampled::Direction {
+                light,
+                wi,
+                le,
+                pdf,
+                delta,
+            } => (
+                if delta {
+                    LightPoint {
+                        light,
+                        prim: 0,
+                        param: glam::Vec2::ZERO,
+                    }
+                } else {
+                    LightPoint::environment(light, wi)
+                },
+                Resolved::Direction { wi, le, delta },
+                pdf,
+            ),
+            Presampled::Light { light, pmf } => {
+                let ls = scene.lights.sample_light(&scene.shapes, light, x, u)?;
+                return Self::from_sample(&ls, ls.pdf_sa * pmf, ls.pdf_sa * pmf);
+            }
+        };
+        let contact = resolved.contact(x)?;
+        // Area lights: the area density over the measure factor is the solid-angle density.
+        let power_pdf_sa = if contact.measure > 0.0 {
+            pdf / contact.measure
+        } else {
+            return None;
+        };
+        Some(Self {
+            sample,
+            contact,
+            source_pdf: pdf,
+            power_pdf_sa,
+        })
     }
 }
 
@@ -245,14 +401,15 @@ impl RestirDiIntegrator {
     /// Bytes per pixel of one reservoir buffer.
     pub const RESERVOIR_BYTES: usize = std::mem::size_of::<DiReservoir>();
 
-    /// Initial resampling at receiver `r`. Returns the reservoir and the rays traced.
+    /// Initial resampling at receiver `r`, with candidates from `source`. Returns the reservoir
+    /// and the rays traced.
     #[inline(never)]
     fn initial(
         &self,
         scene: &Scene,
         r: &Receiver,
         ng: Vec3,
-        tile: Option<&restir_sampling::AliasTable>,
+        source: Candidates<'_>,
         rng: &mut Pcg32,
     ) -> (DiReservoir, u64) {
         let bsdf = &r.resolve_bsdf(scene);
@@ -269,83 +426,83 @@ impl RestirDiIntegrator {
         let nf = n as f32;
         let mut stream = StreamingReservoir::new();
         let u0 = rng.next_f32();
+        // A pool tile's entries `start + i·S/N_L`: one from each of N_L strata of the selection.
+        let (start, stride) = match source {
+            Candidates::Pool(tile) => (
+                rng.next_u32() as usize % tile.len(),
+                (tile.len() / n as usize).max(1),
+            ),
+            _ => (0, 0),
+        };
         for i in 0..n {
             let u_select = ((i as f32 + u0) / nf).min(restir_sampling::ONE_MINUS_EPSILON);
             let u_light = rng.next_2d();
             let u_pick = rng.next_f32();
-            // The candidate, its solid-angle source density (selection included) and the
-            // power sampler's density (which the light/BSDF split uses, whatever picked it).
-            let (ls, source_pdf_sa, power_pdf_sa) = match tile {
-                None if !self.settings.light_sampler.is_hierarchy() => {
-                    let Some(ls) = scene.lights.sample(&scene.shapes, r.p, u_select, u_light)
-                    else {
-                        continue;
-                    };
-                    (ls, ls.pdf_sa, ls.pdf_sa)
-                }
-                None => {
+            // The candidate, its source density in the sample's measure (selection included)
+            // and the power sampler's solid-angle density (which the light/BSDF split uses,
+            // whatever drew the candidate).
+            let drawn = match source {
+                Candidates::Power => scene
+                    .lights
+                    .sample(&scene.shapes, r.p, u_select, u_light)
+                    .and_then(|ls| Candidate::from_sample(&ls, ls.pdf_sa, ls.pdf_sa)),
+                Candidates::Pool(tile) => tile[(start + i as usize * stride) % tile.len()]
+                    .and_then(|mut e| {
+                        if self.settings.light_sampler == LightSampler::PoolWithoutSelection {
+                            e = pool::without_selection(scene, e); // the negative control
+                        }
+                        Candidate::presampled(scene, &e, r.p, u_light)
+                    }),
+                Candidates::Hierarchy => {
                     // 48 bits for the descent: the stratified number and 24 more random ones.
                     let u =
                         (i as f64 + u0 as f64 + rng.next_f32() as f64 / 16_777_216.0) / n as f64;
-                    let Some((ls, power_pdf_sa)) = scene.lights.sample_hierarchy(
-                        &scene.shapes,
-                        r.p,
-                        r.n,
-                        u.min(1.0 - f64::EPSILON),
-                        u_light,
-                    ) else {
-                        continue;
-                    };
-                    let source = if self.settings.light_sampler == LightSampler::Bvh {
-                        ls.pdf_sa
-                    } else {
-                        power_pdf_sa // the negative control's wrong density
-                    };
-                    (ls, source, power_pdf_sa)
-                }
-                Some(table) => {
-                    let Some((light, pmf, power_pmf)) = tiles::select(scene, table, u_select)
-                    else {
-                        continue;
-                    };
-                    let Some(ls) = scene
+                    scene
                         .lights
-                        .sample_light(&scene.shapes, light, r.p, u_light)
-                    else {
-                        continue;
-                    };
-                    (ls, pmf * ls.pdf_sa, power_pmf * ls.pdf_sa)
+                        .sample_hierarchy(
+                            &scene.shapes,
+                            r.p,
+                            r.n,
+                            u.min(1.0 - f64::EPSILON),
+                            u_light,
+                        )
+                        .and_then(|(ls, power_pdf_sa)| {
+                            let source = if self.settings.light_sampler == LightSampler::Bvh {
+                                ls.pdf_sa
+                            } else {
+                                power_pdf_sa // the negative control's wrong density
+                            };
+                            Candidate::from_sample(&ls, source, power_pdf_sa)
+                        })
+                }
+                Candidates::Tile(table) => {
+                    tiles::select(scene, table, u_select).and_then(|(light, pmf, power_pmf)| {
+                        let ls = scene
+                            .lights
+                            .sample_light(&scene.shapes, light, r.p, u_light)?;
+                        Candidate::from_sample(&ls, pmf * ls.pdf_sa, power_pmf * ls.pdf_sa)
+                    })
                 }
             };
-            let sample = LightPoint::from_light_sample(&ls);
-            let measure = if ls.delta || !ls.dist.is_finite() {
-                1.0
-            } else {
-                ls.ng.dot(ls.wi).abs() / (ls.dist * ls.dist)
+            let Some(cand) = drawn else {
+                continue;
             };
-            let c = Contact {
-                wi: ls.wi,
-                p: ls.p,
-                dist: ls.dist,
-                le: ls.le,
-                measure,
-                delta: ls.delta,
-                ng: ls.ng,
-            };
-            let e = evaluate(scene, r, bsdf, &sample, &c, Some(power_pdf_sa), self.counts);
-            // The source density in the sample's measure (the light sampler's is solid angle).
-            let light_pdf = if ls.delta {
-                source_pdf_sa
-            } else {
-                source_pdf_sa * measure
-            };
-            let w = e.target / (nf * light_pdf);
-            stream.add_candidate(sample, e.target, w, 0.0, u_pick);
+            let e = evaluate(
+                scene,
+                r,
+                bsdf,
+                &cand.sample,
+                &cand.contact,
+                Some(cand.power_pdf_sa),
+                self.counts,
+            );
+            let w = e.target / (nf * cand.source_pdf);
+            stream.add_candidate(cand.sample, e.target, w, 0.0, u_pick);
         }
         let mut res = stream.finalize_recorded();
         res.confidence = 1.0;
         let mut rays = 0;
-        if self.settings.visibility_reuse
+        if self.settings.visibility.tests_initial()
             && let Some(y) = res.sample
         {
             let visible = contact(scene, &y, r.p).is_some_and(|c| {
@@ -379,8 +536,13 @@ impl RestirDiIntegrator {
         {
             let e = evaluate(scene, r, bsdf, y, &c, None, self.counts);
             if e.target > 0.0 {
-                rays += 1;
-                if visible(scene, r, ng, &c) {
+                // With visibility in the target, a selected sample is visible (its target
+                // at this receiver, `own_target`, includes the shadow ray already traced).
+                let known = self.settings.visibility == Visibility::Target;
+                if known || {
+                    rays += 1;
+                    visible(scene, r, ng, &c)
+                } {
                     l += e.contribution * res.ucw;
                 }
             }
@@ -445,7 +607,13 @@ impl RestirDiIntegrator {
 /// Whether the light point `c` is visible from receiver `r` (one shadow ray).
 #[inline]
 fn visible(scene: &Scene, r: &Receiver, ng: Vec3, c: &Contact) -> bool {
-    shadow::visible(scene, r.p, ng, ShadowTarget::new(c.p, c.wi, c.dist))
+    shadow::visible(scene, r.p, ng, shadow_target(c))
+}
+
+/// The shadow ray's end at light point `c`.
+#[inline]
+fn shadow_target(c: &Contact) -> ShadowTarget {
+    ShadowTarget::new(c.p, c.wi, c.dist)
 }
 
 impl Integrator for RestirDiIntegrator {
@@ -458,7 +626,7 @@ impl Integrator for RestirDiIntegrator {
         format!(
             "restir-di max_depth={} candidates={} light_sampler={} bsdf_candidates={} neighbors={} \
              radius={} spatial_rounds={} reciprocal={} mis={} mcap={} {} \
-             visibility_reuse={}{}",
+             visibility={}{}",
             s.path.max_depth,
             s.candidates,
             s.light_sampler.name(),
@@ -470,7 +638,7 @@ impl Integrator for RestirDiIntegrator {
             mis_name(s.reuse.mis),
             s.reuse.mcap,
             s.reuse.describe_temporal(),
-            s.visibility_reuse,
+            s.visibility.name(),
             if s.is_unbiased() { "" } else { " (biased)" }
         ) + &self
             .fallback
@@ -533,6 +701,12 @@ impl Integrator for RestirDiIntegrator {
             if s.light_sampler.is_hierarchy() {
                 scene.lights.build_hierarchy(&scene.shapes);
             }
+            let pool = s.light_sampler.is_pool().then(|| {
+                let (fw, fh) = scene.camera.resolution();
+                let tiles =
+                    pool::LightPool::tiles_for(fw as usize * fh as usize, s.candidates as usize);
+                pool::LightPool::build(scene, ctx, tiles, STAGE_POOL)
+            });
             let mut current = vec![DiReservoir::empty(); n];
             rays += current
                 .par_chunks_mut(bands.pixels())
@@ -543,10 +717,21 @@ impl Integrator for RestirDiIntegrator {
                         let index = bands.first(band) + i;
                         if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
-                            let tile = light_tiles
+                            let source = if let Some(pool) = &pool {
+                                let (x, y) = ctx.film_xy(index, w);
+                                Candidates::Pool(pool.tile_of(ctx, x, y))
+                            } else if let Some(t) = light_tiles
                                 .as_ref()
-                                .and_then(|t| t.table(index % w, index / w));
-                            let (init, nr) = self.initial(scene, r, gbuf.ng[index], tile, &mut rng);
+                                .and_then(|t| t.table(index % w, index / w))
+                            {
+                                Candidates::Tile(t)
+                            } else if s.light_sampler.is_hierarchy() {
+                                Candidates::Hierarchy
+                            } else {
+                                Candidates::Power
+                            };
+                            let (init, nr) =
+                                self.initial(scene, r, gbuf.ng[index], source, &mut rng);
                             *res = init;
                             rays += nr;
                         }
@@ -569,6 +754,7 @@ impl Integrator for RestirDiIntegrator {
                     Some(m) if !reuse.temporal_current_scene => &m.prev_scene,
                     _ => scene,
                 },
+                visibility: s.visibility == Visibility::Target,
             };
             if let Some(history) = &history {
                 rays += self.clock.time("temporal", || {

@@ -37,7 +37,8 @@ pub enum LightSampler {
     /// Decided from the scene: [`LightSampler::Bvh`] from [`HIERARCHY_MIN_EMITTERS`] emitters
     /// on, else [`LightSampler::Power`] (the default; [`RestirDiSettings::resolve`]).
     Auto,
-    /// The power-based light sampler (the paper's choice).
+    /// The power-based light sampler (the paper's choice), its draws presampled once per pass
+    /// into a pool that blocks of pixels share (see [`super::pool`]).
     Power,
     /// Per 16×16-pixel tile, a mixture of a distance-aware table and the power sampler
     /// (see [`super::tiles`]).
@@ -49,6 +50,11 @@ pub enum LightSampler {
     /// as if the power table had drawn them (biased).
     #[doc(hidden)]
     BvhWithPowerPmf,
+    /// A negative control for the tests, never a choice: the power sampler's pool with the
+    /// selection probability of whole lights (spheres, point lights, the environment) left out
+    /// of their candidates' density (biased).
+    #[doc(hidden)]
+    PoolWithoutSelection,
 }
 
 impl LightSampler {
@@ -73,7 +79,55 @@ impl LightSampler {
             LightSampler::Tiles => "tiles",
             LightSampler::Bvh => "bvh",
             LightSampler::BvhWithPowerPmf => "bvh-with-power-pmf",
+            LightSampler::PoolWithoutSelection => "pool-without-selection",
         }
+    }
+
+    /// Whether candidates come from the power sampler's pool ([`super::pool`]).
+    pub fn is_pool(self) -> bool {
+        matches!(
+            self,
+            LightSampler::Power | LightSampler::PoolWithoutSelection
+        )
+    }
+}
+
+/// Where ReSTIR DI tests the visibility of its light samples (`--visibility`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Visibility {
+    /// Once, at shading: the targets have no visibility term (Bitterli et al. 2020's unbiased
+    /// configuration). Every reuse step is free of rays; the selected sample is occluded as often
+    /// as the unshadowed target makes it.
+    Shading,
+    /// In every target: `p̂·V`, a shadow ray from the receiver a target is evaluated at (the
+    /// initial selection, and each shift of the reuse passes, in the scene of the shift's
+    /// domain). Unbiased; shading needs no shadow ray (a selected sample is visible).
+    Target,
+    /// The initial selection only, reuse targets without it (Bitterli et al.'s visibility
+    /// reuse): biased wherever neighbours differ in visibility.
+    ReuseBiased,
+}
+
+impl Visibility {
+    /// The names `--visibility` takes.
+    pub const NAMES: &[(&str, Visibility)] = &[
+        ("shading", Visibility::Shading),
+        ("target", Visibility::Target),
+        ("reuse", Visibility::ReuseBiased),
+    ];
+
+    /// The name `--visibility` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Visibility::Shading => "shading",
+            Visibility::Target => "target",
+            Visibility::ReuseBiased => "reuse",
+        }
+    }
+
+    /// Whether the initial selection is tested (and an occluded one dropped).
+    pub fn tests_initial(self) -> bool {
+        self != Visibility::Shading
     }
 }
 
@@ -92,8 +146,8 @@ pub struct RestirDiSettings {
     /// BSDF samples per pixel, `N_B` (default 1), combined with the reservoirs' light strategy
     /// by the balance heuristic.
     pub bsdf_candidates: u32,
-    /// Zero an occluded initial candidate, keeping its confidence. Biased at shadow edges.
-    pub visibility_reuse: bool,
+    /// Where visibility is tested (default at shading).
+    pub visibility: Visibility,
     /// Whether a scene with one dominant light goes to the path tracer (default auto).
     pub fallback: Fallback,
     /// Whether some ReSTIR DI parameter was given ([`RestirDiSettings::apply`]): then
@@ -111,7 +165,7 @@ impl RestirDiSettings {
             candidates: 8,
             light_sampler: LightSampler::Auto,
             bsdf_candidates: 1,
-            visibility_reuse: false,
+            visibility: Visibility::Shading,
             fallback: Fallback::Auto,
             configured: false,
         }
@@ -150,8 +204,9 @@ impl RestirDiSettings {
     /// Whether the estimator is unbiased with these settings.
     pub fn is_unbiased(&self) -> bool {
         self.reuse.is_unbiased()
-            && !self.visibility_reuse
+            && self.visibility != Visibility::ReuseBiased
             && self.light_sampler != LightSampler::BvhWithPowerPmf
+            && self.light_sampler != LightSampler::PoolWithoutSelection
     }
 
     /// Applies `params` in order (later ones win). Names are case-insensitive, `-` and `_` are
@@ -177,8 +232,16 @@ impl RestirDiSettings {
                     self.bsdf_candidates = p.count(0)?;
                     true
                 }
+                "visibility" => {
+                    self.visibility = p.choice(Visibility::NAMES, "shading, target or reuse")?;
+                    true
+                }
                 "visibility_reuse" => {
-                    self.visibility_reuse = p.boolean()?;
+                    self.visibility = if p.boolean()? {
+                        Visibility::ReuseBiased
+                    } else {
+                        Visibility::Shading
+                    };
                     true
                 }
                 _ => self.reuse.apply(key, p)?,

@@ -20,7 +20,7 @@ use restir_sampling::luminance;
 use restir_scene::Scene;
 
 use crate::reuse::gbuffer::Receiver;
-use crate::reuse::light_point::{Contact, LightPoint, Resolved};
+use crate::reuse::light_point::{Contact, LightPoint};
 
 /// The two strategy counts of the direct-light split.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -87,19 +87,4 @@ pub fn evaluate(
         contribution,
         target,
     }
-}
-
-/// The target `p̂` of receiver `r` at `sample`, resolved as `resolved` (0 where it cannot
-/// contribute).
-#[inline]
-pub fn target(
-    scene: &Scene,
-    r: &Receiver,
-    sample: &LightPoint,
-    resolved: &Resolved,
-    counts: StrategyCounts,
-) -> f32 {
-    resolved.contact(r.p).map_or(0.0, |c| {
-        evaluate(scene, r, &r.resolve_bsdf(scene), sample, &c, None, counts).target
-    })
 }
