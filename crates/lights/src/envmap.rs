@@ -278,6 +278,13 @@ impl EnvMap {
     /// angle)`. `None` for a black map or a sample exactly at a pole.
     #[inline]
     pub fn sample(&self, u: Vec2) -> Option<(Vec3, Vec3, f32)> {
+        self.sample_uv(u).map(|(_, d, le, pdf)| (d, le, pdf))
+    }
+
+    /// [`EnvMap::sample`] with the map coordinates of the direction: `(uv, direction, radiance,
+    /// pdf per unit solid angle)`.
+    #[inline]
+    pub fn sample_uv(&self, u: Vec2) -> Option<(Vec2, Vec3, Vec3, f32)> {
         let dist = self.dist.as_ref()?;
         let (st, pdf_uv) = dist.sample(u);
         let mut uu = st.x + 0.5 / self.width as f32;
@@ -289,9 +296,43 @@ impl EnvMap {
         if !(sin_theta > 0.0 && pdf_uv > 0.0) {
             return None;
         }
-        let d = (self.to_world * Self::uv_to_local(uv)).normalize();
+        let d = self.world_direction(uv);
         let pdf = pdf_uv / (2.0 * PI * PI * sin_theta);
-        Some((d, self.eval_uv(uv), pdf))
+        Some((uv, d, self.eval_uv(uv), pdf))
+    }
+
+    /// The world direction of map coordinates `uv`.
+    #[inline]
+    pub fn world_direction(&self, uv: Vec2) -> Vec3 {
+        (self.to_world * Self::uv_to_local(uv)).normalize()
+    }
+
+    /// Map coordinates of world direction `d` (unit).
+    #[inline]
+    pub fn uv_of(&self, d: Vec3) -> Vec2 {
+        Self::local_to_uv((self.to_local * d).normalize_or_zero())
+    }
+
+    /// The solid-angle density of [`EnvMap::sample`] at map coordinates `uv` (the density of
+    /// [`EnvMap::pdf`] without finding the coordinates of a direction).
+    #[inline]
+    pub fn pdf_uv(&self, uv: Vec2) -> f32 {
+        let Some(dist) = self.dist.as_ref() else {
+            return 0.0;
+        };
+        let sin_theta = (PI * uv.y).sin();
+        if !(sin_theta > 0.0) {
+            return 0.0;
+        }
+        let mut s = uv.x - 0.5 / self.width as f32;
+        if s < 0.0 {
+            s += 1.0;
+        }
+        let p = Vec2::new(
+            s.min(restir_sampling::ONE_MINUS_EPSILON),
+            uv.y.min(restir_sampling::ONE_MINUS_EPSILON),
+        );
+        dist.pdf(p) / (2.0 * PI * PI * sin_theta)
     }
 
     /// The solid-angle density of [`EnvMap::sample`] at world direction `d`.

@@ -89,7 +89,8 @@ pub struct LightSample {
     pub delta: bool,
     /// The primitive on the light's shape (area lights).
     pub prim: u32,
-    /// Barycentrics or sphere parameters of `p` on the primitive (area lights).
+    /// Barycentrics or sphere parameters of `p` on the primitive (area lights); the
+    /// environment's coordinates of the direction ([`LightSet::environment_param`]).
     pub param: Vec2,
 }
 
@@ -133,6 +134,9 @@ pub enum Presampled {
     Direction {
         /// Index of the light.
         light: u32,
+        /// The environment's coordinates of the direction ([`LightSet::environment_param`];
+        /// unused for a directional light).
+        param: Vec2,
         /// Unit direction towards the light.
         wi: Vec3,
         /// Radiance (environment) or irradiance (directional light).
@@ -434,6 +438,19 @@ impl LightSet {
         self.spheres[light as usize]
     }
 
+    /// [`LightSet::sample`]'s density per unit area on mesh light `light`, the selection
+    /// included (the same everywhere on the mesh); `None` for other lights (a sphere's points are
+    /// drawn from the receiver).
+    #[inline]
+    pub fn mesh_area_density(&self, shapes: &[Shape], light: u32) -> Option<f32> {
+        match self.lights.get(light as usize)? {
+            Light::Area { shape, .. } if matches!(shapes[*shape as usize], Shape::Mesh(_)) => {
+                Some(self.area_pdf[light as usize])
+            }
+            _ => None,
+        }
+    }
+
     /// Probability that [`LightSet::sample`] picks light `light` (for a mesh, any of its
     /// triangles).
     #[inline]
@@ -448,6 +465,43 @@ impl LightSet {
         match self.lights[light as usize] {
             Light::Area { radiance, .. } if n.dot(w) > 0.0 => radiance,
             _ => Vec3::ZERO,
+        }
+    }
+
+    /// The coordinates by which the environment names direction `d` (unit, away from the
+    /// scene): an environment map's `(u, v)`, a constant environment's the same lat-long
+    /// coordinates in the world frame. [`LightSet::environment_at`] maps them back.
+    #[inline]
+    pub fn environment_param(&self, d: Vec3) -> Vec2 {
+        match (
+            self.environment.map(|i| self.lights[i as usize]),
+            &self.envmap,
+        ) {
+            (Some(Light::Envmap), Some(m)) => m.uv_of(d),
+            _ => EnvMap::local_to_uv(d),
+        }
+    }
+
+    /// The environment at coordinates `param` ([`LightSet::environment_param`]): the direction
+    /// towards it, its radiance there and [`LightSet::sample`]'s density of that direction per
+    /// unit solid angle, the selection included. Cheaper than looking up a direction: no
+    /// inverse trigonometry.
+    #[inline]
+    pub fn environment_at(&self, param: Vec2) -> Option<(Vec3, Vec3, f32)> {
+        let env = self.environment?;
+        let pmf = self.table.pmf(env);
+        match (self.lights[env as usize], &self.envmap) {
+            (Light::Constant { radiance }, _) => Some((
+                EnvMap::uv_to_local(param),
+                radiance,
+                pmf * warp::UNIFORM_SPHERE_PDF,
+            )),
+            (Light::Envmap, Some(m)) => Some((
+                m.world_direction(param),
+                m.eval_uv(param),
+                pmf * m.pdf_uv(param),
+            )),
+            _ => None,
         }
     }
 
@@ -529,6 +583,7 @@ impl LightSet {
                 let s = self.sample_light(shapes, light, Vec3::ZERO, u)?;
                 Some(Presampled::Direction {
                     light,
+                    param: s.param,
                     wi: s.wi,
                     le: s.le,
                     pdf: s.pdf_sa * pmf,
@@ -654,11 +709,11 @@ impl LightSet {
                     pdf_sa: warp::UNIFORM_SPHERE_PDF,
                     delta: false,
                     prim: 0,
-                    param: Vec2::ZERO,
+                    param: EnvMap::local_to_uv(wi),
                 })
             }
             Light::Envmap => {
-                let (wi, le, pdf_sa) = self.envmap.as_ref()?.sample(u)?;
+                let (uv, wi, le, pdf_sa) = self.envmap.as_ref()?.sample_uv(u)?;
                 Some(LightSample {
                     light,
                     p: ref_p + wi * (2.0 * self.scene_radius),
@@ -670,7 +725,7 @@ impl LightSet {
                     pdf_sa,
                     delta: false,
                     prim: 0,
-                    param: Vec2::ZERO,
+                    param: uv,
                 })
             }
         }

@@ -283,6 +283,7 @@ impl Candidate {
                 measure,
                 delta: ls.delta,
                 ng: ls.ng,
+                pdf_sa: Some(power_pdf_sa),
             },
             source_pdf: if ls.delta {
                 source_pdf_sa
@@ -308,7 +309,13 @@ impl Candidate {
                 pdf_area,
             } => (
                 LightPoint { light, prim, param },
-                Resolved::Surface { p, n, ng, le },
+                Resolved::Surface {
+                    p,
+                    n,
+                    ng,
+                    le,
+                    pdf_area: Some(pdf_area),
+                },
                 pdf_area,
             ),
             Presampled::Point {
@@ -327,6 +334,7 @@ impl Candidate {
             ),
             Presampled::Direction {
                 light,
+                param,
                 wi,
                 le,
                 pdf,
@@ -339,9 +347,9 @@ impl Candidate {
                         param: glam::Vec2::ZERO,
                     }
                 } else {
-                    LightPoint::environment(light, wi)
+                    LightPoint::environment(light, param)
                 },
-                Resolved::Direction { wi, le, delta },
+                Resolved::Direction { wi, le, delta, pdf },
                 pdf,
             ),
             Presampled::Light { light, pmf } => {

@@ -114,12 +114,14 @@ pub(crate) fn without_selection(scene: &Scene, e: Presampled) -> Presampled {
         },
         Presampled::Direction {
             light,
+            param,
             wi,
             le,
             pdf,
             delta,
         } => Presampled::Direction {
             light,
+            param,
             wi,
             le,
             pdf: pdf / scene.lights.pmf(light).max(f32::MIN_POSITIVE),

@@ -69,7 +69,7 @@ pub fn evaluate(
     let m_light = if c.delta || counts.bsdf == 0.0 {
         1.0
     } else {
-        let light_pdf_sa = known_light_pdf_sa.unwrap_or_else(|| {
+        let light_pdf_sa = known_light_pdf_sa.or(c.pdf_sa).unwrap_or_else(|| {
             scene
                 .lights
                 .pdf_sa(&scene.shapes, sample.light, r.p, c.p, c.ng)

@@ -11,7 +11,6 @@
 //!
 
 use glam::{Vec2, Vec3};
-use restir_geometry::Sphere;
 use restir_lights::{Light, LightSample};
 use restir_scene::Scene;
 
@@ -22,8 +21,10 @@ pub struct LightPoint {
     pub light: u32,
     /// Primitive on an area light's shape (0 otherwise).
     pub prim: u32,
-    /// Barycentrics or sphere parameters on an area light; the octahedral encoding of the
-    /// direction towards the environment; unused for point and directional lights.
+    /// Barycentrics or sphere parameters on an area light; the environment's coordinates of the
+    /// direction towards it (`LightSet::environment_param`: an environment map's `(u, v)`, so
+    /// that resolving the sample needs no inverse trigonometry); unused for point and
+    /// directional lights.
     pub param: Vec2,
 }
 
@@ -32,7 +33,7 @@ impl LightPoint {
     #[inline]
     pub fn from_light_sample(ls: &LightSample) -> Self {
         if !ls.delta && !ls.dist.is_finite() {
-            return Self::environment(ls.light, ls.wi);
+            return Self::environment(ls.light, ls.param);
         }
         Self {
             light: ls.light,
@@ -41,13 +42,14 @@ impl LightPoint {
         }
     }
 
-    /// The environment sample in direction `d` (unit, pointing away from the scene).
+    /// The environment sample at the environment's coordinates `param`
+    /// (`LightSet::environment_param` of a direction).
     #[inline]
-    pub fn environment(light: u32, d: Vec3) -> Self {
+    pub fn environment(light: u32, param: Vec2) -> Self {
         Self {
             light,
             prim: 0,
-            param: Sphere::param_of(d),
+            param,
         }
     }
 }
@@ -70,6 +72,9 @@ pub struct Contact {
     pub delta: bool,
     /// The light's geometric normal at `p` (area lights), for the light pdf.
     pub ng: Vec3,
+    /// The power sampler's density of the sample per unit solid angle at the receiver (selection
+    /// included), where it is known without a lookup (mesh lights, the environment).
+    pub pdf_sa: Option<f32>,
 }
 
 /// A sample resolved in world space, independent of any receiver: resolving once and
@@ -86,6 +91,9 @@ pub enum Resolved {
         ng: Vec3,
         /// Emitted radiance.
         le: Vec3,
+        /// The power sampler's density per unit area (mesh lights; `None` on a sphere, whose
+        /// density depends on the receiver).
+        pdf_area: Option<f32>,
     },
     /// A point light.
     Point {
@@ -102,6 +110,9 @@ pub enum Resolved {
         le: Vec3,
         /// Whether the light is a delta light (directional).
         delta: bool,
+        /// The power sampler's density per unit solid angle (the environment; unused for a
+        /// directional light).
+        pdf: f32,
     },
 }
 
@@ -121,6 +132,7 @@ pub fn resolve(scene: &Scene, sample: &LightPoint) -> Resolved {
                 n: ps.n,
                 ng: ps.ng,
                 le: radiance,
+                pdf_area: scene.lights.mesh_area_density(&scene.shapes, sample.light),
             }
         }
         Light::Point {
@@ -137,13 +149,19 @@ pub fn resolve(scene: &Scene, sample: &LightPoint) -> Resolved {
             wi: -direction,
             le: irradiance,
             delta: true,
+            pdf: 0.0,
         },
         Light::Constant { .. } | Light::Envmap => {
-            let (_, wi) = Sphere::new(Vec3::ZERO, 1.0, false).point_at(sample.param);
+            let (wi, le, pdf) =
+                scene
+                    .lights
+                    .environment_at(sample.param)
+                    .unwrap_or((Vec3::Z, Vec3::ZERO, 0.0));
             Resolved::Direction {
                 wi,
-                le: scene.lights.environment_radiance(wi),
+                le,
                 delta: false,
+                pdf,
             }
         }
     }
@@ -155,7 +173,13 @@ impl Resolved {
     #[inline]
     pub fn contact(&self, x: Vec3) -> Option<Contact> {
         match *self {
-            Resolved::Surface { p, n, ng, le } => {
+            Resolved::Surface {
+                p,
+                n,
+                ng,
+                le,
+                pdf_area,
+            } => {
                 let to = p - x;
                 let d2 = to.length_squared();
                 if d2.is_nan() || d2 <= 0.0 {
@@ -166,14 +190,16 @@ impl Resolved {
                 if n.dot(wi) >= 0.0 {
                     return None; // the back of a one-sided emitter
                 }
+                let measure = ng.dot(wi).abs() / d2;
                 Some(Contact {
                     wi,
                     p,
                     dist,
                     le,
-                    measure: ng.dot(wi).abs() / d2,
+                    measure,
                     delta: false,
                     ng,
+                    pdf_sa: pdf_area.filter(|_| measure > 0.0).map(|a| a / measure),
                 })
             }
             Resolved::Point { p, intensity } => {
@@ -191,9 +217,10 @@ impl Resolved {
                     measure: 1.0,
                     delta: true,
                     ng: Vec3::ZERO,
+                    pdf_sa: None,
                 })
             }
-            Resolved::Direction { wi, le, delta } => Some(Contact {
+            Resolved::Direction { wi, le, delta, pdf } => Some(Contact {
                 wi,
                 p: x + wi,
                 dist: f32::INFINITY,
@@ -201,6 +228,7 @@ impl Resolved {
                 measure: 1.0,
                 delta,
                 ng: -wi,
+                pdf_sa: (!delta).then_some(pdf),
             }),
         }
     }
