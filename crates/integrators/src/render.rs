@@ -462,7 +462,10 @@ mod tests {
     /// The halo is `rounds × ⌈radius⌉`, none without neighbours.
     #[test]
     fn reuse_halo() {
-        let mut s = ReuseSettings::default();
+        let mut s = ReuseSettings {
+            radius: 30.0,
+            ..ReuseSettings::default()
+        };
         assert_eq!(s.halo(), 30);
         s.radius = 2.5;
         s.spatial_rounds = 3;

@@ -144,10 +144,10 @@ struct RestirArgs {
     /// BSDF samples per pixel, MIS-combined with the reservoirs [default: 1].
     #[arg(long)]
     bsdf_candidates: Option<u32>,
-    /// Spatial neighbours per round [default: 3 for restir-di, 4 for restir-pt].
+    /// Spatial neighbours per round [default: 4].
     #[arg(long, alias = "neighbours")]
     neighbors: Option<u32>,
-    /// Spatial reuse radius in pixels [default: 30 for restir-di, 3 for restir-pt].
+    /// Spatial reuse radius in pixels [default: 3].
     #[arg(long)]
     radius: Option<f32>,
     /// Spatial reuse rounds [default: 1 for restir-di, 3 for restir-pt].
@@ -171,14 +171,14 @@ struct RestirArgs {
     temporal: Option<bool>,
     /// restir-di: where light samples' visibility is tested: shading (once, for the selected
     /// sample), target (in every target, a shadow ray per shift; unbiased) or reuse (the
-    /// initial selection only; biased) [default: shading].
+    /// initial selection only; biased) [default: target].
     #[arg(long)]
     visibility: Option<String>,
     /// restir-di: the same as --visibility reuse (biased at shadow edges).
     #[arg(long)]
     visibility_reuse: bool,
     /// Spatial neighbours in reciprocal pairs that share their shifts (pairwise MIS):
-    /// true or false [default: false for restir-di, true for restir-pt].
+    /// true or false [default: true].
     #[arg(long)]
     reciprocal: Option<bool>,
     /// restir-pt shift map: reconnection, replay or hybrid [default: hybrid; reconnection in

@@ -146,7 +146,8 @@ pub struct RestirDiSettings {
     /// BSDF samples per pixel, `N_B` (default 1), combined with the reservoirs' light strategy
     /// by the balance heuristic.
     pub bsdf_candidates: u32,
-    /// Where visibility is tested (default at shading).
+    /// Where visibility is tested (default in every target: chosen on the training family with
+    /// the reuse defaults, `docs/BENCHMARKS.md`, "ReSTIR DI defaults, fifth session").
     pub visibility: Visibility,
     /// Whether a scene with one dominant light goes to the path tracer (default auto).
     pub fallback: Fallback,
@@ -156,8 +157,9 @@ pub struct RestirDiSettings {
 }
 
 impl RestirDiSettings {
-    /// The defaults (Bitterli et al. 2020's unbiased configuration with 8 candidates instead of
-    /// the paper's 32, which cost more than they gain on a CPU; `docs/RESTIR_DI.md`).
+    /// The defaults: 8 candidates from the power sampler's pool, one round of reuse over two
+    /// reciprocal pairs within 3 pixels, visibility in every target, one BSDF sample (chosen on
+    /// a training family of generated scenes; `docs/RESTIR_DI.md`).
     pub fn new(path: PathSettings) -> Self {
         Self {
             path,
@@ -165,7 +167,7 @@ impl RestirDiSettings {
             candidates: 8,
             light_sampler: LightSampler::Auto,
             bsdf_candidates: 1,
-            visibility: Visibility::Shading,
+            visibility: Visibility::Target,
             fallback: Fallback::Auto,
             configured: false,
         }

@@ -105,10 +105,7 @@ impl RestirPtSettings {
         Self {
             path,
             reuse: ReuseSettings {
-                neighbors: 4,
-                radius: 3.0,
                 spatial_rounds: 3,
-                reciprocal: true,
                 ..ReuseSettings::default()
             },
             candidates: 2,

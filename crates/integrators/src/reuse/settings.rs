@@ -38,9 +38,9 @@ impl Param {
 /// Spatial and temporal reuse settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReuseSettings {
-    /// Spatial neighbours per round, `k` (default 3).
+    /// Spatial neighbours per round, `k` (default 4).
     pub neighbors: u32,
-    /// Spatial radius in pixels (default 30).
+    /// Spatial radius in pixels (default 3).
     pub radius: f32,
     /// Spatial reuse rounds, `R` (default 1).
     pub spatial_rounds: u32,
@@ -58,7 +58,7 @@ pub struct ReuseSettings {
     /// Largest relative difference of camera distances (default 0.1).
     pub depth_tolerance: f32,
     /// Spatial neighbours in reciprocal pairs that share their shifts ([`super::reciprocal`];
-    /// pairwise MIS only, default off).
+    /// pairwise MIS only, default on).
     pub reciprocal: bool,
     /// Negative control only: reciprocal pairs read the wrong one of a pair's two shifts
     /// (biased).
@@ -69,12 +69,14 @@ pub struct ReuseSettings {
 }
 
 impl Default for ReuseSettings {
-    /// One round of three neighbours within 30 pixels, defensive pairwise MIS, `M` capped at 20,
-    /// no temporal reuse, 25° and 10 % similarity.
+    /// One round of four neighbours in two reciprocal pairs within 3 pixels, defensive pairwise
+    /// MIS, `M` capped at 20, no temporal reuse, 25° and 10 % similarity: chosen for ReSTIR DI
+    /// and ReSTIR PT on their training families (`docs/BENCHMARKS.md`; ReSTIR PT runs three
+    /// rounds).
     fn default() -> Self {
         Self {
-            neighbors: 3,
-            radius: 30.0,
+            neighbors: 4,
+            radius: 3.0,
             spatial_rounds: 1,
             mis: MisScheme::DefensivePairwise,
             mcap: 20.0,
@@ -82,7 +84,7 @@ impl Default for ReuseSettings {
             temporal_scheme: None,
             normal_cos: 25f32.to_radians().cos(),
             depth_tolerance: 0.1,
-            reciprocal: false,
+            reciprocal: true,
             reciprocal_mismatched: false,
             temporal_current_scene: false,
         }
