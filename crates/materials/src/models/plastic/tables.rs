@@ -124,6 +124,22 @@ impl Nodes {
         };
         Self { gl, grid }
     }
+
+    /// The nodes for an interface of relative IOR `eta` as seen from the view: Mitsuba's order
+    /// 32 if `eta > 1`, else 128 (total internal reflection makes the integrand rougher). Made
+    /// once per process: they depend on neither α nor η beyond that choice.
+    fn for_eta(distribution: Distribution, eta: f32) -> &'static Nodes {
+        static NODES: [[OnceLock<Nodes>; 2]; 2] = [
+            [OnceLock::new(), OnceLock::new()],
+            [OnceLock::new(), OnceLock::new()],
+        ];
+        let d = match distribution {
+            Distribution::Beckmann => 0,
+            Distribution::Ggx => 1,
+        };
+        let (o, order) = if eta > 1.0 { (0, 32) } else { (1, 128) };
+        NODES[d][o].get_or_init(|| Nodes::new(distribution, order))
+    }
 }
 
 /// What is integrated along the visible normals of a view `v`.
@@ -272,17 +288,16 @@ fn build(distribution: Distribution, alpha: f32, eta: f32) -> RoughPlasticTable 
 
 fn build_with(distribution: Distribution, alpha: f32, eta: f32, avx2: bool) -> RoughPlasticTable {
     let mf = Microfacet::new(distribution, alpha);
-    let order = |e: f32| if e > 1.0 { 32 } else { 128 };
-    let nodes_t = Nodes::new(distribution, order(eta));
-    let nodes_r = Nodes::new(distribution, order(1.0 / eta));
+    let nodes_t = Nodes::for_eta(distribution, eta);
+    let nodes_r = Nodes::for_eta(distribution, 1.0 / eta);
     // Row k: (T(μ_k), R(μ_k)·μ_k).
     let row = |k: usize| -> (f32, f64) {
         let mu = (k as f32 / (TABLE_RES - 1) as f32).max(1e-6);
         let v = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
         // Transmission through the interface from outside (relative IOR η).
-        let t = integrate_vndf(Lobe::Transmit, &mf, v, eta, &nodes_t, avx2) as f32;
+        let t = integrate_vndf(Lobe::Transmit, &mf, v, eta, nodes_t, avx2) as f32;
         // Reflection at the interface from inside (relative IOR 1/η).
-        let r = integrate_vndf(Lobe::Reflect, &mf, v, 1.0 / eta, &nodes_r, avx2);
+        let r = integrate_vndf(Lobe::Reflect, &mf, v, 1.0 / eta, nodes_r, avx2);
         (t, r * mu as f64)
     };
     // The rows are independent: spread them over the cores (loading a scene waits for this).
