@@ -229,16 +229,24 @@ impl StretchedView {
 /// "A Simpler and Exact Sampling Routine for the GGX Distribution of Visible Normals", 2017),
 /// lifted to the hemisphere, projected onto the plane normal to the view, and returned as slopes.
 fn sample_slopes_ggx(cos_theta: f32, u: Vec2) -> Vec2 {
-    ggx_slopes_from_disk(cos_theta, warp::sample_concentric_disk(u))
+    let p = warp::sample_concentric_disk(u);
+    ggx_slopes_from_disk(cos_theta, p, ggx_disk_chord(p.x))
 }
 
-/// [`sample_slopes_ggx`] from the point `p = warp::sample_concentric_disk(u)`, which does not
-/// depend on the view (so a quadrature over `u` for many views maps its nodes to the disk once).
-#[inline]
-pub(crate) fn ggx_slopes_from_disk(cos_theta: f32, p: Vec2) -> Vec2 {
+/// `√(1 − x²)`: the half chord of the unit disk at `x`, which [`ggx_slopes_from_disk`] needs.
+#[inline(always)]
+pub(crate) fn ggx_disk_chord(x: f32) -> f32 {
+    (1.0 - x * x).max(0.0).sqrt()
+}
+
+/// [`sample_slopes_ggx`] from the point `p = warp::sample_concentric_disk(u)` and its
+/// [`ggx_disk_chord`], which do not depend on the view (so a quadrature over `u` for many views
+/// computes them once per node).
+#[inline(always)]
+pub(crate) fn ggx_slopes_from_disk(cos_theta: f32, p: Vec2, chord: f32) -> Vec2 {
     let s = 0.5 * (1.0 + cos_theta);
     let x = p.x;
-    let y = (1.0 - s) * (1.0 - x * x).max(0.0).sqrt() + s * p.y;
+    let y = (1.0 - s) * chord + s * p.y;
     let z = (1.0 - x * x - y * y).max(0.0).sqrt();
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
     // The hemisphere point in the frame (T1, T2, v) with T1 = (0, 1, 0) and

@@ -28,7 +28,7 @@ use crate::fresnel::{fresnel_dielectric, reflect, refract};
 use restir_sampling::warp;
 
 use crate::microfacet::{
-    Distribution, Microfacet, StretchedView, beckmann_slope_x, beckmann_slope_y,
+    Distribution, Microfacet, StretchedView, beckmann_slope_x, beckmann_slope_y, ggx_disk_chord,
     ggx_slopes_from_disk,
 };
 
@@ -99,8 +99,13 @@ enum NodeGrid {
     /// Beckmann's sampler is separable: slope `x` from `u_x` and the view, slope `y` from `u_y`
     /// alone. Holds `u_x` per node and slope `y` per node.
     Beckmann { ux: Vec<f32>, sy: Vec<f32> },
-    /// GGX's starts from the concentric-disk point of `u`: one per node pair, row-major.
-    Ggx { disk: Vec<Vec2> },
+    /// GGX's starts from the concentric-disk point `p` of `u`: `p.x`, `p.y` and the half chord
+    /// `√(1 − p.x²)` per node pair, row-major.
+    Ggx {
+        x: Vec<f32>,
+        y: Vec<f32>,
+        chord: Vec<f32>,
+    },
 }
 
 impl Nodes {
@@ -112,15 +117,20 @@ impl Nodes {
                 sy: u.iter().map(|&y| beckmann_slope_y(y)).collect(),
                 ux: u,
             },
-            Distribution::Ggx => NodeGrid::Ggx {
-                disk: u
+            Distribution::Ggx => {
+                let disk: Vec<Vec2> = u
                     .iter()
                     .flat_map(|&x| {
                         u.iter()
                             .map(move |&y| warp::sample_concentric_disk(Vec2::new(x, y)))
                     })
-                    .collect(),
-            },
+                    .collect();
+                NodeGrid::Ggx {
+                    x: disk.iter().map(|p| p.x).collect(),
+                    y: disk.iter().map(|p| p.y).collect(),
+                    chord: disk.iter().map(|p| ggx_disk_chord(p.x)).collect(),
+                }
+            }
         };
         Self { gl, grid }
     }
@@ -202,10 +212,12 @@ fn row_terms(
                 *o = value(lobe, mf, v, eta, view.normal_unchecked(Vec2::new(sx, sy)));
             }
         }
-        NodeGrid::Ggx { disk } => {
-            let n = out.len();
-            for (o, &p) in out.iter_mut().zip(&disk[i * n..(i + 1) * n]) {
-                let m = view.normal_unchecked(ggx_slopes_from_disk(view.cos_theta, p));
+        NodeGrid::Ggx { x, y, chord } => {
+            let row = i * out.len()..(i + 1) * out.len();
+            let (x, y, chord) = (&x[row.clone()], &y[row.clone()], &chord[row]);
+            for (j, o) in out.iter_mut().enumerate() {
+                let p = Vec2::new(x[j], y[j]);
+                let m = view.normal_unchecked(ggx_slopes_from_disk(view.cos_theta, p, chord[j]));
                 *o = value(lobe, mf, v, eta, m);
             }
         }
