@@ -45,6 +45,14 @@ pub struct RoughPlasticTable {
 }
 
 impl RoughPlasticTable {
+    /// Integrates the table for (distribution, α, η) now, on every core the process may run on,
+    /// without the process's registry or the disk cache: what [`rough_plastic_table`] does when
+    /// neither has it (for benchmarks and checks; materials should share tables through
+    /// [`rough_plastic_table`]).
+    pub fn compute(distribution: Distribution, alpha: f32, eta: f32) -> Self {
+        build(distribution, alpha, eta)
+    }
+
     /// `T(cos θ)` by linear interpolation in the table (Mitsuba's `lerp_gather`).
     #[inline]
     pub fn transmittance_at(&self, cos_theta: f32) -> f32 {
