@@ -157,6 +157,18 @@ impl Microfacet {
     /// hemisphere, `v·m ≥ 0`) or `None` when `v` is not above the surface or the result is
     /// degenerate.
     pub fn sample(&self, v: Vec3, u: Vec2) -> Option<Vec3> {
+        let view = self.stretched_view(v)?;
+        let s = match self.distribution {
+            Distribution::Ggx => sample_slopes_ggx(view.cos_theta, u),
+            Distribution::Beckmann => sample_slopes_beckmann(view.cos_theta, u),
+        };
+        view.normal(s)
+    }
+
+    /// The part of [`Microfacet::sample`] that depends on `v` only: `v` stretched to unit
+    /// roughness, as its polar cosine and azimuth. `None` when `v` is not above the surface.
+    #[inline]
+    pub(crate) fn stretched_view(&self, v: Vec3) -> Option<StretchedView> {
         if v.z <= 0.0 || !v.is_finite() {
             return None;
         }
@@ -168,16 +180,47 @@ impl Microfacet {
         } else {
             (0.0, 1.0)
         };
-        let s = match self.distribution {
-            Distribution::Ggx => sample_slopes_ggx(vs.z, u),
-            Distribution::Beckmann => sample_slopes_beckmann(vs.z, u),
-        };
+        Some(StretchedView {
+            cos_theta: vs.z,
+            sin_phi,
+            cos_phi,
+            alpha_u: self.alpha_u,
+            alpha_v: self.alpha_v,
+        })
+    }
+}
+
+/// A view direction stretched to unit roughness ([`Microfacet::stretched_view`]): what turns
+/// unit-roughness slopes sampled for it into a microfacet normal. Kept apart so that sampling at
+/// many points `u` for one view (the rough plastic's quadrature) computes it once.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct StretchedView {
+    /// Cosine of the stretched view's polar angle.
+    pub cos_theta: f32,
+    sin_phi: f32,
+    cos_phi: f32,
+    alpha_u: f32,
+    alpha_v: f32,
+}
+
+impl StretchedView {
+    /// The normal of unit-roughness slopes `s` (sampled for this view in its own azimuth): rotated
+    /// back, unstretched and normalised; `None` if not finite.
+    #[inline]
+    pub(crate) fn normal(&self, s: Vec2) -> Option<Vec3> {
+        let m = self.normal_unchecked(s);
+        m.is_finite().then_some(m)
+    }
+
+    /// [`StretchedView::normal`] without the check: possibly not finite.
+    #[inline(always)]
+    pub(crate) fn normal_unchecked(&self, s: Vec2) -> Vec3 {
+        let (sin_phi, cos_phi) = (self.sin_phi, self.cos_phi);
         let slope = Vec2::new(
             (cos_phi * s.x - sin_phi * s.y) * self.alpha_u,
             (sin_phi * s.x + cos_phi * s.y) * self.alpha_v,
         );
-        let m = Vec3::new(-slope.x, -slope.y, 1.0).normalize();
-        m.is_finite().then_some(m)
+        Vec3::new(-slope.x, -slope.y, 1.0).normalize()
     }
 }
 
@@ -187,9 +230,23 @@ impl Microfacet {
 /// lifted to the hemisphere, projected onto the plane normal to the view, and returned as slopes.
 fn sample_slopes_ggx(cos_theta: f32, u: Vec2) -> Vec2 {
     let p = warp::sample_concentric_disk(u);
+    ggx_slopes_from_disk(cos_theta, p, ggx_disk_chord(p.x))
+}
+
+/// `√(1 − x²)`: the half chord of the unit disk at `x`, which [`ggx_slopes_from_disk`] needs.
+#[inline(always)]
+pub(crate) fn ggx_disk_chord(x: f32) -> f32 {
+    (1.0 - x * x).max(0.0).sqrt()
+}
+
+/// [`sample_slopes_ggx`] from the point `p = warp::sample_concentric_disk(u)` and its
+/// [`ggx_disk_chord`], which do not depend on the view (so a quadrature over `u` for many views
+/// computes them once per node).
+#[inline(always)]
+pub(crate) fn ggx_slopes_from_disk(cos_theta: f32, p: Vec2, chord: f32) -> Vec2 {
     let s = 0.5 * (1.0 + cos_theta);
     let x = p.x;
-    let y = (1.0 - s) * (1.0 - x * x).max(0.0).sqrt() + s * p.y;
+    let y = (1.0 - s) * chord + s * p.y;
     let z = (1.0 - x * x - y * y).max(0.0).sqrt();
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
     // The hemisphere point in the frame (T1, T2, v) with T1 = (0, 1, 0) and
@@ -222,11 +279,22 @@ const BECKMANN_NEWTON_STEPS: usize = 2;
 /// normal incidence, where the CDF is linear in `b`), each step kept inside the bracket the
 /// previous residuals give (bisection when Newton leaves it).
 fn sample_slopes_beckmann(cos_theta: f32, u: Vec2) -> Vec2 {
-    let sy = erfinv_f32((2.0 * u.y - 1.0).clamp(-B_MAX, B_MAX));
+    Vec2::new(beckmann_slope_x(cos_theta, u.x), beckmann_slope_y(u.y))
+}
+
+/// The slope `y` of [`sample_slopes_beckmann`]: Gaussian, independent of the view.
+#[inline]
+pub(crate) fn beckmann_slope_y(u: f32) -> f32 {
+    erfinv_f32((2.0 * u - 1.0).clamp(-B_MAX, B_MAX))
+}
+
+/// The slope `x` of [`sample_slopes_beckmann`]: it depends on `u.x` and the view only, so the
+/// sampler is separable in `u` (the rough plastic's quadrature solves it once per node row).
+pub(crate) fn beckmann_slope_x(cos_theta: f32, ux: f32) -> f32 {
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
     if sin_theta < 1e-6 {
         // Normal incidence: the marginal is Gaussian too.
-        return Vec2::new(erfinv_f32((2.0 * u.x - 1.0).clamp(-B_MAX, B_MAX)), sy);
+        return erfinv_f32((2.0 * ux - 1.0).clamp(-B_MAX, B_MAX));
     }
     let tan_theta = sin_theta / cos_theta;
     let cot_theta = cos_theta / sin_theta;
@@ -236,10 +304,10 @@ fn sample_slopes_beckmann(cos_theta: f32, u: Vec2) -> Vec2 {
     let theta = cos_theta.acos();
     let p = 1.0 + theta * (-0.876 + theta * (0.4265 - 0.0594 * theta));
     let (mut lo, mut hi) = (-B_MAX, c);
-    let mut b = (c - (1.0 + c) * (1.0 - u.x).powf(p)).clamp(lo, hi);
+    let mut b = (c - (1.0 + c) * (1.0 - ux).powf(p)).clamp(lo, hi);
     for _ in 0..BECKMANN_NEWTON_STEPS {
         let x = erfinv_f32(b);
-        let residual = inv_norm * (1.0 + b + skew * (-x * x).exp()) - u.x;
+        let residual = inv_norm * (1.0 + b + skew * (-x * x).exp()) - ux;
         if residual > 0.0 {
             hi = b;
         } else {
@@ -253,7 +321,7 @@ fn sample_slopes_beckmann(cos_theta: f32, u: Vec2) -> Vec2 {
             0.5 * (lo + hi)
         };
     }
-    Vec2::new(erfinv_f32(b), sy)
+    erfinv_f32(b)
 }
 
 /// The inverse error function in `f32` for `|x| < 1`: Giles' single-precision approximation

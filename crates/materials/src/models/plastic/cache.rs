@@ -1,5 +1,6 @@
 //! A disk cache for the rough-plastic tables, so that loading a scene does not integrate them
-//! again (a table takes about a tenth of a second of two cores; a scene has a few).
+//! again (a table takes about 15 ms of one core; a scene has a few, a generated one may have
+//! dozens).
 //!
 //! Off unless a program turns it on with [`set_cache_dir`] (a library does not write files
 //! behind its user's back); the `restir` binary turns it on at [`default_cache_dir`]. One small
