@@ -7,7 +7,9 @@ numbers less than wall-clock budgets would). For every scene it renders (or reus
 reference, calibrates each configuration's CPU cost per pass, renders it for about `--budget` CPU
 seconds with `--seeds` seeds (interleaved: seed-major, configuration-minor), and prints relMSE,
 CPU seconds, efficiency 1/(relMSE·s) and the efficiency relative to the first configuration, per
-scene and as the median over scenes.
+scene and as the median over scenes. With `--spp N` every configuration renders N passes
+instead (equal passes, not equal time) and the rows add each one's error per pass, relMSE × N:
+what a pass is worth, apart from what it costs.
 
     python3 scripts/equal_time_sweep.py --bin target/release/restir --size 160x120 \
         --budget 3 --seeds 3 --refs /tmp/refs \
@@ -69,6 +71,9 @@ def main():
     ap.add_argument("--ref-flags", default="--integrator path")
     ap.add_argument("--refs", default="/tmp/restir-refs")
     ap.add_argument("--config", action="append", required=True, help="NAME=FLAGS")
+    ap.add_argument("--spp", type=int, default=None,
+                    help="equal passes instead of equal time: every configuration renders this "
+                         "many; the table adds each one's error per pass (relMSE × passes)")
     a = ap.parse_args()
     configs = [c.split("=", 1) for c in a.config]
     os.makedirs(a.refs, exist_ok=True)
@@ -93,7 +98,7 @@ def main():
             c2, _ = render(a, scene, flags, 10, 1000, os.path.join(work, "cal.exr"), a.threads)
             per_pass = max((c2 - c1) / 8, 1e-4)
             fixed[name] = max(c1 - 2 * per_pass, 0.0)
-            spp[name] = max(1, round(a.budget / per_pass))
+            spp[name] = a.spp or max(1, round(a.budget / per_pass))
         rows = {name: [] for name, _ in configs}
         for seed in range(a.seeds):
             for name, flags in configs:
@@ -110,8 +115,9 @@ def main():
             eff = statistics.median(1.0 / (r[0] * r[1]) for r in rows[name])
             base = base or eff
             table[scene][name] = eff / base
+            per_pass = f" | error per pass {e * spp[name]:.4f}" if a.spp else ""
             print(f"{os.path.basename(scene)} | {name} | {spp[name]} spp | relMSE {e:.4e} | "
-                  f"{cpu:.2f} s | efficiency {eff:.3f} | ×{eff / base:.2f}", flush=True)
+                  f"{cpu:.2f} s | efficiency {eff:.3f} | ×{eff / base:.2f}{per_pass}", flush=True)
     print("\n| configuration | median × first | min | max |")
     print("|---|---|---|---|")
     for name, _ in configs:
