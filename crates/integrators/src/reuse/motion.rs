@@ -29,13 +29,16 @@ pub struct FrameMotion {
     /// Per shape (the two frames' shapes are the same list): the rigid map taking a point of
     /// the shape in the current frame to where it was in the previous frame.
     to_prev: Vec<Mat4>,
+    /// Per shape, the inverse map (previous frame to current).
+    from_prev: Vec<Mat4>,
     /// Per light of the current frame, the same light in the previous frame (`None`: it did
     /// not emit then).
     light_to_prev: Vec<Option<u32>>,
     /// Per light of the previous frame, the same light now.
     light_from_prev: Vec<Option<u32>>,
     /// Whether only the camera moved: every shape in place, the same lights with the same
-    /// radiance (everything a sample names or caches is then the same in both frames).
+    /// radiance and the same light selection (everything a sample names or caches is then the
+    /// same in both frames).
     scene_still: bool,
 }
 
@@ -97,11 +100,17 @@ impl FrameMotion {
             "one motion per shape of the current frame"
         );
         let (now, then) = (scene.lights.lights(), prev_scene.lights.lights());
-        let scene_still = to_prev.iter().all(|m| *m == Mat4::IDENTITY) && now == then;
+        // The environment's share of light selections is decided per frame from what the
+        // camera sees; a light sample's density (cached in ReSTIR PT's paths for their MIS
+        // weights) depends on it.
+        let scene_still = to_prev.iter().all(|m| *m == Mat4::IDENTITY)
+            && now == then
+            && scene.lights.environment_share() == prev_scene.lights.environment_share();
         Self {
             scene_still,
             light_to_prev: light_map(now, then),
             light_from_prev: light_map(then, now),
+            from_prev: to_prev.iter().map(Mat4::inverse).collect(),
             to_prev,
             prev_scene,
         }
@@ -129,6 +138,30 @@ impl FrameMotion {
     #[inline]
     pub fn point_to_prev(&self, shape: u32, p: Vec3) -> Vec3 {
         self.to_prev[shape as usize].transform_point3(p)
+    }
+
+    /// Direction `d` (unit) fixed to shape `shape`, turned with the shape's rigid motion: from
+    /// the current frame to the previous one (`to_prev`), or back. A rotation, so solid angle
+    /// is kept (Jacobian 1).
+    #[inline]
+    pub fn turn_direction(&self, shape: u32, d: Vec3, to_prev: bool) -> Vec3 {
+        let m = if to_prev {
+            &self.to_prev
+        } else {
+            &self.from_prev
+        };
+        m[shape as usize].transform_vector3(d).normalize_or_zero()
+    }
+
+    /// The light of the other frame that is light `light` of this one: of the previous frame
+    /// when `to_prev` (`light` is the current frame's), else of the current frame.
+    #[inline]
+    pub fn map_light(&self, light: u32, to_prev: bool) -> Option<u32> {
+        if to_prev {
+            self.light_to_prev(light)
+        } else {
+            self.light_from_prev(light)
+        }
     }
 
     /// The pixel of the previous frame's `prev` G-buffer that saw pixel `index`'s primary hit
