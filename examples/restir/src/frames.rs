@@ -172,6 +172,10 @@ pub struct SequenceStats {
     pub seed: u64,
     /// Per frame.
     pub frames: Vec<FrameStats>,
+    /// Wall seconds of each stage of the estimator's passes, summed over the frames (empty for
+    /// the path tracer).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stage_seconds: Vec<crate::StageSeconds>,
 }
 
 /// Renders the frames of `plan`: per frame, the scene at its time, rendered with `job`'s passes
@@ -247,6 +251,12 @@ pub fn render_frames(
     Ok((
         SequenceStats {
             scene: scene_path.display().to_string(),
+            stage_seconds: integrator
+                .as_ref()
+                .map_or(Vec::new(), |e| e.stage_seconds())
+                .into_iter()
+                .map(|(stage, seconds)| crate::StageSeconds { stage, seconds })
+                .collect(),
             integrator_settings: integrator.map(|e| e.describe()).unwrap_or_default(),
             rebuilt: FRAME_REBUILDS,
             fps: plan.fps,
