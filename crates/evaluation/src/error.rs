@@ -63,6 +63,9 @@ pub enum BenchError {
     ReferenceMismatch,
     /// The HTML page cannot be made.
     Page(crate::html::PageError),
+    /// A scene given `frames` in the suite has no animation (no `animation` section, no XML
+    /// sidecar).
+    NoAnimation(PathBuf),
     /// A Markdown document lacks a results marker.
     Marker {
         /// The document.
@@ -121,6 +124,12 @@ impl std::fmt::Display for BenchError {
                 path.display()
             ),
             Self::ReferenceMismatch => f.write_str("reference size mismatch"),
+            Self::NoAnimation(path) => write!(
+                f,
+                "{}: the suite gives `frames` but the scene has no animation (an `animation` \
+                 section, or NAME.anim.ron beside NAME.xml)",
+                path.display()
+            ),
             Self::Page(e) => e.fmt(f),
             Self::Marker { doc, begin: true } => write!(
                 f,

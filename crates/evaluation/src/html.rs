@@ -19,7 +19,7 @@ use restir_image::{Image, compare};
 use serde_json::{Value, json};
 
 use crate::metrics::{flip_map, mape, mean};
-use crate::report::{summarize, utc};
+use crate::report::{sequence_runs, summarize, utc};
 use crate::{BenchResults, RunRecord};
 
 const TEMPLATE: &str = include_str!("../assets/report.html");
@@ -266,13 +266,10 @@ pub fn compare_page(
 /// budget, and the error-versus-time plot over all seeds.
 pub fn bench_page(results: &BenchResults) -> Result<String, PageError> {
     let summaries = summarize(results);
+    let runs = sequence_runs(&results.records);
     let mut scenes = Vec::new();
     for (info, imgs) in results.references.iter().zip(&results.images) {
-        let records: Vec<&RunRecord> = results
-            .records
-            .iter()
-            .filter(|r| r.scene == info.scene)
-            .collect();
+        let records: Vec<&RunRecord> = runs.iter().filter(|r| r.scene == info.scene).collect();
         let seed0 = |label: &str, budget: f64| {
             records
                 .iter()
@@ -325,13 +322,28 @@ pub fn bench_page(results: &BenchResults) -> Result<String, PageError> {
             _ => format!("{} (given)", info.path.display()),
         };
         let (w, h) = (imgs.reference.width, imgs.reference.height);
+        let frames = results
+            .suite
+            .scenes
+            .iter()
+            .find(|e| e.display_name() == info.scene)
+            .and_then(|e| e.frames);
         scenes.push(PageScene {
             name: info.scene.clone(),
-            note: format!(
-                "{} ({w}×{h}). Reference: {reference}. Images: seed 0 of every configuration at \
-                 every budget; the plot has every seed.",
-                info.scene
-            ),
+            note: match frames {
+                None => format!(
+                    "{} ({w}×{h}). Reference: {reference}. Images: seed 0 of every \
+                     configuration at every budget; the plot has every seed.",
+                    info.scene
+                ),
+                Some((a, b)) => format!(
+                    "{} ({w}×{h}), frames {a} to {b}, the budget per frame. Reference of frame \
+                     {b}: {reference} (the mean over frames). Images: frame {b} of seed 0 of \
+                     every configuration at every budget; the plot has every seed, each \
+                     sequence's mean relMSE over its frames against its time per frame.",
+                    info.scene
+                ),
+            },
             reference_label: "reference".into(),
             reference: &imgs.reference,
             images,

@@ -8,6 +8,20 @@
 //! ([`html`]); [`update_doc`] puts the report into a marked section of another Markdown file.
 //! Besides relMSE every run records MAPE and FLIP ([`metrics`]).
 //!
+//! **Animation suites.** A suite scene with `frames` is a sequence: each configuration renders
+//! its frames in order with one estimator (made for the first frame's scene and told of each
+//! next frame's motion through [`FrameSequence`], so temporal reuse carries across frames),
+//! every frame with the budget (equal time per frame), frame `n` of seed `s` with the seed
+//! `FrameSequence::seed(s, n)` as `restir render --frames` does. Every frame has its own
+//! cached reference. The records are per frame (relMSE against that frame's reference, and
+//! flicker: the mean over pixels and channels of the squared change of the error from the
+//! previous frame, `((I_f − R_f) − (I_{f−1} − R_{f−1}))² / (max(R_f, R_{f−1})² + 0.01)`, which
+//! independent noise per frame puts near twice the relMSE and errors that persist across frames
+//! below it); [`sequence_runs`] folds each sequence into one record (means over its frames),
+//! which the summaries, the relMSE-versus-time plot and the report use like a still render's.
+//! The report adds a per-frame relMSE plot per sequence, efficiency `1/(relMSE · CPU s per
+//! frame)` and flicker relative to the suite's first configuration.
+//!
 //! **References.** A scene's `reference` EXR is used as given (its noise is unknown). Otherwise
 //! the path tracer renders the scene at the suite's `reference_spp`, as two halves of
 //! `reference_spp / 2` passes with two seeds that no benchmark run uses, and the average is the
@@ -28,16 +42,22 @@
 //! approximates what the render itself added (accumulation buffer, reservoirs, primary hits).
 //! Where the reset is not allowed, `VmHWM` is the peak since the process started and only grows
 //! from run to run; the report says which case applied.
+//!
+//! **CPU time.** Besides its wall time every render records the CPU time the process spent
+//! while it ran (the sum over its threads of their time on a CPU, from `/proc`; NaN where
+//! `/proc` is missing): on a shared machine it is what a render costs, whatever else runs.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 use restir_image::{Image, compare};
 
 use crate::metrics::evaluate;
-use restir_integrators::{IntegratorOptions, RenderJob, make_integrator, render};
-use restir_scene::{LoadOptions, Scene, load_scene};
+use restir_integrators::reuse::motion::FrameSequence;
+use restir_integrators::{Integrator, IntegratorOptions, RenderJob, make_integrator, render};
+use restir_scene::{LoadOptions, Scene, SceneDesc, load_scene};
 
 mod error;
 pub mod html;
@@ -48,8 +68,8 @@ pub mod suite;
 
 pub use error::BenchError;
 pub use report::{
-    BEGIN_MARKER, END_MARKER, Summary, TimeToError, check_doc, summarize, time_to_error,
-    update_doc, write_outputs,
+    BEGIN_MARKER, END_MARKER, Summary, TimeToError, check_doc, sequence_runs, summarize,
+    time_to_error, update_doc, write_outputs,
 };
 pub use suite::{IntegratorConfig, Suite, SuiteError, SuiteScene};
 
@@ -75,6 +95,8 @@ pub struct RunRecord {
     pub seed: u64,
     /// Render time in seconds (whole passes: at least the budget, unless one pass is longer).
     pub seconds: f64,
+    /// The process's user + system CPU seconds during the render (NaN where unknown).
+    pub cpu_seconds: f64,
     /// Passes rendered.
     pub passes: u32,
     /// Rays traced.
@@ -95,6 +117,13 @@ pub struct RunRecord {
     pub rss_before_mib: f64,
     /// Peak resident memory during the render, MiB (see the crate documentation).
     pub peak_rss_mib: f64,
+    /// The frame, for a frame of a sequence (`None`: a still render, or a whole sequence folded
+    /// by [`sequence_runs`]).
+    pub frame: Option<u32>,
+    /// Flicker against the previous frame of the sequence (see the crate documentation; for a
+    /// folded sequence the mean over its frames after the first); NaN for a still render and
+    /// a sequence's first frame.
+    pub flicker: f64,
 }
 
 impl RunRecord {
@@ -104,7 +133,8 @@ impl RunRecord {
     }
 }
 
-/// Where a scene's reference came from and how noisy it is.
+/// Where a scene's reference came from and how noisy it is. For a sequence: the last frame's
+/// file, the mean of the frames' noise estimates, and the seconds of all of them.
 #[derive(Clone, Debug)]
 pub struct ReferenceInfo {
     /// Scene name.
@@ -121,7 +151,8 @@ pub struct ReferenceInfo {
     pub seconds: f64,
 }
 
-/// A scene's strip of crops: the reference first, then each configuration in suite order.
+/// A scene's strip of crops: the reference first, then each configuration in suite order (of a
+/// sequence: its last frame).
 #[derive(Clone, Debug)]
 pub struct Strip {
     /// Scene name.
@@ -137,7 +168,7 @@ pub struct Strip {
 }
 
 /// A scene's full images for the HTML report: the reference, then seed 0 of every configuration
-/// at every budget.
+/// at every budget (of a sequence: its last frame).
 #[derive(Clone, Debug)]
 pub struct SceneImages {
     /// Scene name.
@@ -237,6 +268,30 @@ fn reset_peak_rss() -> bool {
     std::fs::write("/proc/self/clear_refs", "5").is_ok()
 }
 
+/// CPU seconds this process has run so far: the sum over its threads of the time each has
+/// spent on a CPU (`/proc/self/task/*/schedstat`, nanoseconds; the render pool's threads live
+/// as long as the run), else user + system time from `/proc/self/stat` (fields 14 and 15, in
+/// the 1/100 s ticks Linux reports them in); NaN without either.
+fn process_cpu_seconds() -> f64 {
+    let schedstat = || -> Option<f64> {
+        let mut ns = 0u64;
+        for task in std::fs::read_dir("/proc/self/task").ok()? {
+            let text = std::fs::read_to_string(task.ok()?.path().join("schedstat")).ok()?;
+            ns += text.split_whitespace().next()?.parse::<u64>().ok()?;
+        }
+        Some(ns as f64 * 1e-9)
+    };
+    let stat = || -> Option<f64> {
+        let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+        // The command name (field 2) may hold spaces; the fields after it start at 3 (state).
+        let rest = &stat[stat.rfind(')')? + 1..];
+        let f: Vec<&str> = rest.split_whitespace().collect();
+        let ticks = f.get(11)?.parse::<u64>().ok()? + f.get(12)?.parse::<u64>().ok()?;
+        Some(ticks as f64 / 100.0)
+    };
+    schedstat().or_else(stat).unwrap_or(f64::NAN)
+}
+
 fn mib(kib: Option<u64>) -> f64 {
     kib.map_or(f64::NAN, |k| k as f64 / 1024.0)
 }
@@ -267,8 +322,34 @@ fn load_average() -> String {
 /// A scene loaded with the suite's overrides.
 struct LoadedSuiteScene {
     name: String,
-    scene: Scene,
+    /// The scene as written (a still entry), or its first frame (a sequence).
+    scene: Arc<Scene>,
     file_bytes: Vec<u8>,
+    /// The file and the description (with the overrides), for a sequence's frames.
+    path: PathBuf,
+    desc: SceneDesc,
+    /// A sequence's frames `(frame, scene)`; empty for a still entry.
+    frames: Vec<(u32, Arc<Scene>)>,
+    /// A sequence's frame rate.
+    fps: f32,
+}
+
+impl LoadedSuiteScene {
+    /// What gets a reference: the scene (`None`), or each frame of a sequence.
+    fn views(&self) -> Vec<(Option<u32>, Arc<Scene>)> {
+        if self.frames.is_empty() {
+            vec![(None, self.scene.clone())]
+        } else {
+            self.frames
+                .iter()
+                .map(|(f, s)| (Some(*f), s.clone()))
+                .collect()
+        }
+    }
+
+    fn sequence(&self) -> Option<FrameSequence<'_>> {
+        FrameSequence::new(&self.desc, &self.path, self.fps)
+    }
 }
 
 fn load_suite_scene(entry: &SuiteScene, suite_dir: &Path) -> Result<LoadedSuiteScene, BenchError> {
@@ -279,12 +360,31 @@ fn load_suite_scene(entry: &SuiteScene, suite_dir: &Path) -> Result<LoadedSuiteS
         height: entry.height,
         ..LoadOptions::default()
     };
-    let scene = load_scene(&path, &options)?.scene;
-    Ok(LoadedSuiteScene {
+    let loaded = load_scene(&path, &options)?;
+    let mut out = LoadedSuiteScene {
         name: entry.display_name(),
-        scene,
+        scene: Arc::new(loaded.scene),
         file_bytes,
-    })
+        path,
+        fps: 0.0,
+        desc: loaded.desc,
+        frames: Vec::new(),
+    };
+    if let Some((first, last)) = entry.frames {
+        let Some(anim) = &out.desc.animation else {
+            return Err(BenchError::NoAnimation(out.path));
+        };
+        out.fps = entry.fps.unwrap_or(anim.fps);
+        let sequence = out
+            .sequence()
+            .ok_or(BenchError::NoAnimation(out.path.clone()))?;
+        let frames = (first..=last)
+            .map(|f| Ok((f, Arc::new(sequence.build(f)?))))
+            .collect::<Result<Vec<_>, BenchError>>()?;
+        out.scene = frames[0].1.clone();
+        out.frames = frames;
+    }
+    Ok(out)
 }
 
 fn options_for(config: &IntegratorConfig, entry: &SuiteScene) -> IntegratorOptions {
@@ -372,14 +472,16 @@ fn render_once(
     )
 }
 
-/// Loads, or renders and caches, the reference of one scene.
+/// Loads, or renders and caches, the reference of one scene (`frame = None`) or of one frame of
+/// a sequence (`scene` the frame's).
 fn reference_for(
     entry: &SuiteScene,
     loaded: &LoadedSuiteScene,
+    (frame, scene): (Option<u32>, &Scene),
     suite: &Suite,
     opts: &RunOptions,
 ) -> Result<(Image, ReferenceInfo), BenchError> {
-    let (w, h) = loaded.scene.camera.resolution();
+    let (w, h) = scene.camera.resolution();
     if let Some(given) = &entry.reference {
         let path = opts.suite_dir.join(given);
         let image = Image::read_exr(&path)?;
@@ -406,12 +508,18 @@ fn reference_for(
     let depth = entry
         .max_depth
         .map_or("scene".to_string(), |d| d.to_string());
+    // A frame's key adds its number and the frame rate (which decide its time); a still
+    // scene's is what it always was, so cached references stay valid.
+    let frame_key = frame.map_or(String::new(), |f| format!(" frame={f} fps={}", loaded.fps));
     let key = fnv1a(&[
         &loaded.file_bytes,
-        format!("{w}x{h} max_depth={depth} spp={spp} path-halves-v1").as_bytes(),
+        format!("{w}x{h} max_depth={depth} spp={spp} path-halves-v1{frame_key}").as_bytes(),
     ]);
     let dir = opts.out.join("references");
-    let stem = format!("{}-{key:016x}", loaded.name);
+    let stem = match frame {
+        Some(f) => format!("{}-{f:04}-{key:016x}", loaded.name),
+        None => format!("{}-{key:016x}", loaded.name),
+    };
     let exr = dir.join(format!("{stem}.exr"));
     let noise_file = dir.join(format!("{stem}.noise"));
     // A cached reference needs its EXR (of the right size) and its noise estimate.
@@ -443,7 +551,7 @@ fn reference_for(
         integrator: "path".into(),
         params: Vec::new(),
     };
-    let integrator = build_integrator(&loaded.scene, &path_config, entry)?;
+    let integrator = build_integrator(scene, &path_config, entry)?;
     let start = Instant::now();
     let halves: Vec<Image> = REFERENCE_SEEDS
         .iter()
@@ -453,7 +561,7 @@ fn reference_for(
                 seed,
                 ..RenderJob::default()
             };
-            render_once(&loaded.scene, integrator.as_ref(), &job).image
+            render_once(scene, integrator.as_ref(), &job).image
         })
         .collect();
     let seconds = start.elapsed().as_secs_f64();
@@ -477,6 +585,155 @@ fn reference_for(
     ))
 }
 
+/// The flicker between consecutive frames: the mean over pixels and channels of
+/// `((I_f − R_f) − (I_{f−1} − R_{f−1}))² / (max(R_f, R_{f−1})² + 0.01)` (see the crate
+/// documentation).
+pub fn flicker(image: &Image, reference: &Image, prev: &Image, prev_reference: &Image) -> f64 {
+    let n = image.pixels.len();
+    if n == 0
+        || [reference, prev, prev_reference]
+            .iter()
+            .any(|i| i.pixels.len() != n)
+    {
+        return f64::NAN;
+    }
+    let mut sum = 0.0f64;
+    for i in 0..n {
+        let (a, r, pa, pr) = (
+            image.pixels[i].as_dvec3(),
+            reference.pixels[i].as_dvec3(),
+            prev.pixels[i].as_dvec3(),
+            prev_reference.pixels[i].as_dvec3(),
+        );
+        let d = (a - r) - (pa - pr);
+        let m = r.max(pr);
+        sum += (d * d / (m * m + 0.01)).element_sum();
+    }
+    sum / (3 * n) as f64
+}
+
+/// One render measured: what the record of a still image or a sequence's frame holds besides
+/// its scene, configuration, budget, seed and frame.
+struct Measured {
+    out: restir_integrators::RenderOutput,
+    cpu_seconds: f64,
+    before: Option<u64>,
+    after: Option<u64>,
+}
+
+/// Renders `job` with the peak memory reset before and the CPU time around it.
+fn measured_render(scene: &Scene, integrator: &dyn Integrator, job: &RenderJob) -> Measured {
+    reset_peak_rss();
+    let before = vm_hwm_kib();
+    let cpu = process_cpu_seconds();
+    let out = render_once(scene, integrator, job);
+    Measured {
+        cpu_seconds: process_cpu_seconds() - cpu,
+        after: vm_hwm_kib(),
+        before,
+        out,
+    }
+}
+
+/// What one (scene, configuration, budget, seed) rendered: its records (one, or one per frame)
+/// and the image for the strip and the page (a sequence's last frame).
+struct Rendered {
+    records: Vec<RunRecord>,
+    image: Image,
+}
+
+/// The references of a scene's views (one, or one per frame), in order.
+struct References {
+    images: Vec<Image>,
+}
+
+/// Renders one (configuration, budget, seed) of a scene: a still image, or the frames of a
+/// sequence in order with one estimator made for the first frame (history carried across
+/// frames through [`FrameSequence`]), each frame with the budget. `step` is called before each
+/// frame.
+#[allow(clippy::too_many_arguments)]
+fn render_entry(
+    entry: &SuiteScene,
+    loaded: &LoadedSuiteScene,
+    references: &References,
+    config: &IntegratorConfig,
+    integrator: Option<&dyn Integrator>,
+    budget: f64,
+    seed: u64,
+    step: &mut dyn FnMut(Option<u32>),
+) -> Result<Rendered, BenchError> {
+    let job = |seed| RenderJob {
+        spp: u32::MAX,
+        time_limit: Some(Duration::from_secs_f64(budget)),
+        seed,
+        output: None,
+    };
+    let record = |m: &Measured, reference: &Image, frame, flicker| {
+        let (w, h) = (reference.width, reference.height);
+        evaluate(&m.out.image, reference)
+            .ok_or(BenchError::ReferenceMismatch)
+            .map(|e| RunRecord {
+                scene: loaded.name.clone(),
+                label: config.label.clone(),
+                describe: String::new(),
+                width: w,
+                height: h,
+                budget,
+                seed,
+                seconds: m.out.seconds,
+                cpu_seconds: m.cpu_seconds,
+                passes: m.out.passes,
+                rays: m.out.rays,
+                relmse: e.relmse,
+                mse: e.mse,
+                mape: e.mape,
+                flip: e.flip,
+                mean_ratio: e.mean_ratio,
+                nonfinite: e.nonfinite,
+                rss_before_mib: mib(m.before),
+                peak_rss_mib: mib(m.after),
+                frame,
+                flicker,
+            })
+    };
+    let Some(mut sequence) = loaded.sequence().filter(|_| !loaded.frames.is_empty()) else {
+        let integrator = integrator.expect("a still scene's integrator is built once");
+        step(None);
+        let m = measured_render(&loaded.scene, integrator, &job(seed));
+        let mut r = record(&m, &references.images[0], None, f64::NAN)?;
+        r.describe = integrator.describe();
+        return Ok(Rendered {
+            records: vec![r],
+            image: m.out.image,
+        });
+    };
+    // A fresh estimator per sequence: its history starts empty at the first frame.
+    let estimator = build_integrator(&loaded.scene, config, entry)?;
+    let mut records = Vec::with_capacity(loaded.frames.len());
+    let mut prev: Option<Image> = None;
+    for (i, (frame, scene)) in loaded.frames.iter().enumerate() {
+        step(Some(*frame));
+        sequence.enter(estimator.as_ref(), scene.clone(), *frame);
+        let m = measured_render(
+            scene,
+            estimator.as_ref(),
+            &job(FrameSequence::seed(seed, *frame)),
+        );
+        let reference = &references.images[i];
+        let flicker = prev.as_ref().map_or(f64::NAN, |p| {
+            flicker(&m.out.image, reference, p, &references.images[i - 1])
+        });
+        let mut r = record(&m, reference, Some(*frame), flicker)?;
+        r.describe = estimator.describe();
+        records.push(r);
+        prev = Some(m.out.image);
+    }
+    Ok(Rendered {
+        records,
+        image: prev.expect("a sequence has at least one frame"),
+    })
+}
+
 /// Runs every render of `suite` in the current rayon pool, calling `progress` before each step.
 pub fn run_suite(
     suite: &Suite,
@@ -492,8 +749,8 @@ pub fn run_suite(
     let load_start = load_average();
     let peak_reset = reset_peak_rss();
 
-    // Load every scene and build every integrator once up front, so that a bad scene or
-    // parameter fails in seconds rather than after an hour of rendering.
+    // Load every scene (every frame of a sequence) and build every integrator once up front,
+    // so that a bad scene or parameter fails in seconds rather than after an hour of rendering.
     let mut scenes = Vec::new();
     for entry in &suite.scenes {
         let loaded = load_suite_scene(entry, &opts.suite_dir)?;
@@ -508,9 +765,10 @@ pub fn run_suite(
     let per_config = suite.budgets.len() as u64 * suite.seeds as u64;
     let total: u64 = scenes
         .iter()
-        .map(|(entry, _, _)| {
+        .map(|(entry, loaded, _)| {
             let configs = suite.integrators.iter().filter(|c| entry.runs(&c.label));
-            1 + configs.count() as u64 * per_config
+            let views = loaded.frames.len().max(1) as u64;
+            views + configs.count() as u64 * per_config * views
         })
         .sum();
     let mut done = 0u64;
@@ -523,23 +781,45 @@ pub fn run_suite(
     let mut strips = Vec::new();
     let mut images = Vec::new();
     for (entry, loaded, rect) in &scenes {
-        let (w, h) = loaded.scene.camera.resolution();
-        progress(&Progress {
-            done,
-            total,
-            message: format!("{}: reference", loaded.name),
-        });
-        let (reference, info) = reference_for(entry, loaded, suite, opts)?;
-        done += 1;
+        let mut refs = References { images: Vec::new() };
+        let mut info: Option<ReferenceInfo> = None;
+        for (frame, scene) in loaded.views() {
+            progress(&Progress {
+                done,
+                total,
+                message: match frame {
+                    Some(f) => format!("{}: reference of frame {f}", loaded.name),
+                    None => format!("{}: reference", loaded.name),
+                },
+            });
+            let (image, i) = reference_for(entry, loaded, (frame, &scene), suite, opts)?;
+            done += 1;
+            refs.images.push(image);
+            // A sequence's entry: the last frame's file, every frame's time, the mean noise.
+            info = Some(match info {
+                None => i,
+                Some(prev) => ReferenceInfo {
+                    seconds: prev.seconds + i.seconds,
+                    reused: prev.reused && i.reused,
+                    noise_relmse: prev.noise_relmse.zip(i.noise_relmse).map(|(a, b)| a + b),
+                    ..i
+                },
+            });
+        }
+        let mut info = info.expect("every scene has a view");
+        if let Some(n) = &mut info.noise_relmse {
+            *n /= refs.images.len() as f64;
+        }
         references.push(info);
+        let reference = refs.images.last().expect("a reference").clone();
         let mut strip_crops: Vec<Option<Image>> = vec![None; suite.integrators.len()];
         let mut renders: Vec<(usize, String, f64, Image)> = Vec::new();
+        // A still scene's estimators are built once; a sequence builds one per sequence.
         let integrators = suite
             .integrators
             .iter()
             .map(|c| {
-                entry
-                    .runs(&c.label)
+                (entry.runs(&c.label) && loaded.frames.is_empty())
                     .then(|| build_integrator(&loaded.scene, c, entry))
                     .transpose()
             })
@@ -549,56 +829,38 @@ pub fn run_suite(
         for seed in 0..suite.seeds as u64 {
             for &budget in &suite.budgets {
                 for (ci, config) in suite.integrators.iter().enumerate() {
-                    let Some(integrator) = integrators[ci].as_deref() else {
+                    if !entry.runs(&config.label) {
                         continue;
-                    };
-                    progress(&Progress {
-                        done,
-                        total,
-                        message: format!(
-                            "{}: {} {budget} s seed {seed}",
-                            loaded.name, config.label
-                        ),
-                    });
-                    let job = RenderJob {
-                        spp: u32::MAX,
-                        time_limit: Some(Duration::from_secs_f64(budget)),
-                        seed,
-                        output: None,
-                    };
-                    reset_peak_rss();
-                    let before = vm_hwm_kib();
-                    let out = render_once(&loaded.scene, integrator, &job);
-                    let after = vm_hwm_kib();
-                    let m =
-                        evaluate(&out.image, &reference).ok_or(BenchError::ReferenceMismatch)?;
-                    if seed == 0 && budget == strip_budget {
-                        strip_crops[ci] = Some(crop(&out.image, *rect));
                     }
-                    records.push(RunRecord {
-                        scene: loaded.name.clone(),
-                        label: config.label.clone(),
-                        describe: integrator.describe(),
-                        width: w,
-                        height: h,
+                    let r = render_entry(
+                        entry,
+                        loaded,
+                        &refs,
+                        config,
+                        integrators[ci].as_deref(),
                         budget,
                         seed,
-                        seconds: out.seconds,
-                        passes: out.passes,
-                        rays: out.rays,
-                        relmse: m.relmse,
-                        mse: m.mse,
-                        mape: m.mape,
-                        flip: m.flip,
-                        mean_ratio: m.mean_ratio,
-                        nonfinite: m.nonfinite,
-                        rss_before_mib: mib(before),
-                        peak_rss_mib: mib(after),
-                    });
-                    if seed == 0 {
-                        renders.push((ci, config.label.clone(), budget, out.image));
+                        &mut |frame| {
+                            progress(&Progress {
+                                done,
+                                total,
+                                message: format!(
+                                    "{}: {} {budget} s seed {seed}{}",
+                                    loaded.name,
+                                    config.label,
+                                    frame.map_or(String::new(), |f| format!(" frame {f}"))
+                                ),
+                            });
+                            done += 1;
+                        },
+                    )?;
+                    records.extend(r.records);
+                    if seed == 0 && budget == strip_budget {
+                        strip_crops[ci] = Some(crop(&r.image, *rect));
                     }
-                    done += 1;
+                    if seed == 0 {
+                        renders.push((ci, config.label.clone(), budget, r.image));
+                    }
                 }
             }
         }
@@ -672,6 +934,8 @@ mod tests {
             reference_spp: None,
             crop: None,
             integrators: None,
+            frames: None,
+            fps: None,
         };
         assert_eq!(crop_rect(&entry, 64, 32).unwrap(), (16, 8, 32, 16));
         let bad = SuiteScene {

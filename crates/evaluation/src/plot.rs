@@ -147,6 +147,85 @@ fn draw(
     Ok(())
 }
 
+/// One configuration's relMSE per frame of a sequence.
+pub(crate) struct FrameSeries {
+    /// Legend text.
+    pub label: String,
+    /// `(frame, relMSE)` by frame.
+    pub points: Vec<(u32, f64)>,
+}
+
+/// Writes the per-frame relMSE plot of a sequence to `path` (SVG): frames on a linear axis,
+/// relMSE on a log axis, one line with dots per configuration.
+pub(crate) fn frame_plot(
+    path: &Path,
+    title: &str,
+    series: &[FrameSeries],
+) -> Result<(), BenchError> {
+    draw_frames(path, title, series).map_err(|e| BenchError::Plot {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
+}
+
+fn draw_frames(
+    path: &Path,
+    title: &str,
+    series: &[FrameSeries],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let root = SVGBackend::new(path, (760, 500)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let frames = series.iter().flat_map(|s| s.points.iter().map(|p| p.0));
+    let (first, last) = frames.fold((u32::MAX, 0), |(a, b), f| (a.min(f), b.max(f)));
+    let (first, last) = if first > last {
+        (0, 1)
+    } else {
+        (first, last.max(first + 1))
+    };
+    let (ymin, ymax) = log_range(series.iter().flat_map(|s| s.points.iter().map(|p| p.1)));
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 20))
+        .margin(12)
+        .margin_right(28)
+        .x_label_area_size(45)
+        .y_label_area_size(75)
+        .build_cartesian_2d(
+            f64::from(first) - 0.5..f64::from(last) + 0.5,
+            (ymin..ymax).log_scale(),
+        )?;
+    chart
+        .configure_mesh()
+        .x_desc("frame")
+        .y_desc("relMSE")
+        .x_label_formatter(&|x| short(x.round()))
+        .y_label_formatter(&|y| format!("{y:.1e}"))
+        .draw()?;
+    for (i, s) in series.iter().enumerate() {
+        let color = COLORS[i % COLORS.len()];
+        let pts: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .filter(|p| usable(p.1))
+            .map(|&(f, e)| (f64::from(f), e))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))?
+            .label(s.label.as_str())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], color.stroke_width(2))
+            });
+        chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled())))?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

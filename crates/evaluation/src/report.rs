@@ -7,8 +7,8 @@ use std::path::{Component, Path, PathBuf};
 use glam::Vec3;
 use restir_image::Image;
 
-use crate::plot::{Series, relmse_plot};
-use crate::{BenchError, BenchResults, RunRecord, Strip};
+use crate::plot::{FrameSeries, Series, frame_plot, relmse_plot};
+use crate::{BenchError, BenchResults, RunRecord, Strip, SuiteScene};
 
 /// Start marker of the generated section in a Markdown file.
 pub const BEGIN_MARKER: &str = "<!-- restir bench results begin -->";
@@ -26,8 +26,10 @@ pub struct Summary {
     pub budget: f64,
     /// Runs (seeds).
     pub runs: usize,
-    /// Median render seconds.
+    /// Median render seconds (of a sequence: per frame).
     pub seconds: f64,
+    /// Median CPU seconds (of a sequence: per frame).
+    pub cpu_seconds: f64,
     /// Median passes.
     pub passes: f64,
     /// Median Mrays/s.
@@ -50,6 +52,11 @@ pub struct Summary {
     pub nonfinite: usize,
     /// Largest peak resident memory, MiB.
     pub peak_rss_mib: f64,
+    /// Median flicker of a sequence (NaN for a still scene).
+    pub flicker: f64,
+    /// Median over runs of `1 / (relMSE · CPU seconds)` (of a sequence: mean relMSE over its
+    /// frames, CPU seconds per frame).
+    pub efficiency: f64,
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -66,17 +73,91 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-/// Summaries in suite order: scenes, then configurations, then budgets ascending.
+/// The mean of `values`, NaN for none.
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    if n == 0 { f64::NAN } else { sum / n as f64 }
+}
+
+/// The records with each sequence (the frames of one scene, configuration, budget and seed)
+/// folded into one record, in order: the mean over its frames of the per-frame relMSE, MSE,
+/// MAPE, FLIP, mean ratio, seconds, CPU seconds, passes and rays; the mean flicker over its
+/// frames after the first; non-finite pixels summed, the largest peak memory; `frame` `None`.
+/// Records of still renders pass unchanged.
+pub fn sequence_runs(records: &[RunRecord]) -> Vec<RunRecord> {
+    let mut out: Vec<RunRecord> = Vec::new();
+    let mut group: Vec<&RunRecord> = Vec::new();
+    let same = |a: &RunRecord, b: &RunRecord| {
+        a.scene == b.scene && a.label == b.label && a.budget == b.budget && a.seed == b.seed
+    };
+    let fold = |group: &[&RunRecord]| -> RunRecord {
+        let m = |f: fn(&RunRecord) -> f64| mean(group.iter().map(|r| f(r)));
+        RunRecord {
+            seconds: m(|r| r.seconds),
+            cpu_seconds: m(|r| r.cpu_seconds),
+            passes: m(|r| f64::from(r.passes)).round() as u32,
+            rays: m(|r| r.rays as f64).round() as u64,
+            relmse: m(|r| r.relmse),
+            mse: m(|r| r.mse),
+            mape: m(|r| r.mape),
+            flip: m(|r| r.flip),
+            mean_ratio: m(|r| r.mean_ratio),
+            nonfinite: group.iter().map(|r| r.nonfinite).sum(),
+            rss_before_mib: group
+                .iter()
+                .map(|r| r.rss_before_mib)
+                .fold(f64::NAN, f64::min),
+            peak_rss_mib: group
+                .iter()
+                .map(|r| r.peak_rss_mib)
+                .fold(f64::NAN, f64::max),
+            frame: None,
+            flicker: mean(group.iter().map(|r| r.flicker).filter(|f| !f.is_nan())),
+            ..group[0].clone()
+        }
+    };
+    for r in records {
+        if r.frame.is_none() {
+            if !group.is_empty() {
+                out.push(fold(&group));
+                group.clear();
+            }
+            out.push(r.clone());
+            continue;
+        }
+        if group.last().is_some_and(|g| !same(g, r)) {
+            out.push(fold(&group));
+            group.clear();
+        }
+        group.push(r);
+    }
+    if !group.is_empty() {
+        out.push(fold(&group));
+    }
+    out
+}
+
+/// The suite's entry of scene `name`.
+fn entry<'a>(results: &'a BenchResults, name: &str) -> Option<&'a SuiteScene> {
+    results
+        .suite
+        .scenes
+        .iter()
+        .find(|e| e.display_name() == name)
+}
+
+/// Summaries in suite order: scenes, then configurations, then budgets ascending; a sequence's
+/// runs folded first ([`sequence_runs`]).
 pub fn summarize(results: &BenchResults) -> Vec<Summary> {
     let mut budgets = results.suite.budgets.clone();
     budgets.sort_by(|a, b| a.total_cmp(b));
     budgets.dedup();
+    let all = sequence_runs(&results.records);
     let mut out = Vec::new();
     for r in &results.references {
         for c in &results.suite.integrators {
             for &b in &budgets {
-                let runs: Vec<&RunRecord> = results
-                    .records
+                let runs: Vec<&RunRecord> = all
                     .iter()
                     .filter(|x| x.scene == r.scene && x.label == c.label && x.budget == b)
                     .collect();
@@ -90,6 +171,7 @@ pub fn summarize(results: &BenchResults) -> Vec<Summary> {
                     budget: b,
                     runs: runs.len(),
                     seconds: col(|x| x.seconds),
+                    cpu_seconds: col(|x| x.cpu_seconds),
                     passes: col(|x| x.passes as f64),
                     mrays: col(|x| x.mrays_per_second()),
                     relmse: col(|x| x.relmse),
@@ -101,6 +183,8 @@ pub fn summarize(results: &BenchResults) -> Vec<Summary> {
                     mean_ratio: col(|x| x.mean_ratio),
                     nonfinite: runs.iter().map(|x| x.nonfinite).sum(),
                     peak_rss_mib: runs.iter().map(|x| x.peak_rss_mib).fold(0.0, f64::max),
+                    flicker: col(|x| x.flicker),
+                    efficiency: col(|x| 1.0 / (x.relmse * x.cpu_seconds)),
                 });
             }
         }
@@ -163,8 +247,9 @@ fn csv_field(s: &str) -> String {
     }
 }
 
-/// The CSV header.
-pub const CSV_HEADER: &str = "scene,label,integrator_settings,width,height,budget_s,seed,seconds,passes,rays,mrays_per_s,relmse,mse,mape,flip,mean_ratio,nonfinite_pixels,rss_before_mib,peak_rss_mib,reference_noise_relmse";
+/// The CSV header: one row per render, a sequence's frames one row each (`frame` empty for a
+/// still render; `flicker` empty for it and for a sequence's first frame).
+pub const CSV_HEADER: &str = "scene,label,integrator_settings,width,height,budget_s,seed,seconds,passes,rays,mrays_per_s,relmse,mse,mape,flip,mean_ratio,nonfinite_pixels,rss_before_mib,peak_rss_mib,reference_noise_relmse,frame,flicker,cpu_seconds";
 
 fn csv(results: &BenchResults) -> String {
     let mut s = String::from(CSV_HEADER);
@@ -173,7 +258,7 @@ fn csv(results: &BenchResults) -> String {
         let noise = reference_noise(results, &r.scene).map_or(String::new(), |n| format!("{n:e}"));
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{:.4},{},{},{:.3},{:e},{:e},{:e},{:.6},{:.6},{},{:.1},{:.1},{}",
+            "{},{},{},{},{},{},{},{:.4},{},{},{:.3},{:e},{:e},{:e},{:.6},{:.6},{},{:.1},{:.1},{},{},{},{:.4}",
             csv_field(&r.scene),
             csv_field(&r.label),
             csv_field(&r.describe),
@@ -193,7 +278,14 @@ fn csv(results: &BenchResults) -> String {
             r.nonfinite,
             r.rss_before_mib,
             r.peak_rss_mib,
-            noise
+            noise,
+            r.frame.map_or(String::new(), |f| f.to_string()),
+            if r.flicker.is_nan() {
+                String::new()
+            } else {
+                format!("{:e}", r.flicker)
+            },
+            r.cpu_seconds
         );
     }
     s
@@ -325,6 +417,22 @@ pub fn report_markdown(results: &BenchResults, h: &str, link: &str) -> String {
             "could not be reset: the peak since the process started"
         }
     );
+    if results.suite.scenes.iter().any(|e| e.frames.is_some()) {
+        let _ = writeln!(
+            s,
+            "**Sequences.** A scene with frames is rendered by each configuration frame after \
+             frame with one estimator, whose history (temporal reuse) carries across frames, \
+             every frame with the budget: equal time per frame. Every frame has its own \
+             path-traced reference. Its relMSE, MSE, MAPE, FLIP, mean ratio, time, passes and \
+             Mrays/s are the means over the frames (times per frame), then medians over seeds. \
+             *Flicker* is the mean over consecutive frames of \
+             ((I_f − R_f) − (I_f−1 − R_f−1))² / (max(R_f, R_f−1)² + 0.01): independent noise \
+             per frame gives about twice the relMSE, errors that persist across frames less. \
+             *Efficiency* is 1 / (mean relMSE × CPU seconds per frame), CPU time being the \
+             process's user + system time during the frames' renders; both are given relative to \
+             the scene's first configuration. Crops and images are of the last frame.\n"
+        );
+    }
 
     let path_label = results
         .suite
@@ -346,18 +454,32 @@ pub fn report_markdown(results: &BenchResults, h: &str, link: &str) -> String {
             .iter()
             .find(|x| x.scene == r.scene)
             .map_or((0, 0), |x| (x.width, x.height));
-        let _ = writeln!(s, "{h}# {} ({w}×{h_px})\n", r.scene);
+        let frames = entry(results, &r.scene).and_then(|e| e.frames);
+        match frames {
+            Some((a, b)) => {
+                let _ = writeln!(s, "{h}# {} ({w}×{h_px}, frames {a} to {b})\n", r.scene);
+            }
+            None => {
+                let _ = writeln!(s, "{h}# {} ({w}×{h_px})\n", r.scene);
+            }
+        }
         match (r.spp, r.noise_relmse) {
             (Some(spp), Some(noise)) => {
                 let _ = writeln!(
                     s,
-                    "Reference: path tracer, {spp} passes ({}); its own relMSE ≈ {}.\n",
+                    "Reference: path tracer, {spp} passes{} ({}); its own relMSE ≈ {}{}.\n",
+                    if frames.is_some() { " per frame" } else { "" },
                     if r.reused {
                         "cached".to_string()
                     } else {
                         format!("rendered in {:.0} s", r.seconds)
                     },
-                    sci(noise)
+                    sci(noise),
+                    if frames.is_some() {
+                        " (mean over the frames)"
+                    } else {
+                        ""
+                    }
                 );
             }
             _ => {
@@ -373,6 +495,14 @@ pub fn report_markdown(results: &BenchResults, h: &str, link: &str) -> String {
             "![relMSE against time, {}]({link}relmse-{}.svg)\n",
             r.scene, r.scene
         );
+        if frames.is_some() {
+            let _ = writeln!(
+                s,
+                "![relMSE of every frame, {}]({link}frames-{}.svg)\n\nrelMSE of each frame \
+                 (median over seeds) at the {} s budget.\n",
+                r.scene, r.scene, strip.budget
+            );
+        }
         let (cx, cy, cw, ch) = strip.crop;
         let k = strip_scale(strip);
         let names = &strip.labels;
@@ -413,6 +543,9 @@ pub fn report_markdown(results: &BenchResults, h: &str, link: &str) -> String {
             );
         }
         s.push('\n');
+        if frames.is_some() {
+            animation_table(&mut s, &rows);
+        }
         let Some(path_label) = &path_label else {
             continue;
         };
@@ -484,16 +617,53 @@ pub fn report_markdown(results: &BenchResults, h: &str, link: &str) -> String {
     s
 }
 
+/// A sequence's table: per budget, each configuration's mean relMSE, CPU seconds per frame,
+/// efficiency and flicker, the last two relative to the first configuration at that budget.
+fn animation_table(s: &mut String, rows: &[&Summary]) {
+    let Some(first) = rows.first().map(|x| x.label.clone()) else {
+        return;
+    };
+    let _ = writeln!(
+        s,
+        "| configuration | budget (s) | mean relMSE | CPU s per frame | efficiency × {first} | \
+         flicker | flicker × {first} |\n|---|---|---|---|---|---|---|"
+    );
+    let mut budgets: Vec<f64> = rows.iter().map(|x| x.budget).collect();
+    budgets.sort_by(|a, b| a.total_cmp(b));
+    budgets.dedup();
+    for b in budgets {
+        let base = rows.iter().find(|x| x.budget == b && x.label == first);
+        for x in rows.iter().filter(|x| x.budget == b) {
+            let ratio = |v: f64, of: fn(&Summary) -> f64| {
+                base.map_or("–".to_string(), |base| format!("{:.2}", v / of(base)))
+            };
+            let _ = writeln!(
+                s,
+                "| {} | {b} | {} | {:.3} | {} | {} | {} |",
+                x.label,
+                sci(x.relmse),
+                x.cpu_seconds,
+                ratio(x.efficiency, |y| y.efficiency),
+                sci(x.flicker),
+                ratio(x.flicker, |y| y.flicker),
+            );
+        }
+    }
+    s.push('\n');
+}
+
 fn write_file(path: &Path, bytes: &[u8]) -> Result<(), BenchError> {
     std::fs::write(path, bytes).map_err(BenchError::io(path, ""))
 }
 
-/// Writes `results.csv`, `relmse-<scene>.svg`, `strip-<scene>.png`, `report.md` and the
-/// interactive `report.html` ([`crate::html`]) into `out`.
+/// Writes `results.csv`, `relmse-<scene>.svg`, `strip-<scene>.png`, for a sequence
+/// `frames-<scene>.svg` (relMSE of every frame), `report.md` and the interactive `report.html`
+/// ([`crate::html`]) into `out`.
 pub fn write_outputs(results: &BenchResults, out: &Path) -> Result<(), BenchError> {
     std::fs::create_dir_all(out).map_err(BenchError::io(out, "cannot create directory: "))?;
     write_file(&out.join("results.csv"), csv(results).as_bytes())?;
     let summaries = summarize(results);
+    let runs = sequence_runs(&results.records);
     for r in &results.references {
         let series: Vec<Series> = results
             .suite
@@ -506,8 +676,7 @@ pub fn write_outputs(results: &BenchResults, out: &Path) -> Result<(), BenchErro
                     .filter(|x| x.scene == r.scene && x.label == c.label)
                     .map(|x| (x.seconds, x.relmse, x.relmse_min, x.relmse_max))
                     .collect(),
-                points: results
-                    .records
+                points: runs
                     .iter()
                     .filter(|x| x.scene == r.scene && x.label == c.label)
                     .map(|x| (x.seconds, x.relmse))
@@ -518,12 +687,29 @@ pub fn write_outputs(results: &BenchResults, out: &Path) -> Result<(), BenchErro
             .into_iter()
             .filter(|s| !s.points.is_empty())
             .collect();
+        let sequence = entry(results, &r.scene).is_some_and(|e| e.frames.is_some());
         relmse_plot(
             &out.join(format!("relmse-{}.svg", r.scene)),
-            &format!("{}: relMSE against render time", r.scene),
+            &if sequence {
+                format!("{}: mean relMSE against render time per frame", r.scene)
+            } else {
+                format!("{}: relMSE against render time", r.scene)
+            },
             &series,
             r.noise_relmse,
         )?;
+        if sequence {
+            let budget = results
+                .strips
+                .iter()
+                .find(|s| s.scene == r.scene)
+                .map_or(f64::NAN, |s| s.budget);
+            frame_plot(
+                &out.join(format!("frames-{}.svg", r.scene)),
+                &format!("{}: relMSE of every frame ({budget} s per frame)", r.scene),
+                &frame_series(results, &r.scene, budget),
+            )?;
+        }
     }
     for strip in &results.strips {
         strip_image(strip).write(&out.join(format!("strip-{}.png", strip.scene)))?;
@@ -536,6 +722,47 @@ pub fn write_outputs(results: &BenchResults, out: &Path) -> Result<(), BenchErro
         &out.join("report.html"),
         crate::html::bench_page(results)?.as_bytes(),
     )
+}
+
+/// Per configuration, the median over seeds of each frame's relMSE of sequence `scene` at
+/// `budget`.
+fn frame_series(results: &BenchResults, scene: &str, budget: f64) -> Vec<FrameSeries> {
+    results
+        .suite
+        .integrators
+        .iter()
+        .map(|c| {
+            let mut frames: Vec<u32> = results
+                .records
+                .iter()
+                .filter(|x| x.scene == scene && x.label == c.label && x.budget == budget)
+                .filter_map(|x| x.frame)
+                .collect();
+            frames.sort_unstable();
+            frames.dedup();
+            FrameSeries {
+                label: c.label.clone(),
+                points: frames
+                    .into_iter()
+                    .map(|f| {
+                        let per_seed = results
+                            .records
+                            .iter()
+                            .filter(|x| {
+                                x.scene == scene
+                                    && x.label == c.label
+                                    && x.budget == budget
+                                    && x.frame == Some(f)
+                            })
+                            .map(|x| x.relmse)
+                            .collect();
+                        (f, median(per_seed))
+                    })
+                    .collect(),
+            }
+        })
+        .filter(|s| !s.points.is_empty())
+        .collect()
 }
 
 /// `to` relative to the directory `from` (both made absolute first).

@@ -1,4 +1,6 @@
-//! The suite file: scenes × integrator configurations × time budgets × seeds (RON, strict).
+//! The suite file: scenes × integrator configurations × time budgets × seeds (RON, strict). A
+//! scene with `frames` is an animated sequence (an animation suite's entry): every
+//! configuration renders its frames in order with one estimator, each frame with the budget.
 
 use std::path::{Path, PathBuf};
 
@@ -58,6 +60,14 @@ pub struct SuiteScene {
     /// Labels of the integrator configurations that render this scene (default: all of them).
     #[serde(default)]
     pub integrators: Option<Vec<String>>,
+    /// Frames `(first, last)` of the scene's animation (inclusive): the scene is rendered as a
+    /// sequence, every frame with the budget by one estimator that carries its history across
+    /// frames, against a reference per frame (default: a still image).
+    #[serde(default)]
+    pub frames: Option<(u32, u32)>,
+    /// Frames per second of a sequence (default: the animation's).
+    #[serde(default)]
+    pub fps: Option<f32>,
 }
 
 /// One integrator configuration: what `IntegratorOptions` takes, plus a label.
@@ -238,6 +248,36 @@ impl Suite {
             if let Some(spp) = s.reference_spp {
                 check_spp(spp)?;
             }
+            if let Some((first, last)) = s.frames
+                && (first > last || last - first >= 10_000)
+            {
+                return Err(SuiteError::rule(format!(
+                    "{}: frames ({first}, {last}): expected (first, last) with first ≤ last, at \
+                     most 10000 frames",
+                    s.path.display()
+                )));
+            }
+            if s.frames.is_some() && s.reference.is_some() {
+                return Err(SuiteError::rule(format!(
+                    "{}: a sequence (`frames`) takes no `reference` image: every frame gets its \
+                     own path-traced one",
+                    s.path.display()
+                )));
+            }
+            if let Some(fps) = s.fps {
+                if s.frames.is_none() {
+                    return Err(SuiteError::rule(format!(
+                        "{}: `fps` without `frames`",
+                        s.path.display()
+                    )));
+                }
+                if !(fps.is_finite() && fps > 0.0) {
+                    return Err(SuiteError::rule(format!(
+                        "{}: fps {fps}: expected a positive number",
+                        s.path.display()
+                    )));
+                }
+            }
             if s.crop.is_some_and(|(_, _, w, h)| w == 0 || h == 0) {
                 return Err(SuiteError::rule(format!(
                     "{}: empty crop rectangle",
@@ -341,5 +381,27 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("'dj'"), "{e}");
+    }
+
+    #[test]
+    fn sequences() {
+        let seq = GOOD.replace("height: Some(16)", "height: 16, frames: (2, 5), fps: 12");
+        let s = Suite::parse(&seq, Path::new("s.ron")).unwrap();
+        assert_eq!(
+            (s.scenes[0].frames, s.scenes[0].fps),
+            (Some((2, 5)), Some(12.0))
+        );
+        for (bad, needle) in [
+            ("frames: (5, 2)", "frames (5, 2)"),
+            ("frames: (0, 20000)", "at most 10000"),
+            ("frames: (0, 1), fps: 0", "fps 0"),
+            ("fps: 12", "`fps` without `frames`"),
+        ] {
+            let text = GOOD.replace("height: Some(16)", &format!("height: 16, {bad}"));
+            let e = Suite::parse(&text, Path::new("s.ron"))
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with("s.ron: a.xml: ") && e.contains(needle), "{e}");
+        }
     }
 }

@@ -220,6 +220,7 @@ fn synthetic_results() -> BenchResults {
                         budget,
                         seed,
                         seconds: budget * 1.05,
+                        cpu_seconds: budget * 1.05,
                         passes: 10 * (bi as u32 + 1),
                         rays: 1000,
                         relmse: m.relmse,
@@ -230,6 +231,8 @@ fn synthetic_results() -> BenchResults {
                         nonfinite: m.nonfinite,
                         rss_before_mib: 10.0,
                         peak_rss_mib: 12.0,
+                        frame: None,
+                        flicker: f64::NAN,
                     });
                     if seed == 0 {
                         renders.push((label.to_string(), budget, img));
@@ -268,6 +271,8 @@ fn synthetic_results() -> BenchResults {
         reference_spp: None,
         crop: None,
         integrators: None,
+        frames: None,
+        fps: None,
     };
     BenchResults {
         suite: Suite {

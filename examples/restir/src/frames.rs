@@ -10,10 +10,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use restir_image::Image;
-use restir_integrators::reuse::motion::FrameMotion;
+use restir_integrators::reuse::motion::FrameSequence;
 use restir_integrators::{Integrator, IntegratorOptions, RenderJob, make_integrator, render};
-use restir_scene::animation::{FRAME_REBUILDS, build_at, frame_time};
-use restir_scene::{Scene, SceneDesc};
+use restir_scene::SceneDesc;
+use restir_scene::animation::FRAME_REBUILDS;
 
 /// The frames to render, checked.
 #[derive(Clone, Debug)]
@@ -172,19 +172,18 @@ pub struct SequenceStats {
     pub seed: u64,
     /// Per frame.
     pub frames: Vec<FrameStats>,
-}
-
-/// The seed of frame `frame`: its own random streams, so noise does not repeat across frames.
-pub fn frame_seed(seed: u64, frame: u32) -> u64 {
-    seed ^ u64::from(frame).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+    /// Wall seconds of each stage of the estimator's passes, summed over the frames (empty for
+    /// the path tracer).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stage_seconds: Vec<crate::StageSeconds>,
 }
 
 /// Renders the frames of `plan`: per frame, the scene at its time, rendered with `job`'s passes
 /// or time limit by one estimator made from `options` for the first frame and told of each
-/// next frame's motion ([`Integrator::next_frame`]: with temporal reuse, ReSTIR DI carries its
-/// reservoirs across frames), and the image at [`frame_path`]. `progress` gets `(frame index,
-/// frames, passes of this frame)`. Stops after the current frame when `cancel` is set; returns
-/// the statistics and whether it was stopped.
+/// next frame's motion ([`FrameSequence`]: with temporal reuse, the ReSTIR estimators carry
+/// their reservoirs across frames), and the image at [`frame_path`]. `progress` gets `(frame
+/// index, frames, passes of this frame)`. Stops after the current frame when `cancel` is set;
+/// returns the statistics and whether it was stopped.
 #[allow(clippy::too_many_arguments)]
 pub fn render_frames(
     scene_path: &Path,
@@ -197,19 +196,15 @@ pub fn render_frames(
     progress: &mut dyn FnMut(u32, u32, u32),
 ) -> Result<(SequenceStats, bool), String> {
     let count = plan.last - plan.first + 1;
-    let anim = desc
-        .animation
-        .as_ref()
+    let mut sequence = FrameSequence::new(desc, scene_path, plan.fps)
         .ok_or_else(|| format!("{}: the scene has no animation", scene_path.display()))?;
     let mut frames = Vec::with_capacity(count as usize);
     let mut preview = Vec::new();
     let mut integrator: Option<Box<dyn Integrator>> = None;
-    let mut previous: Option<(Arc<Scene>, f32)> = None;
     let mut stopped = false;
     for (i, frame) in (plan.first..=plan.last).enumerate() {
-        let time = frame_time(frame, plan.fps);
         let build = Instant::now();
-        let scene = Arc::new(build_at(desc, scene_path, time).map_err(|e| e.to_string())?);
+        let scene = Arc::new(sequence.build(frame).map_err(|e| e.to_string())?);
         let build_seconds = build.elapsed().as_secs_f64();
         let estimator = match &integrator {
             Some(e) => e,
@@ -219,11 +214,9 @@ pub fn render_frames(
                     .integrator,
             ),
         };
-        if let Some((prev, t_prev)) = previous.take() {
-            estimator.next_frame(Arc::new(FrameMotion::new(prev, &scene, anim, t_prev, time)));
-        }
+        sequence.enter(estimator.as_ref(), scene.clone(), frame);
         let frame_job = RenderJob {
-            seed: frame_seed(job.seed, frame),
+            seed: FrameSequence::seed(job.seed, frame),
             ..job.clone()
         };
         let out = render(
@@ -233,7 +226,6 @@ pub fn render_frames(
             cancel,
             &mut |passes, _| progress(i as u32, count, passes),
         );
-        previous = Some((scene, time));
         let path = frame_path(output, frame);
         out.image.write(&path).map_err(|e| e.to_string())?;
         if plan.preview.is_some() {
@@ -241,7 +233,7 @@ pub fn render_frames(
         }
         frames.push(FrameStats {
             frame,
-            time,
+            time: sequence.time(frame),
             build_seconds,
             seconds: out.seconds,
             passes: out.passes,
@@ -259,6 +251,12 @@ pub fn render_frames(
     Ok((
         SequenceStats {
             scene: scene_path.display().to_string(),
+            stage_seconds: integrator
+                .as_ref()
+                .map_or(Vec::new(), |e| e.stage_seconds())
+                .into_iter()
+                .map(|(stage, seconds)| crate::StageSeconds { stage, seconds })
+                .collect(),
             integrator_settings: integrator.map(|e| e.describe()).unwrap_or_default(),
             rebuilt: FRAME_REBUILDS,
             fps: plan.fps,

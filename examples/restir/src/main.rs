@@ -269,10 +269,10 @@ struct Stats<'a> {
 }
 
 /// One stage's summed wall time in `--stats`.
-#[derive(serde::Serialize)]
-struct StageSeconds {
-    stage: &'static str,
-    seconds: f64,
+#[derive(serde::Serialize, Debug)]
+pub(crate) struct StageSeconds {
+    pub(crate) stage: &'static str,
+    pub(crate) seconds: f64,
 }
 
 /// How a render ended: completely, or stopped by an interrupt (the partial image written).

@@ -185,6 +185,101 @@ fn smoke_suite_end_to_end() {
     assert!(report.contains("64 passes (cached)"), "{report}");
 }
 
+/// The animation kind on its smoke suite: three frames of the glossy still life rendered by
+/// spatial-only and spatiotemporal ReSTIR PT and the path tracer at one budget per frame; the
+/// CSV has one row per frame, each frame its own reference, flicker from the second frame on,
+/// and the report the per-frame plot and the sequence table.
+#[test]
+fn animation_suite_end_to_end() {
+    let dir = temp_dir("anim");
+    let out_dir = dir.join("out");
+    let suite = repo("scenes/bench/animation-smoke.ron");
+    let out = restir(&["bench", s(&suite), "--out", s(&out_dir), "--quiet"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "stderr:\n{stderr}");
+
+    let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    // 3 configurations × 3 frames × 1 budget × 1 seed.
+    assert_eq!(rows.len(), 9, "{csv}");
+    for (i, r) in rows.iter().enumerate() {
+        assert_eq!(r.len(), header.len(), "{r:?}");
+        let num = |name: &str| r[col(name)].parse::<f64>().unwrap();
+        assert_eq!(num("frame"), (i % 3) as f64, "{r:?}");
+        assert!(num("relmse") > 0.0 && num("relmse").is_finite(), "{r:?}");
+        assert!(num("seconds") >= 0.05 && num("passes") >= 1.0, "{r:?}");
+        assert!(num("cpu_seconds") > 0.0, "{r:?}");
+        assert_eq!(num("nonfinite_pixels"), 0.0);
+        if i % 3 == 0 {
+            assert_eq!(r[col("flicker")], "", "{r:?}");
+        } else {
+            assert!(num("flicker") > 0.0 && num("flicker").is_finite(), "{r:?}");
+        }
+    }
+    let labels: Vec<&str> = rows.iter().step_by(3).map(|r| r[col("label")]).collect();
+    assert_eq!(
+        labels,
+        ["restir-pt spatial", "restir-pt spatiotemporal", "path"]
+    );
+    assert!(rows[4][col("integrator_settings")].contains("temporal=true"));
+    // One cached reference per frame.
+    let refs = std::fs::read_dir(out_dir.join("references"))
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .path()
+                .extension()
+                .is_some_and(|x| x == "exr")
+        })
+        .count();
+    assert_eq!(refs, 3);
+
+    let svg = std::fs::read_to_string(out_dir.join("frames-glossy-still-life.svg")).unwrap();
+    assert!(svg.contains("<svg") && svg.trim_end().ends_with("</svg>"));
+    assert!(svg.contains("restir-pt spatiotemporal") && svg.contains("frame"));
+    let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    for needle in [
+        "## glossy-still-life (32×24, frames 0 to 2)",
+        "16 passes per frame",
+        "frames-glossy-still-life.svg",
+        "relmse-glossy-still-life.svg",
+        "**Sequences.**",
+        "| efficiency × restir-pt spatial | flicker | flicker × restir-pt spatial |",
+        "| restir-pt spatial | 0.05 | ",
+    ] {
+        assert!(
+            report.contains(needle),
+            "report lacks {needle:?}:\n{report}"
+        );
+    }
+    let html = std::fs::read_to_string(out_dir.join("report.html")).unwrap();
+    assert!(html.contains("frames 0 to 2"));
+    assert_eq!(html.matches("\"hdr_f16\"").count(), 1 + 3);
+
+    // A second run reuses every frame's reference.
+    let out = restir(&["bench", s(&suite), "--out", s(&out_dir), "--quiet"]);
+    assert!(out.status.success());
+    let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    assert!(report.contains("16 passes per frame (cached)"), "{report}");
+
+    // A scene without animation given `frames` fails before anything renders.
+    let text = std::fs::read_to_string(&suite).unwrap().replace(
+        "\"../glossy-still-life.xml\"",
+        &format!("\"{}\"", s(&repo("scenes/cornell-box.xml"))),
+    );
+    let bad = dir.join("still.ron");
+    std::fs::write(&bad, text).unwrap();
+    fails(
+        &["bench", s(&bad), "--out", s(&dir.join("o"))],
+        &["cornell-box.xml", "no animation"],
+    );
+    assert!(!dir.join("o").exists());
+}
+
 #[test]
 fn bad_suites_fail_with_one_line() {
     let dir = temp_dir("bad");

@@ -41,10 +41,11 @@ pub use fallback::{GLOSSY_VIEW_MIN, INDIRECT_VIEW_MIN, ViewPilot, view_pilot};
 pub use sample::{Kind, PathSample, ShiftKind};
 pub use settings::{DirectLight, Fallback, RestirPtSettings, SHIFT_NAMES};
 use shift::PtReuse;
-pub use shift::PtShift;
+pub use shift::{Frames, PtShift};
 
 use crate::bands::Bands;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
+use crate::reuse::motion::FrameMotion;
 use crate::reuse::neighbors::NeighborPattern;
 use crate::reuse::passes::{self, HistorySlot};
 use crate::reuse::reciprocal;
@@ -158,9 +159,41 @@ impl RestirPtIntegrator {
             settings: &self.settings,
             gbuf,
             prev: None,
+            frames: None,
             pixels: 0,
         }
         .shift()
+    }
+
+    /// The shift map over the pixels of `gbuf` (domains `0..n`, in `scene`) and of the previous
+    /// frame's `prev` (domains `n..2n`, in `motion.prev_scene`), the map temporal reuse uses
+    /// across frames in which shapes or lights moved.
+    pub fn frame_shift_map<'a>(
+        &'a self,
+        scene: &'a Scene,
+        gbuf: &'a GBuffer,
+        prev: &'a GBuffer,
+        motion: &'a FrameMotion,
+    ) -> PtShift<'a> {
+        PtReuse {
+            walker: self.walker(scene),
+            settings: &self.settings,
+            gbuf,
+            prev: Some(prev),
+            frames: Some(self.frames(motion)),
+            pixels: gbuf.receivers.len(),
+        }
+        .shift()
+    }
+
+    /// The previous frame for the cross-frame shift, with the negative controls' switches.
+    fn frames<'a>(&'a self, motion: &'a FrameMotion) -> shift::Frames<'a> {
+        shift::Frames {
+            walker: self.walker(&motion.prev_scene),
+            motion,
+            current_scene: self.settings.reuse.temporal_current_scene,
+            stale_suffix: self.settings.temporal_stale_suffix,
+        }
     }
 
     /// The primary hits and the initial reservoirs of pass `ctx` (what reuse starts from), with
@@ -335,19 +368,18 @@ impl Integrator for RestirPtIntegrator {
         self.clock.seconds()
     }
 
-    /// Across frames where only the camera moved, the previous frame's reservoirs are reused
-    /// through motion vectors: the scene is the same, so every vertex, light index and cached
-    /// suffix radiance of a path means the same in both frames and the shift is the one between
-    /// pixels. Where anything else moved or changed, a path's cached suffix (its radiance after
-    /// the reconnection vertex, its light index) may be stale, so the history is dropped and the
-    /// frame starts afresh (`docs/ANIMATION.md`); `temporal_ignore_motion` (negative control
-    /// only) keeps it anyway.
-    fn next_frame(&self, motion: std::sync::Arc<crate::reuse::motion::FrameMotion>) {
-        let keep = motion.scene_is_still() || self.settings.temporal_ignore_motion;
+    /// The previous frame's reservoirs are reused through motion vectors. Where only the camera
+    /// moved, every vertex, light index and cached suffix of a path means the same in both
+    /// frames and the shift is the one between pixels; where shapes or lights moved, the shift
+    /// between the two frames' domains walks in the destination frame's scene, `x_k` moving with
+    /// its shape and what follows it evaluated there ([`shift::PtShift::shift_full`],
+    /// `docs/ANIMATION.md`). `temporal_ignore_motion` (negative control only) shifts as if
+    /// nothing but the camera had moved.
+    fn next_frame(&self, motion: std::sync::Arc<FrameMotion>) {
         if let Some(di) = &self.di {
             di.next_frame(motion.clone()); // its light samples move with their lights
         }
-        self.history.next_frame(keep.then_some(motion));
+        self.history.next_frame(Some(motion));
     }
 
     fn buffer_bytes_per_pixel(&self) -> usize {
@@ -383,11 +415,19 @@ impl Integrator for RestirPtIntegrator {
         rays += nr;
         if self.max_depth() >= 2 {
             let history = self.history.take(s, n);
+            // The previous frame, when the history is its last pass and more than the camera
+            // moved.
+            let frames = history
+                .as_ref()
+                .and_then(|h| h.motion.as_deref())
+                .filter(|m| !m.scene_is_still() && !self.settings.temporal_ignore_motion)
+                .map(|m| self.frames(m));
             let shift = PtReuse {
                 walker: self.walker(scene),
                 settings: &self.settings,
                 gbuf: &gbuf,
                 prev: history.as_ref().map(|h| &h.gbuffer),
+                frames,
                 // Domains: pixel `i` of this pass is `i`, of the previous pass `n + i`.
                 pixels: n,
             };

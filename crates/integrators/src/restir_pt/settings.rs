@@ -81,9 +81,14 @@ pub struct RestirPtSettings {
     pub direct: DirectLight,
     /// Negative control only: use Jacobian 1 in every shift (biased).
     pub unit_jacobian: bool,
-    /// Negative control only: keep the history across frames in which shapes or lights moved
-    /// (cached path suffixes go stale; biased).
+    /// Negative control only: across frames in which shapes or lights moved, shift paths as if
+    /// only the camera had moved (vertices, light indices and cached suffixes of the previous
+    /// frame taken for the current one's; biased).
     pub temporal_ignore_motion: bool,
+    /// Negative control only: across frames in which shapes or lights moved, keep the suffix a
+    /// path cached in its own frame (the radiance beyond its reconnection vertex, its
+    /// direction and light density) instead of evaluating it in the other frame (biased).
+    pub temporal_stale_suffix: bool,
     /// The shift between pixels (default hybrid; plain reconnection in scenes without
     /// near-specular materials).
     pub shift: ShiftKind,
@@ -114,6 +119,7 @@ impl RestirPtSettings {
             direct: DirectLight::Reservoir,
             unit_jacobian: false,
             temporal_ignore_motion: false,
+            temporal_stale_suffix: false,
             shift: ShiftKind::Hybrid,
             skip_invertibility: false,
             fallback: Fallback::Auto,
@@ -151,7 +157,8 @@ impl RestirPtSettings {
         self.reuse.is_unbiased()
             && !self.unit_jacobian
             && !self.skip_invertibility
-            && (!self.reuse.temporal || !self.temporal_ignore_motion)
+            && (!self.reuse.temporal
+                || !(self.temporal_ignore_motion || self.temporal_stale_suffix))
     }
 
     /// Applies `params` in order (later ones win). Names are case-insensitive, `-` and `_` are
@@ -189,6 +196,7 @@ impl RestirPtSettings {
             }
             "unit_jacobian" => self.unit_jacobian = p.boolean()?,
             "temporal_ignore_motion" => self.temporal_ignore_motion = p.boolean()?,
+            "temporal_stale_suffix" => self.temporal_stale_suffix = p.boolean()?,
             "skip_invertibility" => self.skip_invertibility = p.boolean()?,
             "fallback" => self.fallback = p.choice(Fallback::NAMES, "auto or off")?,
             _ => return self.reuse.apply(key, p),

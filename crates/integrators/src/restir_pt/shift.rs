@@ -19,7 +19,10 @@ use restir_gris::jacobian::{reconnection_jacobian_from_geometry, reject_jacobian
 use restir_gris::{ShiftMap, Shifted};
 use restir_sampling::luminance;
 
+use restir_scene::Scene;
+
 use crate::reuse::gbuffer::GBuffer;
+use crate::reuse::motion::FrameMotion;
 use crate::reuse::passes::ReuseShift;
 use crate::shadow::visible;
 
@@ -38,6 +41,9 @@ pub struct PtShift<'a> {
     pub gbuf: &'a GBuffer,
     /// The previous pass's primary hits (temporal reuse).
     pub prev: Option<&'a GBuffer>,
+    /// When the previous pass was the previous frame of a sequence in which shapes or lights
+    /// moved: that frame and how it relates to this one.
+    pub frames: Option<Frames<'a>>,
     /// Rays traced by this map's shifts (shadow rays and replayed segments).
     pub rays: Cell<u64>,
     /// Symmetric Jacobian rejection bound (`max(J, 1/J)`); 0 for none.
@@ -46,10 +52,27 @@ pub struct PtShift<'a> {
     pub unit_jacobian: bool,
 }
 
+/// The previous frame, for shifts between the domains of two frames (`docs/ANIMATION.md`,
+/// "ReSTIR PT across frames").
+#[derive(Clone, Copy, Debug)]
+pub struct Frames<'a> {
+    /// The walks' rules in the previous frame's scene (its geometry, lights and `d_near`).
+    pub walker: Walker<'a>,
+    /// Each shape's rigid motion and the light correspondence between the frames.
+    pub motion: &'a FrameMotion,
+    /// Negative control only: a shift into a previous domain is taken in the current frame's
+    /// scene, as if the previous pixel's primary hit lay there (biased).
+    pub current_scene: bool,
+    /// Negative control only: a shift across frames keeps the suffix the path cached in its
+    /// own frame (the radiance beyond `x_k`, its direction and light density) instead of
+    /// evaluating it in the destination frame (biased).
+    pub stale_suffix: bool,
+}
+
 impl PtShift<'_> {
-    /// The primary hit of domain `d`.
+    /// The primary hit of domain `d`, as a vertex of `scene`.
     #[inline]
-    fn hit(&self, d: usize) -> Option<ScatterVertex> {
+    fn hit(&self, d: usize, scene: &Scene) -> Option<ScatterVertex> {
         let n = self.gbuf.receivers.len();
         let (buf, i) = if d < n {
             (self.gbuf, d)
@@ -57,28 +80,51 @@ impl PtShift<'_> {
             (self.prev?, d - n)
         };
         buf.receiver(i)
-            .map(|r| ScatterVertex::primary(self.walker.scene, r, buf.ng[i]))
+            .map(|r| ScatterVertex::primary(scene, r, buf.ng[i]))
+    }
+
+    #[inline]
+    fn count(&self, rays: u64) {
+        self.rays.set(self.rays.get() + rays);
     }
 
     /// The target (luminance, with visibility), the Jacobian and the shifted sample (its
     /// `value` the integrand at `to`) of shifting `s` from pixel `from` to pixel `to`; `None` if
     /// the shift is not defined there.
+    ///
+    /// Between the domains of two frames in which shapes or lights moved ([`Frames`]), the
+    /// destination's walk is in the destination frame's scene: the replayed prefix, `x_k`
+    /// (named by shape, primitive and parameters, so it moved with its shape; a light vertex's
+    /// light renamed through the frames' correspondence, failing where the light does not
+    /// exist), the reconnection and its visibility, and what follows `x_k`
+    /// ([`Walker::suffix_in_frame`]). The reconnection Jacobian `G_y / G_x` takes `G_x` as the
+    /// source frame cached it and `G_y` in the destination frame (a rigid motion keeps area on
+    /// `x_k`'s shape); the suffix contributes its own factor.
     pub fn shift_full(
         &self,
         from: usize,
         to: usize,
         s: &PathSample,
     ) -> Option<(f32, f32, PathSample)> {
-        let _ = from;
-        let walker = &self.walker;
+        let n = self.gbuf.receivers.len();
+        let to_prev = to >= n;
+        // Across frames: the motion and its direction (towards the previous frame or not).
+        let across = self
+            .frames
+            .filter(|f| (from >= n) != to_prev && !(to_prev && f.current_scene));
+        let walker = match (&self.frames, to_prev) {
+            (Some(f), true) if !f.current_scene => &f.walker,
+            _ => &self.walker,
+        };
         let scene = walker.scene;
-        let y1 = self.hit(to)?;
+        let y1 = self.hit(to, scene)?;
         if s.kind == Kind::Frozen {
+            // Primary sample space throughout: replayed in the destination's scene, J = 1.
             if walker.shift == ShiftKind::Reconnection {
                 return None;
             }
             let (out, rays) = walker.walk(&y1, s.seed, Some(s), &mut |_, _| {});
-            self.rays.set(self.rays.get() + rays);
+            self.count(rays);
             let Replayed::Value(f) = out else {
                 return None;
             };
@@ -91,7 +137,7 @@ impl PtShift<'_> {
             (y1, Vec3::ONE)
         } else {
             let (out, rays) = walker.walk(&y1, s.seed, Some(s), &mut |_, _| {});
-            self.rays.set(self.rays.get() + rays);
+            self.count(rays);
             match out {
                 Replayed::Prefix { v, beta } => (v, beta),
                 _ => return None,
@@ -101,7 +147,14 @@ impl PtShift<'_> {
         if !prev.conn && !walker.skip_invertibility {
             return None;
         }
-        let v = resolve_vertex(scene, s);
+        // The sample as the destination's frame names it.
+        let mut s = *s;
+        if let Some(f) = &across
+            && s.is_direct()
+        {
+            s.id = f.motion.map_light(s.id, to_prev)?;
+        }
+        let v = resolve_vertex(scene, &s);
         if let Vertex::Surface(si) = &v
             && !connectible(&scene.bsdf(si))
         {
@@ -112,13 +165,24 @@ impl PtShift<'_> {
         {
             return None;
         }
-        let (geometry, f, target) = walker.reconnect(&prev, beta, s, &v);
+        let mut suffix_jacobian = 1.0;
+        if let Some(f) = &across
+            && let Vertex::Surface(si) = &v
+            && !f.stale_suffix
+        {
+            let dir = f.motion.turn_direction(si.shape, s.dir, to_prev);
+            let mut rays = 0;
+            let j = walker.suffix_in_frame(si, &mut s, dir, &mut rays);
+            self.count(rays);
+            suffix_jacobian = j?;
+        }
+        let (geometry, f, target) = walker.reconnect(&prev, beta, &s, &v);
         let jacobian = if v.area_point().is_some() {
             reconnection_jacobian_from_geometry(geometry, s.geometry)
         } else {
             1.0
-        };
-        if jacobian.is_nan() || jacobian <= 0.0 {
+        } * suffix_jacobian;
+        if jacobian.is_nan() || jacobian <= 0.0 || jacobian.is_infinite() {
             return None;
         }
         if self.max_jacobian > 0.0 && reject_jacobian(jacobian, self.max_jacobian) {
@@ -129,7 +193,7 @@ impl PtShift<'_> {
         if !(p > 0.0 && p.is_finite()) {
             p = 0.0;
         } else {
-            self.rays.set(self.rays.get() + 1);
+            self.count(1);
             if !target.is_some_and(|t| visible(scene, prev.r.p, prev.ng, t)) {
                 p = 0.0;
             }
@@ -137,7 +201,7 @@ impl PtShift<'_> {
         let shifted = PathSample {
             geometry,
             value: if p > 0.0 { f } else { Vec3::ZERO },
-            ..*s
+            ..s
         };
         Some((p, jacobian, shifted))
     }
@@ -168,6 +232,8 @@ pub(super) struct PtReuse<'p> {
     pub(super) gbuf: &'p GBuffer,
     /// The previous pass's primary hits.
     pub(super) prev: Option<&'p GBuffer>,
+    /// The previous frame, when the previous pass was its last and shapes or lights moved.
+    pub(super) frames: Option<Frames<'p>>,
     /// Pixels per pass: pixel `i` of the previous pass is domain `n + i`.
     pub(super) pixels: usize,
 }
@@ -180,6 +246,7 @@ impl<'p> PtReuse<'p> {
             walker: self.walker,
             gbuf: self.gbuf,
             prev: self.prev,
+            frames: self.frames,
             rays: Cell::new(0),
             max_jacobian: self.settings.max_jacobian,
             unit_jacobian: self.settings.unit_jacobian,

@@ -404,31 +404,7 @@ impl Walker<'_> {
         sink: &mut dyn FnMut(PathSample, Vec3),
     ) -> Option<Replayed> {
         let scene = self.scene;
-        let (lights, shapes) = (&scene.lights, &scene.shapes);
-        let (p, d) = (w.cur.r.p, step.d);
-        let (y, le, light_pdf_sa) = match hit {
-            None => lights.environment().map(|env| {
-                let le = lights.environment_radiance(d);
-                let lp = lights.pdf_sa(shapes, env, p, p + d, -d);
-                (
-                    LightPoint::environment(env, lights.environment_param(d)),
-                    le,
-                    lp,
-                )
-            }),
-            Some(si) => lights.light_on_shape(si.shape).and_then(|light| {
-                let le = lights.area_radiance(light, si.shading.n, -d);
-                (le != Vec3::ZERO).then(|| {
-                    let lp = lights.pdf_sa(shapes, light, p, si.p, si.ng);
-                    let y = LightPoint {
-                        light,
-                        prim: si.prim,
-                        param: si.param,
-                    };
-                    (y, le, lp)
-                })
-            }),
-        }?;
+        let (y, le, light_pdf_sa) = self.emission(w.cur.r.p, step.d, hit)?;
         let mis = step.prev.emission_weight(light_pdf_sa);
         let direct = PathSample::direct(y, Kind::DirectHit);
         let eligible =
@@ -448,6 +424,135 @@ impl Walker<'_> {
         let sample = self.candidate(w, &connection, direct, eligible);
         sink(sample, connection.contribution(w.beta, w.inv_q));
         None
+    }
+
+    /// The emitter (or the environment) a ray from `p` along `d` reached (`hit`, `None` for a
+    /// miss): the light point, its radiance towards `p` and the light-sampling density of that
+    /// point from `p` (solid angle); `None` when it emits nothing towards `p`.
+    fn emission(
+        &self,
+        p: Vec3,
+        d: Vec3,
+        hit: Option<&SurfaceInteraction>,
+    ) -> Option<(LightPoint, Vec3, f32)> {
+        let (lights, shapes) = (&self.scene.lights, &self.scene.shapes);
+        match hit {
+            None => lights.environment().map(|env| {
+                let le = lights.environment_radiance(d);
+                let lp = lights.pdf_sa(shapes, env, p, p + d, -d);
+                (LightPoint::environment(env, lights.environment_param(d)), le, lp)
+            }),
+            Some(si) => lights.light_on_shape(si.shape).and_then(|light| {
+                let le = lights.area_radiance(light, si.shading.n, -d);
+                (le != Vec3::ZERO).then(|| {
+                    let lp = lights.pdf_sa(shapes, light, p, si.p, si.ng);
+                    let y = LightPoint {
+                        light,
+                        prim: si.prim,
+                        param: si.param,
+                    };
+                    (y, le, lp)
+                })
+            }),
+        }
+    }
+
+    /// What follows the reconnection vertex `x_k` of `s` (a sample whose `x_k` is a surface:
+    /// [`Kind::NeeAtX2`], [`Kind::HitAtX3`], [`Kind::Continue`]), evaluated afresh in this
+    /// walker's scene — another frame of a moving sequence than the one `s` was found in.
+    /// `xk` is `x_k` resolved in this scene (it moved with its shape) and `dir` the direction
+    /// that left it, turned with its shape. Updates `s.dir`, `s.radiance` and
+    /// `s.light_pdf_sa` (zero radiance where the suffix is now occluded) and returns the
+    /// Jacobian of the map of the direction leaving `x_k` (solid angle to solid angle), or
+    /// `None` when the suffix leaves the sample's subspace; `rays` counts the rays traced.
+    ///
+    /// * Light sampling at `x_k` ([`Kind::NeeAtX2`]) is drawn again with the path's stored
+    ///   numbers of that bounce (selection, point): primary sample space in between, so the
+    ///   direction's Jacobian is the ratio of the two frames' light-sampling densities,
+    ///   `p_from(ω) / p_to(ω')` (the stored `light_pdf_sa` over the new one). A delta light in
+    ///   either frame has no density: the shift fails, in both directions alike.
+    /// * Otherwise the direction is kept on the shape (`dir`, a rotation: Jacobian 1) and traced:
+    ///   an emitter reached along it ([`Kind::HitAtX3`]), or `x_{k+1}`, from which the rest of
+    ///   the path is replayed with its stored numbers (primary sample space: Jacobian 1) to its
+    ///   light connection, which must end as the stored one (length, technique, lobes).
+    pub fn suffix_in_frame(
+        &self,
+        xk: &SurfaceInteraction,
+        s: &mut PathSample,
+        dir: Vec3,
+        rays: &mut u64,
+    ) -> Option<f32> {
+        let scene = self.scene;
+        let k = u32::from(s.rc);
+        let mut rng = s.seed;
+        rng.advance(RANDOMS_PER_BOUNCE as u64 * u64::from(k.saturating_sub(1)));
+        let u = BounceRandoms::draw(&mut rng); // x_k's; `rng` is now at x_{k+1}'s
+        match s.kind {
+            Kind::NeeAtX2 => {
+                if s.light_pdf_sa <= 0.0 {
+                    return None;
+                }
+                let ls = scene
+                    .lights
+                    .sample(&scene.shapes, xk.p, u.select, u.light)?;
+                if ls.delta || !(ls.pdf_sa > 0.0 && ls.pdf_sa.is_finite()) {
+                    return None;
+                }
+                *rays += 1;
+                let seen = visible(scene, xk.p, xk.ng, ShadowTarget::new(ls.p, ls.wi, ls.dist));
+                let jacobian = s.light_pdf_sa / ls.pdf_sa;
+                s.dir = ls.wi;
+                s.radiance = if seen { ls.le } else { Vec3::ZERO };
+                s.light_pdf_sa = ls.pdf_sa;
+                Some(jacobian)
+            }
+            Kind::HitAtX3 | Kind::Continue => {
+                if dir == Vec3::ZERO {
+                    return None;
+                }
+                *rays += 1;
+                let hit = scene.intersect(&Ray::new(offset_ray_origin(xk.p, xk.ng, dir), dir));
+                s.dir = dir;
+                if s.kind == Kind::HitAtX3 {
+                    let (_, le, light_pdf_sa) = self.emission(xk.p, dir, hit.as_ref())?;
+                    s.radiance = le;
+                    s.light_pdf_sa = light_pdf_sa;
+                    return Some(1.0);
+                }
+                let si = hit?;
+                let base = *s;
+                let mut w = Walk {
+                    replay: Some(&base),
+                    terminal: Some(&base),
+                    // The reconnection vertex is behind: nothing after it can be an earlier one.
+                    check: false,
+                    seed: base.seed,
+                    rng,
+                    rays: 0,
+                    cur: ScatterVertex::at(scene, &si, -dir),
+                    j: k + 1,
+                    beta: Vec3::ONE,
+                    inv_q: 1.0,
+                    eta_scale: 1.0,
+                    lobes: 0,
+                    rc: None,
+                };
+                let out = loop {
+                    if let Some(out) = self.bounce(&mut w, &mut |_, _| {}) {
+                        break out;
+                    }
+                };
+                *rays += w.rays;
+                match out {
+                    Replayed::Value(l) => {
+                        s.radiance = l;
+                        Some(1.0)
+                    }
+                    _ => None,
+                }
+            }
+            _ => Some(1.0),
+        }
     }
 
     /// The step to the surface `si` the BSDF ray of `step` hit: the depth limit, the search for

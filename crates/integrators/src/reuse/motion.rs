@@ -12,12 +12,15 @@
 //! (`docs/ANIMATION.md`, "Across frames").
 
 use std::collections::HashMap;
+use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
 use restir_lights::Light;
-use restir_scene::{AnimationDesc, Scene};
+use restir_scene::animation::{build_at, frame_time};
+use restir_scene::{AnimationDesc, Scene, SceneDesc, SceneError};
 
+use crate::render::Integrator;
 use crate::reuse::gbuffer::GBuffer;
 use crate::reuse::settings::ReuseSettings;
 
@@ -29,13 +32,16 @@ pub struct FrameMotion {
     /// Per shape (the two frames' shapes are the same list): the rigid map taking a point of
     /// the shape in the current frame to where it was in the previous frame.
     to_prev: Vec<Mat4>,
+    /// Per shape, the inverse map (previous frame to current).
+    from_prev: Vec<Mat4>,
     /// Per light of the current frame, the same light in the previous frame (`None`: it did
     /// not emit then).
     light_to_prev: Vec<Option<u32>>,
     /// Per light of the previous frame, the same light now.
     light_from_prev: Vec<Option<u32>>,
     /// Whether only the camera moved: every shape in place, the same lights with the same
-    /// radiance (everything a sample names or caches is then the same in both frames).
+    /// radiance and the same light selection (everything a sample names or caches is then the
+    /// same in both frames).
     scene_still: bool,
 }
 
@@ -97,11 +103,17 @@ impl FrameMotion {
             "one motion per shape of the current frame"
         );
         let (now, then) = (scene.lights.lights(), prev_scene.lights.lights());
-        let scene_still = to_prev.iter().all(|m| *m == Mat4::IDENTITY) && now == then;
+        // The environment's share of light selections is decided per frame from what the
+        // camera sees; a light sample's density (cached in ReSTIR PT's paths for their MIS
+        // weights) depends on it.
+        let scene_still = to_prev.iter().all(|m| *m == Mat4::IDENTITY)
+            && now == then
+            && scene.lights.environment_share() == prev_scene.lights.environment_share();
         Self {
             scene_still,
             light_to_prev: light_map(now, then),
             light_from_prev: light_map(then, now),
+            from_prev: to_prev.iter().map(Mat4::inverse).collect(),
             to_prev,
             prev_scene,
         }
@@ -129,6 +141,30 @@ impl FrameMotion {
     #[inline]
     pub fn point_to_prev(&self, shape: u32, p: Vec3) -> Vec3 {
         self.to_prev[shape as usize].transform_point3(p)
+    }
+
+    /// Direction `d` (unit) fixed to shape `shape`, turned with the shape's rigid motion: from
+    /// the current frame to the previous one (`to_prev`), or back. A rotation, so solid angle
+    /// is kept (Jacobian 1).
+    #[inline]
+    pub fn turn_direction(&self, shape: u32, d: Vec3, to_prev: bool) -> Vec3 {
+        let m = if to_prev {
+            &self.to_prev
+        } else {
+            &self.from_prev
+        };
+        m[shape as usize].transform_vector3(d).normalize_or_zero()
+    }
+
+    /// The light of the other frame that is light `light` of this one: of the previous frame
+    /// when `to_prev` (`light` is the current frame's), else of the current frame.
+    #[inline]
+    pub fn map_light(&self, light: u32, to_prev: bool) -> Option<u32> {
+        if to_prev {
+            self.light_to_prev(light)
+        } else {
+            self.light_from_prev(light)
+        }
     }
 
     /// The pixel of the previous frame's `prev` G-buffer that saw pixel `index`'s primary hit
@@ -164,5 +200,62 @@ impl FrameMotion {
         let similar = pr.n.dot(n) >= settings.normal_cos
             && (pr.depth - depth).abs() <= settings.depth_tolerance * pr.depth.max(depth);
         similar.then_some(q)
+    }
+}
+
+/// Steps one estimator through the frames of an animated scene description: each frame's scene
+/// (the description at the frame's time, built by the one builder) and, before every frame
+/// after the first, the motion since the previous one told to the estimator
+/// ([`Integrator::next_frame`]). `restir render --frames` and `restir bench`'s animation suites
+/// both render sequences through it.
+#[derive(Debug)]
+pub struct FrameSequence<'a> {
+    desc: &'a SceneDesc,
+    anim: &'a AnimationDesc,
+    path: &'a Path,
+    fps: f32,
+    /// The last frame entered and its time.
+    previous: Option<(Arc<Scene>, f32)>,
+}
+
+impl<'a> FrameSequence<'a> {
+    /// The frames of `desc` (read from `path`, which relative files are resolved against) at
+    /// `fps` frames per second; `None` when the description has no animation.
+    pub fn new(desc: &'a SceneDesc, path: &'a Path, fps: f32) -> Option<Self> {
+        Some(Self {
+            anim: desc.animation.as_ref()?,
+            desc,
+            path,
+            fps,
+            previous: None,
+        })
+    }
+
+    /// The time frame `frame` shows, in seconds.
+    pub fn time(&self, frame: u32) -> f32 {
+        frame_time(frame, self.fps)
+    }
+
+    /// The scene of frame `frame`.
+    pub fn build(&self, frame: u32) -> Result<Scene, SceneError> {
+        build_at(self.desc, self.path, self.time(frame))
+    }
+
+    /// Makes `scene` (frame `frame`, from [`Self::build`]) the current frame: `estimator`,
+    /// which rendered the previous frame entered (if any), is told how the scene moved since.
+    pub fn enter(&mut self, estimator: &dyn Integrator, scene: Arc<Scene>, frame: u32) {
+        let time = self.time(frame);
+        if let Some((prev, t_prev)) = self.previous.take() {
+            estimator.next_frame(Arc::new(FrameMotion::new(
+                prev, &scene, self.anim, t_prev, time,
+            )));
+        }
+        self.previous = Some((scene, time));
+    }
+
+    /// The seed frame `frame` renders with, from the sequence's `seed`: its own random streams,
+    /// so the noise of consecutive frames is independent rather than the same pattern.
+    pub fn seed(seed: u64, frame: u32) -> u64 {
+        seed ^ u64::from(frame).wrapping_mul(0x9e37_79b9_7f4a_7c15)
     }
 }
