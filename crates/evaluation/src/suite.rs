@@ -12,7 +12,12 @@ use serde::Deserialize;
 #[serde(deny_unknown_fields)]
 pub struct Suite {
     /// Scenes to render.
+    #[serde(default)]
     pub scenes: Vec<SuiteScene>,
+    /// Generated families of scenes (`restir generate family`), each member a scene of the
+    /// suite: written into the output directory on first use ([`Suite::expand_families`]).
+    #[serde(default)]
+    pub families: Vec<SuiteFamily>,
     /// Integrator configurations; each renders every scene.
     pub integrators: Vec<IntegratorConfig>,
     /// Time budgets in seconds (each render stops starting passes once its budget is spent).
@@ -68,6 +73,79 @@ pub struct SuiteScene {
     /// Frames per second of a sequence (default: the animation's).
     #[serde(default)]
     pub fps: Option<f32>,
+}
+
+/// A generated family of scenes in a suite: the training or test family of a study
+/// (`restir generate family --issue ISSUE --split SPLIT`), every member (or those listed) a
+/// scene with the settings given here.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SuiteFamily {
+    /// The study: `di` or `pt` (the still families).
+    pub issue: String,
+    /// `train` or `test`.
+    pub split: String,
+    /// Indices of the members to render (default: all of them).
+    #[serde(default)]
+    pub members: Option<Vec<usize>>,
+    /// Image width; overrides the scenes'.
+    #[serde(default)]
+    pub width: Option<u32>,
+    /// Image height; overrides the scenes'.
+    #[serde(default)]
+    pub height: Option<u32>,
+    /// Longest path; overrides the scenes'.
+    #[serde(default)]
+    pub max_depth: Option<i32>,
+    /// Reference passes for these scenes; overrides the suite's `reference_spp`.
+    #[serde(default)]
+    pub reference_spp: Option<u32>,
+    /// Labels of the integrator configurations that render these scenes (default: all).
+    #[serde(default)]
+    pub integrators: Option<Vec<String>>,
+}
+
+impl SuiteFamily {
+    /// The family's members to render (checked: a known still study and split, members in
+    /// range).
+    pub fn chosen(&self) -> Result<Vec<restir_scene::generate::FamilyMember>, SuiteError> {
+        use restir_scene::generate::{Issue, Split, family};
+        let issue = Issue::ALL
+            .into_iter()
+            .find(|i| i.name() == self.issue && !i.animated())
+            .ok_or_else(|| {
+                SuiteError::rule(format!(
+                    "family issue '{}': expected di or pt (the moving families are sequences)",
+                    self.issue
+                ))
+            })?;
+        let split = match self.split.as_str() {
+            "train" => Split::Train,
+            "test" => Split::Test,
+            other => {
+                return Err(SuiteError::rule(format!(
+                    "family split '{other}': expected train or test"
+                )));
+            }
+        };
+        let all = family(issue, split);
+        match &self.members {
+            None => Ok(all),
+            Some(list) => list
+                .iter()
+                .map(|&i| {
+                    all.get(i).cloned().ok_or_else(|| {
+                        SuiteError::rule(format!(
+                            "the {} {} family has members 0 to {}, not {i}",
+                            self.issue,
+                            self.split,
+                            all.len() - 1
+                        ))
+                    })
+                })
+                .collect(),
+        }
+    }
 }
 
 /// One integrator configuration: what `IntegratorOptions` takes, plus a label.
@@ -189,10 +267,56 @@ impl Suite {
         Self::parse(&text, file)
     }
 
+    /// Writes the members of the suite's families that are not there yet into
+    /// `dir/<issue>-<split>/` (the scene and its assets, as `restir generate family` writes
+    /// them) and appends each as a scene. Afterwards the suite has no families left.
+    pub fn expand_families(&mut self, dir: &Path) -> Result<(), SuiteError> {
+        for f in std::mem::take(&mut self.families) {
+            let out = dir.join(format!("{}-{}", f.issue, f.split));
+            for member in f.chosen()? {
+                let name = member.name();
+                let path = out.join(format!("{name}.ron"));
+                if !path.is_file() {
+                    let generated = member
+                        .generate()
+                        .map_err(|e| SuiteError::rule(format!("{name}: {e}")))?;
+                    generated
+                        .write(&out, &name)
+                        .map_err(|e| SuiteError::rule(format!("writing {}: {e}", out.display())))?;
+                }
+                self.scenes.push(SuiteScene {
+                    path,
+                    name: Some(name),
+                    width: f.width,
+                    height: f.height,
+                    max_depth: f.max_depth,
+                    reference: None,
+                    reference_spp: f.reference_spp,
+                    crop: None,
+                    integrators: f.integrators.clone(),
+                    frames: None,
+                    fps: None,
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// Checks what the format cannot: non-empty lists, positive budgets, unique names.
     pub fn validate(&self) -> Result<(), SuiteError> {
-        if self.scenes.is_empty() {
+        if self.scenes.is_empty() && self.families.is_empty() {
             return Err(SuiteError::rule("the suite has no scenes"));
+        }
+        for f in &self.families {
+            f.chosen()?;
+            if let Some(spp) = f.reference_spp
+                && !(2..=1 << 24).contains(&spp)
+            {
+                return Err(SuiteError::rule(format!(
+                    "family {}-{}: reference_spp {spp}: expected 2 to 16777216",
+                    f.issue, f.split
+                )));
+            }
         }
         if self.integrators.is_empty() {
             return Err(SuiteError::rule("the suite has no integrators"));
@@ -357,6 +481,53 @@ mod tests {
         assert_eq!(s.scenes[0].height, Some(16));
         assert_eq!(s.scenes[0].display_name(), "a");
         assert_eq!(s.integrators[1].params_string(), "candidates=8");
+    }
+
+    /// A family is checked when the suite is parsed, written into the output directory once and
+    /// expanded into one scene per chosen member, with the family's settings.
+    #[test]
+    fn families_expand_into_scenes() {
+        let text = r#"(
+            families: [(issue: "di", split: "test", members: [0], width: 40, height: 30,
+                        integrators: ["path"])],
+            integrators: [(label: "path", integrator: "path")],
+            budgets: [0.5],
+        )"#;
+        let mut s = Suite::parse(text, Path::new("f.ron")).unwrap();
+        let dir = std::env::temp_dir().join(format!("restir-families-{}", std::process::id()));
+        s.expand_families(&dir).unwrap();
+        assert!(s.families.is_empty());
+        assert_eq!(s.scenes.len(), 1);
+        let scene = &s.scenes[0];
+        let name = "di-test-00-rects-n1000-diffuse-occ-s101";
+        assert_eq!(scene.display_name(), name);
+        assert_eq!((scene.width, scene.height), (Some(40), Some(30)));
+        assert_eq!(scene.path, dir.join("di-test").join(format!("{name}.ron")));
+        let written = std::fs::metadata(&scene.path).unwrap().modified().unwrap();
+        // A second expansion finds the member written and leaves it.
+        let mut again = Suite::parse(text, Path::new("f.ron")).unwrap();
+        again.expand_families(&dir).unwrap();
+        let kept = std::fs::metadata(&again.scenes[0].path).unwrap().modified().unwrap();
+        assert_eq!(written, kept);
+        std::fs::remove_dir_all(&dir).unwrap();
+
+        for (bad, says) in [
+            (r#"issue: "dj""#, "family issue 'dj': expected di or pt"),
+            (r#"issue: "di-motion""#, "family issue 'di-motion'"),
+            (r#"split: "validation""#, "family split 'validation': expected train or test"),
+            ("members: [0, 10]", "the di test family has members 0 to 9, not 10"),
+        ] {
+            let key = bad.split(':').next().unwrap();
+            let original = match key {
+                "issue" => r#"issue: "di""#,
+                "split" => r#"split: "test""#,
+                _ => "members: [0]",
+            };
+            let e = Suite::parse(&text.replace(original, bad), Path::new("f.ron"))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(says), "{bad}: {e}");
+        }
     }
 
     #[test]

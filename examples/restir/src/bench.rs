@@ -42,6 +42,10 @@ pub struct BenchArgs {
 /// Runs `restir bench`.
 pub fn run(args: BenchArgs) -> Result<(), String> {
     let mut suite = Suite::load(&args.suite).map_err(|e| e.to_string())?;
+    // Generated families are written beside the references, once.
+    suite
+        .expand_families(&args.out.join("families"))
+        .map_err(|e| format!("{}: {e}", args.suite.display()))?;
     if let Some(b) = &args.budgets {
         suite::check_budgets(b).map_err(|e| format!("--budgets: {e}"))?;
         suite.budgets = b.clone();
