@@ -277,6 +277,7 @@ fn synthetic_results() -> BenchResults {
     BenchResults {
         suite: Suite {
             scenes: vec![scene_entry("room.xml"), scene_entry("lamps.xml")],
+            families: Vec::new(),
             integrators: configs
                 .iter()
                 .map(|l| IntegratorConfig {

@@ -321,7 +321,7 @@ impl EnvMap {
             return 0.0;
         };
         let sin_theta = (PI * uv.y).sin();
-        if !(sin_theta > 0.0) {
+        if sin_theta.is_nan() || sin_theta <= 0.0 {
             return 0.0;
         }
         let mut s = uv.x - 0.5 / self.width as f32;
