@@ -507,15 +507,24 @@ mod tests {
         // A second expansion finds the member written and leaves it.
         let mut again = Suite::parse(text, Path::new("f.ron")).unwrap();
         again.expand_families(&dir).unwrap();
-        let kept = std::fs::metadata(&again.scenes[0].path).unwrap().modified().unwrap();
+        let kept = std::fs::metadata(&again.scenes[0].path)
+            .unwrap()
+            .modified()
+            .unwrap();
         assert_eq!(written, kept);
         std::fs::remove_dir_all(&dir).unwrap();
 
         for (bad, says) in [
             (r#"issue: "dj""#, "family issue 'dj': expected di or pt"),
             (r#"issue: "di-motion""#, "family issue 'di-motion'"),
-            (r#"split: "validation""#, "family split 'validation': expected train or test"),
-            ("members: [0, 10]", "the di test family has members 0 to 9, not 10"),
+            (
+                r#"split: "validation""#,
+                "family split 'validation': expected train or test",
+            ),
+            (
+                "members: [0, 10]",
+                "the di test family has members 0 to 9, not 10",
+            ),
         ] {
             let key = bad.split(':').next().unwrap();
             let original = match key {

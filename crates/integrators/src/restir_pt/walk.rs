@@ -440,7 +440,11 @@ impl Walker<'_> {
             None => lights.environment().map(|env| {
                 let le = lights.environment_radiance(d);
                 let lp = lights.pdf_sa(shapes, env, p, p + d, -d);
-                (LightPoint::environment(env, lights.environment_param(d)), le, lp)
+                (
+                    LightPoint::environment(env, lights.environment_param(d)),
+                    le,
+                    lp,
+                )
             }),
             Some(si) => lights.light_on_shape(si.shape).and_then(|light| {
                 let le = lights.area_radiance(light, si.shading.n, -d);
