@@ -10,7 +10,7 @@
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
 
-use super::wide::{Entries, Kernel, Node, TRay, TriBlock, Wide, any, closest};
+use super::wide::{Entries, Found, Kernel, Node, TRay, TriBlock, TriHit, Wide, any, closest};
 
 /// The AVX2 kernel (x86-64 only).
 #[derive(Debug)]
@@ -38,10 +38,10 @@ fn load(x: &[f32; 8]) -> __m256 {
     unsafe { _mm256_load_ps(x.as_ptr()) }
 }
 
-/// The triangle distances of a block (Möller–Trumbore, the scalar test's operations lane by
-/// lane) and the mask of lanes hit with `0 < t < t_max`.
+/// The triangle distances and barycentrics `(u, v)` of a block (Möller–Trumbore, the scalar
+/// test's operations lane by lane) and the mask of lanes hit with `0 < t < t_max`.
 #[inline(always)]
-fn block_t(b: &TriBlock, r: &TRay, t_max: f32) -> (__m256, i32) {
+fn block_t(b: &TriBlock, r: &TRay, t_max: f32) -> (__m256, __m256, __m256, i32) {
     // SAFETY: arithmetic intrinsics only; AVX2 is guaranteed by the callers.
     unsafe {
         let (ox, oy, oz) = (splat(r.o.x), splat(r.o.y), splat(r.o.z));
@@ -78,7 +78,7 @@ fn block_t(b: &TriBlock, r: &TRay, t_max: f32) -> (__m256, i32) {
         let t = mul(add(add(mul(e2x, qx), mul(e2y, qy)), mul(e2z, qz)), inv_det);
         ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_GT_OQ>(t, splat(0.0)));
         ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_LT_OQ>(t, splat(t_max)));
-        (t, _mm256_movemask_ps(ok))
+        (t, u, vv, _mm256_movemask_ps(ok))
     }
 }
 
@@ -115,8 +115,8 @@ impl Kernel for Avx2 {
     }
 
     #[inline(always)]
-    fn block_closest(b: &TriBlock, r: &TRay, t_max: f32, lanes: u32) -> Option<(f32, u32)> {
-        let (t, hit) = block_t(b, r, t_max);
+    fn block_closest(b: &TriBlock, r: &TRay, t_max: f32, lanes: u32) -> Option<TriHit> {
+        let (t, u, v, hit) = block_t(b, r, t_max);
         let hit = hit as u32 & lanes;
         if hit == 0 {
             return None;
@@ -134,12 +134,24 @@ impl Kernel for Avx2 {
                 best = (ts[j as usize], j);
             }
         }
-        Some(best)
+        let (mut us, mut vs) = ([0.0f32; 8], [0.0f32; 8]);
+        // SAFETY: stores eight floats into eight-float arrays.
+        unsafe {
+            _mm256_storeu_ps(us.as_mut_ptr(), u);
+            _mm256_storeu_ps(vs.as_mut_ptr(), v);
+        }
+        let j = best.1 as usize;
+        Some(TriHit {
+            t: best.0,
+            lane: best.1,
+            u: us[j],
+            v: vs[j],
+        })
     }
 
     #[inline(always)]
     fn block_any(b: &TriBlock, r: &TRay, t_max: f32, lanes: u32) -> bool {
-        block_t(b, r, t_max).1 as u32 & lanes != 0
+        block_t(b, r, t_max).3 as u32 & lanes != 0
     }
 }
 
@@ -154,7 +166,7 @@ pub(super) unsafe fn closest_avx2(
     t_max: f32,
     stack: &mut [(u32, u32)],
     entries: &impl Entries,
-) -> Option<(f32, u32, u32)> {
+) -> Option<Found> {
     closest::<Avx2>(w, r, t_max, stack, entries)
 }
 

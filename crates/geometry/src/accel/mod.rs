@@ -22,7 +22,7 @@ mod wide;
 use prims::{Prim, group_entries};
 use wide::{Entries, Scalar, TRay, Wide};
 
-/// A closest hit: distance and which primitive.
+/// A closest hit: distance, which primitive, and where on it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
     /// Ray parameter of the hit.
@@ -31,6 +31,9 @@ pub struct Hit {
     pub shape: u32,
     /// The triangle within the shape (0 for spheres).
     pub prim: u32,
+    /// A triangle's barycentrics `(b1, b2)` of the hit point (the weights of its second and
+    /// third corner), as the ray-triangle test computed them; zero for spheres.
+    pub bary: Vec2,
 }
 
 /// Everything about a surface point that shading needs.
@@ -260,14 +263,29 @@ impl Accel {
             }
             wide::closest::<Scalar>(w, &r, t_max, stack, self)
         });
-        let (t, entry, member) = found?;
-        let id = match (member, &self.groups) {
-            (u32::MAX, Some(starts)) => starts[entry as usize],
-            (u32::MAX, None) => entry,
+        let f = found?;
+        let id = match (f.member, &self.groups) {
+            (u32::MAX, Some(starts)) => starts[f.entry as usize],
+            (u32::MAX, None) => f.entry,
             (m, _) => m,
         };
+        let bary = match (f.member, self.prims[id as usize]) {
+            // A triangle tested one at a time (in a group): the same test again, for its
+            // barycentrics.
+            (u32::MAX, _) => f.bary,
+            (_, Prim::Triangle { v0, e1, e2 }) => {
+                prims::triangle_hit(v0, e1, e2, r.o, r.d, f32::INFINITY)
+                    .map_or([0.0; 2], |(_, u, v)| [u, v])
+            }
+            (_, Prim::Sphere { .. }) => [0.0; 2],
+        };
         let (shape, prim) = self.ids[id as usize];
-        Some(Hit { t, shape, prim })
+        Some(Hit {
+            t: f.t,
+            shape,
+            prim,
+            bary: Vec2::from(bary),
+        })
     }
 
     /// Whether anything blocks `ray` before `t_max`.
@@ -298,17 +316,10 @@ impl Accel {
     ) -> SurfaceInteraction {
         let shape = &shapes[hit.shape as usize];
         let param = match shape {
-            Shape::Mesh(m) => {
-                // Barycentrics of the hit point, recomputed on the original vertices.
-                let [p0, p1, p2] = m.triangle(hit.prim as usize);
-                let (e1, e2) = (p1 - p0, p2 - p0);
-                let pvec = ray.d.cross(e2);
-                let inv_det = 1.0 / e1.dot(pvec);
-                let tvec = ray.o - p0;
-                let u = tvec.dot(pvec) * inv_det;
-                let v = ray.d.dot(tvec.cross(e1)) * inv_det;
-                let u = u.clamp(0.0, 1.0);
-                let v = v.clamp(0.0, 1.0 - u);
+            Shape::Mesh(_) => {
+                // The traversal's barycentrics, kept inside the triangle despite rounding.
+                let u = hit.bary.x.clamp(0.0, 1.0);
+                let v = hit.bary.y.clamp(0.0, 1.0 - u);
                 Vec2::new(u, v)
             }
             Shape::Sphere(s) => {

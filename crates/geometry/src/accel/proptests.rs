@@ -7,8 +7,8 @@ use glam::{Vec3, Vec3A};
 use obvhs::ray::{Ray as BvhRay, RayHit};
 use proptest::prelude::*;
 
+use super::Accel;
 use super::wide::TRay;
-use super::{Accel, Hit};
 use crate::{Ray, Shape, Sphere, TriangleMesh};
 
 /// obvhs's `ray_traverse` / `ray_traverse_miss` with our primitive tests in the closure (the
@@ -157,15 +157,40 @@ fn rays(shapes: &[Shape]) -> Vec<(Ray, f32)> {
 
 fn check(shapes: &[Shape], ray: &Ray, t_max: f32) -> Result<(), TestCaseError> {
     let mut accel = Accel::build(shapes);
+    let tr = TRay::new(ray.o.into(), ray.d.into());
     let got = accel.intersect(ray, t_max);
     let occluded = accel.occluded(ray, t_max);
     // The reference traversal gives the same bits.
     let (ref_hit, ref_occ) = reference(&accel, ray, t_max);
     let ref_hit = ref_hit.map(|(t, id)| {
         let (shape, prim) = accel.ids[id as usize];
-        Hit { t, shape, prim }
+        (t, shape, prim)
     });
-    prop_assert_eq!(got, ref_hit, "closest hit differs from obvhs's traversal");
+    prop_assert_eq!(
+        got.map(|h| (h.t, h.shape, h.prim)),
+        ref_hit,
+        "closest hit differs from obvhs's traversal"
+    );
+    // The barycentrics are the test's: recomputed from the primitive, the same bits.
+    if let Some(h) = got
+        && let Shape::Mesh(m) = &shapes[h.shape as usize]
+    {
+        let [a, b, c] = m.triangle(h.prim as usize);
+        let bary = super::prims::triangle_hit(
+            a.into(),
+            (b - a).into(),
+            (c - a).into(),
+            tr.o,
+            tr.d,
+            f32::INFINITY,
+        )
+        .map(|(_, u, v)| glam::Vec2::new(u, v));
+        prop_assert_eq!(
+            Some(h.bary),
+            bary,
+            "barycentrics differ from the hit's test"
+        );
+    }
     prop_assert_eq!(
         occluded,
         ref_occ,
@@ -178,7 +203,6 @@ fn check(shapes: &[Shape], ray: &Ray, t_max: f32) -> Result<(), TestCaseError> {
     // a box face or at `t_max` is decided by rounding. So: every hit reported is a brute-force
     // hit of the primitive named, and none is farther than the closest well-posed brute-force hit
     // (beyond 1e-4, short of `t_max`, not in the plane, inside its primitive's box).
-    let tr = TRay::new(ray.o.into(), ray.d.into());
     let ts: Vec<f32> = (0..accel.prims.len())
         .map(|i| accel.intersect_prim(i, &tr, t_max))
         .collect();

@@ -15,7 +15,7 @@
 use glam::Vec3A;
 use obvhs::cwbvh::CwBvh;
 
-use super::prims::intersect_triangle;
+use super::prims::{intersect_triangle, triangle_hit};
 
 /// obvhs's lower bound on a child box's entry distance.
 const NODE_EPSILON: f32 = 0.0001;
@@ -133,11 +133,20 @@ fn min_ps(a: f32, b: f32) -> f32 {
 pub(super) trait Kernel {
     /// Bit `s` set when child slot `s`'s box is entered before `t_max`.
     fn node_hits(node: &Node, ray: &TRay, t_max: f32) -> u32;
-    /// The closest hit among `lanes` (a mask) with `t < t_max`: `(t, lane)`, ties to the highest
-    /// lane.
-    fn block_closest(block: &TriBlock, ray: &TRay, t_max: f32, lanes: u32) -> Option<(f32, u32)>;
+    /// The closest hit among `lanes` (a mask) with `t < t_max`, ties to the highest lane.
+    fn block_closest(block: &TriBlock, ray: &TRay, t_max: f32, lanes: u32) -> Option<TriHit>;
     /// Whether any of `lanes` is hit with `t < t_max`.
     fn block_any(block: &TriBlock, ray: &TRay, t_max: f32, lanes: u32) -> bool;
+}
+
+/// A triangle hit in a block: distance, lane and the barycentrics `(u, v)` (the weights of the
+/// second and third vertex), as Möller–Trumbore computed them for the test.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct TriHit {
+    pub t: f32,
+    pub lane: u32,
+    pub u: f32,
+    pub v: f32,
 }
 
 /// The scalar kernel (every target; the reference the SIMD kernels match).
@@ -170,17 +179,16 @@ impl Kernel for Scalar {
     }
 
     #[inline(always)]
-    fn block_closest(b: &TriBlock, r: &TRay, t_max: f32, mut lanes: u32) -> Option<(f32, u32)> {
-        let mut best: Option<(f32, u32)> = None;
+    fn block_closest(b: &TriBlock, r: &TRay, t_max: f32, mut lanes: u32) -> Option<TriHit> {
+        let mut best: Option<TriHit> = None;
         let mut t_max = t_max;
         while lanes != 0 {
             let j = 31 - lanes.leading_zeros();
             lanes &= !(1 << j);
             let (v0, e1, e2) = b.lane(j as usize);
-            let t = intersect_triangle(v0, e1, e2, r.o, r.d, t_max);
-            if t < t_max {
+            if let Some((t, u, v)) = triangle_hit(v0, e1, e2, r.o, r.d, t_max) {
                 t_max = t;
-                best = Some((t, j));
+                best = Some(TriHit { t, lane: j, u, v });
             }
         }
         best
@@ -382,23 +390,34 @@ struct Closest<'a, K, E> {
     w: &'a Wide,
     r: &'a TRay,
     entries: &'a E,
-    best: Option<(f32, u32, u32)>,
+    best: Option<Found>,
     kernel: std::marker::PhantomData<K>,
+}
+
+/// The closest hit a traversal found: distance, BVH entry, the member [`Entries::entry`] named
+/// for an entry tested one at a time (`u32::MAX` for an inline triangle), and an inline
+/// triangle's barycentrics (zero otherwise).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Found {
+    pub t: f32,
+    pub entry: u32,
+    pub member: u32,
+    pub bary: [f32; 2],
 }
 
 impl<K: Kernel, E: Entries> Visit for Closest<'_, K, E> {
     #[inline(always)]
     fn visit(&mut self, node: &Node, entries: u32, t_max: f32) -> Option<f32> {
         let mut bt = t_max;
-        let mut found: Option<(u32, u32)> = None;
+        let mut found: Option<(u32, u32, [f32; 2])> = None;
         let tris = entries & !node.scalar;
         for c in (0..3).rev() {
             let lanes = (tris >> (8 * c)) & 0xff;
             if lanes != 0 {
                 let b = &self.w.blocks[(node.block + c) as usize];
-                if let Some((t, j)) = K::block_closest(b, self.r, bt, lanes) {
-                    bt = t;
-                    found = Some((8 * c + j, u32::MAX));
+                if let Some(h) = K::block_closest(b, self.r, bt, lanes) {
+                    bt = h.t;
+                    found = Some((8 * c + h.lane, u32::MAX, [h.u, h.v]));
                 }
             }
         }
@@ -411,13 +430,18 @@ impl<K: Kernel, E: Entries> Visit for Closest<'_, K, E> {
                 .entry((node.first + off) as usize, self.r, t_max);
             // Sequentially (highest offset first, strict `<`), equal distances go to the
             // highest offset.
-            if t < bt || (t == bt && found.is_some_and(|(o, _)| off > o)) {
+            if t < bt || (t == bt && found.is_some_and(|(o, _, _)| off > o)) {
                 bt = t;
-                found = Some((off, member));
+                found = Some((off, member, [0.0; 2]));
             }
         }
-        if let Some((off, member)) = found {
-            self.best = Some((bt, node.first + off, member));
+        if let Some((off, member, bary)) = found {
+            self.best = Some(Found {
+                t: bt,
+                entry: node.first + off,
+                member,
+                bary,
+            });
         }
         Some(bt)
     }
@@ -467,8 +491,7 @@ impl<K: Kernel, E: Entries> Visit for Any<'_, K, E> {
     }
 }
 
-/// The closest entry hit before `t_max`: `(t, entry, member)` where `member` is what
-/// [`Entries::entry`] returned for a scalar entry (`u32::MAX` for an inline triangle).
+/// The closest entry hit before `t_max`.
 #[inline(always)]
 pub(super) fn closest<K: Kernel>(
     w: &Wide,
@@ -476,7 +499,7 @@ pub(super) fn closest<K: Kernel>(
     t_max: f32,
     stack: &mut [(u32, u32)],
     entries: &impl Entries,
-) -> Option<(f32, u32, u32)> {
+) -> Option<Found> {
     let mut v = Closest::<K, _> {
         w,
         r,
