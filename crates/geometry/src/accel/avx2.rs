@@ -1,10 +1,12 @@
 //! The AVX2 kernel: a node's eight child boxes and a block's eight triangles tested in one
 //! 256-bit pass each, with exactly the scalar kernel's float operations (multiply then add, no
 //! FMA; the same min/max operand order), so both give the same bits. Used only when the CPU
-//! reports AVX2, checked once when the [`super::Accel`] is built.
+//! reports AVX2 (and the bit-counting POPCNT, BMI1 and LZCNT that come with it), checked once
+//! when the [`super::Accel`] is built.
 //!
-//! The entry points are `#[target_feature(enable = "avx2")]` functions around the generic
-//! traversal, so the whole loop is compiled for AVX2 and the kernel's intrinsics inline into it.
+//! The entry points are `#[target_feature(enable = "avx2,popcnt,bmi1,lzcnt")]` functions around
+//! the generic traversal, so the whole loop is compiled for them and the kernel's intrinsics
+//! inline into it.
 #![allow(unsafe_code)]
 
 #[cfg(target_arch = "x86_64")]
@@ -158,8 +160,8 @@ impl Kernel for Avx2 {
 /// [`closest`] with the AVX2 kernel.
 ///
 /// # Safety
-/// The CPU must support AVX2.
-#[target_feature(enable = "avx2")]
+/// The CPU must support AVX2, POPCNT, BMI1 and LZCNT.
+#[target_feature(enable = "avx2,popcnt,bmi1,lzcnt")]
 pub(super) unsafe fn closest_avx2(
     w: &Wide,
     r: &TRay,
@@ -173,8 +175,8 @@ pub(super) unsafe fn closest_avx2(
 /// [`any`] with the AVX2 kernel.
 ///
 /// # Safety
-/// The CPU must support AVX2.
-#[target_feature(enable = "avx2")]
+/// The CPU must support AVX2, POPCNT, BMI1 and LZCNT.
+#[target_feature(enable = "avx2,popcnt,bmi1,lzcnt")]
 pub(super) unsafe fn any_avx2(
     w: &Wide,
     r: &TRay,

@@ -85,7 +85,13 @@ pub struct Accel {
 fn detect_avx2() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
+        // The bit-counting instructions come with AVX2 on every CPU that has it (Haswell,
+        // Excavator and later), but are separate features; the kernel uses them for the child
+        // index and the lane loops.
         std::is_x86_feature_detected!("avx2")
+            && std::is_x86_feature_detected!("popcnt")
+            && std::is_x86_feature_detected!("bmi1")
+            && std::is_x86_feature_detected!("lzcnt")
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
@@ -257,7 +263,8 @@ impl Accel {
         let found = wide::with_stack(w.depth, |stack| {
             #[cfg(target_arch = "x86_64")]
             if self.avx2 {
-                // SAFETY: `avx2` is set only when the CPU reported AVX2 (`detect_avx2`).
+                // SAFETY: `avx2` is set only when the CPU reported AVX2, POPCNT, BMI1 and LZCNT
+                // (`detect_avx2`).
                 #[allow(unsafe_code)]
                 return unsafe { avx2::closest_avx2(w, &r, t_max, stack, self) };
             }
@@ -298,7 +305,8 @@ impl Accel {
         wide::with_stack(w.depth, |stack| {
             #[cfg(target_arch = "x86_64")]
             if self.avx2 {
-                // SAFETY: `avx2` is set only when the CPU reported AVX2 (`detect_avx2`).
+                // SAFETY: `avx2` is set only when the CPU reported AVX2, POPCNT, BMI1 and LZCNT
+                // (`detect_avx2`).
                 #[allow(unsafe_code)]
                 return unsafe { avx2::any_avx2(w, &r, t_max, stack, self) };
             }
