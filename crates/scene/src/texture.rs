@@ -209,14 +209,11 @@ impl Texture {
                 let y = p.y * *height as f32 - 0.5;
                 let (x0, y0) = (x.floor(), y.floor());
                 let (fx, fy) = (x - x0, y - y0);
-                let wrap = |i: f32, n: usize| -> usize {
-                    let n = n as i64;
-                    let i = if i.is_finite() { i as i64 } else { 0 };
-                    i.rem_euclid(n) as usize
-                };
-                let at = |xi: f32, yi: f32| texels[wrap(yi, *height) * width + wrap(xi, *width)];
-                let top = at(x0, y0) * (1.0 - fx) + at(x0 + 1.0, y0) * fx;
-                let bottom = at(x0, y0 + 1.0) * (1.0 - fx) + at(x0 + 1.0, y0 + 1.0) * fx;
+                let (xa, xb) = wrap_pair(x0, *width);
+                let (ya, yb) = wrap_pair(y0, *height);
+                let (ra, rb) = (ya * width, yb * width);
+                let top = texels[ra + xa] * (1.0 - fx) + texels[ra + xb] * fx;
+                let bottom = texels[rb + xa] * (1.0 - fx) + texels[rb + xb] * fx;
                 top * (1.0 - fy) + bottom * fy
             }
         }
@@ -231,6 +228,30 @@ impl Texture {
             }
         }
     }
+}
+
+/// The texel indices of whole-number coordinates `i` and `i + 1` (as floats) on an axis of `n`
+/// texels, repeating (non-finite coordinates read texel 0). The integer remainder, a division,
+/// only when `i` lies outside the image.
+#[inline]
+fn wrap_pair(i: f32, n: usize) -> (usize, usize) {
+    let wrap = |i: f32| -> usize {
+        let n = n as i64;
+        let i = if i.is_finite() { i as i64 } else { 0 };
+        if (0..n).contains(&i) {
+            i as usize
+        } else {
+            i.rem_euclid(n) as usize
+        }
+    };
+    let a = wrap(i);
+    // `i + 1` is the next texel unless it rounds back to `i` (|i| ≥ 2²⁴) or is not finite.
+    let b = if i.is_finite() && i + 1.0 != i {
+        if a + 1 == n { 0 } else { a + 1 }
+    } else {
+        wrap(i + 1.0)
+    };
+    (a, b)
 }
 
 /// Reads an image file as linear RGB texels, the first row at the top
@@ -253,6 +274,49 @@ pub(crate) fn read_image(
 mod tests {
     use super::*;
     use restir_image::srgb::decode as srgb_to_linear;
+
+    /// `wrap_pair` gives the texels the lookup read before it (each coordinate wrapped by its
+    /// own remainder), at the edges, outside the image, at huge and non-finite coordinates.
+    #[test]
+    fn wrap_pair_is_the_remainder_of_each_coordinate() {
+        let wrap = |i: f32, n: usize| -> usize {
+            let i = if i.is_finite() { i as i64 } else { 0 };
+            i.rem_euclid(n as i64) as usize
+        };
+        let values = [
+            0.0,
+            -0.0,
+            1.0,
+            2.0,
+            3.0,
+            4.0,
+            -1.0,
+            -2.0,
+            -5.0,
+            17.0,
+            -17.0,
+            16_777_215.0,
+            16_777_216.0,
+            -16_777_216.0,
+            3.0e9,
+            -3.0e9,
+            1.0e20,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        for n in [1, 2, 3, 4, 7] {
+            for &i in &values {
+                assert_eq!(
+                    wrap_pair(i, n),
+                    (wrap(i, n), wrap(i + 1.0, n)),
+                    "{i} of {n}"
+                );
+            }
+        }
+    }
 
     #[test]
     fn checkerboard_pattern_and_scale() {
