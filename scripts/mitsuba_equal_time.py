@@ -77,9 +77,80 @@ def load_mitsuba(mi, scene, w, h, max_depth):
         os.remove(tmp)
 
 
+def many_lights_xml(ron):
+    """`scenes/many-lights.ron` as Mitsuba 3 XML with each sphere light replaced by a one-sided
+    emissive square facing down (-y) at the sphere's centre, half-width the sphere's radius, same
+    radiance: 400 small emissive rectangles over diffuse receivers (the many-light scene of the
+    equal-time table). Reads the generator's one-shape-per-line RON."""
+    num = r"(-?\d+(?:\.\d*)?(?:[eE][+-]?\d+)?)"
+    vec = rf"\(\s*{num},\s*{num},\s*{num}\s*\)"
+    text = open(ron).read()
+    cam = re.search(rf"fov: {num}.*?LookAt\(origin: {vec}, target: {vec}, up: {vec}\)", text, re.S)
+    fov, o, t, u = cam.group(1), cam.groups()[1:4], cam.groups()[4:7], cam.groups()[7:10]
+    out = ['<scene version="3.0.0">',
+           '    <integrator type="path">',
+           '        <integer name="max_depth" value="2"/>',
+           '        <boolean name="hide_emitters" value="true"/>',
+           '    </integrator>',
+           '    <sensor type="perspective">',
+           f'        <float name="fov" value="{fov}"/>',
+           '        <string name="fov_axis" value="x"/>',
+           '        <transform name="to_world">',
+           f'            <lookat origin="{", ".join(o)}" target="{", ".join(t)}" up="{", ".join(u)}"/>',
+           '        </transform>',
+           '        <sampler type="independent"><integer name="sample_count" value="16"/></sampler>',
+           '        <film type="hdrfilm">',
+           '            <integer name="width" value="320"/>',
+           '            <integer name="height" value="240"/>',
+           '            <rfilter type="box"/>',
+           '        </film>',
+           '    </sensor>']
+    for name, r, g, b in re.findall(rf'\(name: "(\w+)", material: Diffuse\(reflectance: {vec}\)\)', text):
+        out.append(f'    <bsdf type="diffuse" id="{name}"><rgb name="reflectance" value="{r}, {g}, {b}"/></bsdf>')
+    for line in text.splitlines():
+        line = line.strip()
+        if not line.startswith("(geometry:"):
+            continue
+        sph = re.match(rf"\(geometry: Sphere\(center: {vec}, radius: {num}\).*emission: Some\({vec}\)", line)
+        if sph:
+            x, y, z, rad, *le = sph.groups()
+            out += ['    <shape type="rectangle">',
+                    '        <transform name="to_world">',
+                    f'            <scale value="{rad}"/>',
+                    '            <rotate x="1" angle="90"/>',
+                    f'            <translate x="{x}" y="{y}" z="{z}"/>',
+                    '        </transform>',
+                    f'        <emitter type="area"><rgb name="radiance" value="{", ".join(le)}"/></emitter>',
+                    '    </shape>']
+            continue
+        geo = re.match(r"\(geometry: (Rectangle|Cube), to_world: \[(.*?)\], material: Some\(Ref\(\"(\w+)\"\)\)", line)
+        if not geo:
+            sys.exit(f"unexpected shape line: {line}")
+        kind, ops, mat = geo.groups()
+        out += [f'    <shape type="{kind.lower()}">', '        <transform name="to_world">']
+        depth, start, parts = 0, 0, []
+        for i, ch in enumerate(ops + ","):
+            depth += (ch == "(") - (ch == ")")
+            if ch == "," and depth == 0:
+                parts.append(ops[start:i].strip())
+                start = i + 1
+        for part in filter(None, parts):
+            op = part.split("(", 1)[0]
+            v = re.findall(r"-?\d+(?:\.\d*)?(?:[eE][+-]?\d+)?", part)
+            if op == "Scale":
+                out.append(f'            <scale x="{v[0]}" y="{v[1]}" z="{v[2]}"/>')
+            elif op == "Rotate":
+                out.append(f'            <rotate x="{v[0]}" y="{v[1]}" z="{v[2]}" angle="{v[3]}"/>')
+            else:
+                out.append(f'            <translate x="{v[0]}" y="{v[1]}" z="{v[2]}"/>')
+        out += ['        </transform>', f'        <ref id="{mat}"/>', '    </shape>']
+    out.append("</scene>")
+    return "\n".join(out) + "\n"
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("scenes", nargs="+")
+    ap.add_argument("scenes", nargs="*")
     ap.add_argument("--bin", default="target/release/restir")
     ap.add_argument("--size", default="256x256")
     ap.add_argument("--max-depth", type=int, default=6)
@@ -90,7 +161,16 @@ def main():
     ap.add_argument("--variant", default="llvm_ad_rgb")
     ap.add_argument("--mi-threads", type=int, default=0,
                     help="Mitsuba's threads (0: its default; 1 hung here)")
+    ap.add_argument("--many-lights-xml", metavar="OUT",
+                    help="write scenes/many-lights.ron as Mitsuba XML with emissive rectangles "
+                    "for its sphere lights (see many_lights_xml) to OUT, and exit")
     a = ap.parse_args()
+    if a.many_lights_xml:
+        ron = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenes",
+                           "many-lights.ron")
+        with open(a.many_lights_xml, "w") as f:
+            f.write(many_lights_xml(ron))
+        return
 
     import drjit as dr
     import mitsuba as mi
