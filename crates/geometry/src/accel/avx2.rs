@@ -101,7 +101,7 @@ fn slab(n: &Node, r: &TRay, axis: usize, scale: f32, offset: f32) -> (__m256, __
 
 impl Kernel for Avx2 {
     #[inline(always)]
-    fn node_hits(n: &Node, r: &TRay, t_max: f32) -> u32 {
+    fn node_hits(n: &Node, r: &TRay, t_max: f32) -> (u32, [f32; 8]) {
         let adj_inv = glam::Vec3A::from(n.extent) * r.inv_d;
         let adj_o = (glam::Vec3A::from(n.p) - r.o) * r.inv_d;
         let (ai, ao) = (adj_inv.to_array(), adj_o.to_array());
@@ -112,7 +112,12 @@ impl Kernel for Avx2 {
         unsafe {
             let tmin = _mm256_max_ps(_mm256_max_ps(x0, _mm256_max_ps(y0, z0)), splat(1e-4));
             let tmax = _mm256_min_ps(_mm256_min_ps(x1, _mm256_min_ps(y1, z1)), splat(t_max));
-            _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tmin, tmax)) as u32
+            let mut entry = [0.0f32; 8];
+            _mm256_storeu_ps(entry.as_mut_ptr(), tmin);
+            (
+                _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tmin, tmax)) as u32,
+                entry,
+            )
         }
     }
 
@@ -166,7 +171,7 @@ pub(super) unsafe fn closest_avx2(
     w: &Wide,
     r: &TRay,
     t_max: f32,
-    stack: &mut [(u32, u32)],
+    stack: &mut [(u32, f32)],
     entries: &impl Entries,
 ) -> Option<Found> {
     closest::<Avx2>(w, r, t_max, stack, entries)

@@ -260,7 +260,7 @@ impl Accel {
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         let w = self.wide.as_ref()?;
         let r = TRay::new(ray.o.into(), ray.d.into());
-        let found = wide::with_stack(w.depth, |stack| {
+        let found = wide::with_nearest_stack(w.depth, |stack| {
             #[cfg(target_arch = "x86_64")]
             if self.avx2 {
                 // SAFETY: `avx2` is set only when the CPU reported AVX2, POPCNT, BMI1 and LZCNT
