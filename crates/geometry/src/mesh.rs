@@ -306,7 +306,7 @@ impl TriangleMesh {
 
     /// Point, geometric normal and shading normal at barycentrics `b = (b1, b2)` of triangle `i`
     /// (the cheaper part of [`TriangleMesh::surface_at`], for light sampling).
-    #[inline]
+    #[inline(always)]
     pub fn point_at(&self, i: usize, b: Vec2) -> (Vec3, Vec3, Vec3) {
         let [ia, ib, ic] = self.indices[i];
         let (p0, p1, p2) = (
@@ -336,7 +336,7 @@ impl TriangleMesh {
 
     /// Point, geometric normal, shading normal, uv and `dp/du` at barycentrics `b = (b1, b2)` of
     /// triangle `i`.
-    #[inline]
+    #[inline(always)]
     pub fn surface_at(&self, i: usize, b: Vec2) -> (Vec3, Vec3, Vec3, Vec2, Vec3) {
         let [ia, ib, ic] = self.indices[i];
         let b0 = 1.0 - b.x - b.y;

@@ -256,7 +256,7 @@ impl Accel {
     }
 
     /// The closest hit along `ray` with `t < t_max`.
-    #[inline]
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         let w = self.wide.as_ref()?;
         let r = TRay::new(ray.o.into(), ray.d.into());
@@ -296,7 +296,7 @@ impl Accel {
     }
 
     /// Whether anything blocks `ray` before `t_max`.
-    #[inline]
+    #[inline(always)]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         let Some(w) = self.wide.as_ref() else {
             return false;
@@ -315,7 +315,7 @@ impl Accel {
     }
 
     /// Surface details of a hit returned by [`Accel::intersect`] for the same `ray`.
-    #[inline]
+    #[inline(always)]
     pub fn surface_interaction(
         &self,
         shapes: &[Shape],
@@ -348,7 +348,7 @@ impl Accel {
 
 /// The surface interaction at a point named by `(shape, prim, param)` (see
 /// [`SurfaceInteraction::param`]); `t` is left at 0.
-#[inline]
+#[inline(always)]
 pub fn surface_at(shapes: &[Shape], shape: u32, prim: u32, param: Vec2) -> SurfaceInteraction {
     match &shapes[shape as usize] {
         Shape::Mesh(m) => {
