@@ -182,7 +182,7 @@ impl Kernel for Scalar {
         let (ai, ao) = (adj_inv.to_array(), adj_o.to_array());
         let mut mask = 0;
         let mut entry = [0.0; 8];
-        for s in 0..8 {
+        for (s, e) in entry.iter_mut().enumerate() {
             let mut t0 = [0.0; 3];
             let mut t1 = [0.0; 3];
             for a in 0..3 {
@@ -196,7 +196,7 @@ impl Kernel for Scalar {
             if tmin <= tmax {
                 mask |= 1 << s;
             }
-            entry[s] = tmin;
+            *e = tmin;
         }
         (mask, entry)
     }
