@@ -250,7 +250,7 @@ pub enum Texels {
 }
 
 impl Texels {
-    /// The texels `values` (linear, as [`read_image`] returns them), in bytes when every channel
+    /// The texels `values` (linear, as the image reader returns them), in bytes when every channel
     /// value is the decoding of an 8-bit code (sRGB, or linear when `raw`) as the image reader
     /// decodes it, bit for bit.
     pub fn new(values: Vec<Vec3>, raw: bool) -> Self {
