@@ -84,6 +84,18 @@ pub struct TriangleMesh {
     flip_normals: bool,
     area: f32,
     area_distribution: Option<Distribution1D>,
+    /// Per triangle, what a surface lookup needs that depends on the triangle alone.
+    faces: Vec<Face>,
+}
+
+/// The per-triangle part of a surface lookup, computed once when the mesh is built, transformed
+/// or trimmed (the same operations a lookup did, so the same bits): the unit geometric normal
+/// (flipped with the mesh; zero for a degenerate triangle) and `dp/du` (from the texture
+/// coordinates, or the first edge without them).
+#[derive(Clone, Copy, Debug)]
+struct Face {
+    ng: Vec3,
+    dpdu: Vec3,
 }
 
 impl TriangleMesh {
@@ -159,12 +171,15 @@ impl TriangleMesh {
             flip_normals,
             area: 0.0,
             area_distribution: None,
+            faces: Vec::new(),
         };
-        mesh.update_areas();
+        mesh.update_tables();
         Ok(mesh)
     }
 
-    fn update_areas(&mut self) {
+    /// The area table and the per-triangle faces, after the triangles changed.
+    fn update_tables(&mut self) {
+        self.faces = (0..self.indices.len()).map(|i| self.face(i)).collect();
         let areas: Vec<f32> = (0..self.indices.len())
             .map(|i| self.triangle_area(i))
             .map(|a| if a.is_finite() { a } else { 0.0 })
@@ -191,7 +206,7 @@ impl TriangleMesh {
                 tri.swap(1, 2);
             }
         }
-        self.update_areas();
+        self.update_tables();
     }
 
     /// Removes the triangles of zero area (collinear or coincident corners: they can never be
@@ -211,7 +226,7 @@ impl TriangleMesh {
         }
         let mut k = keep.iter();
         self.indices.retain(|_| *k.next().unwrap_or(&true));
-        self.update_areas();
+        self.update_tables();
         Ok(dropped)
     }
 
@@ -264,14 +279,34 @@ impl TriangleMesh {
     /// The unit geometric normal of triangle `i` (zero for a degenerate triangle).
     #[inline]
     pub fn face_normal(&self, i: usize) -> Vec3 {
+        self.faces[i].ng
+    }
+
+    /// Triangle `i`'s geometric normal and `dp/du`, computed from its corners.
+    fn face(&self, i: usize) -> Face {
+        let [ia, ib, ic] = self.indices[i];
         let [p0, p1, p2] = self.triangle(i);
         let n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
-        if self.flip_normals { -n } else { n }
+        let ng = if self.flip_normals { -n } else { n };
+        let dpdu = match &self.uvs {
+            Some(uvs) => {
+                let (t0, t1, t2) = (uvs[ia as usize], uvs[ib as usize], uvs[ic as usize]);
+                let (d1, d2) = (t1 - t0, t2 - t0);
+                let det = d1.x * d2.y - d1.y * d2.x;
+                if det.abs() > 1e-12 {
+                    ((p1 - p0) * d2.y - (p2 - p0) * d1.y) / det
+                } else {
+                    p1 - p0
+                }
+            }
+            None => p1 - p0,
+        };
+        Face { ng, dpdu }
     }
 
     /// Point, geometric normal and shading normal at barycentrics `b = (b1, b2)` of triangle `i`
     /// (the cheaper part of [`TriangleMesh::surface_at`], for light sampling).
-    #[inline]
+    #[inline(always)]
     pub fn point_at(&self, i: usize, b: Vec2) -> (Vec3, Vec3, Vec3) {
         let [ia, ib, ic] = self.indices[i];
         let (p0, p1, p2) = (
@@ -281,8 +316,7 @@ impl TriangleMesh {
         );
         let b0 = 1.0 - b.x - b.y;
         let p = b0 * p0 + b.x * p1 + b.y * p2;
-        let n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
-        let ng = if self.flip_normals { -n } else { n };
+        let ng = self.faces[i].ng;
         let ns = match &self.normals {
             Some(ns) => {
                 let n = (b0 * ns[ia as usize] + b.x * ns[ib as usize] + b.y * ns[ic as usize])
@@ -302,28 +336,19 @@ impl TriangleMesh {
 
     /// Point, geometric normal, shading normal, uv and `dp/du` at barycentrics `b = (b1, b2)` of
     /// triangle `i`.
-    #[inline]
+    #[inline(always)]
     pub fn surface_at(&self, i: usize, b: Vec2) -> (Vec3, Vec3, Vec3, Vec2, Vec3) {
         let [ia, ib, ic] = self.indices[i];
-        let [p0, p1, p2] = self.triangle(i);
         let b0 = 1.0 - b.x - b.y;
         let (p, ng, ns) = self.point_at(i, b);
-        let (uv, dpdu) = match &self.uvs {
+        let uv = match &self.uvs {
             Some(uvs) => {
                 let (t0, t1, t2) = (uvs[ia as usize], uvs[ib as usize], uvs[ic as usize]);
-                let uv = b0 * t0 + b.x * t1 + b.y * t2;
-                let (d1, d2) = (t1 - t0, t2 - t0);
-                let det = d1.x * d2.y - d1.y * d2.x;
-                let dpdu = if det.abs() > 1e-12 {
-                    ((p1 - p0) * d2.y - (p2 - p0) * d1.y) / det
-                } else {
-                    p1 - p0
-                };
-                (uv, dpdu)
+                b0 * t0 + b.x * t1 + b.y * t2
             }
-            None => (b, p1 - p0),
+            None => b,
         };
-        (p, ng, ns, uv, dpdu)
+        (p, ng, ns, uv, self.faces[i].dpdu)
     }
 
     /// Picks a triangle proportionally to area and a uniform point on it. Returns the triangle,

@@ -102,7 +102,7 @@ pub struct Scene {
 
 impl Scene {
     /// The closest surface hit by `ray`.
-    #[inline]
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
         let hit: Hit = self.accel.intersect(ray, f32::INFINITY)?;
         Some(self.accel.surface_interaction(&self.shapes, &hit, ray))

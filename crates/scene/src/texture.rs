@@ -88,7 +88,7 @@ pub enum Texture {
         /// Height in texels.
         height: usize,
         /// `width × height` linear RGB texels, the first row at the top of the image.
-        texels: Vec<Vec3>,
+        texels: Texels,
         /// uv transform.
         uv: UvTransform,
     },
@@ -173,7 +173,7 @@ impl Texture {
                 Ok(Texture::Bitmap {
                     width,
                     height,
-                    texels,
+                    texels: Texels::new(texels, *raw),
                     uv: *uv,
                 })
             }
@@ -209,14 +209,12 @@ impl Texture {
                 let y = p.y * *height as f32 - 0.5;
                 let (x0, y0) = (x.floor(), y.floor());
                 let (fx, fy) = (x - x0, y - y0);
-                let wrap = |i: f32, n: usize| -> usize {
-                    let n = n as i64;
-                    let i = if i.is_finite() { i as i64 } else { 0 };
-                    i.rem_euclid(n) as usize
-                };
-                let at = |xi: f32, yi: f32| texels[wrap(yi, *height) * width + wrap(xi, *width)];
-                let top = at(x0, y0) * (1.0 - fx) + at(x0 + 1.0, y0) * fx;
-                let bottom = at(x0, y0 + 1.0) * (1.0 - fx) + at(x0 + 1.0, y0 + 1.0) * fx;
+                let (xa, xb) = wrap_pair(x0, *width);
+                let (ya, yb) = wrap_pair(y0, *height);
+                let (ra, rb) = (ya * width, yb * width);
+                let at = |i: usize| texels.get(i);
+                let top = at(ra + xa) * (1.0 - fx) + at(ra + xb) * fx;
+                let bottom = at(rb + xa) * (1.0 - fx) + at(rb + xb) * fx;
                 top * (1.0 - fy) + bottom * fy
             }
         }
@@ -227,10 +225,125 @@ impl Texture {
         match self {
             Texture::Checkerboard { color0, color1, .. } => 0.5 * (*color0 + *color1),
             Texture::Bitmap { texels, .. } => {
-                texels.iter().copied().sum::<Vec3>() / texels.len().max(1) as f32
+                let n = texels.len();
+                (0..n).map(|i| texels.get(i)).sum::<Vec3>() / n.max(1) as f32
             }
         }
     }
+}
+
+/// A bitmap's texels. Images read from 8-bit files hold at most 256 values per channel (the
+/// decoded codes 0–255), so they are kept as one byte per channel and the table of the 256
+/// values: a third of the memory of three floats, so more of a scene's textures stay in cache,
+/// and exactly the same values. Anything else (EXR, HDR, 16-bit files) stays in floats.
+#[derive(Clone, Debug)]
+pub enum Texels {
+    /// Linear RGB floats.
+    Float(Vec<Vec3>),
+    /// Codes into `levels`, three per texel (the fourth byte is padding).
+    Levels {
+        /// The linear value of each code.
+        levels: Box<[f32; 256]>,
+        /// Per texel, the codes of red, green and blue.
+        codes: Vec<[u8; 4]>,
+    },
+}
+
+impl Texels {
+    /// The texels `values` (linear, as the image reader returns them), in bytes when every channel
+    /// value is the decoding of an 8-bit code (sRGB, or linear when `raw`) as the image reader
+    /// decodes it, bit for bit.
+    pub fn new(values: Vec<Vec3>, raw: bool) -> Self {
+        let mut levels = Box::new([0.0f32; 256]);
+        for (k, l) in levels.iter_mut().enumerate() {
+            // The image reader's 8-bit conversion (`image`: code / 255), then its decoding.
+            let c = k as f32 / 255.0;
+            *l = if raw {
+                c
+            } else {
+                restir_image::srgb::decode(c)
+            };
+        }
+        // An open-addressing table from a level's bits to its code.
+        const SLOTS: usize = 1024;
+        let slot = |bits: u32| (bits.wrapping_mul(0x9E37_79B9) >> 22) as usize;
+        let mut table = [(u32::MAX, 0u8); SLOTS];
+        for (k, l) in levels.iter().enumerate() {
+            let mut i = slot(l.to_bits());
+            while table[i].0 != u32::MAX {
+                i = (i + 1) % SLOTS;
+            }
+            table[i] = (l.to_bits(), k as u8);
+        }
+        let code = |v: f32| -> Option<u8> {
+            let bits = v.to_bits();
+            let mut i = slot(bits);
+            loop {
+                match table[i] {
+                    (b, k) if b == bits => return Some(k),
+                    (u32::MAX, _) => return None,
+                    _ => i = (i + 1) % SLOTS,
+                }
+            }
+        };
+        let codes: Option<Vec<[u8; 4]>> = values
+            .iter()
+            .map(|t| Some([code(t.x)?, code(t.y)?, code(t.z)?, 0]))
+            .collect();
+        match codes {
+            Some(codes) => Texels::Levels { levels, codes },
+            None => Texels::Float(values),
+        }
+    }
+
+    /// Number of texels.
+    pub fn len(&self) -> usize {
+        match self {
+            Texels::Float(v) => v.len(),
+            Texels::Levels { codes, .. } => codes.len(),
+        }
+    }
+
+    /// Whether there are no texels.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Texel `i`.
+    #[inline(always)]
+    pub fn get(&self, i: usize) -> Vec3 {
+        match self {
+            Texels::Float(v) => v[i],
+            Texels::Levels { levels, codes } => {
+                let [r, g, b, _] = codes[i];
+                Vec3::new(levels[r as usize], levels[g as usize], levels[b as usize])
+            }
+        }
+    }
+}
+
+/// The texel indices of whole-number coordinates `i` and `i + 1` (as floats) on an axis of `n`
+/// texels, repeating (non-finite coordinates read texel 0). The integer remainder, a division,
+/// only when `i` lies outside the image.
+#[inline]
+fn wrap_pair(i: f32, n: usize) -> (usize, usize) {
+    let wrap = |i: f32| -> usize {
+        let n = n as i64;
+        let i = if i.is_finite() { i as i64 } else { 0 };
+        if (0..n).contains(&i) {
+            i as usize
+        } else {
+            i.rem_euclid(n) as usize
+        }
+    };
+    let a = wrap(i);
+    // `i + 1` is the next texel unless it rounds back to `i` (|i| ≥ 2²⁴) or is not finite.
+    let b = if i.is_finite() && i + 1.0 != i {
+        if a + 1 == n { 0 } else { a + 1 }
+    } else {
+        wrap(i + 1.0)
+    };
+    (a, b)
 }
 
 /// Reads an image file as linear RGB texels, the first row at the top
@@ -253,6 +366,83 @@ pub(crate) fn read_image(
 mod tests {
     use super::*;
     use restir_image::srgb::decode as srgb_to_linear;
+
+    /// `wrap_pair` gives the texels the lookup read before it (each coordinate wrapped by its
+    /// own remainder), at the edges, outside the image, at huge and non-finite coordinates.
+    #[test]
+    fn wrap_pair_is_the_remainder_of_each_coordinate() {
+        let wrap = |i: f32, n: usize| -> usize {
+            let i = if i.is_finite() { i as i64 } else { 0 };
+            i.rem_euclid(n as i64) as usize
+        };
+        let values = [
+            0.0,
+            -0.0,
+            1.0,
+            2.0,
+            3.0,
+            4.0,
+            -1.0,
+            -2.0,
+            -5.0,
+            17.0,
+            -17.0,
+            16_777_215.0,
+            16_777_216.0,
+            -16_777_216.0,
+            3.0e9,
+            -3.0e9,
+            1.0e20,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        for n in [1, 2, 3, 4, 7] {
+            for &i in &values {
+                assert_eq!(
+                    wrap_pair(i, n),
+                    (wrap(i, n), wrap(i + 1.0, n)),
+                    "{i} of {n}"
+                );
+            }
+        }
+    }
+
+    /// 8-bit texels are kept as codes with exactly the values the reader decoded; other values
+    /// stay floats.
+    #[test]
+    fn texels_in_bytes_hold_the_same_values() {
+        for raw in [false, true] {
+            let level = |k: u8| {
+                let c = k as f32 / 255.0;
+                if raw {
+                    c
+                } else {
+                    restir_image::srgb::decode(c)
+                }
+            };
+            let values: Vec<Vec3> = (0..=255u8)
+                .map(|k| Vec3::new(level(k), level(255 - k), level(k / 2)))
+                .collect();
+            let t = Texels::new(values.clone(), raw);
+            assert!(matches!(t, Texels::Levels { .. }), "raw {raw}");
+            assert_eq!(t.len(), values.len());
+            for (i, v) in values.iter().enumerate() {
+                assert_eq!(
+                    t.get(i).to_array().map(f32::to_bits),
+                    v.to_array().map(f32::to_bits)
+                );
+            }
+            // One value that is no 8-bit level (a 16-bit or float image): floats.
+            let mut other = values.clone();
+            other[7].y = 0.123_456_7;
+            let t = Texels::new(other.clone(), raw);
+            assert!(matches!(t, Texels::Float(_)), "raw {raw}");
+            assert_eq!(t.get(7), other[7]);
+        }
+    }
 
     #[test]
     fn checkerboard_pattern_and_scale() {

@@ -1,16 +1,18 @@
 //! The AVX2 kernel: a node's eight child boxes and a block's eight triangles tested in one
 //! 256-bit pass each, with exactly the scalar kernel's float operations (multiply then add, no
 //! FMA; the same min/max operand order), so both give the same bits. Used only when the CPU
-//! reports AVX2, checked once when the [`super::Accel`] is built.
+//! reports AVX2 (and the bit-counting POPCNT, BMI1 and LZCNT that come with it), checked once
+//! when the [`super::Accel`] is built.
 //!
-//! The entry points are `#[target_feature(enable = "avx2")]` functions around the generic
-//! traversal, so the whole loop is compiled for AVX2 and the kernel's intrinsics inline into it.
+//! The entry points are `#[target_feature(enable = "avx2,popcnt,bmi1,lzcnt")]` functions around
+//! the generic traversal, so the whole loop is compiled for them and the kernel's intrinsics
+//! inline into it.
 #![allow(unsafe_code)]
 
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
 
-use super::wide::{Entries, Kernel, Node, TRay, TriBlock, Wide, any, closest};
+use super::wide::{Entries, Found, Kernel, Node, TRay, TriBlock, TriHit, Wide, any, closest};
 
 /// The AVX2 kernel (x86-64 only).
 #[derive(Debug)]
@@ -38,10 +40,10 @@ fn load(x: &[f32; 8]) -> __m256 {
     unsafe { _mm256_load_ps(x.as_ptr()) }
 }
 
-/// The triangle distances of a block (Möller–Trumbore, the scalar test's operations lane by
-/// lane) and the mask of lanes hit with `0 < t < t_max`.
+/// The triangle distances and barycentrics `(u, v)` of a block (Möller–Trumbore, the scalar
+/// test's operations lane by lane) and the mask of lanes hit with `0 < t < t_max`.
 #[inline(always)]
-fn block_t(b: &TriBlock, r: &TRay, t_max: f32) -> (__m256, i32) {
+fn block_t(b: &TriBlock, r: &TRay, t_max: f32) -> (__m256, __m256, __m256, i32) {
     // SAFETY: arithmetic intrinsics only; AVX2 is guaranteed by the callers.
     unsafe {
         let (ox, oy, oz) = (splat(r.o.x), splat(r.o.y), splat(r.o.z));
@@ -78,7 +80,7 @@ fn block_t(b: &TriBlock, r: &TRay, t_max: f32) -> (__m256, i32) {
         let t = mul(add(add(mul(e2x, qx), mul(e2y, qy)), mul(e2z, qz)), inv_det);
         ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_GT_OQ>(t, splat(0.0)));
         ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_LT_OQ>(t, splat(t_max)));
-        (t, _mm256_movemask_ps(ok))
+        (t, u, vv, _mm256_movemask_ps(ok))
     }
 }
 
@@ -99,7 +101,7 @@ fn slab(n: &Node, r: &TRay, axis: usize, scale: f32, offset: f32) -> (__m256, __
 
 impl Kernel for Avx2 {
     #[inline(always)]
-    fn node_hits(n: &Node, r: &TRay, t_max: f32) -> u32 {
+    fn node_hits(n: &Node, r: &TRay, t_max: f32) -> (u32, [f32; 8]) {
         let adj_inv = glam::Vec3A::from(n.extent) * r.inv_d;
         let adj_o = (glam::Vec3A::from(n.p) - r.o) * r.inv_d;
         let (ai, ao) = (adj_inv.to_array(), adj_o.to_array());
@@ -110,13 +112,18 @@ impl Kernel for Avx2 {
         unsafe {
             let tmin = _mm256_max_ps(_mm256_max_ps(x0, _mm256_max_ps(y0, z0)), splat(1e-4));
             let tmax = _mm256_min_ps(_mm256_min_ps(x1, _mm256_min_ps(y1, z1)), splat(t_max));
-            _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tmin, tmax)) as u32
+            let mut entry = [0.0f32; 8];
+            _mm256_storeu_ps(entry.as_mut_ptr(), tmin);
+            (
+                _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tmin, tmax)) as u32,
+                entry,
+            )
         }
     }
 
     #[inline(always)]
-    fn block_closest(b: &TriBlock, r: &TRay, t_max: f32, lanes: u32) -> Option<(f32, u32)> {
-        let (t, hit) = block_t(b, r, t_max);
+    fn block_closest(b: &TriBlock, r: &TRay, t_max: f32, lanes: u32) -> Option<TriHit> {
+        let (t, u, v, hit) = block_t(b, r, t_max);
         let hit = hit as u32 & lanes;
         if hit == 0 {
             return None;
@@ -134,35 +141,47 @@ impl Kernel for Avx2 {
                 best = (ts[j as usize], j);
             }
         }
-        Some(best)
+        let (mut us, mut vs) = ([0.0f32; 8], [0.0f32; 8]);
+        // SAFETY: stores eight floats into eight-float arrays.
+        unsafe {
+            _mm256_storeu_ps(us.as_mut_ptr(), u);
+            _mm256_storeu_ps(vs.as_mut_ptr(), v);
+        }
+        let j = best.1 as usize;
+        Some(TriHit {
+            t: best.0,
+            lane: best.1,
+            u: us[j],
+            v: vs[j],
+        })
     }
 
     #[inline(always)]
     fn block_any(b: &TriBlock, r: &TRay, t_max: f32, lanes: u32) -> bool {
-        block_t(b, r, t_max).1 as u32 & lanes != 0
+        block_t(b, r, t_max).3 as u32 & lanes != 0
     }
 }
 
 /// [`closest`] with the AVX2 kernel.
 ///
 /// # Safety
-/// The CPU must support AVX2.
-#[target_feature(enable = "avx2")]
+/// The CPU must support AVX2, POPCNT, BMI1 and LZCNT.
+#[target_feature(enable = "avx2,popcnt,bmi1,lzcnt")]
 pub(super) unsafe fn closest_avx2(
     w: &Wide,
     r: &TRay,
     t_max: f32,
-    stack: &mut [(u32, u32)],
+    stack: &mut [(u32, f32)],
     entries: &impl Entries,
-) -> Option<(f32, u32, u32)> {
+) -> Option<Found> {
     closest::<Avx2>(w, r, t_max, stack, entries)
 }
 
 /// [`any`] with the AVX2 kernel.
 ///
 /// # Safety
-/// The CPU must support AVX2.
-#[target_feature(enable = "avx2")]
+/// The CPU must support AVX2, POPCNT, BMI1 and LZCNT.
+#[target_feature(enable = "avx2,popcnt,bmi1,lzcnt")]
 pub(super) unsafe fn any_avx2(
     w: &Wide,
     r: &TRay,

@@ -22,7 +22,7 @@ mod wide;
 use prims::{Prim, group_entries};
 use wide::{Entries, Scalar, TRay, Wide};
 
-/// A closest hit: distance and which primitive.
+/// A closest hit: distance, which primitive, and where on it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
     /// Ray parameter of the hit.
@@ -31,6 +31,9 @@ pub struct Hit {
     pub shape: u32,
     /// The triangle within the shape (0 for spheres).
     pub prim: u32,
+    /// A triangle's barycentrics `(b1, b2)` of the hit point (the weights of its second and
+    /// third corner), as the ray-triangle test computed them; zero for spheres.
+    pub bary: Vec2,
 }
 
 /// Everything about a surface point that shading needs.
@@ -82,7 +85,13 @@ pub struct Accel {
 fn detect_avx2() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
+        // The bit-counting instructions come with AVX2 on every CPU that has it (Haswell,
+        // Excavator and later), but are separate features; the kernel uses them for the child
+        // index and the lane loops.
         std::is_x86_feature_detected!("avx2")
+            && std::is_x86_feature_detected!("popcnt")
+            && std::is_x86_feature_detected!("bmi1")
+            && std::is_x86_feature_detected!("lzcnt")
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
@@ -247,31 +256,47 @@ impl Accel {
     }
 
     /// The closest hit along `ray` with `t < t_max`.
-    #[inline]
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         let w = self.wide.as_ref()?;
         let r = TRay::new(ray.o.into(), ray.d.into());
-        let found = wide::with_stack(w.depth, |stack| {
+        let found = wide::with_nearest_stack(w.depth, |stack| {
             #[cfg(target_arch = "x86_64")]
             if self.avx2 {
-                // SAFETY: `avx2` is set only when the CPU reported AVX2 (`detect_avx2`).
+                // SAFETY: `avx2` is set only when the CPU reported AVX2, POPCNT, BMI1 and LZCNT
+                // (`detect_avx2`).
                 #[allow(unsafe_code)]
                 return unsafe { avx2::closest_avx2(w, &r, t_max, stack, self) };
             }
             wide::closest::<Scalar>(w, &r, t_max, stack, self)
         });
-        let (t, entry, member) = found?;
-        let id = match (member, &self.groups) {
-            (u32::MAX, Some(starts)) => starts[entry as usize],
-            (u32::MAX, None) => entry,
+        let f = found?;
+        let id = match (f.member, &self.groups) {
+            (u32::MAX, Some(starts)) => starts[f.entry as usize],
+            (u32::MAX, None) => f.entry,
             (m, _) => m,
         };
+        let bary = match (f.member, self.prims[id as usize]) {
+            // A triangle tested one at a time (in a group): the same test again, for its
+            // barycentrics.
+            (u32::MAX, _) => f.bary,
+            (_, Prim::Triangle { v0, e1, e2 }) => {
+                prims::triangle_hit(v0, e1, e2, r.o, r.d, f32::INFINITY)
+                    .map_or([0.0; 2], |(_, u, v)| [u, v])
+            }
+            (_, Prim::Sphere { .. }) => [0.0; 2],
+        };
         let (shape, prim) = self.ids[id as usize];
-        Some(Hit { t, shape, prim })
+        Some(Hit {
+            t: f.t,
+            shape,
+            prim,
+            bary: Vec2::from(bary),
+        })
     }
 
     /// Whether anything blocks `ray` before `t_max`.
-    #[inline]
+    #[inline(always)]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         let Some(w) = self.wide.as_ref() else {
             return false;
@@ -280,7 +305,8 @@ impl Accel {
         wide::with_stack(w.depth, |stack| {
             #[cfg(target_arch = "x86_64")]
             if self.avx2 {
-                // SAFETY: `avx2` is set only when the CPU reported AVX2 (`detect_avx2`).
+                // SAFETY: `avx2` is set only when the CPU reported AVX2, POPCNT, BMI1 and LZCNT
+                // (`detect_avx2`).
                 #[allow(unsafe_code)]
                 return unsafe { avx2::any_avx2(w, &r, t_max, stack, self) };
             }
@@ -289,7 +315,7 @@ impl Accel {
     }
 
     /// Surface details of a hit returned by [`Accel::intersect`] for the same `ray`.
-    #[inline]
+    #[inline(always)]
     pub fn surface_interaction(
         &self,
         shapes: &[Shape],
@@ -298,17 +324,10 @@ impl Accel {
     ) -> SurfaceInteraction {
         let shape = &shapes[hit.shape as usize];
         let param = match shape {
-            Shape::Mesh(m) => {
-                // Barycentrics of the hit point, recomputed on the original vertices.
-                let [p0, p1, p2] = m.triangle(hit.prim as usize);
-                let (e1, e2) = (p1 - p0, p2 - p0);
-                let pvec = ray.d.cross(e2);
-                let inv_det = 1.0 / e1.dot(pvec);
-                let tvec = ray.o - p0;
-                let u = tvec.dot(pvec) * inv_det;
-                let v = ray.d.dot(tvec.cross(e1)) * inv_det;
-                let u = u.clamp(0.0, 1.0);
-                let v = v.clamp(0.0, 1.0 - u);
+            Shape::Mesh(_) => {
+                // The traversal's barycentrics, kept inside the triangle despite rounding.
+                let u = hit.bary.x.clamp(0.0, 1.0);
+                let v = hit.bary.y.clamp(0.0, 1.0 - u);
                 Vec2::new(u, v)
             }
             Shape::Sphere(s) => {
@@ -329,7 +348,7 @@ impl Accel {
 
 /// The surface interaction at a point named by `(shape, prim, param)` (see
 /// [`SurfaceInteraction::param`]); `t` is left at 0.
-#[inline]
+#[inline(always)]
 pub fn surface_at(shapes: &[Shape], shape: u32, prim: u32, param: Vec2) -> SurfaceInteraction {
     match &shapes[shape as usize] {
         Shape::Mesh(m) => {

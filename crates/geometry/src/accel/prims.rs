@@ -84,29 +84,38 @@ pub(super) fn intersect_triangle(
     d: Vec3A,
     t_max: f32,
 ) -> f32 {
-    // Möller–Trumbore.
+    triangle_hit(v0, e1, e2, o, d, t_max).map_or(f32::INFINITY, |(t, _, _)| t)
+}
+
+/// Möller–Trumbore: the distance and the barycentrics `(u, v)` of the hit (weights of `v0 + e1`
+/// and `v0 + e2`) when `0 < t < t_max`.
+#[inline(always)]
+pub(super) fn triangle_hit(
+    v0: Vec3A,
+    e1: Vec3A,
+    e2: Vec3A,
+    o: Vec3A,
+    d: Vec3A,
+    t_max: f32,
+) -> Option<(f32, f32, f32)> {
     let pvec = d.cross(e2);
     let det = e1.dot(pvec);
     if det.abs() < 1e-20 {
-        return f32::INFINITY;
+        return None;
     }
     let inv_det = 1.0 / det;
     let tvec = o - v0;
     let u = tvec.dot(pvec) * inv_det;
     if !(0.0..=1.0).contains(&u) {
-        return f32::INFINITY;
+        return None;
     }
     let qvec = tvec.cross(e1);
     let v = d.dot(qvec) * inv_det;
     if v < 0.0 || u + v > 1.0 {
-        return f32::INFINITY;
+        return None;
     }
     let t = e2.dot(qvec) * inv_det;
-    if t > 0.0 && t < t_max {
-        t
-    } else {
-        f32::INFINITY
-    }
+    (t > 0.0 && t < t_max).then_some((t, u, v))
 }
 
 #[inline(always)]
