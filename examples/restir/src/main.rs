@@ -21,6 +21,7 @@ use restir_scene::{LoadOptions, load_scene};
 
 mod bench;
 mod cluster;
+mod convert;
 mod frames;
 mod generate;
 mod interrupt;
@@ -61,6 +62,11 @@ enum Command {
     /// Write a procedurally generated scene (RON).
     #[command(subcommand)]
     Generate(generate::Generate),
+    /// Write a scene (.ron or .xml) as a Mitsuba 3 XML file that Mitsuba 3 and restir both read
+    /// to the same scene (film size, spp and max depth as <default> variables resx, resy, spp,
+    /// max_depth). What Mitsuba 3 cannot express is an error naming it: an animation, a ReSTIR
+    /// integrator or its parameters, an inline triangle mesh.
+    Convert(convert::ConvertArgs),
     /// Equal-time evaluation: render a suite of scenes × integrators × time budgets × seeds,
     /// compare with references, write a CSV, relMSE-versus-time plots, crops and a report.
     Bench(Box<bench::BenchArgs>),
@@ -661,6 +667,7 @@ fn main() -> ExitCode {
             html,
         } => run_compare(&test, &reference, html.as_deref()).map(|()| Rendered::Complete),
         Command::Generate(what) => generate::run(what).map(|()| Rendered::Complete),
+        Command::Convert(args) => convert::run(args).map(|()| Rendered::Complete),
         Command::Bench(args) => bench::run(*args).map(|()| Rendered::Complete),
         Command::Merge(args) => merge::run(args).map(|()| Rendered::Complete),
     };
