@@ -417,6 +417,13 @@ fn write_family(args: &FamilyArgs) -> Result<(), String> {
     } else {
         Split::Test
     };
+    if args.xml && issue.animated() {
+        return Err(format!(
+            "--xml: the {} family is animated, and Mitsuba 3 XML describes one instant (the \
+             static families pt and di convert)",
+            issue.name()
+        ));
+    }
     let members: Vec<FamilyMember> = family(issue, split);
     if let Some(i) = args.index {
         let member = members.get(i).ok_or_else(|| {
