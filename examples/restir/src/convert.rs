@@ -103,7 +103,7 @@ fn same_file(a: &Path, b: &Path) -> bool {
 
 /// How a file name relative to `scene_dir` is written in a file in `out_dir`: nothing when they
 /// are one directory, else the relative path from `out_dir` to `scene_dir` (or `scene_dir`
-/// absolute when there is none).
+/// absolute when they share nothing below the root).
 fn file_prefix(scene_dir: &Path, out_dir: &Path) -> Option<PathBuf> {
     let (Ok(from), Ok(to)) = (out_dir.canonicalize(), scene_dir.canonicalize()) else {
         return Some(std::path::absolute(scene_dir).unwrap_or(scene_dir.to_path_buf()));
@@ -114,7 +114,8 @@ fn file_prefix(scene_dir: &Path, out_dir: &Path) -> Option<PathBuf> {
     let (f, t): (Vec<Component>, Vec<Component>) =
         (from.components().collect(), to.components().collect());
     let common = f.iter().zip(&t).take_while(|(a, b)| a == b).count();
-    if common == 0 {
+    // Nothing in common but the root: the absolute path says more than a climb to the root.
+    if common <= 1 {
         return Some(to);
     }
     let mut rel = PathBuf::new();
@@ -135,6 +136,7 @@ mod tests {
     fn prefixes_lead_from_the_output_to_the_scene() {
         let tmp = std::env::temp_dir().join(format!("restir-convert-{}", std::process::id()));
         let (a, b, c) = (tmp.join("a"), tmp.join("a/b"), tmp.join("c/d"));
+        let root = std::path::Path::new("/");
         for d in [&a, &b, &c] {
             std::fs::create_dir_all(d).unwrap();
         }
@@ -142,6 +144,9 @@ mod tests {
         assert_eq!(file_prefix(&a, &b), Some(PathBuf::from("..")));
         assert_eq!(file_prefix(&b, &a), Some(PathBuf::from("b")));
         assert_eq!(file_prefix(&c, &b), Some(PathBuf::from("../../c/d")));
+        if cfg!(unix) {
+            assert_eq!(file_prefix(&a, root), Some(a.canonicalize().unwrap()));
+        }
         std::fs::remove_dir_all(&tmp).unwrap();
     }
 }
