@@ -6,9 +6,10 @@ libllvm19); never part of CI or of the project's dependencies.
 
 Scenes are RON or XML. Mitsuba reads an XML scene as it is, or, for a RON scene (and for any
 scene with `--convert`, e.g. Lajolla's camelCase files that Mitsuba 3 refuses), the Mitsuba 3
-XML that `restir convert` writes of it (a hidden temporary file beside the scene, so relative
-asset paths hold; removed after loading). Film size and, with `--max-depth`, the path depth are
-rewritten in that copy; without `--max-depth` both renderers use the scene's own.
+XML that `restir convert` writes of it (into a temporary directory: it rewrites file names for
+it). Film size and, with `--max-depth`, the path depth are rewritten in a copy (beside an XML
+scene read as it is, so relative asset paths hold; removed after loading); without
+`--max-depth` both renderers use the scene's own.
 
 For each scene, each of our configurations (`--config NAME=FLAGS`, flags of `restir render`;
 default `path=--integrator path`) and Mitsuba's `path` render at the same size, and each render
@@ -111,12 +112,14 @@ def load_mitsuba(a, mi, scene, w, h):
     """The scene in Mitsuba at this size (and depth): the XML, or the XML `restir convert` writes
     of it, with its film size and the path integrator's max_depth rewritten, in a temporary
     copy beside it (relative paths hold)."""
-    tmp = os.path.join(os.path.dirname(os.path.abspath(scene)),
-                       f".mitsuba-et-{os.getpid()}.xml")
     if a.convert or not scene.endswith(".xml"):
+        # `restir convert` rewrites file names for the directory it writes to.
+        tmp = os.path.join(a.work, "scene.xml")
         child_cpu([a.bin, "convert", scene, "-o", tmp])
         text = open(tmp).read()
     else:
+        tmp = os.path.join(os.path.dirname(os.path.abspath(scene)),
+                           f".mitsuba-et-{os.getpid()}.xml")
         text = open(scene).read()
     values = [("width", w), ("height", h)]
     if a.max_depth is not None:
@@ -166,7 +169,7 @@ def main():
         dr.set_thread_count(a.mi_threads)
     w, h = (int(v) for v in a.size.split("x"))
     os.makedirs(a.refs, exist_ok=True)
-    work = tempfile.mkdtemp(prefix="mitsuba-et-")
+    work = a.work = tempfile.mkdtemp(prefix="mitsuba-et-")
     depth = "each scene's max depth" if a.max_depth is None else f"max depth {a.max_depth}"
     print(f"# Mitsuba {mi.__version__} {a.variant} ({dr.thread_count()} thread(s)) vs restir "
           f"(1 thread): {', '.join(n for n, _ in configs)}; {a.size}, {depth}, ~{a.budget} CPU s "

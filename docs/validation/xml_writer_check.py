@@ -5,8 +5,8 @@
         --size 128x96 --ours-spp 1024 --mi-passes 8 --mi-spp 512 --work /tmp/xmlcheck \
         SCENE.ron ...
 
-For each scene (RON or XML): `restir convert` writes it as Mitsuba 3 XML (a hidden file beside
-the scene, so relative asset paths hold; removed afterwards); our path tracer renders the
+For each scene (RON or XML): `restir convert` writes it as Mitsuba 3 XML (`scene.xml` in the
+scene's work directory, file names rewritten for it); our path tracer renders the
 scene as given in two halves of `--ours-spp` passes (seeds 1 and 2), Mitsuba 3 renders the XML
 in `--mi-passes` independent passes of `--mi-spp` samples (seeds 1000..), both at `--size` and
 the scene's own max depth. Each renderer's mean is compared with the other's by the project's
@@ -75,13 +75,10 @@ def main():
         name = os.path.splitext(os.path.basename(scene))[0]
         out = os.path.join(a.work, name)
         os.makedirs(out, exist_ok=True)
-        xml = os.path.join(os.path.dirname(os.path.abspath(scene)), f".xmlcheck-{os.getpid()}.xml")
+        xml = os.path.join(out, "scene.xml")  # file names inside are rewritten for `out`
         subprocess.run([a.restir, "convert", scene, "-o", xml], check=True,
                        stdout=subprocess.DEVNULL)
-        try:
-            ms = mi.load_file(xml, resx=int(w), resy=int(h))
-        finally:
-            os.remove(xml)
+        ms = mi.load_file(xml, resx=int(w), resy=int(h))
         halves = []
         for seed in (1, 2):
             path = os.path.join(out, f"ours-half{seed}.exr")
