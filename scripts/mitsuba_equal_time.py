@@ -34,11 +34,13 @@ Mitsuba's; then a table of the ratios per scene and their medians.
 import argparse
 import faulthandler
 import hashlib
+import importlib.metadata
 import json
 import os
 import re
 import resource
 import shlex
+import shutil
 import struct
 import statistics
 import subprocess
@@ -137,6 +139,9 @@ def load_mitsuba(a, mi, scene, w, h):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scene-timeout", type=float, default=2400,
+                    help="wall seconds before a scene's process is taken for hung and rerun once")
+    ap.add_argument("--child-json", help=argparse.SUPPRESS)
     ap.add_argument("scenes", nargs="+")
     ap.add_argument("--bin", default="target/release/restir")
     ap.add_argument("--size", default="128x96")
@@ -158,8 +163,11 @@ def main():
     if any(len(c) != 2 or not c[0] for c in configs):
         sys.exit("--config: expected NAME=FLAGS")
 
-    # A stack trace on stderr if anything hangs for an hour (Mitsuba's pool has, once).
-    faulthandler.dump_traceback_later(3600, repeat=True)
+    if a.child_json is None:
+        return parent(a, configs)
+    # Where a scene's process hangs, on stderr, before the parent kills it.
+    faulthandler.dump_traceback_later(max(a.scene_timeout - 60, 60))
+
     import drjit as dr
     import mitsuba as mi
     import numpy as np
@@ -168,15 +176,7 @@ def main():
     if a.mi_threads:
         dr.set_thread_count(a.mi_threads)
     w, h = (int(v) for v in a.size.split("x"))
-    os.makedirs(a.refs, exist_ok=True)
     work = a.work = tempfile.mkdtemp(prefix="mitsuba-et-")
-    depth = "each scene's max depth" if a.max_depth is None else f"max depth {a.max_depth}"
-    print(f"# Mitsuba {mi.__version__} {a.variant} ({dr.thread_count()} thread(s)) vs restir "
-          f"(1 thread): {', '.join(n for n, _ in configs)}; {a.size}, {depth}, ~{a.budget} CPU s "
-          f"per render (process CPU time), {a.seeds} seeds, reference: restir path "
-          f"{a.ref_spp} spp")
-    print("| scene | renderer | spp | CPU s | relMSE | efficiency | × Mitsuba |")
-    print("|---|---|---|---|---|---|---|")
     summary = {}
     for scene in a.scenes:
         key = hashlib.sha1((open(scene, "rb").read().hex() + a.size + str(a.max_depth)
@@ -229,6 +229,43 @@ def main():
             print(f"| {os.path.basename(scene)} | {name} | {spp[name]} | {cpu:.2f} | {err:.4e} | "
                   f"{eff[name]:.3f} | {ratio} |", flush=True)
         summary[scene] = eff
+    with open(a.child_json, "w") as f:
+        json.dump(summary, f)
+    shutil.rmtree(work, ignore_errors=True)
+
+
+def parent(a, configs):
+    """Runs each scene in a process of its own (Mitsuba 3.9.1's one-thread pool hung here
+    loading a second scene into one process), then prints the table of ratios."""
+    os.makedirs(a.refs, exist_ok=True)
+    depth = "each scene's max depth" if a.max_depth is None else f"max depth {a.max_depth}"
+    threads = a.mi_threads or "all"
+    version = importlib.metadata.version("mitsuba")
+    print(f"# Mitsuba {version} {a.variant} ({threads} thread(s)) vs restir (1 thread): "
+          f"{', '.join(n for n, _ in configs)}; {a.size}, {depth}, ~{a.budget} CPU s per render "
+          f"(process CPU time), {a.seeds} seeds, reference: restir path {a.ref_spp} spp")
+    print("| scene | renderer | spp | CPU s | relMSE | efficiency | × Mitsuba |")
+    print("|---|---|---|---|---|---|---|", flush=True)
+    summary = {}
+    argv = [x for x in sys.argv[1:] if x not in a.scenes]
+    for scene in a.scenes:
+        out = tempfile.mktemp(prefix="mitsuba-et-", suffix=".json")
+        for attempt in (1, 2):
+            child = subprocess.Popen([sys.executable, os.path.abspath(__file__), *argv,
+                                      "--child-json", out, scene], start_new_session=True)
+            try:
+                child.wait(timeout=a.scene_timeout)
+                break
+            except subprocess.TimeoutExpired:
+                os.killpg(child.pid, 9)
+                child.wait()
+                print(f"# {scene}: no result after {a.scene_timeout:.0f} s "
+                      f"(attempt {attempt}; killed)", flush=True)
+        if child.returncode != 0 or not os.path.exists(out):
+            sys.exit(f"{scene}: failed")
+        with open(out) as f:
+            summary.update(json.load(f))
+        os.remove(out)
 
     names = [n for n, _ in configs]
     cols = [f"{n} / Mitsuba" for n in names] + [f"{n} / {names[0]}" for n in names[1:]]
