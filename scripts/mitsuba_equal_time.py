@@ -15,8 +15,8 @@ For each scene, each of our configurations (`--config NAME=FLAGS`, flags of `res
 default `path=--integrator path`) and Mitsuba's `path` render at the same size, and each render
 is timed by the CPU time it uses, because the machines this runs on are shared and noisy:
 ours on one thread, the child process's user+system time minus its load time; Mitsuba on
-`--mi-threads` threads of its pool (default 1, `dr.set_thread_count`; 0 keeps its default, one
-per core), this process's CPU time of all threads around `mi.render` and reading the image
+`--mi-threads` threads of its pool (default 1, `dr.set_thread_count` after loading the scene on
+its default pool; 0 keeps its default, one per core), this process's CPU time of all threads around `mi.render` and reading the image
 back, after a warm-up render at the same sample count (its kernels compiled). Sample counts
 are calibrated (ours from 4 and 12 passes; Mitsuba from 4 samples, then once more at the count
 that gave) so that each render takes about `--budget` CPU seconds; relMSE is measured by
@@ -131,7 +131,6 @@ def load_mitsuba(a, mi, scene, w, h):
     with open(tmp, "w") as f:
         f.write(text)
     try:
-        # Parallel loading hung here with a one-thread pool (Mitsuba 3.9.1).
         return mi.load_file(tmp, parallel=False)
     finally:
         os.remove(tmp)
@@ -173,8 +172,6 @@ def main():
     import numpy as np
 
     mi.set_variant(a.variant)
-    if a.mi_threads:
-        dr.set_thread_count(a.mi_threads)
     w, h = (int(v) for v in a.size.split("x"))
     work = a.work = tempfile.mkdtemp(prefix="mitsuba-et-")
     summary = {}
@@ -186,6 +183,10 @@ def main():
             ours(a, scene, "--integrator path", a.ref_spp, 999, ref, 0)
 
         ms = load_mitsuba(a, mi, scene, w, h)
+        # Loaded on Mitsuba's default pool: with one thread, loading a scene with an envmap hung
+        # (Mitsuba 3.9.1); rendering on one thread does not.
+        if a.mi_threads:
+            dr.set_thread_count(a.mi_threads)
 
         def mitsuba(spp, seed, out):
             t = self_cpu()
@@ -235,8 +236,8 @@ def main():
 
 
 def parent(a, configs):
-    """Runs each scene in a process of its own (Mitsuba 3.9.1's one-thread pool hung here
-    loading a second scene into one process), then prints the table of ratios."""
+    """Runs each scene in a process of its own (a fresh Mitsuba per scene; one that hangs is
+    killed and rerun), then prints the table of ratios."""
     os.makedirs(a.refs, exist_ok=True)
     depth = "each scene's max depth" if a.max_depth is None else f"max depth {a.max_depth}"
     threads = a.mi_threads or "all"
