@@ -62,10 +62,13 @@ enum Command {
     /// Write a procedurally generated scene (RON).
     #[command(subcommand)]
     Generate(generate::Generate),
-    /// Write a scene (.ron or .xml) as a Mitsuba 3 XML file that Mitsuba 3 and restir both read
-    /// to the same scene (film size, spp and max depth as <default> variables resx, resy, spp,
-    /// max_depth). What Mitsuba 3 cannot express is an error naming it: an animation, a ReSTIR
-    /// integrator or its parameters, an inline triangle mesh.
+    /// Write a scene (.ron or .xml) as Mitsuba 3 XML, which Mitsuba 3 and restir read to the
+    /// same scene.
+    ///
+    /// The film size, sample count and max depth become <default> variables resx, resy, spp and
+    /// max_depth (restir render -D resx=128; in Mitsuba, mi.load_file(path, resx=128)). What
+    /// Mitsuba 3 cannot express is an error naming it: an animation, a ReSTIR integrator or its
+    /// parameters, an inline triangle mesh. See docs/SCENES.md, "Writing Mitsuba 3 XML".
     Convert(convert::ConvertArgs),
     /// Equal-time evaluation: render a suite of scenes × integrators × time budgets × seeds,
     /// compare with references, write a CSV, relMSE-versus-time plots, crops and a report.
