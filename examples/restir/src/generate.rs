@@ -277,6 +277,10 @@ pub struct FamilyArgs {
     /// Write only the member with this index (0-based; its scene and assets, no family.txt).
     #[arg(long)]
     index: Option<usize>,
+    /// Also write each scene as Mitsuba 3 XML, NAME.xml beside NAME.ron (as `restir convert`
+    /// does; animated families cannot be).
+    #[arg(long)]
+    xml: bool,
 }
 
 fn di_params(kind: Kind, args: &DiArgs) -> Result<Params, String> {
@@ -413,6 +417,13 @@ fn write_family(args: &FamilyArgs) -> Result<(), String> {
     } else {
         Split::Test
     };
+    if args.xml && issue.animated() {
+        return Err(format!(
+            "--xml: the {} family is animated, and Mitsuba 3 XML describes one instant (the \
+             static families pt and di convert)",
+            issue.name()
+        ));
+    }
     let members: Vec<FamilyMember> = family(issue, split);
     if let Some(i) = args.index {
         let member = members.get(i).ok_or_else(|| {
@@ -426,6 +437,9 @@ fn write_family(args: &FamilyArgs) -> Result<(), String> {
         let path = generated
             .write(&args.out, &member.name())
             .map_err(|e| e.to_string())?;
+        if args.xml {
+            write_xml(&generated, &path)?;
+        }
         println!(
             "{}, seed {} -> {} (+{} assets)",
             describe_member(member),
@@ -449,6 +463,9 @@ fn write_family(args: &FamilyArgs) -> Result<(), String> {
         let path = generated
             .write(&args.out, &member.name())
             .map_err(|e| e.to_string())?;
+        if args.xml {
+            write_xml(&generated, &path)?;
+        }
         let assets: Vec<&str> = generated
             .assets
             .iter()
@@ -471,6 +488,19 @@ fn write_family(args: &FamilyArgs) -> Result<(), String> {
     std::fs::write(&path, index).map_err(|e| format!("{}: {e}", path.display()))?;
     println!("{} scenes, index {}", members.len(), path.display());
     Ok(())
+}
+
+/// Writes a generated scene, just written as `ron`, as Mitsuba 3 XML beside it.
+fn write_xml(generated: &Generated, ron: &std::path::Path) -> Result<(), String> {
+    let header = format!(
+        "{}\nWritten as Mitsuba 3 XML by `restir generate family --xml` beside {}; regenerate \
+         rather than edit.",
+        generated.header.trim_end(),
+        ron.file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("the RON file")
+    );
+    crate::convert::write_xml(&generated.desc, ron, &ron.with_extension("xml"), header)
 }
 
 /// Writes one many-light scene (`restir generate rects|spheres|meshes`).

@@ -21,6 +21,7 @@ use restir_scene::{LoadOptions, load_scene};
 
 mod bench;
 mod cluster;
+mod convert;
 mod frames;
 mod generate;
 mod interrupt;
@@ -61,6 +62,14 @@ enum Command {
     /// Write a procedurally generated scene (RON).
     #[command(subcommand)]
     Generate(generate::Generate),
+    /// Write a scene (.ron or .xml) as Mitsuba 3 XML, which Mitsuba 3 and restir read to the
+    /// same scene.
+    ///
+    /// The film size, sample count and max depth become <default> variables resx, resy, spp and
+    /// max_depth (restir render -D resx=128; in Mitsuba, mi.load_file(path, resx=128)). What
+    /// Mitsuba 3 cannot express is an error naming it: an animation, a ReSTIR integrator or its
+    /// parameters, an inline triangle mesh. See docs/SCENES.md, "Writing Mitsuba 3 XML".
+    Convert(convert::ConvertArgs),
     /// Equal-time evaluation: render a suite of scenes × integrators × time budgets × seeds,
     /// compare with references, write a CSV, relMSE-versus-time plots, crops and a report.
     Bench(Box<bench::BenchArgs>),
@@ -667,6 +676,7 @@ fn main() -> ExitCode {
             html,
         } => run_compare(&test, &reference, html.as_deref()).map(|()| Rendered::Complete),
         Command::Generate(what) => generate::run(what).map(|()| Rendered::Complete),
+        Command::Convert(args) => convert::run(args).map(|()| Rendered::Complete),
         Command::Bench(args) => bench::run(*args).map(|()| Rendered::Complete),
         Command::Merge(args) => merge::run(args).map(|()| Rendered::Complete),
     };

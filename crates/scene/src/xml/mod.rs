@@ -11,6 +11,9 @@
 //! getters, located errors, unused-property warnings), and `bsdfs`, `textures`, `shapes`,
 //! `emitters`, `sensor` (camera, film, sampler) and `integrator` turn them into descriptions.
 //! This module walks the document: `<default>` variables, top-level ids and references.
+//!
+//! The other direction is [`to_mitsuba_xml`] (`write.rs`): a description as a Mitsuba 3 scene
+//! file, which this importer reads back to the same scene.
 
 mod bsdfs;
 mod emitters;
@@ -21,6 +24,9 @@ mod shapes;
 mod source;
 mod textures;
 mod values;
+mod write;
+
+pub use write::{XmlWriteError, XmlWriteOptions, to_mitsuba_xml};
 
 use std::collections::HashMap;
 use std::path::Path;
