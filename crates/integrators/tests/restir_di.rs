@@ -64,6 +64,28 @@ fn statistics(
     block_statistics(render_one, seeds, seed_base(), BLOCK)
 }
 
+/// Per block, as [`statistics`], for settings no parameter string reaches (the hidden negative
+/// controls): one pass per render.
+fn settings_statistics(scene: &Scene, settings: RestirDiSettings, seeds: u64) -> Vec<(f64, f64)> {
+    let integrator = RestirDiIntegrator::new(settings);
+    let render_one = |seed| {
+        let job = RenderJob {
+            spp: 1,
+            seed,
+            ..RenderJob::default()
+        };
+        render(
+            scene,
+            &integrator,
+            &job,
+            &AtomicBool::new(false),
+            &mut |_, _| {},
+        )
+        .image
+    };
+    block_statistics(render_one, seeds, seed_base(), BLOCK)
+}
+
 fn direct_reference(scene: &Scene) -> Vec<(f64, f64)> {
     statistics(scene, "path", &[], 256, 48)
 }
@@ -213,25 +235,7 @@ fn light_pool_and_visible_targets() {
     let mut wrong =
         RestirDiSettings::new(restir_integrators::path::PathSettings::from_scene(&scene));
     wrong.light_sampler = LightSampler::PoolWithoutSelection;
-    let render_one = |seed| {
-        let job = RenderJob {
-            spp: 1,
-            seed,
-            ..RenderJob::default()
-        };
-        render(
-            &scene,
-            &RestirDiIntegrator::new(wrong),
-            &job,
-            &AtomicBool::new(false),
-            &mut |_, _| {},
-        )
-        .image
-    };
-    let z = max_z(
-        &block_statistics(render_one, 200, seed_base(), BLOCK),
-        &reference,
-    );
+    let z = max_z(&settings_statistics(&scene, wrong, 200), &reference);
     eprintln!("pool without the selection probability: max |z| = {z:.2}");
     assert!(
         z > 2.0 * Z_MAX,
@@ -380,26 +384,7 @@ fn light_hierarchy_is_unbiased_and_a_wrong_pmf_is_caught() {
         RestirDiSettings::new(restir_integrators::path::PathSettings::from_scene(&scene));
     wrong.light_sampler = LightSampler::BvhWithPowerPmf;
     wrong.candidates = 4;
-    let render_one = |seed| {
-        let integrator = RestirDiIntegrator::new(wrong);
-        let job = RenderJob {
-            spp: 1,
-            seed,
-            ..RenderJob::default()
-        };
-        render(
-            &scene,
-            &integrator,
-            &job,
-            &AtomicBool::new(false),
-            &mut |_, _| {},
-        )
-        .image
-    };
-    let z = max_z(
-        &block_statistics(render_one, 200, seed_base(), BLOCK),
-        &reference,
-    );
+    let z = max_z(&settings_statistics(&scene, wrong, 200), &reference);
     eprintln!("hierarchy with the power pmf: max |z| = {z:.2}");
     assert!(
         z > 2.0 * Z_MAX,
