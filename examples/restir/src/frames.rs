@@ -2,7 +2,8 @@
 //! the scene at time `frame / fps` (`restir_scene::animation::build_at`, a whole new scene per
 //! frame), rendered with the job's passes or time limit and written as `NAME_0001.exr` (or
 //! `.png`) through the atomic writer; `--preview OUT.png` also writes an animated PNG of the
-//! frames. The flags are checked before anything renders.
+//! frames, and `--preview OUT.mp4` (`.webm`, `.mkv`, `.mov`, `.gif`) a video through `ffmpeg`
+//! when it is on `PATH`. The flags are checked before anything renders.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -24,8 +25,72 @@ pub struct FramePlan {
     pub last: u32,
     /// Frames per second.
     pub fps: f32,
-    /// Where the animated preview goes.
-    pub preview: Option<PathBuf>,
+    /// Where the animated preview goes, and how it is written.
+    pub preview: Option<(PathBuf, Preview)>,
+}
+
+/// How the preview of a sequence is written, from its file name's extension.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Preview {
+    /// An animated PNG, written by us.
+    Apng,
+    /// A video (or GIF) encoded by `ffmpeg`, found on `PATH` before rendering.
+    Video {
+        /// The `ffmpeg` executable.
+        ffmpeg: PathBuf,
+        /// ffmpeg's name of the container (`-f`).
+        format: &'static str,
+    },
+}
+
+/// The preview's extensions and ffmpeg's container for each (`None`: an animated PNG).
+const PREVIEW_FORMATS: [(&str, Option<&str>); 6] = [
+    ("png", None),
+    ("gif", Some("gif")),
+    ("mp4", Some("mp4")),
+    ("webm", Some("webm")),
+    ("mkv", Some("matroska")),
+    ("mov", Some("mov")),
+];
+
+impl Preview {
+    /// The preview `path` asks for: an animated PNG for `.png`, else a video through the
+    /// `ffmpeg` found on `search_path` (the `PATH` variable).
+    fn of(path: &Path, search_path: Option<&std::ffi::OsStr>) -> Result<Self, String> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        let Some(&(_, format)) = PREVIEW_FORMATS
+            .iter()
+            .find(|(e, _)| Some(*e) == ext.as_deref())
+        else {
+            let names: Vec<String> = PREVIEW_FORMATS
+                .iter()
+                .map(|(e, _)| format!(".{e}"))
+                .collect();
+            return Err(format!(
+                "{}: --preview must end in one of {} (.png: an animated PNG; the others: a video through ffmpeg)",
+                path.display(),
+                names.join(", ")
+            ));
+        };
+        let Some(format) = format else {
+            return Ok(Preview::Apng);
+        };
+        let ffmpeg = search_path
+            .into_iter()
+            .flat_map(std::env::split_paths)
+            .map(|dir| dir.join("ffmpeg"))
+            .find(|p| p.is_file())
+            .ok_or_else(|| {
+                format!(
+                    "{}: a video preview needs ffmpeg on PATH, and there is none (install it, or write an animated PNG with --preview NAME.png)",
+                    path.display()
+                )
+            })?;
+        Ok(Preview::Video { ffmpeg, format })
+    }
 }
 
 /// The flags of an animation render.
@@ -43,8 +108,10 @@ pub struct FrameArgs {
     /// beside the scene).
     #[arg(long, value_name = "FILE")]
     pub animation: Option<PathBuf>,
-    /// Also write the frames as one animated PNG (8-bit sRGB), played at the frame rate.
-    #[arg(long, value_name = "OUT.png")]
+    /// Also write the frames as one preview played at the frame rate: an animated PNG (8-bit
+    /// sRGB) for .png; a video for .mp4, .webm, .mkv, .mov or .gif, encoded by ffmpeg (which
+    /// must be on PATH).
+    #[arg(long, value_name = "OUT.png|OUT.mp4")]
     pub preview: Option<PathBuf>,
 }
 
@@ -108,22 +175,18 @@ impl FrameArgs {
             }
             None => anim.fps,
         };
-        if let Some(p) = &self.preview
-            && !p
-                .extension()
-                .and_then(|e| e.to_str())
-                .is_some_and(|e| e.eq_ignore_ascii_case("png"))
-        {
-            return Err(format!(
-                "{}: --preview must end in .png (an animated PNG)",
-                p.display()
-            ));
-        }
+        let preview = match &self.preview {
+            Some(p) => Some((
+                p.clone(),
+                Preview::of(p, std::env::var_os("PATH").as_deref())?,
+            )),
+            None => None,
+        };
         Ok(Some(FramePlan {
             first,
             last,
             fps,
-            preview: self.preview.clone(),
+            preview,
         }))
     }
 }
@@ -245,8 +308,12 @@ pub fn render_frames(
             break;
         }
     }
-    if let Some(p) = &plan.preview {
-        write_apng(p, &preview, plan.fps)?;
+    match &plan.preview {
+        Some((p, Preview::Apng)) => write_apng(p, &preview, plan.fps)?,
+        Some((p, Preview::Video { ffmpeg, format })) => {
+            write_video(ffmpeg, format, p, &preview, plan.fps)?
+        }
+        None => {}
     }
     Ok((
         SequenceStats {
@@ -285,16 +352,80 @@ pub fn write_apng(path: &Path, frames: &[Image], fps: f32) -> Result<(), String>
         enc.set_frame_delay(100, den).map_err(fail)?;
         let mut w = enc.write_header().map_err(fail)?;
         for img in frames {
-            let data: Vec<u8> = img
-                .pixels
-                .iter()
-                .flat_map(|p| p.to_array().map(restir_image::srgb::encode_u8))
-                .collect();
-            w.write_image_data(&data).map_err(fail)?;
+            w.write_image_data(&srgb_bytes(img)).map_err(fail)?;
         }
         w.finish().map_err(fail)?;
     }
     restir_image::write_file_atomically(path, &bytes).map_err(|e| e.to_string())
+}
+
+/// The frames as 8-bit sRGB bytes, row by row (what [`write_apng`] and ffmpeg's `rgb24` take).
+fn srgb_bytes(img: &Image) -> Vec<u8> {
+    img.pixels
+        .iter()
+        .flat_map(|p| p.to_array().map(restir_image::srgb::encode_u8))
+        .collect()
+}
+
+/// Writes `frames` as a video (or GIF) at `fps` through `ffmpeg`, in the container `format`:
+/// the 8-bit sRGB frames go to its standard input as raw `rgb24`; odd sizes are padded by a
+/// pixel (H.264's 4:2:0 needs even ones). ffmpeg writes a temporary file beside `path`,
+/// renamed into place once it succeeds.
+pub fn write_video(
+    ffmpeg: &Path,
+    format: &str,
+    path: &Path,
+    frames: &[Image],
+    fps: f32,
+) -> Result<(), String> {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    let Some(first) = frames.first() else {
+        return Ok(());
+    };
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(format!(".tmp-{}", std::process::id()));
+    let tmp = PathBuf::from(tmp);
+    let mut cmd = Command::new(ffmpeg);
+    cmd.args(["-hide_banner", "-loglevel", "error", "-y"])
+        .args(["-f", "rawvideo", "-pix_fmt", "rgb24"])
+        .args(["-s", &format!("{}x{}", first.width, first.height)])
+        .args(["-framerate", &fps.to_string(), "-i", "pipe:0"]);
+    if format != "gif" {
+        cmd.args([
+            "-vf",
+            "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+            "-pix_fmt",
+            "yuv420p",
+        ]);
+    }
+    cmd.args(["-f", format])
+        .arg(&tmp)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped());
+    let fail = |what: String| format!("{}: ffmpeg ({}) {what}", path.display(), ffmpeg.display());
+    let mut child = cmd
+        .spawn()
+        .map_err(|e| fail(format!("could not start: {e}")))?;
+    let mut stdin = child.stdin.take().expect("stdin is piped");
+    // A write fails when ffmpeg exits early; its status and message say why.
+    let written = frames
+        .iter()
+        .try_for_each(|img| stdin.write_all(&srgb_bytes(img)));
+    drop(stdin);
+    let out = child
+        .wait_with_output()
+        .map_err(|e| fail(format!("failed: {e}")))?;
+    if !out.status.success() || written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+        let said = String::from_utf8_lossy(&out.stderr);
+        return Err(fail(format!("failed ({}): {}", out.status, said.trim())));
+    }
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        format!("{}: cannot write the preview: {e}", path.display())
+    })
 }
 
 /// The command's side of [`render_frames`]: a progress bar (frame and pass), the statistics
@@ -388,7 +519,7 @@ pub fn run(
             start.elapsed().as_secs_f64(),
             frame_path(&output, plan.first).display(),
             match &plan.preview {
-                Some(p) => format!(", preview {}", p.display()),
+                Some((p, _)) => format!(", preview {}", p.display()),
                 None => String::new(),
             }
         );

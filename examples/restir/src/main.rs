@@ -421,7 +421,7 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
         Some(f) => frames::frame_path(&output, f.first),
         None => output,
     };
-    if let Some(p) = frame_plan.as_ref().and_then(|f| f.preview.as_ref()) {
+    if let Some((p, _)) = frame_plan.as_ref().and_then(|f| f.preview.as_ref()) {
         if let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)
                 .map_err(|e| format!("{}: cannot create output directory: {e}", dir.display()))?;

@@ -119,6 +119,93 @@ fn frames_are_written_one_file_each_with_a_preview_and_stats() {
     assert!(stdout.contains("3 frames (0 to 2) at 2 fps"), "{stdout}");
 }
 
+/// `--preview NAME.mp4` hands the frames to the `ffmpeg` on `PATH` as raw 8-bit RGB at the
+/// frame rate. A stand-in `ffmpeg` (a shell script) writes its arguments and the number of
+/// bytes it read into the file it is told to write, so this checks our side of the pipe; and
+/// without an `ffmpeg` on `PATH` a video preview is refused before anything renders.
+#[cfg(unix)]
+#[test]
+fn video_previews_go_through_ffmpeg_on_path() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = temp_dir("video");
+    let scene = animated(&dir);
+    let bin = dir.0.join("bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    let fake = bin.join("ffmpeg");
+    std::fs::write(
+        &fake,
+        "#!/bin/sh\nfor a in \"$@\"; do out=\"$a\"; done\nprintf '%s\\n' \"$@\" > \"$out\"\nwc -c | tr -d ' ' >> \"$out\"\n",
+    )
+    .unwrap();
+    std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let out = dir.0.join("seq.exr");
+    let video = dir.0.join("seq.mp4");
+    let args = [
+        "render",
+        s(&scene),
+        "--frames",
+        "0..1",
+        "--spp",
+        "1",
+        "-o",
+        s(&out),
+        "--preview",
+        s(&video),
+    ];
+    // The stand-in first, then the system's tools (its `wc`).
+    let path = std::env::join_paths(std::iter::once(bin.clone()).chain(std::env::split_paths(
+        &std::env::var_os("PATH").unwrap_or_default(),
+    )))
+    .unwrap();
+    let run = Command::new(RESTIR)
+        .args(args)
+        .env("PATH", &path)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let said = std::fs::read_to_string(&video).unwrap();
+    let lines: Vec<&str> = said.lines().collect();
+    let after = |flag: &str| lines[lines.iter().position(|l| *l == flag).unwrap() + 1];
+    assert_eq!(after("-pix_fmt"), "rgb24");
+    assert_eq!(after("-s"), "8x8");
+    assert_eq!(after("-framerate"), "2");
+    assert_eq!(lines.iter().filter(|l| **l == "-f").count(), 2);
+    assert_eq!(*lines.iter().rev().nth(2).unwrap(), "mp4", "{said}");
+    // Two 8x8 frames of 3 bytes a pixel.
+    assert_eq!(*lines.last().unwrap(), (2 * 8 * 8 * 3).to_string());
+    let left: Vec<_> = std::fs::read_dir(&dir.0)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".tmp-"))
+        .collect();
+    assert!(left.is_empty(), "temporary files left: {left:?}");
+
+    // No ffmpeg: refused before rendering.
+    let empty = dir.0.join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let gif = dir.0.join("none.gif");
+    let mut args = args;
+    args[9] = s(&gif);
+    let run = Command::new(RESTIR)
+        .args(args)
+        .env("PATH", &empty)
+        .output()
+        .unwrap();
+    assert_eq!(run.status.code(), Some(1));
+    assert_eq!(
+        String::from_utf8_lossy(&run.stderr),
+        format!(
+            "error: {}: a video preview needs ffmpeg on PATH, and there is none (install it, or write an animated PNG with --preview NAME.png)\n",
+            s(&gif)
+        )
+    );
+    assert!(!gif.exists());
+}
+
 /// With `--temporal`, ReSTIR DI's first pass of a frame reuses the previous frame (the frame
 /// differs from the one rendered without it, same seed; the first frame, with no history,
 /// does not); ReSTIR PT starts every frame afresh and renders too.
@@ -232,9 +319,9 @@ fn bad_frame_flags_are_refused_before_rendering() {
             "--frames",
             "1..3",
             "--preview",
-            "p.gif",
+            "p.jpg",
         ],
-        "error: p.gif: --preview must end in .png (an animated PNG)",
+        "error: p.jpg: --preview must end in one of .png, .gif, .mp4, .webm, .mkv, .mov (.png: an animated PNG; the others: a video through ffmpeg)",
     );
     fails_with(
         &[
