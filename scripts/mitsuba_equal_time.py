@@ -128,6 +128,16 @@ def load_mitsuba(a, mi, scene, w, h):
         values += [("max_depth", a.max_depth), ("maxDepth", a.max_depth)]
     for name, value in values:
         text = re.sub(rf'(name="{name}"\s+value=")[^"]*(")', rf"\g<1>{value}\g<2>", text)
+    if a.mi_integrator != "path":
+        # Another of Mitsuba's integrators (e.g. `direct`) in place of the scene's, keeping
+        # whether emitters seen directly are hidden.
+        block = re.search(r'<integrator\b[^>]*?/>|<integrator\b[^>]*>.*?</integrator>',
+                          text, re.S)
+        if block is None:
+            sys.exit(f"{scene}: no <integrator> element to replace with {a.mi_integrator}")
+        hide = re.search(r'<boolean name="hide_emitters"[^>]*/>', block.group(0))
+        text = (text[:block.start()] + f'<integrator type="{a.mi_integrator}">'
+                + (hide.group(0) if hide else "") + "</integrator>" + text[block.end():])
     with open(tmp, "w") as f:
         f.write(text)
     try:
@@ -226,6 +236,11 @@ def main():
     ap.add_argument("--variant", default="llvm_ad_rgb")
     ap.add_argument("--mi-threads", type=int, default=1,
                     help="Mitsuba's threads (0: its default, one per core)")
+    ap.add_argument("--mi-integrator", default="path",
+                    help="Mitsuba's integrator (e.g. direct: replaces the scene's, keeping "
+                    "hide_emitters)")
+    ap.add_argument("--ref-flags", default="--integrator path",
+                    help="restir render flags of the reference (default: the path tracer)")
     ap.add_argument("--convert", action="store_true",
                     help="give Mitsuba XML scenes too as `restir convert` writes them")
     ap.add_argument("--many-lights-xml", metavar="OUT",
@@ -258,11 +273,12 @@ def main():
     work = a.work = tempfile.mkdtemp(prefix="mitsuba-et-")
     summary = {}
     for scene in a.scenes:
+        ref_flags = "" if a.ref_flags == "--integrator path" else a.ref_flags
         key = hashlib.sha1((open(scene, "rb").read().hex() + a.size + str(a.max_depth)
-                            + str(a.ref_spp)).encode()).hexdigest()[:12]
+                            + str(a.ref_spp) + ref_flags).encode()).hexdigest()[:12]
         ref = os.path.join(a.refs, f"{os.path.basename(scene)}-{key}.exr")
         if not os.path.exists(ref):
-            ours(a, scene, "--integrator path", a.ref_spp, 999, ref, 0)
+            ours(a, scene, a.ref_flags, a.ref_spp, 999, ref, 0)
 
         ms = load_mitsuba(a, mi, scene, w, h)
         # Loaded on Mitsuba's default pool: with one thread, loading a scene with an envmap hung
@@ -332,9 +348,10 @@ def parent(a, configs):
     depth = "each scene's max depth" if a.max_depth is None else f"max depth {a.max_depth}"
     threads = a.mi_threads or "all"
     version = importlib.metadata.version("mitsuba")
-    print(f"# Mitsuba {version} {a.variant} ({threads} thread(s)) vs restir (1 thread): "
+    print(f"# Mitsuba {version} {a.variant} `{a.mi_integrator}` ({threads} thread(s)) vs "
+          f"restir (1 thread): "
           f"{', '.join(n for n, _ in configs)}; {a.size}, {depth}, ~{a.budget} CPU s per render "
-          f"(process CPU time), {a.seeds} seeds, reference: restir path {a.ref_spp} spp")
+          f"(process CPU time), {a.seeds} seeds, reference: restir {a.ref_flags} {a.ref_spp} spp")
     print("| scene | renderer | spp | CPU s | relMSE | efficiency | × Mitsuba |")
     print("|---|---|---|---|---|---|---|", flush=True)
     summary = {}
