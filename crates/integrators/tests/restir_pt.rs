@@ -409,14 +409,26 @@ fn jacobian_rejection_and_footprint_rule_unbiased() {
         eprintln!("max_depth 4, {params:?}: max |z| = {z:.2}");
         assert!(z < Z_MAX, "{params:?}: max |z| = {z:.2}");
     }
-    let one_sided = [("max_jacobian", "1.5"), ("one_sided_jacobian", "true")];
+    // More reuse (3 rounds of 6 neighbours) makes the bias of the negative controls visible.
+    let reuse = [("spatial_rounds", "3"), ("neighbors", "6")];
+    let one_sided = [
+        reuse[0],
+        reuse[1],
+        ("max_jacobian", "1.1"),
+        ("one_sided_jacobian", "true"),
+    ];
     let z = max_z(
         &statistics(&scene, "restir-pt", &one_sided, 1, 2000),
         &reference,
     );
-    eprintln!("one-sided Jacobian rejection (J > 1.5 only): max |z| = {z:.2}");
+    eprintln!("one-sided Jacobian rejection (J > 1.1 only): max |z| = {z:.2}");
     assert!(z > Z_MAX, "a one-sided rejection should be biased: {z:.2}");
-    let nojac = [("reconnection", "footprint"), ("unit_jacobian", "true")];
+    let nojac = [
+        reuse[0],
+        reuse[1],
+        ("reconnection", "footprint"),
+        ("unit_jacobian", "true"),
+    ];
     let z = max_z(&statistics(&scene, "restir-pt", &nojac, 1, 2000), &reference);
     eprintln!("footprint rule, Jacobian omitted: max |z| = {z:.2}");
     assert!(z > Z_MAX, "J = 1 should be biased: {z:.2}");

@@ -129,10 +129,15 @@ impl RestirPtIntegrator {
     }
 
     /// The shift used for this scene: `--shift`, except that `hybrid` becomes `reconnection` in
-    /// scenes where every material is connectible (nothing to replay through; decided once here).
+    /// scenes where every material is connectible under the fixed rule (nothing to replay
+    /// through; decided once here). The footprint rule keeps the hybrid shift: it turns down
+    /// reconnections at glossy vertices on short segments, which the hybrid shift replays.
     pub fn effective_shift(&self, scene: &Scene) -> ShiftKind {
         let s = self.settings.shift;
-        if s == ShiftKind::Hybrid && !has_near_specular(scene) {
+        if s == ShiftKind::Hybrid
+            && self.settings.reconnection == Reconnection::Fixed
+            && !has_near_specular(scene)
+        {
             ShiftKind::Reconnection
         } else {
             s
