@@ -429,7 +429,10 @@ fn jacobian_rejection_and_footprint_rule_unbiased() {
         ("reconnection", "footprint"),
         ("unit_jacobian", "true"),
     ];
-    let z = max_z(&statistics(&scene, "restir-pt", &nojac, 1, 2000), &reference);
+    let z = max_z(
+        &statistics(&scene, "restir-pt", &nojac, 1, 2000),
+        &reference,
+    );
     eprintln!("footprint rule, Jacobian omitted: max |z| = {z:.2}");
     assert!(z > Z_MAX, "J = 1 should be biased: {z:.2}");
 }

@@ -173,7 +173,7 @@ impl RestirPtSettings {
     pub fn is_unbiased(&self) -> bool {
         self.reuse.is_unbiased()
             && !self.unit_jacobian
-            && !(self.one_sided_jacobian && self.max_jacobian > 0.0)
+            && (!self.one_sided_jacobian || self.max_jacobian <= 0.0)
             && !self.skip_invertibility
             && (!self.reuse.temporal
                 || !(self.temporal_ignore_motion || self.temporal_stale_suffix))
