@@ -274,6 +274,25 @@ mod tests {
         assert!(s.apply(&p("candidates", "0")).is_err());
         s.apply(&p("direct", "restir_di")).unwrap();
         assert_eq!(s.direct, DirectLight::RestirDi);
+        assert_eq!(s.reconnection, Reconnection::Fixed);
+        s.apply(&p("reconnection", "Footprint")).unwrap();
+        s.apply(&p("footprint", "3")).unwrap();
+        assert_eq!(
+            (s.reconnection, s.footprint),
+            (Reconnection::Footprint, 3.0)
+        );
+        assert!(
+            s.apply(&p("reconnection", "roughness"))
+                .unwrap_err()
+                .to_string()
+                .contains("fixed or footprint")
+        );
+        assert!(s.apply(&p("footprint", "-1")).is_err());
+        assert!(s.is_unbiased());
+        s.apply(&p("one_sided_jacobian", "true")).unwrap();
+        assert!(s.is_unbiased(), "no rejection: nothing one-sided");
+        s.apply(&p("max_jacobian", "2")).unwrap();
+        assert!(!s.is_unbiased());
     }
 
     /// `fallback` takes auto or off and is the one parameter that does not count as
