@@ -131,6 +131,12 @@ impl Camera {
         self.resolution
     }
 
+    /// The angle one pixel spans at the centre of the film, vertically (radians, small-angle):
+    /// the spread of a primary ray's cone.
+    pub fn pixel_angle(&self) -> f32 {
+        2.0 * self.tan_half.y / self.resolution.1 as f32
+    }
+
     /// The camera position.
     pub fn origin(&self) -> Vec3 {
         self.origin

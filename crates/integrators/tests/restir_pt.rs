@@ -8,7 +8,7 @@
 use restir_gris::ShiftMap;
 use restir_integrators::film::Filter;
 use restir_integrators::path::PathSettings;
-use restir_integrators::restir_pt::{Kind, ShiftKind};
+use restir_integrators::restir_pt::{Kind, Reconnection, ShiftKind};
 use restir_integrators::reuse::MIS_NAMES;
 use restir_integrators::{
     Image, IntegratorOptions, PassContext, RestirPtIntegrator, RestirPtSettings, make_integrator,
@@ -192,6 +192,21 @@ fn shift_identity_and_round_trip_on_scene_paths() {
     let mut settings = *integrator(-1).settings();
     settings.max_jacobian = 2.0;
     check_shifts(&glass_scene(), &RestirPtIntegrator::new(settings));
+    // The footprint reconnection rule: evaluated on the destination's path by the shift, so
+    // forward and inverse still succeed and fail together.
+    let mut settings = *integrator(-1).settings();
+    settings.reconnection = Reconnection::Footprint;
+    for shift in [ShiftKind::Reconnection, ShiftKind::Hybrid] {
+        let pt = with_shift(RestirPtIntegrator::new(settings), shift);
+        check_shifts(&scene(), &pt);
+        let stats = check_shifts(&glass_scene(), &pt);
+        assert!(stats.kinds[Kind::Frozen as usize] > 0, "{:?}", stats.kinds);
+    }
+    let stats = check_shifts(
+        &striped_floor_scene(0.01),
+        &with_shift(RestirPtIntegrator::new(settings), ShiftKind::Hybrid),
+    );
+    assert!(stats.rc[3..].iter().sum::<usize>() >= 50, "{:?}", stats.rc);
 }
 
 #[derive(Debug, Default)]
@@ -376,6 +391,52 @@ fn unbiased_against_the_path_tracer() {
     assert!(z > Z_MAX, "J = 1 should be biased: {z:.2}");
 }
 
+/// The quality-per-sample options (issue 15, goal 5) against the path tracer: symmetric
+/// Jacobian rejection and the footprint reconnection rule, alone and together; and their
+/// negative controls: a rejection of `J > τ` only (not symmetric, so a shift can succeed while
+/// its inverse fails) and the footprint rule without the Jacobian.
+#[test]
+fn jacobian_rejection_and_footprint_rule_unbiased() {
+    let scene = scene();
+    let reference = statistics(&scene, "path", &[], 128, 64);
+    let configurations: [&[(&str, &str)]; 3] = [
+        &[("max_jacobian", "2")],
+        &[("reconnection", "footprint")],
+        &[("reconnection", "footprint"), ("max_jacobian", "2")],
+    ];
+    for params in configurations {
+        let z = max_z(&statistics(&scene, "restir-pt", params, 1, 400), &reference);
+        eprintln!("max_depth 4, {params:?}: max |z| = {z:.2}");
+        assert!(z < Z_MAX, "{params:?}: max |z| = {z:.2}");
+    }
+    // More reuse (3 rounds of 6 neighbours) makes the bias of the negative controls visible.
+    let reuse = [("spatial_rounds", "3"), ("neighbors", "6")];
+    let one_sided = [
+        reuse[0],
+        reuse[1],
+        ("max_jacobian", "1.1"),
+        ("one_sided_jacobian", "true"),
+    ];
+    let z = max_z(
+        &statistics(&scene, "restir-pt", &one_sided, 1, 2000),
+        &reference,
+    );
+    eprintln!("one-sided Jacobian rejection (J > 1.1 only): max |z| = {z:.2}");
+    assert!(z > Z_MAX, "a one-sided rejection should be biased: {z:.2}");
+    let nojac = [
+        reuse[0],
+        reuse[1],
+        ("reconnection", "footprint"),
+        ("unit_jacobian", "true"),
+    ];
+    let z = max_z(
+        &statistics(&scene, "restir-pt", &nojac, 1, 2000),
+        &reference,
+    );
+    eprintln!("footprint rule, Jacobian omitted: max |z| = {z:.2}");
+    assert!(z > Z_MAX, "J = 1 should be biased: {z:.2}");
+}
+
 /// The defaults (two candidates, three rounds of two reciprocal pairs within 3 pixels).
 #[test]
 fn unbiased_at_the_defaults() {
@@ -490,6 +551,15 @@ fn shifts_unbiased_with_glass_and_near_specular() {
             eprintln!("{label}, {shift}: max |z| = {z:.2}");
             assert!(z < Z_MAX, "{label}, {shift}: max |z| = {z:.2}");
         }
+        // The footprint reconnection rule with the hybrid shift (which decides more often
+        // here than the fixed rule whether a glossy vertex is reconnected at or replayed).
+        let params = [depth, ("reconnection", "footprint")];
+        let z = max_z(
+            &statistics(&scene, "restir-pt", &params, 1, 300),
+            &reference,
+        );
+        eprintln!("{label}, hybrid, footprint rule: max |z| = {z:.2}");
+        assert!(z < Z_MAX, "{label}, footprint rule: max |z| = {z:.2}");
         let pt_fireflies = fireflies(&scene, "path", &[depth], 100);
         for shift in ["reconnection", "hybrid"] {
             let f = fireflies(&scene, "restir-pt", &[depth, ("shift", shift)], 100);

@@ -197,6 +197,15 @@ struct RestirArgs {
     /// restir-pt: reject shifts with max(J, 1/J) above this (unbiased) [default: none].
     #[arg(long)]
     max_jacobian: Option<f32>,
+    /// restir-pt: the rule for a path's reconnection vertex: fixed (roughness and distance
+    /// thresholds) or footprint (the lobe's footprint against the pixel's ray cone)
+    /// [default: fixed].
+    #[arg(long)]
+    reconnection: Option<String>,
+    /// restir-pt: the footprint rule's threshold T (lobe footprint over squared cone width)
+    /// [default: 30].
+    #[arg(long)]
+    footprint: Option<f32>,
     /// restir-pt: direct light in the reservoirs (reservoir), path traced per pixel (path) or
     /// from a ReSTIR DI pass (restir-di)
     /// [default: reservoir].
@@ -241,6 +250,11 @@ impl RestirArgs {
         );
         put("shift", self.shift.clone().map(ParamValue::Text));
         put("max_jacobian", self.max_jacobian.map(ParamValue::Number));
+        put(
+            "reconnection",
+            self.reconnection.clone().map(ParamValue::Text),
+        );
+        put("footprint", self.footprint.map(ParamValue::Number));
         put("direct", self.direct.clone().map(ParamValue::Text));
         p
     }

@@ -38,7 +38,7 @@ use restir_sampling::{Pcg32, luminance};
 use restir_scene::Scene;
 
 pub use fallback::{GLOSSY_VIEW_MIN, INDIRECT_VIEW_MIN, ViewPilot, view_pilot};
-pub use sample::{Kind, PathSample, ShiftKind};
+pub use sample::{Kind, PathSample, Reconnection, ShiftKind};
 pub use settings::{DirectLight, Fallback, RestirPtSettings, SHIFT_NAMES};
 use shift::PtReuse;
 pub use shift::{Frames, PtShift};
@@ -129,10 +129,15 @@ impl RestirPtIntegrator {
     }
 
     /// The shift used for this scene: `--shift`, except that `hybrid` becomes `reconnection` in
-    /// scenes where every material is connectible (nothing to replay through; decided once here).
+    /// scenes where every material is connectible under the fixed rule (nothing to replay
+    /// through; decided once here). The footprint rule keeps the hybrid shift: it turns down
+    /// reconnections at glossy vertices on short segments, which the hybrid shift replays.
     pub fn effective_shift(&self, scene: &Scene) -> ShiftKind {
         let s = self.settings.shift;
-        if s == ShiftKind::Hybrid && !has_near_specular(scene) {
+        if s == ShiftKind::Hybrid
+            && self.settings.reconnection == Reconnection::Fixed
+            && !has_near_specular(scene)
+        {
             ShiftKind::Reconnection
         } else {
             s
@@ -148,6 +153,8 @@ impl RestirPtIntegrator {
             max_depth: self.max_depth(),
             rr_depth: self.settings.path.rr_depth,
             near2: d * d,
+            rule: self.settings.reconnection,
+            footprint2: self.settings.footprint * scene.camera.pixel_angle().powi(2),
             skip_invertibility: self.settings.skip_invertibility,
         }
     }
@@ -335,7 +342,7 @@ impl Integrator for RestirPtIntegrator {
         let s = &self.settings;
         format!(
             "restir-pt max_depth={} candidates={} neighbors={} radius={} spatial_rounds={} \
-             reciprocal={} mis={} mcap={} {} shift={} near_distance={} max_jacobian={} \
+             reciprocal={} mis={} mcap={} {} shift={} reconnection={} max_jacobian={} \
              direct={}{}",
             s.path.max_depth,
             s.candidates,
@@ -347,7 +354,10 @@ impl Integrator for RestirPtIntegrator {
             s.reuse.mcap,
             s.reuse.describe_temporal(),
             s.shift.name(),
-            s.near_distance,
+            match s.reconnection {
+                Reconnection::Fixed => format!("fixed near_distance={}", s.near_distance),
+                Reconnection::Footprint => format!("footprint({})", s.footprint),
+            },
             s.max_jacobian,
             s.direct.name(),
             if s.is_unbiased() { "" } else { " (biased)" }

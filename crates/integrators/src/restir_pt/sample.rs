@@ -82,6 +82,32 @@ impl ShiftKind {
     }
 }
 
+/// The rule that picks a path's reconnection vertex (`--reconnection`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reconnection {
+    /// Fixed thresholds: `x_{k−1}` and `x_k` [`connectible`] (material roughness) and
+    /// `|x_k − x_{k−1}| ≥ d_near` (a fraction of the scene radius).
+    Fixed,
+    /// The footprint rule (after Lin, Kettunen and Wyman's footprint-based reconnection,
+    /// "ReSTIR PT Enhanced"): `x_{k−1}` has no delta lobe, `x_k` is [`connectible`] (or the
+    /// light vertex), and the area the BSDF lobe of `x_{k−1}` spreads over at `x_k`,
+    /// `d² / (|cos θ_k| · p_ω)`, is at least `T` times the squared width of the pixel's ray
+    /// cone at `x_{k−1}` (pixel angle × path length from the camera): the reconnection is made
+    /// only where moving `x_{k−1}` by a few pixels' footprint turns the segment by little
+    /// compared to the lobe (`walk.rs`).
+    Footprint,
+}
+
+impl Reconnection {
+    /// The name `--reconnection` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Reconnection::Fixed => "fixed",
+            Reconnection::Footprint => "footprint",
+        }
+    }
+}
+
 /// A path sample: a path from the primary hit `x1`, named by its walk's random-number state
 /// and, when it has one, its reconnection vertex `x_k` (the "rc vertex"; `k ≥ 2`, `x1` is the
 /// primary hit). Geometry is never copied: `x_k` is named by (shape, primitive, parameters).
@@ -232,6 +258,13 @@ pub fn connectible(bsdf: &Bsdf) -> bool {
         BsdfKind::RoughPlastic(p) => p.microfacet.alpha() >= ROUGH_ALPHA,
         _ => false,
     }
+}
+
+/// Whether a BSDF has no delta lobe and some lobe `eval` can evaluate (the footprint rule's
+/// test of the vertex a path reconnects from; its lobe width is judged from the direction's
+/// density instead of a roughness threshold).
+pub fn smooth(bsdf: &Bsdf) -> bool {
+    bsdf.has_smooth_lobe() && !bsdf.flags().is_delta()
 }
 
 /// The integrand of sample `s` at receiver `r` without the visibility of `r → x2` (RGB, in the

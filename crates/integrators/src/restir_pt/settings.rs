@@ -13,7 +13,7 @@ use crate::path::PathSettings;
 use crate::reuse::settings::ReuseSettings;
 
 use super::fallback::{GLOSSY_VIEW_MIN, INDIRECT_VIEW_MIN, view_pilot};
-use super::sample::ShiftKind;
+use super::sample::{Reconnection, ShiftKind};
 
 /// The shifts `--shift` accepts.
 pub const SHIFT_NAMES: &[&str] = &["reconnection", "replay", "hybrid"];
@@ -25,6 +25,12 @@ const SHIFT_CHOICES: &[(&str, ShiftKind)] = &[
     ("replay", ShiftKind::Replay),
     ("random-replay", ShiftKind::Replay),
     ("hybrid", ShiftKind::Hybrid),
+];
+
+/// Every name `--reconnection` accepts.
+const RECONNECTION_CHOICES: &[(&str, Reconnection)] = &[
+    ("fixed", Reconnection::Fixed),
+    ("footprint", Reconnection::Footprint),
 ];
 
 /// Where the direct light at the primary hit comes from (`--direct`).
@@ -74,6 +80,11 @@ pub struct RestirPtSettings {
     /// Shortest reconnection segment, as a fraction of the scene's bounding-sphere radius
     /// (default 0.01).
     pub near_distance: f32,
+    /// The rule for the reconnection segment (default fixed thresholds).
+    pub reconnection: Reconnection,
+    /// The footprint rule's `T`: the lobe's footprint at `x_k` must be at least `T` times the
+    /// squared ray-cone width at `x_{k−1}` (default 30).
+    pub footprint: f32,
     /// Reject shifts whose Jacobian `J` has `max(J, 1/J)` above this (symmetric, so unbiased);
     /// 0 (default) rejects none.
     pub max_jacobian: f32,
@@ -81,6 +92,9 @@ pub struct RestirPtSettings {
     pub direct: DirectLight,
     /// Negative control only: use Jacobian 1 in every shift (biased).
     pub unit_jacobian: bool,
+    /// Negative control only: with `max_jacobian`, reject only `J > τ`, not `1/J > τ` (a
+    /// rejection that is not symmetric; biased).
+    pub one_sided_jacobian: bool,
     /// Negative control only: across frames in which shapes or lights moved, shift paths as if
     /// only the camera had moved (vertices, light indices and cached suffixes of the previous
     /// frame taken for the current one's; biased).
@@ -115,9 +129,12 @@ impl RestirPtSettings {
             },
             candidates: 2,
             near_distance: 0.01,
+            reconnection: Reconnection::Fixed,
+            footprint: 30.0,
             max_jacobian: 0.0,
             direct: DirectLight::Reservoir,
             unit_jacobian: false,
+            one_sided_jacobian: false,
             temporal_ignore_motion: false,
             temporal_stale_suffix: false,
             shift: ShiftKind::Hybrid,
@@ -156,6 +173,7 @@ impl RestirPtSettings {
     pub fn is_unbiased(&self) -> bool {
         self.reuse.is_unbiased()
             && !self.unit_jacobian
+            && (!self.one_sided_jacobian || self.max_jacobian <= 0.0)
             && !self.skip_invertibility
             && (!self.reuse.temporal
                 || !(self.temporal_ignore_motion || self.temporal_stale_suffix))
@@ -184,6 +202,10 @@ impl RestirPtSettings {
                     p.choice(SHIFT_CHOICES, &format!("one of {}", SHIFT_NAMES.join(", ")))?;
             }
             "near_distance" | "distance_threshold" => self.near_distance = p.positive()?,
+            "reconnection" | "reconnection_rule" => {
+                self.reconnection = p.choice(RECONNECTION_CHOICES, "fixed or footprint")?;
+            }
+            "footprint" | "footprint_threshold" => self.footprint = p.positive()?,
             "max_jacobian" | "jacobian_threshold" => {
                 let j = p.positive()?;
                 if j <= 1.0 {
@@ -195,6 +217,7 @@ impl RestirPtSettings {
                 self.direct = p.choice(DirectLight::CHOICES, "reservoir, path or restir-di")?;
             }
             "unit_jacobian" => self.unit_jacobian = p.boolean()?,
+            "one_sided_jacobian" => self.one_sided_jacobian = p.boolean()?,
             "temporal_ignore_motion" => self.temporal_ignore_motion = p.boolean()?,
             "temporal_stale_suffix" => self.temporal_stale_suffix = p.boolean()?,
             "skip_invertibility" => self.skip_invertibility = p.boolean()?,
@@ -251,6 +274,25 @@ mod tests {
         assert!(s.apply(&p("candidates", "0")).is_err());
         s.apply(&p("direct", "restir_di")).unwrap();
         assert_eq!(s.direct, DirectLight::RestirDi);
+        assert_eq!(s.reconnection, Reconnection::Fixed);
+        s.apply(&p("reconnection", "Footprint")).unwrap();
+        s.apply(&p("footprint", "3")).unwrap();
+        assert_eq!(
+            (s.reconnection, s.footprint),
+            (Reconnection::Footprint, 3.0)
+        );
+        assert!(
+            s.apply(&p("reconnection", "roughness"))
+                .unwrap_err()
+                .to_string()
+                .contains("fixed or footprint")
+        );
+        assert!(s.apply(&p("footprint", "-1")).is_err());
+        assert!(s.is_unbiased());
+        s.apply(&p("one_sided_jacobian", "true")).unwrap();
+        assert!(s.is_unbiased(), "no rejection: nothing one-sided");
+        s.apply(&p("max_jacobian", "2")).unwrap();
+        assert!(!s.is_unbiased());
     }
 
     /// `fallback` takes auto or off and is the one parameter that does not count as

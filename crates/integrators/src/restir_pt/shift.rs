@@ -26,7 +26,9 @@ use crate::reuse::motion::FrameMotion;
 use crate::reuse::passes::ReuseShift;
 use crate::shadow::visible;
 
-use super::sample::{Kind, PathSample, ShiftKind, Vertex, connectible, resolve_vertex};
+use super::sample::{
+    Kind, PathSample, Reconnection, ShiftKind, Vertex, connectible, resolve_vertex,
+};
 use super::walk::{Replayed, ScatterVertex, Walker};
 use super::{PtReservoir, RestirPtSettings};
 
@@ -50,6 +52,8 @@ pub struct PtShift<'a> {
     pub max_jacobian: f32,
     /// Negative control: Jacobian 1 (biased).
     pub unit_jacobian: bool,
+    /// Negative control: reject only `J > max_jacobian` (biased).
+    pub one_sided_jacobian: bool,
 }
 
 /// The previous frame, for shifts between the domains of two frames (`docs/ANIMATION.md`,
@@ -143,10 +147,6 @@ impl PtShift<'_> {
                 _ => return None,
             }
         };
-        // Invertibility (ii): the inverse shift reconnects from `y_{k−1}` only if it is rough.
-        if !prev.conn && !walker.skip_invertibility {
-            return None;
-        }
         // The sample as the destination's frame names it.
         let mut s = *s;
         if let Some(f) = &across
@@ -160,9 +160,18 @@ impl PtShift<'_> {
         {
             return None;
         }
-        if let Some(p) = v.position()
-            && (p - prev.r.p).length_squared() < walker.near2
-        {
+        // Invertibility (ii): the inverse shift reconnects from `y_{k−1}` only if the segment
+        // `y_{k−1} → x_k` passes the reconnection rule (the fixed rule's roughness test of
+        // `y_{k−1}` is what `skip_invertibility` skips).
+        let segment_ok = match walker.rule {
+            Reconnection::Fixed => {
+                (prev.conn || walker.skip_invertibility)
+                    && v.position()
+                        .is_none_or(|p| (p - prev.r.p).length_squared() >= walker.near2)
+            }
+            Reconnection::Footprint => walker.skip_invertibility || walker.segment_ok(&prev, &v),
+        };
+        if !segment_ok {
             return None;
         }
         let mut suffix_jacobian = 1.0;
@@ -185,8 +194,15 @@ impl PtShift<'_> {
         if jacobian.is_nan() || jacobian <= 0.0 || jacobian.is_infinite() {
             return None;
         }
-        if self.max_jacobian > 0.0 && reject_jacobian(jacobian, self.max_jacobian) {
-            return None;
+        if self.max_jacobian > 0.0 {
+            let reject = if self.one_sided_jacobian {
+                jacobian > self.max_jacobian
+            } else {
+                reject_jacobian(jacobian, self.max_jacobian)
+            };
+            if reject {
+                return None;
+            }
         }
         let jacobian = if self.unit_jacobian { 1.0 } else { jacobian };
         let mut p = luminance(f);
@@ -250,6 +266,7 @@ impl<'p> PtReuse<'p> {
             rays: Cell::new(0),
             max_jacobian: self.settings.max_jacobian,
             unit_jacobian: self.settings.unit_jacobian,
+            one_sided_jacobian: self.settings.one_sided_jacobian,
         }
     }
 }

@@ -14,11 +14,22 @@
 //! # Reconnection vertex
 //!
 //! The reconnection vertex of a path `x1 … x_n` is its first vertex `x_k`, `k ≥ 2`, such that
-//! `x_{k−1}` is connectible ([`connectible`]: rough, no delta lobe), `x_k` is connectible or
-//! is the path's light vertex, and `|x_k − x_{k−1}| ≥ d_near`. [`ShiftKind::Reconnection`]
-//! only allows `k = 2`, [`ShiftKind::Replay`] none. The rule is a function of the path (its
-//! vertices, materials and length), so a shifted path has the same `k` iff the shift checks it
-//! (the invertibility checks of [`Walker::walk`] in replay mode).
+//! `x_k` is connectible ([`connectible`]: rough, no delta lobe) or is the path's light vertex,
+//! and the segment `x_{k−1} → x_k` passes the rule of [`Reconnection`] ([`Walker::segment_ok`]):
+//!
+//! * fixed (default): `x_{k−1}` is connectible and `|x_k − x_{k−1}| ≥ d_near`;
+//! * footprint: `x_{k−1}` has no delta lobe ([`smooth`]) and
+//!   `d² · |cos θ_k| ≥ T · w² · p_ω`, where `d = |x_k − x_{k−1}|`, `θ_k` the angle at `x_k`
+//!   (geometric normal; 1 for a point light), `p_ω` the BSDF density at `x_{k−1}` of the
+//!   direction to `x_k` (the lobe mixture, given the direction the path arrived from), and
+//!   `w = θ_pixel · L` the width of the pixel's ray cone at `x_{k−1}`, `L` the path length from
+//!   the camera to `x_{k−1}` (`ScatterVertex::reach`). Directions (the environment) pass when
+//!   `x_{k−1}` is connectible.
+//!
+//! [`ShiftKind::Reconnection`] only allows `k = 2`, [`ShiftKind::Replay`] none. Either rule is
+//! a function of the path (its vertices, materials, directions and length), so a shifted path
+//! has the same `k` iff the shift checks it (the invertibility checks of [`Walker::walk`] in
+//! replay mode, and of the reconnection from `y_{k−1}` in the shift).
 
 use glam::{Vec2, Vec3};
 use restir_geometry::{Frame, Ray, SurfaceInteraction, offset_ray_origin};
@@ -28,7 +39,8 @@ use restir_sampling::{Pcg32, warp::power_heuristic};
 use restir_scene::Scene;
 
 use super::sample::{
-    Kind, PathSample, ShiftKind, Vertex, connectible, evaluate_unshadowed, resolve_vertex,
+    Kind, PathSample, Reconnection, ShiftKind, Vertex, connectible, evaluate_unshadowed,
+    resolve_vertex, smooth,
 };
 use crate::path::{EmissionMis, PrevVertex};
 use crate::reuse::gbuffer::Receiver;
@@ -50,27 +62,37 @@ pub struct ScatterVertex {
     pub ng: Vec3,
     /// [`connectible`] of its material.
     pub conn: bool,
+    /// [`smooth`] of its material (no delta lobe).
+    pub smooth: bool,
+    /// Path length from the camera to this vertex (the footprint rule's ray-cone width).
+    pub reach: f32,
 }
 
 impl ScatterVertex {
     /// A primary hit.
     #[inline]
     pub fn primary(scene: &Scene, r: &Receiver, ng: Vec3) -> Self {
+        let bsdf = r.resolve_bsdf(scene);
         Self {
             r: *r,
             ng,
-            conn: connectible(&r.resolve_bsdf(scene)),
+            conn: connectible(&bsdf),
+            smooth: smooth(&bsdf),
+            reach: r.depth,
         }
     }
 
-    /// A surface hit, reached along `-to_prev`.
+    /// A surface hit, reached along `-to_prev`, `reach` from the camera along the path.
     #[inline]
-    fn at(scene: &Scene, si: &SurfaceInteraction, to_prev: Vec3) -> Self {
+    fn at(scene: &Scene, si: &SurfaceInteraction, to_prev: Vec3, reach: f32) -> Self {
         let bsdf = scene.shape_bsdf[si.shape as usize];
+        let resolved = scene.bsdf_at(bsdf, si.uv);
         Self {
             r: Receiver::new(si.p, &si.shading, si.uv, to_prev, bsdf, 0.0),
             ng: si.ng,
-            conn: connectible(&scene.bsdf_at(bsdf, si.uv)),
+            conn: connectible(&resolved),
+            smooth: smooth(&resolved),
+            reach,
         }
     }
 }
@@ -104,8 +126,12 @@ pub struct Walker<'a> {
     pub max_depth: u32,
     /// Depth at which Russian roulette starts.
     pub rr_depth: u32,
-    /// Square of the shortest reconnection segment.
+    /// Square of the shortest reconnection segment (the fixed rule).
     pub near2: f32,
+    /// The rule for the reconnection segment.
+    pub rule: Reconnection,
+    /// The footprint rule's `T · θ_pixel²` (see the module doc).
+    pub footprint2: f32,
     /// Negative control only: skip the invertibility checks (the replayed prefix has no earlier
     /// reconnection vertex; the vertex reconnected from is rough), which makes the shift
     /// non-bijective (biased).
@@ -135,11 +161,46 @@ impl Walker<'_> {
         q.is_none_or(|q| (q - p).length_squared() >= self.near2)
     }
 
+    /// Whether `prev → v` may be a path's reconnection segment under [`Walker::rule`] (the
+    /// test of `v` itself, [`connectible`] for a surface, is separate). Used alike by initial
+    /// sampling, by replays and by the shift's reconnection from `y_{k−1}`, so it is one
+    /// function of the path.
+    #[inline]
+    pub fn segment_ok(&self, prev: &ScatterVertex, v: &Vertex) -> bool {
+        match self.rule {
+            Reconnection::Fixed => prev.conn && self.far(prev.r.p, v.position()),
+            Reconnection::Footprint => prev.smooth && self.footprint_ok(prev, v),
+        }
+    }
+
+    /// The footprint test of `prev → v` (module doc).
+    #[inline]
+    fn footprint_ok(&self, prev: &ScatterVertex, v: &Vertex) -> bool {
+        let (p, n) = match (v.area_point(), v.position()) {
+            (Some((p, n)), _) => (p, Some(n)),
+            (None, Some(p)) => (p, None),
+            // A direction (the environment): no distance to judge by.
+            (None, None) => return prev.conn,
+        };
+        let to = p - prev.r.p;
+        let d2 = to.length_squared();
+        if !(d2 > 0.0 && d2.is_finite()) {
+            return false;
+        }
+        let wi = to / d2.sqrt();
+        let cos = n.map_or(1.0, |n| n.dot(wi).abs());
+        let pdf = prev
+            .r
+            .resolve_bsdf(self.scene)
+            .pdf_sa(prev.r.wo, prev.r.frame().to_local(wi));
+        d2 * cos >= self.footprint2 * prev.reach * prev.reach * pdf
+    }
+
     /// Whether the light vertex `v` (index `k`, the path's last) is the reconnection vertex of a
     /// path arriving from `prev`, given that no earlier vertex was.
     #[inline]
     fn end_eligible(&self, k: u32, prev: &ScatterVertex, v: &Vertex) -> bool {
-        self.may_rc(k) && prev.conn && self.far(prev.r.p, v.position())
+        self.may_rc(k) && self.segment_ok(prev, v)
     }
 
     /// Whether the surface vertex `next` (index `k`, not the path's last) is the reconnection
@@ -153,11 +214,11 @@ impl Walker<'_> {
         next: &ScatterVertex,
         si: &SurfaceInteraction,
     ) -> bool {
-        if !(self.may_rc(k) && prev.conn && next.conn) {
+        if !(self.may_rc(k) && next.conn) {
             return false;
         }
-        let p = restir_geometry::surface_at(&self.scene.shapes, si.shape, si.prim, si.param).p;
-        self.far(prev.r.p, Some(p))
+        let at = restir_geometry::surface_at(&self.scene.shapes, si.shape, si.prim, si.param);
+        self.segment_ok(prev, &Vertex::Surface(at))
     }
 
     /// The reconnection of sample `s` from `prev` (throughput `beta` before it): the geometry
@@ -533,7 +594,7 @@ impl Walker<'_> {
                     seed: base.seed,
                     rng,
                     rays: 0,
-                    cur: ScatterVertex::at(scene, &si, -dir),
+                    cur: ScatterVertex::at(scene, &si, -dir, 0.0),
                     j: k + 1,
                     beta: Vec3::ONE,
                     inv_q: 1.0,
@@ -567,7 +628,8 @@ impl Walker<'_> {
         if w.j + 2 > self.max_depth {
             return Some(Replayed::Fail);
         }
-        let next = ScatterVertex::at(self.scene, si, -step.d);
+        let reach = w.cur.reach + (si.p - w.cur.r.p).length();
+        let next = ScatterVertex::at(self.scene, si, -step.d, reach);
         if w.rc.is_none() && self.mid_eligible(w.j + 1, &w.cur, &next, si) {
             match w.replay {
                 None => {
