@@ -437,7 +437,7 @@ mod lights {
         };
         let (w, h) = scene.camera.resolution();
         let mut radiance = vec![Vec3::ZERO; (w * h) as usize];
-        GBuffer::trace(scene, &ctx, true, true, &mut radiance).0
+        GBuffer::trace(scene, &ctx, false, false, true, &mut radiance).0
     }
 
     /// Building the per-tile light tables of one 128×128 pass (64 tiles; one thread).

@@ -128,8 +128,15 @@ pub fn trace_path(
     let has_env = scene.features.has_environment;
     let mut eta_scale = 1.0f32;
     loop {
-        let hit = scene.intersect(&ray);
-        rays += 1;
+        // With hidden emitters the camera sees through area lights (as in Mitsuba 3).
+        let hit = if depth == 0 && settings.hide_emitters {
+            let (hit, n) = scene.intersect_past_emitters(&ray);
+            rays += n;
+            hit
+        } else {
+            rays += 1;
+            scene.intersect(&ray)
+        };
         let Some(si) = hit else {
             if has_env && !(depth == 0 && settings.hide_emitters) {
                 let le = lights.environment_radiance(ray.d);

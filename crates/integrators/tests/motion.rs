@@ -322,7 +322,7 @@ fn gbuffer(scene: &Scene, pass: u32) -> GBuffer {
         crop: None,
     };
     let mut radiance = vec![glam::Vec3::ZERO; (SIZE * SIZE) as usize];
-    GBuffer::trace(scene, &ctx, false, true, &mut radiance).0
+    GBuffer::trace(scene, &ctx, false, true, true, &mut radiance).0
 }
 
 /// Motion vectors: in a still frame every pixel finds itself (up to hits on another shape at

@@ -108,6 +108,29 @@ impl Scene {
         Some(self.accel.surface_interaction(&self.shapes, &hit, ray))
     }
 
+    /// The closest surface along camera ray `ray` that is not an area light, as a camera with
+    /// `hide_emitters` sees it (Mitsuba 3's rule: its camera rays pass through area emitters);
+    /// `si.t` is the distance along `ray`. Returns the hit and the number of rays traced.
+    pub fn intersect_past_emitters(&self, ray: &Ray) -> (Option<SurfaceInteraction>, u64) {
+        // Enough for any real scene; a ray still inside emitters after this many stops there.
+        const MAX_SKIPS: u64 = 256;
+        let mut next = *ray;
+        for rays in 1..=MAX_SKIPS {
+            let Some(mut si) = self.intersect(&next) else {
+                return (None, rays);
+            };
+            if rays == MAX_SKIPS || self.lights.light_on_shape(si.shape).is_none() {
+                si.t = (si.p - ray.o).length() / ray.d.length();
+                return (Some(si), rays);
+            }
+            next = Ray::new(
+                restir_geometry::offset_ray_origin(si.p, si.ng, ray.d),
+                ray.d,
+            );
+        }
+        unreachable!("the loop returns at MAX_SKIPS")
+    }
+
     /// Whether the segment `ray` up to `t_max` is blocked.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {

@@ -695,7 +695,7 @@ impl Integrator for RestirDiIntegrator {
         let mut radiance = vec![Vec3::ZERO; n];
         let keep = s.path.max_segments() >= 2;
         let (gbuf, mut rays) = self.clock.time("primary", || {
-            GBuffer::trace(scene, ctx, s.path.hide_emitters, keep, &mut radiance)
+            GBuffer::trace(scene, ctx, s.path.hide_emitters, true, keep, &mut radiance)
         });
         let w = gbuf.width;
         let bands = Bands::new(w);

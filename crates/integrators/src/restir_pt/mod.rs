@@ -220,7 +220,8 @@ impl RestirPtIntegrator {
             GBuffer::trace(
                 scene,
                 ctx,
-                s.path.hide_emitters || s.direct == DirectLight::RestirDi,
+                s.path.hide_emitters,
+                s.direct != DirectLight::RestirDi,
                 keep,
                 &mut radiance,
             )

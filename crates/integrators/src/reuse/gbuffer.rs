@@ -177,17 +177,20 @@ impl GBuffer {
         ka.hit() && kb.hit() && ka.is_similar(kb, normal_cos, depth_tolerance)
     }
 
-    /// Traces the camera rays of pass `ctx`. Adds what the camera sees directly (emitters and
-    /// the environment, unless `hide_emitters`) to `radiance`, which must have one entry per
-    /// pixel. With `keep_hits = false` (`max_depth ≤ 1`) no hits are stored. Returns the buffer
-    /// and the number of rays traced.
+    /// Traces the camera rays of pass `ctx`; with `hide_emitters` they pass through area lights
+    /// (as in Mitsuba 3) and see no environment. With `add_seen`, adds what the camera sees
+    /// directly (emitters and the environment, unless hidden) to `radiance`, which must have one
+    /// entry per pixel. With `keep_hits = false` (`max_depth ≤ 1`) no hits are stored. Returns
+    /// the buffer and the number of rays traced.
     pub fn trace(
         scene: &Scene,
         ctx: &PassContext,
         hide_emitters: bool,
+        add_seen: bool,
         keep_hits: bool,
         radiance: &mut [Vec3],
     ) -> (Self, u64) {
+        let add_seen = add_seen && !hide_emitters;
         let (w, h) = ctx.resolution(scene);
         let (w, h) = (w as usize, h as usize);
         let mut receivers = vec![Receiver::EMPTY; w * h];
@@ -202,19 +205,28 @@ impl GBuffer {
             .zip(radiance.par_chunks_mut(bands.pixels()))
             .enumerate()
             .map(|(band, (((recv, ngs), shapes), rad))| {
+                let mut rays = 0;
                 for (i, l) in rad.iter_mut().enumerate() {
                     let index = bands.first(band) + i;
                     let (x, y) = ((index % w) as u32, (index / w) as u32);
                     let mut rng = ctx.pixel_rng(index);
                     let film = ctx.film_position(x, y, &mut rng);
                     let ray = scene.camera.generate_ray(film, rng.next_2d());
-                    let Some(si) = scene.intersect(&ray) else {
-                        if !hide_emitters {
+                    let hit = if hide_emitters {
+                        let (hit, n) = scene.intersect_past_emitters(&ray);
+                        rays += n;
+                        hit
+                    } else {
+                        rays += 1;
+                        scene.intersect(&ray)
+                    };
+                    let Some(si) = hit else {
+                        if add_seen {
                             *l += lights.environment_radiance(ray.d);
                         }
                         continue;
                     };
-                    if !hide_emitters && let Some(light) = lights.light_on_shape(si.shape) {
+                    if add_seen && let Some(light) = lights.light_on_shape(si.shape) {
                         *l += lights.area_radiance(light, si.shading.n, -ray.d);
                     }
                     if keep_hits {
@@ -230,7 +242,7 @@ impl GBuffer {
                         shapes[i] = si.shape;
                     }
                 }
-                rad.len() as u64
+                rays
             })
             .sum();
         let keys = receivers.par_iter().map(Receiver::key).collect();
