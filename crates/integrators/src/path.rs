@@ -129,14 +129,8 @@ pub fn trace_path(
     let mut eta_scale = 1.0f32;
     loop {
         // With hidden emitters the camera sees through area lights (as in Mitsuba 3).
-        let hit = if depth == 0 && settings.hide_emitters {
-            let (hit, n) = scene.intersect_past_emitters(&ray);
-            rays += n;
-            hit
-        } else {
-            rays += 1;
-            scene.intersect(&ray)
-        };
+        let (hit, n) = scene.camera_intersect(&ray, depth == 0 && settings.hide_emitters);
+        rays += n;
         let Some(si) = hit else {
             if has_env && !(depth == 0 && settings.hide_emitters) {
                 let le = lights.environment_radiance(ray.d);

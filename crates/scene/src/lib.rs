@@ -108,6 +108,22 @@ impl Scene {
         Some(self.accel.surface_interaction(&self.shapes, &hit, ray))
     }
 
+    /// The surface a camera ray `ray` sees: the closest hit, or with `hide_emitters` the closest
+    /// that is not an area light ([`Scene::intersect_past_emitters`]). Returns the hit and the
+    /// number of rays traced.
+    #[inline]
+    pub fn camera_intersect(
+        &self,
+        ray: &Ray,
+        hide_emitters: bool,
+    ) -> (Option<SurfaceInteraction>, u64) {
+        if hide_emitters {
+            self.intersect_past_emitters(ray)
+        } else {
+            (self.intersect(ray), 1)
+        }
+    }
+
     /// The closest surface along camera ray `ray` that is not an area light, as a camera with
     /// `hide_emitters` sees it (Mitsuba 3's rule: its camera rays pass through area emitters);
     /// `si.t` is the distance along `ray`. Returns the hit and the number of rays traced.

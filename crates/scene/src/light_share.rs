@@ -83,12 +83,7 @@ impl Scene {
                     (j as f32 + rng.next_f32()) / GRID as f32 * h as f32,
                 );
                 let ray = self.camera.generate_ray(film, Vec2::splat(0.5));
-                // What the camera sees: through hidden area lights.
-                let hit = if self.integrator.hide_emitters {
-                    self.intersect_past_emitters(&ray).0
-                } else {
-                    self.intersect(&ray)
-                };
+                let (hit, _) = self.camera_intersect(&ray, self.integrator.hide_emitters);
                 let Some(si) = hit else {
                     continue;
                 };

@@ -115,12 +115,8 @@ pub fn view_pilot(scene: &Scene) -> ViewPilot {
             let mut ray = scene.camera.generate_ray(film, Vec2::splat(0.5));
             view.rays += 1;
             for bounce in 0..=MAX_BOUNCES {
-                // The camera sees through hidden area lights.
-                let hit = if bounce == 0 && scene.integrator.hide_emitters {
-                    scene.intersect_past_emitters(&ray).0
-                } else {
-                    scene.intersect(&ray)
-                };
+                let (hit, _) =
+                    scene.camera_intersect(&ray, bounce == 0 && scene.integrator.hide_emitters);
                 let Some(si) = hit else {
                     break;
                 };

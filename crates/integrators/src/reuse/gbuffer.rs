@@ -212,14 +212,8 @@ impl GBuffer {
                     let mut rng = ctx.pixel_rng(index);
                     let film = ctx.film_position(x, y, &mut rng);
                     let ray = scene.camera.generate_ray(film, rng.next_2d());
-                    let hit = if hide_emitters {
-                        let (hit, n) = scene.intersect_past_emitters(&ray);
-                        rays += n;
-                        hit
-                    } else {
-                        rays += 1;
-                        scene.intersect(&ray)
-                    };
+                    let (hit, n) = scene.camera_intersect(&ray, hide_emitters);
+                    rays += n;
                     let Some(si) = hit else {
                         if add_seen {
                             *l += lights.environment_radiance(ray.d);
