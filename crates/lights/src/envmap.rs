@@ -317,36 +317,27 @@ impl EnvMap {
     /// [`EnvMap::pdf`] without finding the coordinates of a direction).
     #[inline]
     pub fn pdf_uv(&self, uv: Vec2) -> f32 {
-        let Some(dist) = self.dist.as_ref() else {
-            return 0.0;
-        };
-        let sin_theta = (PI * uv.y).sin();
-        if sin_theta.is_nan() || sin_theta <= 0.0 {
-            return 0.0;
-        }
-        let mut s = uv.x - 0.5 / self.width as f32;
-        if s < 0.0 {
-            s += 1.0;
-        }
-        let p = Vec2::new(
-            s.min(restir_sampling::ONE_MINUS_EPSILON),
-            uv.y.min(restir_sampling::ONE_MINUS_EPSILON),
-        );
-        dist.pdf(p) / (2.0 * PI * PI * sin_theta)
+        self.pdf_at(uv, (PI * uv.y).sin())
     }
 
     /// The solid-angle density of [`EnvMap::sample`] at world direction `d`.
     #[inline]
     pub fn pdf(&self, d: Vec3) -> f32 {
+        let v = (self.to_local * d).normalize_or_zero();
+        self.pdf_at(Self::local_to_uv(v), v.x.hypot(v.z))
+    }
+
+    /// The solid-angle density at map coordinates `uv` whose polar angle has sine `sin_theta`:
+    /// the map distribution's density (texel centres at half a column) over the Jacobian
+    /// `2π² sin θ` of the (u, v) → direction map.
+    #[inline]
+    fn pdf_at(&self, uv: Vec2, sin_theta: f32) -> f32 {
         let Some(dist) = self.dist.as_ref() else {
             return 0.0;
         };
-        let v = (self.to_local * d).normalize_or_zero();
-        let sin_theta = v.x.hypot(v.z);
         if sin_theta.is_nan() || sin_theta <= 0.0 {
             return 0.0;
         }
-        let uv = Self::local_to_uv(v);
         let mut s = uv.x - 0.5 / self.width as f32;
         if s < 0.0 {
             s += 1.0;
