@@ -25,14 +25,7 @@ pub struct ConvertArgs {
 
 /// Runs `restir convert`.
 pub fn run(args: ConvertArgs) -> Result<(), String> {
-    let mut defines = Vec::new();
-    for d in &args.defines {
-        let (k, v) = d
-            .split_once('=')
-            .filter(|(k, _)| !k.trim().is_empty())
-            .ok_or_else(|| format!("-D {d}: expected NAME=VALUE"))?;
-        defines.push((k.trim().to_string(), v.trim().to_string()));
-    }
+    let defines = crate::parse_defines(&args.defines)?;
     if args.output.extension().and_then(|e| e.to_str()) != Some("xml") {
         return Err(format!(
             "{}: the output must end in .xml",

@@ -304,16 +304,23 @@ enum Rendered {
     Interrupted,
 }
 
+/// `-D NAME=VALUE` flags as (name, value) pairs for the XML loader's `<default>` variables.
+pub(crate) fn parse_defines(flags: &[String]) -> Result<Vec<(String, String)>, String> {
+    flags
+        .iter()
+        .map(|d| {
+            let (k, v) = d
+                .split_once('=')
+                .filter(|(k, _)| !k.trim().is_empty())
+                .ok_or_else(|| format!("-D {d}: expected NAME=VALUE"))?;
+            Ok((k.trim().to_string(), v.trim().to_string()))
+        })
+        .collect()
+}
+
 fn run_render(args: RenderArgs) -> Result<Rendered, String> {
     let load_start = Instant::now();
-    let mut defines = Vec::new();
-    for d in &args.defines {
-        let (k, v) = d
-            .split_once('=')
-            .filter(|(k, _)| !k.trim().is_empty())
-            .ok_or_else(|| format!("-D {d}: expected NAME=VALUE"))?;
-        defines.push((k.trim().to_string(), v.trim().to_string()));
-    }
+    let defines = parse_defines(&args.defines)?;
     let options = LoadOptions {
         defines,
         width: args.width,
