@@ -127,6 +127,8 @@ pub enum ParamProblem {
     AngleTooLarge,
     /// A number not above 1.
     NotAboveOne,
+    /// A number outside `0 ..= 1`.
+    NotFraction,
 }
 
 /// A parameter that could not be read: its name, its value as given and where it came from.
@@ -169,6 +171,7 @@ impl fmt::Display for ParamError {
                 write!(f, "{name} = {v}: expected an angle in degrees up to 180")
             }
             ParamProblem::NotAboveOne => write!(f, "{name} = {v}: expected a number above 1"),
+            ParamProblem::NotFraction => write!(f, "{name} = {v}: expected a number from 0 to 1"),
         }
     }
 }
@@ -244,6 +247,21 @@ impl Param {
         };
         if !(x > 0.0 && x.is_finite()) {
             return Err(self.error(ParamProblem::NotPositive));
+        }
+        Ok(x)
+    }
+
+    /// A number from 0 to 1.
+    pub fn fraction(&self) -> Result<f32, ParamError> {
+        let x: f32 = match self.value {
+            ParamValue::Number(x) => x,
+            _ => self
+                .text()
+                .parse()
+                .map_err(|_| self.error(ParamProblem::NotNumber))?,
+        };
+        if !(0.0..=1.0).contains(&x) {
+            return Err(self.error(ParamProblem::NotFraction));
         }
         Ok(x)
     }

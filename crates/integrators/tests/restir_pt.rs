@@ -11,7 +11,8 @@ use restir_integrators::path::PathSettings;
 use restir_integrators::restir_pt::{Kind, Reconnection, ShiftKind};
 use restir_integrators::reuse::MIS_NAMES;
 use restir_integrators::{
-    Image, IntegratorOptions, PassContext, RestirPtIntegrator, RestirPtSettings, make_integrator,
+    Image, Integrator, IntegratorOptions, PassContext, RestirPtIntegrator, RestirPtSettings,
+    make_integrator,
 };
 use restir_sampling::Pcg32;
 use restir_scene::{Scene, parse_ron};
@@ -784,4 +785,42 @@ fn no_glossy_surface_in_view_falls_back_to_the_path_tracer() {
     let z = max_z(&fallback, &brighter);
     eprintln!("fallback vs light × 1.05: max |z| = {z:.2}");
     assert!(z > Z_MAX, "a 5 % error went unnoticed: max |z| = {z:.2}");
+}
+
+/// Duplication-aware history confidence (`duplication`, off by default) is labelled biased: the
+/// history's cap depends on its own sample (`docs/GRIS.md` §5), and the statistic that passes
+/// temporal reuse without it catches the bias with the same renders.
+#[test]
+fn duplication_aware_confidence_is_biased_and_labelled() {
+    let mut settings = *integrator(4).settings();
+    assert_eq!(settings.reuse.duplication, 0.0, "off by default");
+    settings.reuse.temporal = true;
+    settings.reuse.duplication = 0.8;
+    assert!(!settings.is_unbiased());
+    let pt = RestirPtIntegrator::new(settings);
+    assert!(
+        pt.describe().contains("duplication=0.8"),
+        "{}",
+        pt.describe()
+    );
+    assert!(pt.describe().ends_with("(biased)"), "{}", pt.describe());
+    // Without temporal reuse there is no history to cap.
+    settings.reuse.temporal = false;
+    assert!(settings.is_unbiased());
+
+    let scene = scene();
+    let reference = statistics(&scene, "path", &[], 128, 64);
+    let mean = |stats: &[(f64, f64)]| stats.iter().map(|b| b.0).sum::<f64>();
+    for s in ["0", "1"] {
+        let params = [("temporal", "true"), ("duplication", s)];
+        let stats = statistics(&scene, "restir-pt", &params, 16, 400);
+        let z = max_z(&stats, &reference);
+        let ratio = mean(&stats) / mean(&reference);
+        eprintln!("max_depth 4, temporal, duplication {s}: max |z| = {z:.2}, mean {ratio:.4}");
+        if s == "0" {
+            assert!(z < Z_MAX, "temporal: max |z| = {z:.2}");
+        } else {
+            assert!(z > Z_MAX, "duplication {s} should be biased: {z:.2}");
+        }
+    }
 }

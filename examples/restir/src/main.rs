@@ -178,6 +178,10 @@ struct RestirArgs {
     /// scene file turned on.
     #[arg(long, value_name = "BOOL", num_args = 0..=1, default_missing_value = "true")]
     temporal: Option<bool>,
+    /// With --temporal: cap the history's confidence lower where neighbouring pixels hold the
+    /// same sample, strength 0 (off) to 1 (biased) [default: 0].
+    #[arg(long, value_name = "S")]
+    duplication: Option<f32>,
     /// restir-di: where light samples' visibility is tested: shading (once, for the selected
     /// sample), target (in every target, a shadow ray per shift; unbiased) or reuse (the
     /// initial selection only; biased) [default: target].
@@ -241,6 +245,7 @@ impl RestirArgs {
             self.temporal_mis.clone().map(ParamValue::Text),
         );
         put("mcap", self.mcap.map(ParamValue::Number));
+        put("duplication", self.duplication.map(ParamValue::Number));
         put("temporal", self.temporal.map(ParamValue::Bool));
         put("reciprocal", self.reciprocal.map(ParamValue::Bool));
         put("visibility", self.visibility.clone().map(ParamValue::Text));

@@ -239,6 +239,12 @@ impl<'p> ReuseShift for DiReuse<'p> {
             }
         }
     }
+
+    /// The identity shift keeps the light point.
+    #[inline]
+    fn same_sample(a: &LightPoint, b: &LightPoint) -> bool {
+        a == b
+    }
 }
 
 /// Where a pixel's initial candidates come from.

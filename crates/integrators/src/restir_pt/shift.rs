@@ -297,4 +297,10 @@ impl ReuseShift for PtReuse<'_> {
     fn domain(&self, index: usize, previous: bool) -> usize {
         if previous { self.pixels + index } else { index }
     }
+
+    /// The same initial path: shifts keep the walk's random-number state.
+    #[inline]
+    fn same_sample(a: &PathSample, b: &PathSample) -> bool {
+        a.seed == b.seed && a.kind == b.kind && a.length == b.length
+    }
 }

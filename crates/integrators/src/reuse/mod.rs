@@ -5,8 +5,9 @@
 //! over the estimator's sample and shift map, as pbrt-v4's `ImageTileIntegrator` is over its
 //! `RayIntegrator`; [`reciprocal`]: spatial rounds over reciprocal neighbour pairs, which share
 //! their shifts; [`motion`]: the previous frame of a moving sequence, for temporal reuse across
-//! frames).
+//! frames; [`duplication`]: the history's confidence cap for duplicated samples).
 
+pub mod duplication;
 pub mod gbuffer;
 pub mod light_point;
 pub mod motion;

@@ -17,6 +17,7 @@ use restir_gris::{Reservoir, ShiftMap, resample};
 
 use crate::bands::Bands;
 use crate::render::PassContext;
+use crate::reuse::duplication;
 use crate::reuse::gbuffer::GBuffer;
 use crate::reuse::motion::FrameMotion;
 use crate::reuse::neighbors::NeighborPattern;
@@ -53,6 +54,10 @@ pub trait ReuseShift: Sync {
     /// The domain of pixel `index` (which has a primary hit) in this pass, or in the previous
     /// pass with `previous`.
     fn domain(&self, index: usize, previous: bool) -> Self::DomainRef<'_>;
+
+    /// Whether two pixels hold the same sample (one of them shifted from the other, or both
+    /// from a common one), for the duplication-aware history cap ([`super::duplication`]).
+    fn same_sample(a: &Self::Sample, b: &Self::Sample) -> bool;
 }
 
 /// What temporal reuse keeps from the previous pass.
@@ -142,7 +147,8 @@ impl<S> HistorySlot<S> {
 
 /// Temporal reuse: every pixel whose primary hit was seen by a similar one in the previous pass
 /// ([`History::previous_pixel`]: the same pixel, or across frames the motion vector's)
-/// resamples its reservoir with that pixel's (confidence capped at `mcap`); the previous domain
+/// resamples its reservoir with that pixel's (confidence capped at `mcap`, or lower where its
+/// sample is duplicated with `duplication` on: [`super::duplication`]); the previous domain
 /// is `reuse.domain(previous pixel, true)`. Returns the rays traced.
 pub fn temporal<R: ReuseShift>(
     reuse: &R,
@@ -154,6 +160,16 @@ pub fn temporal<R: ReuseShift>(
     current: &mut [Reservoir<R::Sample>],
 ) -> u64 {
     let mis = settings.temporal_mis();
+    let caps = (settings.duplication > 0.0).then(|| {
+        duplication::history_caps(
+            &history.reservoirs,
+            history.gbuffer.width,
+            settings.halo().max(1) as usize,
+            settings.duplication,
+            settings.mcap,
+            R::same_sample,
+        )
+    });
     let bands = Bands::new(gbuf.width);
     current
         .par_chunks_mut(bands.pixels())
@@ -165,7 +181,8 @@ pub fn temporal<R: ReuseShift>(
                 let Some(q) = history.previous_pixel(gbuf, index, settings) else {
                     continue;
                 };
-                let prev = history.reservoirs[q].with_confidence_cap(settings.mcap);
+                let cap = caps.as_ref().map_or(settings.mcap, |c| c[q]);
+                let prev = history.reservoirs[q].with_confidence_cap(cap);
                 let mut rng = ctx.stage_rng(index, stage);
                 let map = reuse.map(res);
                 *res = resample(

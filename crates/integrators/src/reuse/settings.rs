@@ -63,6 +63,10 @@ pub struct ReuseSettings {
     /// Negative control only: reciprocal pairs read the wrong one of a pair's two shifts
     /// (biased).
     pub reciprocal_mismatched: bool,
+    /// Duplication-aware history confidence, strength from 0 (off, the default) to 1: temporal
+    /// reuse caps the previous pixel's confidence lower the more of its neighbours hold the
+    /// same sample ([`super::duplication`]). Biased: the cap depends on the sample it weighs.
+    pub duplication: f32,
     /// Negative control only: temporal reuse across frames evaluates the previous frame's
     /// domains in the current frame's scene (lights where they are now; biased).
     pub temporal_current_scene: bool,
@@ -86,6 +90,7 @@ impl Default for ReuseSettings {
             depth_tolerance: 0.1,
             reciprocal: true,
             reciprocal_mismatched: false,
+            duplication: 0.0,
             temporal_current_scene: false,
         }
     }
@@ -98,6 +103,7 @@ impl ReuseSettings {
             && (!self.temporal || self.temporal_mis().is_unbiased())
             && !(self.reciprocal && self.reciprocal_mismatched)
             && !(self.temporal && self.temporal_current_scene)
+            && !(self.temporal && self.duplication > 0.0)
     }
 
     /// How many pixels from a pixel the spatial rounds of one pass reach: `rounds × ⌈radius⌉`
@@ -140,11 +146,16 @@ impl ReuseSettings {
     }
 
     /// `temporal=…` in an estimator's one-line description: `false`, or `true` with the
-    /// temporal MIS.
+    /// temporal MIS (and the duplication strength when it is on).
     pub fn describe_temporal(&self) -> String {
         if self.temporal {
+            let duplication = if self.duplication > 0.0 {
+                format!(" duplication={}", self.duplication)
+            } else {
+                String::new()
+            };
             format!(
-                "temporal=true temporal_mis={}",
+                "temporal=true temporal_mis={}{duplication}",
                 mis_name(self.temporal_mis())
             )
         } else {
@@ -175,6 +186,9 @@ impl ReuseSettings {
             "reciprocal" | "reciprocal_neighbors" => self.reciprocal = p.boolean()?,
             "reciprocal_mismatched" => self.reciprocal_mismatched = p.boolean()?,
             "temporal_current_scene" => self.temporal_current_scene = p.boolean()?,
+            "duplication" | "duplication_map" | "duplication_strength" => {
+                self.duplication = p.fraction()?;
+            }
             "normal_threshold" => {
                 let deg = p.positive()?;
                 if deg > 180.0 {
