@@ -1,8 +1,10 @@
 //! Confidence weights (`M`) and M-capping.
 //!
 //! Confidence weights enter only the MIS weights of later resampling steps, so any non-negative
-//! choice keeps GRIS unbiased as long as those MIS weights form a partition of unity
-//! (Lin et al. 2022; `docs/GRIS.md` §5). Capping bounds how much stale history can dominate
+//! choice keeps GRIS unbiased as long as those MIS weights form a partition of unity and the
+//! confidences do not depend on the samples being resampled (Lin et al. 2022; `docs/GRIS.md`
+//! §5): counts of candidates and caps of them are fine; a confidence computed from a reservoir's
+//! own sample ([`confidence_similarity_factor`], a duplication count) is not. Capping bounds how much stale history can dominate
 //! the reuse (lag, ghosting, correlation); a lower cap means more noise.
 //!
 //! Every function here maps NaN and negative inputs to 0 and never returns NaN.
@@ -42,7 +44,10 @@ pub fn cap_confidence_relative(previous: f32, current: f32, history_limit: f32) 
 ///
 /// `q0` is the neighbour's target at its own sample, `q1` the canonical target at the same
 /// (shifted) sample. The output confidence then adds `M_i · min(MF(..at y_i), MF(..at y_c))`
-/// instead of `M_i`. This changes only future MIS weights, so it keeps the estimator unbiased.
+/// instead of `M_i`. This changes only future MIS weights, which stay a partition of unity;
+/// but the factor is a function of the selected sample, so in a later step the weight of that
+/// sample depends on the sample itself, which the unbiasedness argument excludes: a bias (not measured here),
+/// accepted by the renderers that use it.
 #[inline]
 pub fn confidence_similarity_factor(q0: f32, q1: f32) -> f32 {
     if !(q0 > 0.0) {
