@@ -236,15 +236,20 @@ impl Param {
         Ok(n)
     }
 
-    /// A positive finite number.
-    pub fn positive(&self) -> Result<f32, ParamError> {
-        let x: f32 = match self.value {
-            ParamValue::Number(x) => x,
+    /// A number, as given or parsed from text.
+    fn number(&self) -> Result<f32, ParamError> {
+        match self.value {
+            ParamValue::Number(x) => Ok(x),
             _ => self
                 .text()
                 .parse()
-                .map_err(|_| self.error(ParamProblem::NotNumber))?,
-        };
+                .map_err(|_| self.error(ParamProblem::NotNumber)),
+        }
+    }
+
+    /// A positive finite number.
+    pub fn positive(&self) -> Result<f32, ParamError> {
+        let x = self.number()?;
         if !(x > 0.0 && x.is_finite()) {
             return Err(self.error(ParamProblem::NotPositive));
         }
@@ -253,13 +258,7 @@ impl Param {
 
     /// A number from 0 to 1.
     pub fn fraction(&self) -> Result<f32, ParamError> {
-        let x: f32 = match self.value {
-            ParamValue::Number(x) => x,
-            _ => self
-                .text()
-                .parse()
-                .map_err(|_| self.error(ParamProblem::NotNumber))?,
-        };
+        let x = self.number()?;
         if !(0.0..=1.0).contains(&x) {
             return Err(self.error(ParamProblem::NotFraction));
         }
@@ -407,6 +406,21 @@ mod tests {
         assert_eq!(
             Param::flag("mis", "One_Over_Z").mis().unwrap(),
             restir_gris::MisScheme::OneOverZ
+        );
+        assert_eq!(Param::flag("duplication", "0.8").fraction().unwrap(), 0.8);
+        assert_eq!(
+            Param::flag("duplication", f32::NAN)
+                .fraction()
+                .unwrap_err()
+                .to_string(),
+            "duplication = NaN: expected a number from 0 to 1"
+        );
+        assert_eq!(
+            Param::flag("duplication", "1.5")
+                .fraction()
+                .unwrap_err()
+                .to_string(),
+            "duplication = 1.5: expected a number from 0 to 1"
         );
     }
 }
