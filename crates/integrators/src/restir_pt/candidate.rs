@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 
-use super::sample::{Kind, PathSample, resolve_vertex};
+use super::sample::{Kind, PathSample, Vertex, resolve_vertex};
 use super::walk::{ScatterVertex, Walk, Walker};
 
 /// The reconnection vertex found along a walk.
@@ -16,6 +16,8 @@ pub(super) struct Rc {
     pub(super) beta: Vec3,
     /// The sample fields naming `x_k`.
     pub(super) base: PathSample,
+    /// `x_k` resolved from them ([`resolve_vertex`]), once for all the walk's candidates.
+    pub(super) vertex: Vertex,
     /// Direction leaving `x_k` (set once sampled).
     pub(super) dir: Vec3,
     /// Throughput of the bounces after `x_k`.
@@ -86,8 +88,7 @@ impl Walker<'_> {
     /// Completes a candidate that reconnects at `rc` and computes its value.
     #[inline]
     fn rc_candidate(&self, rc: &Rc, mut s: PathSample) -> PathSample {
-        let v = resolve_vertex(self.scene, &s);
-        let (g, f, _) = self.reconnect(&rc.prev, rc.beta, &s, &v);
+        let (g, f, _) = self.reconnect(&rc.prev, rc.beta, &s, &rc.vertex);
         s.geometry = g;
         s.value = f;
         s
@@ -147,6 +148,7 @@ impl Walker<'_> {
                 prev: w.cur,
                 beta: w.beta,
                 base: direct,
+                vertex: resolve_vertex(self.scene, &direct),
                 dir: Vec3::ZERO,
                 rest: Vec3::ONE,
             };

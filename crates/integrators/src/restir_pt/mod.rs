@@ -264,7 +264,8 @@ impl RestirPtIntegrator {
         ng: Vec3,
         rng: &mut Pcg32,
     ) -> (PtReservoir, Vec3, u64) {
-        let bsdf = &r.resolve_bsdf(scene);
+        let x1 = ScatterVertex::primary(scene, r, ng);
+        let bsdf = &x1.bsdf;
         let empty = Reservoir {
             confidence: 1.0,
             ..Reservoir::empty()
@@ -280,7 +281,6 @@ impl RestirPtIntegrator {
         let mut direct = Vec3::ZERO;
         let mut rays = 0;
         let walker = self.walker(scene);
-        let x1 = ScatterVertex::primary(scene, r, ng);
         for _ in 0..n {
             // The walk's own generator (stored in its samples for replay); candidate selection
             // draws from `rng`.

@@ -267,16 +267,17 @@ pub fn smooth(bsdf: &Bsdf) -> bool {
     bsdf.has_smooth_lobe() && !bsdf.flags().is_delta()
 }
 
-/// The integrand of sample `s` at receiver `r` without the visibility of `r → x2` (RGB, in the
-/// sample's measure), and where its shadow ray goes (`None` when the integrand is zero).
+/// The integrand of sample `s` at receiver `r` (whose BSDF, textures resolved, is `bsdf1`)
+/// without the visibility of `r → x2` (RGB, in the sample's measure), and where its shadow ray
+/// goes (`None` when the integrand is zero).
 #[inline]
 pub fn evaluate_unshadowed(
     scene: &Scene,
     r: &Receiver,
+    bsdf1: &Bsdf,
     s: &PathSample,
     v: &Vertex,
 ) -> (Vec3, Option<ShadowTarget>) {
-    let bsdf1 = &r.resolve_bsdf(scene);
     let frame1 = r.frame();
     match v {
         Vertex::Light(resolved) => {

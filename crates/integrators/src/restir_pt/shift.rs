@@ -155,7 +155,10 @@ impl PtShift<'_> {
             s.id = f.motion.map_light(s.id, to_prev)?;
         }
         let v = resolve_vertex(scene, &s);
-        if let Vertex::Surface(si) = &v
+        // `x_k` was connectible on the base path; within one scene its material is the same
+        // at every pixel, so only a shift across frames (another scene) tests it again.
+        if across.is_some()
+            && let Vertex::Surface(si) = &v
             && !connectible(&scene.bsdf(si))
         {
             return None;

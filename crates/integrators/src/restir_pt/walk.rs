@@ -53,11 +53,15 @@ pub use crate::path::RANDOMS_PER_BOUNCE;
 
 /// A vertex a walk scatters from (`x1`, the primary hit, or a later surface hit; [`Vertex`] is
 /// the reconnection vertex `x_k` resolved from a sample): the shading point as a [`Receiver`]
-/// (frame, `wo`, material), its geometric normal and whether it is connectible.
+/// (frame, `wo`, material), its geometric normal, its BSDF with textures resolved, and whether
+/// it is connectible.
 #[derive(Clone, Copy, Debug)]
 pub struct ScatterVertex {
     /// Shading point, frame, direction back along the path, material.
     pub r: Receiver,
+    /// The BSDF at the point, textures resolved once (every bounce from the vertex and every
+    /// reconnection to it evaluates it).
+    pub bsdf: Bsdf,
     /// Geometric normal (ray offsets).
     pub ng: Vec3,
     /// [`connectible`] of its material.
@@ -75,6 +79,7 @@ impl ScatterVertex {
         let bsdf = r.resolve_bsdf(scene);
         Self {
             r: *r,
+            bsdf,
             ng,
             conn: connectible(&bsdf),
             smooth: smooth(&bsdf),
@@ -89,6 +94,7 @@ impl ScatterVertex {
         let resolved = scene.bsdf_at(bsdf, si.uv);
         Self {
             r: Receiver::new(si.p, &si.shading, si.uv, to_prev, bsdf, 0.0),
+            bsdf: resolved,
             ng: si.ng,
             conn: connectible(&resolved),
             smooth: smooth(&resolved),
@@ -189,10 +195,7 @@ impl Walker<'_> {
         }
         let wi = to / d2.sqrt();
         let cos = n.map_or(1.0, |n| n.dot(wi).abs());
-        let pdf = prev
-            .r
-            .resolve_bsdf(self.scene)
-            .pdf_sa(prev.r.wo, prev.r.frame().to_local(wi));
+        let pdf = prev.bsdf.pdf_sa(prev.r.wo, prev.r.frame().to_local(wi));
         d2 * cos >= self.footprint2 * prev.reach * prev.reach * pdf
     }
 
@@ -213,12 +216,13 @@ impl Walker<'_> {
         prev: &ScatterVertex,
         next: &ScatterVertex,
         si: &SurfaceInteraction,
-    ) -> bool {
+    ) -> Option<Vertex> {
         if !(self.may_rc(k) && next.conn) {
-            return false;
+            return None;
         }
         let at = restir_geometry::surface_at(&self.scene.shapes, si.shape, si.prim, si.param);
-        self.segment_ok(prev, &Vertex::Surface(at))
+        let v = Vertex::Surface(at);
+        self.segment_ok(prev, &v).then_some(v)
     }
 
     /// The reconnection of sample `s` from `prev` (throughput `beta` before it): the geometry
@@ -236,7 +240,7 @@ impl Walker<'_> {
             Some((p, n)) => geometry_term(prev.r.p.into(), p.into(), n.into()),
             None => 0.0,
         };
-        let (f, target) = evaluate_unshadowed(self.scene, &prev.r, s, v);
+        let (f, target) = evaluate_unshadowed(self.scene, &prev.r, &prev.bsdf, s, v);
         (geometry, beta * f, target)
     }
 
@@ -296,7 +300,7 @@ impl Walker<'_> {
 
     /// One bounce at `w.cur`; returns the walk's outcome if it ends here.
     fn bounce(&self, w: &mut Walk, sink: &mut dyn FnMut(PathSample, Vec3)) -> Option<Replayed> {
-        let bsdf = &w.cur.r.resolve_bsdf(self.scene);
+        let bsdf = &{ w.cur.bsdf };
         let frame = w.cur.r.frame();
         let u = BounceRandoms::draw(&mut w.rng);
 
@@ -630,7 +634,9 @@ impl Walker<'_> {
         }
         let reach = w.cur.reach + (si.p - w.cur.r.p).length();
         let next = ScatterVertex::at(self.scene, si, -step.d, reach);
-        if w.rc.is_none() && self.mid_eligible(w.j + 1, &w.cur, &next, si) {
+        if w.rc.is_none()
+            && let Some(vertex) = self.mid_eligible(w.j + 1, &w.cur, &next, si)
+        {
             match w.replay {
                 None => {
                     let base = PathSample {
@@ -648,6 +654,7 @@ impl Walker<'_> {
                         prev: w.cur,
                         beta: w.beta,
                         base,
+                        vertex,
                         dir: Vec3::ZERO,
                         rest: Vec3::ONE,
                     });
