@@ -397,7 +397,7 @@ mod lights {
         bencher.counter(ItemsCount::new(BATCH)).bench_local(|| {
             let mut acc = 0.0f32;
             for &(p, us, u) in &input {
-                if let Some(s) = scene.lights.sample(&scene.shapes, p, us, u) {
+                if let Some(s) = scene.lights.sample(p, us, u) {
                     acc += s.pdf_sa;
                 }
             }
@@ -412,7 +412,7 @@ mod lights {
         let samples: Vec<_> = receivers()
             .into_iter()
             .filter_map(|(p, us, u)| {
-                let s = scene.lights.sample(&scene.shapes, p, us, u)?;
+                let s = scene.lights.sample(p, us, u)?;
                 Some((p, s.light, s.p, s.ng))
             })
             .collect();
@@ -421,7 +421,7 @@ mod lights {
             .bench_local(|| {
                 let mut acc = 0.0f32;
                 for &(p, l, q, ng) in &samples {
-                    acc += scene.lights.pdf_sa(&scene.shapes, l, p, q, ng);
+                    acc += scene.lights.pdf_sa(l, p, q, ng);
                 }
                 black_box(acc)
             });

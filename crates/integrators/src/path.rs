@@ -139,7 +139,7 @@ pub fn trace_path(
                         let env = lights
                             .environment()
                             .expect("feature summary says there is one");
-                        let em_pdf = lights.pdf_sa(&scene.shapes, env, pv.p, pv.p + ray.d, -ray.d);
+                        let em_pdf = lights.pdf_sa(env, pv.p, pv.p + ray.d, -ray.d);
                         pv.emission_weight(em_pdf)
                     }
                     _ => 1.0,
@@ -157,7 +157,7 @@ pub fn trace_path(
             if le != Vec3::ZERO {
                 let w = match prev {
                     Some(pv) if !pv.delta => {
-                        let em_pdf = lights.pdf_sa(&scene.shapes, light, pv.p, si.p, si.ng);
+                        let em_pdf = lights.pdf_sa(light, pv.p, si.p, si.ng);
                         pv.emission_weight(em_pdf)
                     }
                     _ => 1.0,
@@ -182,7 +182,7 @@ pub fn trace_path(
 
         // Next-event estimation.
         if bsdf.has_smooth_lobe()
-            && let Some(ls) = lights.sample(&scene.shapes, si.p, u_select, u_light)
+            && let Some(ls) = lights.sample(si.p, u_select, u_light)
         {
             let wi = si.shading.to_local(ls.wi);
             let f = bsdf.eval(wo, wi);

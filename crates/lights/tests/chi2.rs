@@ -113,7 +113,7 @@ fn scene() -> (Vec<Shape>, LightSet) {
             radiance: Vec3::new(2.0, 0.5, 0.5),
         },
     ];
-    let set = LightSet::new(lights, &shapes, (Vec3::splat(-3.0), Vec3::splat(3.0))).unwrap();
+    let set = LightSet::new(lights, &shapes[..], (Vec3::splat(-3.0), Vec3::splat(3.0))).unwrap();
     (shapes, set)
 }
 
@@ -188,7 +188,7 @@ fn light_density(set: &LightSet, shapes: &[Shape], light: u32, ref_p: Vec3, w: V
     if n.dot(w) >= 0.0 {
         return 0.0;
     }
-    set.pdf_sa(shapes, light, ref_p, p, ng) as f64
+    set.pdf_sa(light, ref_p, p, ng) as f64
 }
 
 fn is_delta(light: &Light) -> bool {
@@ -244,7 +244,6 @@ fn mixture(set: &LightSet, per_light: &[Vec<f64>], weight: impl Fn(u32) -> f64) 
 /// failed samples in the remainder. Also checks each sample's reported pdf.
 fn sample_directions(
     set: &LightSet,
-    shapes: &[Shape],
     ref_p: Vec3,
     grid: &SphereGrid,
     seed: u64,
@@ -254,7 +253,7 @@ fn sample_directions(
     let mut hist = Histogram::new(grid.len() + 1);
     for _ in 0..n {
         let u_select = rng.next_f32();
-        let Some(s) = set.sample(shapes, ref_p, u_select, rng.next_2d()) else {
+        let Some(s) = set.sample(ref_p, u_select, rng.next_2d()) else {
             hist.record_remainder();
             continue;
         };
@@ -266,7 +265,7 @@ fn sample_directions(
             );
             hist.record(Some(grid.len()));
         } else {
-            let pdf = set.pdf_sa(shapes, s.light, ref_p, s.p, s.ng);
+            let pdf = set.pdf_sa(s.light, ref_p, s.p, s.ng);
             assert!(
                 (pdf - s.pdf_sa).abs() <= 1e-3 * pdf,
                 "light {}: sampled pdf {} vs pdf_sa {pdf}",
@@ -315,7 +314,7 @@ fn light_selection_follows_pmf() {
         let u_select = rng.next_f32();
         let (light, p) = set.select(u_select).expect("the set has lights");
         assert_eq!(p, set.pmf(light));
-        if let Some(s) = set.sample(&shapes, REF_P, u_select, rng.next_2d()) {
+        if let Some(s) = set.sample(REF_P, u_select, rng.next_2d()) {
             assert_eq!(s.light, light);
             sampled += 1;
         }
@@ -332,7 +331,7 @@ fn light_directions_follow_mixture_pdf() {
     let grid = SphereGrid::new(16, 32).unwrap();
     let per_light = per_light_cells(&set, &shapes, REF_P, &grid);
     let p = mixture(&set, &per_light, |l| set.pmf(l) as f64);
-    let hist = sample_directions(&set, &shapes, REF_P, &grid, 22, 1_000_000);
+    let hist = sample_directions(&set, REF_P, &grid, 22, 1_000_000);
     assert!(
         hist.remainder() > 0,
         "the cube's back faces must be rejected"
@@ -360,14 +359,18 @@ fn sphere_light_inside_and_outside() {
             shape: 0,
             radiance: Vec3::splat(2.0),
         };
-        let set =
-            LightSet::new(vec![light], &shapes, (Vec3::splat(-2.0), Vec3::splat(2.0))).unwrap();
+        let set = LightSet::new(
+            vec![light],
+            &shapes[..],
+            (Vec3::splat(-2.0), Vec3::splat(2.0)),
+        )
+        .unwrap();
         let grid = SphereGrid::default();
         let per_light = per_light_cells(&set, &shapes, ref_p, &grid);
         let p = mixture(&set, &per_light, |l| set.pmf(l) as f64);
         let mass: f64 = p.iter().sum();
         assert!((mass - 1.0).abs() < 1e-3, "{name}: ∫ pdf_sa = {mass}");
-        let hist = sample_directions(&set, &shapes, ref_p, &grid, 30 + k as u64, 500_000);
+        let hist = sample_directions(&set, ref_p, &grid, 30 + k as u64, 500_000);
         assert_accepted(&format!("sphere light, {name}"), hist.chi2(&p));
     }
 }
@@ -398,14 +401,19 @@ fn mesh_light_with_shading_normals() {
         shape: 0,
         radiance: Vec3::ONE,
     };
-    let set = LightSet::new(vec![light], &shapes, (Vec3::splat(-2.0), Vec3::splat(2.0))).unwrap();
+    let set = LightSet::new(
+        vec![light],
+        &shapes[..],
+        (Vec3::splat(-2.0), Vec3::splat(2.0)),
+    )
+    .unwrap();
     let ref_p = Vec3::new(0.3, 0.2, 0.0);
     let grid = SphereGrid::default();
     // The density the sampler claims, from `pdf_sa` at the traced point (as in the other tests).
     let claimed = mixture(&set, &per_light_cells(&set, &shapes, ref_p, &grid), |l| {
         set.pmf(l) as f64
     });
-    let hist = sample_directions(&set, &shapes, ref_p, &grid, 40, 500_000);
+    let hist = sample_directions(&set, ref_p, &grid, 40, 500_000);
     assert_accepted("mesh light with shading normals", hist.chi2(&claimed));
 }
 
@@ -418,7 +426,7 @@ fn control_uniform_selection_is_rejected() {
     let per_light = per_light_cells(&set, &shapes, REF_P, &grid);
     let uniform = 1.0 / set.len() as f64;
     let wrong = mixture(&set, &per_light, |_| uniform);
-    let hist = sample_directions(&set, &shapes, REF_P, &grid, 22, 1_000_000);
+    let hist = sample_directions(&set, REF_P, &grid, 22, 1_000_000);
     let o = hist
         .chi2(&wrong)
         .unwrap_or_else(|e| panic!("expected a p-value, got {e}"));

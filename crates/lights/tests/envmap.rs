@@ -49,7 +49,7 @@ fn set() -> LightSet {
     LightSet::with_envmap(
         vec![Light::Envmap],
         Some(map(2.0)),
-        &[],
+        Vec::new(),
         (Vec3::splat(-1.0), Vec3::splat(1.0)),
     )
     .unwrap()
@@ -62,7 +62,7 @@ fn histogram(set: &LightSet, grid: &SphereGrid, n: usize) -> Histogram {
     let mut off = 0;
     for _ in 0..n {
         let u_select = rng.next_f32();
-        let Some(s) = set.sample(&[], Vec3::ZERO, u_select, rng.next_2d()) else {
+        let Some(s) = set.sample(Vec3::ZERO, u_select, rng.next_2d()) else {
             hist.record_remainder();
             continue;
         };
@@ -73,7 +73,7 @@ fn histogram(set: &LightSet, grid: &SphereGrid, n: usize) -> Histogram {
         if (s.le - le).length() > 1e-3 * s.le.length().max(1e-2) {
             off += 1;
         }
-        let pdf = set.pdf_sa(&[], s.light, Vec3::ZERO, s.p, s.ng);
+        let pdf = set.pdf_sa(s.light, Vec3::ZERO, s.p, s.ng);
         if (pdf - s.pdf_sa).abs() > 1e-3 * pdf {
             off += 1; // within rounding of a patch boundary
         }
@@ -91,7 +91,7 @@ fn histogram(set: &LightSet, grid: &SphereGrid, n: usize) -> Histogram {
 fn envmap_directions_follow_pdf() {
     let set = set();
     let grid = SphereGrid::new(24, 48).unwrap();
-    let p = grid.integrate(|w| set.pdf_sa(&[], 0, Vec3::ZERO, w, -w) as f64, &QUAD);
+    let p = grid.integrate(|w| set.pdf_sa(0, Vec3::ZERO, w, -w) as f64, &QUAD);
     let mass: f64 = p.iter().sum();
     assert!((mass - 1.0).abs() < 2e-3, "∫ pdf = {mass}");
     let hist = histogram(&set, &grid, 1_000_000);
@@ -128,8 +128,8 @@ fn envmap_power_matches_constant() {
     let bounds = (Vec3::splat(-1.0), Vec3::splat(1.0));
     let l = Vec3::new(0.5, 1.0, 2.0);
     let env = EnvMap::new(64, 32, vec![l; 64 * 32], 1.0, Mat3::IDENTITY).unwrap();
-    let a = LightSet::with_envmap(vec![Light::Envmap], Some(env), &[], bounds).unwrap();
-    let b = LightSet::new(vec![Light::Constant { radiance: l }], &[], bounds).unwrap();
+    let a = LightSet::with_envmap(vec![Light::Envmap], Some(env), Vec::new(), bounds).unwrap();
+    let b = LightSet::new(vec![Light::Constant { radiance: l }], Vec::new(), bounds).unwrap();
     let (pa, pb) = (a.power(0), b.power(0));
     assert!((pa / pb - 1.0).abs() < 1e-3, "{pa} vs {pb}");
     assert_eq!(a.environment(), Some(0));
@@ -137,6 +137,6 @@ fn envmap_power_matches_constant() {
     // Two environments, or an Envmap light without its image, are errors.
     let env = EnvMap::new(2, 2, vec![l; 4], 1.0, Mat3::IDENTITY).unwrap();
     let two = vec![Light::Constant { radiance: l }, Light::Envmap];
-    assert!(LightSet::with_envmap(two, Some(env), &[], bounds).is_err());
-    assert!(LightSet::new(vec![Light::Envmap], &[], bounds).is_err());
+    assert!(LightSet::with_envmap(two, Some(env), Vec::new(), bounds).is_err());
+    assert!(LightSet::new(vec![Light::Envmap], Vec::new(), bounds).is_err());
 }

@@ -65,7 +65,7 @@ fn scene() -> (Vec<Shape>, LightSet) {
         direction: Vec3::new(0.2, 0.1, -1.0),
         irradiance: Vec3::splat(0.05),
     });
-    let set = LightSet::new(lights, &shapes, (Vec3::splat(-5.0), Vec3::splat(5.0))).unwrap();
+    let set = LightSet::new(lights, &shapes[..], (Vec3::splat(-5.0), Vec3::splat(5.0))).unwrap();
     (shapes, set)
 }
 
@@ -87,29 +87,22 @@ fn seed_offset() -> u64 {
         .unwrap_or(0)
 }
 
-fn pmfs(shapes: &[Shape], set: &LightSet, p: Vec3, n: Vec3) -> Vec<f64> {
+fn pmfs(set: &LightSet, p: Vec3, n: Vec3) -> Vec<f64> {
     (0..set.emitter_count())
-        .map(|e| set.hierarchy_pmf(shapes, p, n, e) as f64)
+        .map(|e| set.hierarchy_pmf(p, n, e) as f64)
         .collect()
 }
 
 /// Picks of the descent; `misses` counts the descents that found no light as the remainder
 /// (else they are left out).
-fn histogram(
-    shapes: &[Shape],
-    set: &LightSet,
-    p: Vec3,
-    n: Vec3,
-    seed: u64,
-    misses: bool,
-) -> Histogram {
+fn histogram(set: &LightSet, p: Vec3, n: Vec3, seed: u64, misses: bool) -> Histogram {
     let mut rng = Pcg32::new(seed, 1);
     let mut hist = Histogram::new(set.emitter_count());
     for _ in 0..SAMPLES {
         let u = rng.next_f32() as f64 + rng.next_f32() as f64 * (1.0 / 16_777_216.0);
-        match set.hierarchy_select(shapes, p, n, u.min(1.0 - f64::EPSILON)) {
+        match set.hierarchy_select(p, n, u.min(1.0 - f64::EPSILON)) {
             Some((e, pmf)) => {
-                assert_eq!(pmf, set.hierarchy_pmf(shapes, p, n, e), "entry {e}");
+                assert_eq!(pmf, set.hierarchy_pmf(p, n, e), "entry {e}");
                 assert!(pmf > 0.0);
                 hist.record(Some(e));
             }
@@ -122,19 +115,19 @@ fn histogram(
 
 #[test]
 fn descent_follows_its_pmf() {
-    let (shapes, set) = scene();
+    let (_, set) = scene();
     assert_eq!(set.emitter_count(), 600 + 4);
     let level = sidak_level(0.01, RECEIVERS.len());
     for (i, &(p, n)) in RECEIVERS.iter().enumerate() {
         // Σ pmf ≤ 1: the rest is the probability that the descent reaches a node none of whose
         // children can light the receiver (then no light is picked), tested as one more cell.
-        let pmf = pmfs(&shapes, &set, p, n);
+        let pmf = pmfs(&set, p, n);
         let total: f64 = pmf.iter().sum();
         assert!(
             total <= 1.0 + 1e-4 && total > 0.5,
             "receiver {i}: Σ pmf = {total}"
         );
-        let outcome = histogram(&shapes, &set, p, n, 100 + i as u64 + seed_offset(), true)
+        let outcome = histogram(&set, p, n, 100 + i as u64 + seed_offset(), true)
             .chi2(&pmf)
             .unwrap();
         eprintln!("receiver {i}: {outcome}");
@@ -147,13 +140,13 @@ fn descent_follows_its_pmf() {
 /// above shows the other lights share the whole mass).
 #[test]
 fn back_facing_lights_get_no_probability() {
-    let (shapes, set) = scene();
+    let (_, set) = scene();
     let (p, n) = RECEIVERS[3];
     let mut back = 0;
     for e in 0..set.emitter_count() {
         let light = set.entry_light(e) as usize;
         if light < 300 && light.is_multiple_of(3) {
-            assert_eq!(set.hierarchy_pmf(&shapes, p, n, e), 0.0, "entry {e}");
+            assert_eq!(set.hierarchy_pmf(p, n, e), 0.0, "entry {e}");
             back += 1;
         }
     }
@@ -164,19 +157,19 @@ fn back_facing_lights_get_no_probability() {
 /// to solid angle; the power density beside it is `LightSet::pdf_sa`'s.
 #[test]
 fn sample_densities_agree() {
-    let (shapes, set) = scene();
+    let (_, set) = scene();
     let mut rng = Pcg32::new(9, 0);
     for &(p, n) in &RECEIVERS {
         let mut checked = 0;
         for _ in 0..20_000 {
             let u = rng.next_f32() as f64;
-            let Some((s, power_pdf)) = set.sample_hierarchy(&shapes, p, n, u, rng.next_2d()) else {
+            let Some((s, power_pdf)) = set.sample_hierarchy(p, n, u, rng.next_2d()) else {
                 continue;
             };
             if s.delta {
                 continue;
             }
-            let want_power = set.pdf_sa(&shapes, s.light, p, s.p, s.ng);
+            let want_power = set.pdf_sa(s.light, p, s.p, s.ng);
             assert!(
                 (power_pdf - want_power).abs() <= 1e-3 * want_power,
                 "{power_pdf} vs {want_power}"
@@ -185,7 +178,7 @@ fn sample_densities_agree() {
             // triangle's power weight is its area's share of its mesh's).
             let e = set.entry_of(s.light, s.prim).unwrap();
             let ratio = s.pdf_sa / power_pdf;
-            let want = set.hierarchy_pmf(&shapes, p, n, e) / set.entry_power_pmf(e);
+            let want = set.hierarchy_pmf(p, n, e) / set.entry_power_pmf(e);
             assert!((ratio - want).abs() <= 1e-3 * want, "{ratio} vs {want}");
             checked += 1;
         }
@@ -197,15 +190,13 @@ fn sample_densities_agree() {
 /// says so.
 #[test]
 fn negative_control_power_pmf_is_rejected() {
-    let (shapes, set) = scene();
+    let (_, set) = scene();
     let (p, n) = RECEIVERS[0];
     let power: Vec<f64> = (0..set.emitter_count())
         .map(|e| set.entry_power_pmf(e) as f64)
         .collect();
     assert!((power.iter().sum::<f64>() - 1.0).abs() < 1e-4);
-    let outcome = histogram(&shapes, &set, p, n, 77, false)
-        .chi2(&power)
-        .unwrap();
+    let outcome = histogram(&set, p, n, 77, false).chi2(&power).unwrap();
     eprintln!("power pmf: {outcome}");
     assert!(outcome.p_value < 1e-6, "{outcome}");
 }
@@ -236,11 +227,11 @@ fn pmf_sums_to_one_over_omnidirectional_lights() {
             });
         }
     }
-    let set = LightSet::new(lights, &shapes, (Vec3::splat(-4.0), Vec3::splat(4.0))).unwrap();
+    let set = LightSet::new(lights, &shapes[..], (Vec3::splat(-4.0), Vec3::splat(4.0))).unwrap();
     for p in [Vec3::ZERO, Vec3::new(2.0, -1.0, 0.5), Vec3::splat(10.0)] {
-        let total: f64 = pmfs(&shapes, &set, p, Vec3::ZERO).iter().sum();
+        let total: f64 = pmfs(&set, p, Vec3::ZERO).iter().sum();
         assert!((total - 1.0).abs() < 1e-5, "at {p}: Σ pmf = {total}");
-        let hist = histogram(&shapes, &set, p, Vec3::ZERO, 3, true);
+        let hist = histogram(&set, p, Vec3::ZERO, 3, true);
         assert_eq!(hist.remainder(), 0);
     }
 }

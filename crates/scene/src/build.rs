@@ -411,7 +411,8 @@ impl Scene {
         }
 
         let accel = Accel::build(&shapes);
-        let light_set = LightSet::with_envmap(lights, envmap, &shapes, accel.bounds())
+        let shapes: std::sync::Arc<[Shape]> = shapes.into();
+        let light_set = LightSet::with_envmap(lights, envmap, shapes.clone(), accel.bounds())
             .map_err(|e| whole(e.to_string()))?;
 
         // Feature summary, decided once.

@@ -77,7 +77,7 @@ pub struct SceneFeatures {
 #[derive(Debug)]
 pub struct Scene {
     /// World-space shapes.
-    pub shapes: Vec<Shape>,
+    pub shapes: std::sync::Arc<[Shape]>,
     /// For each shape, the index of its BSDF in `bsdfs`.
     pub shape_bsdf: Vec<u32>,
     /// The materials (with their constant parameters; see [`Scene::bsdf_at`]).

@@ -97,9 +97,9 @@ impl Scene {
                 for k in 0..2 * SAMPLES {
                     let u = rng.next_2d();
                     let s = if k < SAMPLES {
-                        self.lights.sample_light(&self.shapes, env, si.p, u)
+                        self.lights.sample_light(env, si.p, u)
                     } else {
-                        self.lights.sample(&self.shapes, si.p, rng.next_f32(), u)
+                        self.lights.sample(si.p, rng.next_f32(), u)
                     };
                     let Some(s) = s else { continue };
                     let cos = n.dot(s.wi);

@@ -14,7 +14,7 @@
 //! 4. **Spatial reuse**: `R` rounds of `k` neighbours from a low-discrepancy disk pattern with a
 //!    per-pixel random start, rejected by normal and depth similarity, resampled with the chosen
 //!    MIS scheme ([`restir_gris::resample`]; the shift is the identity, see
-//!    [`crate::reuse::light_point`]).
+//!    [`restir_lights::LightPoint`]).
 //!    Each round reads the previous round's buffer and writes a new one, so the result does not
 //!    depend on scheduling. Confidence is capped at `mcap` after every step. Steps 3 and 4
 //!    are the shared [`crate::reuse::passes`]; this module plugs in the identity shift.
@@ -36,7 +36,7 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use restir_geometry::{Ray, offset_ray_origin};
 use restir_gris::{Reservoir, ShiftMap, Shifted, StreamingReservoir};
-use restir_lights::{LightSample, Presampled};
+use restir_lights::{Contact, LightPoint, LightSample, Presampled, Resolved};
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
@@ -50,7 +50,6 @@ use crate::fallback::PathFallback;
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
 use crate::render::{Integrator, PassContext};
 use crate::reuse::gbuffer::{GBuffer, Receiver};
-use crate::reuse::light_point::{Contact, LightPoint, Resolved, contact, resolve};
 use crate::reuse::motion::FrameMotion;
 use crate::reuse::neighbors::NeighborPattern;
 use crate::reuse::passes::{self, HistorySlot, ReuseShift};
@@ -123,7 +122,7 @@ impl<'a> DiShift<'a> {
             scene,
             counts,
             motion,
-            canonical: canonical.sample.map(|x| (x, resolve(scene, &x))),
+            canonical: canonical.sample.map(|x| (x, scene.lights.resolve(&x))),
             visibility,
             rays: std::cell::Cell::new(0),
         }
@@ -133,7 +132,7 @@ impl<'a> DiShift<'a> {
     fn resolved(&self, x: &LightPoint) -> Resolved {
         match &self.canonical {
             Some((y, r)) if y == x => *r,
-            _ => resolve(self.scene, x),
+            _ => self.scene.lights.resolve(x),
         }
     }
 }
@@ -161,7 +160,7 @@ impl<'a> ShiftMap<LightPoint> for DiShift<'a> {
         let resolved = if std::ptr::eq(to.scene, self.scene) {
             self.resolved(&y)
         } else {
-            resolve(to.scene, &y)
+            to.scene.lights.resolve(&y)
         };
         let Some(c) = resolved.contact(to.r.p) else {
             return Some(Shifted::identity(y, 0.0));
@@ -304,62 +303,13 @@ impl Candidate {
     #[inline]
     fn presampled(scene: &Scene, e: &Presampled, x: Vec3, u: glam::Vec2) -> Option<Self> {
         let (sample, resolved, pdf) = match *e {
-            Presampled::Surface {
-                light,
-                prim,
-                param,
-                p,
-                n,
-                ng,
-                le,
-                pdf_area,
-            } => (
-                LightPoint { light, prim, param },
-                Resolved::Surface {
-                    p,
-                    n,
-                    ng,
-                    le,
-                    pdf_area: Some(pdf_area),
-                },
-                pdf_area,
-            ),
-            Presampled::Point {
-                light,
-                p,
-                intensity,
-                pmf,
-            } => (
-                LightPoint {
-                    light,
-                    prim: 0,
-                    param: glam::Vec2::ZERO,
-                },
-                Resolved::Point { p, intensity },
-                pmf,
-            ),
-            Presampled::Direction {
-                light,
-                param,
-                wi,
-                le,
+            Presampled::Fixed {
+                point,
+                resolved,
                 pdf,
-                delta,
-            } => (
-                if delta {
-                    LightPoint {
-                        light,
-                        prim: 0,
-                        param: glam::Vec2::ZERO,
-                    }
-                } else {
-                    LightPoint::environment(light, param)
-                },
-                Resolved::Direction { wi, le, delta, pdf },
-                pdf,
-            ),
+            } => (point, resolved, pdf),
             Presampled::Light { light, pmf } => {
-                let ls = scene.lights.sample_light(&scene.shapes, light, x, u)?;
+                let ls = scene.lights.sample_light(light, x, u)?;
                 return Self::from_sample(&ls, ls.pdf_sa * pmf, ls.pdf_sa * pmf);
             }
         };
@@ -458,7 +408,7 @@ impl RestirDiIntegrator {
             let drawn = match source {
                 Candidates::Power => scene
                     .lights
-                    .sample(&scene.shapes, r.p, u_select, u_light)
+                    .sample(r.p, u_select, u_light)
                     .and_then(|ls| Candidate::from_sample(&ls, ls.pdf_sa, ls.pdf_sa)),
                 Candidates::Pool(tile) => tile[(start + i as usize * stride) % tile.len()]
                     .and_then(|mut e| {
@@ -473,13 +423,7 @@ impl RestirDiIntegrator {
                         (i as f64 + u0 as f64 + rng.next_f32() as f64 / 16_777_216.0) / n as f64;
                     scene
                         .lights
-                        .sample_hierarchy(
-                            &scene.shapes,
-                            r.p,
-                            r.n,
-                            u.min(1.0 - f64::EPSILON),
-                            u_light,
-                        )
+                        .sample_hierarchy(r.p, r.n, u.min(1.0 - f64::EPSILON), u_light)
                         .and_then(|(ls, power_pdf_sa)| {
                             let source = if self.settings.light_sampler == LightSampler::Bvh {
                                 ls.pdf_sa
@@ -491,9 +435,7 @@ impl RestirDiIntegrator {
                 }
                 Candidates::Tile(table) => {
                     tiles::select(scene, table, u_select).and_then(|(light, pmf, power_pmf)| {
-                        let ls = scene
-                            .lights
-                            .sample_light(&scene.shapes, light, r.p, u_light)?;
+                        let ls = scene.lights.sample_light(light, r.p, u_light)?;
                         Candidate::from_sample(&ls, pmf * ls.pdf_sa, power_pmf * ls.pdf_sa)
                     })
                 }
@@ -519,7 +461,7 @@ impl RestirDiIntegrator {
         if self.settings.visibility.tests_initial()
             && let Some(y) = res.sample
         {
-            let visible = contact(scene, &y, r.p).is_some_and(|c| {
+            let visible = scene.lights.contact(&y, r.p).is_some_and(|c| {
                 rays += 1;
                 visible(scene, r, ng, &c)
             });
@@ -546,7 +488,7 @@ impl RestirDiIntegrator {
         let mut rays = 0;
         let bsdf = &r.resolve_bsdf(scene);
         if let Some(y) = &res.sample
-            && let Some(c) = contact(scene, y, r.p)
+            && let Some(c) = scene.lights.contact(y, r.p)
         {
             let e = evaluate(scene, r, bsdf, y, &c, None, self.counts);
             if e.target > 0.0 {
@@ -713,7 +655,7 @@ impl Integrator for RestirDiIntegrator {
                 _ => None,
             };
             if s.light_sampler.is_hierarchy() {
-                scene.lights.build_hierarchy(&scene.shapes);
+                scene.lights.build_hierarchy();
             }
             let pool = s.light_sampler.is_pool().then(|| {
                 let (fw, fh) = scene.camera.resolution();

@@ -26,7 +26,7 @@
 //! the film, so a cropped render (`--crop`) and any thread count give the same image.
 
 use rayon::prelude::*;
-use restir_lights::Presampled;
+use restir_lights::{Presampled, Resolved};
 use restir_sampling::ONE_MINUS_EPSILON;
 use restir_scene::Scene;
 
@@ -76,9 +76,7 @@ impl LightPool {
                 let u0 = rng.next_f32();
                 for (j, e) in tile.iter_mut().enumerate() {
                     let u_select = ((j as f32 + u0) / TILE_SIZE as f32).min(ONE_MINUS_EPSILON);
-                    *e = scene
-                        .lights
-                        .presample(&scene.shapes, u_select, rng.next_2d());
+                    *e = scene.lights.presample(u_select, rng.next_2d());
                 }
             });
         Self { entries, tiles }
@@ -101,32 +99,27 @@ impl LightPool {
 pub(crate) fn without_selection(scene: &Scene, e: Presampled) -> Presampled {
     match e {
         Presampled::Light { light, .. } => Presampled::Light { light, pmf: 1.0 },
-        Presampled::Point {
-            light,
-            p,
-            intensity,
+        Presampled::Fixed {
+            point,
+            resolved: resolved @ Resolved::Point { .. },
             ..
-        } => Presampled::Point {
-            light,
-            p,
-            intensity,
-            pmf: 1.0,
+        } => Presampled::Fixed {
+            point,
+            resolved,
+            pdf: 1.0,
         },
-        Presampled::Direction {
-            light,
-            param,
-            wi,
-            le,
-            pdf,
-            delta,
-        } => Presampled::Direction {
-            light,
-            param,
-            wi,
-            le,
-            pdf: pdf / scene.lights.pmf(light).max(f32::MIN_POSITIVE),
-            delta,
-        },
-        surface @ Presampled::Surface { .. } => surface,
+        Presampled::Fixed {
+            point,
+            resolved: Resolved::Direction { wi, le, delta, pdf },
+            ..
+        } => {
+            let pdf = pdf / scene.lights.pmf(point.light).max(f32::MIN_POSITIVE);
+            Presampled::Fixed {
+                point,
+                resolved: Resolved::Direction { wi, le, delta, pdf },
+                pdf,
+            }
+        }
+        surface @ Presampled::Fixed { .. } => surface,
     }
 }

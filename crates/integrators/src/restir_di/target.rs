@@ -20,7 +20,7 @@ use restir_sampling::luminance;
 use restir_scene::Scene;
 
 use crate::reuse::gbuffer::Receiver;
-use crate::reuse::light_point::{Contact, LightPoint};
+use restir_lights::{Contact, LightPoint};
 
 /// The two strategy counts of the direct-light split.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -48,7 +48,7 @@ impl Evaluated {
 }
 
 /// Evaluates `sample` at receiver `r` (whose BSDF, textures resolved, is `bsdf`) seen as `c`
-/// (from [`contact`](crate::reuse::light_point::contact)). `known_light_pdf_sa` is
+/// (from [`LightSet::contact`](restir_lights::LightSet::contact)). `known_light_pdf_sa` is
 /// the light-sampling density at `r` if the caller has it (selection included; the pmf for
 /// delta lights); otherwise it is computed when the light/BSDF split needs it (`N_B > 0`).
 #[inline]
@@ -69,11 +69,9 @@ pub fn evaluate(
     let m_light = if c.delta || counts.bsdf == 0.0 {
         1.0
     } else {
-        let light_pdf_sa = known_light_pdf_sa.or(c.pdf_sa).unwrap_or_else(|| {
-            scene
-                .lights
-                .pdf_sa(&scene.shapes, sample.light, r.p, c.p, c.ng)
-        });
+        let light_pdf_sa = known_light_pdf_sa
+            .or(c.pdf_sa)
+            .unwrap_or_else(|| scene.lights.pdf_sa(sample.light, r.p, c.p, c.ng));
         let nl = counts.light * light_pdf_sa;
         let nb = counts.bsdf * bsdf.pdf_sa(r.wo, wi);
         if nl > 0.0 { nl / (nl + nb) } else { 0.0 }

@@ -152,7 +152,7 @@ pub fn view_pilot(scene: &Scene) -> ViewPilot {
 /// sample.
 fn direct(scene: &Scene, si: &SurfaceInteraction, bsdf: &Bsdf, wo: Vec3, rng: &mut Pcg32) -> Vec3 {
     let (u_select, u) = (rng.next_f32(), rng.next_2d());
-    let Some(ls) = scene.lights.sample(&scene.shapes, si.p, u_select, u) else {
+    let Some(ls) = scene.lights.sample(si.p, u_select, u) else {
         return Vec3::ZERO;
     };
     let f = bsdf.eval(wo, si.shading.to_local(ls.wi));

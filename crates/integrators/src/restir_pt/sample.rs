@@ -33,7 +33,7 @@ use restir_sampling::{Pcg32, warp::power_heuristic};
 use restir_scene::Scene;
 
 use crate::reuse::gbuffer::Receiver;
-use crate::reuse::light_point::{LightPoint, Resolved, resolve};
+use restir_lights::{LightPoint, Resolved};
 
 use crate::shadow::ShadowTarget;
 
@@ -219,7 +219,7 @@ pub enum Vertex {
 #[inline]
 pub fn resolve_vertex(scene: &Scene, s: &PathSample) -> Vertex {
     if s.is_direct() {
-        Vertex::Light(resolve(scene, &s.light_point()))
+        Vertex::Light(scene.lights.resolve(&s.light_point()))
     } else {
         Vertex::Surface(surface_at(&scene.shapes, s.id, s.prim, s.param))
     }
@@ -289,7 +289,7 @@ pub fn evaluate_unshadowed(
             if f == Vec3::ZERO {
                 return (Vec3::ZERO, None);
             }
-            let light_pdf_sa = || scene.lights.pdf_sa(&scene.shapes, s.id, r.p, c.p, c.ng);
+            let light_pdf_sa = || scene.lights.pdf_sa(s.id, r.p, c.p, c.ng);
             let w = match (s.kind, c.delta) {
                 (Kind::DirectNee, true) => 1.0,
                 (Kind::DirectNee, false) => power_heuristic(light_pdf_sa(), bsdf1.pdf_sa(r.wo, wi)),

@@ -44,8 +44,8 @@ use super::sample::{
 };
 use crate::path::{EmissionMis, PrevVertex};
 use crate::reuse::gbuffer::Receiver;
-use crate::reuse::light_point::LightPoint;
 use crate::shadow::{ShadowTarget, visible};
+use restir_lights::LightPoint;
 
 use super::candidate::{Connection, Rc};
 
@@ -358,9 +358,7 @@ impl Walker<'_> {
     ) -> Option<Replayed> {
         let scene = self.scene;
         let cur = w.cur;
-        let ls = scene
-            .lights
-            .sample(&scene.shapes, cur.r.p, u.select, u.light)?;
+        let ls = scene.lights.sample(cur.r.p, u.select, u.light)?;
         let direct = PathSample::direct(LightPoint::from_light_sample(&ls), Kind::DirectNee);
         let eligible =
             w.rc.is_none() && self.end_eligible(w.j + 1, &cur, &resolve_vertex(scene, &direct));
@@ -500,11 +498,11 @@ impl Walker<'_> {
         d: Vec3,
         hit: Option<&SurfaceInteraction>,
     ) -> Option<(LightPoint, Vec3, f32)> {
-        let (lights, shapes) = (&self.scene.lights, &self.scene.shapes);
+        let lights = &self.scene.lights;
         match hit {
             None => lights.environment().map(|env| {
                 let le = lights.environment_radiance(d);
-                let lp = lights.pdf_sa(shapes, env, p, p + d, -d);
+                let lp = lights.pdf_sa(env, p, p + d, -d);
                 (
                     LightPoint::environment(env, lights.environment_param(d)),
                     le,
@@ -514,7 +512,7 @@ impl Walker<'_> {
             Some(si) => lights.light_on_shape(si.shape).and_then(|light| {
                 let le = lights.area_radiance(light, si.shading.n, -d);
                 (le != Vec3::ZERO).then(|| {
-                    let lp = lights.pdf_sa(shapes, light, p, si.p, si.ng);
+                    let lp = lights.pdf_sa(light, p, si.p, si.ng);
                     let y = LightPoint {
                         light,
                         prim: si.prim,
@@ -561,9 +559,7 @@ impl Walker<'_> {
                 if s.light_pdf_sa <= 0.0 {
                     return None;
                 }
-                let ls = scene
-                    .lights
-                    .sample(&scene.shapes, xk.p, u.select, u.light)?;
+                let ls = scene.lights.sample(xk.p, u.select, u.light)?;
                 if ls.delta || !(ls.pdf_sa > 0.0 && ls.pdf_sa.is_finite()) {
                     return None;
                 }

@@ -1,6 +1,6 @@
 //! What the screen-space ReSTIR estimators (ReSTIR DI and ReSTIR PT) share, one floor below
 //! them: the per-pixel primary hits ([`gbuffer`]), neighbour selection ([`neighbors`]) and
-//! the light-point sample ([`light_point`]), the reuse settings ([`settings`]) and the reuse
+//! the reuse settings ([`settings`]) and the reuse
 //! passes themselves ([`passes`]: temporal reuse, the spatial rounds and the history, generic
 //! over the estimator's sample and shift map, as pbrt-v4's `ImageTileIntegrator` is over its
 //! `RayIntegrator`; [`reciprocal`]: spatial rounds over reciprocal neighbour pairs, which share
@@ -9,7 +9,6 @@
 
 pub mod duplication;
 pub mod gbuffer;
-pub mod light_point;
 pub mod motion;
 pub mod neighbors;
 pub mod passes;

@@ -1,18 +1,19 @@
-//! A point on a light named independently of any receiver: ReSTIR DI's sample, and the light
-//! vertex of ReSTIR PT's direct paths; resolved in world space and seen from a receiver.
+//! A point on a light named independently of any receiver ([`LightPoint`]: a reservoir's light
+//! sample in ReSTIR DI, the light vertex of ReSTIR PT's direct paths), resolved in world space
+//! through the set ([`Resolved`]) and seen from a receiver ([`Contact`]).
 //!
 //! # Sample space and measure
 //!
 //! A sample is a point on an area light (area measure), a point light (counting measure), a
 //! directional light (counting measure) or a direction towards the environment (solid-angle
 //! measure on the sphere at infinity). None of these depend on the receiver, so the shift
-//! between pixels is the identity with Jacobian 1 (`docs/GRIS.md` §6.7); each pixel's target and
+//! between pixels is the identity with Jacobian 1 (GRIS, Lin et al. 2022, §6: a shift that keeps the sample has Jacobian 1); each pixel's target and
 //! source densities are expressed in these measures.
 //!
 
 use glam::{Vec2, Vec3};
-use restir_lights::{Light, LightSample};
-use restir_scene::Scene;
+
+use crate::{Light, LightSample, LightSet};
 
 /// A ReSTIR DI sample: 16 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -79,7 +80,7 @@ pub struct Contact {
 
 /// A sample resolved in world space, independent of any receiver: resolving once and
 /// evaluating at several receivers (as spatial reuse does) saves the surface lookup.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Resolved {
     /// A point on an area light.
     Surface {
@@ -116,54 +117,60 @@ pub enum Resolved {
     },
 }
 
-/// Resolves `sample` in world space.
-#[inline]
-pub fn resolve(scene: &Scene, sample: &LightPoint) -> Resolved {
-    match scene.lights.lights()[sample.light as usize] {
-        Light::Area { shape, radiance } => {
-            let ps = scene.lights.area_point(
-                &scene.shapes[shape as usize],
-                sample.light,
-                sample.prim,
-                sample.param,
-            );
-            Resolved::Surface {
-                p: ps.p,
-                n: ps.n,
-                ng: ps.ng,
-                le: radiance,
-                pdf_area: scene.lights.mesh_area_density(&scene.shapes, sample.light),
+impl LightSet {
+    /// Resolves `sample` in world space.
+    #[inline]
+    pub fn resolve(&self, sample: &LightPoint) -> Resolved {
+        match self.lights()[sample.light as usize] {
+            Light::Area { shape, radiance } => {
+                let ps = self.area_point(
+                    &self.shapes[shape as usize],
+                    sample.light,
+                    sample.prim,
+                    sample.param,
+                );
+                Resolved::Surface {
+                    p: ps.p,
+                    n: ps.n,
+                    ng: ps.ng,
+                    le: radiance,
+                    pdf_area: self.mesh_area_density(sample.light),
+                }
+            }
+            Light::Point {
+                position,
+                intensity,
+            } => Resolved::Point {
+                p: position,
+                intensity,
+            },
+            Light::Directional {
+                direction,
+                irradiance,
+            } => Resolved::Direction {
+                wi: -direction,
+                le: irradiance,
+                delta: true,
+                pdf: 0.0,
+            },
+            Light::Constant { .. } | Light::Envmap => {
+                let (wi, le, pdf) =
+                    self.environment_at(sample.param)
+                        .unwrap_or((Vec3::Z, Vec3::ZERO, 0.0));
+                Resolved::Direction {
+                    wi,
+                    le,
+                    delta: false,
+                    pdf,
+                }
             }
         }
-        Light::Point {
-            position,
-            intensity,
-        } => Resolved::Point {
-            p: position,
-            intensity,
-        },
-        Light::Directional {
-            direction,
-            irradiance,
-        } => Resolved::Direction {
-            wi: -direction,
-            le: irradiance,
-            delta: true,
-            pdf: 0.0,
-        },
-        Light::Constant { .. } | Light::Envmap => {
-            let (wi, le, pdf) =
-                scene
-                    .lights
-                    .environment_at(sample.param)
-                    .unwrap_or((Vec3::Z, Vec3::ZERO, 0.0));
-            Resolved::Direction {
-                wi,
-                le,
-                delta: false,
-                pdf,
-            }
-        }
+    }
+
+    /// Where `sample` lies as seen from `x` ([`LightSet::resolve`] then [`Resolved::contact`]).
+    #[inline]
+    pub fn contact(&self, sample: &LightPoint, x: Vec3) -> Option<Contact> {
+        self.resolve(sample).contact(x)
     }
 }
 
@@ -232,10 +239,4 @@ impl Resolved {
             }),
         }
     }
-}
-
-/// Where `sample` lies as seen from `x` ([`resolve`] then [`Resolved::contact`]).
-#[inline]
-pub fn contact(scene: &Scene, sample: &LightPoint, x: Vec3) -> Option<Contact> {
-    resolve(scene, sample).contact(x)
 }

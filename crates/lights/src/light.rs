@@ -1,0 +1,319 @@
+//! A light, a sample of one seen from a receiver, and the densities: what one light emits
+//! ([`Light`]), a point on it drawn for a receiver ([`LightSample`], [`LightSet::sample_light`]),
+//! the density of a point reached another way ([`LightSet::pdf_sa`]), and the environment's
+//! radiance and coordinates.
+
+use glam::{Vec2, Vec3};
+use restir_geometry::{PositionSample, Shape, area_to_solid_angle};
+use restir_sampling::warp;
+
+use crate::table::Emitter;
+use crate::{EnvMap, LightSet};
+
+/// An emitter.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    /// Uniform radiance leaving the front side of a shape.
+    Area {
+        /// Index of the shape in the scene's shape list.
+        shape: u32,
+        /// Emitted radiance (linear RGB).
+        radiance: Vec3,
+    },
+    /// An isotropic point light of intensity `intensity` (W/sr).
+    Point {
+        /// Position.
+        position: Vec3,
+        /// Radiant intensity.
+        intensity: Vec3,
+    },
+    /// A directional light.
+    Directional {
+        /// Unit direction in which the light travels.
+        direction: Vec3,
+        /// Irradiance on a surface facing the light.
+        irradiance: Vec3,
+    },
+    /// Constant radiance from every direction at infinity.
+    Constant {
+        /// Radiance.
+        radiance: Vec3,
+    },
+    /// Radiance at infinity from a latitude-longitude image: the [`EnvMap`] given to
+    /// [`LightSet::with_envmap`] (at most one per set).
+    Envmap,
+}
+
+/// A point (or direction) on a light chosen for next-event estimation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightSample {
+    /// Index of the light.
+    pub light: u32,
+    /// The point on the light (for lights at infinity, a far point along `wi`).
+    pub p: Vec3,
+    /// The light's shading normal at `p` (zero for point lights, `-wi` for lights at infinity);
+    /// one-sided emission is judged against it.
+    pub n: Vec3,
+    /// The light's geometric normal at `p` (the one [`LightSet::pdf_sa`] takes).
+    pub ng: Vec3,
+    /// Unit direction from the receiver to the light.
+    pub wi: Vec3,
+    /// Distance to `p`; infinite for lights at infinity.
+    pub dist: f32,
+    /// Radiance (or, for point lights, intensity / distance²) arriving along `-wi`.
+    pub le: Vec3,
+    /// Density per unit solid angle at the receiver including the light-selection probability;
+    /// for delta lights the selection probability alone.
+    pub pdf_sa: f32,
+    /// Whether the light is a delta light (no BSDF sampling can reach it).
+    pub delta: bool,
+    /// The primitive on the light's shape (area lights).
+    pub prim: u32,
+    /// Barycentrics or sphere parameters of `p` on the primitive (area lights); the
+    /// environment's coordinates of the direction ([`LightSet::environment_param`]).
+    pub param: Vec2,
+}
+
+impl LightSet {
+    /// Radiance leaving an area light's surface point with shading normal `n` towards unit `w`
+    /// (pointing away from the light). One-sided: zero behind the surface.
+    #[inline]
+    pub fn area_radiance(&self, light: u32, n: Vec3, w: Vec3) -> Vec3 {
+        match self.lights[light as usize] {
+            Light::Area { radiance, .. } if n.dot(w) > 0.0 => radiance,
+            _ => Vec3::ZERO,
+        }
+    }
+
+    /// The coordinates by which the environment names direction `d` (unit, away from the
+    /// scene): an environment map's `(u, v)`, a constant environment's the same lat-long
+    /// coordinates in the world frame. [`LightSet::environment_at`] maps them back.
+    #[inline]
+    pub fn environment_param(&self, d: Vec3) -> Vec2 {
+        match (
+            self.environment.map(|i| self.lights[i as usize]),
+            &self.envmap,
+        ) {
+            (Some(Light::Envmap), Some(m)) => m.uv_of(d),
+            _ => EnvMap::local_to_uv(d),
+        }
+    }
+
+    /// The environment at coordinates `param` ([`LightSet::environment_param`]): the direction
+    /// towards it, its radiance there and [`LightSet::sample`]'s density of that direction per
+    /// unit solid angle, the selection included. Cheaper than looking up a direction: no
+    /// inverse trigonometry.
+    #[inline]
+    pub fn environment_at(&self, param: Vec2) -> Option<(Vec3, Vec3, f32)> {
+        let env = self.environment?;
+        let pmf = self.table.pmf(env);
+        match (self.lights[env as usize], &self.envmap) {
+            (Light::Constant { radiance }, _) => Some((
+                EnvMap::uv_to_local(param),
+                radiance,
+                pmf * warp::UNIFORM_SPHERE_PDF,
+            )),
+            (Light::Envmap, Some(m)) => Some((
+                m.world_direction(param),
+                m.eval_uv(param),
+                pmf * m.pdf_uv(param),
+            )),
+            _ => None,
+        }
+    }
+
+    /// Radiance arriving from the environment along a ray that left the scene in direction `d`
+    /// (unit, pointing away from the scene).
+    #[inline]
+    pub fn environment_radiance(&self, d: Vec3) -> Vec3 {
+        match self.environment.map(|i| self.lights[i as usize]) {
+            Some(Light::Constant { radiance }) => radiance,
+            Some(Light::Envmap) => self.envmap.as_ref().map_or(Vec3::ZERO, |m| m.eval(d)),
+            _ => Vec3::ZERO,
+        }
+    }
+
+    /// The point of area light `light`, whose shape is `shape`, named by primitive `prim` and
+    /// parameters `param` (barycentrics on a triangle, sphere parameters): the same bits as
+    /// [`Shape::position_at`]. A triangle of a light whose mesh is in the emitter table is read
+    /// from its table entry (corners and normals inline: one lookup instead of the chain shape →
+    /// indices → positions).
+    #[inline]
+    pub fn area_point(&self, shape: &Shape, light: u32, prim: u32, param: Vec2) -> PositionSample {
+        match self.table.triangle_entry(light, prim) {
+            Some(&Emitter::Triangle {
+                ref p,
+                ng,
+                n,
+                smooth,
+                ..
+            }) => Emitter::point_at(p, ng, n, smooth, shape, prim, param),
+            _ => shape.position_at(prim, param),
+        }
+    }
+
+    /// Samples a point on light `light` as seen from `ref_p`, with `pdf_sa` *not* including the
+    /// selection probability.
+    #[inline]
+    pub fn sample_light(&self, light: u32, ref_p: Vec3, u: Vec2) -> Option<LightSample> {
+        match self.lights[light as usize] {
+            Light::Area { shape, radiance } => {
+                let (ps, pdf_sa) = self.shapes[shape as usize].sample_from(ref_p, u)?;
+                area_light_sample(light, radiance, ref_p, ps, pdf_sa)
+            }
+            Light::Point {
+                position,
+                intensity,
+            } => {
+                let to = position - ref_p;
+                let d2 = to.length_squared();
+                if d2 <= 0.0 {
+                    return None;
+                }
+                let dist = d2.sqrt();
+                Some(LightSample {
+                    light,
+                    p: position,
+                    n: Vec3::ZERO,
+                    ng: Vec3::ZERO,
+                    wi: to / dist,
+                    dist,
+                    le: intensity / d2,
+                    pdf_sa: 1.0,
+                    delta: true,
+                    prim: 0,
+                    param: Vec2::ZERO,
+                })
+            }
+            Light::Directional {
+                direction,
+                irradiance,
+            } => Some(LightSample {
+                light,
+                p: ref_p - direction * (2.0 * self.scene_radius),
+                n: direction,
+                ng: direction,
+                wi: -direction,
+                dist: f32::INFINITY,
+                le: irradiance,
+                pdf_sa: 1.0,
+                delta: true,
+                prim: 0,
+                param: Vec2::ZERO,
+            }),
+            Light::Constant { radiance } => {
+                let wi = warp::sample_uniform_sphere(u);
+                Some(LightSample {
+                    light,
+                    p: ref_p + wi * (2.0 * self.scene_radius),
+                    n: -wi,
+                    ng: -wi,
+                    wi,
+                    dist: f32::INFINITY,
+                    le: radiance,
+                    pdf_sa: warp::UNIFORM_SPHERE_PDF,
+                    delta: false,
+                    prim: 0,
+                    param: EnvMap::local_to_uv(wi),
+                })
+            }
+            Light::Envmap => {
+                let (uv, wi, le, pdf_sa) = self.envmap.as_ref()?.sample_uv(u)?;
+                Some(LightSample {
+                    light,
+                    p: ref_p + wi * (2.0 * self.scene_radius),
+                    n: -wi,
+                    ng: -wi,
+                    wi,
+                    dist: f32::INFINITY,
+                    le,
+                    pdf_sa,
+                    delta: false,
+                    prim: 0,
+                    param: uv,
+                })
+            }
+        }
+    }
+
+    /// The solid-angle density, including the selection probability, with which
+    /// [`LightSet::sample`] would return point `p` (geometric normal `n`) on light `light` from `ref_p`; for
+    /// the environment `p` is ignored and `n` must be the direction back from the environment
+    /// (`−wi`, as [`LightSample::ng`] is). Zero for delta lights.
+    #[inline]
+    pub fn pdf_sa(&self, light: u32, ref_p: Vec3, p: Vec3, n: Vec3) -> f32 {
+        let pmf = self.pmf(light);
+        if pmf == 0.0 {
+            return 0.0;
+        }
+        match self.lights[light as usize] {
+            Light::Area { shape, .. } => match &self.shapes[shape as usize] {
+                Shape::Mesh(_) => {
+                    area_to_solid_angle(self.area_pdf[light as usize], ref_p, p, n).unwrap_or(0.0)
+                }
+                s => pmf * s.pdf_sa_from(ref_p, p, n),
+            },
+            Light::Constant { .. } => pmf * warp::UNIFORM_SPHERE_PDF,
+            Light::Envmap => self
+                .envmap
+                .as_ref()
+                .map_or(0.0, |m| pmf * m.pdf(-n.normalize_or_zero())),
+            Light::Point { .. } | Light::Directional { .. } => 0.0,
+        }
+    }
+}
+
+/// The sample of area light `light` (radiance `radiance`) at point `ps` seen from `ref_p`, with
+/// solid-angle density `pdf_sa`; `None` at the receiver itself or behind the one-sided emitter.
+#[inline]
+pub(crate) fn area_light_sample(
+    light: u32,
+    radiance: Vec3,
+    ref_p: Vec3,
+    ps: PositionSample,
+    pdf_sa: f32,
+) -> Option<LightSample> {
+    let to = ps.p - ref_p;
+    let dist = to.length();
+    if dist <= 0.0 {
+        return None;
+    }
+    let wi = to / dist;
+    if ps.n.dot(wi) >= 0.0 {
+        return None; // back of a one-sided emitter
+    }
+    Some(LightSample {
+        light,
+        p: ps.p,
+        n: ps.n,
+        ng: ps.ng,
+        wi,
+        dist,
+        le: radiance,
+        pdf_sa,
+        delta: false,
+        prim: ps.prim,
+        param: ps.param,
+    })
+}
+
+/// A sphere around a shape (for meshes, around its bounding box).
+pub(crate) fn bounding_sphere(shape: &Shape) -> (Vec3, f32) {
+    match shape {
+        Shape::Sphere(s) => (s.center, s.radius),
+        Shape::Mesh(m) => {
+            let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+            for i in 0..m.triangle_count() {
+                for p in m.triangle(i) {
+                    lo = lo.min(p);
+                    hi = hi.max(p);
+                }
+            }
+            if lo.cmple(hi).all() {
+                (0.5 * (lo + hi), 0.5 * (hi - lo).length())
+            } else {
+                (Vec3::ZERO, 0.0)
+            }
+        }
+    }
+}

@@ -1,0 +1,195 @@
+//! Which light: the power sampler (one alias table over the emitter table's entries, every
+//! emissive triangle and every other light, the environment with its own share) and the light
+//! hierarchy over the same entries (`bvh.rs`, receiver-aware, with the exact probability of any
+//! entry). Where on the chosen light is [`LightSet::sample_light`]'s, or for a triangle of the
+//! table a uniform point on it.
+
+use glam::{Vec2, Vec3};
+use restir_geometry::area_to_solid_angle;
+
+use crate::bvh::LightBvh;
+use crate::light::area_light_sample;
+use crate::table::Emitter;
+use crate::{Light, LightSample, LightSet};
+
+impl LightSet {
+    /// Picks a light: `(index, probability)`, the probability being [`LightSet::pmf`].
+    #[inline]
+    pub fn select(&self, u: f32) -> Option<(u32, f32)> {
+        let light = match self.table.pick(u)? {
+            Ok(e) => e.light(),
+            Err(env) => env,
+        };
+        Some((light, self.table.pmf(light)))
+    }
+
+    /// Picks a light by power (`u_select`) and a point on it (`u`) as seen from `ref_p`.
+    #[inline]
+    pub fn sample(&self, ref_p: Vec3, u_select: f32, u: Vec2) -> Option<LightSample> {
+        let light = match self.table.pick(u_select)? {
+            Ok(e @ Emitter::Triangle { .. }) => return self.sample_triangle(e, ref_p, u),
+            Ok(&Emitter::Whole { light }) => light,
+            Err(env) => env,
+        };
+        let mut s = self.sample_light(light, ref_p, u)?;
+        s.pdf_sa *= self.table.pmf(light);
+        Some(s)
+    }
+
+    /// A uniform point on an emissive triangle the table picked, with the selection in its
+    /// density.
+    #[inline]
+    fn sample_triangle(&self, e: &Emitter, ref_p: Vec3, u: Vec2) -> Option<LightSample> {
+        let Emitter::Triangle {
+            light,
+            prim,
+            ref p,
+            ng,
+            n,
+            smooth,
+        } = *e
+        else {
+            return None;
+        };
+        let Light::Area { shape, radiance } = self.lights[light as usize] else {
+            return None;
+        };
+        let ps = Emitter::triangle_point(p, ng, n, smooth, &self.shapes[shape as usize], prim, u);
+        let pdf_sa = area_to_solid_angle(self.area_pdf[light as usize], ref_p, ps.p, ps.ng)?;
+        area_light_sample(light, radiance, ref_p, ps, pdf_sa)
+    }
+
+    /// The light hierarchy over the table's entries (built on the first call).
+    fn hierarchy(&self) -> &LightBvh {
+        self.hierarchy.get_or_init(|| {
+            LightBvh::new(
+                &self.lights,
+                &self.shapes,
+                self.table.entries(),
+                self.table.weights(),
+            )
+        })
+    }
+
+    /// Builds the light hierarchy now (else the first [`LightSet::sample_hierarchy`] does);
+    /// returns its node count.
+    pub fn build_hierarchy(&self) -> usize {
+        self.hierarchy().node_count()
+    }
+
+    /// Picks a light for a receiver at `ref_p` with normal `ref_n` (zero if unknown) by the
+    /// light hierarchy (`u_select ∈ [0, 1)`, the environment keeping its share), and a point on
+    /// it (`u`). Returns the sample, whose `pdf_sa` includes the hierarchy's selection
+    /// probability, and the density [`LightSet::sample`] (power selection) would give the same
+    /// point. `None` if nothing can light the receiver or the point is on a back face.
+    #[inline]
+    pub fn sample_hierarchy(
+        &self,
+        ref_p: Vec3,
+        ref_n: Vec3,
+        u_select: f64,
+        u: Vec2,
+    ) -> Option<(LightSample, f32)> {
+        let share = self.table.env_share() as f64;
+        if let Some(env) = self.environment
+            && u_select < share
+        {
+            let s = self.sample_light(env, ref_p, u)?;
+            let pdf = s.pdf_sa * self.table.pmf(env);
+            return Some((LightSample { pdf_sa: pdf, ..s }, pdf));
+        }
+        let v = if share > 0.0 {
+            ((u_select - share) / (1.0 - share)).clamp(0.0, 1.0 - f64::EPSILON)
+        } else {
+            u_select
+        };
+        let (entry, pmf) = self.hierarchy().sample(ref_p, ref_n, v)?;
+        let pmf = pmf * (1.0 - self.table.env_share());
+        match self.table.entries()[entry as usize] {
+            Emitter::Triangle {
+                light,
+                prim,
+                ref p,
+                ng,
+                n,
+                smooth,
+            } => {
+                let Light::Area { shape, radiance } = self.lights[light as usize] else {
+                    return None;
+                };
+                let ps = Emitter::triangle_point(
+                    p,
+                    ng,
+                    n,
+                    smooth,
+                    &self.shapes[shape as usize],
+                    prim,
+                    u,
+                );
+                let area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
+                let pdf_sa = area_to_solid_angle(pmf / area, ref_p, ps.p, ps.ng)?;
+                let power_pdf =
+                    area_to_solid_angle(self.area_pdf[light as usize], ref_p, ps.p, ps.ng)?;
+                Some((
+                    area_light_sample(light, radiance, ref_p, ps, pdf_sa)?,
+                    power_pdf,
+                ))
+            }
+            Emitter::Whole { light } => {
+                let s = self.sample_light(light, ref_p, u)?;
+                let power_pdf = s.pdf_sa * self.table.pmf(light);
+                Some((
+                    LightSample {
+                        pdf_sa: s.pdf_sa * pmf,
+                        ..s
+                    },
+                    power_pdf,
+                ))
+            }
+        }
+    }
+
+    /// Picks a local entry (an emissive triangle or another light; the environment aside) for a
+    /// receiver at `ref_p` with normal `ref_n` by the light hierarchy: `(entry, probability)`,
+    /// the probability among local entries. The entries are numbered `0..emitter_count()`.
+    pub fn hierarchy_select(&self, ref_p: Vec3, ref_n: Vec3, u: f64) -> Option<(usize, f32)> {
+        let (e, pmf) = self.hierarchy().sample(ref_p, ref_n, u)?;
+        Some((e as usize, pmf))
+    }
+
+    /// The probability that [`LightSet::hierarchy_select`] picks local entry `entry` for a
+    /// receiver at `ref_p` with normal `ref_n` (a second descent of the hierarchy, exact: the
+    /// same factors as the sampling descent multiplies).
+    pub fn hierarchy_pmf(&self, ref_p: Vec3, ref_n: Vec3, entry: usize) -> f32 {
+        self.hierarchy().pmf(ref_p, ref_n, entry as u32)
+    }
+
+    /// The probability that the power table picks local entry `entry` among the local entries.
+    pub fn entry_power_pmf(&self, entry: usize) -> f32 {
+        let w = self.table.weights();
+        let total: f64 = w.iter().map(|&x| x as f64).sum();
+        w.get(entry).map_or(0.0, |&x| (x as f64 / total) as f32)
+    }
+
+    /// The light local entry `entry` belongs to.
+    pub fn entry_light(&self, entry: usize) -> u32 {
+        self.table.entries()[entry].light()
+    }
+
+    /// The local entry of light `light`'s primitive `prim` (a triangle of a mesh light; `prim`
+    /// is ignored for other lights): entries are ordered by light, then by triangle.
+    pub fn entry_of(&self, light: u32, prim: u32) -> Option<usize> {
+        let key = |e: &Emitter| match *e {
+            Emitter::Triangle { light, prim, .. } => (light, prim),
+            Emitter::Whole { light } => (light, 0),
+        };
+        let prim = match self.table.entries().iter().find(|e| e.light() == light)? {
+            Emitter::Triangle { .. } => prim,
+            Emitter::Whole { .. } => 0,
+        };
+        self.table
+            .entries()
+            .binary_search_by(|e| key(e).cmp(&(light, prim)))
+            .ok()
+    }
+}
