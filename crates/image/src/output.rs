@@ -421,7 +421,20 @@ mod tests {
     #[test]
     fn a_device_is_written_in_place() {
         use std::os::unix::fs::FileTypeExt;
-        let null = Path::new("/dev/null");
+        // As root a private null device (a faulty writer could replace the system's).
+        let dir = temp_dir("device");
+        let private = dir.join("null");
+        let made = std::process::Command::new("mknod")
+            .arg(&private)
+            .args(["c", "1", "3"])
+            .stderr(std::process::Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success());
+        let null = if made {
+            private.as_path()
+        } else {
+            Path::new("/dev/null")
+        };
         assert_eq!(destination(null).unwrap(), Destination::Direct(null.into()));
         check_writable(null).unwrap();
         write_file_atomically(null, b"{}\n").unwrap();
@@ -434,6 +447,7 @@ mod tests {
         for stdout in ["-", "/dev/stdout"] {
             assert_eq!(destination(Path::new(stdout)).unwrap(), Destination::Stdout);
         }
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     /// A FIFO is opened and written (a reader gets the bytes) and stays a FIFO; the check
