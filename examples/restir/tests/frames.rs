@@ -419,7 +419,15 @@ fn ffmpeg_stderr_is_drained_and_a_non_executable_one_refused() {
     let out = dir.0.join("seq.exr");
     // Two 128² frames (96 KiB) are more than a pipe holds.
     let mut child = Command::new(RESTIR)
-        .args(["render", s(&scene), "--frames", "0..1", "--spp", "1", "--quiet"])
+        .args([
+            "render",
+            s(&scene),
+            "--frames",
+            "0..1",
+            "--spp",
+            "1",
+            "--quiet",
+        ])
         .args(["--width", "128", "--height", "128", "-o", s(&out)])
         .args(["--preview", s(&video)])
         .env("PATH", &path)
@@ -451,7 +459,10 @@ fn ffmpeg_stderr_is_drained_and_a_non_executable_one_refused() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("/bin/ffmpeg is not executable"), "{stderr}");
-    assert!(!dir.0.join("seq_0000.exr").exists(), "refused before rendering");
+    assert!(
+        !dir.0.join("seq_0000.exr").exists(),
+        "refused before rendering"
+    );
 }
 
 /// `--frames 0..4294967295` (2^32 frames) is an error, not an overflow.
@@ -461,7 +472,14 @@ fn a_frame_count_beyond_u32_is_an_error() {
     let scene = animated(&dir);
     let o = dir.0.join("o.exr");
     fails_with(
-        &["render", s(&scene), "-o", s(&o), "--frames", "0..4294967295"],
+        &[
+            "render",
+            s(&scene),
+            "-o",
+            s(&o),
+            "--frames",
+            "0..4294967295",
+        ],
         "error: --frames 0..4294967295: 4294967296 frames, more than the most a sequence may have (4294967295)",
     );
 }

@@ -260,7 +260,12 @@ fn stats_to_a_device_or_stdout_are_written_directly() {
     let null = private_null(&dir.0);
     let o = render(&out, &["--stats", s(&null)]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(std::fs::metadata(&null).unwrap().file_type().is_char_device());
+    assert!(
+        std::fs::metadata(&null)
+            .unwrap()
+            .file_type()
+            .is_char_device()
+    );
     for stdout in ["-", "/dev/stdout"] {
         let o = render(&out, &["--stats", stdout]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -269,9 +274,9 @@ fn stats_to_a_device_or_stdout_are_written_directly() {
     }
     let mut want = vec!["o.exr".to_string()];
     if null.starts_with(&dir.0) {
-        want.push("null".into());
+        want.insert(0, "null".into());
     }
-    assert_eq!(entries(&dir.0), want);
+    assert_eq!(entries(&dir.0), want, "no temporary file left");
 }
 
 /// A null device to write to: as root (who could replace the system's /dev/null by mistake) a
@@ -436,4 +441,35 @@ fn compare_html_is_checked() {
             .unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
+}
+
+/// `generate` and `merge` with their summary line going to a closed pipe: no panic, exit 0.
+#[test]
+fn generate_and_merge_survive_a_closed_stdout() {
+    let dir = temp_dir("closed-generate");
+    let scene = dir.0.join("lights.ron");
+    let part = dir.0.join("part.exr");
+    let merged = dir.0.join("merged.exr");
+    assert!(
+        render(&part, &["--chain", "0", "--chains", "1"])
+            .status
+            .success()
+    );
+    for args in [
+        vec!["generate", "many-lights", "--lights", "2", "-o", s(&scene)],
+        vec!["merge", s(&merged), s(&part)],
+    ] {
+        let mut child = Command::new(RESTIR)
+            .args(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let o = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {stderr}");
+    }
+    assert!(scene.is_file() && merged.is_file());
 }
