@@ -1,5 +1,6 @@
 //! `restir-fuzz`: deterministic mutation fuzzing of the scene loader, one target per input format
-//! (`xml`, `ron`, `obj`, `ply`, `serialized`, `exr`, `hdr`, `png`).
+//! (`xml`, `ron`, `obj`, `ply`, `serialized`, `exr`, `hdr`, `png`), and the reader of the parts
+//! of a split render that `restir merge` reads (`part`: `restir_image::Image::read_exr_part`).
 //!
 //! Coverage-guided fuzzers need nightly Rust (cargo-fuzz) or an AFL++ toolchain; this workspace
 //! builds on one stable toolchain, so the harness mutates the checked-in seeds in
@@ -21,7 +22,8 @@ use std::process::{Command, ExitCode, Stdio};
 use std::time::{Duration, Instant};
 
 /// The formats, with how an input of each is placed into a scene.
-const TARGETS: [&str; 8] = [
+const TARGETS: [&str; 9] = [
+    "part",
     "xml",
     "ron",
     "obj",
@@ -190,6 +192,20 @@ fn wrapper_scene(target: &str, asset: &str) -> String {
 /// The child: loads one input of `target` (`input` is the mutated file) and exits 0 whatever the
 /// loader says, so that only panics, aborts, signals and hangs count as failures.
 fn run_one(target: &str, input: &Path) -> ExitCode {
+    if target == "part" {
+        match restir_image::Image::read_exr_part(input) {
+            Ok(_) => println!("ok"),
+            Err(e) => {
+                let msg = e.to_string();
+                if std::env::var_os("RESTIR_FUZZ_SEED").is_some() {
+                    eprintln!("a seed must load: {msg}");
+                    return ExitCode::from(4);
+                }
+                println!("error: {msg}");
+            }
+        }
+        return ExitCode::SUCCESS;
+    }
     let scene = match target {
         "xml" | "ron" => input.to_path_buf(),
         _ => {

@@ -36,7 +36,10 @@ pub mod srgb;
 pub use error::{ImageError, ReadFailure};
 pub use io::IntegerEncoding;
 pub use metrics::{ErrorMetrics, compare};
-pub use output::{check_writable, temp_path, write_atomically, write_file_atomically};
+pub use output::{
+    Destination, OutputWriter, check_writable, destination, same_destination, temp_path,
+    write_atomically, write_file_atomically,
+};
 pub use part::ExrPart;
 
 use glam::Vec3;

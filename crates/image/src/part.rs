@@ -74,52 +74,115 @@ impl Image {
         crate::write_atomically(path, |out| image.write().to_buffered(out), err)
     }
 
-    /// Reads an EXR written by [`Image::write_exr_part`]: the data window's pixels, and where they
-    /// sit with the text attributes. Files without attributes read as parts with none.
-    pub fn read_exr_part(path: &Path) -> Result<(Self, ExrPart), ImageError> {
-        let img = exr::prelude::read_first_rgba_layer_from_file(
-            path,
-            |res, _| (res.width(), vec![Vec3::ZERO; res.width() * res.height()]),
-            |(w, px): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-                if let Some(t) = px.get_mut(pos.y() * *w + pos.x()) {
-                    *t = Vec3::new(r, g, b);
-                }
-            },
-        )
-        .map_err(|source| ImageError::ReadExr {
+    /// Reads the header of an EXR written by [`Image::write_exr_part`]: the data window's size
+    /// `(width, height)` and where it sits, with the text attributes, without decoding pixels.
+    /// Only a regular file is opened ([`crate::input::open_regular`]), and the data and display
+    /// windows are checked against [`crate::input::MAX_IMAGE_PIXELS`] / side limits; a data
+    /// window outside the display window is an error.
+    pub fn read_exr_part_header(path: &Path) -> Result<((u32, u32), ExrPart), ImageError> {
+        let err = |source| ImageError::ReadExr {
             path: path.to_path_buf(),
             source,
-        })?;
-        let layer = &img.layer_data;
-        let mut attributes: Vec<(String, String)> = layer
-            .attributes
-            .other
-            .iter()
-            .chain(img.attributes.other.iter())
-            .filter_map(|(k, v)| match v {
-                AttributeValue::Text(t) => Some((k.to_string(), t.to_string())),
-                _ => None,
-            })
-            .collect();
-        attributes.sort();
-        let display = img.attributes.display_window;
-        let pos = layer.attributes.layer_position;
-        let offset = (
-            (pos.0 - display.position.0).max(0) as u32,
-            (pos.1 - display.position.1).max(0) as u32,
-        );
+        };
+        let file = crate::input::open_regular(path).map_err(|e| err(e.into()))?;
+        let mut file = std::io::BufReader::new(file);
+        let meta = exr::meta::MetaData::read_from_buffered(&mut file, false).map_err(err)?;
+        part_of_header(&meta).map_err(err)
+    }
+
+    /// Reads an EXR written by [`Image::write_exr_part`]: the data window's pixels, and where they
+    /// sit with the text attributes. Files without attributes read as parts with none. The
+    /// header is checked as [`Image::read_exr_part_header`] does before pixels are allocated.
+    pub fn read_exr_part(path: &Path) -> Result<(Self, ExrPart), ImageError> {
+        use exr::prelude::*;
+        use std::io::Seek;
+        let err = |source| ImageError::ReadExr {
+            path: path.to_path_buf(),
+            source,
+        };
+        let file = crate::input::open_regular(path).map_err(|e| err(e.into()))?;
+        let mut file = std::io::BufReader::new(file);
+        let meta = exr::meta::MetaData::read_from_buffered(&mut file, false).map_err(err)?;
+        let (_, part) = part_of_header(&meta).map_err(err)?;
+        file.rewind().map_err(|e| err(e.into()))?;
+        let img = exr::prelude::read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .rgba_channels(
+                |res, _| (res.width(), vec![Vec3::ZERO; res.width() * res.height()]),
+                |(w, px): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                    if let Some(t) = px.get_mut(pos.y() * *w + pos.x()) {
+                        *t = Vec3::new(r, g, b);
+                    }
+                },
+            )
+            .first_valid_layer()
+            .all_attributes()
+            .from_buffered(file)
+            .map_err(err)?;
+        let layer = img.layer_data;
         let image = Self {
             width: layer.size.width() as u32,
             height: layer.size.height() as u32,
-            pixels: layer.channel_data.pixels.1.clone(),
-        };
-        let part = ExrPart {
-            film: (display.size.0 as u32, display.size.1 as u32),
-            offset,
-            attributes,
+            pixels: layer.channel_data.pixels.1,
         };
         Ok((image, part))
     }
+}
+
+/// The part described by the first layer's header (the layer [`Image::read_exr_part`] decodes),
+/// after the size checks; `((width, height), part)`.
+fn part_of_header(meta: &exr::meta::MetaData) -> Result<((u32, u32), ExrPart), exr::error::Error> {
+    let invalid = |m: String| exr::error::Error::Invalid(m.into());
+    for header in meta.headers.iter() {
+        let size = header.layer_size;
+        if let Some(problem) = crate::input::size_problem(size.width(), size.height()) {
+            return Err(invalid(problem));
+        }
+    }
+    let header = meta
+        .headers
+        .first()
+        .ok_or_else(|| invalid("no layer".into()))?;
+    let display = header.shared_attributes.display_window;
+    if let Some(problem) = crate::input::size_problem(display.size.0, display.size.1) {
+        return Err(invalid(format!("display window: {problem}")));
+    }
+    let pos = header.own_attributes.layer_position;
+    let size = header.layer_size;
+    let (ox, oy) = (
+        i64::from(pos.0) - i64::from(display.position.0),
+        i64::from(pos.1) - i64::from(display.position.1),
+    );
+    if ox < 0
+        || oy < 0
+        || ox as u64 + size.0 as u64 > display.size.0 as u64
+        || oy as u64 + size.1 as u64 > display.size.1 as u64
+    {
+        return Err(invalid(format!(
+            "the data window ({}×{} at {ox},{oy}) is outside the display window ({}×{})",
+            size.0, size.1, display.size.0, display.size.1
+        )));
+    }
+    let mut attributes: Vec<(String, String)> = header
+        .own_attributes
+        .other
+        .iter()
+        .chain(header.shared_attributes.other.iter())
+        .filter_map(|(k, v)| match v {
+            AttributeValue::Text(t) => Some((k.to_string(), t.to_string())),
+            _ => None,
+        })
+        .collect();
+    attributes.sort();
+    Ok((
+        (size.0 as u32, size.1 as u32),
+        ExrPart {
+            film: (display.size.0 as u32, display.size.1 as u32),
+            offset: (ox as u32, oy as u32),
+            attributes,
+        },
+    ))
 }
 
 #[cfg(test)]
@@ -155,6 +218,45 @@ mod tests {
         let (_, plain) = Image::read_exr_part(&path).unwrap();
         assert_eq!((plain.film, plain.offset), ((3, 2), (0, 0)));
         assert!(plain.attribute("restir:passes").is_none());
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// A part whose display window claims more pixels than any image read may have, or whose
+    /// data window lies outside it, is refused from its header; so is a FIFO (which would
+    /// block).
+    #[test]
+    fn bad_part_headers_are_refused() {
+        let dir = std::env::temp_dir().join(format!("restir-image-badpart-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("huge.exr");
+        let image = Image::new(2, 2);
+        let part = |film| ExrPart {
+            film,
+            offset: (0, 0),
+            attributes: vec![],
+        };
+        image.write_exr_part(&path, &part((65536, 65536))).unwrap();
+        let e = Image::read_exr_part(&path).unwrap_err().to_string();
+        assert!(
+            e.contains("display window: the image is 65536×65536 pixels"),
+            "{e}"
+        );
+        assert!(Image::read_exr_part_header(&path).is_err());
+        image.write_exr_part(&path, &part((1, 1))).unwrap();
+        let e = Image::read_exr_part(&path).unwrap_err().to_string();
+        assert!(e.contains("outside the display window"), "{e}");
+        image.write_exr_part(&path, &part((2, 3))).unwrap();
+        let (size, p) = Image::read_exr_part_header(&path).unwrap();
+        assert_eq!((size, p.film), ((2, 2), (2, 3)));
+        let fifo = dir.join("fifo.exr");
+        if std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .is_ok_and(|s| s.success())
+        {
+            let e = Image::read_exr_part(&fifo).unwrap_err().to_string();
+            assert!(e.contains("not a regular file"), "{e}");
+        }
         std::fs::remove_dir_all(&dir).ok();
     }
 }

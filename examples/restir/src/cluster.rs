@@ -234,7 +234,10 @@ impl Plan {
             (attr::SCENE.into(), scene.display().to_string()),
             (
                 attr::SCENE_HASH.into(),
-                format!("{:016x}", scene_hash(desc)),
+                format!(
+                    "{:016x}",
+                    scene_hash(desc, scene.parent().unwrap_or(Path::new(".")))
+                ),
             ),
             (attr::INTEGRATOR.into(), integrator.describe()),
             (attr::SEED.into(), seed.to_string()),
@@ -260,13 +263,63 @@ impl Plan {
     }
 }
 
-/// FNV-1a (64-bit) of the scene description's JSON: the same for the same scene, file and
-/// overrides, whatever machine renders it.
-pub fn scene_hash(desc: &SceneDesc) -> u64 {
-    let json = serde_json::to_string(desc).unwrap_or_default();
-    json.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-    })
+/// FNV-1a (64-bit) of the scene description's JSON and of the contents of every file it refers
+/// to (meshes, textures, environment maps; `filename` values, relative to `base_dir`): the same
+/// for the same scene, assets and overrides, whatever machine renders it, and different when an
+/// asset changed between parts. A file that cannot be read hashes as missing.
+pub fn scene_hash(desc: &SceneDesc, base_dir: &Path) -> u64 {
+    use std::io::Read;
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    let mut add = |bytes: &[u8]| {
+        for &b in bytes {
+            h = (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    };
+    let mut value = serde_json::to_value(desc).unwrap_or_default();
+    add(value.to_string().as_bytes());
+    // The film's file name is where the image goes, not an input.
+    if let Some(film) = value.get_mut("film").and_then(|f| f.as_object_mut()) {
+        film.remove("filename");
+    }
+    let mut files = Vec::new();
+    referenced_files(&value, &mut files);
+    for f in files {
+        add(f.as_bytes());
+        match restir_image::input::open_regular(&base_dir.join(f)) {
+            Ok(file) => {
+                let mut reader = std::io::BufReader::new(file);
+                let mut buf = [0u8; 1 << 16];
+                loop {
+                    match reader.read(&mut buf) {
+                        Ok(0) => break,
+                        Ok(n) => add(&buf[..n]),
+                        Err(_) => {
+                            add(b"\0unreadable");
+                            break;
+                        }
+                    }
+                }
+            }
+            Err(_) => add(b"\0missing"),
+        }
+    }
+    h
+}
+
+/// The `filename` strings of a scene description's JSON, in order.
+fn referenced_files<'a>(value: &'a serde_json::Value, out: &mut Vec<&'a str>) {
+    match value {
+        serde_json::Value::Object(map) => {
+            for (k, v) in map {
+                match (k.as_str(), v) {
+                    ("filename", serde_json::Value::String(f)) => out.push(f),
+                    _ => referenced_files(v, out),
+                }
+            }
+        }
+        serde_json::Value::Array(items) => items.iter().for_each(|v| referenced_files(v, out)),
+        _ => {}
+    }
 }
 
 /// Renders the plan's part, or the whole render without a plan.

@@ -3,14 +3,14 @@
 //! frame), rendered with the job's passes or time limit and written as `NAME_0001.exr` (or
 //! `.png`) through the atomic writer; `--preview OUT.png` also writes an animated PNG of the
 //! frames, and `--preview OUT.mp4` (`.webm`, `.mkv`, `.mov`, `.gif`) a video through `ffmpeg`
-//! when it is on `PATH`. The flags are checked before anything renders.
+//! when it is on `PATH` ([`crate::preview`]: written as the frames come, in memory independent
+//! of their number). The flags are checked before anything renders.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use restir_image::Image;
 use restir_integrators::reuse::motion::FrameSequence;
 use restir_integrators::{Integrator, IntegratorOptions, RenderJob, make_integrator, render};
 use restir_scene::SceneDesc;
@@ -78,18 +78,40 @@ impl Preview {
         let Some(format) = format else {
             return Ok(Preview::Apng);
         };
-        let ffmpeg = search_path
+        // As a shell searches: the first executable file named ffmpeg.
+        let candidates: Vec<PathBuf> = search_path
             .into_iter()
             .flat_map(std::env::split_paths)
             .map(|dir| dir.join("ffmpeg"))
-            .find(|p| p.is_file())
-            .ok_or_else(|| {
-                format!(
+            .filter(|p| p.is_file())
+            .collect();
+        let Some(ffmpeg) = candidates.iter().find(|p| executable(p)).cloned() else {
+            return Err(match candidates.first() {
+                Some(p) => format!(
+                    "{}: a video preview needs ffmpeg, and {} is not executable (chmod +x it, or write an animated PNG with --preview NAME.png)",
+                    path.display(),
+                    p.display()
+                ),
+                None => format!(
                     "{}: a video preview needs ffmpeg on PATH, and there is none (install it, or write an animated PNG with --preview NAME.png)",
                     path.display()
-                )
-            })?;
+                ),
+            });
+        };
         Ok(Preview::Video { ffmpeg, format })
+    }
+}
+
+/// Whether `path` may be run (an execute bit is set; elsewhere than Unix, whether it exists).
+fn executable(path: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::metadata(path).is_ok_and(|m| m.permissions().mode() & 0o111 != 0)
+    }
+    #[cfg(not(unix))]
+    {
+        path.is_file()
     }
 }
 
@@ -155,6 +177,13 @@ impl FrameArgs {
         let last: u32 = b.trim().parse().map_err(|_| bad())?;
         if first > last {
             return Err(bad());
+        }
+        if last - first == u32::MAX {
+            return Err(format!(
+                "--frames {range}: {} frames, more than the most a sequence may have ({})",
+                u64::from(last - first) + 1,
+                u32::MAX
+            ));
         }
         if split {
             return Err("--frames cannot be combined with --chain or --crop".into());
@@ -261,8 +290,11 @@ pub fn render_frames(
     let count = plan.last - plan.first + 1;
     let mut sequence = FrameSequence::new(desc, scene_path, plan.fps)
         .ok_or_else(|| format!("{}: the scene has no animation", scene_path.display()))?;
-    let mut frames = Vec::with_capacity(count as usize);
-    let mut preview = Vec::new();
+    let mut frames = Vec::new();
+    let mut preview = plan
+        .preview
+        .as_ref()
+        .map(|(p, how)| crate::preview::PreviewWriter::new(p, how, plan.fps));
     let mut integrator: Option<Box<dyn Integrator>> = None;
     let mut stopped = false;
     for (i, frame) in (plan.first..=plan.last).enumerate() {
@@ -291,8 +323,8 @@ pub fn render_frames(
         );
         let path = frame_path(output, frame);
         out.image.write(&path).map_err(|e| e.to_string())?;
-        if plan.preview.is_some() {
-            preview.push(out.image);
+        if let Some(p) = &mut preview {
+            p.push(&out.image)?;
         }
         frames.push(FrameStats {
             frame,
@@ -308,12 +340,8 @@ pub fn render_frames(
             break;
         }
     }
-    match &plan.preview {
-        Some((p, Preview::Apng)) => write_apng(p, &preview, plan.fps)?,
-        Some((p, Preview::Video { ffmpeg, format })) => {
-            write_video(ffmpeg, format, p, &preview, plan.fps)?
-        }
-        None => {}
+    if let Some(p) = preview {
+        p.finish()?;
     }
     Ok((
         SequenceStats {
@@ -332,100 +360,6 @@ pub fn render_frames(
         },
         stopped,
     ))
-}
-
-/// Writes `frames` as an animated PNG (8-bit sRGB, looping) at `fps`, atomically.
-pub fn write_apng(path: &Path, frames: &[Image], fps: f32) -> Result<(), String> {
-    let Some(first) = frames.first() else {
-        return Ok(());
-    };
-    let fail =
-        |e: png::EncodingError| format!("{}: cannot encode the preview: {e}", path.display());
-    let mut bytes = Vec::new();
-    {
-        let mut enc = png::Encoder::new(&mut bytes, first.width, first.height);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        enc.set_animated(frames.len() as u32, 0).map_err(fail)?;
-        // The delay in seconds as a fraction: 100 / (100 fps).
-        let den = (fps * 100.0).round().clamp(1.0, 65535.0) as u16;
-        enc.set_frame_delay(100, den).map_err(fail)?;
-        let mut w = enc.write_header().map_err(fail)?;
-        for img in frames {
-            w.write_image_data(&srgb_bytes(img)).map_err(fail)?;
-        }
-        w.finish().map_err(fail)?;
-    }
-    restir_image::write_file_atomically(path, &bytes).map_err(|e| e.to_string())
-}
-
-/// The frames as 8-bit sRGB bytes, row by row (what [`write_apng`] and ffmpeg's `rgb24` take).
-fn srgb_bytes(img: &Image) -> Vec<u8> {
-    img.pixels
-        .iter()
-        .flat_map(|p| p.to_array().map(restir_image::srgb::encode_u8))
-        .collect()
-}
-
-/// Writes `frames` as a video (or GIF) at `fps` through `ffmpeg`, in the container `format`:
-/// the 8-bit sRGB frames go to its standard input as raw `rgb24`; odd sizes are padded by a
-/// pixel (H.264's 4:2:0 needs even ones). ffmpeg writes a temporary file beside `path`,
-/// renamed into place once it succeeds.
-pub fn write_video(
-    ffmpeg: &Path,
-    format: &str,
-    path: &Path,
-    frames: &[Image],
-    fps: f32,
-) -> Result<(), String> {
-    use std::io::Write;
-    use std::process::{Command, Stdio};
-    let Some(first) = frames.first() else {
-        return Ok(());
-    };
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(format!(".tmp-{}", std::process::id()));
-    let tmp = PathBuf::from(tmp);
-    let mut cmd = Command::new(ffmpeg);
-    cmd.args(["-hide_banner", "-loglevel", "error", "-y"])
-        .args(["-f", "rawvideo", "-pix_fmt", "rgb24"])
-        .args(["-s", &format!("{}x{}", first.width, first.height)])
-        .args(["-framerate", &fps.to_string(), "-i", "pipe:0"]);
-    if format != "gif" {
-        cmd.args([
-            "-vf",
-            "pad=ceil(iw/2)*2:ceil(ih/2)*2",
-            "-pix_fmt",
-            "yuv420p",
-        ]);
-    }
-    cmd.args(["-f", format])
-        .arg(&tmp)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped());
-    let fail = |what: String| format!("{}: ffmpeg ({}) {what}", path.display(), ffmpeg.display());
-    let mut child = cmd
-        .spawn()
-        .map_err(|e| fail(format!("could not start: {e}")))?;
-    let mut stdin = child.stdin.take().expect("stdin is piped");
-    // A write fails when ffmpeg exits early; its status and message say why.
-    let written = frames
-        .iter()
-        .try_for_each(|img| stdin.write_all(&srgb_bytes(img)));
-    drop(stdin);
-    let out = child
-        .wait_with_output()
-        .map_err(|e| fail(format!("failed: {e}")))?;
-    if !out.status.success() || written.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-        let said = String::from_utf8_lossy(&out.stderr);
-        return Err(fail(format!("failed ({}): {}", out.status, said.trim())));
-    }
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        format!("{}: cannot write the preview: {e}", path.display())
-    })
 }
 
 /// The command's side of [`render_frames`]: a progress bar (frame and pass), the statistics

@@ -83,8 +83,8 @@ pub fn run(what: Generate) -> Result<(), String> {
                 ));
             }
             let text = many_lights_ron(args.lights, args.seed).map_err(|e| e.to_string())?;
-            std::fs::write(&args.output, text)
-                .map_err(|e| format!("{}: {e}", args.output.display()))?;
+            restir_image::write_file_atomically(&args.output, text.as_bytes())
+                .map_err(|e| e.to_string())?;
             say!(
                 "many-lights: {} lights, seed {} -> {}",
                 args.lights,
@@ -392,7 +392,7 @@ fn write_one(params: &Params, seed: u64, output: Option<PathBuf>) -> Result<(), 
         ));
     }
     let path = generated.write(dir, stem).map_err(|e| e.to_string())?;
-    println!(
+    say!(
         "{}, seed {seed} -> {} (+{} assets)",
         describe(params),
         path.display(),
@@ -440,7 +440,7 @@ fn write_family(args: &FamilyArgs) -> Result<(), String> {
         if args.xml {
             write_xml(&generated, &path)?;
         }
-        println!(
+        say!(
             "{}, seed {} -> {} (+{} assets)",
             describe_member(member),
             member.seed,
@@ -482,11 +482,11 @@ fn write_family(args: &FamilyArgs) -> Result<(), String> {
                 format!("\tassets: {}", assets.join(" "))
             }
         ));
-        println!("{}", path.display());
+        say!("{}", path.display());
     }
     let path = args.out.join("family.txt");
-    std::fs::write(&path, index).map_err(|e| format!("{}: {e}", path.display()))?;
-    println!("{} scenes, index {}", members.len(), path.display());
+    restir_image::write_file_atomically(&path, index.as_bytes()).map_err(|e| e.to_string())?;
+    say!("{} scenes, index {}", members.len(), path.display());
     Ok(())
 }
 

@@ -26,6 +26,7 @@ mod frames;
 mod generate;
 mod interrupt;
 mod merge;
+mod preview;
 mod progress;
 mod say;
 mod strict;
@@ -463,6 +464,12 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
     }
     Image::check_output(&output).map_err(|e| e.to_string())?;
     if let Some(stats) = &args.stats {
+        if restir_image::same_destination(stats, &output) {
+            return Err(format!(
+                "--stats {}: the same file as the output image",
+                stats.display()
+            ));
+        }
         restir_image::check_writable(stats).map_err(|e| e.to_string())?;
     }
 
@@ -544,6 +551,11 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
         b.finish_and_clear();
     }
 
+    // An interrupted part holds only the passes it rendered, and says so.
+    let plan = plan.map(|p| cluster::Plan {
+        passes: p.passes.start..p.passes.start + out.passes,
+        ..p
+    });
     match &plan {
         Some(p) => p.write(
             &out.image,
@@ -635,6 +647,19 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
 }
 
 fn run_compare(test: &Path, reference: &Path, html: Option<&Path>) -> Result<(), String> {
+    if let Some(out) = html {
+        if let Some(input) = [test, reference]
+            .into_iter()
+            .find(|i| restir_image::same_destination(out, i))
+        {
+            return Err(format!(
+                "--html {}: the same file as the input {}",
+                out.display(),
+                input.display()
+            ));
+        }
+        restir_image::check_writable(out).map_err(|e| e.to_string())?;
+    }
     let t = Image::read_exr(test).map_err(|e| e.to_string())?;
     let r = Image::read_exr(reference).map_err(|e| e.to_string())?;
     let m = restir_evaluation::metrics::evaluate(&t, &r).ok_or_else(|| {
@@ -668,7 +693,22 @@ fn run_compare(test: &Path, reference: &Path, html: Option<&Path>) -> Result<(),
     Ok(())
 }
 
+/// A file-size limit (`ulimit -f`) is a write error naming the file, not a silent death by
+/// SIGXFSZ: the signal is blocked here, before any thread starts (threads inherit the mask), so
+/// the write that crosses the limit returns EFBIG, is reported, and the temporary file is
+/// removed. Blocked rather than ignored because blocking is safe code (`sigprocmask`), and a
+/// blocked SIGXFSZ has the same effect on `write`.
+#[cfg(unix)]
+fn report_file_size_limit() {
+    use nix::sys::signal::{SigSet, Signal};
+    let mut set = SigSet::empty();
+    set.add(Signal::SIGXFSZ);
+    let _ = set.thread_block();
+}
+
 fn main() -> ExitCode {
+    #[cfg(unix)]
+    report_file_size_limit();
     // Rough-plastic tables are kept between runs (`RESTIR_CACHE_DIR=` turns this off).
     restir_materials::table_cache::set_cache_dir(restir_materials::table_cache::default_cache_dir());
     let cli = match Cli::try_parse() {

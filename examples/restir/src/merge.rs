@@ -3,6 +3,11 @@
 //! settings, seed, pass count and film); parts with the same window are chains, combined
 //! pass-weighted (`Σ nᵢ·meanᵢ / Σ nᵢ` in f64), and their passes must be `0..spp` exactly once;
 //! the windows must cover the film exactly once. The result is written as a plain render.
+//!
+//! Parts are read as every input is: regular files only, their sizes checked from the header
+//! (and the film against `--max-memory`) before pixels are allocated. Everything is checked from
+//! the headers first; then the pixels of one part at a time are added into the film, so memory
+//! is the film's and one part's, whatever the number of parts.
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -12,6 +17,7 @@ use restir_image::Image;
 use restir_integrators::PixelWindow;
 
 use crate::cluster::attr;
+use crate::say::{say, say_err};
 
 /// `restir merge` arguments.
 #[derive(clap::Args, Debug)]
@@ -21,15 +27,17 @@ pub struct MergeArgs {
     /// The parts: EXR files written by `restir render --chain/--crop`.
     #[arg(required = true)]
     pub inputs: Vec<PathBuf>,
+    /// Refuse a merge whose estimated memory (the film's sums and image, the largest part)
+    /// exceeds this many GiB, before allocating anything [default: 8].
+    #[arg(long, value_name = "GIB")]
+    pub max_memory: Option<f64>,
 }
 
-/// One part as read back.
+/// One part as described by its header (its pixels are read when merged).
 #[derive(Clone, Debug)]
 pub struct Part {
     /// Its file (for messages).
     pub path: PathBuf,
-    /// The window's pixels.
-    pub image: Image,
     /// The passes it holds.
     pub passes: Range<u32>,
     /// The window it holds.
@@ -69,9 +77,17 @@ fn parse_window(text: &str) -> Option<PixelWindow> {
 }
 
 impl Part {
-    /// Reads a part file.
+    /// Reads a part file's header and checks that its attributes agree with its windows.
     pub fn read(path: &Path) -> Result<Self, String> {
-        let (image, exr) = Image::read_exr_part(path).map_err(|e| e.to_string())?;
+        let (size, exr) = Image::read_exr_part_header(path).map_err(|e| e.to_string())?;
+        Self::from_header(path, size, &exr)
+    }
+
+    fn from_header(
+        path: &Path,
+        size: (u32, u32),
+        exr: &restir_image::ExrPart,
+    ) -> Result<Self, String> {
         let get = |name: &str| {
             exr.attribute(name).ok_or_else(|| {
                 format!(
@@ -86,7 +102,7 @@ impl Part {
         let window = get(attr::WINDOW)?;
         let window = parse_window(window).ok_or_else(|| bad(attr::WINDOW, window))?;
         if (window.x0, window.y0) != exr.offset
-            || (window.width, window.height) != (image.width, image.height)
+            || (window.width, window.height) != size
             || !window.fits(exr.film)
         {
             return Err(format!(
@@ -95,17 +111,45 @@ impl Part {
                 attr::WINDOW
             ));
         }
+        let film = get(attr::FILM)?;
+        if film != format!("{}x{}", exr.film.0, exr.film.1) {
+            return Err(format!(
+                "{}: its {} attribute '{film}' does not match its display window ({}x{})",
+                path.display(),
+                attr::FILM,
+                exr.film.0,
+                exr.film.1
+            ));
+        }
+        let spp = get(attr::SPP)?;
+        if !spp.parse::<u32>().is_ok_and(|n| n >= passes.end) {
+            return Err(bad(attr::SPP, spp));
+        }
         let identity = IDENTITY
             .iter()
             .map(|(name, _)| Ok((*name, get(name)?.to_string())))
             .collect::<Result<_, String>>()?;
         Ok(Self {
             path: path.to_path_buf(),
-            image,
             passes,
             window,
             identity,
         })
+    }
+
+    /// Reads the part's pixels, checking that the file still says what its header said.
+    pub fn pixels(&self) -> Result<Image, String> {
+        let (image, exr) = Image::read_exr_part(&self.path).map_err(|e| e.to_string())?;
+        let again = Self::from_header(&self.path, (image.width, image.height), &exr)?;
+        if (again.passes, again.window, again.identity)
+            != (self.passes.clone(), self.window, self.identity.clone())
+        {
+            return Err(format!(
+                "{}: changed while being merged",
+                self.path.display()
+            ));
+        }
+        Ok(image)
     }
 }
 
@@ -120,9 +164,18 @@ fn show(w: &PixelWindow) -> String {
     format!("{},{},{x1},{y1}", w.x0, w.y0)
 }
 
-/// Merges parts of one render into the whole image. Checks that they belong to one render, that
-/// each window's passes are `0..spp` exactly once and that the windows tile the film.
-pub fn merge(parts: &[Part]) -> Result<Image, String> {
+/// What the parts of one render make: the pass count and the film.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Layout {
+    /// Passes of the whole render.
+    pub spp: u32,
+    /// The whole film.
+    pub film: PixelWindow,
+}
+
+/// Checks that the parts belong to one render, that each window's passes are `0..spp` exactly
+/// once and that the windows tile the film.
+pub fn check(parts: &[Part]) -> Result<Layout, String> {
     let first = parts.first().ok_or("nothing to merge")?;
     for p in &parts[1..] {
         for ((name, what), ((_, a), (_, b))) in
@@ -178,8 +231,6 @@ pub fn merge(parts: &[Part]) -> Result<Image, String> {
             film.pixels()
         ));
     }
-
-    let mut out = Image::new(film.width, film.height);
     for (window, chains) in &mut tiles {
         chains.sort_by_key(|p| p.passes.start);
         let mut next = 0u32;
@@ -214,29 +265,50 @@ pub fn merge(parts: &[Part]) -> Result<Image, String> {
                 show(window)
             ));
         }
-        let combined = combine(chains);
-        let w = window.width as usize;
-        for (i, px) in combined.into_iter().enumerate() {
-            let (x, y) = (i % w + window.x0 as usize, i / w + window.y0 as usize);
-            out.pixels[y * film.width as usize + x] = px;
-        }
     }
-    Ok(out)
+    Ok(Layout { spp, film })
 }
 
-/// The pass-weighted mean of chains of one window: `Σ nᵢ·meanᵢ / Σ nᵢ` per pixel, in f64.
-pub fn combine(chains: &[&Part]) -> Vec<glam::Vec3> {
-    let total: f64 = chains.iter().map(|p| p.passes.len() as f64).sum();
-    let n = chains[0].image.pixels.len();
-    (0..n)
-        .map(|i| {
-            let sum: DVec3 = chains
-                .iter()
-                .map(|p| p.image.pixels[i].as_dvec3() * p.passes.len() as f64)
-                .sum();
-            (sum / total).as_vec3()
-        })
-        .collect()
+/// Bytes a merge needs: the film's f64 sums and its f32 image, and the largest part's pixels
+/// twice (the decoder's buffer and the image).
+pub fn memory_bytes(layout: &Layout, parts: &[Part]) -> u64 {
+    let largest = parts
+        .iter()
+        .map(|p| p.window.pixels() as u64)
+        .max()
+        .unwrap_or(0);
+    (layout.film.pixels() as u64) * (24 + 12) + largest * 24
+}
+
+/// Merges parts of one render into the whole image ([`check`] first): the pixels of each part,
+/// read by `load` one part at a time, are added pass-weighted into the film's f64 sums, which
+/// are divided by the pass count at the end (every window's passes add up to it).
+pub fn merge(
+    parts: &[Part],
+    mut load: impl FnMut(&Part) -> Result<Image, String>,
+) -> Result<Image, String> {
+    let layout = check(parts)?;
+    let film = layout.film;
+    let width = film.width as usize;
+    let mut sums = vec![DVec3::ZERO; film.pixels()];
+    for p in parts {
+        let image = load(p)?;
+        if (image.width, image.height) != (p.window.width, p.window.height) {
+            return Err(format!("{}: changed while being merged", p.path.display()));
+        }
+        let n = p.passes.len() as f64;
+        let w = p.window.width as usize;
+        for (i, px) in image.pixels.iter().enumerate() {
+            let (x, y) = (i % w + p.window.x0 as usize, i / w + p.window.y0 as usize);
+            sums[y * width + x] += px.as_dvec3() * n;
+        }
+    }
+    let total = f64::from(layout.spp);
+    let mut out = Image::new(film.width, film.height);
+    for (o, s) in out.pixels.iter_mut().zip(&sums) {
+        *o = (*s / total).as_vec3();
+    }
+    Ok(out)
 }
 
 /// `restir merge`.
@@ -256,19 +328,46 @@ pub fn run(args: MergeArgs) -> Result<(), String> {
             ));
         }
     }
+    let max_gib = crate::strict::max_memory(args.max_memory)?;
+    if let Some(input) = args
+        .inputs
+        .iter()
+        .find(|i| restir_image::same_destination(&args.output, i))
+    {
+        return Err(format!(
+            "{}: the same file as the part {}: merging would overwrite one of its inputs",
+            args.output.display(),
+            input.display()
+        ));
+    }
+    Image::check_output(&args.output).map_err(|e| e.to_string())?;
     let parts = args
         .inputs
         .iter()
         .map(|p| Part::read(p))
         .collect::<Result<Vec<_>, _>>()?;
-    let image = merge(&parts)?;
+    let layout = check(&parts)?;
+    let need = memory_bytes(&layout, &parts);
+    let gib = need as f64 / (1u64 << 30) as f64;
+    if gib > max_gib {
+        return Err(format!(
+            "merging a {}×{} film needs about {need} bytes ({gib:.1} GiB), more than the limit \
+             of {max_gib} GiB: raise --max-memory",
+            layout.film.width, layout.film.height
+        ));
+    }
+    let image = merge(&parts, Part::pixels)?;
+    let nonfinite = image.nonfinite_count();
     image.write(&args.output).map_err(|e| e.to_string())?;
-    println!(
+    if nonfinite > 0 {
+        say_err!("warning: {nonfinite} pixels are NaN or infinite");
+    }
+    say!(
         "merged {} parts: {}×{}, {} passes -> {}",
         parts.len(),
         image.width,
         image.height,
-        parts[0].identity[3].1,
+        layout.spp,
         args.output.display()
     );
     Ok(())
@@ -279,14 +378,13 @@ mod tests {
     use super::*;
     use glam::Vec3;
 
-    fn part(name: &str, passes: Range<u32>, window: PixelWindow, value: f32) -> Part {
+    fn part(name: &str, passes: Range<u32>, window: PixelWindow, value: f32) -> (Part, Image) {
         let mut image = Image::new(window.width, window.height);
         for (i, p) in image.pixels.iter_mut().enumerate() {
             *p = Vec3::new(value, value * i as f32, 1.0);
         }
-        Part {
+        let part = Part {
             path: PathBuf::from(name),
-            image,
             passes,
             window,
             identity: vec![
@@ -296,7 +394,21 @@ mod tests {
                 (attr::SPP, "10".into()),
                 (attr::FILM, "4x2".into()),
             ],
-        }
+        };
+        (part, image)
+    }
+
+    /// [`merge`] with the images held in memory.
+    fn merged(parts: &[(Part, Image)]) -> Result<Image, String> {
+        let headers: Vec<Part> = parts.iter().map(|(p, _)| p.clone()).collect();
+        merge(&headers, |p| {
+            Ok(parts
+                .iter()
+                .find(|(q, _)| q.path == p.path)
+                .expect("a part")
+                .1
+                .clone())
+        })
     }
 
     fn win(x0: u32, y0: u32, x1: u32, y1: u32) -> PixelWindow {
@@ -313,7 +425,7 @@ mod tests {
     fn merge_arithmetic() {
         let full = win(0, 0, 4, 2);
         let parts = [part("a", 0..3, full, 1.0), part("b", 3..10, full, 2.0)];
-        let m = merge(&parts).unwrap();
+        let m = merged(&parts).unwrap();
         let want = (3.0 * 1.0 + 7.0 * 2.0) / 10.0;
         assert_eq!(m.pixels[0], Vec3::new(want, 0.0, 1.0));
         assert_eq!(
@@ -326,14 +438,14 @@ mod tests {
             part("r0", 0..5, win(1, 0, 4, 2), 1.0),
             part("r1", 5..10, win(1, 0, 4, 2), 3.0),
         ];
-        let m = merge(&parts).unwrap();
+        let m = merged(&parts).unwrap();
         assert_eq!(m.pixels[0], Vec3::new(5.0, 0.0, 1.0));
         assert_eq!(m.pixels[4], Vec3::new(5.0, 5.0, 1.0));
         assert_eq!(m.pixels[1], Vec3::new(2.0, 0.0, 1.0));
         assert_eq!(m.pixels[7], Vec3::new(2.0, 10.0, 1.0));
         // One part holding everything is copied exactly.
         let one = part("x", 0..10, full, 0.1);
-        assert_eq!(merge(std::slice::from_ref(&one)).unwrap(), one.image);
+        assert_eq!(merged(std::slice::from_ref(&one)).unwrap(), one.1);
     }
 
     /// Overlapping or missing passes and tiles, and parts of different renders, are errors
@@ -341,7 +453,7 @@ mod tests {
     #[test]
     fn merge_errors() {
         let full = win(0, 0, 4, 2);
-        let err = |parts: &[Part]| merge(parts).unwrap_err();
+        let err = |parts: &[(Part, Image)]| merged(parts).unwrap_err();
         assert_eq!(
             err(&[part("a", 0..6, full, 1.0), part("b", 5..10, full, 1.0)]),
             "a (passes 0..6) and b (passes 5..10): passes overlap"
@@ -366,14 +478,14 @@ mod tests {
             "a (window 0,0,3,2) and b (window 2,0,4,2): windows overlap"
         );
         let mut other = part("b", 5..10, full, 1.0);
-        other.identity[1].1 = "restir-di".into();
+        other.0.identity[1].1 = "restir-di".into();
         assert_eq!(
             err(&[part("a", 0..5, full, 1.0), other]),
             "a and b: parts of different renders (integrator settings differs: \
              restir:integrator 'path' vs 'restir-di')"
         );
         let mut other = part("b", 5..10, full, 1.0);
-        other.identity[4].1 = "8x2".into();
+        other.0.identity[4].1 = "8x2".into();
         assert!(err(&[part("a", 0..5, full, 1.0), other]).contains("film size differs"));
     }
 }

@@ -248,3 +248,178 @@ fn parts_of_different_renders_do_not_merge() {
         ),
     );
 }
+
+/// Writes a crafted part: a `w`×`h` image of `value` at `offset` in a `film` display window,
+/// with attributes claiming `film_attr`.
+fn crafted_part(
+    path: &str,
+    (w, h): (u32, u32),
+    value: f32,
+    offset: (u32, u32),
+    film: (u32, u32),
+    film_attr: &str,
+) {
+    let mut image = restir_image::Image::new(w, h);
+    image.pixels.fill(glam::Vec3::splat(value));
+    let (x1, y1) = (offset.0 + w, offset.1 + h);
+    let attributes = [
+        ("restir:scene", "s.xml".to_string()),
+        ("restir:scene_hash", "0".into()),
+        ("restir:integrator", "path".into()),
+        ("restir:seed", "0".into()),
+        ("restir:spp", "1".into()),
+        ("restir:passes", "0..1".into()),
+        (
+            "restir:window",
+            format!("{},{},{x1},{y1}", offset.0, offset.1),
+        ),
+        ("restir:film", film_attr.into()),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v))
+    .collect();
+    let part = restir_image::ExrPart {
+        film,
+        offset,
+        attributes,
+    };
+    image.write_exr_part(Path::new(path), &part).unwrap();
+}
+
+/// Expects exit code 1, no panic, and stderr containing `want`.
+fn fails_with(args: &[&str], want: &str) {
+    let out = restir(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+    assert!(stderr.contains(want), "{args:?}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+}
+
+/// A part claiming a 65536² film, a `restir:film` attribute that disagrees with the display
+/// window, the output naming an input, a memory limit: errors before anything is allocated
+/// or overwritten, never an abort or a panic. NaN pixels merge with a warning.
+#[test]
+fn merge_checks_parts_as_every_reader() {
+    let dir = temp_dir("merge-checks");
+    let d = &dir.0;
+    let (huge, out) = (p(d, "huge.exr"), p(d, "out.exr"));
+    crafted_part(&huge, (2, 2), 1.0, (0, 0), (65536, 65536), "65536x65536");
+    fails_with(&["merge", &out, &huge], "beyond the limit");
+    // The film attribute says 4×4 while the display window is 2×2.
+    let liar = p(d, "liar.exr");
+    crafted_part(&liar, (2, 2), 1.0, (0, 0), (2, 2), "4x4");
+    fails_with(
+        &["merge", &out, &liar],
+        "its restir:film attribute '4x4' does not match its display window (2x2)",
+    );
+    let good = p(d, "good.exr");
+    crafted_part(&good, (2, 2), 0.5, (0, 0), (2, 2), "2x2");
+    let before = std::fs::read(&good).unwrap();
+    fails_with(
+        &["merge", &good, &good],
+        "merging would overwrite one of its inputs",
+    );
+    assert_eq!(std::fs::read(&good).unwrap(), before);
+    fails_with(
+        &["merge", &out, &good, "--max-memory", "1e-9"],
+        "bytes (0.0 GiB), more than the limit of 0.000000001 GiB",
+    );
+    ok(&["merge", &out, &good]);
+    let nan = p(d, "nan.exr");
+    crafted_part(&nan, (2, 2), f32::NAN, (0, 0), (2, 2), "2x2");
+    let o = restir(&["merge", &out, &nan]);
+    assert!(o.status.success());
+    assert_eq!(
+        String::from_utf8_lossy(&o.stderr),
+        "warning: 4 pixels are NaN or infinite\n"
+    );
+}
+
+/// A FIFO among the parts is refused at once (opening it would wait for a writer forever).
+#[cfg(unix)]
+#[test]
+fn merge_refuses_a_fifo() {
+    let dir = temp_dir("merge-fifo");
+    let fifo = p(&dir.0, "part.exr");
+    assert!(
+        Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success()
+    );
+    let mut child = Command::new(RESTIR)
+        .args(["merge", &p(&dir.0, "out.exr"), &fifo])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > std::time::Duration::from_secs(20) {
+            child.kill().unwrap();
+            panic!("merge hangs on a FIFO");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("not a regular file"));
+}
+
+/// Parts rendered before and after a mesh file changed are parts of different renders; with
+/// the mesh unchanged they merge.
+#[test]
+fn the_scene_hash_covers_mesh_contents() {
+    let dir = temp_dir("merge-assets");
+    let d = &dir.0;
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/textured");
+    for f in ["textured-shapes.xml", "quad.obj", "quad.ply", "tex.png"] {
+        std::fs::copy(src.join(f), d.join(f)).unwrap();
+    }
+    let scene = p(d, "textured-shapes.xml");
+    let chain =
+        |i: &str, out: &str| render(&scene, &["--spp", "2", "--chains", "2", "--chain", i], out);
+    let (a, b, m) = (p(d, "a.exr"), p(d, "b.exr"), p(d, "m.exr"));
+    chain("0", &a);
+    chain("1", &b);
+    ok(&["merge", &m, &a, &b]);
+    let mut obj = std::fs::read(d.join("quad.obj")).unwrap();
+    obj.extend_from_slice(b"\n# edited\n");
+    std::fs::write(d.join("quad.obj"), obj).unwrap();
+    chain("1", &b);
+    fails_with(&["merge", &m, &a, &b], "scene differs");
+}
+
+/// An interrupted chain's part holds the passes it rendered and says so: its `restir:passes`
+/// ends where the render stopped, so the merge reports the missing passes.
+#[cfg(unix)]
+#[test]
+fn an_interrupted_part_records_its_passes() {
+    let dir = temp_dir("merge-interrupted");
+    let out = p(&dir.0, "part.exr");
+    let child = Command::new(RESTIR)
+        .args(["render", &cornell(), "-o", &out, "--spp", "100000"])
+        .args(["--chain", "0", "--chains", "2", "--quiet"])
+        .args(["--width", "16", "--height", "16"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    assert!(
+        Command::new("kill")
+            .args(["-INT", &child.id().to_string()])
+            .status()
+            .unwrap()
+            .success()
+    );
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(130));
+    let (_, part) = restir_image::Image::read_exr_part(Path::new(&out)).unwrap();
+    let passes = part.attribute("restir:passes").unwrap();
+    let end: u32 = passes.strip_prefix("0..").unwrap().parse().unwrap();
+    assert!(end > 0 && end < 50000, "{passes}");
+    fails_with(
+        &["merge", &p(&dir.0, "m.exr"), &out],
+        &format!("passes {end}..100000 of 100000 are missing"),
+    );
+}

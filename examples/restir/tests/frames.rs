@@ -385,3 +385,101 @@ fn out_exists(dir: &TempDir) -> bool {
         .unwrap()
         .any(|e| e.unwrap().file_name().to_string_lossy().starts_with("o"))
 }
+
+/// A stand-in `ffmpeg` in a fresh `bin` directory with `body`, executable or not, and a `PATH`
+/// that finds it first (then the system's tools).
+#[cfg(unix)]
+fn fake_ffmpeg(dir: &TempDir, body: &str, mode: u32) -> std::ffi::OsString {
+    use std::os::unix::fs::PermissionsExt;
+    let bin = dir.0.join("bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    let fake = bin.join("ffmpeg");
+    std::fs::write(&fake, format!("#!/bin/sh\n{body}\n")).unwrap();
+    std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(mode)).unwrap();
+    std::env::join_paths(std::iter::once(bin).chain(std::env::split_paths(
+        &std::env::var_os("PATH").unwrap_or_default(),
+    )))
+    .unwrap()
+}
+
+/// An ffmpeg that writes a megabyte to its standard error before reading its input does not
+/// deadlock the render (its stderr is drained while frames are written); one that is not
+/// executable is refused before rendering.
+#[cfg(unix)]
+#[test]
+fn ffmpeg_stderr_is_drained_and_a_non_executable_one_refused() {
+    let dir = temp_dir("ffmpeg-flood");
+    let scene = animated(&dir);
+    let path = fake_ffmpeg(
+        &dir,
+        "for a in \"$@\"; do out=\"$a\"; done\nhead -c 1000000 /dev/zero >&2\ncat > /dev/null\necho ok > \"$out\"",
+        0o755,
+    );
+    let video = dir.0.join("seq.mp4");
+    let out = dir.0.join("seq.exr");
+    // Two 128² frames (96 KiB) are more than a pipe holds.
+    let mut child = Command::new(RESTIR)
+        .args([
+            "render",
+            s(&scene),
+            "--frames",
+            "0..1",
+            "--spp",
+            "1",
+            "--quiet",
+        ])
+        .args(["--width", "128", "--height", "128", "-o", s(&out)])
+        .args(["--preview", s(&video)])
+        .env("PATH", &path)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > std::time::Duration::from_secs(60) {
+            child.kill().unwrap();
+            panic!("the render deadlocked on ffmpeg's stderr");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let o = child.wait_with_output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(std::fs::read_to_string(&video).unwrap(), "ok\n");
+
+    let dir = temp_dir("ffmpeg-noexec");
+    let scene = animated(&dir);
+    let path = fake_ffmpeg(&dir, "exit 0", 0o644);
+    let video = dir.0.join("seq.mp4");
+    let o = Command::new(RESTIR)
+        .args(["render", s(&scene), "--frames", "0..1", "--spp", "1"])
+        .args(["-o", s(&dir.0.join("seq.exr")), "--preview", s(&video)])
+        .env("PATH", &path)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("/bin/ffmpeg is not executable"), "{stderr}");
+    assert!(
+        !dir.0.join("seq_0000.exr").exists(),
+        "refused before rendering"
+    );
+}
+
+/// `--frames 0..4294967295` (2^32 frames) is an error, not an overflow.
+#[test]
+fn a_frame_count_beyond_u32_is_an_error() {
+    let dir = temp_dir("frames-overflow");
+    let scene = animated(&dir);
+    let o = dir.0.join("o.exr");
+    fails_with(
+        &[
+            "render",
+            s(&scene),
+            "-o",
+            s(&o),
+            "--frames",
+            "0..4294967295",
+        ],
+        "error: --frames 0..4294967295: 4294967296 frames, more than the most a sequence may have (4294967295)",
+    );
+}
