@@ -62,7 +62,7 @@ pub enum BenchError {
     /// A render and the reference differ in size.
     ReferenceMismatch,
     /// The HTML page cannot be made.
-    Page(crate::html::PageError),
+    Page(crate::report::html::PageError),
     /// A scene given `frames` in the suite has no animation (no `animation` section, no XML
     /// sidecar).
     NoAnimation(PathBuf),
@@ -72,6 +72,8 @@ pub enum BenchError {
         doc: PathBuf,
         /// Which marker is missing: `true` for the begin marker.
         begin: bool,
+        /// The missing marker's text.
+        marker: &'static str,
     },
 }
 
@@ -131,17 +133,23 @@ impl std::fmt::Display for BenchError {
                 path.display()
             ),
             Self::Page(e) => e.fmt(f),
-            Self::Marker { doc, begin: true } => write!(
+            Self::Marker {
+                doc,
+                begin: true,
+                marker,
+            } => write!(
                 f,
-                "{}: no '{}' marker: add the markers where the results belong",
-                doc.display(),
-                crate::BEGIN_MARKER
+                "{}: no '{marker}' marker: add the markers where the results belong",
+                doc.display()
             ),
-            Self::Marker { doc, begin: false } => write!(
+            Self::Marker {
+                doc,
+                begin: false,
+                marker,
+            } => write!(
                 f,
-                "{}: no '{}' after the begin marker",
-                doc.display(),
-                crate::END_MARKER
+                "{}: no '{marker}' after the begin marker",
+                doc.display()
             ),
         }
     }
@@ -172,8 +180,8 @@ impl From<SceneError> for BenchError {
     }
 }
 
-impl From<crate::html::PageError> for BenchError {
-    fn from(e: crate::html::PageError) -> Self {
+impl From<crate::report::html::PageError> for BenchError {
+    fn from(e: crate::report::html::PageError) -> Self {
         Self::Page(e)
     }
 }
