@@ -22,6 +22,15 @@
 //! The report adds a per-frame relMSE plot per sequence, efficiency `1/(relMSE · CPU s per
 //! frame)` and flicker relative to the suite's first configuration.
 //!
+//! A sequence keeps only its first frame's scene: every other frame is built when its
+//! reference or render needs it and dropped after, and each frame's reference is read back from
+//! its cached file when the frame is compared, so memory does not grow with the frame count.
+//!
+//! **Memory and errors.** Before anything of the size of an image is allocated, each scene's
+//! renders are estimated ([`BYTES_PER_PIXEL`], the largest estimator buffers, the images kept for
+//! the page) against [`RunOptions::max_memory_gib`]. Errors about one entry of the suite name
+//! its line in the suite file ([`suite::SuiteLines`]).
+//!
 //! **References.** A scene's `reference` EXR is used as given (its noise is unknown). Otherwise
 //! the path tracer renders the scene at the suite's `reference_spp`, as two halves of
 //! `reference_spp / 2` passes with two seeds that no benchmark run uses, and the average is the
@@ -67,5 +76,5 @@ pub use reference::{REFERENCE_SEEDS, fnv1a};
 pub use report::doc::{BEGIN_MARKER, END_MARKER, check_doc, update_doc};
 pub use report::files::write_outputs;
 pub use report::html;
-pub use run::run_suite;
-pub use suite::{IntegratorConfig, Suite, SuiteError, SuiteScene};
+pub use run::{BYTES_PER_PIXEL, run_suite};
+pub use suite::{IntegratorConfig, Suite, SuiteError, SuiteLines, SuiteScene};

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use restir_image::Image;
 
-use crate::suite::Suite;
+use crate::suite::{Suite, SuiteLines};
 
 /// One render of the suite.
 #[derive(Clone, Debug)]
@@ -170,4 +170,9 @@ pub struct RunOptions {
     pub out: PathBuf,
     /// The command line, for the report.
     pub command_line: String,
+    /// The most memory a scene's renders may need, in GiB (`--max-memory`), estimated before
+    /// anything of the size of the image is allocated ([`crate::BYTES_PER_PIXEL`]).
+    pub max_memory_gib: f64,
+    /// Where the suite's entries are in its file, so that errors name the line.
+    pub lines: SuiteLines,
 }

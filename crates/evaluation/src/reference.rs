@@ -1,6 +1,8 @@
 //! The reference of a scene or of a sequence's frame: given, cached, or path-traced as two halves
 //! whose difference estimates the reference's own noise (see the crate documentation).
 
+use std::borrow::Cow;
+use std::path::PathBuf;
 use std::time::Instant;
 
 use restir_image::{Image, compare};
@@ -30,9 +32,24 @@ pub fn fnv1a(chunks: &[&[u8]]) -> u64 {
     h
 }
 
-/// The references of a scene's views (one, or one per frame), in order.
+/// The references of a scene's views, in order: a still scene's image kept in memory, a
+/// sequence's frames read back from their cached EXR files one at a time (the files are written
+/// as 32-bit floats, so they read back exactly), so that memory does not grow with the frames.
 pub(crate) struct References {
-    pub(crate) images: Vec<Image>,
+    /// A still scene's reference.
+    pub(crate) still: Option<Image>,
+    /// A sequence's reference files, one per frame.
+    pub(crate) frames: Vec<PathBuf>,
+}
+
+impl References {
+    /// The reference of view `i`.
+    pub(crate) fn get(&self, i: usize) -> Result<Cow<'_, Image>, BenchError> {
+        match &self.still {
+            Some(image) => Ok(Cow::Borrowed(image)),
+            None => Ok(Cow::Owned(Image::read_exr(&self.frames[i])?)),
+        }
+    }
 }
 
 /// Loads, or renders and caches, the reference of one scene (`frame = None`) or of one frame of

@@ -136,11 +136,11 @@ fn render_entry(
                 flicker,
             })
     };
-    let Some(mut sequence) = loaded.sequence().filter(|_| !loaded.frames.is_empty()) else {
+    let Some(mut sequence) = loaded.sequence().filter(|_| loaded.frames.is_some()) else {
         let integrator = integrator.expect("a still scene's integrator is built once");
         step(None);
         let m = measured_render(&loaded.scene, integrator, &job(seed));
-        let mut r = record(&m, &references.images[0], None, f64::NAN)?;
+        let mut r = record(&m, &*references.get(0)?, None, f64::NAN)?;
         r.describe = integrator.describe();
         return Ok(Rendered {
             records: vec![r],
@@ -149,29 +149,63 @@ fn render_entry(
     };
     // A fresh estimator per sequence: its history starts empty at the first frame.
     let estimator = build_integrator(&loaded.scene, config, entry)?;
-    let mut records = Vec::with_capacity(loaded.frames.len());
-    let mut prev: Option<Image> = None;
-    for (i, (frame, scene)) in loaded.frames.iter().enumerate() {
-        step(Some(*frame));
-        sequence.enter(estimator.as_ref(), scene.clone(), *frame);
+    let mut records = Vec::with_capacity(loaded.view_count());
+    // The previous frame's image and reference, for the flicker; each frame's scene is built
+    // here and dropped once the next one has entered the sequence.
+    let mut prev: Option<(Image, Image)> = None;
+    for (i, view) in loaded.views().into_iter().enumerate() {
+        let frame = view.expect("a sequence's views are frames");
+        step(Some(frame));
+        let scene = loaded.frame(view)?;
+        sequence.enter(estimator.as_ref(), scene.clone(), frame);
         let m = measured_render(
-            scene,
+            &scene,
             estimator.as_ref(),
-            &job(FrameSequence::seed(seed, *frame)),
+            &job(FrameSequence::seed(seed, frame)),
         );
-        let reference = &references.images[i];
-        let flicker = prev.as_ref().map_or(f64::NAN, |p| {
-            flicker(&m.out.image, reference, p, &references.images[i - 1])
+        drop(scene);
+        let reference = references.get(i)?.into_owned();
+        let flicker = prev.as_ref().map_or(f64::NAN, |(p, pr)| {
+            flicker(&m.out.image, &reference, p, pr)
         });
-        let mut r = record(&m, reference, Some(*frame), flicker)?;
+        let mut r = record(&m, &reference, Some(frame), flicker)?;
         r.describe = estimator.describe();
         records.push(r);
-        prev = Some(m.out.image);
+        prev = Some((m.out.image, reference));
     }
     Ok(Rendered {
         records,
-        image: prev.expect("a sequence has at least one frame"),
+        image: prev.expect("a sequence has at least one frame").0,
     })
+}
+
+/// Bytes per pixel a scene's renders need besides the largest estimator's own buffers: the
+/// film's sums (3 × f64), one pass's image and the output image (3 × f32 each), and six more
+/// images of 3 × f32 (a reference's two halves and their average while it renders; the
+/// reference, the previous frame and its reference while a frame is compared). Each image kept
+/// for the HTML page (seed 0 of every configuration and budget) adds 12.
+pub const BYTES_PER_PIXEL: u64 = 24 + 12 + 12 + 6 * 12;
+
+/// Refuses a scene whose renders would need more than `max_gib` GiB: [`BYTES_PER_PIXEL`], the
+/// largest buffers of the configurations that render it, and the images kept for the page.
+fn check_memory(
+    name: &str,
+    (w, h): (u32, u32),
+    largest_buffers: u64,
+    kept_images: u64,
+    max_gib: f64,
+) -> Result<(), BenchError> {
+    let per_pixel = BYTES_PER_PIXEL + largest_buffers + 12 * kept_images;
+    let need = (w as u64 * h as u64).saturating_mul(per_pixel);
+    if need as f64 / (1u64 << 30) as f64 > max_gib {
+        return Err(BenchError::Memory {
+            scene: name.to_string(),
+            size: (w, h),
+            bytes_per_pixel: per_pixel,
+            max_gib,
+        });
+    }
+    Ok(())
 }
 
 /// Runs every render of `suite` in the current rayon pool, calling `progress` before each step.
@@ -191,23 +225,45 @@ pub fn run_suite(
 
     // Load every scene (every frame of a sequence) and build every integrator once up front,
     // so that a bad scene or parameter fails in seconds rather than after an hour of rendering.
+    // A sequence's frames are built one at a time and dropped. Errors name the entry's line in
+    // the suite file: a configuration's for its integrator, else the scene's.
+    let file = opts.lines.file.as_ref();
+    let scene_line = |i: usize| opts.lines.scenes.get(i).copied().flatten();
+    let config_line = |i: usize| opts.lines.integrators.get(i).copied().flatten();
     let mut scenes = Vec::new();
-    for entry in &suite.scenes {
-        let loaded = load_suite_scene(entry, &opts.suite_dir)?;
-        for config in suite.integrators.iter().filter(|c| entry.runs(&c.label)) {
-            build_integrator(&loaded.scene, config, entry)?;
+    for (si, entry) in suite.scenes.iter().enumerate() {
+        let at_scene = |e: BenchError| e.at(file, scene_line(si));
+        let loaded = load_suite_scene(entry, &opts.suite_dir).map_err(at_scene)?;
+        let mut largest_buffers = 0u64;
+        let mut configs = 0u64;
+        for (ci, config) in suite.integrators.iter().enumerate() {
+            if !entry.runs(&config.label) {
+                continue;
+            }
+            let integrator = build_integrator(&loaded.scene, config, entry)
+                .map_err(|e| e.at(file, config_line(ci)))?;
+            largest_buffers = largest_buffers.max(integrator.buffer_bytes_per_pixel() as u64);
+            configs += 1;
         }
         let (w, h) = loaded.scene.camera.resolution();
-        let rect = crop_rect(entry, w, h)?;
-        scenes.push((entry, loaded, rect));
+        check_memory(
+            &loaded.name,
+            (w, h),
+            largest_buffers,
+            configs * suite.budgets.len() as u64,
+            opts.max_memory_gib,
+        )
+        .map_err(at_scene)?;
+        let rect = crop_rect(entry, w, h).map_err(at_scene)?;
+        scenes.push((si, entry, loaded, rect));
     }
 
     let per_config = suite.budgets.len() as u64 * suite.seeds as u64;
     let total: u64 = scenes
         .iter()
-        .map(|(entry, loaded, _)| {
+        .map(|(_, entry, loaded, _)| {
             let configs = suite.integrators.iter().filter(|c| entry.runs(&c.label));
-            let views = loaded.frames.len().max(1) as u64;
+            let views = loaded.view_count() as u64;
             views + configs.count() as u64 * per_config * views
         })
         .sum();
@@ -220,10 +276,15 @@ pub fn run_suite(
     let mut references = Vec::new();
     let mut strips = Vec::new();
     let mut images = Vec::new();
-    for (entry, loaded, rect) in &scenes {
-        let mut refs = References { images: Vec::new() };
+    for (si, entry, loaded, rect) in &scenes {
+        let at_scene = |e: BenchError| e.at(file, scene_line(*si));
+        let mut refs = References {
+            still: None,
+            frames: Vec::new(),
+        };
         let mut info: Option<ReferenceInfo> = None;
-        for (frame, scene) in loaded.views() {
+        let mut reference: Option<Image> = None;
+        for frame in loaded.views() {
             progress(&Progress {
                 done,
                 total,
@@ -232,9 +293,15 @@ pub fn run_suite(
                     None => format!("{}: reference", loaded.name),
                 },
             });
-            let (image, i) = reference_for(entry, loaded, (frame, &scene), suite, opts)?;
+            let scene = loaded.frame(frame).map_err(at_scene)?;
+            let (image, i) =
+                reference_for(entry, loaded, (frame, &scene), suite, opts).map_err(at_scene)?;
+            drop(scene);
             done += 1;
-            refs.images.push(image);
+            if frame.is_some() {
+                refs.frames.push(i.path.clone());
+            }
+            reference = Some(image);
             // A sequence's entry: the last frame's file, every frame's time, the mean noise.
             info = Some(match info {
                 None => i,
@@ -248,10 +315,13 @@ pub fn run_suite(
         }
         let mut info = info.expect("every scene has a view");
         if let Some(n) = &mut info.noise_relmse {
-            *n /= refs.images.len() as f64;
+            *n /= loaded.view_count() as f64;
         }
         references.push(info);
-        let reference = refs.images.last().expect("a reference").clone();
+        let reference = reference.expect("a reference");
+        if loaded.frames.is_none() {
+            refs.still = Some(reference.clone());
+        }
         let mut strip_crops: Vec<Option<Image>> = vec![None; suite.integrators.len()];
         let mut renders: Vec<(usize, String, f64, Image)> = Vec::new();
         // A still scene's estimators are built once; a sequence builds one per sequence.
@@ -259,11 +329,12 @@ pub fn run_suite(
             .integrators
             .iter()
             .map(|c| {
-                (entry.runs(&c.label) && loaded.frames.is_empty())
+                (entry.runs(&c.label) && loaded.frames.is_none())
                     .then(|| build_integrator(&loaded.scene, c, entry))
                     .transpose()
             })
-            .collect::<Result<Vec<_>, _>>()?;
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(at_scene)?;
         // Seeds outermost, so that a load spike on the shared machine hits every configuration
         // and budget rather than all seeds of one.
         for seed in 0..suite.seeds as u64 {
@@ -293,7 +364,8 @@ pub fn run_suite(
                             });
                             done += 1;
                         },
-                    )?;
+                    )
+                    .map_err(at_scene)?;
                     records.extend(r.records);
                     if seed == 0 && budget == strip_budget {
                         strip_crops[ci] = Some(crop(&r.image, *rect));
