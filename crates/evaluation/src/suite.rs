@@ -108,9 +108,9 @@ pub struct SuiteFamily {
 impl SuiteFamily {
     /// The family's members to render (checked: a known still study and split, members in
     /// range).
-    pub fn chosen(&self) -> Result<Vec<restir_scene::generate::FamilyMember>, SuiteError> {
-        use restir_scene::generate::{Issue, Split, family};
-        let issue = Issue::ALL
+    pub fn chosen(&self) -> Result<Vec<restir_families::FamilyMember>, SuiteError> {
+        use restir_families::{Family, Split, members};
+        let family = Family::ALL
             .into_iter()
             .find(|i| i.name() == self.issue && !i.animated())
             .ok_or_else(|| {
@@ -128,7 +128,7 @@ impl SuiteFamily {
                 )));
             }
         };
-        let all = family(issue, split);
+        let all = members(family, split);
         match &self.members {
             None => Ok(all),
             Some(list) => list
