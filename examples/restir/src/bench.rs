@@ -31,7 +31,7 @@ pub struct BenchArgs {
     /// Worker threads, 1 to 256 (0 or absent: one per core).
     #[arg(long)]
     threads: Option<usize>,
-    /// Also rewrite the marked results section of this Markdown file (e.g. docs/BENCHMARKS.md).
+    /// Also rewrite the marked results section of this Markdown file (e.g. docs/BENCH_RESULTS.md).
     #[arg(long, value_name = "FILE.md")]
     update_doc: Option<PathBuf>,
     /// The most memory a scene's renders may need, in GiB (estimated from its size, the
