@@ -4,22 +4,12 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use restir_testkit::TempDir;
 
 const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
 
-/// A fresh directory for one test, removed when dropped.
-struct TempDir(PathBuf);
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 fn temp_dir(tag: &str) -> TempDir {
-    let dir = std::env::temp_dir().join(format!("restir-frames-{}-{tag}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    TempDir(dir)
+    TempDir::new("frames", tag)
 }
 
 fn s(p: &Path) -> &str {
