@@ -17,20 +17,9 @@ use crate::suite::{IntegratorConfig, Suite, SuiteScene};
 /// Seeds of the two reference halves; benchmark runs use seeds `0..seeds`.
 pub const REFERENCE_SEEDS: [u64; 2] = [0x5eed_0000_0000_0001, 0x5eed_0000_0000_0002];
 
-/// Stable 64-bit FNV-1a hash (for cache keys that must not change between Rust versions).
-pub fn fnv1a(chunks: &[&[u8]]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for chunk in chunks {
-        for &b in *chunk {
-            h ^= b as u64;
-            h = h.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-        // Separate chunks so that ("ab", "c") and ("a", "bc") differ.
-        h ^= 0xff;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
-}
+/// Stable 64-bit FNV-1a hash of byte strings, each followed by a separator (for cache keys that
+/// must not change between Rust versions).
+pub use restir_sampling::hash::fnv1a_chunks as fnv1a;
 
 /// The references of a scene's views, in order: a still scene's image kept in memory, a
 /// sequence's frames read back from their cached EXR files one at a time (the files are written

@@ -264,9 +264,7 @@ impl Plan {
 /// overrides, whatever machine renders it.
 pub fn scene_hash(desc: &SceneDesc) -> u64 {
     let json = serde_json::to_string(desc).unwrap_or_default();
-    json.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-    })
+    restir_sampling::hash::fnv1a(json.as_bytes())
 }
 
 /// Renders the plan's part, or the whole render without a plan.
