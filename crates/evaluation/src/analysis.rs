@@ -238,7 +238,6 @@ pub(crate) fn reference_noise(results: &BenchResults, scene: &str) -> Option<f64
         .and_then(|r| r.noise_relmse)
 }
 
-
 /// The flicker between consecutive frames: the mean over pixels and channels of
 /// `((I_f − R_f) − (I_{f−1} − R_{f−1}))² / (max(R_f, R_{f−1})² + 0.01)` (see the crate
 /// documentation).

@@ -195,11 +195,7 @@ impl std::fmt::Display for BenchError {
                 doc,
                 begin: false,
                 marker,
-            } => write!(
-                f,
-                "{}: no '{marker}' after the begin marker",
-                doc.display()
-            ),
+            } => write!(f, "{}: no '{marker}' after the begin marker", doc.display()),
         }
     }
 }

@@ -70,8 +70,7 @@ pub(crate) fn load_suite_scene(
     suite_dir: &Path,
 ) -> Result<LoadedSuiteScene, BenchError> {
     let path = suite_dir.join(&entry.path);
-    let file_bytes =
-        read_regular(&path).map_err(BenchError::io(&path, "cannot read scene: "))?;
+    let file_bytes = read_regular(&path).map_err(BenchError::io(&path, "cannot read scene: "))?;
     let options = LoadOptions {
         width: entry.width,
         height: entry.height,

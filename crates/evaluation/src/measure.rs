@@ -83,4 +83,3 @@ pub(crate) fn utc(unix: u64) -> String {
         secs / 60 % 60
     )
 }
-

@@ -165,9 +165,9 @@ fn render_entry(
         );
         drop(scene);
         let reference = references.get(i)?.into_owned();
-        let flicker = prev.as_ref().map_or(f64::NAN, |(p, pr)| {
-            flicker(&m.out.image, &reference, p, pr)
-        });
+        let flicker = prev
+            .as_ref()
+            .map_or(f64::NAN, |(p, pr)| flicker(&m.out.image, &reference, p, pr));
         let mut r = record(&m, &reference, Some(frame), flicker)?;
         r.describe = estimator.describe();
         records.push(r);

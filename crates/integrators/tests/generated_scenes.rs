@@ -10,8 +10,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use restir_families::{
-    AssetContents, DiOptions, Generated, Glass, Family, Kind, Params, Receivers, RoomOptions, Split,
-    members, generate,
+    AssetContents, DiOptions, Family, Generated, Glass, Kind, Params, Receivers, RoomOptions,
+    Split, generate, members,
 };
 use restir_scene::{LoadOptions, Scene, load_scene};
 

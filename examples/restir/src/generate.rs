@@ -5,8 +5,8 @@
 use std::path::PathBuf;
 
 use glam::Vec3;
-use restir_image::Image;
 use restir_families::many_lights_ron;
+use restir_image::Image;
 
 use crate::say::say;
 

@@ -1,9 +1,9 @@
 //! `restir bench` end to end on the smoke suite (tiny images, 0.2 s budgets, 64-pass references
 //! rendered into a temporary directory), and its errors on bad input.
 
+use restir_testkit::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use restir_testkit::TempDir;
 
 const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
 
@@ -378,7 +378,14 @@ fn suite_files_are_bounded_and_errors_name_the_line() {
         &["huge.ron:5: ", "16384×16384", "limit of 8 GiB"],
     );
     fails(
-        &["bench", s(&huge), "--out", s(&dir.join("o")), "--max-memory", "0"],
+        &[
+            "bench",
+            s(&huge),
+            "--out",
+            s(&dir.join("o")),
+            "--max-memory",
+            "0",
+        ],
         &["--max-memory 0", "positive"],
     );
     assert!(!dir.join("o").exists());

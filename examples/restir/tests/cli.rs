@@ -1,9 +1,9 @@
 //! The `restir` command on bad input (exit code 1, a one-line error naming the problem, never a
 //! panic) and on a tiny happy path (images, `--stats` JSON, `compare`).
 
+use restir_testkit::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use restir_testkit::TempDir;
 
 const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
 

@@ -2,9 +2,9 @@
 //! into the single-process image (tiles to the same bytes), the parts' `--stats` say which passes
 //! and window they hold, and bad splits or mismatched parts are one-line errors.
 
+use restir_testkit::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use restir_testkit::TempDir;
 
 const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
 

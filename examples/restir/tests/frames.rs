@@ -2,9 +2,9 @@
 //! animated PNG preview and the statistics, and every bad flag refused before rendering with
 //! exit code 1 and exactly the message checked here.
 
+use restir_testkit::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use restir_testkit::TempDir;
 
 const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
 

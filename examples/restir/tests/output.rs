@@ -4,10 +4,10 @@
 //! or stderr is no panic; an interrupt writes what was rendered and exits 130, a second one
 //! aborts at once without writing.
 
+use restir_testkit::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-use restir_testkit::TempDir;
 
 const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
 

@@ -2,9 +2,9 @@
 //! exit code 1 and exactly the message checked here, naming the file and line or the flag, and
 //! the valid choices.
 
+use restir_testkit::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use restir_testkit::TempDir;
 
 const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
 

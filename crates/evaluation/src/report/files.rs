@@ -77,12 +77,8 @@ pub fn write_outputs(results: &BenchResults, out: &Path) -> Result<(), BenchErro
         &out.join("report.md"),
         report_markdown(results, "#", "").as_bytes(),
     )?;
-    write_file(
-        &out.join("report.html"),
-        bench_page(results)?.as_bytes(),
-    )
+    write_file(&out.join("report.html"), bench_page(results)?.as_bytes())
 }
-
 
 /// Per configuration, the median over seeds of each frame's relMSE of sequence `scene` at
 /// `budget`.

@@ -18,9 +18,9 @@ use std::io::Write as _;
 use restir_image::{Image, compare};
 use serde_json::{Value, json};
 
-use crate::metrics::{flip_map, mape, mean};
 use crate::analysis::{sequence_runs, summarize};
 use crate::measure::utc;
+use crate::metrics::{flip_map, mape, mean};
 use crate::records::{BenchResults, RunRecord};
 
 const TEMPLATE: &str = include_str!("../../assets/report.html");

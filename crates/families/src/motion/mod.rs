@@ -117,7 +117,13 @@ pub(super) fn sign(rng: &mut Pcg32) -> f32 {
 
 /// The camera track: an orbit of `angle` degrees about the vertical through the target, the
 /// distance scaled to `dolly` and the eye raised by `lift` by the end, at constant speed.
-pub(super) fn camera_track(eye: Vec3, target: Vec3, angle: f32, dolly: f32, lift: f32) -> CameraTrack {
+pub(super) fn camera_track(
+    eye: Vec3,
+    target: Vec3,
+    angle: f32,
+    dolly: f32,
+    lift: f32,
+) -> CameraTrack {
     let keys = (0..=4)
         .map(|k| {
             let f = k as f32 / 4.0;
@@ -290,7 +296,6 @@ pub(super) fn material_is(shape: &ShapeDesc, pred: impl Fn(&str) -> bool) -> boo
 /// What a generated animation does, for the header.
 pub(super) struct Summary(pub(super) Vec<String>);
 
-
 mod many;
 mod room;
 
@@ -328,8 +333,8 @@ mod tests {
     use glam::Vec3;
     use restir_geometry::Shape;
 
-    use crate::{Family, Split, members};
     use super::{DURATION, FPS};
+    use crate::{Family, Split, members};
     use restir_scene::animation::{build_at, frame_time};
 
     /// A point that moves with the shape: a sphere's centre, the mean of a mesh's vertices.

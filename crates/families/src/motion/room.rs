@@ -183,4 +183,3 @@ pub(super) fn room(
         location: Default::default(),
     })
 }
-
