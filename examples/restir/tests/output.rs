@@ -1,5 +1,5 @@
 //! Outputs that are never half-written and a command that never panics on its streams
-//! (issue 17, "output"; issue 16 §2, Ctrl-C): a write that fails (here a file-size limit, as a
+//! (and Ctrl-C): a write that fails (here a file-size limit, as a
 //! full disk would) is exit code 1 with the file named and the old file kept; a closed stdout
 //! or stderr is no panic; an interrupt writes what was rendered and exits 130, a second one
 //! aborts at once without writing.

@@ -1,4 +1,4 @@
-//! Strict inputs on the command line (issue 16 §2): each bad input fails before rendering with
+//! Strict inputs on the command line: each bad input fails before rendering with
 //! exit code 1 and exactly the message checked here, naming the file and line or the flag, and
 //! the valid choices.
 
