@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""The CPU cost of a ReSTIR DI pass over a path-traced pass (issue 14, goal 1).
+"""The CPU cost of a ReSTIR DI pass over a path-traced pass,
+against a target of at most 1.5×.
 
 Development tool. For each scene, at 160x120 and 640x480, both estimators render n1 and n2
 passes; a pass costs (CPU(n2) - CPU(n1)) / (n2 - n1) of the child's user+system time, so loading

@@ -8,7 +8,7 @@ Run from the repository root after `cargo build --release -p restir`:
 Every render runs on one thread with `--stats` and the script reads the render's own wall time
 (scene loading excluded) from the statistics file. It reports the median over `--repeats`
 renders of milliseconds per pass and nanoseconds per pixel-pass, and writes
-`<out>/scaling.csv` and `<out>/scaling.md` (the Markdown tables quoted in docs/BENCHMARKS.md).
+`<out>/scaling.csv` and `<out>/scaling.md` (the Markdown tables quoted in docs/studies/2026-11-22-cost-scaling.md).
 Generated many-light scenes are written to a temporary directory. Development tool; not run in CI.
 """
 

@@ -1,7 +1,7 @@
 //! Estimator throughput on the shipped scenes: passes per second and Mrays/s (camera,
 //! continuation and shadow rays) of one pass of the `path` and `restir-di` integrators (ReSTIR DI
 //! with its defaults and with the configuration of the equal-time comparison in
-//! docs/BENCHMARKS.md).
+//! docs/studies/2026-11-22-restir-di-many-lights.md).
 //!
 //! Run with `cargo bench -p restir-bench --bench render`. A small harness rather than divan,
 //! because the two numbers wanted are rates of whole passes: each scene is loaded at 128×128,

@@ -62,20 +62,54 @@ pub enum BenchError {
     /// A render and the reference differ in size.
     ReferenceMismatch,
     /// The HTML page cannot be made.
-    Page(crate::html::PageError),
+    Page(crate::report::html::PageError),
     /// A scene given `frames` in the suite has no animation (no `animation` section, no XML
     /// sidecar).
     NoAnimation(PathBuf),
+    /// A scene's renders would need more memory than the limit (`--max-memory`).
+    Memory {
+        /// The scene's name.
+        scene: String,
+        /// Its image size.
+        size: (u32, u32),
+        /// The estimate per pixel, in bytes.
+        bytes_per_pixel: u64,
+        /// The limit, in GiB.
+        max_gib: f64,
+    },
+    /// An error about one entry of the suite file, at its line.
+    At {
+        /// The suite file.
+        file: PathBuf,
+        /// The 1-based line of the entry.
+        line: usize,
+        /// The error.
+        source: Box<BenchError>,
+    },
     /// A Markdown document lacks a results marker.
     Marker {
         /// The document.
         doc: PathBuf,
         /// Which marker is missing: `true` for the begin marker.
         begin: bool,
+        /// The missing marker's text.
+        marker: &'static str,
     },
 }
 
 impl BenchError {
+    /// The same error, at `line` of the suite file when both are known.
+    pub(crate) fn at(self, file: Option<&PathBuf>, line: Option<usize>) -> Self {
+        match (file, line) {
+            (Some(file), Some(line)) => Self::At {
+                file: file.clone(),
+                line,
+                source: Box::new(self),
+            },
+            _ => self,
+        }
+    }
+
     /// An I/O error on `path` while `doing` (a message prefix such as `"cannot read: "`).
     pub(crate) fn io(
         path: impl Into<PathBuf>,
@@ -131,18 +165,37 @@ impl std::fmt::Display for BenchError {
                 path.display()
             ),
             Self::Page(e) => e.fmt(f),
-            Self::Marker { doc, begin: true } => write!(
+            Self::Memory {
+                scene,
+                size: (w, h),
+                bytes_per_pixel,
+                max_gib,
+            } => {
+                let gib = (*w as u64 * *h as u64).saturating_mul(*bytes_per_pixel) as f64
+                    / (1u64 << 30) as f64;
+                write!(
+                    f,
+                    "scene '{scene}': its {w}×{h} renders need about {gib:.1} GiB \
+                     ({bytes_per_pixel} bytes per pixel: film, estimator buffers, reference and \
+                     kept images), more than the limit of {max_gib} GiB: render smaller or raise \
+                     --max-memory"
+                )
+            }
+            Self::At { file, line, source } => write!(f, "{}:{line}: {source}", file.display()),
+            Self::Marker {
+                doc,
+                begin: true,
+                marker,
+            } => write!(
                 f,
-                "{}: no '{}' marker: add the markers where the results belong",
-                doc.display(),
-                crate::BEGIN_MARKER
+                "{}: no '{marker}' marker: add the markers where the results belong",
+                doc.display()
             ),
-            Self::Marker { doc, begin: false } => write!(
-                f,
-                "{}: no '{}' after the begin marker",
-                doc.display(),
-                crate::END_MARKER
-            ),
+            Self::Marker {
+                doc,
+                begin: false,
+                marker,
+            } => write!(f, "{}: no '{marker}' after the begin marker", doc.display()),
         }
     }
 }
@@ -155,6 +208,7 @@ impl std::error::Error for BenchError {
             Self::Io { source, .. } => Some(source),
             Self::Image(e) => Some(e),
             Self::Page(e) => Some(e),
+            Self::At { source, .. } => Some(source.as_ref()),
             _ => None,
         }
     }
@@ -172,8 +226,8 @@ impl From<SceneError> for BenchError {
     }
 }
 
-impl From<crate::html::PageError> for BenchError {
-    fn from(e: crate::html::PageError) -> Self {
+impl From<crate::report::html::PageError> for BenchError {
+    fn from(e: crate::report::html::PageError) -> Self {
         Self::Page(e)
     }
 }

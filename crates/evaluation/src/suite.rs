@@ -108,9 +108,9 @@ pub struct SuiteFamily {
 impl SuiteFamily {
     /// The family's members to render (checked: a known still study and split, members in
     /// range).
-    pub fn chosen(&self) -> Result<Vec<restir_scene::generate::FamilyMember>, SuiteError> {
-        use restir_scene::generate::{Issue, Split, family};
-        let issue = Issue::ALL
+    pub fn chosen(&self) -> Result<Vec<restir_families::FamilyMember>, SuiteError> {
+        use restir_families::{Family, Split, members};
+        let family = Family::ALL
             .into_iter()
             .find(|i| i.name() == self.issue && !i.animated())
             .ok_or_else(|| {
@@ -128,7 +128,7 @@ impl SuiteFamily {
                 )));
             }
         };
-        let all = family(issue, split);
+        let all = members(family, split);
         match &self.members {
             None => Ok(all),
             Some(list) => list
@@ -262,9 +262,18 @@ impl Suite {
 
     /// Reads and parses a suite file.
     pub fn load(file: &Path) -> Result<Suite, SuiteError> {
-        let text = std::fs::read_to_string(file)
+        Self::load_located(file).map(|(suite, _)| suite)
+    }
+
+    /// Reads and parses a suite file, and finds the line of each scene, family member and
+    /// integrator configuration in it ([`SuiteLines`]). Only a regular file of at most
+    /// [`MAX_SUITE_BYTES`] is read: a FIFO, a device or a directory is an error, not a hang.
+    pub fn load_located(file: &Path) -> Result<(Suite, SuiteLines), SuiteError> {
+        let text = read_suite_text(file)
             .map_err(|e| SuiteError::rule(format!("cannot read suite: {e}")).in_file(file))?;
-        Self::parse(&text, file)
+        let suite = Self::parse(&text, file)?;
+        let lines = SuiteLines::locate(&suite, &text, file);
+        Ok((suite, lines))
     }
 
     /// Writes the members of the suite's families that are not there yet into
@@ -443,6 +452,91 @@ impl Suite {
             }
         }
         Ok(())
+    }
+}
+
+/// The largest suite file read: 16 MiB (a suite lists scenes and settings; anything larger is
+/// not one).
+pub const MAX_SUITE_BYTES: u64 = 16 << 20;
+
+/// The text of a suite file: a regular file (checked before opening, since opening a FIFO
+/// blocks), at most [`MAX_SUITE_BYTES`], UTF-8.
+fn read_suite_text(file: &Path) -> std::io::Result<String> {
+    use std::io::Read as _;
+    let too_large = |n: u64| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("the file has {n} bytes or more, more than the limit of {MAX_SUITE_BYTES}"),
+        )
+    };
+    let f = restir_image::input::open_regular(file)?;
+    let len = f.metadata()?.len();
+    if len > MAX_SUITE_BYTES {
+        return Err(too_large(len));
+    }
+    let mut bytes = Vec::new();
+    f.take(MAX_SUITE_BYTES + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_SUITE_BYTES {
+        return Err(too_large(bytes.len() as u64));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        std::io::Error::new(std::io::ErrorKind::InvalidData, format!("not UTF-8: {e}"))
+    })
+}
+
+/// Where a suite's entries are written in its file, for errors found while running it: the
+/// 1-based line of each scene (then of the family that made each family member, in the order
+/// [`Suite::expand_families`] appends them) and of each integrator configuration; `None` where
+/// the entry could not be found in the text.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct SuiteLines {
+    /// The suite file.
+    pub file: Option<PathBuf>,
+    /// Per scene of the expanded suite.
+    pub scenes: Vec<Option<usize>>,
+    /// Per integrator configuration.
+    pub integrators: Vec<Option<usize>>,
+}
+
+impl SuiteLines {
+    /// Finds the entries of `suite` (as parsed from `text`, before its families are expanded):
+    /// a scene on the first line not yet taken that holds `path` and its quoted path, a family
+    /// on the line that holds `issue` and its quoted study, a configuration on the line that
+    /// holds `label` and its quoted label.
+    pub fn locate(suite: &Suite, text: &str, file: &Path) -> SuiteLines {
+        let lines: Vec<&str> = text.lines().collect();
+        let mut taken = vec![false; lines.len()];
+        let mut find = |key: &str, value: &str, take: bool| -> Option<usize> {
+            let quoted = format!("\"{value}\"");
+            let i = lines
+                .iter()
+                .enumerate()
+                .position(|(i, l)| !taken[i] && l.contains(key) && l.contains(&quoted))?;
+            if take {
+                taken[i] = true;
+            }
+            Some(i + 1)
+        };
+        let mut scenes: Vec<Option<usize>> = suite
+            .scenes
+            .iter()
+            .map(|s| find("path", &s.path.to_string_lossy(), true))
+            .collect();
+        for f in &suite.families {
+            let line = find("issue", &f.issue, true);
+            let members = f.chosen().map_or(0, |m| m.len());
+            scenes.extend(std::iter::repeat_n(line, members));
+        }
+        let integrators = suite
+            .integrators
+            .iter()
+            .map(|c| find("label", &c.label, false))
+            .collect();
+        SuiteLines {
+            file: Some(file.to_path_buf()),
+            scenes,
+            integrators,
+        }
     }
 }
 

@@ -19,6 +19,7 @@ use restir_evaluation::{
     write_outputs,
 };
 use restir_image::{Image, IntegerEncoding};
+use restir_testkit::TempDir;
 
 const IGNORE_REASON: &str = "needs headless Chromium: run with --ignored (.ci/run installs it)";
 
@@ -41,20 +42,8 @@ fn chromium() -> PathBuf {
          install it (`apt-get install chromium`) or set RESTIR_CHROMIUM ({IGNORE_REASON})"
     );
 }
-
-struct TempDir(PathBuf);
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 fn temp_dir(tag: &str) -> TempDir {
-    let dir = std::env::temp_dir().join(format!("restir-html-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    TempDir(dir)
+    TempDir::new("html", tag)
 }
 
 /// Runs headless Chromium on `page` with `extra` arguments (a fresh profile each time), killing

@@ -1,4 +1,4 @@
-//! The generated scene kinds of `restir_scene::generate` (the issue 14 and 15 families): every
+//! The generated scene kinds of `restir_families` (the ReSTIR DI and PT families): every
 //! kind builds, renders a tiny image with the path tracer and its ReSTIR estimator without a
 //! non-finite pixel and not black, the same seed gives the same scene, the families' splits are
 //! disjoint and cover every kind and light count, and the 10⁵-light members build (the time is
@@ -9,9 +9,9 @@ mod common;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use restir_scene::generate::{
-    AssetContents, DiOptions, Generated, Glass, Issue, Kind, Params, Receivers, RoomOptions, Split,
-    family, generate,
+use restir_families::{
+    AssetContents, DiOptions, Family, Generated, Glass, Kind, Params, Receivers, RoomOptions,
+    Split, generate, members,
 };
 use restir_scene::{LoadOptions, Scene, load_scene};
 
@@ -164,19 +164,19 @@ fn same_seed_same_scene_other_seed_other_scene() {
 
 #[test]
 fn families_are_disjoint_and_cover_every_kind_and_light_count() {
-    for issue in [Issue::Di, Issue::Pt] {
-        let train = family(issue, Split::Train);
-        let test = family(issue, Split::Test);
+    for family in [Family::Di, Family::Pt] {
+        let train = members(family, Split::Train);
+        let test = members(family, Split::Test);
         assert!(
             (8..=12).contains(&train.len()),
-            "{issue:?}: {} members",
+            "{family:?}: {} members",
             train.len()
         );
         assert_eq!(train.len(), test.len());
         for t in &train {
             assert!(
                 test.iter().all(|s| s.seed != t.seed),
-                "{issue:?}: seed {} shared",
+                "{family:?}: seed {} shared",
                 t.seed
             );
         }
@@ -186,10 +186,10 @@ fn families_are_disjoint_and_cover_every_kind_and_light_count() {
         assert_eq!(
             names.len(),
             2 * train.len(),
-            "{issue:?}: member names collide"
+            "{family:?}: member names collide"
         );
     }
-    let di = family(Issue::Di, Split::Test);
+    let di = members(Family::Di, Split::Test);
     for kind in [Kind::Rects, Kind::Spheres, Kind::Meshes] {
         for lights in [1_000, 10_000, 100_000] {
             assert!(
@@ -215,7 +215,7 @@ fn families_are_disjoint_and_cover_every_kind_and_light_count() {
             |m| matches!(&m.params, Params::Di(_, o) if o.occluders && o.power_ratio == 1000.0)
         )
     );
-    let pt = family(Issue::Pt, Split::Test);
+    let pt = members(Family::Pt, Split::Test);
     for glass in Glass::ALL {
         for window in [false, true] {
             assert!(
@@ -228,7 +228,7 @@ fn families_are_disjoint_and_cover_every_kind_and_light_count() {
 
 #[test]
 fn hundred_thousand_light_members_build() {
-    for member in family(Issue::Di, Split::Test)
+    for member in members(Family::Di, Split::Test)
         .into_iter()
         .filter(|m| matches!(&m.params, Params::Di(_, o) if o.lights == 100_000))
     {

@@ -1,6 +1,6 @@
 //! Mitsuba 3's `envmap` emitter: a latitude-longitude image of radiance at infinity.
 //!
-//! # Mapping (Mitsuba 3.9, `src/emitters/envmap.cpp`; ../shared/MATERIALS.md §6)
+//! # Mapping (Mitsuba 3.9, `src/emitters/envmap.cpp` and the `envmap` plugin reference)
 //!
 //! A world direction `ω` (pointing from the scene towards the sky) is taken to the emitter's
 //! local frame, `v = to_world⁻¹·ω`, and then

@@ -1,6 +1,7 @@
 //! Named indices of refraction (Mitsuba 3's `include/mitsuba/render/ior.h`) and the RGB complex
 //! IORs of Mitsuba 3's named conductors (its `data/ior/*.spd` files integrated to linear sRGB
-//! without D65 weighting; see `shared/MATERIALS.md` §3.5). The values were read with
+//! without D65 weighting; the `conductor` plugin's reference lists the names, Mitsuba 3's
+//! `include/mitsuba/core/spectrum.h` the conversion). The values were read with
 //! `mi.traverse` from Mitsuba 3.9.1 `scalar_rgb` for every `material` name it accepts (the
 //! `_palik` variants included); names it rejects (`W_palik`, `Pt`, `Fe`, `Ti`, `CuZn`) are not
 //! here either.

@@ -31,7 +31,8 @@
 //!
 //! [`BsdfKind`] holds Mitsuba 3's `diffuse`, `conductor`, `roughconductor`, `dielectric`,
 //! `roughdielectric`, `plastic`, `roughplastic` and `null` with Mitsuba's parameters, defaults and
-//! formulas (`shared/MATERIALS.md` is the specification, with Mitsuba source paths). Each family's
+//! formulas (the specification is Mitsuba 3's plugin reference, "BSDFs", and its
+//! `src/bsdfs/*.cpp`; each model's documentation names the paper it follows). Each family's
 //! maths sits in one file of `src/models/` (`diffuse`, `conductor`, `dielectric`, `plastic`: its
 //! parameters, `eval`, `pdf` and `sample` and their tests); `src/bsdf.rs` holds [`Bsdf`] and the
 //! dispatch, one `match` per method. Beneath them: [`microfacet`] (GGX and Beckmann,

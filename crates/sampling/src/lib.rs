@@ -6,6 +6,7 @@
 //! - [`sequences`]: low-discrepancy sequences (Halton, R2).
 //! - [`warp`]: warps from the unit square with their pdfs, in triples (`sample_*`, `*_pdf`, and the
 //!   inverse where it exists).
+//! - [`hash`]: FNV-1a, a stable hash for cache keys and checksums.
 //! - [`Distribution1D`], [`Distribution2D`]: piecewise-constant distributions; [`AliasTable`]: O(1)
 //!   discrete sampling.
 //!
@@ -24,6 +25,7 @@
 //! ```
 
 mod distribution;
+pub mod hash;
 mod rng;
 pub mod sequences;
 pub mod warp;

@@ -68,7 +68,7 @@ fn line_of(text: &str, needle: &str, from: usize, nth: usize) -> u32 {
 /// Attaches `anim` to `desc`: every track's shape id resolved to its index. `text` is the text
 /// the animation was read from (for the lines of errors) and `from` the byte offset where the
 /// animation starts in it.
-pub(crate) fn attach(
+pub fn attach(
     desc: &mut SceneDesc,
     mut anim: AnimationDesc,
     text: &str,

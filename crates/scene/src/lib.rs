@@ -25,7 +25,6 @@ pub mod animation;
 mod build;
 pub mod desc;
 mod error;
-pub mod generate;
 mod light_share;
 mod load;
 mod material;

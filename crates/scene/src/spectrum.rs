@@ -1,5 +1,6 @@
 //! Spectra given as `wavelength:value` lists, converted to linear sRGB once at load time the way
-//! Mitsuba 3's RGB variants do it (`shared/MATERIALS.md` §7).
+//! Mitsuba 3's RGB variants do it (its `include/mitsuba/core/spectrum.h`, and the "Spectra"
+//! section of its plugin reference).
 //!
 //! The spectrum is linearly interpolated (zero outside its wavelength range), integrated against
 //! the CIE 1931 2° colour-matching functions by a 1000-point Riemann sum over 360–830 nm,

@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use restir_scene::generate::{Issue, Params, Split, family};
+use restir_families::{Family, Params, Split, members};
 use restir_scene::xml::{XmlWriteOptions, to_mitsuba_xml};
 use restir_scene::{ColorParam, MaterialDesc, MaterialRef, Scene, SceneDesc, defaults, load_desc};
 
@@ -161,12 +161,12 @@ fn round_trip(desc: &SceneDesc, source: &Path, xml: &Path, prefix: Option<&str>)
 #[test]
 fn the_static_families_round_trip() {
     let dir = temp_dir("families");
-    for (issue, split) in [
-        (Issue::Pt, Split::Train),
-        (Issue::Pt, Split::Test),
-        (Issue::Di, Split::Test),
+    for (family, split) in [
+        (Family::Pt, Split::Train),
+        (Family::Pt, Split::Test),
+        (Family::Di, Split::Test),
     ] {
-        for member in family(issue, split) {
+        for member in members(family, split) {
             // The many-light members at 10³ lights stand for the rest (10⁵ lights build slowly).
             if matches!(&member.params, Params::Di(_, o) if o.lights > 1000) {
                 continue;

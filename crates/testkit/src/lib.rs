@@ -14,6 +14,7 @@
 //!   (outside CI).
 //! - [`blocks`]: per-block means of images and their mean and standard error over independent
 //!   renders ([`block_statistics`], [`max_z`]), for comparing two estimators of the same image.
+//! - [`tempdir`]: a fresh temporary directory per test, removed when dropped ([`TempDir`]).
 //!
 //! # Chi-square tests of samplers
 //!
@@ -67,6 +68,7 @@ pub mod corpus;
 pub mod grid;
 pub mod running;
 pub mod special;
+pub mod tempdir;
 
 pub use blocks::{block_means, block_statistics, max_z};
 pub use chi2::{
@@ -77,3 +79,4 @@ pub use corpus::{CORPUS_IGNORE_REASON, corpus_dir};
 pub use grid::{Grid2D, Quadrature, SphereGrid};
 pub use running::{RunningStats, SplitMix64, trials};
 pub use special::{chi2_sf, gamma_p, gamma_q, ln_gamma, sidak_level};
+pub use tempdir::TempDir;

@@ -31,9 +31,13 @@ pub struct BenchArgs {
     /// Worker threads, 1 to 256 (0 or absent: one per core).
     #[arg(long)]
     threads: Option<usize>,
-    /// Also rewrite the marked results section of this Markdown file (e.g. docs/BENCHMARKS.md).
+    /// Also rewrite the marked results section of this Markdown file (e.g. docs/BENCH_RESULTS.md).
     #[arg(long, value_name = "FILE.md")]
     update_doc: Option<PathBuf>,
+    /// The most memory a scene's renders may need, in GiB (estimated from its size, the
+    /// estimators' buffers and the images kept for the report, before rendering).
+    #[arg(long, value_name = "GIB")]
+    max_memory: Option<f64>,
     /// No progress bar and no summary line.
     #[arg(long)]
     quiet: bool,
@@ -41,7 +45,8 @@ pub struct BenchArgs {
 
 /// Runs `restir bench`.
 pub fn run(args: BenchArgs) -> Result<(), String> {
-    let mut suite = Suite::load(&args.suite).map_err(|e| e.to_string())?;
+    let (mut suite, lines) = Suite::load_located(&args.suite).map_err(|e| e.to_string())?;
+    let max_memory_gib = crate::strict::max_memory(args.max_memory)?;
     // Generated families are written beside the references, once.
     suite
         .expand_families(&args.out.join("families"))
@@ -74,6 +79,8 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
             .chain(std::env::args().skip(1))
             .collect::<Vec<_>>()
             .join(" "),
+        max_memory_gib,
+        lines,
     };
     let bar = (!args.quiet && std::io::stderr().is_terminal()).then(|| {
         let b = indicatif::ProgressBar::new(0);

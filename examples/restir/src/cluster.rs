@@ -269,22 +269,17 @@ impl Plan {
 /// asset changed between parts. A file that cannot be read hashes as missing.
 pub fn scene_hash(desc: &SceneDesc, base_dir: &Path) -> u64 {
     use std::io::Read;
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
-    let mut add = |bytes: &[u8]| {
-        for &b in bytes {
-            h = (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
-        }
-    };
+    let mut h = restir_sampling::hash::Fnv1a::new();
     let mut value = serde_json::to_value(desc).unwrap_or_default();
-    add(value.to_string().as_bytes());
     // The film's file name is where the image goes, not an input.
     if let Some(film) = value.get_mut("film").and_then(|f| f.as_object_mut()) {
         film.remove("filename");
     }
+    h.write(value.to_string().as_bytes());
     let mut files = Vec::new();
     referenced_files(&value, &mut files);
     for f in files {
-        add(f.as_bytes());
+        h.write(f.as_bytes());
         match restir_image::input::open_regular(&base_dir.join(f)) {
             Ok(file) => {
                 let mut reader = std::io::BufReader::new(file);
@@ -292,18 +287,18 @@ pub fn scene_hash(desc: &SceneDesc, base_dir: &Path) -> u64 {
                 loop {
                     match reader.read(&mut buf) {
                         Ok(0) => break,
-                        Ok(n) => add(&buf[..n]),
+                        Ok(n) => h.write(&buf[..n]),
                         Err(_) => {
-                            add(b"\0unreadable");
+                            h.write(b"\0unreadable");
                             break;
                         }
                     }
                 }
             }
-            Err(_) => add(b"\0missing"),
+            Err(_) => h.write(b"\0missing"),
         }
     }
-    h
+    h.finish()
 }
 
 /// The `filename` strings of a scene description's JSON, in order.

@@ -1,12 +1,12 @@
 //! `restir generate`: the subcommand's arguments and writing the file; the scenes themselves
-//! come from [`restir_scene::generate`], the environment map (a procedural sky, the asset of
+//! come from [`restir_families`], the environment map (a procedural sky, the asset of
 //! `scenes/envmap-spheres.xml`) from [`sky`].
 
 use std::path::PathBuf;
 
 use glam::Vec3;
+use restir_families::many_lights_ron;
 use restir_image::Image;
-use restir_scene::generate::many_lights_ron;
 
 use crate::say::say;
 
@@ -23,8 +23,8 @@ pub enum Generate {
     Meshes(DiArgs),
     /// A glossy room lit mostly indirectly by one hidden area light.
     Room(RoomArgs),
-    /// Every scene of a training or test family with an index: issue 14 di, issue 15 pt, and
-    /// issue 19's moving di-motion and pt-motion (animated, 12 fps; render them with
+    /// Every scene of a training or test family with an index: di (ReSTIR DI), pt (ReSTIR PT),
+    /// and the moving di-motion and pt-motion (animated, 12 fps; render them with
     /// `restir render DIR/NAME.ron --frames 0..23`).
     Family(FamilyArgs),
     /// A latitude-longitude environment map (EXR): a sky with a sun over a dark ground, the map
@@ -210,11 +210,11 @@ pub fn sky(width: u32, height: u32) -> Image {
     img
 }
 
-// ---- the scene families' kinds (issues 14 and 15) ----
+// ---- the generated kinds and the scene families (restir-families) ----
 
-use restir_scene::generate::{
-    DiOptions, FamilyMember, Generated, Glass, Issue, Kind, Params, Receivers, RoomOptions, Split,
-    family,
+use restir_families::{
+    DiOptions, Family, FamilyMember, Generated, Glass, Kind, Params, Receivers, RoomOptions, Split,
+    members,
 };
 
 /// Options of `restir generate rects|spheres|meshes`.
@@ -347,12 +347,12 @@ fn describe(params: &Params) -> String {
 
 /// [`describe`], saying when the member is animated.
 fn describe_member(member: &FamilyMember) -> String {
-    if member.issue.animated() {
+    if member.family.animated() {
         format!(
             "{}, animated ({} fps, frames 0..{})",
             describe(&member.params),
-            restir_scene::generate::FPS,
-            (restir_scene::generate::FPS * restir_scene::generate::DURATION) as u32 - 1
+            restir_families::FPS,
+            (restir_families::FPS * restir_families::DURATION) as u32 - 1
         )
     } else {
         describe(&member.params)
@@ -369,7 +369,7 @@ fn tag(params: &Params) -> String {
 /// Writes one generated scene to `output` (or its default name) and says so.
 fn write_one(params: &Params, seed: u64, output: Option<PathBuf>) -> Result<(), String> {
     let generated: Generated =
-        restir_scene::generate::generate(params, seed).map_err(|e| e.to_string())?;
+        restir_families::generate(params, seed).map_err(|e| e.to_string())?;
     let output = output.unwrap_or_else(|| {
         PathBuf::from(format!(
             "{}-{}-s{seed}.ron",
@@ -403,7 +403,7 @@ fn write_one(params: &Params, seed: u64, output: Option<PathBuf>) -> Result<(), 
 
 /// Writes every member of a family and the index `family.txt`.
 fn write_family(args: &FamilyArgs) -> Result<(), String> {
-    let issue = Issue::ALL
+    let family = Family::ALL
         .into_iter()
         .find(|i| i.name() == args.issue)
         .ok_or_else(|| {
@@ -417,19 +417,19 @@ fn write_family(args: &FamilyArgs) -> Result<(), String> {
     } else {
         Split::Test
     };
-    if args.xml && issue.animated() {
+    if args.xml && family.animated() {
         return Err(format!(
             "--xml: the {} family is animated, and Mitsuba 3 XML describes one instant (the \
              static families pt and di convert)",
-            issue.name()
+            family.name()
         ));
     }
-    let members: Vec<FamilyMember> = family(issue, split);
+    let members: Vec<FamilyMember> = members(family, split);
     if let Some(i) = args.index {
         let member = members.get(i).ok_or_else(|| {
             format!(
                 "--index {i}: the {} family has members 0 to {}",
-                issue.name(),
+                family.name(),
                 members.len() - 1
             )
         })?;
@@ -453,9 +453,9 @@ fn write_family(args: &FamilyArgs) -> Result<(), String> {
         "# The {} {} family: written by `restir generate family --issue {} --split {} --out DIR`.\n\
          # Regenerate rather than edit. One line per scene: file, seed, kind and parameters.\n\
          # Training seeds start at 1, test seeds at 101 (the splits never share a scene).\n",
-        issue.name(),
+        family.name(),
         split.name(),
-        issue.name(),
+        family.name(),
         split.name()
     );
     for member in &members {

@@ -1,9 +1,9 @@
 //! `restir bench` end to end on the smoke suite (tiny images, 0.2 s budgets, 64-pass references
 //! rendered into a temporary directory), and its errors on bad input.
 
+use restir_testkit::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use std::sync::atomic::{AtomicU32, Ordering};
 
 const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
 
@@ -13,28 +13,8 @@ fn repo(rel: &str) -> PathBuf {
         .join(rel)
 }
 
-/// A fresh directory under the system temp dir, removed when dropped.
-struct TempDir(PathBuf);
-
-impl std::ops::Deref for TempDir {
-    type Target = Path;
-    fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 fn temp_dir(tag: &str) -> TempDir {
-    static COUNTER: AtomicU32 = AtomicU32::new(0);
-    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-    let dir = std::env::temp_dir().join(format!("restir-bench-{}-{n}-{tag}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    TempDir(dir)
+    TempDir::new("bench", tag)
 }
 
 fn restir(args: &[&str]) -> Output {
@@ -320,7 +300,7 @@ fn bad_suites_fail_with_one_line() {
     std::fs::write(&typo, text).unwrap();
     fails(
         &["bench", s(&typo), "--out", s(&dir.join("typo-out"))],
-        &["restir-di tuned", "neighbours_x"],
+        &["typo.ron:15: ", "restir-di tuned", "neighbours_x"],
     );
     assert!(!dir.join("typo-out").exists());
 
@@ -337,6 +317,76 @@ fn bad_suites_fail_with_one_line() {
             s(&doc),
         ],
         &["NOMARK.md", "marker"],
+    );
+    assert!(!dir.join("o").exists());
+}
+
+#[test]
+fn suite_files_are_bounded_and_errors_name_the_line() {
+    let dir = temp_dir("bounded");
+    // Not a regular file: a device is refused, not read until memory runs out, and a FIFO is
+    // refused, not waited on.
+    fails(
+        &["bench", "/dev/zero", "--out", s(&dir.join("o"))],
+        &["/dev/zero", "not a regular file"],
+    );
+    let fifo = dir.join("suite.fifo");
+    let made = Command::new("mkfifo").arg(&fifo).status();
+    if made.is_ok_and(|st| st.success()) {
+        fails(
+            &["bench", s(&fifo), "--out", s(&dir.join("o"))],
+            &["suite.fifo", "not a regular file"],
+        );
+    }
+    // Too large: refused before it is read.
+    let big = dir.join("big.ron");
+    let file = std::fs::File::create(&big).unwrap();
+    file.set_len((16 << 20) + 1).unwrap();
+    fails(
+        &["bench", s(&big), "--out", s(&dir.join("o"))],
+        &["big.ron", "more than the limit"],
+    );
+    assert!(!dir.join("o").exists());
+
+    // A scene whose renders would need more than --max-memory fails before anything renders,
+    // at the scene's line; 16384² fails under the default limit.
+    let suite = repo("scenes/bench/smoke.ron");
+    let text = std::fs::read_to_string(&suite)
+        .unwrap()
+        .replace("\"../", &format!("\"{}/", s(&repo("scenes"))));
+    let local = dir.join("smoke.ron");
+    std::fs::write(&local, &text).unwrap();
+    fails(
+        &[
+            "bench",
+            s(&local),
+            "--out",
+            s(&dir.join("o")),
+            "--max-memory",
+            "0.00001",
+        ],
+        &["smoke.ron:5: ", "cornell-box", "--max-memory"],
+    );
+    let huge = dir.join("huge.ron");
+    std::fs::write(
+        &huge,
+        text.replacen("width: 24, height: 24", "width: 16384, height: 16384", 2),
+    )
+    .unwrap();
+    fails(
+        &["bench", s(&huge), "--out", s(&dir.join("o"))],
+        &["huge.ron:5: ", "16384×16384", "limit of 8 GiB"],
+    );
+    fails(
+        &[
+            "bench",
+            s(&huge),
+            "--out",
+            s(&dir.join("o")),
+            "--max-memory",
+            "0",
+        ],
+        &["--max-memory 0", "positive"],
     );
     assert!(!dir.join("o").exists());
 }

@@ -1,9 +1,9 @@
 //! The `restir` command on bad input (exit code 1, a one-line error naming the problem, never a
 //! panic) and on a tiny happy path (images, `--stats` JSON, `compare`).
 
+use restir_testkit::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use std::sync::atomic::{AtomicU32, Ordering};
 
 const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
 
@@ -11,29 +11,8 @@ fn cornell() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml")
 }
 
-/// A fresh directory under the system temp dir, unique to this process and call, removed when
-/// dropped.
-struct TempDir(PathBuf);
-
-impl std::ops::Deref for TempDir {
-    type Target = Path;
-    fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 fn temp_dir(tag: &str) -> TempDir {
-    static COUNTER: AtomicU32 = AtomicU32::new(0);
-    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-    let dir = std::env::temp_dir().join(format!("restir-cli-{}-{n}-{tag}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    TempDir(dir)
+    TempDir::new("cli", tag)
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {

@@ -2,6 +2,7 @@
 //! into the single-process image (tiles to the same bytes), the parts' `--stats` say which passes
 //! and window they hold, and bad splits or mismatched parts are one-line errors.
 
+use restir_testkit::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -14,20 +15,8 @@ fn cornell() -> String {
         .to_string()
 }
 
-/// A fresh directory, removed when dropped.
-struct TempDir(PathBuf);
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 fn temp_dir(tag: &str) -> TempDir {
-    let dir = std::env::temp_dir().join(format!("restir-cluster-{}-{tag}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    TempDir(dir)
+    TempDir::new("cluster", tag)
 }
 
 fn restir(args: &[&str]) -> Output {

@@ -2,24 +2,14 @@
 //! animated PNG preview and the statistics, and every bad flag refused before rendering with
 //! exit code 1 and exactly the message checked here.
 
+use restir_testkit::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
 
-/// A fresh directory for one test, removed when dropped.
-struct TempDir(PathBuf);
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 fn temp_dir(tag: &str) -> TempDir {
-    let dir = std::env::temp_dir().join(format!("restir-frames-{}-{tag}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    TempDir(dir)
+    TempDir::new("frames", tag)
 }
 
 fn s(p: &Path) -> &str {

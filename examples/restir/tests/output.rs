@@ -1,9 +1,10 @@
 //! Outputs that are never half-written and a command that never panics on its streams
-//! (issue 17, "output"; issue 16 §2, Ctrl-C): a write that fails (here a file-size limit, as a
+//! (and Ctrl-C): a write that fails (here a file-size limit, as a
 //! full disk would) is exit code 1 with the file named and the old file kept; a closed stdout
 //! or stderr is no panic; an interrupt writes what was rendered and exits 130, a second one
 //! aborts at once without writing.
 
+use restir_testkit::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -14,19 +15,8 @@ fn cornell() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml")
 }
 
-/// A fresh directory for one test, removed when dropped.
-struct TempDir(PathBuf);
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 fn temp_dir(tag: &str) -> TempDir {
-    let dir = std::env::temp_dir().join(format!("restir-output-{}-{tag}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    TempDir(dir)
+    TempDir::new("output", tag)
 }
 
 fn s(p: &Path) -> &str {

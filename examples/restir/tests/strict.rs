@@ -1,7 +1,8 @@
-//! Strict inputs on the command line (issue 16 §2): each bad input fails before rendering with
+//! Strict inputs on the command line: each bad input fails before rendering with
 //! exit code 1 and exactly the message checked here, naming the file and line or the flag, and
 //! the valid choices.
 
+use restir_testkit::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -11,19 +12,8 @@ fn cornell() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml")
 }
 
-/// A fresh directory for one test, removed when dropped.
-struct TempDir(PathBuf);
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 fn temp_dir(tag: &str) -> TempDir {
-    let dir = std::env::temp_dir().join(format!("restir-strict-{}-{tag}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    TempDir(dir)
+    TempDir::new("strict", tag)
 }
 
 fn s(p: &Path) -> &str {

@@ -38,7 +38,7 @@ pub const TILE_SIZE: usize = 1024;
 /// At most this many tiles: 8192 entries, about 590 KB, which stay in a core's cache. On the
 /// training family a pass is as good with 2 tiles as with 128 (the samples are reused more,
 /// never biased), while 128 tiles cost as many draws per pass as the candidates at 160×120
-/// and, at 640×480, a working set of 9 MB (`docs/BENCHMARKS.md`, "ReSTIR DI pass cost").
+/// and, at 640×480, a working set of 9 MB (`docs/studies/2026-12-02-restir-di-light-pool-and-defaults.md`).
 pub const MAX_TILES: usize = 8;
 
 /// Blocks of `BLOCK × BLOCK` pixels share a tile.

@@ -14,7 +14,7 @@ use crate::reuse::settings::ReuseSettings;
 
 /// Emitter-table entries (emissive triangles and other lights) from which the light hierarchy
 /// is the default candidate source. On the training family (10², 10³ and 10⁴ lights, equal CPU
-/// time, `docs/BENCHMARKS.md`, "Light hierarchy") a hierarchy pass costs 1.6–3.0× a power-table
+/// time, `docs/studies/2026-12-02-light-hierarchy.md`) a hierarchy pass costs 1.6–3.0× a power-table
 /// pass and its candidates make a pass only 1.3–1.7× better, so no measured light count
 /// qualifies (`None`): `auto` is the power table everywhere until the descent gets cheaper,
 /// and this bound is where the rule lives.
@@ -23,7 +23,7 @@ pub const HIERARCHY_MIN_EMITTERS: Option<usize> = None;
 /// The share of light selections one light must hold for ReSTIR DI to hand the scene to the
 /// path tracer at its defaults (`fallback = auto`), when the emitter table also holds at most
 /// [`FEW_EMITTERS`] entries: with one dominant light made of a few surfaces the reservoirs have
-/// little to choose from and their cost is not repaid (`docs/BENCHMARKS.md`, "Never worse").
+/// little to choose from and their cost is not repaid (`docs/studies/2026-12-02-never-worse.md`).
 /// A dominant mesh light of thousands of small triangles is a many-light problem and keeps
 /// ReSTIR DI.
 pub const DOMINANT_LIGHT_SHARE: f32 = 0.5;
@@ -139,7 +139,7 @@ pub struct RestirDiSettings {
     /// Spatial and temporal reuse.
     pub reuse: ReuseSettings,
     /// Light candidates per pixel in initial resampling, `N_L` (default 8, chosen by an
-    /// equal-CPU-time sweep on a training family of generated scenes; `docs/BENCHMARKS.md`).
+    /// equal-CPU-time sweep on a training family of generated scenes; `docs/studies/2026-12-01-restir-di-defaults.md`).
     pub candidates: u32,
     /// Where candidates' lights come from (default the power sampler).
     pub light_sampler: LightSampler,
@@ -147,7 +147,7 @@ pub struct RestirDiSettings {
     /// by the balance heuristic.
     pub bsdf_candidates: u32,
     /// Where visibility is tested (default in every target: chosen on the training family with
-    /// the reuse defaults, `docs/BENCHMARKS.md`, "ReSTIR DI defaults, fifth session").
+    /// the reuse defaults, `docs/studies/2026-12-02-restir-di-light-pool-and-defaults.md`).
     pub visibility: Visibility,
     /// Whether a scene with one dominant light goes to the path tracer (default auto).
     pub fallback: Fallback,

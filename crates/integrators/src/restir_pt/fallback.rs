@@ -12,7 +12,7 @@
 //!
 //! On a diffuse surface lit mostly directly, next-event estimation is already close to the
 //! product, and a default ReSTIR PT pass (3–6 path-tracer passes) is not repaid: at equal CPU
-//! time (`docs/BENCHMARKS.md`, "ReSTIR PT defaults") the Cornell boxes gained 0.42–0.78×,
+//! time (`docs/studies/2026-12-02-restir-pt-defaults.md`) the Cornell boxes gained 0.42–0.78×,
 //! matpreview (smooth glass over diffuse surfaces under an environment) 0.41–0.52×, against
 //! 1.2–4.7× in the glossy rooms and 1.8–1.9× in Sponza (diffuse, mostly in the shadow of its
 //! one small light).
@@ -36,12 +36,12 @@ use crate::shadow::{ShadowTarget, visible};
 
 /// The share of the pilot's camera paths (among those that reach a surface a path can
 /// reconnect at) whose first such surface must be glossy for ReSTIR PT to keep a scene at its
-/// defaults, unless [`INDIRECT_VIEW_MIN`] keeps it (`docs/BENCHMARKS.md`, "Never worse").
+/// defaults, unless [`INDIRECT_VIEW_MIN`] keeps it (`docs/studies/2026-12-02-never-worse.md`).
 pub const GLOSSY_VIEW_MIN: f32 = 0.05;
 
 /// The mean indirect share (one more bounce over direct plus one more bounce) of the light at
 /// the camera paths' first reconnectable surfaces for ReSTIR PT to keep a scene without glossy
-/// surfaces in view at its defaults (`docs/BENCHMARKS.md`, "Never worse").
+/// surfaces in view at its defaults (`docs/studies/2026-12-02-never-worse.md`).
 pub const INDIRECT_VIEW_MIN: f32 = 0.65;
 
 /// Camera rays per side of the pilot grid.

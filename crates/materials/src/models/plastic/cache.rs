@@ -62,9 +62,7 @@ fn file_name(distribution: Distribution, alpha: f32, eta: f32) -> String {
 
 /// FNV-1a, 64 bits: enough to tell a torn or damaged file from a good one.
 fn checksum(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
-    })
+    restir_sampling::hash::fnv1a(bytes)
 }
 
 fn encode(t: &RoughPlasticTable) -> Vec<u8> {

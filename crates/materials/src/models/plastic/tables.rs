@@ -1,7 +1,8 @@
 //! The tables of Mitsuba 3's `roughplastic`: the transmittance of the rough dielectric coating
 //! into the base, `T(cos θ)`, and the hemispherical reflectance of its inside, `R_int`, both
 //! integrated numerically when the material is made (Mitsuba's `parameters_changed` with
-//! `eval_transmittance`/`eval_reflectance`, see `shared/MATERIALS.md` §4.3).
+//! `eval_transmittance`/`eval_reflectance` in `src/bsdfs/roughplastic.cpp`; Weidlich and Wilkie,
+//! "Arbitrarily layered micro-facet surfaces", 2007, for the layered model).
 //!
 //! Both are `Σ_ij w_i w_j/4 · g(m_ij)` over Gauss–Legendre nodes `u_ij` mapped to normals
 //! `m_ij` by the visible-normal sampler, for 64 views (64 × 32² nodes for `T`, 64 × 128² for

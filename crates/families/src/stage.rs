@@ -14,7 +14,7 @@ use super::util::{
     rough_plastic, round, round3, shape, uniform,
 };
 use super::{Asset, AssetContents, envmap};
-use crate::{
+use restir_scene::{
     CameraDesc, FilmDesc, FilterDesc, GeometryDesc, IntegratorDesc, LightDesc, MaterialDesc,
     NamedMaterial, SceneDesc, ShapeDesc, TransformOp,
 };

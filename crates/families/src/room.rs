@@ -12,7 +12,7 @@ use super::util::{
     rough_conductor, rough_plastic, round, round3, shape, uniform,
 };
 use super::{Asset, AssetContents, Generated, envmap};
-use crate::{
+use restir_scene::{
     CameraDesc, FilmDesc, FilterDesc, GeometryDesc, IntegratorDesc, LightDesc, MaterialDesc,
     MaterialRef, NamedMaterial, RoughnessDesc, SceneDesc, ShapeDesc, TransformOp,
 };
@@ -301,14 +301,14 @@ pub fn room(seed: u64, options: &RoomOptions) -> Generated {
         let material = if i == glass_index {
             MaterialRef::Inline(match options.glass {
                 Glass::Smooth => MaterialDesc::Dielectric {
-                    int_ior: crate::BK7_IOR,
-                    ext_ior: crate::AIR_IOR,
+                    int_ior: restir_scene::BK7_IOR,
+                    ext_ior: restir_scene::AIR_IOR,
                     specular_reflectance: [1.0; 3],
                     specular_transmittance: [1.0; 3],
                 },
                 _ => MaterialDesc::RoughDielectric {
-                    int_ior: crate::BK7_IOR,
-                    ext_ior: crate::AIR_IOR,
+                    int_ior: restir_scene::BK7_IOR,
+                    ext_ior: restir_scene::AIR_IOR,
                     specular_reflectance: [1.0; 3],
                     specular_transmittance: [1.0; 3],
                     roughness: RoughnessDesc {

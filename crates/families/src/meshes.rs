@@ -11,7 +11,7 @@ use restir_sampling::Pcg32;
 use super::stage::{EXTENT, LIGHT_HEIGHT, radiance_scale, stage};
 use super::util::{emitter, hue_colour, round, uniform};
 use super::{Asset, AssetContents, DiOptions, Generated};
-use crate::GeometryDesc;
+use restir_scene::GeometryDesc;
 
 /// Meshes per scene.
 pub(super) const MESHES: u32 = 8;

@@ -1,18 +1,18 @@
-//! The scene families of the equal-time studies: for each issue a fixed list of kinds and
+//! The scene families of the equal-time studies: for each family a fixed list of kinds and
 //! parameters, and for each split its own seeds (training `1..`, test `101..`), so a family is a
 //! list of seeds and the two splits never share a scene. Defaults are chosen on the training
 //! family and gains reported on the test family.
 //!
-//! - [`Issue::Di`] (ReSTIR DI, direct light only): rectangles, spheres and emissive meshes at
+//! - [`Family::Di`] (ReSTIR DI, direct light only): rectangles, spheres and emissive meshes at
 //!   10³, 10⁴ and 10⁵ lights, radiances spread over 1000×, occluders between lights and receivers,
 //!   diffuse, checkerboard, glossy and mixed receivers, four members with a sky beside the lights.
-//! - [`Issue::Pt`] (ReSTIR PT): glossy rooms without glass, with smooth and with rough glass,
+//! - [`Family::Pt`] (ReSTIR PT): glossy rooms without glass, with smooth and with rough glass,
 //!   each with and without a window to a sky.
-//! - [`Issue::DiMotion`] (ReSTIR DI under motion, issue 19): rectangles, spheres and emissive
+//! - [`Family::DiMotion`] (ReSTIR DI under motion): rectangles, spheres and emissive
 //!   meshes at 10³ lights, two of each, with diffuse, glossy, mixed and textured receivers,
 //!   occluders everywhere and a sky in three, each animated by [`super::animate`] (camera,
 //!   receivers, slats and lights move, lights change radiance and one goes dark and back).
-//! - [`Issue::PtMotion`] (ReSTIR PT under motion): the six glossy rooms (each glass choice with
+//! - [`Family::PtMotion`] (ReSTIR PT under motion): the six glossy rooms (each glass choice with
 //!   and without a window), animated likewise (camera, two objects, the hidden light, and two
 //!   added lamps move; one lamp goes dark and back).
 //!
@@ -21,9 +21,9 @@
 
 use super::{DiOptions, GenerateError, Generated, Glass, Kind, Params, Receivers, RoomOptions};
 
-/// Which study a family serves.
+/// A family of generated scenes: which study it serves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Issue {
+pub enum Family {
     /// ReSTIR DI against the path tracer at max depth 2.
     Di,
     /// ReSTIR PT against the path tracer in glossy rooms.
@@ -34,23 +34,23 @@ pub enum Issue {
     PtMotion,
 }
 
-impl Issue {
+impl Family {
     /// Every study.
-    pub const ALL: [Issue; 4] = [Issue::Di, Issue::Pt, Issue::DiMotion, Issue::PtMotion];
+    pub const ALL: [Family; 4] = [Family::Di, Family::Pt, Family::DiMotion, Family::PtMotion];
 
     /// The name on the command line.
     pub fn name(self) -> &'static str {
         match self {
-            Issue::Di => "di",
-            Issue::Pt => "pt",
-            Issue::DiMotion => "di-motion",
-            Issue::PtMotion => "pt-motion",
+            Family::Di => "di",
+            Family::Pt => "pt",
+            Family::DiMotion => "di-motion",
+            Family::PtMotion => "pt-motion",
         }
     }
 
     /// Whether the family's scenes are animated (render them with `--frames 0..23`).
     pub fn animated(self) -> bool {
-        matches!(self, Issue::DiMotion | Issue::PtMotion)
+        matches!(self, Family::DiMotion | Family::PtMotion)
     }
 }
 
@@ -84,8 +84,8 @@ impl Split {
 /// One scene of a family.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FamilyMember {
-    /// The study.
-    pub issue: Issue,
+    /// The family.
+    pub family: Family,
     /// The split.
     pub split: Split,
     /// Position in the family (the same parameters in both splits).
@@ -105,7 +105,7 @@ impl FamilyMember {
         };
         format!(
             "{}-{}-{:02}-{}-{tag}-s{}",
-            self.issue.name(),
+            self.family.name(),
             self.split.name(),
             self.index,
             self.params.kind().name(),
@@ -116,7 +116,7 @@ impl FamilyMember {
     /// The scene (animated by [`super::animate`] in the moving families).
     pub fn generate(&self) -> Result<Generated, GenerateError> {
         let mut generated = super::generate(&self.params, self.seed)?;
-        if self.issue.animated() {
+        if self.family.animated() {
             super::animate(&mut generated, self.params.kind(), self.seed)?;
         }
         Ok(generated)
@@ -202,19 +202,19 @@ fn pt_motion_params() -> Vec<Params> {
         .collect()
 }
 
-/// The family of `issue` for `split`.
-pub fn family(issue: Issue, split: Split) -> Vec<FamilyMember> {
-    let params = match issue {
-        Issue::Di => di_params(),
-        Issue::Pt => pt_params(),
-        Issue::DiMotion => di_motion_params(),
-        Issue::PtMotion => pt_motion_params(),
+/// The members of `family` for `split`.
+pub fn members(family: Family, split: Split) -> Vec<FamilyMember> {
+    let params = match family {
+        Family::Di => di_params(),
+        Family::Pt => pt_params(),
+        Family::DiMotion => di_motion_params(),
+        Family::PtMotion => pt_motion_params(),
     };
     params
         .into_iter()
         .enumerate()
         .map(|(index, params)| FamilyMember {
-            issue,
+            family,
             split,
             index,
             params,

@@ -36,9 +36,9 @@ use std::path::{Path, PathBuf};
 
 use restir_image::{Image, ImageError};
 
-use crate::SceneDesc;
+use restir_scene::SceneDesc;
 
-pub use family::{FamilyMember, Issue, Split, family};
+pub use family::{Family, FamilyMember, Split, members};
 pub use many_lights::{many_lights, many_lights_ron};
 pub use motion::{DURATION, FPS, animate};
 pub use room::{Glass, RoomOptions, room};
@@ -222,7 +222,7 @@ mod tests {
 
     #[test]
     fn the_shipped_many_lights_scene_is_what_the_generator_writes() {
-        let shipped = include_str!("../../../../scenes/many-lights.ron");
+        let shipped = include_str!("../../../scenes/many-lights.ron");
         assert_eq!(many_lights_ron(400, 1).unwrap(), shipped);
     }
 

@@ -1,4 +1,4 @@
-//! Animated family members (issue 19, ReSTIR under motion): a generated scene plus an animation
+//! Animated family members (ReSTIR under motion): a generated scene plus an animation
 //! drawn from the member's seed ([`animate`]), so that camera, objects and lights all move. Every
 //! animation runs 2 s at 12 fps (frames `0..23`; [`FPS`], [`DURATION`]); keys start at the scene
 //! as generated, so frame 0 is the still scene (apart from the room's two added lamps).
@@ -24,19 +24,18 @@
 //!   which move 0.6–1.2 m, and `lamp0` goes dark and back (dark, it is a small black sphere).
 //!
 //! Linear and Catmull-Rom tracks are both used. The animation is attached (shape ids resolved),
-//! so [`Generated::desc`] builds at any time with [`crate::animation::build_at`] and its RON text
+//! so [`Generated::desc`] builds at any time with [`restir_scene::animation::build_at`] and its RON text
 //! (with `id`s and the `animation` section) renders with `restir render X.ron --frames 0..23`.
 
 use glam::{Mat4, Vec3};
 use restir_sampling::Pcg32;
 
-use super::stage::LIGHT_HEIGHT;
 use super::util::{emitter, hue_colour, round, round3, uniform};
 use super::{AssetContents, GenerateError, Generated, Kind};
-use crate::desc::{
+use restir_scene::desc::{
     AnimationDesc, CameraKey, CameraTrack, EmissionKey, Interpolation, Keys, MotionKey, ShapeTrack,
 };
-use crate::{GeometryDesc, MaterialRef, SceneDesc, ShapeDesc, TransformOp, V3};
+use restir_scene::{GeometryDesc, MaterialRef, SceneDesc, ShapeDesc, TransformOp, V3};
 
 /// Frames per second of the generated animations.
 pub const FPS: f32 = 12.0;
@@ -45,7 +44,7 @@ pub const DURATION: f32 = 2.0;
 
 /// A shape's world-space bounding box (its centre and half extents), from its geometry and
 /// `to_world`; meshes from files are read from the generated assets.
-fn bounds(shape: &ShapeDesc, generated: &Generated) -> Option<(Vec3, Vec3)> {
+pub(super) fn bounds(shape: &ShapeDesc, generated: &Generated) -> Option<(Vec3, Vec3)> {
     let square = || {
         [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
             .map(|(x, y)| Vec3::new(x, y, 0.0))
@@ -87,7 +86,7 @@ fn bounds(shape: &ShapeDesc, generated: &Generated) -> Option<(Vec3, Vec3)> {
         GeometryDesc::Mesh { positions, .. } => positions.iter().map(|p| Vec3::from(*p)).collect(),
         _ => return None,
     };
-    let m = crate::transform_matrix(&shape.to_world).ok()?;
+    let m = restir_scene::transform_matrix(&shape.to_world).ok()?;
     let points: Vec<Vec3> = points.iter().map(|p| m.transform_point3(*p)).collect();
     let lo = points.iter().copied().reduce(Vec3::min)?;
     let hi = points.iter().copied().reduce(Vec3::max)?;
@@ -95,12 +94,12 @@ fn bounds(shape: &ShapeDesc, generated: &Generated) -> Option<(Vec3, Vec3)> {
 }
 
 /// The luminance of a radiance.
-fn luminance(c: V3) -> f32 {
+pub(super) fn luminance(c: V3) -> f32 {
     0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
 }
 
 /// `count` distinct entries of `from` in random order (fewer if `from` is shorter).
-fn choose(rng: &mut Pcg32, from: &[usize], count: usize) -> Vec<usize> {
+pub(super) fn choose(rng: &mut Pcg32, from: &[usize], count: usize) -> Vec<usize> {
     let mut v = from.to_vec();
     let count = count.min(v.len());
     for i in 0..count {
@@ -112,13 +111,19 @@ fn choose(rng: &mut Pcg32, from: &[usize], count: usize) -> Vec<usize> {
 }
 
 /// A random sign.
-fn sign(rng: &mut Pcg32) -> f32 {
+pub(super) fn sign(rng: &mut Pcg32) -> f32 {
     if rng.next_bounded(2) == 0 { -1.0 } else { 1.0 }
 }
 
 /// The camera track: an orbit of `angle` degrees about the vertical through the target, the
 /// distance scaled to `dolly` and the eye raised by `lift` by the end, at constant speed.
-fn camera_track(eye: Vec3, target: Vec3, angle: f32, dolly: f32, lift: f32) -> CameraTrack {
+pub(super) fn camera_track(
+    eye: Vec3,
+    target: Vec3,
+    angle: f32,
+    dolly: f32,
+    lift: f32,
+) -> CameraTrack {
     let keys = (0..=4)
         .map(|k| {
             let f = k as f32 / 4.0;
@@ -142,7 +147,7 @@ fn camera_track(eye: Vec3, target: Vec3, angle: f32, dolly: f32, lift: f32) -> C
 
 /// Rigid motion keys at 0, 1 and 2 s: from rest to `end` through a point part-way there and off
 /// the straight line, turning to `turn` (degrees about x, y, z).
-fn rigid(rng: &mut Pcg32, end: Vec3, turn: V3) -> Keys<MotionKey> {
+pub(super) fn rigid(rng: &mut Pcg32, end: Vec3, turn: V3) -> Keys<MotionKey> {
     let side = Vec3::new(-end.z, 0.0, end.x) * uniform(rng, -0.3, 0.3);
     let mid = end * uniform(rng, 0.35, 0.65) + side;
     let half = uniform(rng, 0.35, 0.65);
@@ -166,19 +171,19 @@ fn rigid(rng: &mut Pcg32, end: Vec3, turn: V3) -> Keys<MotionKey> {
 }
 
 /// A horizontal vector of a length in `[lo, hi)` in a random direction.
-fn horizontal(rng: &mut Pcg32, lo: f32, hi: f32) -> Vec3 {
+pub(super) fn horizontal(rng: &mut Pcg32, lo: f32, hi: f32) -> Vec3 {
     let length = uniform(rng, lo, hi);
     let phi = uniform(rng, 0.0, core::f32::consts::TAU);
     Vec3::new(phi.cos(), 0.0, phi.sin()) * length
 }
 
-fn scaled(radiance: V3, s: f32) -> V3 {
+pub(super) fn scaled(radiance: V3, s: f32) -> V3 {
     radiance.map(|c| round(c * s, 4))
 }
 
 /// Emission keys that go dark and come back: full until 0.5–0.8 s, down to zero in 0.15 s, dark
 /// for 0.3–0.45 s (at least three frames), back up in 0.15 s. Returns the keys and the dark span.
-fn blink(rng: &mut Pcg32, radiance: V3) -> (Keys<EmissionKey>, (f32, f32)) {
+pub(super) fn blink(rng: &mut Pcg32, radiance: V3) -> (Keys<EmissionKey>, (f32, f32)) {
     let off = round(uniform(rng, 0.5, 0.8), 3);
     let dark = round(uniform(rng, 0.3, 0.45), 3);
     let ramp = 0.15;
@@ -207,7 +212,7 @@ fn blink(rng: &mut Pcg32, radiance: V3) -> (Keys<EmissionKey>, (f32, f32)) {
 
 /// Emission keys at 0, 1 and 2 s: the radiance as generated, then 2–3× (a swell) or 0.2–0.4× (a
 /// fade) of it, then 0.6–1.5× of it.
-fn swell(rng: &mut Pcg32, radiance: V3) -> Keys<EmissionKey> {
+pub(super) fn swell(rng: &mut Pcg32, radiance: V3) -> Keys<EmissionKey> {
     let middle = if rng.next_bounded(2) == 0 {
         uniform(rng, 2.0, 3.0)
     } else {
@@ -230,7 +235,7 @@ fn swell(rng: &mut Pcg32, radiance: V3) -> Keys<EmissionKey> {
 }
 
 /// A track for `shape` under the name `id` (the shape gets the id).
-fn track(
+pub(super) fn track(
     shapes: &mut [ShapeDesc],
     shape: usize,
     id: String,
@@ -249,7 +254,7 @@ fn track(
 }
 
 /// A track that moves shape `shape` rigidly by `motion` ([`track`] with its motion keys).
-fn mover(
+pub(super) fn mover(
     shapes: &mut [ShapeDesc],
     shape: usize,
     id: String,
@@ -264,7 +269,7 @@ fn mover(
 }
 
 /// Catmull-Rom for the even-numbered of a group of moving shapes, linear for the others.
-fn alternate(n: usize) -> Interpolation {
+pub(super) fn alternate(n: usize) -> Interpolation {
     if n.is_multiple_of(2) {
         Interpolation::CatmullRom
     } else {
@@ -273,7 +278,7 @@ fn alternate(n: usize) -> Interpolation {
 }
 
 /// The camera's look-at (eye, target), or an error when the camera is not one look-at.
-fn look_at(desc: &SceneDesc) -> Result<(Vec3, Vec3), GenerateError> {
+pub(super) fn look_at(desc: &SceneDesc) -> Result<(Vec3, Vec3), GenerateError> {
     match desc.camera.to_world.as_slice() {
         [TransformOp::LookAt { origin, target, .. }] => {
             Ok((Vec3::from(*origin), Vec3::from(*target)))
@@ -284,400 +289,18 @@ fn look_at(desc: &SceneDesc) -> Result<(Vec3, Vec3), GenerateError> {
     }
 }
 
-fn material_is(shape: &ShapeDesc, pred: impl Fn(&str) -> bool) -> bool {
+pub(super) fn material_is(shape: &ShapeDesc, pred: impl Fn(&str) -> bool) -> bool {
     matches!(&shape.material, Some(MaterialRef::Ref(name)) if pred(name))
 }
 
 /// What a generated animation does, for the header.
-struct Summary(Vec<String>);
+pub(super) struct Summary(pub(super) Vec<String>);
 
-/// The many-light stages' animation (rectangles, spheres or meshes).
-fn many_lights(
-    generated: &mut Generated,
-    kind: Kind,
-    rng: &mut Pcg32,
-    summary: &mut Summary,
-) -> Result<AnimationDesc, GenerateError> {
-    let (eye, target) = look_at(&generated.desc)?;
-    let angle = sign(rng) * round(uniform(rng, 8.0, 20.0), 1);
-    let dolly = uniform(rng, 0.88, 1.0);
-    let lift = uniform(rng, -0.6, 0.4);
-    let camera = camera_track(eye, target, angle, dolly, lift);
-    summary.0.push(format!(
-        "the camera orbits {angle}° about its target and moves {:.0} % closer",
-        100.0 * (1.0 - dolly)
-    ));
+mod many;
+mod room;
 
-    let info: Vec<Option<(Vec3, Vec3)>> = generated
-        .desc
-        .shapes
-        .iter()
-        .map(|s| bounds(s, generated))
-        .collect();
-    let box_of = |i: usize| {
-        info[i].ok_or_else(|| GenerateError::Animation(format!("shape {i} has no bounds")))
-    };
-    let shapes = &generated.desc.shapes;
-    let receivers: Vec<usize> = (0..shapes.len())
-        .filter(|&i| {
-            shapes[i].emission.is_none() && material_is(&shapes[i], |m| m.starts_with("receiver"))
-        })
-        .collect();
-    let slats: Vec<usize> = (0..shapes.len())
-        .filter(|&i| {
-            shapes[i].geometry == GeometryDesc::Rectangle
-                && material_is(&shapes[i], |m| m == "occluder")
-        })
-        .collect();
-    let mut lights: Vec<usize> = (0..shapes.len())
-        .filter(|&i| shapes[i].emission.is_some())
-        .collect();
-    // Brightest first: radiance times area (a box's largest face stands for the area).
-    let power = |i: usize| {
-        let h = info[i].map_or(Vec3::ZERO, |b| b.1);
-        let area = (h.x * h.y).max(h.y * h.z).max(h.x * h.z);
-        luminance(shapes[i].emission.unwrap_or_default()) * area
-    };
-    lights.sort_by(|&a, &b| power(b).total_cmp(&power(a)).then(a.cmp(&b)));
-    let radiances: Vec<V3> = shapes
-        .iter()
-        .map(|s| s.emission.unwrap_or_default())
-        .collect();
-    let radiance = |i: usize| radiances[i];
-
-    let mut tracks = Vec::new();
-    for (n, &i) in choose(rng, &receivers, 3).iter().enumerate() {
-        let (c, h) = box_of(i)?;
-        let size = 2.0 * h.x.max(h.z);
-        let end = horizontal(rng, 0.4 * size, 0.8 * size);
-        let turn = [0.0, sign(rng) * uniform(rng, 15.0, 45.0), 0.0];
-        tracks.push(mover(
-            &mut generated.desc.shapes,
-            i,
-            format!("object{n}"),
-            Interpolation::CatmullRom,
-            c,
-            rigid(rng, end, turn),
-        ));
-    }
-    summary.0.push("three receivers move and turn".into());
-    for (n, &i) in choose(rng, &slats, 2).iter().enumerate() {
-        let (c, _) = box_of(i)?;
-        let end = horizontal(rng, 0.3, 0.8);
-        let turn = [0.0, sign(rng) * uniform(rng, 20.0, 60.0), 0.0];
-        tracks.push(mover(
-            &mut generated.desc.shapes,
-            i,
-            format!("slat{n}"),
-            Interpolation::Linear,
-            c,
-            rigid(rng, end, turn),
-        ));
-    }
-    if !slats.is_empty() {
-        summary.0.push("two slats move and turn".into());
-    }
-
-    if kind == Kind::Meshes {
-        // lights[0] is the brightest mesh: it moves, as two others; the next two change.
-        let (pulse0, pulse1) = (lights.get(1).copied(), lights.get(2).copied());
-        let mut moving = vec![lights[0]];
-        moving.extend(choose(rng, lights.get(3..).unwrap_or_default(), 2));
-        for (n, &i) in moving.iter().enumerate() {
-            let (c, _) = box_of(i)?;
-            let end = horizontal(rng, 0.5, 1.2);
-            let turn = [
-                sign(rng) * uniform(rng, 0.0, 10.0),
-                sign(rng) * uniform(rng, 30.0, 90.0),
-                0.0,
-            ];
-            tracks.push(mover(
-                &mut generated.desc.shapes,
-                i,
-                format!("light{n}"),
-                alternate(n),
-                c,
-                rigid(rng, end, turn),
-            ));
-        }
-        summary.0.push(format!(
-            "{} emissive meshes move whole (the brightest among them)",
-            moving.len()
-        ));
-        if let Some(i) = pulse0 {
-            let (keys, (a, b)) = blink(rng, radiance(i));
-            let mut t = track(
-                &mut generated.desc.shapes,
-                i,
-                "pulse0".into(),
-                Interpolation::Linear,
-                Vec3::ZERO,
-            );
-            t.emission = Some(keys);
-            tracks.push(t);
-            summary.0.push(format!(
-                "the second brightest mesh is dark from {a} to {b} s"
-            ));
-        }
-        if let Some(i) = pulse1 {
-            let mut t = track(
-                &mut generated.desc.shapes,
-                i,
-                "pulse1".into(),
-                Interpolation::CatmullRom,
-                Vec3::ZERO,
-            );
-            t.emission = Some(swell(rng, radiance(i)));
-            tracks.push(t);
-            summary
-                .0
-                .push("the third brightest mesh swells or fades".into());
-        }
-    } else {
-        let top =
-            |fraction: f32| &lights[..((lights.len() as f32 * fraction).ceil() as usize).max(1)];
-        let pulses = choose(rng, top(0.01).to_vec().as_slice(), 3);
-        let movers: Vec<usize> = top(0.05)
-            .iter()
-            .copied()
-            .filter(|i| !pulses.contains(i))
-            .collect();
-        let movers = choose(rng, &movers, 8);
-        for (n, &i) in movers.iter().enumerate() {
-            let (c, _) = box_of(i)?;
-            let mut end = horizontal(rng, 0.6, 1.5);
-            end.y = (c.y + uniform(rng, -0.15, 0.15)).clamp(LIGHT_HEIGHT.0, LIGHT_HEIGHT.1) - c.y;
-            let turn = if kind == Kind::Rects {
-                [0.0, sign(rng) * uniform(rng, 30.0, 90.0), 0.0]
-            } else {
-                [0.0; 3]
-            };
-            tracks.push(mover(
-                &mut generated.desc.shapes,
-                i,
-                format!("light{n}"),
-                alternate(n),
-                c,
-                rigid(rng, end, turn),
-            ));
-        }
-        summary
-            .0
-            .push(format!("{} lights of the brightest 5 % move", movers.len()));
-        for (n, &i) in pulses.iter().enumerate() {
-            let mut t = track(
-                &mut generated.desc.shapes,
-                i,
-                format!("pulse{n}"),
-                Interpolation::Linear,
-                Vec3::ZERO,
-            );
-            if n == 0 {
-                let (keys, (a, b)) = blink(rng, radiance(i));
-                t.emission = Some(keys);
-                summary.0.push(format!(
-                    "pulse0 (of the brightest 1 %) is dark from {a} to {b} s"
-                ));
-            } else {
-                t.emission = Some(swell(rng, radiance(i)));
-            }
-            tracks.push(t);
-        }
-        if pulses.len() > 1 {
-            summary
-                .0
-                .push(format!("{} more swell or fade", pulses.len() - 1));
-        }
-    }
-    Ok(AnimationDesc {
-        fps: FPS,
-        camera: Some(camera),
-        shapes: tracks,
-        location: Default::default(),
-    })
-}
-
-/// A glossy room's animation (and its two added lamps).
-fn room(
-    generated: &mut Generated,
-    rng: &mut Pcg32,
-    summary: &mut Summary,
-) -> Result<AnimationDesc, GenerateError> {
-    let (eye, target) = look_at(&generated.desc)?;
-    let angle = sign(rng) * round(uniform(rng, 4.0, 10.0), 1);
-    let dolly = uniform(rng, 0.9, 0.97);
-    let camera = camera_track(eye, target, angle, dolly, 0.0);
-    summary.0.push(format!(
-        "the camera orbits {angle}° about its target and moves {:.0} % closer",
-        100.0 * (1.0 - dolly)
-    ));
-    let missing = || GenerateError::Animation("not a generated room".into());
-    // Shape 0 is the floor, shape 1 the ceiling.
-    let shapes = &generated.desc.shapes;
-    let (_, floor_h) = shapes
-        .first()
-        .and_then(|s| bounds(s, generated))
-        .ok_or_else(missing)?;
-    let (ceiling, _) = shapes
-        .get(1)
-        .and_then(|s| bounds(s, generated))
-        .ok_or_else(missing)?;
-    let (hw, hd, h) = (floor_h.x, floor_h.z, ceiling.y);
-    let objects: Vec<usize> = (0..shapes.len())
-        .filter(|&i| {
-            shapes[i].emission.is_none()
-                && matches!(
-                    shapes[i].geometry,
-                    GeometryDesc::Sphere { .. } | GeometryDesc::Cube
-                )
-        })
-        .collect();
-    let light = (0..shapes.len())
-        .find(|&i| shapes[i].emission.is_some())
-        .ok_or_else(missing)?;
-    let mut tracks = Vec::new();
-
-    for (n, &i) in choose(rng, &objects, 2).iter().enumerate() {
-        let (c, _) = bounds(&generated.desc.shapes[i], generated).ok_or_else(missing)?;
-        // Towards the camera or sideways (within 60° of +z), away from the partition and walls.
-        let phi = uniform(rng, -60f32, 60.0).to_radians();
-        let end = Vec3::new(phi.sin(), 0.0, phi.cos()) * uniform(rng, 0.2, 0.4);
-        let turn = [0.0, sign(rng) * uniform(rng, 15.0, 45.0), 0.0];
-        tracks.push(mover(
-            &mut generated.desc.shapes,
-            i,
-            format!("object{n}"),
-            Interpolation::CatmullRom,
-            c,
-            rigid(rng, end, turn),
-        ));
-    }
-    summary.0.push("two floor objects move and turn".into());
-
-    // The hidden light slides along x (staying behind its partition or the camera) and dims.
-    let (c, _) = bounds(&generated.desc.shapes[light], generated).ok_or_else(missing)?;
-    // Towards the middle of the room, where there is always space (0.15–0.4 m).
-    let shift = -c.x.signum() * uniform(rng, 0.15, 0.4);
-    let main = generated.desc.shapes[light].emission.unwrap_or_default();
-    let mut t = track(
-        &mut generated.desc.shapes,
-        light,
-        "light0".into(),
-        Interpolation::Linear,
-        c,
-    );
-    t.motion = Some(Keys(vec![
-        MotionKey {
-            time: 0.0,
-            translate: [0.0; 3],
-            rotate: [0.0; 3],
-        },
-        MotionKey {
-            time: DURATION,
-            translate: [round(shift, 3), 0.0, 0.0],
-            rotate: [0.0; 3],
-        },
-    ]));
-    let dim = round(uniform(rng, 0.4, 0.7), 2);
-    t.emission = Some(Keys(vec![
-        EmissionKey {
-            time: 0.0,
-            radiance: main,
-        },
-        EmissionKey {
-            time: 1.0,
-            radiance: scaled(main, dim),
-        },
-        EmissionKey {
-            time: DURATION,
-            radiance: main,
-        },
-    ]));
-    tracks.push(t);
-    summary.0.push(format!(
-        "the hidden light slides {:.2} m and dims to {:.0} % at 1 s",
-        shift.abs(),
-        100.0 * dim
-    ));
-
-    // Two small lamps floating in the back half, moving mostly across the room.
-    // Inside the room and in the camera's view (which looks a little down at the back wall:
-    // within ±0.45 of the distance across and 0.2 of it above the eye), away from the walls.
-    let inside = |p: Vec3| {
-        let z = p.z.clamp(-hd + 0.6, -0.1);
-        let dist = eye.z - z;
-        Vec3::new(
-            p.x.clamp(
-                (-hw + 0.4).max(eye.x - 0.45 * dist),
-                (hw - 0.4).min(eye.x + 0.45 * dist),
-            ),
-            p.y.clamp(1.1, (h - 0.35).min(eye.y + 0.2 * dist)),
-            z,
-        )
-    };
-    for n in 0..2 {
-        let radius = round(uniform(rng, 0.05, 0.08), 3);
-        let power = uniform(rng, 2.0, 4.0);
-        // A sphere of radius r emits π · L · 4πr².
-        let level = power / (4.0 * core::f32::consts::PI * core::f32::consts::PI * radius * radius);
-        let tint = hue_colour(rng.next_f32(), uniform(rng, 0.1, 0.5));
-        let radiance = tint.map(|c| round(c * level, 3));
-        let start = inside(Vec3::new(
-            uniform(rng, -hw + 0.5, hw - 0.5),
-            uniform(rng, 1.1, h - 0.4),
-            uniform(rng, -hd + 0.7, -0.2),
-        ));
-        let length = uniform(rng, 0.6, 1.2);
-        let dir = Vec3::new(
-            -start.x.signum() * uniform(rng, 0.7, 1.0),
-            uniform(rng, -0.3, 0.3),
-            uniform(rng, -0.4, 0.4),
-        )
-        .normalize();
-        let end = inside(start + dir * length) - start;
-        let center = round3(start.to_array(), 3);
-        generated.desc.shapes.push(emitter(
-            GeometryDesc::Sphere { center, radius },
-            Vec::new(),
-            radiance,
-        ));
-        let i = generated.desc.shapes.len() - 1;
-        let mut t = track(
-            &mut generated.desc.shapes,
-            i,
-            format!("lamp{n}"),
-            if n == 0 {
-                Interpolation::Linear
-            } else {
-                Interpolation::CatmullRom
-            },
-            Vec3::from(center),
-        );
-        // The middle key stays inside too (the path bends a little).
-        let mut keys = rigid(rng, end, [0.0; 3]);
-        let mid = &mut keys.0[1].translate;
-        *mid = round3(
-            (inside(Vec3::from(center) + Vec3::from(*mid)) - Vec3::from(center)).to_array(),
-            3,
-        );
-        t.motion = Some(keys);
-        if n == 0 {
-            let (keys, (a, b)) = blink(rng, radiance);
-            // One track, one interpolation: the blink's keys are piecewise linear.
-            t.emission = Some(keys);
-            summary.0.push(format!(
-                "two small lamps are added and move; lamp0 is dark from {a} to {b} s"
-            ));
-        }
-        tracks.push(t);
-    }
-    Ok(AnimationDesc {
-        fps: FPS,
-        camera: Some(camera),
-        shapes: tracks,
-        location: Default::default(),
-    })
-}
+use many::many_lights;
+use room::room;
 
 /// Animates a generated scene of kind `kind` from `seed` (see the module documentation): shapes
 /// that move get ids, a room gets two lamps, and the animation is attached to the description
@@ -696,7 +319,7 @@ pub fn animate(generated: &mut Generated, kind: Kind, seed: u64) -> Result<(), G
         }
         Kind::Room => room(generated, &mut rng, &mut summary)?,
     };
-    crate::animation::attach(&mut generated.desc, anim, "", 0)
+    restir_scene::animation::attach(&mut generated.desc, anim, "", 0)
         .map_err(|e| GenerateError::Animation(e.message))?;
     generated.header.push_str(&format!(
         "\nAnimated (issue 19): {FPS} fps over {DURATION} s, render with --frames 0..23:\n{}.",
@@ -710,9 +333,9 @@ mod tests {
     use glam::Vec3;
     use restir_geometry::Shape;
 
-    use super::super::{Issue, Split, family};
     use super::{DURATION, FPS};
-    use crate::animation::{build_at, frame_time};
+    use crate::{Family, Split, members};
+    use restir_scene::animation::{build_at, frame_time};
 
     /// A point that moves with the shape: a sphere's centre, the mean of a mesh's vertices.
     fn centroid(s: &Shape) -> Vec3 {
@@ -725,15 +348,15 @@ mod tests {
     #[test]
     fn every_moving_member_generates_parses_builds_and_moves_the_shapes_it_names() {
         let dir = std::env::temp_dir().join(format!("restir-motion-{}", std::process::id()));
-        for issue in [Issue::DiMotion, Issue::PtMotion] {
+        for family in [Family::DiMotion, Family::PtMotion] {
             for split in [Split::Train, Split::Test] {
-                for member in family(issue, split) {
+                for member in members(family, split) {
                     let name = member.name();
                     let generated = member.generate().unwrap();
                     let text = generated.ron().unwrap();
                     assert_eq!(text, member.generate().unwrap().ron().unwrap(), "{name}");
                     let path = generated.write(&dir, &name).unwrap();
-                    let desc = crate::parse_ron(&text, &path).unwrap();
+                    let desc = restir_scene::parse_ron(&text, &path).unwrap();
                     let anim = desc.animation.as_ref().expect("animated");
                     let made = generated.desc.animation.as_ref().unwrap();
                     // Attached in code as the parser attaches it: the same shapes.
@@ -800,9 +423,9 @@ mod tests {
 
     #[test]
     fn the_moving_families_share_the_seeds_and_differ_by_seed() {
-        for issue in [Issue::DiMotion, Issue::PtMotion] {
-            let train = family(issue, Split::Train);
-            let test = family(issue, Split::Test);
+        for family in [Family::DiMotion, Family::PtMotion] {
+            let train = members(family, Split::Train);
+            let test = members(family, Split::Test);
             assert_eq!(train.len(), 6);
             assert_eq!(train.len(), test.len());
             assert_eq!(train[0].seed, 1);
@@ -810,7 +433,7 @@ mod tests {
             assert!(
                 train[0]
                     .name()
-                    .starts_with(&format!("{}-train-00-", issue.name()))
+                    .starts_with(&format!("{}-train-00-", family.name()))
             );
             let (a, b) = (train[0].generate().unwrap(), test[0].generate().unwrap());
             assert_ne!(a.desc.animation, b.desc.animation);

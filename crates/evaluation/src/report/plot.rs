@@ -5,7 +5,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use crate::BenchError;
+use crate::error::BenchError;
 
 /// One configuration's curve.
 pub(crate) struct Series {

@@ -3,7 +3,7 @@
 
 use restir_sampling::Pcg32;
 
-use crate::{
+use restir_scene::{
     GeometryDesc, MaterialDesc, MaterialRef, MicrofacetDesc, RoughnessDesc, SceneDesc, ShapeDesc,
     TransformOp, V3,
 };
@@ -116,7 +116,7 @@ pub(super) fn rough_conductor(
     alpha: f32,
 ) -> MaterialDesc {
     MaterialDesc::RoughConductor {
-        ior: crate::ConductorIorDesc {
+        ior: restir_scene::ConductorIorDesc {
             material: Some(metal.into()),
             eta: None,
             k: None,
@@ -129,8 +129,8 @@ pub(super) fn rough_conductor(
 /// A rough plastic (polypropylene coat) over a diffuse base.
 pub(super) fn rough_plastic(diffuse: V3, distribution: MicrofacetDesc, alpha: f32) -> MaterialDesc {
     MaterialDesc::RoughPlastic {
-        int_ior: crate::POLYPROPYLENE_IOR,
-        ext_ior: crate::AIR_IOR,
+        int_ior: restir_scene::POLYPROPYLENE_IOR,
+        ext_ior: restir_scene::AIR_IOR,
         diffuse_reflectance: diffuse,
         specular_reflectance: [1.0; 3],
         nonlinear: false,
@@ -144,12 +144,12 @@ pub(super) fn checkerboard(color0: V3, color1: V3, tiles: f32) -> MaterialDesc {
         material: Box::new(MaterialDesc::Diffuse {
             reflectance: color0,
         }),
-        textures: vec![crate::TextureBinding {
-            param: crate::ColorParam::Reflectance,
-            texture: crate::TextureDesc::Checkerboard {
+        textures: vec![restir_scene::TextureBinding {
+            param: restir_scene::ColorParam::Reflectance,
+            texture: restir_scene::TextureDesc::Checkerboard {
                 color0,
                 color1,
-                uv: crate::UvTransform {
+                uv: restir_scene::UvTransform {
                     scale: glam::Vec2::splat(tiles),
                     offset: glam::Vec2::ZERO,
                 },

@@ -7,7 +7,7 @@ use restir_sampling::Pcg32;
 use super::stage::{EXTENT, LIGHT_HEIGHT, radiance_scale, stage};
 use super::util::{emitter, hue_colour, log_uniform, rect_transform, round, round3, uniform};
 use super::{DiOptions, Generated};
-use crate::{GeometryDesc, TransformOp};
+use restir_scene::{GeometryDesc, TransformOp};
 
 /// The rectangles scene for `seed`.
 pub(super) fn rects(seed: u64, options: &DiOptions) -> Generated {

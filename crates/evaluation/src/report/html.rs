@@ -18,13 +18,14 @@ use std::io::Write as _;
 use restir_image::{Image, compare};
 use serde_json::{Value, json};
 
+use crate::analysis::{sequence_runs, summarize};
+use crate::measure::utc;
 use crate::metrics::{flip_map, mape, mean};
-use crate::report::{sequence_runs, summarize, utc};
-use crate::{BenchResults, RunRecord};
+use crate::records::{BenchResults, RunRecord};
 
-const TEMPLATE: &str = include_str!("../assets/report.html");
-const STYLE: &str = include_str!("../assets/report.css");
-const SCRIPT: &str = include_str!("../assets/report.js");
+const TEMPLATE: &str = include_str!("../../assets/report.html");
+const STYLE: &str = include_str!("../../assets/report.css");
+const SCRIPT: &str = include_str!("../../assets/report.js");
 
 /// One image of a page besides the reference.
 #[derive(Clone, Debug)]

@@ -13,7 +13,7 @@
 use restir_sampling::Pcg32;
 
 use super::util::{hue_colour, round, uniform};
-use crate::{
+use restir_scene::{
     CameraDesc, FilmDesc, FilterDesc, GeometryDesc, IntegratorDesc, MaterialDesc, MaterialRef,
     NamedMaterial, SceneDesc, ShapeDesc, TransformOp,
 };
@@ -220,7 +220,7 @@ mod tests {
         let a = many_lights_ron(50, 3).unwrap();
         assert_eq!(a, many_lights_ron(50, 3).unwrap());
         assert_ne!(a, many_lights_ron(50, 4).unwrap());
-        let desc = crate::parse_ron(&a, "gen.ron".as_ref()).unwrap();
+        let desc = restir_scene::parse_ron(&a, "gen.ron".as_ref()).unwrap();
         assert_eq!(desc, many_lights(50, 3));
         let lights = desc.shapes.iter().filter(|s| s.emission.is_some()).count();
         assert_eq!(lights, 50);
