@@ -211,7 +211,7 @@ mod tests {
         let mirror: Vec<usize> = (-7..8)
             .map(|i| WrapMode::Mirror.index(i as f32, n))
             .collect();
-        assert_eq!(mirror, [1, 2, 2, 1, 0, 0, 1, 2, 2, 1, 0, 0, 1, 2, 2]);
+        assert_eq!(mirror, [0, 0, 1, 2, 2, 1, 0, 0, 1, 2, 2, 1, 0, 0, 1]);
         let clamp: Vec<usize> = (-2..5)
             .map(|i| WrapMode::Clamp.index(i as f32, n))
             .collect();

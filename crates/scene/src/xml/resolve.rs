@@ -158,12 +158,11 @@ impl<'a> Importer<'a> {
         })?;
         let at = self.loc(node);
         let context = |mut e: SceneError| {
-            e.message = format!(
-                "{} (in the file included at {}:{})",
-                e.message,
-                at.file.display(),
-                at.line
-            );
+            let note = format!(" (in the file included at {}:{})", at.file.display(), at.line);
+            // A file that includes itself would repeat the same note at every level.
+            if !e.message.ends_with(&note) {
+                e.message.push_str(&note);
+            }
             e
         };
         let doc = parse_document(&text, &path).map_err(context)?;

@@ -114,7 +114,29 @@ impl<'a> Importer<'a> {
                 format!("sensor '{ty}': give either 'fov' or 'focal_length', not both"),
             ));
         }
+        // Checked even where it is unused (without `fov`, where a warning says so).
+        let axis = match props.string("fov_axis")?.as_deref() {
+            None | Some("x") => FovAxis::X,
+            Some("y") => FovAxis::Y,
+            Some("diagonal") => FovAxis::Diagonal,
+            Some("smaller") => FovAxis::Smaller,
+            Some("larger") => FovAxis::Larger,
+            Some(other) => {
+                return Err(self.err(
+                    props.node_or("fov_axis", node),
+                    format!(
+                        "sensor '{ty}': unknown fov_axis '{other}' (known: x, y, diagonal, smaller, larger)"
+                    ),
+                ));
+            }
+        };
         if !fov_given {
+            if props.node_or("fov_axis", node) != node {
+                self.warn(
+                    props.node_or("fov_axis", node),
+                    format!("sensor '{ty}': fov_axis has no effect without 'fov' (the focal length fixes the diagonal field of view)"),
+                );
+            }
             let written = props
                 .string("focal_length")?
                 .unwrap_or_else(|| defaults::FOCAL_LENGTH.to_string());
@@ -142,21 +164,6 @@ impl<'a> Importer<'a> {
                 format!("sensor '{ty}': fov {fov} must lie in (0, 180) degrees"),
             ));
         }
-        let axis = match props.string("fov_axis")?.as_deref() {
-            None | Some("x") => FovAxis::X,
-            Some("y") => FovAxis::Y,
-            Some("diagonal") => FovAxis::Diagonal,
-            Some("smaller") => FovAxis::Smaller,
-            Some("larger") => FovAxis::Larger,
-            Some(other) => {
-                return Err(self.err(
-                    props.node_or("fov_axis", node),
-                    format!(
-                        "sensor '{ty}': unknown fov_axis '{other}' (known: x, y, diagonal, smaller, larger)"
-                    ),
-                ));
-            }
-        };
         Ok((fov, axis))
     }
 
