@@ -95,7 +95,12 @@ fn judge(image: &Image, reference: &Image, variance: &Image, spp: u32) -> Judgem
     let alpha = 1.0 - (1.0 - SIGNIFICANCE).powf(1.0 / pixels as f64);
     let mut passed = 0usize;
     let mut min_p = 1.0f64;
-    for ((m, r), v) in image.pixels.iter().zip(&reference.pixels).zip(&variance.pixels) {
+    for ((m, r), v) in image
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .zip(&variance.pixels)
+    {
         let (m, r, v) = (to_xyz(*m), to_xyz(*r), to_xyz(*v));
         for k in 0..3 {
             let z = (m[k] - r[k]).abs() * (f64::from(spp) / v[k].max(MIN_VARIANCE)).sqrt();
@@ -313,6 +318,53 @@ fn mitsuba_render_suite() {
 }
 }
 
+/// Checks the checker with another renderer's images (a development cross-check, run by hand):
+/// `MITSUBA_SUITE_EXTERNAL=dir cargo test --release -p restir-integrators --test mitsuba_suite --
+/// --ignored external`, where `dir` holds renders at Mitsuba's budget named
+/// `<folder>__<scene>.exr` (`texture_interp__test_texture_interp_direct.exr`), such as Mitsuba 3's
+/// own. Each must pass, and fail when scaled by 1.03.
+#[test]
+#[ignore = "needs MITSUBA_SUITE_EXTERNAL, a folder of another renderer's images of the suite"]
+fn external_renders_pass_and_their_scaled_copies_fail() {
+    let dir =
+        PathBuf::from(std::env::var("MITSUBA_SUITE_EXTERNAL").expect("MITSUBA_SUITE_EXTERNAL"));
+    let root = restir_testkit::corpus_dir().join("../mitsuba-tests/tests/scenes");
+    let mut judged = 0;
+    for scene in suite_scenes(&root) {
+        let rel = scene
+            .strip_prefix(&root)
+            .unwrap()
+            .to_str()
+            .unwrap()
+            .to_string();
+        let file = dir.join(rel.replace('/', "__").replace(".xml", ".exr"));
+        if !file.is_file() {
+            continue;
+        }
+        let (r, v) = references(&scene);
+        let (reference, variance) = (Image::read_exr(&r).unwrap(), Image::read_exr(&v).unwrap());
+        let image = Image::read_exr(&file).unwrap();
+        let spp = (MITSUBA_BUDGET / (u64::from(image.width) * u64::from(image.height))) as u32;
+        let j = judge(&image, &reference, &variance, spp);
+        let mut brighter = image.clone();
+        for p in &mut brighter.pixels {
+            *p *= 1.03;
+        }
+        let b = judge(&brighter, &reference, &variance, spp);
+        println!(
+            "{rel}: {:.4} (min p {:.2e}); ×1.03: {:.4}",
+            j.fraction, j.min_p, b.fraction
+        );
+        assert!(j.passes() && !b.passes(), "{rel}");
+        judged += 1;
+    }
+    assert!(
+        judged > 0,
+        "no images named <folder>__<scene>.exr in {}",
+        dir.display()
+    );
+}
+
 /// The p-values of the criterion at known points of the normal distribution.
 #[test]
 fn two_sided_p_values() {
@@ -366,7 +418,11 @@ fn the_criterion_accepts_noise_and_rejects_bias() {
             .iter()
             .map(|p| {
                 let x = to_xyz(*p);
-                let x = [x[0] + sd * gauss(), x[1] + sd * gauss(), x[2] + sd * gauss()];
+                let x = [
+                    x[0] + sd * gauss(),
+                    x[1] + sd * gauss(),
+                    x[2] + sd * gauss(),
+                ];
                 let rgb = inv.map(|row| (row[0] * x[0] + row[1] * x[1] + row[2] * x[2]) as f32);
                 glam::Vec3::from(rgb)
             })

@@ -173,9 +173,10 @@ mod tests {
         assert!((across.to_degrees() - 34.0221).abs() < 1e-3);
         let c = camera(r#"<string name="focal_length" value="35mm"/>"#).unwrap();
         assert!((c.fov - super::fov_of_focal_length(35.0)).abs() < 1e-6);
-        let e = camera(r#"<float name="fov" value="30"/><string name="focal_length" value="35mm"/>"#)
-            .unwrap_err()
-            .to_string();
+        let e =
+            camera(r#"<float name="fov" value="30"/><string name="focal_length" value="35mm"/>"#)
+                .unwrap_err()
+                .to_string();
         assert!(e.contains("either 'fov' or 'focal_length'"), "{e}");
         let e = camera(r#"<string name="focal_length" value="wide"/>"#)
             .unwrap_err()

@@ -156,7 +156,6 @@ fn wrap_pair(i: f32, n: usize) -> (usize, usize) {
     (a, b)
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -106,7 +106,9 @@ impl<'a> Importer<'a> {
                 t => {
                     return Err(self.err(
                         c,
-                        format!("integrator 'moment': unexpected <{t}> (it holds one <integrator>)"),
+                        format!(
+                            "integrator 'moment': unexpected <{t}> (it holds one <integrator>)"
+                        ),
                     ));
                 }
             }

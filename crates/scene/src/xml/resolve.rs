@@ -158,7 +158,11 @@ impl<'a> Importer<'a> {
         })?;
         let at = self.loc(node);
         let context = |mut e: SceneError| {
-            let note = format!(" (in the file included at {}:{})", at.file.display(), at.line);
+            let note = format!(
+                " (in the file included at {}:{})",
+                at.file.display(),
+                at.line
+            );
             // A file that includes itself would repeat the same note at every level.
             if !e.message.ends_with(&note) {
                 e.message.push_str(&note);
@@ -191,9 +195,7 @@ impl<'a> Importer<'a> {
         self.files = nested.files;
         self.declared = nested.declared;
         self.saw_sensor = nested.saw_sensor;
-        self.warnings
-            .borrow_mut()
-            .extend(src.warnings.into_inner());
+        self.warnings.borrow_mut().extend(src.warnings.into_inner());
         result.map_err(context)
     }
 }
