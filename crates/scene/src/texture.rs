@@ -3,7 +3,8 @@
 //!
 //! Conventions are Mitsuba 3's: `uv = (0, 0)` is the top-left corner of the image (the first
 //! row), `v` grows downwards; texel centres are at `(i + ½)/size`; lookups are bilinear with
-//! repeat wrapping unless the bitmap says otherwise (`filter_type`, [`FilterType`]; `wrap_mode`, [`WrapMode`]). OBJ files count `v` from the bottom, so the OBJ reader flips it (as Mitsuba's
+//! repeat wrapping unless the bitmap says otherwise (`filter_type`, [`FilterType`]; `wrap_mode`,
+//! [`WrapMode`]). OBJ files count `v` from the bottom, so the OBJ reader flips it (as Mitsuba's
 //! does); PLY and `.serialized` texture coordinates are used as stored.
 
 use std::path::Path;
