@@ -3,7 +3,8 @@
 //!
 //! Conventions are Mitsuba 3's: `uv = (0, 0)` is the top-left corner of the image (the first
 //! row), `v` grows downwards; texel centres are at `(i + ½)/size`; lookups are bilinear with
-//! repeat wrapping. OBJ files count `v` from the bottom, so the OBJ reader flips it (as Mitsuba's
+//! repeat wrapping unless the bitmap says otherwise (`filter_type`, [`FilterType`]; `wrap_mode`,
+//! [`WrapMode`]). OBJ files count `v` from the bottom, so the OBJ reader flips it (as Mitsuba's
 //! does); PLY and `.serialized` texture coordinates are used as stored.
 
 use std::path::Path;
@@ -11,6 +12,9 @@ use std::path::Path;
 use glam::{Vec2, Vec3};
 use restir_image::{Image, IntegerEncoding};
 use serde::{Deserialize, Serialize};
+
+mod lookup;
+pub use lookup::{FilterType, WrapMode};
 
 /// The `uv` transform of a texture: `uv' = uv · scale + offset` (Mitsuba 0.6 `uscale`/`vscale`/
 /// `uoffset`/`voffset`, Mitsuba 3 `to_uv` with scale and translate).
@@ -56,6 +60,12 @@ pub enum TextureDesc {
         /// uv transform.
         #[serde(default)]
         uv: UvTransform,
+        /// What a lookup outside `[0, 1)` reads (Mitsuba's `wrap_mode`, default repeat).
+        #[serde(default)]
+        wrap: WrapMode,
+        /// Interpolation between texels (Mitsuba's `filter_type`, default bilinear).
+        #[serde(default)]
+        filter: FilterType,
     },
     /// Two colours alternating in a 2×2 pattern per unit square of (transformed) uv.
     Checkerboard {
@@ -81,7 +91,7 @@ fn checker1() -> [f32; 3] {
 /// A decoded texture.
 #[derive(Clone, Debug)]
 pub enum Texture {
-    /// Linear RGB texels, rows top to bottom, bilinearly filtered, repeating.
+    /// Linear RGB texels, rows top to bottom, filtered and wrapped as `filter` and `wrap` say.
     Bitmap {
         /// Width in texels.
         width: usize,
@@ -91,6 +101,10 @@ pub enum Texture {
         texels: Texels,
         /// uv transform.
         uv: UvTransform,
+        /// Wrap mode.
+        wrap: WrapMode,
+        /// Filter.
+        filter: FilterType,
     },
     /// See [`TextureDesc::Checkerboard`].
     Checkerboard {
@@ -166,7 +180,13 @@ impl Texture {
                 color1: Vec3::from(*color1),
                 uv: *uv,
             }),
-            TextureDesc::Bitmap { filename, raw, uv } => {
+            TextureDesc::Bitmap {
+                filename,
+                raw,
+                uv,
+                wrap,
+                filter,
+            } => {
                 let path = base_dir.join(filename);
                 let (width, height, texels) =
                     read_image(&path, *raw).map_err(TextureError::Image)?;
@@ -175,6 +195,8 @@ impl Texture {
                     height,
                     texels: Texels::new(texels, *raw),
                     uv: *uv,
+                    wrap: *wrap,
+                    filter: *filter,
                 })
             }
         }
@@ -202,21 +224,9 @@ impl Texture {
                 height,
                 texels,
                 uv: t,
-            } => {
-                let p = t.apply(uv);
-                // Texel centres at (i + ½)/size; repeat wrapping.
-                let x = p.x * *width as f32 - 0.5;
-                let y = p.y * *height as f32 - 0.5;
-                let (x0, y0) = (x.floor(), y.floor());
-                let (fx, fy) = (x - x0, y - y0);
-                let (xa, xb) = wrap_pair(x0, *width);
-                let (ya, yb) = wrap_pair(y0, *height);
-                let (ra, rb) = (ya * width, yb * width);
-                let at = |i: usize| texels.get(i);
-                let top = at(ra + xa) * (1.0 - fx) + at(ra + xb) * fx;
-                let bottom = at(rb + xa) * (1.0 - fx) + at(rb + xb) * fx;
-                top * (1.0 - fy) + bottom * fy
-            }
+                wrap,
+                filter,
+            } => lookup::lookup(texels, (*width, *height), t.apply(uv), *wrap, *filter),
         }
     }
 
@@ -322,30 +332,6 @@ impl Texels {
     }
 }
 
-/// The texel indices of whole-number coordinates `i` and `i + 1` (as floats) on an axis of `n`
-/// texels, repeating (non-finite coordinates read texel 0). The integer remainder, a division,
-/// only when `i` lies outside the image.
-#[inline]
-fn wrap_pair(i: f32, n: usize) -> (usize, usize) {
-    let wrap = |i: f32| -> usize {
-        let n = n as i64;
-        let i = if i.is_finite() { i as i64 } else { 0 };
-        if (0..n).contains(&i) {
-            i as usize
-        } else {
-            i.rem_euclid(n) as usize
-        }
-    };
-    let a = wrap(i);
-    // `i + 1` is the next texel unless it rounds back to `i` (|i| ≥ 2²⁴) or is not finite.
-    let b = if i.is_finite() && i + 1.0 != i {
-        if a + 1 == n { 0 } else { a + 1 }
-    } else {
-        wrap(i + 1.0)
-    };
-    (a, b)
-}
-
 /// Reads an image file as linear RGB texels, the first row at the top
 /// ([`restir_image::Image::read`]: PNG/JPEG sRGB-decoded unless `raw`, EXR and Radiance HDR linear).
 /// Also used for environment maps.
@@ -366,49 +352,6 @@ pub(crate) fn read_image(
 mod tests {
     use super::*;
     use restir_image::srgb::decode as srgb_to_linear;
-
-    /// `wrap_pair` gives the texels the lookup read before it (each coordinate wrapped by its
-    /// own remainder), at the edges, outside the image, at huge and non-finite coordinates.
-    #[test]
-    fn wrap_pair_is_the_remainder_of_each_coordinate() {
-        let wrap = |i: f32, n: usize| -> usize {
-            let i = if i.is_finite() { i as i64 } else { 0 };
-            i.rem_euclid(n as i64) as usize
-        };
-        let values = [
-            0.0,
-            -0.0,
-            1.0,
-            2.0,
-            3.0,
-            4.0,
-            -1.0,
-            -2.0,
-            -5.0,
-            17.0,
-            -17.0,
-            16_777_215.0,
-            16_777_216.0,
-            -16_777_216.0,
-            3.0e9,
-            -3.0e9,
-            1.0e20,
-            f32::MAX,
-            f32::MIN,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::NAN,
-        ];
-        for n in [1, 2, 3, 4, 7] {
-            for &i in &values {
-                assert_eq!(
-                    wrap_pair(i, n),
-                    (wrap(i, n), wrap(i + 1.0, n)),
-                    "{i} of {n}"
-                );
-            }
-        }
-    }
 
     /// 8-bit texels are kept as codes with exactly the values the reader decoded; other values
     /// stay floats.
@@ -516,6 +459,8 @@ mod tests {
                 filename: "q.png".into(),
                 raw: true,
                 uv: UvTransform { scale, offset },
+                wrap: WrapMode::Repeat,
+                filter: FilterType::Bilinear,
             };
             Texture::load(&desc, &dir).unwrap()
         };
@@ -544,6 +489,46 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
     }
 
+    /// `wrap_mode` mirror and clamp, and `filter_type` nearest, on the same 2×2 image.
+    #[test]
+    fn bitmap_mirror_clamp_and_nearest() {
+        let dir = temp_dir("modes");
+        let img =
+            image::RgbImage::from_raw(2, 2, vec![255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255])
+                .unwrap();
+        img.save(dir.join("q.png")).unwrap();
+        let load = |wrap: WrapMode, filter: FilterType| {
+            let desc = TextureDesc::Bitmap {
+                filename: "q.png".into(),
+                raw: true,
+                uv: UvTransform::default(),
+                wrap,
+                filter,
+            };
+            Texture::load(&desc, &dir).unwrap()
+        };
+        let (red, green, blue) = (Vec3::X, Vec3::Y, Vec3::Z);
+        // Mirror: just right of the image is its right column again, then the left one.
+        let m = load(WrapMode::Mirror, FilterType::Bilinear);
+        assert_eq!(m.eval(Vec2::new(1.25, 0.25)), green);
+        assert_eq!(m.eval(Vec2::new(1.75, 0.25)), red);
+        assert_eq!(m.eval(Vec2::new(-0.25, 0.75)), blue);
+        // Bilinear across the mirrored edge: both texels are the edge texel.
+        assert_eq!(m.eval(Vec2::new(1.0, 0.25)), green);
+        // Clamp: the edge texels extend outwards.
+        let c = load(WrapMode::Clamp, FilterType::Bilinear);
+        assert_eq!(c.eval(Vec2::new(7.0, -3.0)), green);
+        assert_eq!(c.eval(Vec2::new(-7.0, 9.0)), blue);
+        // Nearest: no blending, whichever texel the point is in.
+        let n = load(WrapMode::Repeat, FilterType::Nearest);
+        assert_eq!(n.eval(Vec2::new(0.49, 0.49)), red);
+        assert_eq!(n.eval(Vec2::new(0.51, 0.49)), green);
+        assert_eq!(n.eval(Vec2::new(1.51, -0.49)), Vec3::ONE);
+        let r = load(WrapMode::Repeat, FilterType::Bilinear);
+        assert_ne!(r.eval(Vec2::new(1.0, 0.25)), green);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
     /// 8-bit values go through the exact sRGB curve (both branches), unless `raw`.
     #[test]
     fn srgb_decoding_of_8_bit_values() {
@@ -555,6 +540,8 @@ mod tests {
             filename: "g.png".into(),
             raw: false,
             uv: UvTransform::default(),
+            wrap: WrapMode::default(),
+            filter: FilterType::default(),
         };
         let t = Texture::load(&desc, &dir).unwrap();
         let n = codes.len() as f32;
@@ -616,6 +603,8 @@ mod tests {
             filename: "t.png".into(),
             raw: false,
             uv: UvTransform::default(),
+            wrap: WrapMode::default(),
+            filter: FilterType::default(),
         };
         let t = Texture::load(&desc, &dir).unwrap();
         let lin = srgb_to_linear(188.0 / 255.0);
@@ -630,6 +619,8 @@ mod tests {
             filename: "t.png".into(),
             raw: true,
             uv: UvTransform::default(),
+            wrap: WrapMode::default(),
+            filter: FilterType::default(),
         };
         let t = Texture::load(&raw, &dir).unwrap();
         assert!((t.eval(Vec2::new(0.75, 0.5)).x - 188.0 / 255.0).abs() < 1e-5);
@@ -638,6 +629,8 @@ mod tests {
             filename: "nope.png".into(),
             raw: false,
             uv: UvTransform::default(),
+            wrap: WrapMode::default(),
+            filter: FilterType::default(),
         };
         assert!(
             Texture::load(&missing, &dir)
@@ -650,6 +643,8 @@ mod tests {
             filename: "bad.png".into(),
             raw: false,
             uv: UvTransform::default(),
+            wrap: WrapMode::default(),
+            filter: FilterType::default(),
         };
         assert!(Texture::load(&bad, &dir).is_err());
         let _ = std::fs::remove_dir_all(&dir);

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use restir_scene::texture::{Texture, TextureDesc, UvTransform};
+use restir_scene::texture::{FilterType, Texture, TextureDesc, UvTransform, WrapMode};
 use restir_scene::{LoadOptions, LoadedScene, load_scene};
 
 fn load(dir: &Path, rel: &str) -> LoadedScene {
@@ -170,6 +170,8 @@ fn corpus_exr_and_jpeg_decode() {
         filename: "envmap.exr".into(),
         raw: false,
         uv: UvTransform::default(),
+        wrap: WrapMode::default(),
+        filter: FilterType::default(),
     };
     let t = Texture::load(&desc, &dir.join("lajolla/matpreview")).unwrap();
     let m = t.mean();
@@ -179,6 +181,8 @@ fn corpus_exr_and_jpeg_decode() {
         filename: "textures/KAMEN.JPG".into(),
         raw: false,
         uv: UvTransform::default(),
+        wrap: WrapMode::default(),
+        filter: FilterType::default(),
     };
     let t = Texture::load(&jpeg, &dir.join("lajolla/sponza")).unwrap();
     let m = t.mean();

@@ -230,10 +230,10 @@ const EVERYTHING: &str = r#"(
         (name: "tex", material: Textured(material: RoughPlastic(), textures: [
             (param: DiffuseReflectance, texture: Checkerboard(color0: (0.9, 0.9, 0.9), color1: (0.1, 0.1, 0.1),
                                                               uv: (scale: (8, 4), offset: (0.25, 0.5)))),
-            (param: SpecularReflectance, texture: Bitmap(filename: "textured/tex.png", raw: true)),
+            (param: SpecularReflectance, texture: Bitmap(filename: "textured/tex.png", raw: true, wrap: Mirror, filter: Nearest)),
         ])),
         (name: "two-tex", material: TwoSided(Textured(material: Diffuse(reflectance: (0.5, 0.5, 0.5)),
-            textures: [(param: Reflectance, texture: Bitmap(filename: "textured/tex.png", uv: (scale: (2, 2), offset: (0, 0))))]))),
+            textures: [(param: Reflectance, texture: Bitmap(filename: "textured/tex.png", uv: (scale: (2, 2), offset: (0, 0)), wrap: Clamp))]))),
         (name: "sphere", material: Diffuse(reflectance: (0.5, 0.5, 0.5))),
     ],
     shapes: [
@@ -278,6 +278,9 @@ fn every_model_filter_camera_and_light_round_trips() {
         r#"<rfilter type="gaussian">"#,
         r#"<bsdf type="roughconductor" id="rc">"#,
         r#"<float name="alpha_u" value="0.05"/>"#,
+        r#"<string name="wrap_mode" value="mirror"/>"#,
+        r#"<string name="filter_type" value="nearest"/>"#,
+        r#"<string name="wrap_mode" value="clamp"/>"#,
         r#"<bsdf type="null" id="n">"#,
         r#"<texture type="checkerboard" name="diffuse_reflectance">"#,
         r#"<boolean name="raw" value="true"/>"#,

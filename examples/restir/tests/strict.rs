@@ -55,7 +55,7 @@ fn integrator_type_typo_is_an_error_listing_the_types() {
     fails_with(
         &["render", s(&sc), "-o", s(&out)],
         &format!(
-            "error: {}:2: unknown integrator type 'restir-dl' (known: path, volpath, direct, \
+            "error: {}:2: unknown integrator type 'restir-dl' (known: path, moment, volpath, direct, \
              restir-di, restir_di, restir, restirdi, restir-pt, restir_pt, restirpt)",
             s(&sc)
         ),

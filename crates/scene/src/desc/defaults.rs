@@ -7,8 +7,20 @@ use super::V3;
 /// Samples per pixel when the scene does not say (a sampler's `sample_count`).
 pub const SPP: u32 = 16;
 
-/// Field of view in degrees (`perspective`, `thinlens`).
+/// Field of view in degrees of a RON camera and of the scenes this crate generates. (A Mitsuba
+/// perspective sensor without `fov` has [`FOCAL_LENGTH`] instead.)
 pub const FOV: f32 = 45.0;
+/// The focal length of a Mitsuba 3 `perspective` or `thinlens` sensor that gives neither `fov`
+/// nor `focal_length`.
+pub const FOCAL_LENGTH: &str = "50mm";
+
+/// The diagonal field of view in degrees of a lens of focal length `mm` millimetres on a
+/// 36 × 24 mm film (Mitsuba 3's `focal_length`): `2·atan(√(36² + 24²) / (2·mm))`. For 50 mm
+/// it is 46.79°, which on a square image is 34.02° across.
+pub fn fov_of_focal_length(mm: f32) -> f32 {
+    let diagonal = (36.0f64 * 36.0 + 24.0 * 24.0).sqrt();
+    (2.0 * (diagonal / (2.0 * f64::from(mm))).atan()).to_degrees() as f32
+}
 /// Lens radius of a thin lens (0 is a pinhole).
 pub const APERTURE_RADIUS: f32 = 0.0;
 /// Distance of the plane in focus (`thinlens`).
@@ -144,5 +156,31 @@ mod tests {
         assert_eq!(ron.film, imported.film);
         assert_eq!(ron.spp, imported.spp);
         assert_eq!(ron.integrator, imported.integrator);
+    }
+
+    /// A perspective sensor without `fov` has Mitsuba's 50 mm lens: 46.79° diagonally, 34.02°
+    /// across a square image; `focal_length` sets another lens; both at once is an error.
+    #[test]
+    fn the_default_lens_is_50mm() {
+        let camera = |body: &str| {
+            let xml = format!(r#"<scene><sensor type="perspective">{body}</sensor></scene>"#);
+            crate::xml::parse_xml(&xml, "t.xml".as_ref(), &[]).map(|(d, _)| d.camera)
+        };
+        let c = camera("").unwrap();
+        assert_eq!(c.fov_axis, super::super::FovAxis::Diagonal);
+        assert!((c.fov - 46.7930).abs() < 1e-3, "{}", c.fov);
+        let across = 2.0 * ((c.fov.to_radians() / 2.0).tan() / 2f32.sqrt()).atan();
+        assert!((across.to_degrees() - 34.0221).abs() < 1e-3);
+        let c = camera(r#"<string name="focal_length" value="35mm"/>"#).unwrap();
+        assert!((c.fov - super::fov_of_focal_length(35.0)).abs() < 1e-6);
+        let e =
+            camera(r#"<float name="fov" value="30"/><string name="focal_length" value="35mm"/>"#)
+                .unwrap_err()
+                .to_string();
+        assert!(e.contains("either 'fov' or 'focal_length'"), "{e}");
+        let e = camera(r#"<string name="focal_length" value="wide"/>"#)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("focal_length \"wide\""), "{e}");
     }
 }

@@ -62,6 +62,7 @@ impl<'a> Importer<'a> {
                         "envmap emitter needs a 'filename' (EXR, HDR, PNG or JPEG)",
                     )
                 })?;
+                let filename = self.file_name(props.node_or("filename", node), filename)?;
                 let scale = props.float("scale")?.unwrap_or(defaults::ENVMAP_SCALE);
                 if !(scale.is_finite() && scale >= 0.0) {
                     return Err(self.err(

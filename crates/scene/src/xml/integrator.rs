@@ -3,14 +3,16 @@
 
 use roxmltree::Node;
 
-use super::props::Value;
-use super::{Importer, Result};
+use super::props::{PROPERTY_TAGS, Value};
+use super::{Importer, Result, elements};
 use crate::desc::*;
 
 /// The `<integrator>` types the importer reads: Mitsuba's `path`, `volpath` (read as `path`) and
-/// `direct` (`path` with max_depth 2), and this renderer's estimators under their spellings.
+/// `direct` (`path` with max_depth 2), `moment` around one of them, and this renderer's estimators
+/// under their spellings.
 const INTEGRATOR_TYPES: &[&str] = &[
     "path",
+    "moment",
     "volpath",
     "direct",
     "restir-di",
@@ -25,6 +27,9 @@ const INTEGRATOR_TYPES: &[&str] = &[
 impl<'a> Importer<'a> {
     pub(super) fn integrator<'i>(&self, node: Node<'a, 'i>, desc: &mut SceneDesc) -> Result<()> {
         let ty = self.plugin_type(node)?;
+        if ty == "moment" {
+            return self.moment(node, desc);
+        }
         let props = self.props(node, format!("integrator '{ty}'"))?;
         let mut integ = IntegratorDesc::default();
         let mut keep_params = false;
@@ -84,6 +89,46 @@ impl<'a> Importer<'a> {
         props.finish();
         integ.location = self.loc(node);
         desc.integrator = integ;
+        Ok(())
+    }
+
+    /// Mitsuba 3's `moment` integrator: the nested integrator renders the image
+    /// (<https://mitsuba.readthedocs.io/en/latest/src/generated/plugins_integrators.html#moment-integrator-moment>).
+    /// Mitsuba also writes each pixel's second moment as extra channels; that output is not made
+    /// here, and a warning says so. Exactly one nested integrator is read.
+    fn moment<'i>(&self, node: Node<'a, 'i>, desc: &mut SceneDesc) -> Result<()> {
+        let props = self.props(node, "integrator 'moment'".into())?;
+        let mut nested = Vec::new();
+        for c in elements(node) {
+            match c.tag_name().name() {
+                "integrator" => nested.push(c),
+                t if PROPERTY_TAGS.contains(&t) => {}
+                t => {
+                    return Err(self.err(
+                        c,
+                        format!(
+                            "integrator 'moment': unexpected <{t}> (it holds one <integrator>)"
+                        ),
+                    ));
+                }
+            }
+        }
+        let inner = match nested.as_slice() {
+            [one] => *one,
+            [] => return Err(self.err(node, "integrator 'moment' needs a nested <integrator>")),
+            [_, second, ..] => {
+                return Err(self.err(
+                    *second,
+                    "integrator 'moment': only one nested <integrator> is supported",
+                ));
+            }
+        };
+        props.finish();
+        self.integrator(inner, desc)?;
+        self.warn(
+            node,
+            "integrator 'moment': the image is its nested integrator's; the second-moment channels Mitsuba adds are not written",
+        );
         Ok(())
     }
 }

@@ -2,7 +2,14 @@
 //!
 //! Accepts both camelCase (Mitsuba 0.6, Lajolla: `toWorld`, `maxDepth`) and snake_case (Mitsuba 3)
 //! names. `<default name= value=>` declares variables that `$name` in any attribute refers to;
-//! `-D name=value` on the command line overrides them. Relative paths are relative to the XML file.
+//! `-D name=value` on the command line overrides them.
+//!
+//! Files, as Mitsuba 3 finds them (`resolve.rs`): `<path value="dir"/>` adds a search folder
+//! (relative to the file that declares it); a relative file name (mesh, texture, environment map,
+//! included file) is looked for in the search folders, newest first, then beside the file that
+//! names it, then beside the scene file. `<include filename="part.xml"/>` reads another scene
+//! file's elements in its place (its `<default>`s apply where the including files set none;
+//! errors name the included file and line, and where it was included).
 //!
 //! Unknown *properties* are warnings with `file:line` (legacy files carry many that do not matter,
 //! such as `nearClip`); unknown *plugin types* and malformed values are errors with `file:line`.
@@ -19,6 +26,7 @@ mod bsdfs;
 mod emitters;
 mod integrator;
 mod props;
+mod resolve;
 mod sensor;
 mod shapes;
 mod source;
@@ -28,7 +36,7 @@ mod write;
 
 pub use write::{XmlWriteError, XmlWriteOptions, to_mitsuba_xml};
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
 use roxmltree::{Document, Node};
@@ -66,6 +74,14 @@ struct Importer<'a> {
     bsdf_anon: usize,
     /// Top-level textures by id, with the line that declares them.
     textures: HashMap<String, (TextureDesc, u32)>,
+    /// The `<path>` search folders, newest first, and the scene file's folder.
+    files: resolve::SearchPath,
+    /// Every `<default>` name declared in the scene file or a file it includes.
+    declared: HashSet<String>,
+    /// Whether a sensor was read.
+    saw_sensor: bool,
+    /// How deep in `<include>`s this file is (0: the scene file).
+    depth: u32,
 }
 
 /// The importer reads attributes and reports errors through its source.
@@ -107,7 +123,56 @@ pub fn parse_xml(
     file: &Path,
     defines: &[(String, String)],
 ) -> Result<(SceneDesc, Vec<SceneWarning>)> {
-    let doc = Document::parse(text).map_err(|e| {
+    let doc = parse_document(text, file)?;
+    let root = doc.root_element();
+    let mut src = Source::new(file, text);
+    expect_scene_root(&src, root)?;
+    // Defaults first (the command line wins), so that `$name` works anywhere.
+    let declared = read_defaults(&src, root)?;
+    for (name, value) in &declared {
+        src.defaults.insert(name.clone(), value.clone());
+    }
+    for (k, v) in defines {
+        src.defaults.insert(k.clone(), v.clone());
+    }
+    let mut imp = Importer {
+        src: &src,
+        bsdf_ids: HashMap::new(),
+        bsdf_anon: 0,
+        textures: HashMap::new(),
+        files: resolve::SearchPath::new(file),
+        declared: declared.into_iter().map(|(k, _)| k).collect(),
+        saw_sensor: false,
+        depth: 0,
+    };
+
+    let mut desc = SceneDesc {
+        spp: defaults::SPP,
+        ..SceneDesc::default()
+    };
+    imp.walk(root, &mut desc)?;
+    if !imp.saw_sensor {
+        return Err(imp.err(root, "the scene has no <sensor>"));
+    }
+    let mut warnings: Vec<SceneWarning> = defines
+        .iter()
+        .filter(|(k, _)| !imp.declared.contains(k))
+        .map(|(k, _)| SceneWarning {
+            location: Location {
+                file: file.to_path_buf(),
+                line: 0,
+            },
+            message: format!("-D {k}: the scene declares no <default name=\"{k}\">"),
+        })
+        .collect();
+    drop(imp);
+    warnings.extend(src.warnings.into_inner());
+    Ok((desc, warnings))
+}
+
+/// Parses `text`, read from `file`, as an XML document.
+fn parse_document<'t>(text: &'t str, file: &Path) -> Result<Document<'t>> {
+    Document::parse(text).map_err(|e| {
         SceneError::new(
             Location {
                 file: file.to_path_buf(),
@@ -116,9 +181,11 @@ pub fn parse_xml(
             // One line whatever the parser quotes: a newline it did not expect is shown as `\n`.
             format!("malformed XML: {}", escape_controls(&e.to_string())),
         )
-    })?;
-    let root = doc.root_element();
-    let mut src = Source::new(file, text);
+    })
+}
+
+/// An error unless `root` is a `<scene>`.
+fn expect_scene_root(src: &Source, root: Node) -> Result<()> {
     if root.tag_name().name() != "scene" {
         return Err(src.err(
             root,
@@ -128,7 +195,12 @@ pub fn parse_xml(
             ),
         ));
     }
-    // Defaults first (the command line wins), so that `$name` works anywhere.
+    Ok(())
+}
+
+/// The `<default name= value=>` children of `root`, in file order.
+fn read_defaults(src: &Source, root: Node) -> Result<Vec<(String, String)>> {
+    let mut out = Vec::new();
     for c in elements(root).filter(|c| c.tag_name().name() == "default") {
         let name = c
             .attribute("name")
@@ -136,106 +208,88 @@ pub fn parse_xml(
         let value = c
             .attribute("value")
             .ok_or_else(|| src.err(c, "<default> needs a 'value'"))?;
-        src.defaults.insert(name.to_string(), value.to_string());
+        out.push((name.to_string(), value.to_string()));
     }
-    for (k, v) in defines {
-        if !src.defaults.contains_key(k) {
-            src.warnings.borrow_mut().push(SceneWarning {
-                location: Location {
-                    file: file.to_path_buf(),
-                    line: 0,
-                },
-                message: format!("-D {k}: the scene declares no <default name=\"{k}\">"),
-            });
-        }
-        src.defaults.insert(k.clone(), v.clone());
-    }
-    let mut imp = Importer {
-        src: &src,
-        bsdf_ids: HashMap::new(),
-        bsdf_anon: 0,
-        textures: HashMap::new(),
-    };
+    Ok(out)
+}
 
-    let mut desc = SceneDesc {
-        spp: defaults::SPP,
-        ..SceneDesc::default()
-    };
-    let mut saw_sensor = false;
-    for c in elements(root) {
-        match c.tag_name().name() {
-            "default" => {}
-            "integrator" => imp.integrator(c, &mut desc)?,
-            "sensor" => {
-                if saw_sensor {
-                    imp.warn(c, "only the first sensor is used");
-                    continue;
+impl<'a> Importer<'a> {
+    /// Reads the elements of the `<scene>` `root` into `desc`.
+    fn walk<'i>(&mut self, root: Node<'a, 'i>, desc: &mut SceneDesc) -> Result<()> {
+        for c in elements(root) {
+            match c.tag_name().name() {
+                "default" => {}
+                "path" => self.path(c)?,
+                "include" => self.include(c, desc)?,
+                "integrator" => self.integrator(c, desc)?,
+                "sensor" => {
+                    if self.saw_sensor {
+                        self.warn(c, "only the first sensor is used");
+                        continue;
+                    }
+                    self.saw_sensor = true;
+                    self.sensor(c, desc)?;
                 }
-                saw_sensor = true;
-                imp.sensor(c, &mut desc)?;
-            }
-            "bsdf" => {
-                let material = imp.bsdf(c)?;
-                let name = match imp.attr(c, "id")? {
-                    Some(id) => {
-                        if let Some(line) = imp.bsdf_ids.get(&id) {
-                            return Err(imp.err(
-                                c,
-                                format!("bsdf id '{id}' is already declared at line {line}"),
-                            ));
+                "bsdf" => {
+                    let material = self.bsdf(c)?;
+                    let name = match self.attr(c, "id")? {
+                        Some(id) => {
+                            if let Some(line) = self.bsdf_ids.get(&id) {
+                                return Err(self.err(
+                                    c,
+                                    format!("bsdf id '{id}' is already declared at line {line}"),
+                                ));
+                            }
+                            id
                         }
-                        id
+                        None => {
+                            self.bsdf_anon += 1;
+                            format!("__anonymous_{}", self.bsdf_anon)
+                        }
+                    };
+                    let line = self.loc(c).line;
+                    self.bsdf_ids.insert(name.clone(), line);
+                    desc.materials.push(NamedMaterial { name, material });
+                }
+                "texture" => {
+                    let id = self.req_attr(c, "id")?;
+                    let t = self.texture(c)?;
+                    let line = self.loc(c).line;
+                    self.textures.insert(id, (t, line));
+                }
+                "shape" => {
+                    let s = self.shape(c)?;
+                    desc.shapes.push(s);
+                }
+                "emitter" => {
+                    let l = self.emitter(c)?;
+                    // Mitsuba allows one environment emitter per scene.
+                    let is_env = |l: &LightDesc| {
+                        matches!(l, LightDesc::Constant { .. } | LightDesc::Envmap { .. })
+                    };
+                    if is_env(&l) && desc.lights.iter().any(is_env) {
+                        return Err(self.err(
+                            c,
+                            "a second environment emitter (constant or envmap); only one is allowed per scene",
+                        ));
                     }
-                    None => {
-                        imp.bsdf_anon += 1;
-                        format!("__anonymous_{}", imp.bsdf_anon)
-                    }
-                };
-                imp.bsdf_ids.insert(name.clone(), imp.loc(c).line);
-                desc.materials.push(NamedMaterial { name, material });
-            }
-            "texture" => {
-                let id = imp.req_attr(c, "id")?;
-                let t = imp.texture(c)?;
-                let line = imp.loc(c).line;
-                imp.textures.insert(id, (t, line));
-            }
-            "shape" => {
-                let s = imp.shape(c)?;
-                desc.shapes.push(s);
-            }
-            "emitter" => {
-                let l = imp.emitter(c)?;
-                // Mitsuba allows one environment emitter per scene.
-                let is_env = |l: &LightDesc| {
-                    matches!(l, LightDesc::Constant { .. } | LightDesc::Envmap { .. })
-                };
-                if is_env(&l) && desc.lights.iter().any(is_env) {
-                    return Err(imp.err(
+                    desc.lights.push(l);
+                }
+                t if PROPERTY_TAGS.contains(&t) => {
+                    self.warn(c, format!("ignored <{t}> directly inside <scene>"))
+                }
+                t => {
+                    return Err(self.err(
                         c,
-                        "a second environment emitter (constant or envmap); only one is allowed per scene",
+                        format!(
+                            "unsupported element <{t}> (known: integrator, sensor, bsdf, texture, shape, emitter, default, path, include, and properties)"
+                        ),
                     ));
                 }
-                desc.lights.push(l);
-            }
-            t if PROPERTY_TAGS.contains(&t) => {
-                imp.warn(c, format!("ignored <{t}> directly inside <scene>"))
-            }
-            t => {
-                return Err(imp.err(
-                    c,
-                    format!(
-                        "unsupported element <{t}> (known: integrator, sensor, bsdf, texture, shape, emitter, default, and properties)"
-                    ),
-                ));
             }
         }
+        Ok(())
     }
-    if !saw_sensor {
-        return Err(imp.err(root, "the scene has no <sensor>"));
-    }
-    drop(imp);
-    Ok((desc, src.warnings.into_inner()))
 }
 
 #[cfg(test)]

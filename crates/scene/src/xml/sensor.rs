@@ -3,7 +3,7 @@
 
 use roxmltree::Node;
 
-use super::props::PROPERTY_TAGS;
+use super::props::{PROPERTY_TAGS, Props};
 use super::{Importer, Result, elements};
 use crate::desc::*;
 
@@ -14,34 +14,13 @@ impl<'a> Importer<'a> {
             return Err(self.unknown_type(node, "sensor", &ty, &["perspective", "thinlens"]));
         }
         let props = self.props(node, format!("sensor '{ty}'"))?;
-        let fov = props.float("fov")?.unwrap_or(defaults::FOV);
-        if !(fov > 0.0 && fov < 180.0) {
-            let at = props.node_or("fov", node);
-            return Err(self.err(
-                at,
-                format!("sensor '{ty}': fov {fov} must lie in (0, 180) degrees"),
-            ));
-        }
+        let (fov, fov_axis) = self.field_of_view(node, &props, &ty)?;
         let mut cam = CameraDesc {
             fov,
+            fov_axis,
             to_world: props.transform("to_world")?,
             ..CameraDesc::default()
         };
-        if let Some(axis) = props.string("fov_axis")? {
-            cam.fov_axis = match axis.as_str() {
-                "x" => FovAxis::X,
-                "y" => FovAxis::Y,
-                "diagonal" => FovAxis::Diagonal,
-                "smaller" => FovAxis::Smaller,
-                "larger" => FovAxis::Larger,
-                other => {
-                    return Err(self.err(
-                        node,
-                        format!("unknown fov_axis '{other}' (x, y, diagonal, smaller, larger)"),
-                    ));
-                }
-            };
-        }
         if ty == "thinlens" {
             cam.aperture_radius = props
                 .float("aperture_radius")?
@@ -119,6 +98,73 @@ impl<'a> Importer<'a> {
         props.finish();
         desc.camera = cam;
         Ok(())
+    }
+
+    /// The field of view and the axis it spans, as Mitsuba 3's perspective sensors read them
+    /// (<https://mitsuba.readthedocs.io/en/latest/src/generated/plugins_sensors.html#perspective-pinhole-camera-perspective>):
+    /// `fov` along `fov_axis` (default `x`), or else `focal_length` (default `50mm`) on a
+    /// 36 × 24 mm film, which fixes the diagonal field of view (`fov_axis` is then not read).
+    /// Giving both is an error.
+    fn field_of_view(&self, node: Node, props: &Props, ty: &str) -> Result<(f32, FovAxis)> {
+        let fov_given = props.node_or("fov", node) != node;
+        let focal_given = props.node_or("focal_length", node) != node;
+        if fov_given && focal_given {
+            return Err(self.err(
+                props.node_or("focal_length", node),
+                format!("sensor '{ty}': give either 'fov' or 'focal_length', not both"),
+            ));
+        }
+        // Checked even where it is unused (without `fov`, where a warning says so).
+        let axis = match props.string("fov_axis")?.as_deref() {
+            None | Some("x") => FovAxis::X,
+            Some("y") => FovAxis::Y,
+            Some("diagonal") => FovAxis::Diagonal,
+            Some("smaller") => FovAxis::Smaller,
+            Some("larger") => FovAxis::Larger,
+            Some(other) => {
+                return Err(self.err(
+                    props.node_or("fov_axis", node),
+                    format!(
+                        "sensor '{ty}': unknown fov_axis '{other}' (known: x, y, diagonal, smaller, larger)"
+                    ),
+                ));
+            }
+        };
+        if !fov_given {
+            if props.node_or("fov_axis", node) != node {
+                self.warn(
+                    props.node_or("fov_axis", node),
+                    format!("sensor '{ty}': fov_axis has no effect without 'fov' (the focal length fixes the diagonal field of view)"),
+                );
+            }
+            let written = props
+                .string("focal_length")?
+                .unwrap_or_else(|| defaults::FOCAL_LENGTH.to_string());
+            let number = written.strip_suffix("mm").unwrap_or(&written);
+            let mm = number
+                .trim()
+                .parse::<f32>()
+                .ok()
+                .filter(|f| f.is_finite() && *f > 0.0)
+                .ok_or_else(|| {
+                    self.err(
+                        props.node_or("focal_length", node),
+                        format!(
+                            "sensor '{ty}': focal_length \"{written}\" must be a positive length in millimetres, such as \"50mm\""
+                        ),
+                    )
+                })?;
+            return Ok((defaults::fov_of_focal_length(mm), FovAxis::Diagonal));
+        }
+        let fov = props.float("fov")?.unwrap_or(defaults::FOV);
+        if !(fov > 0.0 && fov < 180.0) {
+            let at = props.node_or("fov", node);
+            return Err(self.err(
+                at,
+                format!("sensor '{ty}': fov {fov} must lie in (0, 180) degrees"),
+            ));
+        }
+        Ok((fov, axis))
     }
 
     fn film<'i>(&self, node: Node<'a, 'i>, film: &mut FilmDesc) -> Result<()> {

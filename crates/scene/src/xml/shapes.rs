@@ -27,18 +27,21 @@ impl<'a> Importer<'a> {
                 let f = props
                     .string("filename")?
                     .ok_or_else(|| self.err(node, "obj shape needs a 'filename'"))?;
+                let f = self.file_name(props.node_or("filename", node), f)?;
                 GeometryDesc::Obj { filename: f }
             }
             "ply" => {
                 let f = props
                     .string("filename")?
                     .ok_or_else(|| self.err(node, "ply shape needs a 'filename'"))?;
+                let f = self.file_name(props.node_or("filename", node), f)?;
                 GeometryDesc::Ply { filename: f }
             }
             "serialized" => {
                 let f = props
                     .string("filename")?
                     .ok_or_else(|| self.err(node, "serialized shape needs a 'filename'"))?;
+                let f = self.file_name(props.node_or("filename", node), f)?;
                 let i = props.int("shape_index")?.unwrap_or(0);
                 let shape_index = u32::try_from(i).map_err(|_| {
                     self.err(

@@ -1,13 +1,11 @@
 //! `<texture>`: `bitmap` and `checkerboard`, with their uv transform.
 
-use std::path::Path;
-
 use roxmltree::Node;
 
 use super::props::{ColorUse, PROPERTY_TAGS};
 use super::{Importer, Result, elements};
 use crate::desc::defaults;
-use crate::texture::{TextureDesc, UvTransform};
+use crate::texture::{FilterType, TextureDesc, UvTransform, WrapMode};
 
 impl<'a> Importer<'a> {
     /// A `<texture>`: `bitmap` or `checkerboard`, with Mitsuba 0.6 `uscale`/`vscale`/
@@ -38,7 +36,8 @@ impl<'a> Importer<'a> {
                 let filename = props
                     .string("filename")?
                     .ok_or_else(|| self.err(node, "bitmap texture needs a 'filename'"))?;
-                let path = self.file.parent().unwrap_or(Path::new("")).join(&filename);
+                let filename = self.file_name(props.node_or("filename", node), filename)?;
+                let path = self.scene_path(&filename);
                 if path.exists() && !path.is_file() {
                     return Err(self.err(
                         node,
@@ -52,23 +51,37 @@ impl<'a> Importer<'a> {
                     ));
                 }
                 let raw = props.bool("raw")?.unwrap_or(false);
-                if let Some(f) = props.string("filter_type")?
-                    && f != "bilinear"
-                {
-                    self.warn(
-                        node,
-                        format!("texture 'bitmap': filter_type '{f}' is replaced by bilinear"),
-                    );
+                let filter = match props.string("filter_type")? {
+                    None => FilterType::default(),
+                    Some(f) => FilterType::from_name(&f).ok_or_else(|| {
+                        self.err(
+                            props.node_or("filter_type", node),
+                            format!(
+                                "texture 'bitmap': unknown filter_type '{f}' (known: {})",
+                                FilterType::NAMES.join(", ")
+                            ),
+                        )
+                    })?,
+                };
+                let wrap = match props.string("wrap_mode")? {
+                    None => WrapMode::default(),
+                    Some(w) => WrapMode::from_name(&w).ok_or_else(|| {
+                        self.err(
+                            props.node_or("wrap_mode", node),
+                            format!(
+                                "texture 'bitmap': unknown wrap_mode '{w}' (known: {})",
+                                WrapMode::NAMES.join(", ")
+                            ),
+                        )
+                    })?,
+                };
+                TextureDesc::Bitmap {
+                    filename,
+                    raw,
+                    uv,
+                    wrap,
+                    filter,
                 }
-                if let Some(w) = props.string("wrap_mode")?
-                    && w != "repeat"
-                {
-                    self.warn(
-                        node,
-                        format!("texture 'bitmap': wrap_mode '{w}' is replaced by repeat"),
-                    );
-                }
-                TextureDesc::Bitmap { filename, raw, uv }
             }
             "checkerboard" => TextureDesc::Checkerboard {
                 color0: props

@@ -26,7 +26,7 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 
 use crate::desc::*;
-use crate::texture::{TextureDesc, UvTransform};
+use crate::texture::{FilterType, TextureDesc, UvTransform, WrapMode};
 
 /// Options of [`to_mitsuba_xml`].
 #[derive(Clone, Debug, Default)]
@@ -563,12 +563,24 @@ impl Writer<'_> {
             &[uv.scale.x, uv.scale.y, uv.offset.x, uv.offset.y],
         )?;
         match t {
-            TextureDesc::Bitmap { filename, raw, .. } => {
+            TextureDesc::Bitmap {
+                filename,
+                raw,
+                wrap,
+                filter,
+                ..
+            } => {
                 self.open(&format!(r#"<texture type="bitmap" name="{name}">"#));
                 let f = self.file(filename);
                 self.string("filename", &f);
                 if *raw {
                     self.boolean("raw", true);
+                }
+                if *wrap != WrapMode::default() {
+                    self.string("wrap_mode", wrap.name());
+                }
+                if *filter != FilterType::default() {
+                    self.string("filter_type", filter.name());
                 }
             }
             TextureDesc::Checkerboard { color0, color1, .. } => {
