@@ -131,6 +131,7 @@ pub fn to_mitsuba_xml(desc: &SceneDesc, options: &XmlWriteOptions) -> Result<Str
         }
         w.blank();
         let item = format!("material '{}'", m.name);
+        literal(&item, "name", &m.name)?;
         w.bsdf(&m.material, Some(&material_id(&m.name)), None, &item)?;
     }
     for (i, s) in desc.shapes.iter().enumerate() {
@@ -184,6 +185,23 @@ fn esc(s: &str) -> String {
     o
 }
 
+/// Refuses a value that Mitsuba 3's XML reader (and this crate's) would not read back as written:
+/// both substitute `$name` in every attribute from the `<default>` variables (this writer declares
+/// `spp`, `resx`, `resy` and `max_depth`), and neither has an escape for a literal `$`, so a file
+/// name `a$spp.ply` would load `a16.ply`.
+fn literal(item: &str, what: &str, s: &str) -> Result<()> {
+    if s.contains('$') {
+        refuse(
+            item,
+            format!(
+                "{what} \"{s}\" holds a '$', which Mitsuba 3 XML reads as a variable and cannot escape (rename it)"
+            ),
+        )
+    } else {
+        Ok(())
+    }
+}
+
 fn finite(item: &str, what: &str, v: &[f32]) -> Result<()> {
     if v.iter().all(|x| x.is_finite()) {
         Ok(())
@@ -231,14 +249,17 @@ impl Writer<'_> {
         self.line(&format!(r#"<boolean name="{name}" value="{v}"/>"#));
     }
 
-    /// A file name as the XML must give it (see [`XmlWriteOptions::file_prefix`]).
-    fn file(&self, name: &str) -> String {
-        match &self.options.file_prefix {
+    /// A file name as the XML must give it (see [`XmlWriteOptions::file_prefix`]), refused when
+    /// it holds a `$` (see [`literal`]).
+    fn file(&self, name: &str, item: &str) -> Result<String> {
+        let f = match &self.options.file_prefix {
             Some(p) if Path::new(name).is_relative() && !p.as_os_str().is_empty() => {
                 p.join(name).to_string_lossy().into_owned()
             }
             _ => name.to_string(),
-        }
+        };
+        literal(item, "file name", &f)?;
+        Ok(f)
     }
 
     /// `<transform name=...>` with the steps in order (nothing when there are none).
@@ -571,7 +592,7 @@ impl Writer<'_> {
                 ..
             } => {
                 self.open(&format!(r#"<texture type="bitmap" name="{name}">"#));
-                let f = self.file(filename);
+                let f = self.file(filename, item)?;
                 self.string("filename", &f);
                 if *raw {
                     self.boolean("raw", true);
@@ -620,6 +641,9 @@ impl Writer<'_> {
             Some(id) => format!("shape {index} ('{id}')"),
             None => format!("shape {index}"),
         };
+        if let Some(id) = &s.id {
+            literal(&item, "id", id)?;
+        }
         let id_attr =
             s.id.as_ref()
                 .map_or(String::new(), |i| format!(r#" id="{}""#, esc(i)));
@@ -647,7 +671,7 @@ impl Writer<'_> {
                     "ply"
                 };
                 self.open(&format!(r#"<shape type="{ty}"{id_attr}>"#));
-                let f = self.file(filename);
+                let f = self.file(filename, &item)?;
                 self.string("filename", &f);
                 mesh_file = true;
             }
@@ -656,7 +680,7 @@ impl Writer<'_> {
                 shape_index,
             } => {
                 self.open(&format!(r#"<shape type="serialized"{id_attr}>"#));
-                let f = self.file(filename);
+                let f = self.file(filename, &item)?;
                 self.string("filename", &f);
                 self.line(&format!(
                     r#"<integer name="shape_index" value="{shape_index}"/>"#
@@ -745,7 +769,7 @@ impl Writer<'_> {
             } => {
                 finite("the environment map", "scale", &[*scale])?;
                 self.open(r#"<emitter type="envmap">"#);
-                let f = self.file(filename);
+                let f = self.file(filename, "the environment map")?;
                 self.string("filename", &f);
                 if *scale != defaults::ENVMAP_SCALE {
                     self.float("scale", *scale);
