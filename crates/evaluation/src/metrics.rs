@@ -29,20 +29,22 @@ pub struct Metrics {
     pub mean_ratio: f64,
     /// Pixels of the test image with a NaN or infinite channel (left out of relMSE, MSE, MAPE).
     pub nonfinite: usize,
+    /// Pixels of the reference with a NaN or infinite channel (left out likewise).
+    pub reference_nonfinite: usize,
 }
 
 /// Offset of MAPE's denominator.
 pub const MAPE_EPSILON: f64 = 0.01;
 
-/// MAPE of `test` against `reference` over the pixels of `test` whose channels are all finite;
-/// `None` if the sizes differ.
+/// MAPE of `test` against `reference` over the pixels whose channels are all finite in both
+/// images (NaN when there are none); `None` if the sizes differ.
 pub fn mape(test: &Image, reference: &Image) -> Option<f64> {
     if (test.width, test.height) != (reference.width, reference.height) {
         return None;
     }
     let (mut sum, mut n) = (0.0f64, 0usize);
     for (x, r) in test.pixels.iter().zip(&reference.pixels) {
-        if !x.is_finite() {
+        if !(x.is_finite() && r.is_finite()) {
             continue;
         }
         for c in 0..3 {
@@ -51,7 +53,7 @@ pub fn mape(test: &Image, reference: &Image) -> Option<f64> {
         }
         n += 3;
     }
-    Some(sum / n.max(1) as f64)
+    Some(sum / n as f64)
 }
 
 /// The image as 8-bit sRGB RGB triples, row by row: clamped to [0, 1], NaN and infinities as 0
@@ -90,7 +92,13 @@ pub fn mean(map: &[f32]) -> f64 {
 /// All metrics of `test` against `reference`; `None` if their sizes differ.
 pub fn evaluate(test: &Image, reference: &Image) -> Option<Metrics> {
     let m = compare(test, reference)?;
-    let flip = flip_map(test, reference).map_or(f64::NAN, |map| mean(&map));
+    // No pixel finite in both images: nothing was compared, so no FLIP either (the tone mapping
+    // would turn NaN into black and score black against black as a match).
+    let flip = if m.mse.is_nan() {
+        f64::NAN
+    } else {
+        flip_map(test, reference).map_or(f64::NAN, |map| mean(&map))
+    };
     Some(Metrics {
         relmse: m.relmse,
         mse: m.mse,
@@ -98,6 +106,7 @@ pub fn evaluate(test: &Image, reference: &Image) -> Option<Metrics> {
         flip,
         mean_ratio: m.mean_ratio,
         nonfinite: m.nonfinite,
+        reference_nonfinite: m.reference_nonfinite,
     })
 }
 
@@ -145,6 +154,17 @@ mod tests {
         a.pixels[1] = Vec3::new(f32::NAN, 0.0, 0.0);
         assert!((mape(&a, &b).unwrap() - 0.5 / 0.51).abs() < 1e-12);
         assert!(mape(&Image::new(1, 1), &b).is_none());
+        // NaN in the reference is left out the same way; nothing left is NaN, not 0.
+        assert!((mape(&b, &a).unwrap() - 0.5 / 1.01).abs() < 1e-12);
+        let nan = Image {
+            pixels: vec![Vec3::NAN; 2],
+            ..Image::new(2, 1)
+        };
+        assert!(mape(&nan, &b).unwrap().is_nan());
+        let m = evaluate(&nan, &Image::new(2, 1)).unwrap();
+        assert!(m.relmse.is_nan() && m.mape.is_nan() && m.flip.is_nan(), "{m:?}");
+        assert_eq!((m.nonfinite, m.reference_nonfinite), (2, 0));
+        assert_eq!(evaluate(&b, &nan).unwrap().reference_nonfinite, 2);
     }
 
     #[test]

@@ -672,6 +672,23 @@ fn run_compare(test: &Path, reference: &Path, html: Option<&Path>) -> Result<(),
             r.height
         )
     })?;
+    if m.mse.is_nan() {
+        return Err(format!(
+            "{} against {}: no pixel is finite in both ({} NaN or infinite in the image, {} in the reference)",
+            test.display(),
+            reference.display(),
+            m.nonfinite,
+            m.reference_nonfinite
+        ));
+    }
+    for (n, which) in [(m.nonfinite, test), (m.reference_nonfinite, reference)] {
+        if n > 0 {
+            say_err!(
+                "warning: {}: {n} pixels are NaN or infinite (left out of every metric)",
+                which.display()
+            );
+        }
+    }
     if let Some(out) = html {
         let name = |p: &Path| {
             p.file_name()
@@ -682,11 +699,12 @@ fn run_compare(test: &Path, reference: &Path, html: Option<&Path>) -> Result<(),
         restir_image::write_file_atomically(out, page.as_bytes()).map_err(|e| e.to_string())?;
     }
     say!(
-        "relmse={:.6e} mse={:.6e} mean_ratio={:.6} nonfinite={} mape={:.6e} flip={:.6}",
+        "relmse={:.6e} mse={:.6e} mean_ratio={:.6} nonfinite={} reference_nonfinite={} mape={:.6e} flip={:.6}",
         m.relmse,
         m.mse,
         m.mean_ratio,
         m.nonfinite,
+        m.reference_nonfinite,
         m.mape,
         m.flip
     );

@@ -345,6 +345,38 @@ fn compare_bad_inputs() {
     fails(&["compare", s(&missing), s(&not_exr)], &[s(&missing)]);
 }
 
+/// NaN is never a perfect match: an all-NaN image is an error, NaN in the reference is counted
+/// and warned about.
+#[test]
+fn compare_counts_nan_on_both_sides() {
+    let dir = temp_dir("compare-nan");
+    let image = |name: &str, v: [f32; 2]| {
+        let mut img = restir_image::Image::new(2, 1);
+        img.pixels = v.iter().map(|&x| glam::Vec3::splat(x)).collect();
+        let p = dir.join(name);
+        img.write(&p).unwrap();
+        p
+    };
+    let nan = image("nan.exr", [f32::NAN; 2]);
+    let black = image("black.exr", [0.0; 2]);
+    let half = image("half.exr", [f32::NAN, 0.0]);
+    fails(
+        &["compare", s(&nan), s(&black)],
+        &["no pixel is finite in both", "2 NaN or infinite in the image"],
+    );
+    fails(
+        &["compare", s(&black), s(&nan)],
+        &["no pixel is finite in both", "2 in the reference"],
+    );
+    let o = restir(&["compare", s(&black), s(&half)]);
+    assert!(o.status.success());
+    let stdout = String::from_utf8(o.stdout).unwrap();
+    assert!(stdout.contains(" nonfinite=0 reference_nonfinite=1 "), "{stdout}");
+    assert!(stdout.contains("relmse=0.0"), "{stdout}");
+    let stderr = String::from_utf8(o.stderr).unwrap();
+    assert!(stderr.contains("half.exr: 1 pixels are NaN"), "{stderr}");
+}
+
 #[test]
 fn tiny_render_writes_images_stats_and_compares() {
     let dir = temp_dir("happy");
@@ -393,7 +425,8 @@ fn tiny_render_writes_images_stats_and_compares() {
     assert!(json["rays"].as_u64().unwrap() >= 16 * 16 * 2);
     assert!(json["seconds"].as_f64().unwrap() >= 0.0);
 
-    // compare: one line `relmse=… mse=… mean_ratio=… nonfinite=… mape=… flip=…`.
+    // compare: one line `relmse=… mse=… mean_ratio=… nonfinite=… reference_nonfinite=… mape=…
+    // flip=…`.
     let o = restir(&["compare", s(&exr), s(&exr2)]);
     assert!(o.status.success());
     let stdout = String::from_utf8(o.stdout).unwrap();
@@ -405,15 +438,24 @@ fn tiny_render_writes_images_stats_and_compares() {
     let names: Vec<&str> = fields.iter().map(|f| f.0).collect();
     assert_eq!(
         names,
-        ["relmse", "mse", "mean_ratio", "nonfinite", "mape", "flip"]
+        [
+            "relmse",
+            "mse",
+            "mean_ratio",
+            "nonfinite",
+            "reference_nonfinite",
+            "mape",
+            "flip"
+        ]
     );
     let relmse: f64 = fields[0].1.parse().unwrap();
     let ratio: f64 = fields[2].1.parse().unwrap();
     assert!(relmse > 0.0 && relmse.is_finite(), "{stdout}");
     assert!(ratio > 0.5 && ratio < 2.0, "{stdout}");
     assert_eq!(fields[3].1, "0");
-    let mape: f64 = fields[4].1.parse().unwrap();
-    let flip: f64 = fields[5].1.parse().unwrap();
+    assert_eq!(fields[4].1, "0");
+    let mape: f64 = fields[5].1.parse().unwrap();
+    let flip: f64 = fields[6].1.parse().unwrap();
     assert!(mape > 0.0 && mape.is_finite(), "{stdout}");
     assert!(flip > 0.0 && flip < 1.0, "{stdout}");
     // An image against itself, with the comparison page.
@@ -422,7 +464,7 @@ fn tiny_render_writes_images_stats_and_compares() {
     let stdout = String::from_utf8(o.stdout).unwrap();
     assert_eq!(
         stdout,
-        "relmse=0.000000e0 mse=0.000000e0 mean_ratio=1.000000 nonfinite=0 mape=0.000000e0 \
+        "relmse=0.000000e0 mse=0.000000e0 mean_ratio=1.000000 nonfinite=0 reference_nonfinite=0 mape=0.000000e0 \
          flip=0.000000\n"
     );
     let html = std::fs::read_to_string(&page).unwrap();
