@@ -31,6 +31,14 @@ pub use point::{Contact, LightPoint, Resolved};
 pub use presample::Presampled;
 pub use set::{LightError, LightSet};
 
+/// The largest emission any light may have, in each channel of its radiance, intensity or
+/// irradiance and in its power: 10²⁶. The estimators multiply emission by BSDF values,
+/// geometry terms, inverse densities, Jacobians and reservoir weights, and add up candidates,
+/// all in `f32` (largest 3.4·10³⁸); this leaves twelve orders of magnitude for those factors, so
+/// a pixel is never infinite because a light is. Brighter is refused when the scene is built,
+/// never clamped or silently dropped.
+pub const MAX_EMISSION: f32 = 1e26;
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -23,6 +23,8 @@ pub enum LightError {
     BadParameter(usize, &'static str),
     /// A second environment light (constant or envmap); a scene has at most one, as in Mitsuba.
     SecondEnvironment(usize),
+    /// A light whose emission or power exceeds [`crate::MAX_EMISSION`] (what, and the value).
+    TooBright(usize, &'static str, f32),
     /// An `Envmap` light without an [`EnvMap`], or an [`EnvMap`] without an `Envmap` light.
     EnvmapMismatch,
 }
@@ -34,6 +36,11 @@ impl core::fmt::Display for LightError {
             LightError::BadParameter(i, what) => {
                 write!(f, "light {i}: {what} must be finite and non-negative")
             }
+            LightError::TooBright(i, what, v) => write!(
+                f,
+                "light {i}: {what} {v:e} exceeds the largest emission this renderer computes with, {:e} (products with geometry terms and sample weights would overflow)",
+                crate::MAX_EMISSION
+            ),
             LightError::SecondEnvironment(i) => write!(
                 f,
                 "light {i}: only one environment emitter (constant or envmap) is allowed per scene"
@@ -170,7 +177,20 @@ impl LightSet {
                     PI * scene_radius * scene_radius * map.luminance_integral()
                 }
             };
-            powers.push(if power.is_finite() { power } else { 0.0 });
+            let emission = match *l {
+                Light::Area { radiance: v, .. }
+                | Light::Point { intensity: v, .. }
+                | Light::Directional { irradiance: v, .. }
+                | Light::Constant { radiance: v } => v.max_element(),
+                Light::Envmap => 0.0,
+            };
+            if emission > crate::MAX_EMISSION {
+                return Err(LightError::TooBright(i, "emission", emission));
+            }
+            if !(power <= crate::MAX_EMISSION) {
+                return Err(LightError::TooBright(i, "power", power));
+            }
+            powers.push(power);
         }
         let lights: Vec<Light> = lights
             .into_iter()

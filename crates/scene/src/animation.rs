@@ -287,7 +287,8 @@ impl ShapeTrack {
     pub fn emission_at(&self, t: f32) -> Option<[f32; 3]> {
         let keys = self.emission.as_ref()?;
         let v = sampled(keys.keys(), |k| k.radiance, self.interpolation, t);
-        Some(v.map(|x| x.max(0.0)))
+        // NaN stays NaN (the builder refuses it with the shape's line; `max` would make it 0).
+        Some(v.map(|x| if x < 0.0 { 0.0 } else { x }))
     }
 }
 

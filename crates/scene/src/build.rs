@@ -358,6 +358,19 @@ impl Scene {
                         ),
                     ));
                 }
+                // Refused here, where the shape's line is known, rather than by the light set.
+                let power = std::f32::consts::PI * shape.area() * restir_sampling::luminance(radiance);
+                if radiance.max_element() > restir_lights::MAX_EMISSION
+                    || !(power <= restir_lights::MAX_EMISSION)
+                {
+                    return Err(at(
+                        &sd.location,
+                        format!(
+                            "shape {i}: emitted radiance {e:?} (power {power:e}) exceeds the largest emission this renderer computes with, {:e} (products with geometry terms and sample weights would overflow)",
+                            restir_lights::MAX_EMISSION
+                        ),
+                    ));
+                }
                 if radiance.max_element() > 0.0 && shape.area() > 0.0 {
                     lights.push(Light::Area {
                         shape: shapes.len() as u32,

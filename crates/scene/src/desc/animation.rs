@@ -210,6 +210,18 @@ fn key_radiance<'de, D: Deserializer<'de>>(d: D) -> Result<V3, D::Error> {
             "emission key: radiance {v:?} must be non-negative"
         )));
     }
+    // A Catmull-Rom spline through evenly spaced keys overshoots them by at most a quarter, so
+    // keys up to 8·10²⁵ stay within the lights' limit (and far from f32's maximum, where the
+    // spline's slopes overflowed and the light went dark). A frame whose interpolated emission
+    // still exceeds the limit (keys spaced very unevenly) is refused when that frame is built.
+    const MAX_KEY: f32 = 8e25;
+    debug_assert!(MAX_KEY * 1.25 <= restir_lights::MAX_EMISSION * 1.000_001);
+    if v.iter().any(|&r| r > MAX_KEY) {
+        return Err(D::Error::custom(format!(
+            "emission key: radiance {v:?} exceeds {MAX_KEY:e}, the largest a key may have (lights are limited to {:e}, and a spline overshoots its keys by up to a quarter)",
+            restir_lights::MAX_EMISSION
+        )));
+    }
     Ok(v)
 }
 
