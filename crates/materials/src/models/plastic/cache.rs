@@ -6,9 +6,13 @@
 //! behind its user's back); the `restir` binary turns it on at [`default_cache_dir`]. One small
 //! file per (distribution, α, η), named by their bits and by [`TABLE_VERSION`], written to a
 //! temporary name and renamed into place (concurrent writers cannot leave a torn file), and read
-//! back only if its magic, length, checksum and values check out; anything else is rebuilt.
+//! back only if it is a regular file of a table's length (nothing longer is read) and its magic,
+//! checksum and values check out; anything else is rebuilt. A checksum only tells damage from a
+//! good file, so the values are also checked against the physics the tables integrate
+//! (`tables::plausible`: two rows integrated again, and energy conservation), and a file
+//! crafted with a valid checksum cannot make a material brighter than its parameters allow.
 
-use std::io::Write;
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -77,7 +81,7 @@ fn encode(t: &RoughPlasticTable) -> Vec<u8> {
 }
 
 fn decode(bytes: &[u8]) -> Option<RoughPlasticTable> {
-    let body = 8 + 4 * (TABLE_RES + 1);
+    let body = table_bytes() - 8;
     if bytes.len() != body + 8 || &bytes[..8] != MAGIC {
         return None;
     }
@@ -106,11 +110,25 @@ fn decode(bytes: &[u8]) -> Option<RoughPlasticTable> {
 pub(super) fn load(distribution: Distribution, alpha: f32, eta: f32) -> Option<RoughPlasticTable> {
     let dir = cache_dir()?;
     let path = dir.join(file_name(distribution, alpha, eta));
-    // Only regular files, and only as many bytes as a table has.
-    if !std::fs::metadata(&path).ok()?.is_file() {
+    // Only regular files, and only as many bytes as a table has: whatever else lies at the name
+    // (a huge file, a file growing while read) is not read past one byte more than a table.
+    let size = table_bytes();
+    let meta = std::fs::metadata(&path).ok()?;
+    if !meta.is_file() || meta.len() != size as u64 {
         return None;
     }
-    decode(&std::fs::read(&path).ok()?)
+    let mut bytes = Vec::with_capacity(size + 1);
+    std::fs::File::open(&path)
+        .ok()?
+        .take(size as u64 + 1)
+        .read_to_end(&mut bytes)
+        .ok()?;
+    decode(&bytes)
+}
+
+/// The length of a table's file: magic, the values, the checksum.
+fn table_bytes() -> usize {
+    8 + 4 * (TABLE_RES + 1) + 8
 }
 
 /// Stores `table` if the cache is on; failures (read-only disk, no space) only cost the next
@@ -182,7 +200,46 @@ mod tests {
         assert_eq!(load(d, a, e), Some(table()));
         std::fs::write(dir.join(file_name(d, a, e)), b"torn").unwrap();
         assert!(load(d, a, e).is_none());
+        // A file longer than a table is not read at all (a sparse 1 GiB file here).
+        let big = std::fs::File::create(dir.join(file_name(d, a, e))).unwrap();
+        big.set_len(1 << 30).unwrap();
+        drop(big);
+        assert!(load(d, a, e).is_none());
         set_cache_dir(previous);
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A table with a valid checksum but values no integration gives is refused by the
+    /// registry's check and rebuilt: an internal reflectance just below 1 (which would scale
+    /// the diffuse base by about 3·10⁶) and transmittances that are not the integral.
+    #[test]
+    fn crafted_tables_with_valid_checksums_are_refused() {
+        use super::super::tables::plausible;
+        let (d, a, e) = (Distribution::Ggx, 0.3f32, 1.5f32);
+        let honest = RoughPlasticTable::compute(d, a, e);
+        assert!(plausible(d, a, e, &honest));
+        let bright = RoughPlasticTable {
+            internal_reflectance: 1.0 - 3e-7,
+            ..honest
+        };
+        assert!(decode(&encode(&bright)).is_some(), "the checksum alone passes it");
+        assert!(!plausible(d, a, e, &bright));
+        let mut shifted = RoughPlasticTable::compute(d, a, e);
+        for t in &mut shifted.transmittance {
+            *t *= 0.99;
+        }
+        // Any row a check picks differs.
+        for _ in 0..8 {
+            assert!(!plausible(d, a, e, &shifted));
+        }
+        // Every table over a grid of roughness and IOR (both distributions) passes.
+        for d in [Distribution::Ggx, Distribution::Beckmann] {
+            for a in [0.002f32, 0.05, 0.3, 0.6, 1.0] {
+                for e in [0.6f32, 0.9, 1.01, 1.2, 1.5, 2.0, 3.0] {
+                    let t = RoughPlasticTable::compute(d, a, e);
+                    assert!(plausible(d, a, e, &t), "{d:?} α {a} η {e}: {t:?}");
+                }
+            }
+        }
     }
 }

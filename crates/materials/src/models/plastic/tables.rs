@@ -304,6 +304,49 @@ fn has_avx2() -> bool {
     }
 }
 
+/// `μ_k` and the view of table row `k`.
+fn view(k: usize) -> (f32, Vec3) {
+    let mu = (k as f32 / (TABLE_RES - 1) as f32).max(1e-6);
+    (mu, Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu))
+}
+
+/// Whether `t`, read from outside the process (the disk cache), can be the table of
+/// (distribution, α, η): every value in [0, 1]; two transmittance rows picked at random (so no
+/// file can be made to pass by keeping known rows) integrated again and equal within 10⁻⁵ (they
+/// are the same sum: 2 of 64 rows of the cheaper integral, about 1 % of a build); and `R_int`
+/// within energy conservation, `R_int ≤ 1 − T̄/η²`. That bound is reciprocity: the light
+/// escaping from inside is `T̄/η²` with `T̄ = 2∫T(μ)μ dμ` the cosine average of the transmittance
+/// from outside (the same single-scattering lobe seen from the other side; for a smooth
+/// interface it is the identity `1 − F_dr,int = (1 − F_dr,ext)/η²`), and reflection and
+/// transmission from inside add to at most 1. It is what bounds the diffuse scale
+/// `1/(1 − R_int)`, which a crafted `R_int` close to 1 would otherwise make as large as it likes.
+pub(super) fn plausible(distribution: Distribution, alpha: f32, eta: f32, t: &RoughPlasticTable) -> bool {
+    let unit = |v: f32| (0.0..=1.0).contains(&v);
+    if !(t.transmittance.iter().all(|&v| unit(v)) && unit(t.internal_reflectance)) {
+        return false;
+    }
+    // The cosine average by the trapezoid rule over the rows (μ_k = k/63); its error at 64
+    // nodes is far inside the margin.
+    let h = 1.0 / (TABLE_RES - 1) as f64;
+    let tmu = |k: usize| t.transmittance[k] as f64 * k as f64 * h;
+    let mean = 2.0 * h * ((1..TABLE_RES - 1).map(tmu).sum::<f64>() + 0.5 * tmu(TABLE_RES - 1));
+    let eta2 = (eta as f64) * (eta as f64);
+    if t.internal_reflectance as f64 > 1.0 - mean / eta2 + 0.02 {
+        return false;
+    }
+    let mf = Microfacet::new(distribution, alpha);
+    let nodes = Nodes::for_eta(distribution, eta);
+    let r = {
+        use std::hash::{BuildHasher, Hasher};
+        std::collections::hash_map::RandomState::new().build_hasher().finish()
+    };
+    let rows = [r as usize % TABLE_RES, (r >> 32) as usize % TABLE_RES];
+    rows.iter().all(|&k| {
+        let v = integrate_vndf(Lobe::Transmit, &mf, view(k).1, eta, nodes, has_avx2()) as f32;
+        (v - t.transmittance[k]).abs() <= 1e-5
+    })
+}
+
 fn build(distribution: Distribution, alpha: f32, eta: f32) -> RoughPlasticTable {
     build_with(distribution, alpha, eta, has_avx2())
 }
@@ -314,8 +357,7 @@ fn build_with(distribution: Distribution, alpha: f32, eta: f32, avx2: bool) -> R
     let nodes_r = Nodes::for_eta(distribution, 1.0 / eta);
     // Row k: (T(μ_k), R(μ_k)·μ_k).
     let row = |k: usize| -> (f32, f64) {
-        let mu = (k as f32 / (TABLE_RES - 1) as f32).max(1e-6);
-        let v = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+        let (mu, v) = view(k);
         // Transmission through the interface from outside (relative IOR η).
         let t = integrate_vndf(Lobe::Transmit, &mf, v, eta, nodes_t, avx2) as f32;
         // Reflection at the interface from inside (relative IOR 1/η).
@@ -364,7 +406,9 @@ pub fn rough_plastic_table(
         return t;
     }
     // Built outside the lock (it takes a moment); a racing thread may build it twice.
-    let table = super::cache::load(distribution, alpha, eta).unwrap_or_else(|| {
+    let table = super::cache::load(distribution, alpha, eta)
+        .filter(|t| plausible(distribution, alpha, eta, t))
+        .unwrap_or_else(|| {
         let t = build(distribution, alpha, eta);
         super::cache::store(distribution, alpha, eta, &t);
         t
