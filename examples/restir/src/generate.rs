@@ -8,7 +8,7 @@ use glam::Vec3;
 use restir_families::many_lights_ron;
 use restir_image::Image;
 
-use crate::say::say;
+use crate::say::tell;
 
 /// Scenes the generator can write.
 #[derive(clap::Subcommand, Debug)]
@@ -85,12 +85,12 @@ pub fn run(what: Generate) -> Result<(), String> {
             let text = many_lights_ron(args.lights, args.seed).map_err(|e| e.to_string())?;
             restir_image::write_file_atomically(&args.output, text.as_bytes())
                 .map_err(|e| e.to_string())?;
-            say!(
+            tell!(
                 "many-lights: {} lights, seed {} -> {}",
                 args.lights,
                 args.seed,
                 args.output.display()
-            );
+            )?;
             Ok(())
         }
         Generate::Rects(args) => write_di(Kind::Rects, args),
@@ -109,12 +109,12 @@ pub fn run(what: Generate) -> Result<(), String> {
             sky(args.width, args.width / 2)
                 .write(&args.output)
                 .map_err(|e| e.to_string())?;
-            say!(
+            tell!(
                 "envmap: sky {}×{} -> {}",
                 args.width,
                 args.width / 2,
                 args.output.display()
-            );
+            )?;
             Ok(())
         }
         Generate::UvPattern(args) => {
@@ -122,7 +122,7 @@ pub fn run(what: Generate) -> Result<(), String> {
             uv_pattern()
                 .write(&args.output)
                 .map_err(|e| e.to_string())?;
-            say!("uv-pattern: 6×8 -> {}", args.output.display());
+            tell!("uv-pattern: 6×8 -> {}", args.output.display())?;
             Ok(())
         }
     }
@@ -392,12 +392,12 @@ fn write_one(params: &Params, seed: u64, output: Option<PathBuf>) -> Result<(), 
         ));
     }
     let path = generated.write(dir, stem).map_err(|e| e.to_string())?;
-    say!(
+    tell!(
         "{}, seed {seed} -> {} (+{} assets)",
         describe(params),
         path.display(),
         generated.assets.len()
-    );
+    )?;
     Ok(())
 }
 
@@ -440,13 +440,13 @@ fn write_family(args: &FamilyArgs) -> Result<(), String> {
         if args.xml {
             write_xml(&generated, &path)?;
         }
-        say!(
+        tell!(
             "{}, seed {} -> {} (+{} assets)",
             describe_member(member),
             member.seed,
             path.display(),
             generated.assets.len()
-        );
+        )?;
         return Ok(());
     }
     let mut index = format!(
@@ -482,11 +482,11 @@ fn write_family(args: &FamilyArgs) -> Result<(), String> {
                 format!("\tassets: {}", assets.join(" "))
             }
         ));
-        say!("{}", path.display());
+        tell!("{}", path.display())?;
     }
     let path = args.out.join("family.txt");
     restir_image::write_file_atomically(&path, index.as_bytes()).map_err(|e| e.to_string())?;
-    say!("{} scenes, index {}", members.len(), path.display());
+    tell!("{} scenes, index {}", members.len(), path.display())?;
     Ok(())
 }
 

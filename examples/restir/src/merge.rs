@@ -17,7 +17,7 @@ use restir_image::Image;
 use restir_integrators::PixelWindow;
 
 use crate::cluster::attr;
-use crate::say::{say, say_err};
+use crate::say::{say_err, tell};
 
 /// `restir merge` arguments.
 #[derive(clap::Args, Debug)]
@@ -362,14 +362,14 @@ pub fn run(args: MergeArgs) -> Result<(), String> {
     if nonfinite > 0 {
         say_err!("warning: {nonfinite} pixels are NaN or infinite");
     }
-    say!(
+    tell!(
         "merged {} parts: {}×{}, {} passes -> {}",
         parts.len(),
         image.width,
         image.height,
         layout.spp,
         args.output.display()
-    );
+    )?;
     Ok(())
 }
 

@@ -412,3 +412,63 @@ fn an_interrupted_part_records_its_passes() {
         &format!("passes {end}..100000 of 100000 are missing"),
     );
 }
+
+/// `merge` and `generate` report what they wrote on stdout: a full stdout (`> /dev/full`) or a
+/// closed one (`| head -c0`) is an error with a message and exit status 1, not a panic and not
+/// a success whose report was lost. (The files are written before the report.)
+#[cfg(unix)]
+#[test]
+fn a_full_or_closed_stdout_is_an_error() {
+    use std::process::Stdio;
+    let dir = temp_dir("stdout");
+    let d = dir.0.as_path();
+    let scene = cornell();
+    for i in 0..2 {
+        let chain = i.to_string();
+        render(
+            &scene,
+            &["--spp", "2", "--chain", &chain, "--chains", "2"],
+            &p(d, &format!("c{i}.exr")),
+        );
+    }
+    let (c0, c1) = (p(d, "c0.exr"), p(d, "c1.exr"));
+    let merged = p(d, "m.exr");
+    let generated = p(d, "g.ron");
+    let commands: [&[&str]; 2] = [
+        &["merge", &merged, &c0, &c1],
+        &["generate", "rects", "--lights", "4", "-o", &generated],
+    ];
+    for args in commands {
+        // Full: every write fails with ENOSPC.
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let out = Command::new(RESTIR)
+            .args(args)
+            .stdout(Stdio::from(full))
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?} > /dev/full: {stderr}");
+        assert!(
+            stderr.contains("cannot write to standard output") && !stderr.contains("panicked"),
+            "{args:?} > /dev/full: {stderr}"
+        );
+        // Closed: the reading end is gone before the report is written.
+        let mut child = Command::new(RESTIR)
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?} | head -c0: {stderr}");
+        assert!(
+            stderr.contains("cannot write to standard output") && !stderr.contains("panicked"),
+            "{args:?} | head -c0: {stderr}"
+        );
+    }
+}
