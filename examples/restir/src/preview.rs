@@ -3,13 +3,18 @@
 //! temporary file beside the preview and is encoded from it one frame at a time at the end; a
 //! video streams each frame to `ffmpeg`'s standard input as it is rendered, while a thread
 //! drains ffmpeg's standard error (kept up to [`STDERR_KEEP`] bytes) so that a chatty ffmpeg
-//! cannot block on a full pipe.
+//! cannot block on a full pipe. The frames are written by a thread of their own, so an ffmpeg
+//! that stops reading its input (or does not exit once it has ended) cannot hang the render: a
+//! frame not taken within [`stall_timeout`] (by the time the next one is ready, or at the end),
+//! or an exit that does not come within it, stops ffmpeg and is an error naming it.
 
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Child, ChildStdin, Command, Stdio};
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender};
 use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
 
 use restir_image::Image;
 
@@ -17,6 +22,16 @@ use crate::frames::Preview;
 
 /// The most of ffmpeg's standard error kept for the message when it fails (the first bytes).
 pub const STDERR_KEEP: usize = 16 << 10;
+
+/// How long ffmpeg may take to read a frame (counted from when the next one is ready) or to exit
+/// after its input ends: `RESTIR_FFMPEG_TIMEOUT` seconds, 120 unless set.
+pub fn stall_timeout() -> Duration {
+    std::env::var("RESTIR_FFMPEG_TIMEOUT")
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .map_or(Duration::from_secs(120), Duration::from_secs_f64)
+}
 
 /// The frames as 8-bit sRGB bytes, row by row (what APNG and ffmpeg's `rgb24` take).
 pub fn srgb_bytes(img: &Image) -> Vec<u8> {
@@ -29,7 +44,13 @@ pub fn srgb_bytes(img: &Image) -> Vec<u8> {
 /// A running ffmpeg fed frame by frame.
 struct Encoder {
     child: Child,
-    stdin: Option<ChildStdin>,
+    /// Frames to the writing thread (which owns ffmpeg's standard input); `None` once closed.
+    frames: Option<SyncSender<Vec<u8>>>,
+    /// The writing thread's answer for each frame.
+    written: Receiver<std::io::Result<()>>,
+    /// A frame was handed over and not yet answered.
+    pending: bool,
+    writer: Option<JoinHandle<()>>,
     stderr: Option<JoinHandle<Vec<u8>>>,
     /// ffmpeg's output, renamed onto the preview once it succeeds.
     tmp: PathBuf,
@@ -134,13 +155,14 @@ impl PreviewWriter {
                     Some(e) => e,
                     None => encoder.insert(start_ffmpeg(ffmpeg, format, path, size, self.fps)?),
                 };
+                enc.settle();
                 if enc.failed.is_none()
-                    && let Some(stdin) = &mut enc.stdin
-                    && let Err(e) = stdin.write_all(&bytes)
+                    && let Some(frames) = &enc.frames
                 {
-                    // ffmpeg stopped reading: its status and message say why, at the end.
-                    enc.failed = Some(e);
-                    enc.stdin = None;
+                    // The thread is idle (the last frame was answered): this does not block.
+                    if frames.send(bytes).is_ok() {
+                        enc.pending = true;
+                    }
                 }
             }
         }
@@ -168,21 +190,27 @@ impl PreviewWriter {
                 let Some(mut enc) = encoder.take() else {
                     return Ok(());
                 };
-                drop(enc.stdin.take());
-                let status = enc.child.wait();
+                enc.settle();
+                let status = enc.finish_input();
                 let said = enc
                     .stderr
                     .take()
-                    .and_then(|t| t.join().ok())
+                    .and_then(|t| join_within(t, Instant::now() + Duration::from_secs(5)))
                     .unwrap_or_default();
                 let fail = |what: String| {
                     format!("{}: ffmpeg ({}) {what}", path.display(), ffmpeg.display())
                 };
-                let status = status.map_err(|e| fail(format!("failed: {e}")))?;
+                let status = status.map_err(|e| {
+                    let _ = std::fs::remove_file(&enc.tmp);
+                    fail(e.to_string())
+                })?;
                 if !status.success() || enc.failed.is_some() {
                     let _ = std::fs::remove_file(&enc.tmp);
                     let said = String::from_utf8_lossy(&said);
-                    return Err(fail(format!("failed ({status}): {}", said.trim())));
+                    return Err(match &enc.failed {
+                        Some(e) if e.kind() == std::io::ErrorKind::TimedOut => fail(e.to_string()),
+                        _ => fail(format!("failed ({status}): {}", said.trim())),
+                    });
                 }
                 std::fs::rename(&enc.tmp, &path).map_err(|e| {
                     let _ = std::fs::remove_file(&enc.tmp);
@@ -202,12 +230,88 @@ impl Drop for PreviewWriter {
             }
             Sink::Video { encoder, .. } => {
                 if let Some(mut enc) = encoder.take() {
-                    drop(enc.stdin.take());
+                    // Killed first: a writer blocked on a full pipe then fails and ends.
                     let _ = enc.child.kill();
+                    drop(enc.frames.take());
                     let _ = enc.child.wait();
                     let _ = std::fs::remove_file(&enc.tmp);
                 }
             }
+        }
+    }
+}
+
+/// The thread's result if it ends before `deadline`; otherwise it is left to end on its own.
+fn join_within<T>(thread: JoinHandle<T>, deadline: Instant) -> Option<T> {
+    while !thread.is_finished() {
+        if Instant::now() > deadline {
+            return None;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    thread.join().ok()
+}
+
+impl Encoder {
+    /// Waits for the answer to the frame handed over last, up to [`stall_timeout`]; a failed
+    /// write (ffmpeg exited) or no answer in time (ffmpeg stopped reading: then it is killed,
+    /// which ends the blocked write) marks the encoder failed, reported by `finish`.
+    fn settle(&mut self) {
+        if !self.pending {
+            return;
+        }
+        let timeout = stall_timeout();
+        let failure = match self.written.recv_timeout(timeout) {
+            Ok(Ok(())) => None,
+            Ok(Err(e)) => Some(e),
+            Err(RecvTimeoutError::Timeout) => {
+                let _ = self.child.kill();
+                Some(std::io::Error::new(
+                    std::io::ErrorKind::TimedOut,
+                    format!(
+                        "stopped reading its input for {} s and was stopped (RESTIR_FFMPEG_TIMEOUT sets how long to wait)",
+                        timeout.as_secs_f64()
+                    ),
+                ))
+            }
+            Err(RecvTimeoutError::Disconnected) => Some(std::io::Error::other(
+                "the thread feeding it ended early",
+            )),
+        };
+        self.pending = false;
+        if let Some(e) = failure {
+            self.failed.get_or_insert(e);
+            self.frames = None;
+        }
+    }
+
+    /// Ends ffmpeg's input and waits for it to exit, up to [`stall_timeout`] (then it is killed
+    /// and the wait is an error).
+    fn finish_input(&mut self) -> std::io::Result<std::process::ExitStatus> {
+        drop(self.frames.take());
+        let timeout = stall_timeout();
+        let start = Instant::now();
+        if let Some(w) = self.writer.take() {
+            // Idle, or in a write that a killed ffmpeg ended; a process ffmpeg left behind may
+            // still hold the pipe, so not waited for past the timeout.
+            let _ = join_within(w, start + timeout);
+        }
+        loop {
+            if let Some(status) = self.child.try_wait()? {
+                return Ok(status);
+            }
+            if start.elapsed() > timeout {
+                let _ = self.child.kill();
+                let _ = self.child.wait();
+                return Err(std::io::Error::new(
+                    std::io::ErrorKind::TimedOut,
+                    format!(
+                        "did not exit within {} s of the end of its input and was stopped (RESTIR_FFMPEG_TIMEOUT sets how long to wait)",
+                        timeout.as_secs_f64()
+                    ),
+                ));
+            }
+            std::thread::sleep(Duration::from_millis(10));
         }
     }
 }
@@ -250,7 +354,18 @@ fn start_ffmpeg(
             ffmpeg.display()
         )
     })?;
-    let stdin = child.stdin.take();
+    let (frames, feed) = std::sync::mpsc::sync_channel::<Vec<u8>>(1);
+    let (answer, written) = std::sync::mpsc::channel();
+    let writer = child.stdin.take().map(|mut stdin| {
+        std::thread::spawn(move || {
+            // Ends when the frames' sender is dropped, closing ffmpeg's input.
+            for frame in feed {
+                if answer.send(stdin.write_all(&frame)).is_err() {
+                    break;
+                }
+            }
+        })
+    });
     let stderr = child.stderr.take().map(|mut err| {
         std::thread::spawn(move || {
             let mut kept = Vec::new();
@@ -267,7 +382,10 @@ fn start_ffmpeg(
     });
     Ok(Encoder {
         child,
-        stdin,
+        frames: Some(frames),
+        written,
+        pending: false,
+        writer,
         stderr,
         tmp,
         failed: None,

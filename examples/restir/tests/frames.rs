@@ -455,6 +455,53 @@ fn ffmpeg_stderr_is_drained_and_a_non_executable_one_refused() {
     );
 }
 
+/// An ffmpeg that stops reading its input, or reads it all and never exits, does not hang the
+/// render: after `RESTIR_FFMPEG_TIMEOUT` seconds it is stopped and the preview is an error
+/// naming it (the frames themselves are written).
+#[cfg(unix)]
+#[test]
+fn a_stalled_ffmpeg_is_stopped_and_reported() {
+    for (tag, body, expected) in [
+        ("ffmpeg-stall", "exec sleep 600", "stopped reading its input for 2 s"),
+        (
+            "ffmpeg-no-exit",
+            "cat > /dev/null\nexec sleep 600",
+            "did not exit within 2 s of the end of its input",
+        ),
+    ] {
+        let dir = temp_dir(tag);
+        let scene = animated(&dir);
+        let path = fake_ffmpeg(&dir, body, 0o755);
+        let video = dir.0.join("seq.mp4");
+        let out = dir.0.join("seq.exr");
+        // Two 128² frames (96 KiB) are more than a pipe holds.
+        let mut child = Command::new(RESTIR)
+            .args(["render", s(&scene), "--frames", "0..1", "--spp", "1"])
+            .args(["--quiet", "--width", "128", "--height", "128", "-o", s(&out)])
+            .args(["--preview", s(&video)])
+            .env("PATH", &path)
+            .env("RESTIR_FFMPEG_TIMEOUT", "2")
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let start = std::time::Instant::now();
+        while child.try_wait().unwrap().is_none() {
+            if start.elapsed() > std::time::Duration::from_secs(60) {
+                child.kill().unwrap();
+                panic!("{tag}: the render hung on ffmpeg");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+        let o = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{tag}: {stderr}");
+        assert!(stderr.contains(expected), "{tag}: {stderr}");
+        assert!(stderr.contains("/bin/ffmpeg"), "{tag}: {stderr}");
+        assert!(!video.exists(), "{tag}: no preview");
+        assert!(dir.0.join("seq_0001.exr").exists(), "{tag}: the frames are written");
+    }
+}
+
 /// `--frames 0..4294967295` (2^32 frames) is an error, not an overflow.
 #[test]
 fn a_frame_count_beyond_u32_is_an_error() {
