@@ -1,4 +1,5 @@
-//! Rays and the ray-origin offsets (Mitsuba 3's relative epsilon) for spawning rays and shadow
+//! Rays and the ray-origin offsets (relative to the magnitude of the hit point, after pbrt-v4's
+//! floating-point error bounds and Mitsuba 3's relative epsilon) for spawning rays and shadow
 //! rays from surfaces without hitting them again.
 
 use glam::Vec3;
@@ -26,11 +27,25 @@ impl Ray {
     }
 }
 
-/// The offset distance used at `p`: `(1 + max|pᵢ|) · RAY_EPSILON` (Mitsuba 3, `offset_p`), which
-/// scales with the magnitude of the coordinates and so with their rounding error.
+/// The offset distance used at `p`: `max|pᵢ| · RAY_EPSILON`, relative to the magnitude of the
+/// coordinates and so to their rounding error, with no absolute floor, so that a scene and the
+/// same scene in other units (10⁻⁶ or 10⁶ times larger) are traced alike.
+///
+/// This follows the error analysis of Pharr, Jakob and Humphreys, *Physically Based Rendering*,
+/// 4th ed., §6.8 "Managing Rounding Error": a computed hit point is off its surface by at most
+/// its rounding error, which is relative to the magnitudes of the positions it was computed from
+/// (pbrt's `γₙ·Σ|bᵢ·pᵢ|` for a triangle, `γₙ·|p|` for a reprojected sphere point), and a ray
+/// spawned from it is offset along the normal by more than that bound. Mitsuba 3's `offset_p`
+/// uses the same relative epsilon (`1500 · 2⁻²⁴`) but adds 1 to the magnitude, an absolute floor
+/// of 8.9·10⁻⁵ scene units that swallows scenes in small units; here the floor is dropped, and
+/// what it guarded against — a point near the origin on a primitive whose vertices are far from
+/// it, where the intersection test's own rounding (relative to the vertices) exceeds the offset —
+/// is handled where that rounding happens: the triangle and sphere tests refuse distances within
+/// their own error bound (see `REL_T_MIN` in the traversal), as pbrt-v4's triangle test refuses
+/// `t ≤ δt`.
 #[inline]
 pub fn ray_epsilon(p: Vec3) -> f32 {
-    (1.0 + p.abs().max_element()) * crate::RAY_EPSILON
+    p.abs().max_element() * crate::RAY_EPSILON
 }
 
 /// Moves `p` off its surface along the geometric normal `ng`, to the side that `d` leaves towards,

@@ -111,8 +111,11 @@ impl LightSet {
             return Err(LightError::EnvmapMismatch);
         }
         let extent = scene_bounds.1 - scene_bounds.0;
-        let scene_radius = if extent.is_finite() {
-            (0.5 * extent.length()).max(1e-3)
+        // Relative to the scene's own size (no absolute floor, which would outweigh every other
+        // light in a scene in small units); 1 when the scene has no extent.
+        let radius = 0.5 * extent.length();
+        let scene_radius = if radius.is_finite() && radius.is_normal() {
+            radius
         } else {
             1.0
         };

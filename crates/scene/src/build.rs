@@ -24,9 +24,21 @@ fn affine(m: Mat4) -> Result<Affine3A, String> {
         return Err("projective transforms are not supported on shapes".into());
     }
     let a = Affine3A::from_mat4(m);
-    let det = a.matrix3.determinant();
-    if det.abs() < 1e-12 || !det.is_finite() {
-        return Err("transform is degenerate (zero scale)".into());
+    // Degenerate when an axis collapses, measured against the scale of the transform itself
+    // (the determinant over the product of the column lengths, 1 for any rotation and uniform
+    // or axis scale), so that a scene in millimetres or kilometres is no more degenerate than in
+    // metres; and refused when the determinant leaves the normal range of `f32` (a uniform
+    // scale below about 2·10⁻¹³ or above 7·10¹², whose cube does).
+    let m3 = a.matrix3;
+    let det = m3.determinant();
+    let lengths = m3.x_axis.length() * m3.y_axis.length() * m3.z_axis.length();
+    if !det.is_finite() || !det.is_normal() || det.abs() <= 1e-6 * lengths {
+        return Err(format!(
+            "transform is degenerate (zero scale): determinant {det:e}, axis lengths {:e}, {:e}, {:e}",
+            m3.x_axis.length(),
+            m3.y_axis.length(),
+            m3.z_axis.length()
+        ));
     }
     Ok(a)
 }

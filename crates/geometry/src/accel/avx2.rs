@@ -12,7 +12,10 @@
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
 
-use super::wide::{Entries, Found, Kernel, Node, TRay, TriBlock, TriHit, Wide, any, closest};
+use super::prims::REL_T_MIN;
+use super::wide::{
+    Entries, Found, Kernel, NODE_EPSILON, Node, TRay, TriBlock, TriHit, Wide, any, closest,
+};
 
 /// The AVX2 kernel (x86-64 only).
 #[derive(Debug)]
@@ -62,7 +65,7 @@ fn block_t(b: &TriBlock, r: &TRay, t_max: f32) -> (__m256, __m256, __m256, i32) 
         let pz = sub(mul(dx, e2y), mul(e2x, dy));
         let det = add(add(mul(e1x, px), mul(e1y, py)), mul(e1z, pz));
         let abs = _mm256_andnot_ps(splat(-0.0), det);
-        let mut ok = _mm256_cmp_ps::<_CMP_NLT_UQ>(abs, splat(1e-20));
+        let mut ok = _mm256_cmp_ps::<_CMP_NLT_UQ>(abs, splat(f32::MIN_POSITIVE));
         let inv_det = _mm256_div_ps(splat(1.0), det);
         let (tx, ty, tz) = (sub(ox, v0x), sub(oy, v0y), sub(oz, v0z));
         let u = mul(add(add(mul(tx, px), mul(ty, py)), mul(tz, pz)), inv_det);
@@ -78,7 +81,18 @@ fn block_t(b: &TriBlock, r: &TRay, t_max: f32) -> (__m256, __m256, __m256, i32) 
         );
         ok = _mm256_andnot_ps(out, ok);
         let t = mul(add(add(mul(e2x, qx), mul(e2y, qy)), mul(e2z, qz)), inv_det);
-        ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_GT_OQ>(t, splat(0.0)));
+        // t > REL_T_MIN · max|o − v0| (glam's `max_element`: max(max(x, y), z)).
+        let sign = splat(-0.0);
+        let (ax, ay, az) = (
+            _mm256_andnot_ps(sign, tx),
+            _mm256_andnot_ps(sign, ty),
+            _mm256_andnot_ps(sign, tz),
+        );
+        let t_min = mul(
+            _mm256_max_ps(_mm256_max_ps(ax, ay), az),
+            splat(REL_T_MIN),
+        );
+        ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_GT_OQ>(t, t_min));
         ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_LT_OQ>(t, splat(t_max)));
         (t, u, vv, _mm256_movemask_ps(ok))
     }
@@ -110,7 +124,7 @@ impl Kernel for Avx2 {
         let (z0, z1) = slab(n, r, 2, ai[2], ao[2]);
         // SAFETY: arithmetic intrinsics only; AVX2 is guaranteed by the callers.
         unsafe {
-            let tmin = _mm256_max_ps(_mm256_max_ps(x0, _mm256_max_ps(y0, z0)), splat(1e-4));
+            let tmin = _mm256_max_ps(_mm256_max_ps(x0, _mm256_max_ps(y0, z0)), splat(NODE_EPSILON));
             let tmax = _mm256_min_ps(_mm256_min_ps(x1, _mm256_min_ps(y1, z1)), splat(t_max));
             let mut entry = [0.0f32; 8];
             _mm256_storeu_ps(entry.as_mut_ptr(), tmin);

@@ -87,8 +87,18 @@ pub(super) fn intersect_triangle(
     triangle_hit(v0, e1, e2, o, d, t_max).map_or(f32::INFINITY, |(t, _, _)| t)
 }
 
+/// Distances below `REL_T_MIN` times the magnitude of the operands of a primitive test (for a
+/// triangle `max|o − v0|`, for a sphere `max|o − c| + r`) are refused as the test's own rounding
+/// noise: the computed `t` of a ray leaving a surface it starts on is the true `t ≈ 0` plus an
+/// error of a few ulps of those magnitudes. 32 units of roundoff (2⁻¹⁹ ≈ 1.9·10⁻⁶), a margin
+/// over the few ulps of Möller–Trumbore's and the sphere test's operations; pbrt-v4 refuses
+/// `t ≤ δt` from its bound `δt` the same way (PBR 4th ed., §6.8.7). Relative, so the same scene
+/// in any unit is traced alike; a real surface this close to the origin of a ray is closer than
+/// the positions' own rounding can tell.
+pub(super) const REL_T_MIN: f32 = 32.0 / 16_777_216.0;
+
 /// Möller–Trumbore: the distance and the barycentrics `(u, v)` of the hit (weights of `v0 + e1`
-/// and `v0 + e2`) when `0 < t < t_max`.
+/// and `v0 + e2`) when `REL_T_MIN · max|o − v0| < t < t_max`.
 #[inline(always)]
 pub(super) fn triangle_hit(
     v0: Vec3A,
@@ -100,7 +110,9 @@ pub(super) fn triangle_hit(
 ) -> Option<(f32, f32, f32)> {
     let pvec = d.cross(e2);
     let det = e1.dot(pvec);
-    if det.abs() < 1e-20 {
+    // Zero or subnormal: no plane to hit (relative: a determinant scales with the square of
+    // the scene's unit, so an absolute threshold would refuse small scenes).
+    if det.abs() < f32::MIN_POSITIVE {
         return None;
     }
     let inv_det = 1.0 / det;
@@ -115,7 +127,8 @@ pub(super) fn triangle_hit(
         return None;
     }
     let t = e2.dot(qvec) * inv_det;
-    (t > 0.0 && t < t_max).then_some((t, u, v))
+    let t_min = REL_T_MIN * tvec.abs().max_element();
+    (t > t_min && t < t_max).then_some((t, u, v))
 }
 
 #[inline(always)]
@@ -138,8 +151,9 @@ pub(super) fn intersect_sphere(center: Vec3A, radius: f32, o: Vec3A, d: Vec3A, t
     let t0 = c / q;
     let t1 = q / a;
     let (near, far) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
-    let t = if near > 0.0 { near } else { far };
-    if t > 0.0 && t < t_max {
+    let t_min = REL_T_MIN * (f.abs().max_element() + radius);
+    let t = if near > t_min { near } else { far };
+    if t > t_min && t < t_max {
         t
     } else {
         f32::INFINITY

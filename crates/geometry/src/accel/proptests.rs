@@ -8,7 +8,11 @@ use obvhs::ray::{Ray as BvhRay, RayHit};
 use proptest::prelude::*;
 
 use super::Accel;
-use super::wide::{NODE_EPSILON, TRay};
+use super::wide::TRay;
+
+/// obvhs's lower bound on a child box's entry distance (ours is 0): below it the two
+/// traversals may differ.
+const OBVHS_NODE_EPSILON: f32 = 1e-4;
 use crate::{Ray, Shape, Sphere, TriangleMesh};
 
 /// obvhs's `ray_traverse` / `ray_traverse_miss` with our primitive tests in the closure (the
@@ -169,7 +173,7 @@ fn check(shapes: &[Shape], ray: &Ray, t_max: f32) -> Result<(), TestCaseError> {
     // can lie outside the triangle's box (found or culled depending on what was found first).
     let (ref_hit, ref_occ) = reference(&accel, ray, t_max);
     let posed = |t: f32, id: usize| {
-        t >= NODE_EPSILON && well_posed(&accel.prims[id], tr.d, Vec3A::from(ray.at(t)))
+        t >= OBVHS_NODE_EPSILON && well_posed(&accel.prims[id], tr.d, Vec3A::from(ray.at(t)))
     };
     let ours_id = got.map(|h| {
         (0..accel.prims.len())
@@ -178,10 +182,13 @@ fn check(shapes: &[Shape], ray: &Ray, t_max: f32) -> Result<(), TestCaseError> {
     });
     match (got.zip(ours_id), ref_hit) {
         (Some((h, i)), Some((t, r))) if !posed(h.t, i) || !posed(t, r as usize) => {}
+        // Without obvhs's node epsilon ours also enters boxes flat in the ray's plane (exit
+        // distance 0), so it may see an in-plane triangle obvhs culls.
+        (Some((h, i)), None) if !posed(h.t, i) => {}
         _ => prop_assert_eq!(
             got.map(|h| h.t),
             ref_hit.map(|(t, _)| t),
-            "closest hit distance differs from obvhs's traversal"
+            "closest hit distance differs from obvhs's traversal for {:?} to {}", ray, t_max
         ),
     }
     // The barycentrics are the test's: recomputed from the primitive, the same bits.
@@ -204,11 +211,19 @@ fn check(shapes: &[Shape], ray: &Ray, t_max: f32) -> Result<(), TestCaseError> {
             "barycentrics differ from the hit's test"
         );
     }
-    prop_assert_eq!(
-        occluded,
-        ref_occ,
-        "occlusion differs from obvhs's traversal"
-    );
+    // obvhs culls boxes ending before its node epsilon (also boxes flat in the ray's plane),
+    // ours does not: an occluder that near, or in the ray's plane, may be seen by ours alone.
+    let near_occluder = (0..accel.prims.len()).any(|i| {
+        let t = accel.intersect_prim(i, &tr, t_max);
+        t < t_max && !posed(t, i)
+    });
+    if !(near_occluder && occluded && !ref_occ) {
+        prop_assert_eq!(
+            occluded,
+            ref_occ,
+            "occlusion differs from obvhs's traversal"
+        );
+    }
     // Brute force. Two allowances, both obvhs's and the replaced traversal's as much as ours:
     // child boxes ending before `t = 1e-4` are skipped (obvhs's node epsilon), and a ray lying in
     // a triangle's plane can get a Möller–Trumbore "hit" from rounding noise (`det` ≈ 1e-7) at a

@@ -149,3 +149,141 @@ fn sphere_hit_from_inside() {
         .unwrap();
     assert!((h.t - 2.0).abs() < 1e-5);
 }
+
+/// [`scene`] uniformly scaled by `s`.
+fn scaled_scene(s: f32) -> Vec<Shape> {
+    let mut shapes = scene();
+    for shape in &mut shapes {
+        match shape {
+            Shape::Mesh(m) => m.transform(&glam::Affine3A::from_scale(Vec3::splat(s))),
+            Shape::Sphere(sp) => *sp = Sphere::new(sp.center * s, sp.radius * s, false),
+        }
+    }
+    shapes
+}
+
+/// The scales a scene may come in (micrometres to thousands of kilometres, in metres).
+const SCALES: [f32; 5] = [1e-6, 1e-3, 1.0, 1e3, 1e6];
+
+/// The same rays into the same scene in any unit find the same hits at the scaled distances:
+/// no absolute epsilon culls a small scene (the traversal once skipped every box ending within
+/// 10⁻⁴ of the ray's origin) or its triangles (a determinant threshold of 10⁻²⁰).
+#[test]
+fn hits_are_the_same_at_every_scale() {
+    for s in SCALES {
+        let shapes = scaled_scene(s);
+        let accel = Accel::build(&shapes);
+        let unit = Accel::build(&scene());
+        let mut rng = Pcg32::new(11, 12);
+        let (mut same, mut total) = (0, 0);
+        for _ in 0..2000 {
+            let o = Vec3::new(
+                rng.next_f32() * 12.0 - 6.0,
+                rng.next_f32() * 12.0 - 6.0,
+                rng.next_f32() * 6.0 + 0.1,
+            );
+            let d = restir_sampling::warp::sample_uniform_sphere(rng.next_2d());
+            let want = unit.intersect(&Ray::new(o, d), f32::INFINITY);
+            let got = accel.intersect(&Ray::new(o * s, d), f32::INFINITY);
+            total += 1;
+            match (want, got) {
+                (Some(w), Some(g)) => {
+                    assert!(
+                        (g.t / s - w.t).abs() <= 1e-4 * w.t.max(1.0),
+                        "scale {s}: t {} against {}",
+                        g.t / s,
+                        w.t
+                    );
+                    same += usize::from((w.shape, w.prim) == (g.shape, g.prim));
+                }
+                (None, None) => same += 1,
+                (w, g) => panic!("scale {s}: {w:?} against {g:?} for o {o} d {d}"),
+            }
+        }
+        // Edges and ties may name a neighbour; nearly all are the same primitive.
+        assert!(same * 100 >= total * 99, "scale {s}: {same} of {total}");
+    }
+}
+
+/// Rays leaving a surface never hit it again, at every scale and at every distance from the
+/// origin: points around the world origin on a floor whose vertices are 10 units away (where
+/// an offset relative to the point alone is smaller than the intersection test's rounding,
+/// which is relative to the vertices), a point exactly at the origin, and points far out.
+/// Reflected rays leave the convex shape they start on for good; transmitted rays must not hit
+/// the same triangle (or the floor's plane) again, nor the sphere short of its far side.
+#[test]
+fn no_self_intersection_at_any_scale_near_the_origin() {
+    for s in SCALES {
+        let shapes = scaled_scene(s);
+        let accel = Accel::build(&shapes);
+        let mut rng = Pcg32::new(21, 22);
+        let mut checked = 0;
+        for i in 0..20_000 {
+            // Half the targets within 10⁻³ units of the origin (10⁻⁴ of the floor's size),
+            // one exactly at it, the rest anywhere.
+            let spread = if i % 2 == 0 { 1e-3 } else { 4.0 };
+            let target = if i == 0 {
+                Vec3::ZERO
+            } else {
+                Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, 0.0) * (2.0 * spread)
+            };
+            let o = Vec3::new(rng.next_f32() * 8.0 - 4.0, rng.next_f32() * 8.0 - 4.0, 5.0);
+            let o = if i % 5 == 0 {
+                // Onto the cube and the sphere too.
+                Vec3::new(rng.next_f32() * 8.0 - 4.0, rng.next_f32() * 8.0 - 4.0, -5.0)
+            } else {
+                o
+            };
+            let ray = Ray::new(o * s, (target - o).normalize());
+            let Some(hit) = accel.intersect(&ray, f32::INFINITY) else {
+                continue;
+            };
+            let si = accel.surface_interaction(&shapes, &hit, &ray);
+            let towards = si.ng * -si.ng.dot(ray.d).signum();
+            let local =
+                restir_sampling::warp::sample_cosine_hemisphere(rng.next_2d());
+            // Reflected: back to the side the ray came from.
+            let d = Frame::from_normal(towards).to_world(local);
+            let o2 = offset_ray_origin(si.p, si.ng, d);
+            if let Some(h2) = accel.intersect(&Ray::new(o2, d), f32::INFINITY) {
+                assert!(
+                    h2.shape != hit.shape,
+                    "scale {s}: reflected ray from {} hit shape {} again at t = {}",
+                    si.p,
+                    hit.shape,
+                    h2.t
+                );
+            }
+            // Shadow ray to a point above, on the reflected side.
+            let (r, t_max) = crate::shadow_ray_towards(si.p, si.ng, d, s * 0.05);
+            if accel.occluded(&r, t_max) {
+                let h = accel.intersect(&r, t_max).unwrap();
+                assert!(h.shape != hit.shape, "scale {s}: shadow ray blocked by its own surface");
+            }
+            // Transmitted: through to the other side.
+            let d = Frame::from_normal(-towards).to_world(local);
+            let o2 = offset_ray_origin(si.p, si.ng, d);
+            if let Some(h2) = accel.intersect(&Ray::new(o2, d), f32::INFINITY) {
+                // The sphere's far side is a real hit (a chord of 10⁻⁴ of its radius is a
+                // direction within 3·10⁻⁵ of its tangent plane); a triangle, and the floor's
+                // plane, are never hit again.
+                let sphere = matches!(shapes[hit.shape as usize], Shape::Sphere(_));
+                let again = if sphere {
+                    h2.shape == hit.shape && h2.t < 0.5e-4 * s
+                } else {
+                    (h2.shape, h2.prim) == (hit.shape, hit.prim) || (hit.shape, h2.shape) == (0, 0)
+                };
+                assert!(
+                    !again,
+                    "scale {s}: transmitted ray from {} hit shape {} prim {} again at t = {}",
+                    si.p,
+                    hit.shape,
+                    hit.prim,
+                    h2.t
+                );
+            }
+            checked += 1;
+        }
+        assert!(checked > 10_000, "scale {s}: {checked}");
+    }
+}
