@@ -162,7 +162,10 @@ mod tests {
         };
         assert!(mape(&nan, &b).unwrap().is_nan());
         let m = evaluate(&nan, &Image::new(2, 1)).unwrap();
-        assert!(m.relmse.is_nan() && m.mape.is_nan() && m.flip.is_nan(), "{m:?}");
+        assert!(
+            m.relmse.is_nan() && m.mape.is_nan() && m.flip.is_nan(),
+            "{m:?}"
+        );
         assert_eq!((m.nonfinite, m.reference_nonfinite), (2, 0));
         assert_eq!(evaluate(&b, &nan).unwrap().reference_nonfinite, 2);
     }

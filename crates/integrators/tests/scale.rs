@@ -71,13 +71,7 @@ fn scene(s: f32, dim: f32) -> Scene {
 }
 
 /// Per block: mean and standard error over `seeds` renders from `seed_base` on.
-fn statistics(
-    scene: &Scene,
-    name: &str,
-    spp: u32,
-    seeds: u64,
-    seed_base: u64,
-) -> Vec<(f64, f64)> {
+fn statistics(scene: &Scene, name: &str, spp: u32, seeds: u64, seed_base: u64) -> Vec<(f64, f64)> {
     block_statistics(
         |seed| render_image(scene, name, &[], spp, seed),
         seeds,
@@ -103,7 +97,10 @@ fn check(name: &str, spp: u32, seeds: u64) {
     let dim = statistics(&scene(1.0, 0.97), name, spp, seeds, 9000);
     let z = max_z(&dim, &unit);
     eprintln!("{name}, lights 3 % dimmer: max |z| = {z:.2}");
-    assert!(z > Z_MAX, "{name}: 3 % dimmer lights are not detected (max |z| = {z:.2})");
+    assert!(
+        z > Z_MAX,
+        "{name}: 3 % dimmer lights are not detected (max |z| = {z:.2})"
+    );
 }
 
 #[test]

@@ -190,7 +190,7 @@ impl LightSet {
             if emission > crate::MAX_EMISSION {
                 return Err(LightError::TooBright(i, "emission", emission));
             }
-            if !(power <= crate::MAX_EMISSION) {
+            if power.is_nan() || power > crate::MAX_EMISSION {
                 return Err(LightError::TooBright(i, "power", power));
             }
             powers.push(power);

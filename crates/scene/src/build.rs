@@ -371,9 +371,11 @@ impl Scene {
                     ));
                 }
                 // Refused here, where the shape's line is known, rather than by the light set.
-                let power = std::f32::consts::PI * shape.area() * restir_sampling::luminance(radiance);
+                let power =
+                    std::f32::consts::PI * shape.area() * restir_sampling::luminance(radiance);
                 if radiance.max_element() > restir_lights::MAX_EMISSION
-                    || !(power <= restir_lights::MAX_EMISSION)
+                    || power.is_nan()
+                    || power > restir_lights::MAX_EMISSION
                 {
                     return Err(at(
                         &sd.location,

@@ -358,12 +358,14 @@ fn what_mitsuba_cannot_say_is_refused_by_name() {
 fn a_dollar_in_a_name_is_refused_not_substituted() {
     let write = |ron: &str| {
         let d = restir_scene::parse_ron(ron, "t.ron".as_ref()).unwrap();
-        to_mitsuba_xml(&d, &XmlWriteOptions::default())
-            .map_err(|e| e.to_string())
+        to_mitsuba_xml(&d, &XmlWriteOptions::default()).map_err(|e| e.to_string())
     };
     let e = write(r#"(camera: (fov: 45), shapes: [(geometry: Ply(filename: "m$spp.ply"))])"#)
         .unwrap_err();
-    assert!(e.contains("shape 0") && e.contains("m$spp.ply") && e.contains("'$'"), "{e}");
+    assert!(
+        e.contains("shape 0") && e.contains("m$spp.ply") && e.contains("'$'"),
+        "{e}"
+    );
     let e = write(r#"(camera: (fov: 45), shapes: [(id: Some("a$resx"), geometry: Rectangle)])"#)
         .unwrap_err();
     assert!(e.contains("id \"a$resx\""), "{e}");
@@ -373,7 +375,10 @@ fn a_dollar_in_a_name_is_refused_not_substituted() {
     .unwrap_err();
     assert!(e.contains("material 'm$spp'"), "{e}");
     let e = write(r#"(camera: (fov: 45), lights: [Envmap(filename: "sky$x.exr")])"#).unwrap_err();
-    assert!(e.contains("the environment map") && e.contains("sky$x.exr"), "{e}");
+    assert!(
+        e.contains("the environment map") && e.contains("sky$x.exr"),
+        "{e}"
+    );
     // Without a '$' the same descriptions are written.
     write(r#"(camera: (fov: 45), shapes: [(geometry: Ply(filename: "m.ply"))])"#).unwrap();
 }

@@ -274,9 +274,9 @@ impl Encoder {
                     ),
                 ))
             }
-            Err(RecvTimeoutError::Disconnected) => Some(std::io::Error::other(
-                "the thread feeding it ended early",
-            )),
+            Err(RecvTimeoutError::Disconnected) => {
+                Some(std::io::Error::other("the thread feeding it ended early"))
+            }
         };
         self.pending = false;
         if let Some(e) = failure {

@@ -362,7 +362,10 @@ fn compare_counts_nan_on_both_sides() {
     let half = image("half.exr", [f32::NAN, 0.0]);
     fails(
         &["compare", s(&nan), s(&black)],
-        &["no pixel is finite in both", "2 NaN or infinite in the image"],
+        &[
+            "no pixel is finite in both",
+            "2 NaN or infinite in the image",
+        ],
     );
     fails(
         &["compare", s(&black), s(&nan)],
@@ -371,7 +374,10 @@ fn compare_counts_nan_on_both_sides() {
     let o = restir(&["compare", s(&black), s(&half)]);
     assert!(o.status.success());
     let stdout = String::from_utf8(o.stdout).unwrap();
-    assert!(stdout.contains(" nonfinite=0 reference_nonfinite=1 "), "{stdout}");
+    assert!(
+        stdout.contains(" nonfinite=0 reference_nonfinite=1 "),
+        "{stdout}"
+    );
     assert!(stdout.contains("relmse=0.0"), "{stdout}");
     let stderr = String::from_utf8(o.stderr).unwrap();
     assert!(stderr.contains("half.exr: 1 pixels are NaN"), "{stderr}");

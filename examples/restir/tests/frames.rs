@@ -462,7 +462,11 @@ fn ffmpeg_stderr_is_drained_and_a_non_executable_one_refused() {
 #[test]
 fn a_stalled_ffmpeg_is_stopped_and_reported() {
     for (tag, body, expected) in [
-        ("ffmpeg-stall", "exec sleep 600", "stopped reading its input for 2 s"),
+        (
+            "ffmpeg-stall",
+            "exec sleep 600",
+            "stopped reading its input for 2 s",
+        ),
         (
             "ffmpeg-no-exit",
             "cat > /dev/null\nexec sleep 600",
@@ -477,7 +481,15 @@ fn a_stalled_ffmpeg_is_stopped_and_reported() {
         // Two 128² frames (96 KiB) are more than a pipe holds.
         let mut child = Command::new(RESTIR)
             .args(["render", s(&scene), "--frames", "0..1", "--spp", "1"])
-            .args(["--quiet", "--width", "128", "--height", "128", "-o", s(&out)])
+            .args([
+                "--quiet",
+                "--width",
+                "128",
+                "--height",
+                "128",
+                "-o",
+                s(&out),
+            ])
             .args(["--preview", s(&video)])
             .env("PATH", &path)
             .env("RESTIR_FFMPEG_TIMEOUT", "2")
@@ -498,7 +510,10 @@ fn a_stalled_ffmpeg_is_stopped_and_reported() {
         assert!(stderr.contains(expected), "{tag}: {stderr}");
         assert!(stderr.contains("/bin/ffmpeg"), "{tag}: {stderr}");
         assert!(!video.exists(), "{tag}: no preview");
-        assert!(dir.0.join("seq_0001.exr").exists(), "{tag}: the frames are written");
+        assert!(
+            dir.0.join("seq_0001.exr").exists(),
+            "{tag}: the frames are written"
+        );
     }
 }
 

@@ -88,10 +88,7 @@ fn block_t(b: &TriBlock, r: &TRay, t_max: f32) -> (__m256, __m256, __m256, i32) 
             _mm256_andnot_ps(sign, ty),
             _mm256_andnot_ps(sign, tz),
         );
-        let t_min = mul(
-            _mm256_max_ps(_mm256_max_ps(ax, ay), az),
-            splat(REL_T_MIN),
-        );
+        let t_min = mul(_mm256_max_ps(_mm256_max_ps(ax, ay), az), splat(REL_T_MIN));
         ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_GT_OQ>(t, t_min));
         ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_LT_OQ>(t, splat(t_max)));
         (t, u, vv, _mm256_movemask_ps(ok))
@@ -124,7 +121,10 @@ impl Kernel for Avx2 {
         let (z0, z1) = slab(n, r, 2, ai[2], ao[2]);
         // SAFETY: arithmetic intrinsics only; AVX2 is guaranteed by the callers.
         unsafe {
-            let tmin = _mm256_max_ps(_mm256_max_ps(x0, _mm256_max_ps(y0, z0)), splat(NODE_EPSILON));
+            let tmin = _mm256_max_ps(
+                _mm256_max_ps(x0, _mm256_max_ps(y0, z0)),
+                splat(NODE_EPSILON),
+            );
             let tmax = _mm256_min_ps(_mm256_min_ps(x1, _mm256_min_ps(y1, z1)), splat(t_max));
             let mut entry = [0.0f32; 8];
             _mm256_storeu_ps(entry.as_mut_ptr(), tmin);

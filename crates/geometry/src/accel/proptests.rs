@@ -188,7 +188,9 @@ fn check(shapes: &[Shape], ray: &Ray, t_max: f32) -> Result<(), TestCaseError> {
         _ => prop_assert_eq!(
             got.map(|h| h.t),
             ref_hit.map(|(t, _)| t),
-            "closest hit distance differs from obvhs's traversal for {:?} to {}", ray, t_max
+            "closest hit distance differs from obvhs's traversal for {:?} to {}",
+            ray,
+            t_max
         ),
     }
     // The barycentrics are the test's: recomputed from the primitive, the same bits.

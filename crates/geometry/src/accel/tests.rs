@@ -240,8 +240,7 @@ fn no_self_intersection_at_any_scale_near_the_origin() {
             };
             let si = accel.surface_interaction(&shapes, &hit, &ray);
             let towards = si.ng * -si.ng.dot(ray.d).signum();
-            let local =
-                restir_sampling::warp::sample_cosine_hemisphere(rng.next_2d());
+            let local = restir_sampling::warp::sample_cosine_hemisphere(rng.next_2d());
             // Reflected: back to the side the ray came from.
             let d = Frame::from_normal(towards).to_world(local);
             let o2 = offset_ray_origin(si.p, si.ng, d);
@@ -258,7 +257,10 @@ fn no_self_intersection_at_any_scale_near_the_origin() {
             let (r, t_max) = crate::shadow_ray_towards(si.p, si.ng, d, s * 0.05);
             if accel.occluded(&r, t_max) {
                 let h = accel.intersect(&r, t_max).unwrap();
-                assert!(h.shape != hit.shape, "scale {s}: shadow ray blocked by its own surface");
+                assert!(
+                    h.shape != hit.shape,
+                    "scale {s}: shadow ray blocked by its own surface"
+                );
             }
             // Transmitted: through to the other side.
             let d = Frame::from_normal(-towards).to_world(local);
@@ -276,10 +278,7 @@ fn no_self_intersection_at_any_scale_near_the_origin() {
                 assert!(
                     !again,
                     "scale {s}: transmitted ray from {} hit shape {} prim {} again at t = {}",
-                    si.p,
-                    hit.shape,
-                    hit.prim,
-                    h2.t
+                    si.p, hit.shape, hit.prim, h2.t
                 );
             }
             checked += 1;

@@ -215,7 +215,7 @@ fn key_radiance<'de, D: Deserializer<'de>>(d: D) -> Result<V3, D::Error> {
     // spline's slopes overflowed and the light went dark). A frame whose interpolated emission
     // still exceeds the limit (keys spaced very unevenly) is refused when that frame is built.
     const MAX_KEY: f32 = 8e25;
-    debug_assert!(MAX_KEY * 1.25 <= restir_lights::MAX_EMISSION * 1.000_001);
+    const { assert!(MAX_KEY * 1.25 <= restir_lights::MAX_EMISSION * 1.000_001) };
     if v.iter().any(|&r| r > MAX_KEY) {
         return Err(D::Error::custom(format!(
             "emission key: radiance {v:?} exceeds {MAX_KEY:e}, the largest a key may have (lights are limited to {:e}, and a spline overshoots its keys by up to a quarter)",

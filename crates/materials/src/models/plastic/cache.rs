@@ -222,7 +222,10 @@ mod tests {
             internal_reflectance: 1.0 - 3e-7,
             ..honest
         };
-        assert!(decode(&encode(&bright)).is_some(), "the checksum alone passes it");
+        assert!(
+            decode(&encode(&bright)).is_some(),
+            "the checksum alone passes it"
+        );
         assert!(!plausible(d, a, e, &bright));
         let mut shifted = RoughPlasticTable::compute(d, a, e);
         for t in &mut shifted.transmittance {

@@ -320,7 +320,12 @@ fn view(k: usize) -> (f32, Vec3) {
 /// interface it is the identity `1 − F_dr,int = (1 − F_dr,ext)/η²`), and reflection and
 /// transmission from inside add to at most 1. It is what bounds the diffuse scale
 /// `1/(1 − R_int)`, which a crafted `R_int` close to 1 would otherwise make as large as it likes.
-pub(super) fn plausible(distribution: Distribution, alpha: f32, eta: f32, t: &RoughPlasticTable) -> bool {
+pub(super) fn plausible(
+    distribution: Distribution,
+    alpha: f32,
+    eta: f32,
+    t: &RoughPlasticTable,
+) -> bool {
     let unit = |v: f32| (0.0..=1.0).contains(&v);
     if !(t.transmittance.iter().all(|&v| unit(v)) && unit(t.internal_reflectance)) {
         return false;
@@ -338,7 +343,9 @@ pub(super) fn plausible(distribution: Distribution, alpha: f32, eta: f32, t: &Ro
     let nodes = Nodes::for_eta(distribution, eta);
     let r = {
         use std::hash::{BuildHasher, Hasher};
-        std::collections::hash_map::RandomState::new().build_hasher().finish()
+        std::collections::hash_map::RandomState::new()
+            .build_hasher()
+            .finish()
     };
     let rows = [r as usize % TABLE_RES, (r >> 32) as usize % TABLE_RES];
     rows.iter().all(|&k| {
@@ -409,10 +416,10 @@ pub fn rough_plastic_table(
     let table = super::cache::load(distribution, alpha, eta)
         .filter(|t| plausible(distribution, alpha, eta, t))
         .unwrap_or_else(|| {
-        let t = build(distribution, alpha, eta);
-        super::cache::store(distribution, alpha, eta, &t);
-        t
-    });
+            let t = build(distribution, alpha, eta);
+            super::cache::store(distribution, alpha, eta, &t);
+            t
+        });
     let table: &'static RoughPlasticTable = Box::leak(Box::new(table));
     let mut guard = tables.lock().unwrap_or_else(|e| e.into_inner());
     let stored: &&'static RoughPlasticTable = guard.entry(key).or_insert(table);
