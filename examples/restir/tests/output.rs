@@ -433,7 +433,8 @@ fn compare_html_is_checked() {
     }
 }
 
-/// `generate` and `merge` with their summary line going to a closed pipe: no panic, exit 0.
+/// `generate` and `merge` with their summary line going to a closed pipe: no panic, the files
+/// written, and the lost report an error (exit 1) rather than a silent success.
 #[test]
 fn generate_and_merge_survive_a_closed_stdout() {
     let dir = temp_dir("closed-generate");
@@ -459,7 +460,11 @@ fn generate_and_merge_survive_a_closed_stdout() {
         let o = child.wait_with_output().unwrap();
         let stderr = String::from_utf8_lossy(&o.stderr);
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
-        assert_eq!(o.status.code(), Some(0), "{args:?}: {stderr}");
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("cannot write to standard output"),
+            "{args:?}: {stderr}"
+        );
     }
     assert!(scene.is_file() && merged.is_file());
 }
