@@ -455,15 +455,14 @@ fn a_full_or_closed_stdout_is_an_error() {
             stderr.contains("cannot write to standard output") && !stderr.contains("panicked"),
             "{args:?} > /dev/full: {stderr}"
         );
-        // Closed: the reading end is gone before the report is written.
-        let mut child = Command::new(RESTIR)
+        // Closed: the reading end is gone before the command starts.
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let out = Command::new(RESTIR)
             .args(args)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
+            .stdout(writer)
+            .output()
             .unwrap();
-        drop(child.stdout.take());
-        let out = child.wait_with_output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{args:?} | head -c0: {stderr}");
         assert!(

@@ -450,14 +450,15 @@ fn generate_and_merge_survive_a_closed_stdout() {
         vec!["generate", "many-lights", "--lights", "2", "-o", s(&scene)],
         vec!["merge", s(&merged), s(&part)],
     ] {
-        let mut child = Command::new(RESTIR)
+        // The reading end closed before the command starts (closing it after spawning races
+        // with a quick command's write into the pipe's buffer).
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let o = Command::new(RESTIR)
             .args(&args)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
+            .stdout(writer)
+            .output()
             .unwrap();
-        drop(child.stdout.take());
-        let o = child.wait_with_output().unwrap();
         let stderr = String::from_utf8_lossy(&o.stderr);
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
         assert_eq!(o.status.code(), Some(1), "{args:?}: {stderr}");
