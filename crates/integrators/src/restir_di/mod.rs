@@ -47,10 +47,10 @@ pub use settings::{
 
 use crate::bands::Bands;
 use crate::fallback::PathFallback;
+use crate::motion::FrameMotion;
+use crate::pass::{Integrator, PassContext};
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
-use crate::render::{Integrator, PassContext};
 use crate::reuse::gbuffer::{GBuffer, Receiver};
-use crate::reuse::motion::FrameMotion;
 use crate::reuse::neighbors::NeighborPattern;
 use crate::reuse::passes::{self, HistorySlot, ReuseShift};
 use crate::reuse::reciprocal;
