@@ -33,6 +33,8 @@
 //! out.image.write("cbox.exr".as_ref()).unwrap();
 //! ```
 
+#![deny(missing_docs)]
+
 mod bands;
 pub mod fallback;
 pub mod film;

@@ -16,6 +16,8 @@
 //! Measures: `pdf_sa` is per unit solid angle at the receiving point; for delta lights (point,
 //! directional) it is the discrete selection probability and `delta` is set.
 
+#![deny(missing_docs)]
+
 mod bvh;
 mod envmap;
 mod light;

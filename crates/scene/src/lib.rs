@@ -21,6 +21,8 @@
 //! assert_eq!(scene.camera.resolution(), (32, 32));
 //! ```
 
+#![deny(missing_docs)]
+
 pub mod animation;
 mod build;
 pub mod desc;
