@@ -145,6 +145,11 @@ struct RestirArgs {
     /// every light count measured so far) [default: auto].
     #[arg(long)]
     light_sampler: Option<String>,
+    /// restir-di: on draws candidates' lights, from the second pass on, from a mixture of the
+    /// power sampler and what each light delivered (after its shadow ray) to a cell of a
+    /// world-space grid in earlier passes; off uses the light sampler alone [default: off].
+    #[arg(long)]
+    learn: Option<String>,
     /// auto hands a scene that does not suit the estimator to the path tracer when no other
     /// option of it is given (restir-di: a few emitters with one dominant light; restir-pt:
     /// fewer than 5% of the camera's paths reconnect at a glossy surface); off never does
@@ -232,6 +237,7 @@ impl RestirArgs {
             "light_sampler",
             self.light_sampler.clone().map(ParamValue::Text),
         );
+        put("learn", self.learn.clone().map(ParamValue::Text));
         put("fallback", self.fallback.clone().map(ParamValue::Text));
         put(
             "bsdf_candidates",

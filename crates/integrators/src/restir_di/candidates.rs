@@ -1,16 +1,17 @@
 //! ReSTIR DI's initial candidates: where a pixel's light candidates come from (the power
-//! sampler, its presampled pool, the light hierarchy, a light tile), each with the density that
+//! sampler, its presampled pool, the light hierarchy, a light tile, the distribution learned in
+//! earlier passes), each with the density that
 //! drew it, and the initial resampling that streams them into a reservoir.
 
 use glam::Vec3;
 use restir_gris::{Reservoir, StreamingReservoir};
-use restir_lights::{Contact, LightPoint, LightSample, Presampled};
+use restir_lights::{Contact, LearnedSampler, LightPoint, LightSample, Presampled};
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
 use super::shift::visible;
 use super::target::evaluate;
-use super::{DiReservoir, LightSampler, RestirDiIntegrator, pool, tiles};
+use super::{DiReservoir, Learn, LightSampler, RestirDiIntegrator, pool, tiles};
 use crate::reuse::gbuffer::Receiver;
 
 /// Where a pixel's initial candidates come from.
@@ -24,6 +25,9 @@ pub(super) enum Candidates<'a> {
     Hierarchy,
     /// The pixel's 16×16 light tile (mixed with the power sampler).
     Tile(&'a restir_sampling::AliasTable),
+    /// The distribution learned in earlier passes at the receiver's cell (mixed with the power
+    /// sampler).
+    Learned(&'a LearnedSampler, u32),
 }
 
 /// An initial candidate seen from a receiver.
@@ -165,6 +169,19 @@ impl RestirDiIntegrator {
                             Candidate::from_sample(&ls, source, power_pdf_sa)
                         })
                 }
+                Candidates::Learned(learned, cell) => learned
+                    .sample(&scene.lights, Some(cell), u_select)
+                    .and_then(|(light, pmf)| {
+                        let ls = scene.lights.sample_light(light, r.p, u_light)?;
+                        let pmf = if self.settings.learn == Learn::WithoutDefensiveShare {
+                            // the negative control's wrong probability
+                            learned.pmf_without_defensive_share(&scene.lights, Some(cell), light)
+                        } else {
+                            pmf
+                        };
+                        let power_pmf = scene.lights.pmf(light);
+                        Candidate::from_sample(&ls, pmf * ls.pdf_sa, power_pmf * ls.pdf_sa)
+                    }),
                 Candidates::Tile(table) => {
                     tiles::select(scene, table, u_select).and_then(|(light, pmf, power_pmf)| {
                         let ls = scene.lights.sample_light(light, r.p, u_light)?;

@@ -28,6 +28,7 @@
 //! exactly the path tracer's, and `describe` (hence `--stats`) says so.
 
 mod candidates;
+pub mod learn;
 pub mod pool;
 mod settings;
 mod shift;
@@ -43,7 +44,7 @@ use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
 pub use settings::{
-    DOMINANT_LIGHT_SHARE, FEW_EMITTERS, Fallback, HIERARCHY_MIN_EMITTERS, LightSampler,
+    DOMINANT_LIGHT_SHARE, FEW_EMITTERS, Fallback, HIERARCHY_MIN_EMITTERS, Learn, LightSampler,
     RestirDiSettings, Visibility,
 };
 
@@ -82,6 +83,8 @@ pub struct RestirDiIntegrator {
     clock: StageClock,
     /// The path tracer that renders instead, and why (a scene with one dominant light).
     fallback: Option<PathFallback>,
+    /// What earlier passes recorded, with `learn` on.
+    learning: learn::Learning,
 }
 
 impl RestirDiIntegrator {
@@ -97,6 +100,7 @@ impl RestirDiIntegrator {
             history: HistorySlot::default(),
             clock: StageClock::default(),
             fallback: None,
+            learning: learn::Learning::default(),
         }
     }
 
@@ -121,7 +125,8 @@ impl RestirDiIntegrator {
     pub const RESERVOIR_BYTES: usize = std::mem::size_of::<DiReservoir>();
 
     /// Shading at receiver `r` with its final reservoir: the reservoir's sample with a shadow
-    /// ray, the BSDF samples, and the continuation. Returns radiance and rays.
+    /// ray, the BSDF samples, and the continuation. Returns radiance, rays, and the light of the
+    /// reservoir's sample with what it delivered (when it was visible and lit the receiver).
     fn shade(
         &self,
         scene: &Scene,
@@ -129,8 +134,9 @@ impl RestirDiIntegrator {
         ng: Vec3,
         res: &DiReservoir,
         rng: &mut Pcg32,
-    ) -> (Vec3, u64) {
+    ) -> (Vec3, u64, Option<(u32, Vec3)>) {
         let mut l = Vec3::ZERO;
+        let mut delivered = None;
         let mut rays = 0;
         let bsdf = &r.resolve_bsdf(scene);
         if let Some(y) = &res.sample
@@ -146,6 +152,7 @@ impl RestirDiIntegrator {
                     visible(scene, r, ng, &c)
                 } {
                     l += e.contribution * res.ucw;
+                    delivered = Some((y.light, e.contribution * res.ucw));
                 }
             }
         }
@@ -202,7 +209,7 @@ impl RestirDiIntegrator {
             l += li;
             rays += n;
         }
-        (l, rays)
+        (l, rays, delivered)
     }
 }
 
@@ -219,7 +226,17 @@ impl Integrator for RestirDiIntegrator {
              visibility={}{}",
             s.path.max_depth,
             s.candidates,
-            s.light_sampler.name(),
+            s.light_sampler.name().to_string()
+                + &if s.learn.is_on() {
+                    format!(
+                        " learn={} (share {}, cells 1/{} of the scene diameter)",
+                        s.learn.name(),
+                        learn::LEARN_SHARE,
+                        learn::LEARN_CELLS_PER_DIAMETER
+                    )
+                } else {
+                    String::new()
+                },
             s.bsdf_candidates,
             s.reuse.neighbors,
             s.reuse.radius,
@@ -245,6 +262,7 @@ impl Integrator for RestirDiIntegrator {
     /// evaluated in the previous frame's scene.
     fn next_frame(&self, motion: std::sync::Arc<FrameMotion>) {
         self.history.next_frame(Some(motion));
+        self.learning.reset();
     }
 
     fn halo(&self) -> u32 {
@@ -297,6 +315,12 @@ impl Integrator for RestirDiIntegrator {
                     pool::LightPool::tiles_for(fw as usize * fh as usize, s.candidates as usize);
                 pool::LightPool::build(scene, ctx, tiles, STAGE_POOL)
             });
+            // The distribution learned in the passes before this one.
+            let learned = if s.learn.is_on() {
+                self.learning.sampler(scene)
+            } else {
+                None
+            };
             let mut current = vec![DiReservoir::empty(); n];
             rays += current
                 .par_chunks_mut(bands.pixels())
@@ -307,7 +331,10 @@ impl Integrator for RestirDiIntegrator {
                         let index = bands.first(band) + i;
                         if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
-                            let source = if let Some(pool) = &pool {
+                            let cell = learned.as_ref().and_then(|l| l.cell(r.p, r.n));
+                            let source = if let (Some(l), Some(c)) = (&learned, cell) {
+                                Candidates::Learned(l, c)
+                            } else if let Some(pool) = &pool {
                                 let (x, y) = ctx.film_xy(index, w);
                                 Candidates::Pool(pool.tile_of(ctx, x, y))
                             } else if let Some(t) = light_tiles
@@ -373,25 +400,40 @@ impl Integrator for RestirDiIntegrator {
 
             // Shading.
             let start = std::time::Instant::now();
-            rays += radiance
+            let grid = s.learn.is_on().then(|| learn::Learning::grid(scene));
+            let per_band: Vec<(u64, Vec<learn::Record>)> = radiance
                 .par_chunks_mut(bands.pixels())
                 .enumerate()
                 .map(|(band, out)| {
                     let mut rays = 0;
+                    let mut records = Vec::new();
                     for (i, l) in out.iter_mut().enumerate() {
                         let index = bands.first(band) + i;
                         if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_SHADE);
                             let ng = gbuf.ng[index];
-                            let (li, nr) = self.shade(scene, r, ng, &current[index], &mut rng);
+                            let (li, nr, delivered) =
+                                self.shade(scene, r, ng, &current[index], &mut rng);
                             *l += li;
                             rays += nr;
+                            if let (Some(g), Some((light, c))) = (&grid, delivered) {
+                                records.push(learn::record(g, r.p, r.n, light, c));
+                            }
                         }
                     }
-                    rays
+                    (rays, records)
                 })
-                .sum::<u64>();
+                .collect();
+            let mut records = Vec::with_capacity(per_band.len());
+            for (nr, band) in per_band {
+                rays += nr;
+                records.push(band);
+            }
             self.clock.add("shade", start.elapsed());
+            if grid.is_some() {
+                // What this pass learned serves the passes after it, never this one.
+                self.clock.time("learn", || self.learning.record(records));
+            }
 
             self.history.store(reuse, gbuf, current);
         }
