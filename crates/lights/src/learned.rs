@@ -11,7 +11,8 @@
 //!
 //! [`LightRecords`] gathers `(cell, light, contribution)` records in the order they are given;
 //! [`LearnedSampler::new`] freezes them into one alias table per cell. A selection at a receiver
-//! picks the cell's table with probability `share` and the power sampler ([`LightSet::select`])
+//! picks the cell's table with probability `share · n / (n + prior)` (`n` the cell's records,
+//! so a cell that has seen little leans on the power sampler) and the power sampler ([`LightSet::select`])
 //! otherwise, so every light with power keeps a positive probability whatever was learned (the
 //! defensive share, Hesterberg 1995), and [`LearnedSampler::pmf`] is the mixture's probability,
 //! exactly, for any receiver and light. A receiver whose cell has no records selects by power
@@ -67,6 +68,8 @@ impl LearnGrid {
 #[derive(Clone, Debug, Default)]
 pub struct LightRecords {
     cells: BTreeMap<CellKey, BTreeMap<u32, f64>>,
+    /// Records per cell.
+    counts: BTreeMap<CellKey, u64>,
     records: u64,
 }
 
@@ -83,6 +86,7 @@ impl LightRecords {
                 .or_default()
                 .entry(light)
                 .or_insert(0.0) += value as f64;
+            *self.counts.entry(key).or_insert(0) += 1;
             self.records += 1;
         }
     }
@@ -104,6 +108,9 @@ struct CellTable {
     /// The lights, ascending.
     lights: Vec<u32>,
     alias: AliasTable,
+    /// The share of selections the table takes in this cell: the sampler's share times
+    /// `n / (n + prior)` for `n` records, so a cell of few records leans on the power sampler.
+    share: f32,
 }
 
 impl CellTable {
@@ -127,32 +134,44 @@ pub struct LearnedSampler {
 }
 
 impl LearnedSampler {
-    /// The sampler of `records` on `grid`, taking the cells' tables with probability `share`
-    /// (in `[0, 1)`: the rest goes to the power sampler).
-    pub fn new(grid: LearnGrid, share: f32, records: &LightRecords) -> Self {
+    /// The sampler of `records` on `grid`, taking a cell's table with probability
+    /// `share · n / (n + prior)` for a cell of `n` records (`share` in `[0, 1)`: the rest goes
+    /// to the power sampler).
+    pub fn new(grid: LearnGrid, share: f32, prior: f32, records: &LightRecords) -> Self {
+        let share = share.clamp(0.0, ONE_MINUS_EPSILON);
+        let prior = prior.max(0.0);
         let mut index = HashMap::with_capacity(records.cells.len());
         let mut tables = Vec::with_capacity(records.cells.len());
         for (key, sums) in &records.cells {
             let weights: Vec<f32> = sums.values().map(|&v| v as f32).collect();
+            let n = records.counts.get(key).copied().unwrap_or(0) as f32;
             if let Some(alias) = AliasTable::new(&weights) {
                 index.insert(*key, tables.len() as u32);
                 tables.push(CellTable {
                     lights: sums.keys().copied().collect(),
                     alias,
+                    share: share * n / (n + prior),
                 });
             }
         }
         Self {
             grid,
-            share: share.clamp(0.0, ONE_MINUS_EPSILON),
+            share,
             index,
             tables,
         }
     }
 
-    /// The share of selections that go to the cells' tables.
+    /// The largest share of selections a cell's table takes (the share of a cell of very many
+    /// records).
     pub fn share(&self) -> f32 {
         self.share
+    }
+
+    /// The share of selections that go to `cell`'s table (0 for no cell).
+    #[inline]
+    pub fn cell_share(&self, cell: Option<u32>) -> f32 {
+        cell.map_or(0.0, |c| self.tables[c as usize].share)
     }
 
     /// Cells with a table.
@@ -184,11 +203,12 @@ impl LearnedSampler {
         let Some(table) = cell.map(|c| &self.tables[c as usize]) else {
             return lights.select(u);
         };
-        let light = if u < self.share {
-            let v = (u / self.share).min(ONE_MINUS_EPSILON);
+        let share = table.share;
+        let light = if u < share {
+            let v = (u / share).min(ONE_MINUS_EPSILON);
             table.lights[table.alias.sample(v).0]
         } else {
-            let v = ((u - self.share) / (1.0 - self.share)).min(ONE_MINUS_EPSILON);
+            let v = ((u - share) / (1.0 - share)).min(ONE_MINUS_EPSILON);
             lights.select(v)?.0
         };
         Some((light, self.pmf(lights, cell, light)))
@@ -201,7 +221,7 @@ impl LearnedSampler {
     pub fn pmf(&self, lights: &LightSet, cell: Option<u32>, light: u32) -> f32 {
         match cell.map(|c| &self.tables[c as usize]) {
             None => lights.pmf(light),
-            Some(t) => self.share * t.pmf(light) + (1.0 - self.share) * lights.pmf(light),
+            Some(t) => t.share * t.pmf(light) + (1.0 - t.share) * lights.pmf(light),
         }
     }
 

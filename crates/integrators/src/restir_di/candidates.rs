@@ -25,9 +25,13 @@ pub(super) enum Candidates<'a> {
     Hierarchy,
     /// The pixel's 16×16 light tile (mixed with the power sampler).
     Tile(&'a restir_sampling::AliasTable),
-    /// The distribution learned in earlier passes at the receiver's cell (mixed with the power
-    /// sampler).
-    Learned(&'a LearnedSampler, u32),
+    /// The distribution learned in earlier passes at the receiver's cell, mixed with the power
+    /// sampler, whose share is drawn from the pass's pool when there is one.
+    Learned {
+        learned: &'a LearnedSampler,
+        cell: u32,
+        pool: Option<&'a [Option<Presampled>]>,
+    },
 }
 
 /// An initial candidate seen from a receiver.
@@ -128,7 +132,10 @@ impl RestirDiIntegrator {
         let u0 = rng.next_f32();
         // A pool tile's entries `start + i·S/N_L`: one from each of N_L strata of the selection.
         let (start, stride) = match source {
-            Candidates::Pool(tile) => (
+            Candidates::Pool(tile)
+            | Candidates::Learned {
+                pool: Some(tile), ..
+            } => (
                 rng.next_u32() as usize % tile.len(),
                 (tile.len() / n as usize).max(1),
             ),
@@ -169,16 +176,31 @@ impl RestirDiIntegrator {
                             Candidate::from_sample(&ls, source, power_pdf_sa)
                         })
                 }
-                Candidates::Learned(learned, cell) => learned
+                Candidates::Learned {
+                    learned,
+                    cell,
+                    pool: Some(tile),
+                } if u_select >= learned.cell_share(Some(cell)) => {
+                    // The power sampler's share, from the pool: its density times the mixture's
+                    // probability of the light over the power sampler's.
+                    tile[(start + i as usize * stride) % tile.len()]
+                        .and_then(|e| Candidate::presampled(scene, &e, r.p, u_light))
+                        .and_then(|mut c| {
+                            let light = c.sample.light;
+                            let power_pmf = scene.lights.pmf(light);
+                            if power_pmf <= 0.0 {
+                                return None;
+                            }
+                            c.source_pdf *=
+                                self.learned_pmf(scene, learned, cell, light) / power_pmf;
+                            Some(c)
+                        })
+                }
+                Candidates::Learned { learned, cell, .. } => learned
                     .sample(&scene.lights, Some(cell), u_select)
-                    .and_then(|(light, pmf)| {
+                    .and_then(|(light, _)| {
                         let ls = scene.lights.sample_light(light, r.p, u_light)?;
-                        let pmf = if self.settings.learn == Learn::WithoutDefensiveShare {
-                            // the negative control's wrong probability
-                            learned.pmf_without_defensive_share(&scene.lights, Some(cell), light)
-                        } else {
-                            pmf
-                        };
+                        let pmf = self.learned_pmf(scene, learned, cell, light);
                         let power_pmf = scene.lights.pmf(light);
                         Candidate::from_sample(&ls, pmf * ls.pdf_sa, power_pmf * ls.pdf_sa)
                     }),
@@ -221,5 +243,16 @@ impl RestirDiIntegrator {
             }
         }
         (res, rays)
+    }
+
+    /// The learned mixture's probability of `light` in `cell` (or, for the negative control, the
+    /// cell's table alone).
+    #[inline]
+    fn learned_pmf(&self, scene: &Scene, learned: &LearnedSampler, cell: u32, light: u32) -> f32 {
+        if self.settings.learn == Learn::WithoutDefensiveShare {
+            learned.pmf_without_defensive_share(&scene.lights, Some(cell), light)
+        } else {
+            learned.pmf(&scene.lights, Some(cell), light)
+        }
     }
 }

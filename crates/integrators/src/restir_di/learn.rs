@@ -15,13 +15,6 @@ use glam::Vec3;
 use restir_lights::{CellKey, LearnGrid, LearnedSampler, LightRecords};
 use restir_scene::Scene;
 
-/// Share of candidate selections that go to the learned tables (the rest, the defensive share,
-/// to the power sampler).
-pub const LEARN_SHARE: f32 = 0.5;
-
-/// Grid cells per scene diameter along each axis.
-pub const LEARN_CELLS_PER_DIAMETER: f32 = 64.0;
-
 /// One record of a pass: a receiver's cell, the light of its shaded sample and what it
 /// delivered (luminance, shadow ray included).
 pub(super) type Record = (CellKey, u32, f32);
@@ -42,12 +35,12 @@ struct State {
 }
 
 impl Learning {
-    /// The grid for `scene`: cubes of a 64th of the scene's diameter.
-    pub fn grid(scene: &Scene) -> LearnGrid {
+    /// The grid for `scene`: cubes of a `cells`th of the scene's diameter.
+    pub fn grid(scene: &Scene, cells: f32) -> LearnGrid {
         let diameter = 2.0 * scene.lights.scene_radius();
         LearnGrid {
             cell: if diameter > 0.0 && diameter.is_finite() {
-                diameter / LEARN_CELLS_PER_DIAMETER
+                diameter / cells
             } else {
                 1.0
             },
@@ -56,13 +49,19 @@ impl Learning {
 
     /// The sampler this pass draws from: the records of the earlier passes only (`None` before
     /// anything was recorded).
-    pub fn sampler(&self, scene: &Scene) -> Option<Arc<LearnedSampler>> {
+    pub fn sampler(
+        &self,
+        scene: &Scene,
+        share: f32,
+        prior: f32,
+        cells: f32,
+    ) -> Option<Arc<LearnedSampler>> {
         let mut s = self.state.lock().ok()?;
         if s.records.records() == 0 {
             return None;
         }
         if s.sampler.is_none() {
-            let sampler = LearnedSampler::new(Self::grid(scene), LEARN_SHARE, &s.records);
+            let sampler = LearnedSampler::new(Self::grid(scene, cells), share, prior, &s.records);
             s.sampler = Some(Arc::new(sampler));
         }
         s.sampler.clone()
@@ -87,14 +86,14 @@ impl Learning {
     }
 }
 
-/// A record of what the shaded sample of `light` delivered to the receiver at `p` with normal
-/// `n`: `contribution` is the sample's unshadowed contribution times its weight, counted only
-/// when the shadow ray found it visible.
+/// A record of the shaded sample of `light` at the receiver at `p` with normal `n`, which
+/// delivered `contribution` (its shadow ray found it visible). The record counts the selection
+/// (1), not the contribution: the final samples are distributed about as the target with
+/// visibility, so how often each light is selected and visible estimates its share of the
+/// receiver's direct light, with the bounded variance of a count, where the contributions'
+/// weights would carry the reservoirs' heavy tails into the tables.
 #[inline]
 pub(super) fn record(grid: &LearnGrid, p: Vec3, n: Vec3, light: u32, contribution: Vec3) -> Record {
-    (
-        grid.key(p, n),
-        light,
-        restir_sampling::luminance(contribution),
-    )
+    let lit = restir_sampling::luminance(contribution) > 0.0;
+    (grid.key(p, n), light, if lit { 1.0 } else { 0.0 })
 }

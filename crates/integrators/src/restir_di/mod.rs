@@ -229,13 +229,14 @@ impl Integrator for RestirDiIntegrator {
             s.light_sampler.name().to_string()
                 + &if s.learn.is_on() {
                     format!(
-                        " learn={} (share {}, cells 1/{} of the scene diameter)",
+                        " learn={} learn_share={} learn_prior={} learn_cells={}",
                         s.learn.name(),
-                        learn::LEARN_SHARE,
-                        learn::LEARN_CELLS_PER_DIAMETER
+                        s.learn_share,
+                        s.learn_prior,
+                        s.learn_cells
                     )
                 } else {
-                    String::new()
+                    " learn=off".to_string()
                 },
             s.bsdf_candidates,
             s.reuse.neighbors,
@@ -317,7 +318,8 @@ impl Integrator for RestirDiIntegrator {
             });
             // The distribution learned in the passes before this one.
             let learned = if s.learn.is_on() {
-                self.learning.sampler(scene)
+                self.learning
+                    .sampler(scene, s.learn_share, s.learn_prior, s.learn_cells)
             } else {
                 None
             };
@@ -332,8 +334,15 @@ impl Integrator for RestirDiIntegrator {
                         if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
                             let cell = learned.as_ref().and_then(|l| l.cell(r.p, r.n));
-                            let source = if let (Some(l), Some(c)) = (&learned, cell) {
-                                Candidates::Learned(l, c)
+                            let source = if let (Some(learned), Some(cell)) = (&learned, cell) {
+                                Candidates::Learned {
+                                    learned,
+                                    cell,
+                                    pool: pool.as_ref().map(|p| {
+                                        let (x, y) = ctx.film_xy(index, w);
+                                        p.tile_of(ctx, x, y)
+                                    }),
+                                }
                             } else if let Some(pool) = &pool {
                                 let (x, y) = ctx.film_xy(index, w);
                                 Candidates::Pool(pool.tile_of(ctx, x, y))
@@ -400,7 +409,10 @@ impl Integrator for RestirDiIntegrator {
 
             // Shading.
             let start = std::time::Instant::now();
-            let grid = s.learn.is_on().then(|| learn::Learning::grid(scene));
+            let grid = s
+                .learn
+                .is_on()
+                .then(|| learn::Learning::grid(scene, s.learn_cells));
             let per_band: Vec<(u64, Vec<learn::Record>)> = radiance
                 .par_chunks_mut(bands.pixels())
                 .enumerate()

@@ -181,6 +181,14 @@ pub struct RestirDiSettings {
     /// Whether candidates come from a light distribution learned across passes (default off:
     /// see `docs/RESTIR_DI.md`, "Learning across passes").
     pub learn: Learn,
+    /// With `learn` on, the share of candidate selections that go to the learned tables, in
+    /// `[0, 1)` (the rest, the defensive share, to the power sampler; default 0.5).
+    pub learn_share: f32,
+    /// With `learn` on, grid cells per scene diameter along each axis (default 16).
+    pub learn_cells: f32,
+    /// With `learn` on, the records a cell needs for its table to take half of `learn_share`
+    /// (a cell of `n` records takes `learn_share · n / (n + learn_prior)`; default 64).
+    pub learn_prior: f32,
     /// BSDF samples per pixel, `N_B` (default 1), combined with the reservoirs' light strategy
     /// by the balance heuristic.
     pub bsdf_candidates: u32,
@@ -205,6 +213,9 @@ impl RestirDiSettings {
             candidates: 8,
             light_sampler: LightSampler::Auto,
             learn: Learn::Off,
+            learn_share: 0.5,
+            learn_cells: 16.0,
+            learn_prior: 64.0,
             bsdf_candidates: 1,
             visibility: Visibility::Target,
             fallback: Fallback::Auto,
@@ -268,6 +279,23 @@ impl RestirDiSettings {
                 }
                 "learn" => {
                     self.learn = p.choice(Learn::NAMES, "off or on")?;
+                    true
+                }
+                "learn_share" => {
+                    let x = p.fraction()?;
+                    if x >= 1.0 {
+                        // All to the tables would drop every light no cell recorded.
+                        return Err(p.error(crate::params::ParamProblem::NotBelowOne));
+                    }
+                    self.learn_share = x;
+                    true
+                }
+                "learn_prior" => {
+                    self.learn_prior = p.positive()?;
+                    true
+                }
+                "learn_cells" => {
+                    self.learn_cells = p.positive()?;
                     true
                 }
                 "fallback" => {
