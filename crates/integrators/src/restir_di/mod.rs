@@ -7,7 +7,8 @@
 //! 2. **Initial resampling**: `N_L` light candidates from the power-based light sampler or the
 //!    light hierarchy (a receiver-aware descent with its exact probability; from
 //!    [`settings::HIERARCHY_MIN_EMITTERS`] emitters on by default; stratified selection either
-//!    way), streamed into a
+//!    way; with `learn` on, from the second pass on, a mixture of the power sampler and what
+//!    lights delivered to the receiver's cell in earlier passes, [`learn`]), streamed into a
 //!    reservoir with weights `p̂/(N_L·p_L)`; the result
 //!    counts as confidence 1. Optional visibility reuse drops an occluded selection (biased).
 //! 3. **Temporal reuse** (optional): the same pixel's reservoir from the previous pass.
