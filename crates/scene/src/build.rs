@@ -66,6 +66,7 @@ fn material(
         diffuse: None,
         specular: None,
         transmittance: None,
+        opacity: None,
     };
     for b in bindings {
         let id = Some(cache.get(&b.texture, base_dir)?);
@@ -73,6 +74,7 @@ fn material(
             ColorParam::Reflectance | ColorParam::DiffuseReflectance => t.diffuse = id,
             ColorParam::SpecularReflectance => t.specular = id,
             ColorParam::SpecularTransmittance => t.transmittance = id,
+            ColorParam::Opacity => t.opacity = id,
         }
     }
     Ok((bsdf, Some(t)))

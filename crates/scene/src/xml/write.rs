@@ -394,6 +394,22 @@ impl Writer<'_> {
                 self.close("</bsdf>");
                 return Ok(());
             }
+            MaterialDesc::Mask { opacity, material } => {
+                self.open(&format!(r#"<bsdf type="mask"{id_attr}>"#));
+                match bound(ColorParam::Opacity) {
+                    Some(b) => self.texture(&b.texture, "opacity", item)?,
+                    None => self.float("opacity", *opacity),
+                }
+                let rest: Option<Vec<TextureBinding>> = textures.map(|t| {
+                    t.iter()
+                        .filter(|b| b.param != ColorParam::Opacity)
+                        .cloned()
+                        .collect()
+                });
+                self.bsdf(material, None, rest.as_deref(), item)?;
+                self.close("</bsdf>");
+                return Ok(());
+            }
             _ => {}
         }
         // The colour parameters, constant or textured.
@@ -529,7 +545,9 @@ impl Writer<'_> {
                     self.roughness(r);
                 }
             }
-            MaterialDesc::Textured { .. } | MaterialDesc::TwoSided(_) => unreachable!(),
+            MaterialDesc::Textured { .. } | MaterialDesc::TwoSided(_) | MaterialDesc::Mask { .. } => {
+                unreachable!()
+            }
         }
         self.close("</bsdf>");
         Ok(())
