@@ -267,14 +267,18 @@ impl Scene {
             FovAxis::Smaller => GeoFovAxis::Smaller,
             FovAxis::Larger => GeoFovAxis::Larger,
         };
-        let camera = Camera::thin_lens(
-            cam_m,
-            desc.camera.fov,
-            fov_axis,
-            (w, h),
-            desc.camera.aperture_radius,
-            desc.camera.focus_distance,
-        )
+        let camera = if desc.camera.orthographic {
+            Camera::orthographic(cam_m, (w, h))
+        } else {
+            Camera::thin_lens(
+                cam_m,
+                desc.camera.fov,
+                fov_axis,
+                (w, h),
+                desc.camera.aperture_radius,
+                desc.camera.focus_distance,
+            )
+        }
         .map_err(|e| whole(format!("camera: {e}")))?;
         match desc.film.filter {
             FilterDesc::Box => {}
