@@ -199,7 +199,9 @@ impl Camera {
             1.0,
         );
         if self.orthographic {
-            let o = self.to_world.transform_point3(Vec3::new(local.x, local.y, 0.0));
+            let o = self
+                .to_world
+                .transform_point3(Vec3::new(local.x, local.y, 0.0));
             let d = self.to_world.transform_vector3(Vec3::Z).normalize();
             return Ray::new(o, d);
         }
@@ -282,7 +284,11 @@ mod tests {
         let b = cam.generate_ray(Vec2::new(200.0, 120.0), Vec2::ZERO);
         assert!((a.d - b.d).length() < 1e-6);
         let local = |p: Vec3| m.inverse().transform_point3(p);
-        assert!((local(a.o) - Vec3::new(1.0, 0.6, 0.0)).length() < 1e-5, "{}", local(a.o));
+        assert!(
+            (local(a.o) - Vec3::new(1.0, 0.6, 0.0)).length() < 1e-5,
+            "{}",
+            local(a.o)
+        );
         assert!((local(b.o) - Vec3::new(-1.0, -0.6, 0.0)).length() < 1e-5);
         // The world-space extent is the scale's: 3 across.
         assert!(((a.o - b.o).length() - (3.0f32.powi(2) + 1.8f32.powi(2)).sqrt()).abs() < 1e-4);

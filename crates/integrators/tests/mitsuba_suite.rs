@@ -18,12 +18,14 @@
 //!
 //! Mitsuba's budget is 2 000 000 samples per scene. The path tracer renders all of it; the ReSTIR
 //! estimators, several times slower per sample, render a quarter ([`RESTIR_BUDGET`]) to keep the
-//! test near two minutes on two cores, and the criterion takes their `spp` (the variance term
+//! test near two minutes on two cores (Mitsuba's budget on a scene where a quarter cannot detect a
+//! 3 % bias: the negative control below), and the criterion takes their `spp` (the variance term
 //! scales with `spp`, so the test stays exact, its tolerance on the mean twice as wide as
 //! Mitsuba's). `MITSUBA_SUITE_RESTIR_BUDGET=2000000` runs them at Mitsuba's budget too.
 //!
 //! Negative control: every image judged is also judged scaled by 1.03, and must then fail, so
-//! each budget is shown to detect a 3 % bias on every scene. What must hold for the test to pass:
+//! each budget is shown to detect a 3 % bias on every scene (counting only the pixel-channels
+//! whose reference is not black, where no scaling shows). What must hold for the test to pass:
 //! at least [`MIN_LOADING`] scenes load, and every estimator passes every scene that loads and
 //! that it applies to, except those listed in [`KNOWN_FAILURES`] with the reason.
 //!
@@ -47,9 +49,13 @@ const PASS_FRACTION: f64 = 0.9975;
 /// The smallest variance the criterion divides by.
 const MIN_VARIANCE: f64 = 1e-4;
 /// Scenes that must load (of the 29).
-const MIN_LOADING: usize = 7;
+const MIN_LOADING: usize = 12;
 /// `(scene, estimator, reason)`: failures that are known and explained in docs/VALIDATION.md.
-const KNOWN_FAILURES: &[(&str, &str, &str)] = &[];
+const KNOWN_FAILURES: &[(&str, &str, &str)] = &[(
+    "bsdf_spheres/test_constant_path.xml",
+    "restir-di",
+    "fails narrowly (0.9973 of 0.9975, a few pixels far off); the cause is not found yet",
+)];
 
 /// Rows of the linear sRGB → CIE XYZ matrix (D65), as Mitsuba's `srgb_to_xyz`.
 const SRGB_TO_XYZ: [[f64; 3]; 3] = [
@@ -75,6 +81,8 @@ struct Judgement {
     fraction: f64,
     /// The smallest p-value.
     min_p: f64,
+    /// Where it is: pixel index and channel.
+    worst: (usize, usize),
 }
 
 impl Judgement {
@@ -86,6 +94,18 @@ impl Judgement {
 /// Mitsuba's criterion: `image` (the mean of `spp` samples per pixel) against `reference` and
 /// the per-sample `variance`, all linear sRGB.
 fn judge(image: &Image, reference: &Image, variance: &Image, spp: u32) -> Judgement {
+    judge_where(image, reference, variance, spp, false)
+}
+
+/// [`judge`], over the pixel-channels whose reference is not zero when `lit_only` (a 3 % bias
+/// cannot show where the reference is black: the negative control counts the others).
+fn judge_where(
+    image: &Image,
+    reference: &Image,
+    variance: &Image,
+    spp: u32,
+    lit_only: bool,
+) -> Judgement {
     assert_eq!(
         (image.width, image.height),
         (reference.width, reference.height)
@@ -97,30 +117,41 @@ fn judge(image: &Image, reference: &Image, variance: &Image, spp: u32) -> Judgem
     let pixels = image.pixels.len();
     let alpha = 1.0 - (1.0 - SIGNIFICANCE).powf(1.0 / pixels as f64);
     let mut passed = 0usize;
+    let mut counted = 0usize;
     let mut min_p = 1.0f64;
-    for ((m, r), v) in image
+    let mut worst = (0, 0);
+    for (i, ((m, r), v)) in image
         .pixels
         .iter()
         .zip(&reference.pixels)
         .zip(&variance.pixels)
+        .enumerate()
     {
         let (m, r, v) = (to_xyz(*m), to_xyz(*r), to_xyz(*v));
         for k in 0..3 {
+            if lit_only && r[k] == 0.0 {
+                continue;
+            }
+            counted += 1;
             let z = (m[k] - r[k]).abs() * (f64::from(spp) / v[k].max(MIN_VARIANCE)).sqrt();
             let p = if m[k].is_finite() && z.is_finite() {
                 two_sided_p(z)
             } else {
                 0.0
             };
-            min_p = min_p.min(p);
+            if p < min_p {
+                min_p = p;
+                worst = (i, k);
+            }
             if p > alpha {
                 passed += 1;
             }
         }
     }
     Judgement {
-        fraction: passed as f64 / (3 * pixels) as f64,
+        fraction: passed as f64 / counted.max(1) as f64,
         min_p,
+        worst,
     }
 }
 
@@ -258,26 +289,37 @@ fn mitsuba_render_suite() {
                     Err(e) => Outcome::Refused(e.to_string()),
                     Ok(made) => {
                         assert!(made.unused_params.is_empty(), "{name} {est}");
-                        let spp = if est == "path" { spp } else { restir_spp };
-                        let start = Instant::now();
-                        let out = restir_integrators::render(
-                            scene,
-                            made.integrator.as_ref(),
-                            &restir_integrators::RenderJob {
-                                spp,
-                                seed: 7,
-                                ..Default::default()
-                            },
-                            &std::sync::atomic::AtomicBool::new(false),
-                            &mut |_, _| {},
-                        );
-                        let secs = start.elapsed().as_secs_f64();
-                        let j = judge(&out.image, &reference, &variance, spp);
-                        let mut brighter = out.image;
-                        for p in &mut brighter.pixels {
-                            *p *= 1.03;
-                        }
-                        let control = judge(&brighter, &reference, &variance, spp);
+                        // The ReSTIR budget, raised to Mitsuba's where it cannot detect a 3 %
+                        // bias (the negative control passes).
+                        let mut spp = if est == "path" { spp } else { restir_spp };
+                        let (j, control, secs) = loop {
+                            let start = Instant::now();
+                            let out = restir_integrators::render(
+                                scene,
+                                made.integrator.as_ref(),
+                                &restir_integrators::RenderJob {
+                                    spp,
+                                    seed: 7,
+                                    ..Default::default()
+                                },
+                                &std::sync::atomic::AtomicBool::new(false),
+                                &mut |_, _| {},
+                            );
+                            let secs = start.elapsed().as_secs_f64();
+                            let j = judge(&out.image, &reference, &variance, spp);
+                            let mut brighter = out.image;
+                            for p in &mut brighter.pixels {
+                                *p *= 1.03;
+                            }
+                            let control =
+                                judge_where(&brighter, &reference, &variance, spp, true);
+                            let full = (MITSUBA_BUDGET / pixels).max(1) as u32;
+                            if control.passes() && spp < full {
+                                spp = full;
+                                continue;
+                            }
+                            break (j, control, secs);
+                        };
                         if control.passes() {
                             problems.push(format!(
                                 "{name} {est}: the negative control passes (the image scaled by 1.03: {:.4})",
@@ -296,8 +338,12 @@ fn mitsuba_render_suite() {
                     verdict = false;
                     if known.is_none() || est == "path" {
                         problems.push(format!(
-                            "{name} {est}: pass fraction {:.4} (min p {:.2e})",
-                            j.fraction, j.min_p
+                            "{name} {est}: pass fraction {:.4} (min p {:.2e} at pixel ({}, {}) channel {})",
+                            j.fraction,
+                            j.min_p,
+                            j.worst.0 % reference.width as usize,
+                            j.worst.0 / reference.width as usize,
+                            j.worst.1
                         ));
                     }
                 }
@@ -366,7 +412,7 @@ fn external_renders_pass_and_their_scaled_copies_fail() {
         for p in &mut brighter.pixels {
             *p *= 1.03;
         }
-        let b = judge(&brighter, &reference, &variance, spp);
+        let b = judge_where(&brighter, &reference, &variance, spp, true);
         println!(
             "{rel}: {:.4} (min p {:.2e}); ×1.03: {:.4}",
             j.fraction, j.min_p, b.fraction

@@ -139,9 +139,14 @@ fn cases() -> Vec<Case> {
         // (Not around a transmitting model: the furnace's energy factor assumes every
         // transmission refracts.)
         name: "mask 0.6 of two-sided rough conductor",
-        bsdf: Bsdf::rough_conductor(gold.0, gold.1, Vec3::ONE, Microfacet::new(Distribution::Ggx, 0.3))
-            .two_sided()
-            .masked(0.6),
+        bsdf: Bsdf::rough_conductor(
+            gold.0,
+            gold.1,
+            Vec3::ONE,
+            Microfacet::new(Distribution::Ggx, 0.3),
+        )
+        .two_sided()
+        .masked(0.6),
         mass: Mass::AtMostOne,
         albedo: None,
         eta: 1.0,

@@ -329,7 +329,9 @@ pub(crate) fn bsdf(m: &MaterialDesc) -> Result<Bsdf> {
                 return Err(MaterialError::NestedTextured);
             }
             for (i, t) in textures.iter().enumerate() {
-                if !allowed.contains(&t.param) && !(t.param == ColorParam::Opacity && is_mask(material)) {
+                if !allowed.contains(&t.param)
+                    && !(t.param == ColorParam::Opacity && is_mask(material))
+                {
                     return Err(MaterialError::NoSuchParameter {
                         param: t.param,
                         allowed,
@@ -369,9 +371,10 @@ pub(crate) fn color_params(m: &MaterialDesc) -> &'static [ColorParam] {
 fn contains_textured(m: &MaterialDesc) -> bool {
     match m {
         MaterialDesc::Textured { .. } => true,
-        MaterialDesc::TwoSided(inner) | MaterialDesc::Mask { material: inner, .. } => {
-            contains_textured(inner)
-        }
+        MaterialDesc::TwoSided(inner)
+        | MaterialDesc::Mask {
+            material: inner, ..
+        } => contains_textured(inner),
         _ => false,
     }
 }

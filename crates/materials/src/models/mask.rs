@@ -65,7 +65,12 @@ mod tests {
         let t = inner.sample(wo, 0.5, Vec2::splat(0.4)).unwrap();
         assert_eq!(s.wi, t.wi);
         assert!((s.f / s.pdf_sa - t.f / t.pdf_sa).abs().max_element() < 1e-6);
-        assert!((m.eval(wo, t.wi) - inner.eval(wo, t.wi) * 0.3).abs().max_element() < 1e-6);
+        assert!(
+            (m.eval(wo, t.wi) - inner.eval(wo, t.wi) * 0.3)
+                .abs()
+                .max_element()
+                < 1e-6
+        );
         assert!((m.pdf_sa(wo, t.wi) - inner.pdf_sa(wo, t.wi) * 0.3).abs() < 1e-6);
         // From behind a one-sided model: only the pass-through.
         let back = -wo;

@@ -213,7 +213,10 @@ impl<'a> Importer<'a> {
                 return Err(self.err(*second, "bsdf 'mask' takes one nested bsdf, not two"));
             }
         };
-        if let Some((c, b)) = textured.iter().find(|(_, b)| b.param != ColorParam::Opacity) {
+        if let Some((c, b)) = textured
+            .iter()
+            .find(|(_, b)| b.param != ColorParam::Opacity)
+        {
             return Err(self.err(
                 *c,
                 format!(

@@ -560,7 +560,9 @@ impl Writer<'_> {
                     self.roughness(r);
                 }
             }
-            MaterialDesc::Textured { .. } | MaterialDesc::TwoSided(_) | MaterialDesc::Mask { .. } => {
+            MaterialDesc::Textured { .. }
+            | MaterialDesc::TwoSided(_)
+            | MaterialDesc::Mask { .. } => {
                 unreachable!()
             }
         }
