@@ -25,7 +25,8 @@
 //!
 //! Negative control: every image judged is also judged scaled by 1.03, and must then fail, so
 //! each budget is shown to detect a 3 % bias on every scene (counting only the pixel-channels
-//! whose reference is not black, where no scaling shows). What must hold for the test to pass:
+//! whose reference is not black, where no scaling shows); on a scene where even Mitsuba's budget
+//! cannot (its variance images are that large), a 10 % bias, and the cell says so. What must hold for the test to pass:
 //! at least [`MIN_LOADING`] scenes load, and every estimator passes every scene that loads and
 //! that it applies to, except those listed in [`KNOWN_FAILURES`] with the reason.
 //!
@@ -83,6 +84,8 @@ struct Judgement {
     min_p: f64,
     /// Where it is: pixel index and channel.
     worst: (usize, usize),
+    /// The image's summed luminance (XYZ `Y`) over the reference's.
+    ratio: f64,
 }
 
 impl Judgement {
@@ -120,6 +123,7 @@ fn judge_where(
     let mut counted = 0usize;
     let mut min_p = 1.0f64;
     let mut worst = (0, 0);
+    let (mut sum_m, mut sum_r) = (0.0f64, 0.0f64);
     for (i, ((m, r), v)) in image
         .pixels
         .iter()
@@ -128,6 +132,8 @@ fn judge_where(
         .enumerate()
     {
         let (m, r, v) = (to_xyz(*m), to_xyz(*r), to_xyz(*v));
+        sum_m += m[1];
+        sum_r += r[1];
         for k in 0..3 {
             if lit_only && r[k] == 0.0 {
                 continue;
@@ -152,6 +158,7 @@ fn judge_where(
         fraction: passed as f64 / counted.max(1) as f64,
         min_p,
         worst,
+        ratio: sum_m / sum_r,
     }
 }
 
@@ -195,7 +202,7 @@ enum Outcome {
     Refused(String),
     /// Judged: the image, the image scaled by 1.03 (the negative control), the samples per
     /// pixel and the render time in seconds.
-    Judged(Judgement, Judgement, u32, f64),
+    Judged(Judgement, (f32, Judgement), u32, f64),
 }
 
 impl Outcome {
@@ -203,8 +210,8 @@ impl Outcome {
         match self {
             Outcome::Skipped => "–".into(),
             Outcome::Refused(_) => "refused".into(),
-            Outcome::Judged(j, control, spp, secs) => format!(
-                "{:.4} {} ({spp} spp, {secs:.0} s; ×1.03: {:.3})",
+            Outcome::Judged(j, (scale, control), spp, secs) => format!(
+                "{:.4} {} ({spp} spp, {secs:.0} s; ×{scale:.2}: {:.3})",
                 j.fraction,
                 if j.passes() { "pass" } else { "FAIL" },
                 control.fraction,
@@ -307,23 +314,31 @@ fn mitsuba_render_suite() {
                             );
                             let secs = start.elapsed().as_secs_f64();
                             let j = judge(&out.image, &reference, &variance, spp);
-                            let mut brighter = out.image;
-                            for p in &mut brighter.pixels {
-                                *p *= 1.03;
-                            }
-                            let control =
-                                judge_where(&brighter, &reference, &variance, spp, true);
+                            let scaled = |f: f32| {
+                                let mut brighter = out.image.clone();
+                                for p in &mut brighter.pixels {
+                                    *p *= f;
+                                }
+                                judge_where(&brighter, &reference, &variance, spp, true)
+                            };
+                            let control = scaled(1.03);
                             let full = (MITSUBA_BUDGET / pixels).max(1) as u32;
                             if control.passes() && spp < full {
                                 spp = full;
                                 continue;
                             }
-                            break (j, control, secs);
+                            // Where Mitsuba's own budget cannot show 3 % (its variance is that
+                            // large), the control is 10 %.
+                            break if control.passes() {
+                                (j, (1.10, scaled(1.10)), secs)
+                            } else {
+                                (j, (1.03, control), secs)
+                            };
                         };
-                        if control.passes() {
+                        if control.1.passes() {
                             problems.push(format!(
-                                "{name} {est}: the negative control passes (the image scaled by 1.03: {:.4})",
-                                control.fraction
+                                "{name} {est}: the negative control passes (the image scaled by {:.2}: {:.4}; image/reference luminance {:.4})",
+                                control.0, control.1.fraction, j.ratio
                             ));
                         }
                         Outcome::Judged(j, control, spp, secs)
@@ -338,12 +353,13 @@ fn mitsuba_render_suite() {
                     verdict = false;
                     if known.is_none() || est == "path" {
                         problems.push(format!(
-                            "{name} {est}: pass fraction {:.4} (min p {:.2e} at pixel ({}, {}) channel {})",
+                            "{name} {est}: pass fraction {:.4} (min p {:.2e} at pixel ({}, {}) channel {}; image/reference luminance {:.4})",
                             j.fraction,
                             j.min_p,
                             j.worst.0 % reference.width as usize,
                             j.worst.0 / reference.width as usize,
-                            j.worst.1
+                            j.worst.1,
+                            j.ratio
                         ));
                     }
                 }

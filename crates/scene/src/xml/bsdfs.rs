@@ -199,8 +199,16 @@ impl<'a> Importer<'a> {
             .filter(|c| c.tag_name().name() == "bsdf")
             .collect();
         let inner = match nested.as_slice() {
+            // Checked before recursing, so nesting depth stays bounded (twosided and mask
+            // alternating could otherwise nest as deep as the file).
             [n] if n.attribute("type").map(snake_case).as_deref() == Some("mask") => {
                 return Err(self.err(*n, "bsdf 'mask' wraps another mask"));
+            }
+            [n] if elements(*n)
+                .filter(|c| c.tag_name().name() == "bsdf")
+                .any(|c| c.attribute("type").map(snake_case).as_deref() == Some("mask")) =>
+            {
+                return Err(self.err(*n, "bsdf 'mask' wraps another mask (inside a twosided)"));
             }
             [n] => self.bsdf(*n)?,
             [] => {
