@@ -329,9 +329,8 @@ pub(crate) fn bsdf(m: &MaterialDesc) -> Result<Bsdf> {
                 return Err(MaterialError::NestedTextured);
             }
             for (i, t) in textures.iter().enumerate() {
-                if !allowed.contains(&t.param)
-                    && !(t.param == ColorParam::Opacity && is_mask(material))
-                {
+                let mask_opacity = t.param == ColorParam::Opacity && is_mask(material);
+                if !(allowed.contains(&t.param) || mask_opacity) {
                     return Err(MaterialError::NoSuchParameter {
                         param: t.param,
                         allowed,
