@@ -97,7 +97,7 @@ pub struct Bsdf {
     pub two_sided: bool,
     /// Mitsuba's `mask`: the model scatters with this probability, and light passes through
     /// unchanged otherwise (a delta transmission of weight `1 − opacity`, from both sides). 1 for
-    /// an opaque surface; in `[0, 1]`. See [`crate::models::mask`].
+    /// an opaque surface; in `[0, 1]`. See [`Bsdf::masked`].
     pub opacity: f32,
 }
 
