@@ -2,7 +2,7 @@
 # family_equal_time.sh — equal-time efficiency of an estimator against the path tracer on every
 # scene of a generated family (development only, not part of CI).
 #
-#   restir generate family --issue di --split test --out /tmp/di-test
+#   restir generate family --kind di --split test --out /tmp/di-test
 #   scripts/family_equal_time.sh /tmp/di-test [options]
 #
 # For each scene listed in DIR/family.txt it renders, interleaved, `--integrator path` and the
@@ -63,10 +63,10 @@ if [[ ! -x "$bin" ]]; then
     exit 2
 fi
 if [[ -z "$estimator" ]]; then
-    case "$(grep -m1 -o 'issue [a-z]*' "$dir/family.txt" | cut -d' ' -f2)" in
+    case "$(grep -m1 -o -- '--kind [a-z]*' "$dir/family.txt" | cut -d' ' -f2)" in
         di) estimator=restir-di ;;
         pt) estimator=restir-pt ;;
-        *) echo "family_equal_time.sh: cannot tell the family's issue from family.txt; give --estimator" >&2; exit 2 ;;
+        *) echo "family_equal_time.sh: cannot tell the family's kind from family.txt; give --estimator" >&2; exit 2 ;;
     esac
 fi
 

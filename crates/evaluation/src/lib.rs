@@ -10,7 +10,7 @@
 //!
 //! **Animation suites.** A suite scene with `frames` is a sequence: each configuration renders
 //! its frames in order with one estimator (made for the first frame's scene and told of each
-//! next frame's motion through [`FrameSequence`](restir_integrators::reuse::motion::FrameSequence), so temporal reuse carries across frames),
+//! next frame's motion through [`FrameSequence`](restir_integrators::FrameSequence), so temporal reuse carries across frames),
 //! every frame with the budget (equal time per frame), frame `n` of seed `s` with the seed
 //! `FrameSequence::seed(s, n)` as `restir render --frames` does. Every frame has its own
 //! cached reference. The records are per frame (relMSE against that frame's reference, and

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use restir_image::input::read_regular;
-use restir_integrators::reuse::motion::FrameSequence;
+use restir_integrators::FrameSequence;
 use restir_integrators::{Integrator, IntegratorOptions, RenderJob, make_integrator, render};
 use restir_scene::{LoadOptions, Scene, SceneDesc, load_scene};
 

@@ -4,7 +4,7 @@
 use std::time::{Duration, Instant};
 
 use restir_image::Image;
-use restir_integrators::reuse::motion::FrameSequence;
+use restir_integrators::FrameSequence;
 use restir_integrators::{Integrator, RenderJob, RenderOutput};
 use restir_scene::Scene;
 

@@ -76,13 +76,13 @@ pub struct SuiteScene {
 }
 
 /// A generated family of scenes in a suite: the training or test family of a study
-/// (`restir generate family --issue ISSUE --split SPLIT`), every member (or those listed) a
+/// (`restir generate family --kind ISSUE --split SPLIT`), every member (or those listed) a
 /// scene with the settings given here.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SuiteFamily {
     /// The study: `di` or `pt` (the still families).
-    pub issue: String,
+    pub kind: String,
     /// `train` or `test`.
     pub split: String,
     /// Indices of the members to render (default: all of them).
@@ -112,11 +112,11 @@ impl SuiteFamily {
         use restir_families::{Family, Split, members};
         let family = Family::ALL
             .into_iter()
-            .find(|i| i.name() == self.issue && !i.animated())
+            .find(|i| i.name() == self.kind && !i.animated())
             .ok_or_else(|| {
                 SuiteError::rule(format!(
-                    "family issue '{}': expected di or pt (the moving families are sequences)",
-                    self.issue
+                    "family kind '{}': expected di or pt (the moving families are sequences)",
+                    self.kind
                 ))
             })?;
         let split = match self.split.as_str() {
@@ -137,7 +137,7 @@ impl SuiteFamily {
                     all.get(i).cloned().ok_or_else(|| {
                         SuiteError::rule(format!(
                             "the {} {} family has members 0 to {}, not {i}",
-                            self.issue,
+                            self.kind,
                             self.split,
                             all.len() - 1
                         ))
@@ -277,11 +277,11 @@ impl Suite {
     }
 
     /// Writes the members of the suite's families that are not there yet into
-    /// `dir/<issue>-<split>/` (the scene and its assets, as `restir generate family` writes
+    /// `dir/<kind>-<split>/` (the scene and its assets, as `restir generate family` writes
     /// them) and appends each as a scene. Afterwards the suite has no families left.
     pub fn expand_families(&mut self, dir: &Path) -> Result<(), SuiteError> {
         for f in std::mem::take(&mut self.families) {
-            let out = dir.join(format!("{}-{}", f.issue, f.split));
+            let out = dir.join(format!("{}-{}", f.kind, f.split));
             for member in f.chosen()? {
                 let name = member.name();
                 let path = out.join(format!("{name}.ron"));
@@ -323,7 +323,7 @@ impl Suite {
             {
                 return Err(SuiteError::rule(format!(
                     "family {}-{}: reference_spp {spp}: expected 2 to 16777216",
-                    f.issue, f.split
+                    f.kind, f.split
                 )));
             }
         }
@@ -501,7 +501,7 @@ pub struct SuiteLines {
 impl SuiteLines {
     /// Finds the entries of `suite` (as parsed from `text`, before its families are expanded):
     /// a scene on the first line not yet taken that holds `path` and its quoted path, a family
-    /// on the line that holds `issue` and its quoted study, a configuration on the line that
+    /// on the line that holds `kind` and its quoted study, a configuration on the line that
     /// holds `label` and its quoted label.
     pub fn locate(suite: &Suite, text: &str, file: &Path) -> SuiteLines {
         let lines: Vec<&str> = text.lines().collect();
@@ -523,7 +523,7 @@ impl SuiteLines {
             .map(|s| find("path", &s.path.to_string_lossy(), true))
             .collect();
         for f in &suite.families {
-            let line = find("issue", &f.issue, true);
+            let line = find("kind", &f.kind, true);
             let members = f.chosen().map_or(0, |m| m.len());
             scenes.extend(std::iter::repeat_n(line, members));
         }
@@ -582,7 +582,7 @@ mod tests {
     #[test]
     fn families_expand_into_scenes() {
         let text = r#"(
-            families: [(issue: "di", split: "test", members: [0], width: 40, height: 30,
+            families: [(kind: "di", split: "test", members: [0], width: 40, height: 30,
                         integrators: ["path"])],
             integrators: [(label: "path", integrator: "path")],
             budgets: [0.5],
@@ -609,8 +609,8 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
 
         for (bad, says) in [
-            (r#"issue: "dj""#, "family issue 'dj': expected di or pt"),
-            (r#"issue: "di-motion""#, "family issue 'di-motion'"),
+            (r#"kind: "dj""#, "family kind 'dj': expected di or pt"),
+            (r#"kind: "di-motion""#, "family kind 'di-motion'"),
             (
                 r#"split: "validation""#,
                 "family split 'validation': expected train or test",
@@ -622,7 +622,7 @@ mod tests {
         ] {
             let key = bad.split(':').next().unwrap();
             let original = match key {
-                "issue" => r#"issue: "di""#,
+                "kind" => r#"kind: "di""#,
                 "split" => r#"split: "test""#,
                 _ => "members: [0]",
             };

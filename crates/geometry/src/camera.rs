@@ -47,18 +47,21 @@ impl core::fmt::Display for CameraError {
 
 impl std::error::Error for CameraError {}
 
-/// A perspective camera (pinhole or thin lens) with Mitsuba's conventions: in camera space the
-/// camera looks along `+z`, `+y` is up and `+x` is left (Mitsuba's `lookat` builds
-/// `left = up × dir`); film position `(0, 0)` is the top-left corner.
+/// A perspective camera (pinhole or thin lens) or an orthographic one, with Mitsuba's
+/// conventions: in camera space the camera looks along `+z`, `+y` is up and `+x` is left
+/// (Mitsuba's `lookat` builds `left = up × dir`); film position `(0, 0)` is the top-left corner.
 #[derive(Clone, Copy, Debug)]
 pub struct Camera {
     to_world: Mat4,
     from_world: Mat4,
     origin: Vec3,
+    /// Half the film's extent on the plane `z = 1` (perspective) or in camera space
+    /// (orthographic).
     tan_half: Vec2,
     resolution: (u32, u32),
     aperture_radius: f32,
     focus_distance: f32,
+    orthographic: bool,
 }
 
 impl Camera {
@@ -123,7 +126,23 @@ impl Camera {
             resolution,
             aperture_radius,
             focus_distance,
+            orthographic: false,
         })
+    }
+
+    /// Mitsuba 3's `orthographic` sensor
+    /// (<https://mitsuba.readthedocs.io/en/latest/src/generated/plugins_sensors.html#orthographic-camera-orthographic>):
+    /// parallel rays along camera `+z` from the plane `z = 0`, the film spanning `[−1, 1]` in
+    /// camera `x` and `[−1/aspect, 1/aspect]` in `y`, so `to_world`'s scale sets the extent.
+    pub fn orthographic(to_world: Mat4, resolution: (u32, u32)) -> Result<Self, CameraError> {
+        let mut cam = Self::perspective(to_world, 90.0, FovAxis::X, resolution)?;
+        cam.orthographic = true;
+        Ok(cam)
+    }
+
+    /// Whether the camera is orthographic.
+    pub fn is_orthographic(&self) -> bool {
+        self.orthographic
     }
 
     /// Film resolution `(width, height)`.
@@ -132,7 +151,8 @@ impl Camera {
     }
 
     /// The angle one pixel spans at the centre of the film, vertically (radians, small-angle):
-    /// the spread of a primary ray's cone.
+    /// the spread of a primary ray's cone (for an orthographic camera, the pixel's width in
+    /// camera units over a unit distance: its rays do not spread).
     pub fn pixel_angle(&self) -> f32 {
         2.0 * self.tan_half.y / self.resolution.1 as f32
     }
@@ -160,8 +180,9 @@ impl Camera {
             return None;
         }
         let (w, h) = self.resolution;
-        let x = local.x / (local.z * self.tan_half.x);
-        let y = local.y / (local.z * self.tan_half.y);
+        let z = if self.orthographic { 1.0 } else { local.z };
+        let x = local.x / (z * self.tan_half.x);
+        let y = local.y / (z * self.tan_half.y);
         let film = Vec2::new((1.0 - x) * 0.5 * w as f32, (1.0 - y) * 0.5 * h as f32);
         film.is_finite().then_some(film)
     }
@@ -177,6 +198,13 @@ impl Camera {
             (1.0 - 2.0 * s.y) * self.tan_half.y,
             1.0,
         );
+        if self.orthographic {
+            let o = self
+                .to_world
+                .transform_point3(Vec3::new(local.x, local.y, 0.0));
+            let d = self.to_world.transform_vector3(Vec3::Z).normalize();
+            return Ray::new(o, d);
+        }
         if self.aperture_radius > 0.0 {
             let lens = self.aperture_radius * restir_sampling::warp::sample_concentric_disk(u_lens);
             let focus = local * self.focus_distance;
@@ -239,6 +267,41 @@ mod tests {
             let ray = cam.generate_ray(Vec2::new(10.0, 10.0), Vec2::ZERO);
             assert!(cam.film_position_of(ray.o - ray.d).is_none());
         }
+    }
+
+    /// Parallel rays over `[−1, 1] × [−1/aspect, 1/aspect]` in camera space, scaled by
+    /// `to_world`; `film_position_of` inverts them. Negative control: the perspective camera
+    /// of the same transform sends diverging rays.
+    #[test]
+    fn orthographic_rays_are_parallel() {
+        let m = Mat4::from_rotation_translation(
+            glam::Quat::from_euler(glam::EulerRot::YXZ, 0.4, -0.3, 0.1),
+            Vec3::new(1.0, 2.0, 5.0),
+        ) * Mat4::from_scale(Vec3::new(1.5, 1.5, 1.0));
+        let cam = Camera::orthographic(m, (200, 120)).unwrap();
+        let persp = Camera::perspective(m, 90.0, FovAxis::X, (200, 120)).unwrap();
+        let a = cam.generate_ray(Vec2::new(0.0, 0.0), Vec2::ZERO);
+        let b = cam.generate_ray(Vec2::new(200.0, 120.0), Vec2::ZERO);
+        assert!((a.d - b.d).length() < 1e-6);
+        let local = |p: Vec3| m.inverse().transform_point3(p);
+        assert!(
+            (local(a.o) - Vec3::new(1.0, 0.6, 0.0)).length() < 1e-5,
+            "{}",
+            local(a.o)
+        );
+        assert!((local(b.o) - Vec3::new(-1.0, -0.6, 0.0)).length() < 1e-5);
+        // The world-space extent is the scale's: 3 across.
+        assert!(((a.o - b.o).length() - (3.0f32.powi(2) + 1.8f32.powi(2)).sqrt()).abs() < 1e-4);
+        for film in [Vec2::new(3.5, 9.25), Vec2::new(150.0, 60.0)] {
+            let r = cam.generate_ray(film, Vec2::ZERO);
+            let back = cam.film_position_of(r.o + 4.2 * r.d).unwrap();
+            assert!((back - film).length() < 1e-3, "{film} -> {back}");
+        }
+        let (pa, pb) = (
+            persp.generate_ray(Vec2::ZERO, Vec2::ZERO),
+            persp.generate_ray(Vec2::new(200.0, 120.0), Vec2::ZERO),
+        );
+        assert!((pa.d - pb.d).length() > 0.1);
     }
 
     #[test]

@@ -17,6 +17,8 @@
 //! assert!((si.p.z - 1.0).abs() < 1e-5);
 //! ```
 
+#![deny(missing_docs)]
+
 mod accel;
 mod camera;
 mod frame;

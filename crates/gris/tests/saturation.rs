@@ -1,4 +1,4 @@
-//! Finite in, finite out (issue 17): confidences saturate at `f32::MAX` instead of overflowing
+//! Finite in, finite out: confidences saturate at `f32::MAX` instead of overflowing
 //! and count unit increments past `2^24`; finalisation, source samples and whole GRIS steps never
 //! return an infinite confidence, weight or target from finite inputs; `1/Z` saturates instead of
 //! dropping to 0; the reconnection Jacobian from points is scale invariant.

@@ -25,6 +25,8 @@
 //! assert_eq!(m.nonfinite, 0);
 //! ```
 
+#![deny(missing_docs)]
+
 mod error;
 pub mod input;
 mod io;

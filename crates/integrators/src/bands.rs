@@ -1,5 +1,10 @@
-//! The parallel work items of a per-pixel pass (every estimator's loops over the image): bands of [`BAND_ROWS`] image rows, and the
-//! arithmetic from a band and a position in it to the pixel index.
+//! The parallel work items of a per-pixel pass (every estimator's loops over the image): bands
+//! of [`BAND_ROWS`] image rows, run in parallel over one or several per-pixel buffers at once
+//! ([`Bands::run`]), each band told the index of its first pixel.
+
+use rayon::iter::Zip;
+use rayon::prelude::*;
+use rayon::slice::ChunksMut;
 
 /// Image rows per parallel work item: small enough to balance the threads, large enough to
 /// amortise the per-item setup.
@@ -9,6 +14,33 @@ pub(crate) const BAND_ROWS: usize = 2;
 #[derive(Clone, Copy, Debug)]
 pub struct Bands {
     len: usize,
+}
+
+/// Per-pixel buffers cut into bands together: a mutable slice, or a pair of them (nest pairs
+/// for more: `((a, b), c)`). A band of a pair is the pair of the bands.
+pub trait BandBuffers: Send + Sized {
+    /// One band's part of the buffers.
+    type Band: Send;
+    /// The bands in order.
+    type Iter: IndexedParallelIterator<Item = Self::Band>;
+    /// Cuts the buffers into pieces of `len` items.
+    fn split(self, len: usize) -> Self::Iter;
+}
+
+impl<'a, T: Send> BandBuffers for &'a mut [T] {
+    type Band = &'a mut [T];
+    type Iter = ChunksMut<'a, T>;
+    fn split(self, len: usize) -> Self::Iter {
+        self.par_chunks_mut(len)
+    }
+}
+
+impl<A: BandBuffers, B: BandBuffers> BandBuffers for (A, B) {
+    type Band = (A::Band, B::Band);
+    type Iter = Zip<A::Iter, B::Iter>;
+    fn split(self, len: usize) -> Self::Iter {
+        self.0.split(len).zip(self.1.split(len))
+    }
 }
 
 impl Bands {
@@ -30,5 +62,30 @@ impl Bands {
     #[inline]
     pub fn first(self, band: usize) -> usize {
         band * self.len
+    }
+
+    /// Runs `f(first pixel, band)` on every band of `buffers` (one item per pixel) in parallel
+    /// and sums what it returns (rays traced).
+    pub fn run<B: BandBuffers>(
+        self,
+        buffers: B,
+        f: impl Fn(usize, B::Band) -> u64 + Sync + Send,
+    ) -> u64 {
+        self.run_strided(buffers, 1, f)
+    }
+
+    /// [`Bands::run`] over buffers with `per_pixel` items per pixel.
+    pub fn run_strided<B: BandBuffers>(
+        self,
+        buffers: B,
+        per_pixel: usize,
+        f: impl Fn(usize, B::Band) -> u64 + Sync + Send,
+    ) -> u64 {
+        let len = self.len;
+        buffers
+            .split(len * per_pixel)
+            .enumerate()
+            .map(|(band, b)| f(band * len, b))
+            .sum()
     }
 }

@@ -6,8 +6,9 @@
 use glam::DVec3;
 use restir_scene::Scene;
 
+use crate::pass::{Integrator, PassContext};
+use crate::path::PathIntegrator;
 use crate::path::PathSettings;
-use crate::render::{Integrator, PassContext, PathIntegrator};
 
 /// Whether a ReSTIR estimator may hand a scene that does not suit it to the path tracer
 /// (`fallback`).

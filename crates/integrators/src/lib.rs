@@ -33,30 +33,36 @@
 //! out.image.write("cbox.exr".as_ref()).unwrap();
 //! ```
 
+#![deny(missing_docs)]
+
 mod bands;
 pub mod fallback;
 pub mod film;
+pub mod motion;
 pub mod params;
+mod pass;
 pub mod path;
 mod render;
 mod renderer;
 pub mod restir_di;
 pub mod restir_pt;
 pub mod reuse;
+pub mod sequence;
 pub mod shadow;
 pub mod stages;
 
 /// The vector types of images and scenes (`Image::pixels` is a `Vec<glam::Vec3>`).
 pub use glam;
+pub use motion::FrameMotion;
 pub use params::{Param, ParamError, ParamSet, ParamSource, ParamValue};
-pub use render::{
-    CROP_ALIGN, Crop, Integrator, PassContext, PathIntegrator, PixelWindow, RenderJob,
-    RenderOutput, RenderPart, render, render_part,
-};
+pub use pass::{CROP_ALIGN, Crop, Integrator, PassContext, PixelWindow};
+pub use path::PathIntegrator;
+pub use render::{RenderJob, RenderOutput, RenderPart, render, render_part};
 pub use renderer::{RenderError, Renderer};
 pub use restir_di::{RestirDiIntegrator, RestirDiSettings};
 pub use restir_image::{ErrorMetrics, Image, ImageError, compare};
 pub use restir_pt::{RestirPtIntegrator, RestirPtSettings};
+pub use sequence::FrameSequence;
 
 use restir_scene::Scene;
 

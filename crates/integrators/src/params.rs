@@ -129,6 +129,8 @@ pub enum ParamProblem {
     NotAboveOne,
     /// A number outside `0 ..= 1`.
     NotFraction,
+    /// Not a number from 0 up to, but not including, 1.
+    NotBelowOne,
 }
 
 /// A parameter that could not be read: its name, its value as given and where it came from.
@@ -172,6 +174,9 @@ impl fmt::Display for ParamError {
             }
             ParamProblem::NotAboveOne => write!(f, "{name} = {v}: expected a number above 1"),
             ParamProblem::NotFraction => write!(f, "{name} = {v}: expected a number from 0 to 1"),
+            ParamProblem::NotBelowOne => {
+                write!(f, "{name} = {v}: expected a number from 0 to below 1")
+            }
         }
     }
 }

@@ -5,11 +5,13 @@
 //! unbounded); Russian roulette starts once `depth ≥ rr_depth` with survival probability
 //! `min(max(β)·η², 0.95)`.
 
-use glam::{Vec2, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 use restir_geometry::{Ray, offset_ray_origin};
 use restir_sampling::{Pcg32, warp::power_heuristic};
 use restir_scene::Scene;
 
+use crate::bands::Bands;
+use crate::pass::{Integrator, PassContext};
 use crate::shadow::{ShadowTarget, visible};
 
 /// Path tracer settings.
@@ -241,4 +243,43 @@ pub fn trace_camera_path(
     let u_lens = rng.next_2d();
     let ray = scene.camera.generate_ray(film, u_lens);
     trace_path(scene, settings, ray, 0, Vec3::ONE, None, rng)
+}
+
+/// The path tracer as an [`Integrator`].
+#[derive(Clone, Debug)]
+pub struct PathIntegrator {
+    /// Settings.
+    pub settings: PathSettings,
+}
+
+impl Integrator for PathIntegrator {
+    fn name(&self) -> &'static str {
+        "path"
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "path max_depth={} rr_depth={}",
+            self.settings.max_depth, self.settings.rr_depth
+        )
+    }
+
+    fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
+        let (w, _) = ctx.resolution(scene);
+        let w = w as usize;
+        let bands = Bands::new(w);
+        bands.run(accum, |first, chunk| {
+            let mut rays = 0;
+            for (i, px) in chunk.iter_mut().enumerate() {
+                let index = first + i;
+                let (x, y) = ((index % w) as u32, (index / w) as u32);
+                let mut rng = ctx.pixel_rng(index);
+                let film = ctx.film_position(x, y, &mut rng);
+                let (l, r) = trace_camera_path(scene, &self.settings, film, &mut rng);
+                *px += l.as_dvec3();
+                rays += r;
+            }
+            rays
+        })
+    }
 }

@@ -20,11 +20,11 @@
 use std::sync::Arc;
 
 use restir_gris::ShiftMap;
+use restir_integrators::FrameMotion;
 use restir_integrators::film::Filter;
 use restir_integrators::path::PathSettings;
 use restir_integrators::reuse::ReuseSettings;
 use restir_integrators::reuse::gbuffer::GBuffer;
-use restir_integrators::reuse::motion::FrameMotion;
 use restir_integrators::{
     Image, IntegratorOptions, Param, ParamSource, PassContext, RestirPtIntegrator,
     RestirPtSettings, make_integrator,
@@ -343,7 +343,7 @@ fn motion_vectors_find_the_previous_hit() {
         .collect();
     let same = hits
         .iter()
-        .filter(|&&i| still.previous_pixel(&now, i, &before, &settings) == Some(i))
+        .filter(|&&i| now.previous_pixel(i, &still, &before, &settings) == Some(i))
         .count();
     assert!(
         same * 100 >= hits.len() * 95,
@@ -357,7 +357,7 @@ fn motion_vectors_find_the_previous_hit() {
     let mut box_missed = 0;
     for &i in &hits {
         let r = now.receiver(i).unwrap();
-        match motion.previous_pixel(&now, i, &prev, &settings) {
+        match now.previous_pixel(i, &motion, &prev, &settings) {
             Some(q) => {
                 found += 1;
                 let moved = motion.point_to_prev(now.shape[i], r.p);

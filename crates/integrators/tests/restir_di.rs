@@ -10,7 +10,7 @@
 
 use std::sync::atomic::AtomicBool;
 
-use restir_integrators::restir_di::LightSampler;
+use restir_integrators::restir_di::{Learn, LightSampler};
 use restir_integrators::reuse::MIS_NAMES;
 use restir_integrators::{
     IntegratorOptions, RenderJob, RestirDiIntegrator, RestirDiSettings, make_integrator, render,
@@ -67,10 +67,21 @@ fn statistics(
 /// Per block, as [`statistics`], for settings no parameter string reaches (the hidden negative
 /// controls): one pass per render.
 fn settings_statistics(scene: &Scene, settings: RestirDiSettings, seeds: u64) -> Vec<(f64, f64)> {
-    let integrator = RestirDiIntegrator::new(settings);
+    settings_statistics_spp(scene, settings, 1, seeds)
+}
+
+/// As [`settings_statistics`] with `spp` passes per render (a fresh integrator per render, so
+/// nothing learned carries from one render to the next).
+fn settings_statistics_spp(
+    scene: &Scene,
+    settings: RestirDiSettings,
+    spp: u32,
+    seeds: u64,
+) -> Vec<(f64, f64)> {
     let render_one = |seed| {
+        let integrator = RestirDiIntegrator::new(settings);
         let job = RenderJob {
-            spp: 1,
+            spp,
             seed,
             ..RenderJob::default()
         };
@@ -293,6 +304,7 @@ fn same_image_for_one_and_two_threads() {
     for params in [
         &[][..],
         &[("temporal", "true"), ("spatial_rounds", "2")][..],
+        &[("learn", "on")][..],
     ] {
         let a = run(1, params);
         let b = run(2, params);
@@ -429,4 +441,38 @@ fn dominant_light_falls_back_to_the_path_tracer() {
     let z = max_z(&statistics(&scene, "restir-di", &[], 1, 200), &reference);
     eprintln!("fallback: max |z| = {z:.2}");
     assert!(z < Z_MAX, "fallback: max |z| = {z:.2}");
+}
+
+/// Learning across passes (`learn = on`): from the second pass of a render on, candidates come
+/// from a mixture of what lights delivered to the receiver's cell in the earlier passes and the
+/// power sampler. Renders of 8 passes (seven of them drawing from what was learned), alone and
+/// with two rounds of reuse and shading-time visibility, match the path tracer; the negative
+/// control — candidates weighted by the cell's table alone, forgetting the power sampler's
+/// defensive share — fails the same test.
+#[test]
+fn learning_across_passes_is_unbiased_and_a_pmf_without_the_defensive_share_is_caught() {
+    let scene = scene();
+    let reference = direct_reference(&scene);
+    for params in [
+        &[("learn", "on")][..],
+        &[
+            ("learn", "on"),
+            ("spatial_rounds", "2"),
+            ("visibility", "shading"),
+        ][..],
+    ] {
+        let z = max_z(&statistics(&scene, "restir-di", params, 8, 100), &reference);
+        eprintln!("{params:?}: max |z| = {z:.2}");
+        assert!(z < Z_MAX, "{params:?}: max |z| = {z:.2}");
+    }
+    let mut wrong =
+        RestirDiSettings::new(restir_integrators::path::PathSettings::from_scene(&scene));
+    wrong.light_sampler = LightSampler::Power;
+    wrong.learn = Learn::WithoutDefensiveShare;
+    let z = max_z(&settings_statistics_spp(&scene, wrong, 8, 100), &reference);
+    eprintln!("learned without the defensive share: max |z| = {z:.2}");
+    assert!(
+        z > 2.0 * Z_MAX,
+        "a pmf forgetting the defensive share should be visibly biased, max |z| = {z:.2}"
+    );
 }

@@ -392,7 +392,7 @@ fn unbiased_against_the_path_tracer() {
     assert!(z > Z_MAX, "J = 1 should be biased: {z:.2}");
 }
 
-/// The quality-per-sample options (issue 15, goal 5) against the path tracer: symmetric
+/// The quality-per-sample options against the path tracer: symmetric
 /// Jacobian rejection and the footprint reconnection rule, alone and together; and their
 /// negative controls: a rejection of `J > τ` only (not symmetric, so a shift can succeed while
 /// its inverse fails) and the footprint rule without the Jacobian.

@@ -7,6 +7,7 @@
 //! | `set.rs` | [`LightSet`]: every light of a scene with the shapes area lights lie on (emitters know their shapes, as in Mitsuba 3's scene, so no caller hands the shape list around), each light's power, the environment's share of selections |
 //! | `select.rs` | which light: the power sampler ([`LightSet::sample`], [`LightSet::select`], [`LightSet::pmf`]) over one flat emitter table (`table.rs`: every emissive triangle, every other light), and the light hierarchy over the same entries (`bvh.rs`: [`LightSet::sample_hierarchy`], [`LightSet::hierarchy_pmf`]) |
 //! | `point.rs` | a light sample named without its receiver ([`LightPoint`], what a reservoir holds), resolved in world space ([`LightSet::resolve`], [`Resolved`]) and seen from a receiver ([`Contact`]) |
+//! | `learned.rs` | a selection learned across passes: per cell of a world-space grid, what each light delivered after its shadow ray ([`LightRecords`]), sampled in a mixture with the power sampler with its exact probability ([`LearnedSampler`]) |
 //! | `presample.rs` | samples drawn without a receiver ([`LightSet::presample`], [`Presampled`]), for pools of presampled candidates |
 //!
 //! [`LightSet::sample`] returns a [`LightSample`] whose `pdf_sa` already includes the selection
@@ -16,8 +17,11 @@
 //! Measures: `pdf_sa` is per unit solid angle at the receiving point; for delta lights (point,
 //! directional) it is the discrete selection probability and `delta` is set.
 
+#![deny(missing_docs)]
+
 mod bvh;
 mod envmap;
+mod learned;
 mod light;
 mod point;
 mod presample;
@@ -26,6 +30,7 @@ mod set;
 mod table;
 
 pub use envmap::{EnvMap, EnvMapError};
+pub use learned::{CellKey, LearnGrid, LearnedSampler, LightRecords};
 pub use light::{Light, LightSample};
 pub use point::{Contact, LightPoint, Resolved};
 pub use presample::Presampled;

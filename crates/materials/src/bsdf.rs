@@ -86,7 +86,8 @@ impl BsdfKind {
     }
 }
 
-/// A BSDF: a model and whether it is mirrored onto the back side (Mitsuba `twosided`).
+/// A BSDF: a model, whether it is mirrored onto the back side (Mitsuba `twosided`) and its
+/// opacity (Mitsuba `mask`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bsdf {
     /// The model.
@@ -94,12 +95,17 @@ pub struct Bsdf {
     /// When set, a `wo` below the surface sees the model mirrored to the back side. Has no
     /// effect on transmitting models, which are two-sided by nature.
     pub two_sided: bool,
+    /// Mitsuba's `mask`: the model scatters with this probability, and light passes through
+    /// unchanged otherwise (a delta transmission of weight `1 − opacity`, from both sides). 1 for
+    /// an opaque surface; in `[0, 1]`. See [`Bsdf::masked`].
+    pub opacity: f32,
 }
 
 fn one_sided(kind: BsdfKind) -> Bsdf {
     Bsdf {
         kind,
         two_sided: false,
+        opacity: 1.0,
     }
 }
 
@@ -115,6 +121,8 @@ pub struct ReflectanceParams {
     pub transmittance: Vec3,
     /// The plastics' `nonlinear` flag (it decides how `diffuse` is precomputed).
     pub nonlinear: bool,
+    /// The opacity of a `mask` (1 for an opaque surface).
+    pub opacity: f32,
 }
 
 impl Bsdf {
@@ -263,7 +271,26 @@ impl Bsdf {
             }
             k @ (BsdfKind::Null | BsdfKind::Black) => k,
         };
-        Self { kind, ..*self }
+        Self {
+            kind,
+            opacity: crate::models::mask::clamp_opacity(p.opacity),
+            ..*self
+        }
+    }
+
+    /// The same model behind Mitsuba's `mask` of opacity `opacity` (clamped to `[0, 1]`, as
+    /// Mitsuba clamps it).
+    pub fn masked(self, opacity: f32) -> Self {
+        Self {
+            opacity: crate::models::mask::clamp_opacity(opacity),
+            ..self
+        }
+    }
+
+    /// Whether the surface lets some light pass through unchanged (a `mask` below opacity 1).
+    #[inline]
+    pub fn is_masked(&self) -> bool {
+        self.opacity < 1.0
     }
 
     /// The same model, visible from both sides (no effect on transmitting models).
@@ -276,6 +303,14 @@ impl Bsdf {
 
     /// Every lobe the BSDF has.
     pub fn flags(&self) -> LobeFlags {
+        if self.is_masked() {
+            return self.model_flags() | TRANSMIT_DELTA;
+        }
+        self.model_flags()
+    }
+
+    /// The lobes of the model (without the pass-through of a mask).
+    fn model_flags(&self) -> LobeFlags {
         match self.kind {
             BsdfKind::Diffuse { .. } => REFLECT_DIFFUSE,
             BsdfKind::Conductor { .. } => REFLECT_DELTA,
@@ -291,7 +326,7 @@ impl Bsdf {
 
     /// Whether light sampling can help: the BSDF has a lobe that `eval` can evaluate.
     pub fn has_smooth_lobe(&self) -> bool {
-        self.flags()
+        self.model_flags()
             .intersects(LobeFlags::DIFFUSE | LobeFlags::GLOSSY)
     }
 
@@ -314,6 +349,15 @@ impl Bsdf {
     /// `f(wo, wi) · |cos θi|`; zero for delta lobes and for directions the model does not reach.
     #[inline]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if self.is_masked() {
+            return self.eval_model(wo, wi) * self.opacity;
+        }
+        self.eval_model(wo, wi)
+    }
+
+    /// [`Bsdf::eval`] of the model alone.
+    #[inline]
+    fn eval_model(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         let (v, l) = self.orient(wo, wi);
         finite_or_zero(match &self.kind {
             BsdfKind::Diffuse { reflectance } => diffuse::eval(*reflectance, v, l),
@@ -348,6 +392,15 @@ impl Bsdf {
     /// Solid-angle density with which [`Bsdf::sample`] returns `wi`; zero for delta lobes.
     #[inline]
     pub fn pdf_sa(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if self.is_masked() {
+            return self.pdf_model(wo, wi) * self.opacity;
+        }
+        self.pdf_model(wo, wi)
+    }
+
+    /// [`Bsdf::pdf_sa`] of the model alone.
+    #[inline]
+    fn pdf_model(&self, wo: Vec3, wi: Vec3) -> f32 {
         let (v, l) = self.orient(wo, wi);
         finite_pdf(match &self.kind {
             BsdfKind::Diffuse { .. } => diffuse::pdf(v, l),
@@ -368,6 +421,17 @@ impl Bsdf {
     /// nothing is scattered (below a one-sided surface, an absorber, or a zero-pdf direction).
     #[inline]
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        if self.is_masked() {
+            return crate::models::mask::sample(self.opacity, wo, u_lobe, |u_lobe| {
+                self.sample_model(wo, u_lobe, u)
+            });
+        }
+        self.sample_model(wo, u_lobe, u)
+    }
+
+    /// [`Bsdf::sample`] of the model alone.
+    #[inline]
+    fn sample_model(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         let flip = self.flips(wo);
         let v = if flip {
             Vec3::new(wo.x, wo.y, -wo.z)
@@ -454,6 +518,7 @@ mod tests {
                 specular: s1,
                 transmittance: t1,
                 nonlinear,
+                opacity: 1.0,
             };
             let pairs = [
                 (Bsdf::diffuse(d0), Bsdf::diffuse(d1)),

@@ -60,6 +60,8 @@
 //! assert!((bsdf.pdf_sa(wo, s.wi) - s.pdf_sa).abs() < 1e-5);
 //! ```
 
+#![deny(missing_docs)]
+
 mod bsdf;
 pub mod fresnel;
 pub mod ior;

@@ -125,6 +125,32 @@ fn cases() -> Vec<Case> {
         albedo: Some(Vec3::ONE),
         eta: 1.0,
     });
+    // Masks: the model with probability `opacity`, a pass-through (delta) otherwise.
+    v.push(Case {
+        name: "mask 0.3 of two-sided diffuse",
+        bsdf: Bsdf::diffuse(Vec3::new(0.8, 0.5, 0.2))
+            .two_sided()
+            .masked(0.3),
+        mass: Mass::AtMostOne,
+        albedo: Some(Vec3::new(0.8, 0.5, 0.2) * 0.3 + Vec3::splat(0.7)),
+        eta: 1.0,
+    });
+    v.push(Case {
+        // (Not around a transmitting model: the furnace's energy factor assumes every
+        // transmission refracts.)
+        name: "mask 0.6 of two-sided rough conductor",
+        bsdf: Bsdf::rough_conductor(
+            gold.0,
+            gold.1,
+            Vec3::ONE,
+            Microfacet::new(Distribution::Ggx, 0.3),
+        )
+        .two_sided()
+        .masked(0.6),
+        mass: Mass::AtMostOne,
+        albedo: None,
+        eta: 1.0,
+    });
     v.push(Case {
         name: "plastic",
         bsdf: Bsdf::plastic(pp, Vec3::new(0.2, 0.5, 0.8), Vec3::ONE, false),
@@ -496,6 +522,19 @@ fn rejected(what: &str, outcome: Result<Chi2Outcome, Chi2Error>) {
     let o = outcome.unwrap_or_else(|e| panic!("{what}: expected a p-value, got {e}"));
     eprintln!("{what}: {o}");
     assert!(o.p_value < 1e-6, "{what}: a wrong pdf passed: {o}");
+}
+
+/// A mask's samples against its model's pdf, as if `pdf_sa` had forgotten the opacity.
+#[test]
+fn control_mask_vs_unmasked_pdf() {
+    let grid = SphereGrid::default();
+    let inner = Bsdf::diffuse(Vec3::ONE).two_sided();
+    let wo = Vec3::new(0.3, 0.2, 0.93).normalize();
+    let hist = sample_histogram(&grid, &inner.masked(0.8), wo, 98, SAMPLES);
+    rejected(
+        "mask samples vs the unmasked pdf",
+        hist.chi2(&pdf_cells(&grid, &inner, wo)),
+    );
 }
 
 /// Diffuse samples against the uniform-hemisphere pdf, as if `pdf_sa` had forgotten the cosine.

@@ -24,6 +24,8 @@
 //! assert!(wi.z >= 0.0 && pdf_sa >= 0.0);
 //! ```
 
+#![deny(missing_docs)]
+
 mod distribution;
 pub mod hash;
 mod rng;

@@ -78,6 +78,7 @@ fn material(
         diffuse: None,
         specular: None,
         transmittance: None,
+        opacity: None,
     };
     for b in bindings {
         let id = Some(cache.get(&b.texture, base_dir)?);
@@ -85,6 +86,7 @@ fn material(
             ColorParam::Reflectance | ColorParam::DiffuseReflectance => t.diffuse = id,
             ColorParam::SpecularReflectance => t.specular = id,
             ColorParam::SpecularTransmittance => t.transmittance = id,
+            ColorParam::Opacity => t.opacity = id,
         }
     }
     Ok((bsdf, Some(t)))
@@ -277,14 +279,18 @@ impl Scene {
             FovAxis::Smaller => GeoFovAxis::Smaller,
             FovAxis::Larger => GeoFovAxis::Larger,
         };
-        let camera = Camera::thin_lens(
-            cam_m,
-            desc.camera.fov,
-            fov_axis,
-            (w, h),
-            desc.camera.aperture_radius,
-            desc.camera.focus_distance,
-        )
+        let camera = if desc.camera.orthographic {
+            Camera::orthographic(cam_m, (w, h))
+        } else {
+            Camera::thin_lens(
+                cam_m,
+                desc.camera.fov,
+                fov_axis,
+                (w, h),
+                desc.camera.aperture_radius,
+                desc.camera.focus_distance,
+            )
+        }
         .map_err(|e| whole(format!("camera: {e}")))?;
         match desc.film.filter {
             FilterDesc::Box => {}

@@ -21,6 +21,8 @@
 //! assert_eq!(scene.camera.resolution(), (32, 32));
 //! ```
 
+#![deny(missing_docs)]
+
 pub mod animation;
 mod build;
 pub mod desc;
@@ -186,6 +188,8 @@ pub struct TexturedParams {
     pub specular: Option<u32>,
     /// Texture of `specular_transmittance`.
     pub transmittance: Option<u32>,
+    /// Texture of a `mask`'s `opacity` (its luminance, as Mitsuba's scalar lookup).
+    pub opacity: Option<u32>,
 }
 
 impl TexturedParams {
@@ -201,6 +205,10 @@ impl TexturedParams {
             specular: look(self.specular, self.base.specular),
             transmittance: look(self.transmittance, self.base.transmittance),
             nonlinear: self.base.nonlinear,
+            opacity: match self.opacity {
+                Some(i) => restir_sampling::luminance(textures[i as usize].eval(uv)),
+                None => self.base.opacity,
+            },
         }
     }
 }

@@ -71,6 +71,13 @@ pub enum MaterialError {
         /// The parameter.
         param: ColorParam,
     },
+    /// A `mask` directly inside a `mask`.
+    NestedMask,
+    /// A `mask` opacity outside `[0, 1]` (or not finite).
+    BadOpacity {
+        /// Its value.
+        value: f32,
+    },
 }
 
 impl core::fmt::Display for MaterialError {
@@ -127,6 +134,10 @@ impl core::fmt::Display for MaterialError {
             }
             MaterialError::TwoTextures { param } => {
                 write!(f, "two textures for '{}'", param.name())
+            }
+            MaterialError::NestedMask => f.write_str("a mask cannot wrap another mask"),
+            MaterialError::BadOpacity { value } => {
+                write!(f, "mask opacity {value} must lie in [0, 1]")
             }
         }
     }
@@ -302,14 +313,24 @@ pub(crate) fn bsdf(m: &MaterialDesc) -> Result<Bsdf> {
             b.two_sided()
         }
         MaterialDesc::Black => Bsdf::black(),
+        MaterialDesc::Mask { opacity, material } => {
+            if matches!(**material, MaterialDesc::Mask { .. }) {
+                return Err(MaterialError::NestedMask);
+            }
+            if !(0.0..=1.0).contains(opacity) {
+                return Err(MaterialError::BadOpacity { value: *opacity });
+            }
+            bsdf(material)?.masked(*opacity)
+        }
         MaterialDesc::Textured { material, textures } => {
             let b = bsdf(material)?;
             let allowed = color_params(material);
-            if matches!(**material, MaterialDesc::Textured { .. }) {
+            if contains_textured(material) {
                 return Err(MaterialError::NestedTextured);
             }
             for (i, t) in textures.iter().enumerate() {
-                if !allowed.contains(&t.param) {
+                let mask_opacity = t.param == ColorParam::Opacity && is_mask(material);
+                if !(allowed.contains(&t.param) || mask_opacity) {
                     return Err(MaterialError::NoSuchParameter {
                         param: t.param,
                         allowed,
@@ -340,7 +361,29 @@ pub(crate) fn color_params(m: &MaterialDesc) -> &'static [ColorParam] {
         }
         MaterialDesc::TwoSided(inner) => color_params(inner),
         MaterialDesc::Textured { material, .. } => color_params(material),
+        MaterialDesc::Mask { material, .. } => color_params(material),
         MaterialDesc::Null | MaterialDesc::Black => &[],
+    }
+}
+
+/// Whether `m` is textured, or wraps (in `twosided` or `mask`) a textured material.
+fn contains_textured(m: &MaterialDesc) -> bool {
+    match m {
+        MaterialDesc::Textured { .. } => true,
+        MaterialDesc::TwoSided(inner)
+        | MaterialDesc::Mask {
+            material: inner, ..
+        } => contains_textured(inner),
+        _ => false,
+    }
+}
+
+/// Whether `m` is a `mask` (perhaps inside `twosided`), whose opacity a texture may give.
+pub(crate) fn is_mask(m: &MaterialDesc) -> bool {
+    match m {
+        MaterialDesc::Mask { .. } => true,
+        MaterialDesc::TwoSided(inner) => is_mask(inner),
+        _ => false,
     }
 }
 
@@ -352,12 +395,17 @@ pub(crate) fn colors(m: &MaterialDesc) -> (ReflectanceParams, &[TextureBinding])
         specular: v3(&defaults::SPECULAR),
         transmittance: v3(&defaults::SPECULAR),
         nonlinear: false,
+        opacity: 1.0,
     };
     let mut bindings: &[TextureBinding] = &[];
     let mut m = m;
     loop {
         match m {
             MaterialDesc::TwoSided(inner) => m = inner,
+            MaterialDesc::Mask { opacity, material } => {
+                p.opacity = *opacity;
+                m = material;
+            }
             MaterialDesc::Textured { material, textures } => {
                 bindings = textures;
                 m = material;

@@ -274,3 +274,47 @@ fn sphere_texture_coordinates() {
     assert_eq!(at(Vec3::new(3.0, 0.3, 1.2)), Vec3::ONE);
     assert_eq!(at(Vec3::new(0.3, -3.0, 1.2)), Vec3::ZERO);
 }
+
+/// A `mask` with a textured opacity around a twosided textured diffuse: both textures reach the
+/// BSDF at a hit (the opacity is the texel's luminance), and a constant opacity stays put.
+#[test]
+fn textured_mask_opacity() {
+    let dir = dir_with_png("mask");
+    let path = write_scene(
+        &dir,
+        "s.xml",
+        r#"    <texture type="bitmap" id="quad"><string name="filename" value="quad.png"/><boolean name="raw" value="true"/></texture>
+    <bsdf type="mask" id="leaf">
+        <ref name="opacity" id="quad"/>
+        <bsdf type="twosided"><bsdf type="diffuse"><ref name="reflectance" id="quad"/></bsdf></bsdf>
+    </bsdf>
+    <bsdf type="mask" id="half"><bsdf type="diffuse"/></bsdf>
+    <shape type="rectangle"><ref id="leaf"/></shape>
+    <shape type="rectangle"><transform name="to_world"><translate x="3"/></transform><ref id="half"/></shape>"#,
+    );
+    let loaded = load_scene(&path, &LoadOptions::default()).unwrap();
+    let scene = &loaded.scene;
+    let at = |x: f32, y: f32| {
+        let si = scene
+            .intersect(&Ray::new(Vec3::new(x, y, 5.0), -Vec3::Z))
+            .expect("hit");
+        scene.bsdf(&si)
+    };
+    // Top-left texel red, top-right green, bottom-right white.
+    let red = at(-0.5, -0.5);
+    assert_eq!(diffuse_reflectance(red.kind), Vec3::X);
+    assert!(red.two_sided);
+    assert!((red.opacity - 0.212_671).abs() < 1e-4, "{}", red.opacity);
+    assert!((at(0.5, -0.5).opacity - 0.715_160).abs() < 1e-4);
+    assert_eq!(at(0.5, 0.5).opacity, 1.0);
+    assert_eq!(at(3.0, 0.0).opacity, 0.5);
+    match &loaded.desc.materials[0].material {
+        MaterialDesc::Textured { material, textures } => {
+            assert!(matches!(**material, MaterialDesc::Mask { .. }));
+            let params: Vec<ColorParam> = textures.iter().map(|t| t.param).collect();
+            assert_eq!(params, [ColorParam::Reflectance, ColorParam::Opacity]);
+        }
+        m => panic!("{m:?}"),
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -11,7 +11,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use restir_integrators::reuse::motion::FrameSequence;
+use restir_integrators::FrameSequence;
 use restir_integrators::{Integrator, IntegratorOptions, RenderJob, make_integrator, render};
 use restir_scene::SceneDesc;
 use restir_scene::animation::FRAME_REBUILDS;

@@ -267,7 +267,7 @@ pub struct FamilyArgs {
     /// the same under motion, di-motion and pt-motion (camera, objects and lights move over 2 s
     /// at 12 fps, frames 0..23).
     #[arg(long, value_parser = ["di", "pt", "di-motion", "pt-motion"])]
-    issue: String,
+    kind: String,
     /// train (seeds 1..) or test (seeds 101..).
     #[arg(long, value_parser = ["train", "test"])]
     split: String,
@@ -405,11 +405,11 @@ fn write_one(params: &Params, seed: u64, output: Option<PathBuf>) -> Result<(), 
 fn write_family(args: &FamilyArgs) -> Result<(), String> {
     let family = Family::ALL
         .into_iter()
-        .find(|i| i.name() == args.issue)
+        .find(|i| i.name() == args.kind)
         .ok_or_else(|| {
             format!(
-                "--issue {}: expected di, pt, di-motion or pt-motion",
-                args.issue
+                "--kind {}: expected di, pt, di-motion or pt-motion",
+                args.kind
             )
         })?;
     let split = if args.split == "train" {
@@ -450,7 +450,7 @@ fn write_family(args: &FamilyArgs) -> Result<(), String> {
         return Ok(());
     }
     let mut index = format!(
-        "# The {} {} family: written by `restir generate family --issue {} --split {} --out DIR`.\n\
+        "# The {} {} family: written by `restir generate family --kind {} --split {} --out DIR`.\n\
          # Regenerate rather than edit. One line per scene: file, seed, kind and parameters.\n\
          # Training seeds start at 1, test seeds at 101 (the splits never share a scene).\n",
         family.name(),

@@ -145,6 +145,23 @@ struct RestirArgs {
     /// every light count measured so far) [default: auto].
     #[arg(long)]
     light_sampler: Option<String>,
+    /// restir-di: on draws candidates' lights, from the second pass on, from a mixture of the
+    /// power sampler and what each light delivered (after its shadow ray) to a cell of a
+    /// world-space grid in earlier passes; off uses the light sampler alone [default: off].
+    #[arg(long)]
+    learn: Option<String>,
+    /// restir-di with --learn on: the share of candidate selections drawn from the learned
+    /// tables, from 0 to below 1 (the rest from the power sampler) [default: 0.5].
+    #[arg(long)]
+    learn_share: Option<f32>,
+    /// restir-di with --learn on: cells of the learning grid per scene diameter, along each
+    /// axis [default: 16].
+    #[arg(long)]
+    learn_cells: Option<f32>,
+    /// restir-di with --learn on: a cell with this many records draws half of --learn-share
+    /// from its table (n records: learn_share·n/(n + learn_prior)) [default: 64].
+    #[arg(long)]
+    learn_prior: Option<f32>,
     /// auto hands a scene that does not suit the estimator to the path tracer when no other
     /// option of it is given (restir-di: a few emitters with one dominant light; restir-pt:
     /// fewer than 5% of the camera's paths reconnect at a glossy surface); off never does
@@ -232,6 +249,10 @@ impl RestirArgs {
             "light_sampler",
             self.light_sampler.clone().map(ParamValue::Text),
         );
+        put("learn", self.learn.clone().map(ParamValue::Text));
+        put("learn_share", self.learn_share.map(ParamValue::Number));
+        put("learn_cells", self.learn_cells.map(ParamValue::Number));
+        put("learn_prior", self.learn_prior.map(ParamValue::Number));
         put("fallback", self.fallback.clone().map(ParamValue::Text));
         put(
             "bsdf_candidates",

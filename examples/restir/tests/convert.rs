@@ -77,7 +77,7 @@ fn written_xml_renders_the_image_of_its_scene() {
     let d = dir.0.to_str().unwrap();
     // A room with a window (an environment map file) and a checkerboard, written with its XML.
     ok(&[
-        "generate", "family", "--issue", "pt", "--split", "test", "--out", d, "--index", "1",
+        "generate", "family", "--kind", "pt", "--split", "test", "--out", d, "--index", "1",
         "--xml",
     ]);
     let ron = dir.0.join("pt-test-01-room-glass-none-window-s102.ron");
@@ -177,7 +177,7 @@ fn what_cannot_be_written_is_an_error() {
         &[
             "generate",
             "family",
-            "--issue",
+            "--kind",
             "pt-motion",
             "--split",
             "test",

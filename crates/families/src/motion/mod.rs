@@ -322,7 +322,7 @@ pub fn animate(generated: &mut Generated, kind: Kind, seed: u64) -> Result<(), G
     restir_scene::animation::attach(&mut generated.desc, anim, "", 0)
         .map_err(|e| GenerateError::Animation(e.message))?;
     generated.header.push_str(&format!(
-        "\nAnimated (issue 19): {FPS} fps over {DURATION} s, render with --frames 0..23:\n{}.",
+        "\nAnimated: {FPS} fps over {DURATION} s, render with --frames 0..23:\n{}.",
         summary.0.join(";\n")
     ));
     Ok(())

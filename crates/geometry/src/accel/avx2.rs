@@ -44,9 +44,17 @@ fn load(x: &[f32; 8]) -> __m256 {
 }
 
 /// The triangle distances and barycentrics `(u, v)` of a block (Möller–Trumbore, the scalar
-/// test's operations lane by lane) and the mask of lanes hit with `0 < t < t_max`.
+/// test's operations lane by lane) and the mask of the `lanes` hit with `0 < t < t_max`; `None`
+/// when none is. Once the first barycentric has been tested, a block whose asked-for lanes have
+/// all failed returns at once (most leaf tests on a ray's way miss every triangle): the second
+/// half of the test is skipped, the answer is the same.
 #[inline(always)]
-fn block_t(b: &TriBlock, r: &TRay, t_max: f32) -> (__m256, __m256, __m256, i32) {
+fn block_t(
+    b: &TriBlock,
+    r: &TRay,
+    t_max: f32,
+    lanes: u32,
+) -> Option<(__m256, __m256, __m256, u32)> {
     // SAFETY: arithmetic intrinsics only; AVX2 is guaranteed by the callers.
     unsafe {
         let (ox, oy, oz) = (splat(r.o.x), splat(r.o.y), splat(r.o.z));
@@ -71,6 +79,9 @@ fn block_t(b: &TriBlock, r: &TRay, t_max: f32) -> (__m256, __m256, __m256, i32) 
         let u = mul(add(add(mul(tx, px), mul(ty, py)), mul(tz, pz)), inv_det);
         ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_GE_OQ>(u, splat(0.0)));
         ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_LE_OQ>(u, splat(1.0)));
+        if _mm256_movemask_ps(ok) as u32 & lanes == 0 {
+            return None;
+        }
         let qx = sub(mul(ty, e1z), mul(e1y, tz));
         let qy = sub(mul(tz, e1x), mul(e1z, tx));
         let qz = sub(mul(tx, e1y), mul(e1x, ty));
@@ -91,7 +102,8 @@ fn block_t(b: &TriBlock, r: &TRay, t_max: f32) -> (__m256, __m256, __m256, i32) 
         let t_min = mul(_mm256_max_ps(_mm256_max_ps(ax, ay), az), splat(REL_T_MIN));
         ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_GT_OQ>(t, t_min));
         ok = _mm256_and_ps(ok, _mm256_cmp_ps::<_CMP_LT_OQ>(t, splat(t_max)));
-        (t, u, vv, _mm256_movemask_ps(ok))
+        let hit = _mm256_movemask_ps(ok) as u32 & lanes;
+        (hit != 0).then_some((t, u, vv, hit))
     }
 }
 
@@ -137,11 +149,7 @@ impl Kernel for Avx2 {
 
     #[inline(always)]
     fn block_closest(b: &TriBlock, r: &TRay, t_max: f32, lanes: u32) -> Option<TriHit> {
-        let (t, u, v, hit) = block_t(b, r, t_max);
-        let hit = hit as u32 & lanes;
-        if hit == 0 {
-            return None;
-        }
+        let (t, u, v, hit) = block_t(b, r, t_max, lanes)?;
         let mut ts = [0.0f32; 8];
         // SAFETY: stores eight floats into an eight-float array.
         unsafe { _mm256_storeu_ps(ts.as_mut_ptr(), t) };
@@ -172,7 +180,7 @@ impl Kernel for Avx2 {
 
     #[inline(always)]
     fn block_any(b: &TriBlock, r: &TRay, t_max: f32, lanes: u32) -> bool {
-        block_t(b, r, t_max).3 as u32 & lanes != 0
+        block_t(b, r, t_max, lanes).is_some()
     }
 }
 

@@ -7,7 +7,8 @@
 //! 2. **Initial resampling**: `N_L` light candidates from the power-based light sampler or the
 //!    light hierarchy (a receiver-aware descent with its exact probability; from
 //!    [`settings::HIERARCHY_MIN_EMITTERS`] emitters on by default; stratified selection either
-//!    way), streamed into a
+//!    way; with `learn` on, from the second pass on, a mixture of the power sampler and what
+//!    lights delivered to the receiver's cell in earlier passes, [`learn`]), streamed into a
 //!    reservoir with weights `p̂/(N_L·p_L)`; the result
 //!    counts as confidence 1. Optional visibility reuse drops an occluded selection (biased).
 //! 3. **Temporal reuse** (optional): the same pixel's reservoir from the previous pass.
@@ -27,36 +28,40 @@
 //! tracer instead (`fallback = auto`, [`RestirDiSettings::resolve`]): the estimator is then
 //! exactly the path tracer's, and `describe` (hence `--stats`) says so.
 
+mod candidates;
+pub mod learn;
 pub mod pool;
 mod settings;
+mod shift;
 pub mod target;
 pub mod tiles;
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use restir_geometry::{Ray, offset_ray_origin};
-use restir_gris::{Reservoir, ShiftMap, Shifted, StreamingReservoir};
-use restir_lights::{Contact, LightPoint, LightSample, Presampled, Resolved};
+use restir_gris::Reservoir;
+use restir_lights::LightPoint;
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
 pub use settings::{
-    DOMINANT_LIGHT_SHARE, FEW_EMITTERS, Fallback, HIERARCHY_MIN_EMITTERS, LightSampler,
+    DOMINANT_LIGHT_SHARE, FEW_EMITTERS, Fallback, HIERARCHY_MIN_EMITTERS, Learn, LightSampler,
     RestirDiSettings, Visibility,
 };
 
 use crate::bands::Bands;
 use crate::fallback::PathFallback;
+use crate::motion::FrameMotion;
+use crate::pass::{Integrator, PassContext};
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
-use crate::render::{Integrator, PassContext};
 use crate::reuse::gbuffer::{GBuffer, Receiver};
-use crate::reuse::motion::FrameMotion;
 use crate::reuse::neighbors::NeighborPattern;
-use crate::reuse::passes::{self, HistorySlot, ReuseShift};
+use crate::reuse::passes::{self, HistorySlot};
 use crate::reuse::reciprocal;
 use crate::reuse::settings::mis_name;
-use crate::shadow::{self, ShadowTarget};
 use crate::stages::StageClock;
+use candidates::Candidates;
+use shift::{DiReuse, visible};
 use target::{StrategyCounts, evaluate};
 
 /// Random-stream stages (see [`PassContext::stage_rng`]).
@@ -79,254 +84,8 @@ pub struct RestirDiIntegrator {
     clock: StageClock,
     /// The path tracer that renders instead, and why (a scene with one dominant light).
     fallback: Option<PathFallback>,
-}
-
-/// A receiver where ReSTIR DI's shift map works: a pixel's primary hit in this pass, or in the
-/// previous pass, which across frames lies in the previous frame's scene.
-#[derive(Clone, Copy)]
-struct DiDomain<'a> {
-    r: &'a Receiver,
-    /// The receiver's geometric normal (shadow rays leave along it).
-    ng: Vec3,
-    /// The scene the receiver's target is evaluated in.
-    scene: &'a Scene,
-    /// Whether the receiver is the previous frame's (its light indices are that frame's).
-    earlier: bool,
-}
-
-/// The identity shift between pixels: the sample stays on the light, `J = 1`; only the target
-/// changes. Across frames the sample moves with its light, which the previous frame may name
-/// by another index ([`FrameMotion`]); a rigid motion keeps area, so `J = 1` still. It keeps
-/// the receiving pixel's own sample resolved, because pairwise MIS evaluates that sample at
-/// every neighbour. With [`Visibility::Target`] a target includes the visibility of the sample
-/// from the receiver it is evaluated at: one shadow ray per shift whose unshadowed target is
-/// positive, in the scene of the destination domain.
-struct DiShift<'a> {
-    scene: &'a Scene,
-    counts: StrategyCounts,
-    motion: Option<&'a FrameMotion>,
-    canonical: Option<(LightPoint, Resolved)>,
-    visibility: bool,
-    rays: std::cell::Cell<u64>,
-}
-
-impl<'a> DiShift<'a> {
-    fn new(
-        scene: &'a Scene,
-        counts: StrategyCounts,
-        motion: Option<&'a FrameMotion>,
-        canonical: &DiReservoir,
-        visibility: bool,
-    ) -> Self {
-        Self {
-            scene,
-            counts,
-            motion,
-            canonical: canonical.sample.map(|x| (x, scene.lights.resolve(&x))),
-            visibility,
-            rays: std::cell::Cell::new(0),
-        }
-    }
-
-    #[inline(always)]
-    fn resolved(&self, x: &LightPoint) -> Resolved {
-        match &self.canonical {
-            Some((y, r)) if y == x => *r,
-            _ => self.scene.lights.resolve(x),
-        }
-    }
-}
-
-impl<'a> ShiftMap<LightPoint> for DiShift<'a> {
-    type Domain = DiDomain<'a>;
-
-    #[inline(always)]
-    fn shift(
-        &self,
-        from: &DiDomain<'a>,
-        to: &DiDomain<'a>,
-        x: &LightPoint,
-    ) -> Option<Shifted<LightPoint>> {
-        let mut y = *x;
-        if from.earlier != to.earlier
-            && let Some(m) = self.motion
-        {
-            y.light = if to.earlier {
-                m.light_to_prev(x.light)?
-            } else {
-                m.light_from_prev(x.light)?
-            };
-        }
-        let resolved = if std::ptr::eq(to.scene, self.scene) {
-            self.resolved(&y)
-        } else {
-            to.scene.lights.resolve(&y)
-        };
-        let Some(c) = resolved.contact(to.r.p) else {
-            return Some(Shifted::identity(y, 0.0));
-        };
-        let bsdf = to.r.resolve_bsdf(to.scene);
-        let mut p = evaluate(to.scene, to.r, &bsdf, &y, &c, None, self.counts).target;
-        if self.visibility && p > 0.0 {
-            self.rays.set(self.rays.get() + 1);
-            if !shadow::visible(to.scene, to.r.p, to.ng, shadow_target(&c)) {
-                p = 0.0;
-            }
-        }
-        Some(Shifted::identity(y, p))
-    }
-}
-
-/// ReSTIR DI's part in the reuse passes: the identity shift between receivers; a domain is a
-/// pixel's receiver in this pass or the previous one (across frames, with the previous
-/// frame's scene, or with this frame's for the negative control `temporal_current_scene`).
-struct DiReuse<'p> {
-    scene: &'p Scene,
-    counts: StrategyCounts,
-    gbuf: &'p GBuffer,
-    prev: Option<&'p GBuffer>,
-    /// The previous pass's scene and the motion since, when it was the previous frame's.
-    motion: Option<&'p FrameMotion>,
-    prev_scene: &'p Scene,
-    /// Whether targets include visibility ([`Visibility::Target`]).
-    visibility: bool,
-}
-
-impl<'p> ReuseShift for DiReuse<'p> {
-    type Sample = LightPoint;
-    type Domain = DiDomain<'p>;
-    type DomainRef<'d>
-        = DiDomain<'p>
-    where
-        Self: 'd;
-    type Map<'m>
-        = DiShift<'p>
-    where
-        Self: 'm;
-
-    #[inline]
-    fn map(&self, canonical: &DiReservoir) -> DiShift<'p> {
-        DiShift::new(
-            self.scene,
-            self.counts,
-            self.motion,
-            canonical,
-            self.visibility,
-        )
-    }
-
-    fn rays(map: &DiShift<'p>) -> u64 {
-        map.rays.get()
-    }
-
-    #[inline]
-    fn domain(&self, index: usize, previous: bool) -> DiDomain<'p> {
-        if previous {
-            let prev = self.prev.expect("temporal reuse has a previous pass");
-            DiDomain {
-                r: &prev.receivers[index],
-                ng: prev.ng[index],
-                scene: self.prev_scene,
-                earlier: self.motion.is_some(),
-            }
-        } else {
-            DiDomain {
-                r: &self.gbuf.receivers[index],
-                ng: self.gbuf.ng[index],
-                scene: self.scene,
-                earlier: false,
-            }
-        }
-    }
-
-    /// The identity shift keeps the light point.
-    #[inline]
-    fn same_sample(a: &LightPoint, b: &LightPoint) -> bool {
-        a == b
-    }
-}
-
-/// Where a pixel's initial candidates come from.
-#[derive(Clone, Copy)]
-enum Candidates<'a> {
-    /// The power sampler, drawn per pixel.
-    Power,
-    /// The power sampler's draws presampled for the pass: the tile of the pixel's block.
-    Pool(&'a [Option<Presampled>]),
-    /// The light hierarchy.
-    Hierarchy,
-    /// The pixel's 16×16 light tile (mixed with the power sampler).
-    Tile(&'a restir_sampling::AliasTable),
-}
-
-/// An initial candidate seen from a receiver.
-struct Candidate {
-    sample: LightPoint,
-    contact: Contact,
-    /// The density that drew it, in the sample's measure (area, counting or solid angle).
-    source_pdf: f32,
-    /// The power sampler's solid-angle density (the light/BSDF split's).
-    power_pdf_sa: f32,
-}
-
-impl Candidate {
-    /// A light sample with its source and power-sampler solid-angle densities.
-    #[inline]
-    fn from_sample(ls: &LightSample, source_pdf_sa: f32, power_pdf_sa: f32) -> Option<Self> {
-        let measure = if ls.delta || !ls.dist.is_finite() {
-            1.0
-        } else {
-            ls.ng.dot(ls.wi).abs() / (ls.dist * ls.dist)
-        };
-        Some(Self {
-            sample: LightPoint::from_light_sample(ls),
-            contact: Contact {
-                wi: ls.wi,
-                p: ls.p,
-                dist: ls.dist,
-                le: ls.le,
-                measure,
-                delta: ls.delta,
-                ng: ls.ng,
-                pdf_sa: Some(power_pdf_sa),
-            },
-            source_pdf: if ls.delta {
-                source_pdf_sa
-            } else {
-                source_pdf_sa * measure
-            },
-            power_pdf_sa,
-        })
-    }
-
-    /// A pool entry seen from `x` (a sphere light gets its point here, with `u`).
-    #[inline]
-    fn presampled(scene: &Scene, e: &Presampled, x: Vec3, u: glam::Vec2) -> Option<Self> {
-        let (sample, resolved, pdf) = match *e {
-            Presampled::Fixed {
-                point,
-                resolved,
-                pdf,
-            } => (point, resolved, pdf),
-            Presampled::Light { light, pmf } => {
-                let ls = scene.lights.sample_light(light, x, u)?;
-                return Self::from_sample(&ls, ls.pdf_sa * pmf, ls.pdf_sa * pmf);
-            }
-        };
-        let contact = resolved.contact(x)?;
-        // Area lights: the area density over the measure factor is the solid-angle density.
-        let power_pdf_sa = if contact.measure > 0.0 {
-            pdf / contact.measure
-        } else {
-            return None;
-        };
-        Some(Self {
-            sample,
-            contact,
-            source_pdf: pdf,
-            power_pdf_sa,
-        })
-    }
+    /// What earlier passes recorded, with `learn` on.
+    learning: learn::Learning,
 }
 
 impl RestirDiIntegrator {
@@ -342,6 +101,7 @@ impl RestirDiIntegrator {
             history: HistorySlot::default(),
             clock: StageClock::default(),
             fallback: None,
+            learning: learn::Learning::default(),
         }
     }
 
@@ -365,117 +125,9 @@ impl RestirDiIntegrator {
     /// Bytes per pixel of one reservoir buffer.
     pub const RESERVOIR_BYTES: usize = std::mem::size_of::<DiReservoir>();
 
-    /// Initial resampling at receiver `r`, with candidates from `source`. Returns the reservoir
-    /// and the rays traced.
-    #[inline(never)]
-    fn initial(
-        &self,
-        scene: &Scene,
-        r: &Receiver,
-        ng: Vec3,
-        source: Candidates<'_>,
-        rng: &mut Pcg32,
-    ) -> (DiReservoir, u64) {
-        let bsdf = &r.resolve_bsdf(scene);
-        if !bsdf.has_smooth_lobe() || scene.lights.is_empty() {
-            return (
-                Reservoir {
-                    confidence: 1.0,
-                    ..Reservoir::empty()
-                },
-                0,
-            );
-        }
-        let n = self.settings.candidates;
-        let nf = n as f32;
-        let mut stream = StreamingReservoir::new();
-        let u0 = rng.next_f32();
-        // A pool tile's entries `start + i·S/N_L`: one from each of N_L strata of the selection.
-        let (start, stride) = match source {
-            Candidates::Pool(tile) => (
-                rng.next_u32() as usize % tile.len(),
-                (tile.len() / n as usize).max(1),
-            ),
-            _ => (0, 0),
-        };
-        for i in 0..n {
-            let u_select = ((i as f32 + u0) / nf).min(restir_sampling::ONE_MINUS_EPSILON);
-            let u_light = rng.next_2d();
-            let u_pick = rng.next_f32();
-            // The candidate, its source density in the sample's measure (selection included)
-            // and the power sampler's solid-angle density (which the light/BSDF split uses,
-            // whatever drew the candidate).
-            let drawn = match source {
-                Candidates::Power => scene
-                    .lights
-                    .sample(r.p, u_select, u_light)
-                    .and_then(|ls| Candidate::from_sample(&ls, ls.pdf_sa, ls.pdf_sa)),
-                Candidates::Pool(tile) => tile[(start + i as usize * stride) % tile.len()]
-                    .and_then(|mut e| {
-                        if self.settings.light_sampler == LightSampler::PoolWithoutSelection {
-                            e = pool::without_selection(scene, e); // the negative control
-                        }
-                        Candidate::presampled(scene, &e, r.p, u_light)
-                    }),
-                Candidates::Hierarchy => {
-                    // 48 bits for the descent: the stratified number and 24 more random ones.
-                    let u =
-                        (i as f64 + u0 as f64 + rng.next_f32() as f64 / 16_777_216.0) / n as f64;
-                    scene
-                        .lights
-                        .sample_hierarchy(r.p, r.n, u.min(1.0 - f64::EPSILON), u_light)
-                        .and_then(|(ls, power_pdf_sa)| {
-                            let source = if self.settings.light_sampler == LightSampler::Bvh {
-                                ls.pdf_sa
-                            } else {
-                                power_pdf_sa // the negative control's wrong density
-                            };
-                            Candidate::from_sample(&ls, source, power_pdf_sa)
-                        })
-                }
-                Candidates::Tile(table) => {
-                    tiles::select(scene, table, u_select).and_then(|(light, pmf, power_pmf)| {
-                        let ls = scene.lights.sample_light(light, r.p, u_light)?;
-                        Candidate::from_sample(&ls, pmf * ls.pdf_sa, power_pmf * ls.pdf_sa)
-                    })
-                }
-            };
-            let Some(cand) = drawn else {
-                continue;
-            };
-            let e = evaluate(
-                scene,
-                r,
-                bsdf,
-                &cand.sample,
-                &cand.contact,
-                Some(cand.power_pdf_sa),
-                self.counts,
-            );
-            let w = e.target / (nf * cand.source_pdf);
-            stream.add_candidate(cand.sample, e.target, w, 0.0, u_pick);
-        }
-        let mut res = stream.finalize_recorded();
-        res.confidence = 1.0;
-        let mut rays = 0;
-        if self.settings.visibility.tests_initial()
-            && let Some(y) = res.sample
-        {
-            let visible = scene.lights.contact(&y, r.p).is_some_and(|c| {
-                rays += 1;
-                visible(scene, r, ng, &c)
-            });
-            if !visible {
-                res.sample = None;
-                res.ucw = 0.0;
-                res.own_target = 0.0;
-            }
-        }
-        (res, rays)
-    }
-
     /// Shading at receiver `r` with its final reservoir: the reservoir's sample with a shadow
-    /// ray, the BSDF samples, and the continuation. Returns radiance and rays.
+    /// ray, the BSDF samples, and the continuation. Returns radiance, rays, and the light of the
+    /// reservoir's sample with what it delivered (when it was visible and lit the receiver).
     fn shade(
         &self,
         scene: &Scene,
@@ -483,8 +135,9 @@ impl RestirDiIntegrator {
         ng: Vec3,
         res: &DiReservoir,
         rng: &mut Pcg32,
-    ) -> (Vec3, u64) {
+    ) -> (Vec3, u64, Option<(u32, Vec3)>) {
         let mut l = Vec3::ZERO;
+        let mut delivered = None;
         let mut rays = 0;
         let bsdf = &r.resolve_bsdf(scene);
         if let Some(y) = &res.sample
@@ -500,6 +153,7 @@ impl RestirDiIntegrator {
                     visible(scene, r, ng, &c)
                 } {
                     l += e.contribution * res.ucw;
+                    delivered = Some((y.light, e.contribution * res.ucw));
                 }
             }
         }
@@ -556,20 +210,8 @@ impl RestirDiIntegrator {
             l += li;
             rays += n;
         }
-        (l, rays)
+        (l, rays, delivered)
     }
-}
-
-/// Whether the light point `c` is visible from receiver `r` (one shadow ray).
-#[inline]
-fn visible(scene: &Scene, r: &Receiver, ng: Vec3, c: &Contact) -> bool {
-    shadow::visible(scene, r.p, ng, shadow_target(c))
-}
-
-/// The shadow ray's end at light point `c`.
-#[inline]
-fn shadow_target(c: &Contact) -> ShadowTarget {
-    ShadowTarget::new(c.p, c.wi, c.dist)
 }
 
 impl Integrator for RestirDiIntegrator {
@@ -585,7 +227,18 @@ impl Integrator for RestirDiIntegrator {
              visibility={}{}",
             s.path.max_depth,
             s.candidates,
-            s.light_sampler.name(),
+            s.light_sampler.name().to_string()
+                + &if s.learn.is_on() {
+                    format!(
+                        " learn={} learn_share={} learn_prior={} learn_cells={}",
+                        s.learn.name(),
+                        s.learn_share,
+                        s.learn_prior,
+                        s.learn_cells
+                    )
+                } else {
+                    " learn=off".to_string()
+                },
             s.bsdf_candidates,
             s.reuse.neighbors,
             s.reuse.radius,
@@ -611,6 +264,7 @@ impl Integrator for RestirDiIntegrator {
     /// evaluated in the previous frame's scene.
     fn next_frame(&self, motion: std::sync::Arc<FrameMotion>) {
         self.history.next_frame(Some(motion));
+        self.learning.reset();
     }
 
     fn halo(&self) -> u32 {
@@ -663,38 +317,50 @@ impl Integrator for RestirDiIntegrator {
                     pool::LightPool::tiles_for(fw as usize * fh as usize, s.candidates as usize);
                 pool::LightPool::build(scene, ctx, tiles, STAGE_POOL)
             });
+            // The distribution learned in the passes before this one.
+            let learned = if s.learn.is_on() {
+                self.learning
+                    .sampler(scene, s.learn_share, s.learn_prior, s.learn_cells)
+            } else {
+                None
+            };
             let mut current = vec![DiReservoir::empty(); n];
-            rays += current
-                .par_chunks_mut(bands.pixels())
-                .enumerate()
-                .map(|(band, out)| {
-                    let mut rays = 0;
-                    for (i, res) in out.iter_mut().enumerate() {
-                        let index = bands.first(band) + i;
-                        if let Some(r) = gbuf.receiver(index) {
-                            let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
-                            let source = if let Some(pool) = &pool {
-                                let (x, y) = ctx.film_xy(index, w);
-                                Candidates::Pool(pool.tile_of(ctx, x, y))
-                            } else if let Some(t) = light_tiles
-                                .as_ref()
-                                .and_then(|t| t.table(index % w, index / w))
-                            {
-                                Candidates::Tile(t)
-                            } else if s.light_sampler.is_hierarchy() {
-                                Candidates::Hierarchy
-                            } else {
-                                Candidates::Power
-                            };
-                            let (init, nr) =
-                                self.initial(scene, r, gbuf.ng[index], source, &mut rng);
-                            *res = init;
-                            rays += nr;
-                        }
+            rays += bands.run(&mut current[..], |first, out| {
+                let mut rays = 0;
+                for (i, res) in out.iter_mut().enumerate() {
+                    let index = first + i;
+                    if let Some(r) = gbuf.receiver(index) {
+                        let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
+                        let cell = learned.as_ref().and_then(|l| l.cell(r.p, r.n));
+                        let source = if let (Some(learned), Some(cell)) = (&learned, cell) {
+                            Candidates::Learned {
+                                learned,
+                                cell,
+                                pool: pool.as_ref().map(|p| {
+                                    let (x, y) = ctx.film_xy(index, w);
+                                    p.tile_of(ctx, x, y)
+                                }),
+                            }
+                        } else if let Some(pool) = &pool {
+                            let (x, y) = ctx.film_xy(index, w);
+                            Candidates::Pool(pool.tile_of(ctx, x, y))
+                        } else if let Some(t) = light_tiles
+                            .as_ref()
+                            .and_then(|t| t.table(index % w, index / w))
+                        {
+                            Candidates::Tile(t)
+                        } else if s.light_sampler.is_hierarchy() {
+                            Candidates::Hierarchy
+                        } else {
+                            Candidates::Power
+                        };
+                        let (init, nr) = self.initial(scene, r, gbuf.ng[index], source, &mut rng);
+                        *res = init;
+                        rays += nr;
                     }
-                    rays
-                })
-                .sum::<u64>();
+                }
+                rays
+            });
             self.clock.add("initial", start.elapsed());
 
             // Temporal and spatial reuse.
@@ -739,25 +405,43 @@ impl Integrator for RestirDiIntegrator {
 
             // Shading.
             let start = std::time::Instant::now();
-            rays += radiance
+            let grid = s
+                .learn
+                .is_on()
+                .then(|| learn::Learning::grid(scene, s.learn_cells));
+            let per_band: Vec<(u64, Vec<learn::Record>)> = radiance
                 .par_chunks_mut(bands.pixels())
                 .enumerate()
                 .map(|(band, out)| {
                     let mut rays = 0;
+                    let mut records = Vec::new();
                     for (i, l) in out.iter_mut().enumerate() {
                         let index = bands.first(band) + i;
                         if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_SHADE);
                             let ng = gbuf.ng[index];
-                            let (li, nr) = self.shade(scene, r, ng, &current[index], &mut rng);
+                            let (li, nr, delivered) =
+                                self.shade(scene, r, ng, &current[index], &mut rng);
                             *l += li;
                             rays += nr;
+                            if let (Some(g), Some((light, c))) = (&grid, delivered) {
+                                records.push(learn::record(g, r.p, r.n, light, c));
+                            }
                         }
                     }
-                    rays
+                    (rays, records)
                 })
-                .sum::<u64>();
+                .collect();
+            let mut records = Vec::with_capacity(per_band.len());
+            for (nr, band) in per_band {
+                rays += nr;
+                records.push(band);
+            }
             self.clock.add("shade", start.elapsed());
+            if grid.is_some() {
+                // What this pass learned serves the passes after it, never this one.
+                self.clock.time("learn", || self.learning.record(records));
+            }
 
             self.history.store(reuse, gbuf, current);
         }

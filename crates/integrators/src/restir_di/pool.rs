@@ -30,7 +30,7 @@ use restir_lights::{Presampled, Resolved};
 use restir_sampling::ONE_MINUS_EPSILON;
 use restir_scene::Scene;
 
-use crate::render::PassContext;
+use crate::pass::PassContext;
 
 /// Entries per tile (RTXDI's default).
 pub const TILE_SIZE: usize = 1024;

@@ -92,6 +92,41 @@ impl LightSampler {
     }
 }
 
+/// Whether candidates' lights come from a distribution learned in earlier passes (`--learn`,
+/// [`super::learn`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Learn {
+    /// The light sampler alone.
+    Off,
+    /// From the second pass on, per cell of a world-space grid, a mixture of what lights
+    /// delivered there in earlier passes (after their shadow rays) and the power sampler.
+    On,
+    /// A negative control for the tests, never a choice: the learned mixture's candidates
+    /// weighted by the cell's table alone, forgetting the power sampler's defensive share
+    /// (biased).
+    #[doc(hidden)]
+    WithoutDefensiveShare,
+}
+
+impl Learn {
+    /// The names `--learn` takes.
+    pub const NAMES: &[(&str, Learn)] = &[("off", Learn::Off), ("on", Learn::On)];
+
+    /// The name `--learn` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Learn::Off => "off",
+            Learn::On => "on",
+            Learn::WithoutDefensiveShare => "without-defensive-share",
+        }
+    }
+
+    /// Whether passes learn and later passes draw from what was learned.
+    pub fn is_on(self) -> bool {
+        self != Learn::Off
+    }
+}
+
 /// Where ReSTIR DI tests the visibility of its light samples (`--visibility`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Visibility {
@@ -143,6 +178,17 @@ pub struct RestirDiSettings {
     pub candidates: u32,
     /// Where candidates' lights come from (default the power sampler).
     pub light_sampler: LightSampler,
+    /// Whether candidates come from a light distribution learned across passes (default off:
+    /// see `docs/RESTIR_DI.md`, "Learning across passes").
+    pub learn: Learn,
+    /// With `learn` on, the share of candidate selections that go to the learned tables, in
+    /// `[0, 1)` (the rest, the defensive share, to the power sampler; default 0.5).
+    pub learn_share: f32,
+    /// With `learn` on, grid cells per scene diameter along each axis (default 16).
+    pub learn_cells: f32,
+    /// With `learn` on, the records a cell needs for its table to take half of `learn_share`
+    /// (a cell of `n` records takes `learn_share · n / (n + learn_prior)`; default 64).
+    pub learn_prior: f32,
     /// BSDF samples per pixel, `N_B` (default 1), combined with the reservoirs' light strategy
     /// by the balance heuristic.
     pub bsdf_candidates: u32,
@@ -166,6 +212,10 @@ impl RestirDiSettings {
             reuse: ReuseSettings::default(),
             candidates: 8,
             light_sampler: LightSampler::Auto,
+            learn: Learn::Off,
+            learn_share: 0.5,
+            learn_cells: 16.0,
+            learn_prior: 64.0,
             bsdf_candidates: 1,
             visibility: Visibility::Target,
             fallback: Fallback::Auto,
@@ -209,6 +259,7 @@ impl RestirDiSettings {
             && self.visibility != Visibility::ReuseBiased
             && self.light_sampler != LightSampler::BvhWithPowerPmf
             && self.light_sampler != LightSampler::PoolWithoutSelection
+            && self.learn != Learn::WithoutDefensiveShare
     }
 
     /// Applies `params` in order (later ones win). Names are case-insensitive, `-` and `_` are
@@ -224,6 +275,27 @@ impl RestirDiSettings {
                 "light_sampler" => {
                     self.light_sampler =
                         p.choice(LightSampler::NAMES, "auto, power, tiles or bvh")?;
+                    true
+                }
+                "learn" => {
+                    self.learn = p.choice(Learn::NAMES, "off or on")?;
+                    true
+                }
+                "learn_share" => {
+                    let x = p.fraction()?;
+                    if x >= 1.0 {
+                        // All to the tables would drop every light no cell recorded.
+                        return Err(p.error(crate::params::ParamProblem::NotBelowOne));
+                    }
+                    self.learn_share = x;
+                    true
+                }
+                "learn_prior" => {
+                    self.learn_prior = p.positive()?;
+                    true
+                }
+                "learn_cells" => {
+                    self.learn_cells = p.positive()?;
                     true
                 }
                 "fallback" => {

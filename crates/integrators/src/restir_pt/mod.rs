@@ -44,15 +44,15 @@ use shift::PtReuse;
 pub use shift::{Frames, PtShift};
 
 use crate::bands::Bands;
+use crate::motion::FrameMotion;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
-use crate::reuse::motion::FrameMotion;
 use crate::reuse::neighbors::NeighborPattern;
 use crate::reuse::passes::{self, HistorySlot};
 use crate::reuse::reciprocal;
 
 use crate::fallback::PathFallback;
+use crate::pass::{Integrator, PassContext};
 use crate::path::PathSettings;
-use crate::render::{Integrator, PassContext};
 use crate::restir_di::{RestirDiIntegrator, RestirDiSettings};
 use crate::reuse::settings::mis_name;
 use crate::stages::StageClock;
@@ -230,14 +230,12 @@ impl RestirPtIntegrator {
         if keep {
             let bands = Bands::new(gbuf.width);
             let start = std::time::Instant::now();
-            rays += current
-                .par_chunks_mut(bands.pixels())
-                .zip(radiance.par_chunks_mut(bands.pixels()))
-                .enumerate()
-                .map(|(band, (out, rad))| {
+            rays += bands.run(
+                (&mut current[..], &mut radiance[..]),
+                |first, (out, rad)| {
                     let mut rays = 0;
                     for (i, (res, l)) in out.iter_mut().zip(rad.iter_mut()).enumerate() {
-                        let index = bands.first(band) + i;
+                        let index = first + i;
                         if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
                             let (init, direct, nr) =
@@ -248,8 +246,8 @@ impl RestirPtIntegrator {
                         }
                     }
                     rays
-                })
-                .sum::<u64>();
+                },
+            );
             self.clock.add("initial", start.elapsed());
         }
         (gbuf, current, radiance, rays)

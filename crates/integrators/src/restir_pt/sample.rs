@@ -248,9 +248,12 @@ impl Vertex {
     }
 }
 
-/// Whether a BSDF is rough enough to reconnect at: no delta lobe, and a diffuse lobe or a
-/// microfacet roughness of at least [`ROUGH_ALPHA`].
+/// Whether a BSDF is rough enough to reconnect at: no delta lobe (a `mask`'s pass-through is
+/// one), and a diffuse lobe or a microfacet roughness of at least [`ROUGH_ALPHA`].
 pub fn connectible(bsdf: &Bsdf) -> bool {
+    if bsdf.is_masked() {
+        return false;
+    }
     match bsdf.kind {
         BsdfKind::Diffuse { .. } => true,
         BsdfKind::RoughConductor { microfacet, .. }

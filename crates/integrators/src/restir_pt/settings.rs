@@ -119,7 +119,7 @@ pub struct RestirPtSettings {
 impl RestirPtSettings {
     /// The defaults: two candidate paths, three spatial rounds of four neighbours within 3
     /// pixels in two reciprocal pairs, defensive pairwise MIS. Chosen on the training family
-    /// of `restir generate family --issue pt` (`docs/studies/2026-12-02-restir-pt-defaults.md`).
+    /// of `restir generate family --kind pt` (`docs/studies/2026-12-02-restir-pt-defaults.md`).
     pub fn new(path: PathSettings) -> Self {
         Self {
             path,

@@ -21,8 +21,8 @@ use restir_sampling::luminance;
 
 use restir_scene::Scene;
 
+use crate::motion::FrameMotion;
 use crate::reuse::gbuffer::GBuffer;
-use crate::reuse::motion::FrameMotion;
 use crate::reuse::passes::ReuseShift;
 use crate::shadow::visible;
 

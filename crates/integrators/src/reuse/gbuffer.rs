@@ -9,7 +9,9 @@ use restir_materials::Bsdf;
 use restir_scene::Scene;
 
 use crate::bands::Bands;
-use crate::render::PassContext;
+use crate::motion::FrameMotion;
+use crate::pass::PassContext;
+use crate::reuse::settings::ReuseSettings;
 
 /// What a reuse pass needs to know about a pixel's primary hit: the shading point, its frame,
 /// its material and texture coordinates, the direction to the camera and what the
@@ -198,47 +200,44 @@ impl GBuffer {
         let mut shape = vec![u32::MAX; w * h];
         let lights = &scene.lights;
         let bands = Bands::new(w);
-        let rays = receivers
-            .par_chunks_mut(bands.pixels())
-            .zip(ng.par_chunks_mut(bands.pixels()))
-            .zip(shape.par_chunks_mut(bands.pixels()))
-            .zip(radiance.par_chunks_mut(bands.pixels()))
-            .enumerate()
-            .map(|(band, (((recv, ngs), shapes), rad))| {
-                let mut rays = 0;
-                for (i, l) in rad.iter_mut().enumerate() {
-                    let index = bands.first(band) + i;
-                    let (x, y) = ((index % w) as u32, (index / w) as u32);
-                    let mut rng = ctx.pixel_rng(index);
-                    let film = ctx.film_position(x, y, &mut rng);
-                    let ray = scene.camera.generate_ray(film, rng.next_2d());
-                    let (hit, n) = scene.camera_intersect(&ray, hide_emitters);
-                    rays += n;
-                    let Some(si) = hit else {
-                        if add_seen {
-                            *l += lights.environment_radiance(ray.d);
-                        }
-                        continue;
-                    };
-                    if add_seen && let Some(light) = lights.light_on_shape(si.shape) {
-                        *l += lights.area_radiance(light, si.shading.n, -ray.d);
+        let buffers = (
+            ((&mut receivers[..], &mut ng[..]), &mut shape[..]),
+            radiance,
+        );
+        let rays = bands.run(buffers, |first, (((recv, ngs), shapes), rad)| {
+            let mut rays = 0;
+            for (i, l) in rad.iter_mut().enumerate() {
+                let index = first + i;
+                let (x, y) = ((index % w) as u32, (index / w) as u32);
+                let mut rng = ctx.pixel_rng(index);
+                let film = ctx.film_position(x, y, &mut rng);
+                let ray = scene.camera.generate_ray(film, rng.next_2d());
+                let (hit, n) = scene.camera_intersect(&ray, hide_emitters);
+                rays += n;
+                let Some(si) = hit else {
+                    if add_seen {
+                        *l += lights.environment_radiance(ray.d);
                     }
-                    if keep_hits {
-                        recv[i] = Receiver::new(
-                            si.p,
-                            &si.shading,
-                            si.uv,
-                            -ray.d,
-                            scene.shape_bsdf[si.shape as usize],
-                            si.t,
-                        );
-                        ngs[i] = si.ng;
-                        shapes[i] = si.shape;
-                    }
+                    continue;
+                };
+                if add_seen && let Some(light) = lights.light_on_shape(si.shape) {
+                    *l += lights.area_radiance(light, si.shading.n, -ray.d);
                 }
-                rays
-            })
-            .sum();
+                if keep_hits {
+                    recv[i] = Receiver::new(
+                        si.p,
+                        &si.shading,
+                        si.uv,
+                        -ray.d,
+                        scene.shape_bsdf[si.shape as usize],
+                        si.t,
+                    );
+                    ngs[i] = si.ng;
+                    shapes[i] = si.shape;
+                }
+            }
+            rays
+        });
         let keys = receivers.par_iter().map(Receiver::key).collect();
         (
             Self {
@@ -251,5 +250,42 @@ impl GBuffer {
             },
             rays,
         )
+    }
+
+    /// The pixel of the previous frame's `prev` G-buffer that saw pixel `index`'s primary hit
+    /// of this one, after the scene moved as `motion` says: the hit moved back with its shape
+    /// and projected by the previous camera. The hit found there must lie on the same shape,
+    /// face the same way (shading normals within `settings.normal_cos`) and lie at the expected
+    /// distance from the previous camera (within `settings.depth_tolerance`), or the pixel is
+    /// disoccluded and has no history (`None`, as for a point outside the previous film). These
+    /// tests only choose which domain takes part; the estimators stay unbiased whatever they
+    /// decide (`docs/ANIMATION.md`, "Across frames").
+    pub fn previous_pixel(
+        &self,
+        index: usize,
+        motion: &FrameMotion,
+        prev: &GBuffer,
+        settings: &ReuseSettings,
+    ) -> Option<usize> {
+        let r = self.receiver(index)?;
+        let shape = self.shape[index];
+        let m = motion.shape_to_prev(shape)?;
+        let p = m.transform_point3(r.p);
+        let camera = &motion.prev_scene.camera;
+        let film = camera.film_position_of(p)?;
+        let (x, y) = (film.x.floor(), film.y.floor());
+        if x < 0.0 || y < 0.0 || x >= prev.width as f32 || y >= prev.height as f32 {
+            return None;
+        }
+        let q = y as usize * prev.width + x as usize;
+        let pr = prev.receiver(q)?;
+        if prev.shape[q] != shape {
+            return None;
+        }
+        let n = m.transform_vector3(r.n).normalize_or_zero();
+        let depth = (p - camera.origin()).length();
+        let similar = pr.n.dot(n) >= settings.normal_cos
+            && (pr.depth - depth).abs() <= settings.depth_tolerance * pr.depth.max(depth);
+        similar.then_some(q)
     }
 }

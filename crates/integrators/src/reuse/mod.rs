@@ -4,12 +4,10 @@
 //! passes themselves ([`passes`]: temporal reuse, the spatial rounds and the history, generic
 //! over the estimator's sample and shift map, as pbrt-v4's `ImageTileIntegrator` is over its
 //! `RayIntegrator`; [`reciprocal`]: spatial rounds over reciprocal neighbour pairs, which share
-//! their shifts; [`motion`]: the previous frame of a moving sequence, for temporal reuse across
-//! frames; [`duplication`]: the history's confidence cap for duplicated samples).
+//! their shifts; [`duplication`]: the history's confidence cap for duplicated samples).
 
 pub mod duplication;
 pub mod gbuffer;
-pub mod motion;
 pub mod neighbors;
 pub mod passes;
 pub mod reciprocal;

@@ -10,16 +10,15 @@
 
 use std::sync::{Arc, Mutex};
 
-use rayon::prelude::*;
 use std::borrow::Borrow;
 
 use restir_gris::{Reservoir, ShiftMap, resample};
 
 use crate::bands::Bands;
-use crate::render::PassContext;
+use crate::motion::FrameMotion;
+use crate::pass::PassContext;
 use crate::reuse::duplication;
 use crate::reuse::gbuffer::GBuffer;
-use crate::reuse::motion::FrameMotion;
 use crate::reuse::neighbors::NeighborPattern;
 use crate::reuse::reciprocal;
 use crate::reuse::settings::ReuseSettings;
@@ -75,7 +74,7 @@ pub struct History<S> {
 impl<S> History<S> {
     /// The previous pass's pixel that saw pixel `index`'s primary hit of `gbuf`, if it saw a
     /// similar one: the same pixel in the same frame, or the motion vector's pixel in the
-    /// previous frame ([`FrameMotion::previous_pixel`]).
+    /// previous frame ([`GBuffer::previous_pixel`]).
     #[inline]
     pub fn previous_pixel(
         &self,
@@ -84,7 +83,7 @@ impl<S> History<S> {
         settings: &ReuseSettings,
     ) -> Option<usize> {
         match &self.motion {
-            Some(m) => m.previous_pixel(gbuf, index, &self.gbuffer, settings),
+            Some(m) => gbuf.previous_pixel(index, m, &self.gbuffer, settings),
             None => {
                 let (r, prev) = (gbuf.receiver(index)?, self.gbuffer.receiver(index)?);
                 r.is_similar(prev, settings.normal_cos, settings.depth_tolerance)
@@ -171,34 +170,30 @@ pub fn temporal<R: ReuseShift>(
         )
     });
     let bands = Bands::new(gbuf.width);
-    current
-        .par_chunks_mut(bands.pixels())
-        .enumerate()
-        .map(|(band, out)| {
-            let mut rays = 0;
-            for (i, res) in out.iter_mut().enumerate() {
-                let index = bands.first(band) + i;
-                let Some(q) = history.previous_pixel(gbuf, index, settings) else {
-                    continue;
-                };
-                let cap = caps.as_ref().map_or(settings.mcap, |c| c[q]);
-                let prev = history.reservoirs[q].with_confidence_cap(cap);
-                let mut rng = ctx.stage_rng(index, stage);
-                let map = reuse.map(res);
-                *res = resample(
-                    &map,
-                    mis,
-                    reuse.domain(index, false).borrow(),
-                    res,
-                    &[(reuse.domain(q, true), &prev)],
-                    || rng.next_f32(),
-                )
-                .with_confidence_cap(settings.mcap);
-                rays += R::rays(&map);
-            }
-            rays
-        })
-        .sum()
+    bands.run(current, |first, out| {
+        let mut rays = 0;
+        for (i, res) in out.iter_mut().enumerate() {
+            let index = first + i;
+            let Some(q) = history.previous_pixel(gbuf, index, settings) else {
+                continue;
+            };
+            let cap = caps.as_ref().map_or(settings.mcap, |c| c[q]);
+            let prev = history.reservoirs[q].with_confidence_cap(cap);
+            let mut rng = ctx.stage_rng(index, stage);
+            let map = reuse.map(res);
+            *res = resample(
+                &map,
+                mis,
+                reuse.domain(index, false).borrow(),
+                res,
+                &[(reuse.domain(q, true), &prev)],
+                || rng.next_f32(),
+            )
+            .with_confidence_cap(settings.mcap);
+            rays += R::rays(&map);
+        }
+        rays
+    })
 }
 
 /// `R` spatial rounds: each pixel with a primary hit resamples its reservoir with up to `k`
@@ -225,39 +220,35 @@ pub fn spatial<R: ReuseShift>(
     let mut rays = 0;
     for round in 0..settings.spatial_rounds {
         let input = &*current;
-        rays += next
-            .par_chunks_mut(bands.pixels())
-            .enumerate()
-            .map(|(band, out)| {
-                let mut rays = 0;
-                let mut picked = Vec::with_capacity(rule.count);
-                let mut neighbors = Vec::with_capacity(rule.count);
-                for (i, res) in out.iter_mut().enumerate() {
-                    let index = bands.first(band) + i;
-                    let canonical = &input[index];
-                    if gbuf.receiver(index).is_none() {
-                        *res = *canonical;
-                        continue;
-                    }
-                    let mut rng = ctx.stage_rng(index, first_stage + u64::from(round));
-                    pattern.select(gbuf, index, &rule, &mut rng, &mut picked);
-                    neighbors.clear();
-                    neighbors.extend(picked.iter().map(|&q| (reuse.domain(q, false), &input[q])));
-                    let map = reuse.map(canonical);
-                    *res = resample(
-                        &map,
-                        settings.mis,
-                        reuse.domain(index, false).borrow(),
-                        canonical,
-                        &neighbors,
-                        || rng.next_f32(),
-                    )
-                    .with_confidence_cap(settings.mcap);
-                    rays += R::rays(&map);
+        rays += bands.run(&mut next[..], |first, out| {
+            let mut rays = 0;
+            let mut picked = Vec::with_capacity(rule.count);
+            let mut neighbors = Vec::with_capacity(rule.count);
+            for (i, res) in out.iter_mut().enumerate() {
+                let index = first + i;
+                let canonical = &input[index];
+                if gbuf.receiver(index).is_none() {
+                    *res = *canonical;
+                    continue;
                 }
-                rays
-            })
-            .sum::<u64>();
+                let mut rng = ctx.stage_rng(index, first_stage + u64::from(round));
+                pattern.select(gbuf, index, &rule, &mut rng, &mut picked);
+                neighbors.clear();
+                neighbors.extend(picked.iter().map(|&q| (reuse.domain(q, false), &input[q])));
+                let map = reuse.map(canonical);
+                *res = resample(
+                    &map,
+                    settings.mis,
+                    reuse.domain(index, false).borrow(),
+                    canonical,
+                    &neighbors,
+                    || rng.next_f32(),
+                )
+                .with_confidence_cap(settings.mcap);
+                rays += R::rays(&map);
+            }
+            rays
+        });
         std::mem::swap(current, &mut next);
     }
     rays

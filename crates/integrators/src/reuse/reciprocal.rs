@@ -18,12 +18,11 @@
 
 use std::borrow::Borrow;
 
-use rayon::prelude::*;
 use restir_gris::{MisScheme, Reservoir, ShiftMap, Shifted, resample};
 use restir_sampling::Pcg32;
 
 use crate::bands::Bands;
-use crate::render::PassContext;
+use crate::pass::PassContext;
 use crate::reuse::gbuffer::GBuffer;
 use crate::reuse::passes::ReuseShift;
 use crate::reuse::settings::ReuseSettings;
@@ -181,88 +180,83 @@ pub fn spatial<R: ReuseShift>(
         // Phase 1: the shifts of every pair (a, a + o_j), at entry a·m + j.
         table.clear();
         table.resize(n * m, None);
-        rays += table
-            .par_chunks_mut(bands.pixels() * m)
-            .enumerate()
-            .map(|(band, out)| {
-                let mut rays = 0;
-                for (i, entries) in out.chunks_mut(m).enumerate() {
-                    let a = bands.first(band) + i;
-                    for (entry, &o) in entries.iter_mut().zip(&offsets) {
-                        let Some(b) = partner(a, o) else {
-                            continue;
-                        };
-                        let (da, db) = (reuse.domain(a, false), reuse.domain(b, false));
-                        let (ra, rb) = (&input[a], &input[b]);
-                        let map_a = reuse.map(ra);
-                        let a_into_b = ra
-                            .sample
-                            .as_ref()
-                            .and_then(|y| map_a.shift(da.borrow(), db.borrow(), y));
-                        rays += R::rays(&map_a);
-                        let map_b = reuse.map(rb);
-                        let b_into_a = rb
-                            .sample
-                            .as_ref()
-                            .and_then(|y| map_b.shift(db.borrow(), da.borrow(), y));
-                        rays += R::rays(&map_b);
-                        *entry = Some(PairShifts { a_into_b, b_into_a });
-                    }
+        rays += bands.run_strided(&mut table[..], m, |first, out| {
+            let mut rays = 0;
+            for (i, entries) in out.chunks_mut(m).enumerate() {
+                let a = first + i;
+                for (entry, &o) in entries.iter_mut().zip(&offsets) {
+                    let Some(b) = partner(a, o) else {
+                        continue;
+                    };
+                    let (da, db) = (reuse.domain(a, false), reuse.domain(b, false));
+                    let (ra, rb) = (&input[a], &input[b]);
+                    let map_a = reuse.map(ra);
+                    let a_into_b = ra
+                        .sample
+                        .as_ref()
+                        .and_then(|y| map_a.shift(da.borrow(), db.borrow(), y));
+                    rays += R::rays(&map_a);
+                    let map_b = reuse.map(rb);
+                    let b_into_a = rb
+                        .sample
+                        .as_ref()
+                        .and_then(|y| map_b.shift(db.borrow(), da.borrow(), y));
+                    rays += R::rays(&map_b);
+                    *entry = Some(PairShifts { a_into_b, b_into_a });
                 }
-                rays
-            })
-            .sum::<u64>();
+            }
+            rays
+        });
 
         // Phase 2: every pixel resamples with its neighbours p + o_j and p − o_j.
         let table = &table;
-        next.par_chunks_mut(bands.pixels())
-            .enumerate()
-            .for_each(|(band, out)| {
-                let mut neighbors = Vec::with_capacity(2 * m);
-                for (i, res) in out.iter_mut().enumerate() {
-                    let p = bands.first(band) + i;
-                    let canonical = &input[p];
-                    if gbuf.receiver(p).is_none() {
-                        *res = *canonical;
-                        continue;
-                    }
-                    neighbors.clear();
-                    for (j, &(ox, oy)) in offsets.iter().enumerate() {
-                        // Pair (p, p + o_j), entered at p; pair (p − o_j, p), entered at p − o_j.
-                        if table[p * m + j].is_some()
-                            && let Some(q) = step(p, (ox, oy))
-                        {
-                            let slot = Slot::Neighbor {
-                                entry: p * m + j,
-                                canonical_is_a: true,
-                            };
-                            neighbors.push((slot, &input[q]));
-                        }
-                        if let Some(q) = step(p, (-ox, -oy))
-                            && table[q * m + j].is_some()
-                        {
-                            let slot = Slot::Neighbor {
-                                entry: q * m + j,
-                                canonical_is_a: false,
-                            };
-                            neighbors.push((slot, &input[q]));
-                        }
-                    }
-                    let mut rng = ctx.stage_rng(p, stage);
-                    *res = resample(
-                        &CachedShifts {
-                            table,
-                            mismatched: settings.reciprocal_mismatched,
-                        },
-                        settings.mis,
-                        &Slot::Canonical,
-                        canonical,
-                        &neighbors,
-                        || rng.next_f32(),
-                    )
-                    .with_confidence_cap(settings.mcap);
+        bands.run(&mut next[..], |first, out| {
+            let mut neighbors = Vec::with_capacity(2 * m);
+            for (i, res) in out.iter_mut().enumerate() {
+                let p = first + i;
+                let canonical = &input[p];
+                if gbuf.receiver(p).is_none() {
+                    *res = *canonical;
+                    continue;
                 }
-            });
+                neighbors.clear();
+                for (j, &(ox, oy)) in offsets.iter().enumerate() {
+                    // Pair (p, p + o_j), entered at p; pair (p − o_j, p), entered at p − o_j.
+                    if table[p * m + j].is_some()
+                        && let Some(q) = step(p, (ox, oy))
+                    {
+                        let slot = Slot::Neighbor {
+                            entry: p * m + j,
+                            canonical_is_a: true,
+                        };
+                        neighbors.push((slot, &input[q]));
+                    }
+                    if let Some(q) = step(p, (-ox, -oy))
+                        && table[q * m + j].is_some()
+                    {
+                        let slot = Slot::Neighbor {
+                            entry: q * m + j,
+                            canonical_is_a: false,
+                        };
+                        neighbors.push((slot, &input[q]));
+                    }
+                }
+                let mut rng = ctx.stage_rng(p, stage);
+                *res = resample(
+                    &CachedShifts {
+                        table,
+                        mismatched: settings.reciprocal_mismatched,
+                    },
+                    settings.mis,
+                    &Slot::Canonical,
+                    canonical,
+                    &neighbors,
+                    || rng.next_f32(),
+                )
+                .with_confidence_cap(settings.mcap);
+            }
+            0
+        });
         std::mem::swap(current, &mut next);
     }
     rays

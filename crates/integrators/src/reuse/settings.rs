@@ -201,3 +201,23 @@ impl ReuseSettings {
         Ok(true)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The halo is `rounds × ⌈radius⌉`, none without neighbours.
+    #[test]
+    fn reuse_halo() {
+        let mut s = ReuseSettings {
+            radius: 30.0,
+            ..ReuseSettings::default()
+        };
+        assert_eq!(s.halo(), 30);
+        s.radius = 2.5;
+        s.spatial_rounds = 3;
+        assert_eq!(s.halo(), 9);
+        s.neighbors = 0;
+        assert_eq!(s.halo(), 0);
+    }
+}

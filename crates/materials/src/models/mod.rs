@@ -17,6 +17,7 @@ use crate::microfacet::Microfacet;
 pub(crate) mod conductor;
 pub(crate) mod dielectric;
 pub(crate) mod diffuse;
+pub(crate) mod mask;
 pub(crate) mod plastic;
 
 /// A sampled scattering direction.

@@ -47,6 +47,8 @@ pub const RR_DEPTH: u32 = 5;
 pub const DIFFUSE_REFLECTANCE: V3 = [0.5; 3];
 /// `specular_reflectance` and `specular_transmittance` multipliers.
 pub const SPECULAR: V3 = [1.0; 3];
+/// `mask`'s `opacity`.
+pub const MASK_OPACITY: f32 = 0.5;
 /// Isotropic microfacet roughness `alpha`.
 pub const ALPHA: f32 = 0.1;
 /// `air` in Mitsuba's IOR table (every `ext_ior`).
@@ -94,6 +96,9 @@ pub(crate) fn rr_depth() -> u32 {
 }
 pub(crate) fn alpha() -> f32 {
     ALPHA
+}
+pub(crate) fn mask_opacity() -> f32 {
+    MASK_OPACITY
 }
 pub(crate) fn specular() -> V3 {
     SPECULAR

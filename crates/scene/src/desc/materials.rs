@@ -181,6 +181,16 @@ pub enum MaterialDesc {
     TwoSided(Box<MaterialDesc>),
     /// Absorbs all light.
     Black,
+    /// Mitsuba's `mask`: `material` with probability `opacity`, and otherwise nothing (light
+    /// passes straight through); a texture may give the opacity (`Textured` with the parameter
+    /// `Opacity` around the mask).
+    Mask {
+        /// Opacity in `[0, 1]` (default 0.5).
+        #[serde(default = "defaults::mask_opacity")]
+        opacity: f32,
+        /// The material where the surface is there.
+        material: Box<MaterialDesc>,
+    },
     /// `material` with some of its colour parameters given by textures, looked up at each
     /// shading point's texture coordinates; the constant values in `material` are unused for
     /// those parameters. In RON: `Textured(material: Diffuse(reflectance: (0.5, 0.5, 0.5)),
@@ -204,6 +214,8 @@ pub enum ColorParam {
     SpecularReflectance,
     /// The dielectrics' `specular_transmittance`.
     SpecularTransmittance,
+    /// A `mask`'s `opacity` (a scalar: a colour texture gives its luminance).
+    Opacity,
 }
 
 impl ColorParam {
@@ -214,6 +226,7 @@ impl ColorParam {
             ColorParam::DiffuseReflectance => "diffuse_reflectance",
             ColorParam::SpecularReflectance => "specular_reflectance",
             ColorParam::SpecularTransmittance => "specular_transmittance",
+            ColorParam::Opacity => "opacity",
         }
     }
 
@@ -224,6 +237,7 @@ impl ColorParam {
             ColorParam::DiffuseReflectance,
             ColorParam::SpecularReflectance,
             ColorParam::SpecularTransmittance,
+            ColorParam::Opacity,
         ]
         .into_iter()
         .find(|p| p.name() == name)

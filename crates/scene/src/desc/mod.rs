@@ -110,6 +110,11 @@ pub struct CameraDesc {
         deserialize_with = "limits::coordinate"
     )]
     pub focus_distance: f32,
+    /// Mitsuba's `orthographic` sensor: parallel rays, the film spanning `[−1, 1]` across
+    /// (and `1/aspect` up and down) in camera space before `to_world` (`fov` and the lens are
+    /// unused).
+    #[serde(default)]
+    pub orthographic: bool,
 }
 
 impl Default for CameraDesc {
@@ -120,6 +125,7 @@ impl Default for CameraDesc {
             to_world: Vec::new(),
             aperture_radius: defaults::APERTURE_RADIUS,
             focus_distance: defaults::FOCUS_DISTANCE,
+            orthographic: false,
         }
     }
 }

@@ -1,4 +1,5 @@
-//! `<bsdf>`: the material models (diffuse, conductors, dielectrics, plastics, twosided, null),
+//! `<bsdf>`: the material models (diffuse, conductors, dielectrics, plastics, twosided, mask,
+//! null),
 //! their roughness and IOR properties, and textures bound to their colour parameters.
 
 use roxmltree::Node;
@@ -18,6 +19,7 @@ const BSDF_TYPES: &[&str] = &[
     "plastic",
     "roughplastic",
     "null",
+    "mask",
 ];
 
 impl<'a> Importer<'a> {
@@ -37,6 +39,7 @@ impl<'a> Importer<'a> {
             "dielectric" | "roughdielectric" => self.dielectric(node, &ty, &props)?,
             "plastic" | "roughplastic" => self.plastic(node, &ty, &props)?,
             "null" => MaterialDesc::Null,
+            "mask" => return self.mask(node, props, textured),
             "thindielectric" => {
                 return Err(self.err(
                     node,
@@ -134,10 +137,10 @@ impl<'a> Importer<'a> {
             if !PROPERTY_TAGS.contains(&tag) && !["bsdf", "texture", "ref"].contains(&tag) {
                 return Err(self.err(c, format!("unexpected <{tag}> inside a bsdf")));
             }
-            if tag == "bsdf" && ty != "twosided" {
+            if tag == "bsdf" && ty != "twosided" && ty != "mask" {
                 return Err(self.err(
                     c,
-                    format!("bsdf '{ty}' takes no nested bsdf (only twosided wraps one)"),
+                    format!("bsdf '{ty}' takes no nested bsdf (only twosided and mask wrap one)"),
                 ));
             }
         }
@@ -181,6 +184,90 @@ impl<'a> Importer<'a> {
             ));
         }
         Ok(MaterialDesc::TwoSided(Box::new(inner)))
+    }
+
+    /// `mask`: one nested bsdf, and an `opacity` (a float or a texture, default 0.5). A texture
+    /// of the nested bsdf is moved outside the mask, beside the opacity's, so the one texture
+    /// slot per material holds both.
+    fn mask<'i>(
+        &self,
+        node: Node<'a, 'i>,
+        props: Props<'a, 'i>,
+        textured: Vec<(Node<'a, 'i>, TextureBinding)>,
+    ) -> Result<MaterialDesc> {
+        let nested: Vec<Node> = elements(node)
+            .filter(|c| c.tag_name().name() == "bsdf")
+            .collect();
+        let inner = match nested.as_slice() {
+            // Checked before recursing, so nesting depth stays bounded (twosided and mask
+            // alternating could otherwise nest as deep as the file).
+            [n] if n.attribute("type").map(snake_case).as_deref() == Some("mask") => {
+                return Err(self.err(*n, "bsdf 'mask' wraps another mask"));
+            }
+            [n] if elements(*n)
+                .filter(|c| c.tag_name().name() == "bsdf")
+                .any(|c| c.attribute("type").map(snake_case).as_deref() == Some("mask")) =>
+            {
+                return Err(self.err(*n, "bsdf 'mask' wraps another mask (inside a twosided)"));
+            }
+            [n] => self.bsdf(*n)?,
+            [] => {
+                return Err(self.err(
+                    node,
+                    "bsdf 'mask' needs one nested <bsdf> (the material where the surface is there)",
+                ));
+            }
+            [_, second, ..] => {
+                return Err(self.err(*second, "bsdf 'mask' takes one nested bsdf, not two"));
+            }
+        };
+        if let Some((c, b)) = textured
+            .iter()
+            .find(|(_, b)| b.param != ColorParam::Opacity)
+        {
+            return Err(self.err(
+                *c,
+                format!(
+                    "bsdf 'mask' has no parameter '{}' (its parameters: opacity and one nested bsdf)",
+                    b.param.name()
+                ),
+            ));
+        }
+        let opacity = props.float("opacity")?.unwrap_or(defaults::MASK_OPACITY);
+        if !(0.0..=1.0).contains(&opacity) {
+            return Err(self.err(
+                props.node_or("opacity", node),
+                format!("bsdf 'mask': opacity {opacity} must lie in [0, 1]"),
+            ));
+        }
+        // A textured nested bsdf: its textures join the opacity's outside the mask.
+        let (inner, mut textures) = match inner {
+            MaterialDesc::Textured { material, textures } => (*material, textures),
+            MaterialDesc::TwoSided(t) => match *t {
+                MaterialDesc::Textured { material, textures } => {
+                    (MaterialDesc::TwoSided(material), textures)
+                }
+                t => (MaterialDesc::TwoSided(Box::new(t)), Vec::new()),
+            },
+            m => (m, Vec::new()),
+        };
+        textures.extend(textured.into_iter().map(|(_, b)| b));
+        let mask = MaterialDesc::Mask {
+            opacity,
+            material: Box::new(inner),
+        };
+        let m = if textures.is_empty() {
+            mask
+        } else {
+            MaterialDesc::Textured {
+                material: Box::new(mask),
+                textures,
+            }
+        };
+        crate::material::check(&m).map_err(|e| self.err(node, format!("bsdf 'mask': {e}")))?;
+        self.check_bsdf_children(node, "mask")?;
+        props.finish();
+        Ok(m)
     }
 
     /// `conductor` and `roughconductor`.

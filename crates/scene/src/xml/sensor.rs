@@ -10,17 +10,26 @@ use crate::desc::*;
 impl<'a> Importer<'a> {
     pub(super) fn sensor<'i>(&self, node: Node<'a, 'i>, desc: &mut SceneDesc) -> Result<()> {
         let ty = self.plugin_type(node)?;
-        if ty != "perspective" && ty != "thinlens" {
-            return Err(self.unknown_type(node, "sensor", &ty, &["perspective", "thinlens"]));
+        const SENSORS: &[&str] = &["perspective", "thinlens", "orthographic"];
+        if !SENSORS.contains(&ty.as_str()) {
+            return Err(self.unknown_type(node, "sensor", &ty, SENSORS));
         }
         let props = self.props(node, format!("sensor '{ty}'"))?;
-        let (fov, fov_axis) = self.field_of_view(node, &props, &ty)?;
-        let mut cam = CameraDesc {
-            fov,
-            fov_axis,
-            to_world: props.transform("to_world")?,
-            ..CameraDesc::default()
+        let mut cam = if ty == "orthographic" {
+            // No field of view: `to_world`'s scale sets the extent.
+            CameraDesc {
+                orthographic: true,
+                ..CameraDesc::default()
+            }
+        } else {
+            let (fov, fov_axis) = self.field_of_view(node, &props, &ty)?;
+            CameraDesc {
+                fov,
+                fov_axis,
+                ..CameraDesc::default()
+            }
         };
+        cam.to_world = props.transform("to_world")?;
         if ty == "thinlens" {
             cam.aperture_radius = props
                 .float("aperture_radius")?

@@ -329,7 +329,18 @@ impl Writer<'_> {
         let item = "the camera";
         finite(item, "fov", &[cam.fov])?;
         finite(item, "lens", &[cam.aperture_radius, cam.focus_distance])?;
-        let thin = cam.aperture_radius != 0.0;
+        let thin = cam.aperture_radius != 0.0 && !cam.orthographic;
+        if cam.orthographic {
+            self.open(r#"<sensor type="orthographic">"#);
+            self.transform("to_world", &cam.to_world, item)?;
+        } else {
+            self.perspective_sensor(cam, thin, item)?;
+        }
+        self.sensor_rest(desc)
+    }
+
+    /// A perspective or thin-lens `<sensor>`'s own properties.
+    fn perspective_sensor(&mut self, cam: &CameraDesc, thin: bool, item: &str) -> Result<()> {
         self.open(&format!(
             r#"<sensor type="{}">"#,
             if thin { "thinlens" } else { "perspective" }
@@ -347,7 +358,11 @@ impl Writer<'_> {
             self.float("aperture_radius", cam.aperture_radius);
             self.float("focus_distance", cam.focus_distance);
         }
-        self.transform("to_world", &cam.to_world, item)?;
+        self.transform("to_world", &cam.to_world, item)
+    }
+
+    /// A `<sensor>`'s sampler and film.
+    fn sensor_rest(&mut self, desc: &SceneDesc) -> Result<()> {
         self.open(r#"<sampler type="independent">"#);
         self.line(r#"<integer name="sample_count" value="$spp"/>"#);
         self.close("</sampler>");
@@ -412,6 +427,22 @@ impl Writer<'_> {
             MaterialDesc::TwoSided(inner) => {
                 self.open(&format!(r#"<bsdf type="twosided"{id_attr}>"#));
                 self.bsdf(inner, None, textures, item)?;
+                self.close("</bsdf>");
+                return Ok(());
+            }
+            MaterialDesc::Mask { opacity, material } => {
+                self.open(&format!(r#"<bsdf type="mask"{id_attr}>"#));
+                match bound(ColorParam::Opacity) {
+                    Some(b) => self.texture(&b.texture, "opacity", item)?,
+                    None => self.float("opacity", *opacity),
+                }
+                let rest: Option<Vec<TextureBinding>> = textures.map(|t| {
+                    t.iter()
+                        .filter(|b| b.param != ColorParam::Opacity)
+                        .cloned()
+                        .collect()
+                });
+                self.bsdf(material, None, rest.as_deref(), item)?;
                 self.close("</bsdf>");
                 return Ok(());
             }
@@ -550,7 +581,11 @@ impl Writer<'_> {
                     self.roughness(r);
                 }
             }
-            MaterialDesc::Textured { .. } | MaterialDesc::TwoSided(_) => unreachable!(),
+            MaterialDesc::Textured { .. }
+            | MaterialDesc::TwoSided(_)
+            | MaterialDesc::Mask { .. } => {
+                unreachable!()
+            }
         }
         self.close("</bsdf>");
         Ok(())

@@ -3,26 +3,16 @@
 //! targets are evaluated), the rigid motion of every shape between the two frames (motion
 //! vectors), and which light of one frame is which light of the other.
 //!
-//! A pixel's previous pixel is found by moving its primary hit back with its shape's motion and
-//! projecting it with the previous camera ([`FrameMotion::previous_pixel`]); the previous hit
-//! there must lie on the same shape, face the same way (the moved shading normal within the
-//! similarity angle) and lie at the expected distance from the previous camera (within the
-//! relative depth tolerance), or the pixel is disoccluded and has no history. These tests only
-//! choose which domain takes part; the estimators stay unbiased whatever they decide
-//! (`docs/ANIMATION.md`, "Across frames").
+//! The reuse passes find a pixel's previous pixel with it
+//! (`reuse::gbuffer::GBuffer::previous_pixel`); [`crate::sequence::FrameSequence`] makes one
+//! per frame of a sequence.
 
 use std::collections::HashMap;
-use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
 use restir_lights::Light;
-use restir_scene::animation::{build_at, frame_time};
-use restir_scene::{AnimationDesc, Scene, SceneDesc, SceneError};
-
-use crate::render::Integrator;
-use crate::reuse::gbuffer::GBuffer;
-use crate::reuse::settings::ReuseSettings;
+use restir_scene::{AnimationDesc, Scene};
 
 /// How the previous frame relates to the current one.
 #[derive(Debug)]
@@ -167,95 +157,10 @@ impl FrameMotion {
         }
     }
 
-    /// The pixel of the previous frame's `prev` G-buffer that saw pixel `index`'s primary hit
-    /// of `gbuf`, if it saw the same surface: the hit moved back with its shape, projected by
-    /// the previous camera, and tested against the hit found there (same shape, shading normals
-    /// within `settings.normal_cos`, distance from the previous camera within
-    /// `settings.depth_tolerance`). `None` for a disocclusion or a point outside the previous
-    /// film.
-    pub fn previous_pixel(
-        &self,
-        gbuf: &GBuffer,
-        index: usize,
-        prev: &GBuffer,
-        settings: &ReuseSettings,
-    ) -> Option<usize> {
-        let r = gbuf.receiver(index)?;
-        let shape = gbuf.shape[index];
-        let m = self.to_prev.get(shape as usize)?;
-        let p = m.transform_point3(r.p);
-        let camera = &self.prev_scene.camera;
-        let film = camera.film_position_of(p)?;
-        let (x, y) = (film.x.floor(), film.y.floor());
-        if x < 0.0 || y < 0.0 || x >= prev.width as f32 || y >= prev.height as f32 {
-            return None;
-        }
-        let q = y as usize * prev.width + x as usize;
-        let pr = prev.receiver(q)?;
-        if prev.shape[q] != shape {
-            return None;
-        }
-        let n = m.transform_vector3(r.n).normalize_or_zero();
-        let depth = (p - camera.origin()).length();
-        let similar = pr.n.dot(n) >= settings.normal_cos
-            && (pr.depth - depth).abs() <= settings.depth_tolerance * pr.depth.max(depth);
-        similar.then_some(q)
-    }
-}
-
-/// Steps one estimator through the frames of an animated scene description: each frame's scene
-/// (the description at the frame's time, built by the one builder) and, before every frame
-/// after the first, the motion since the previous one told to the estimator
-/// ([`Integrator::next_frame`]). `restir render --frames` and `restir bench`'s animation suites
-/// both render sequences through it.
-#[derive(Debug)]
-pub struct FrameSequence<'a> {
-    desc: &'a SceneDesc,
-    anim: &'a AnimationDesc,
-    path: &'a Path,
-    fps: f32,
-    /// The last frame entered and its time.
-    previous: Option<(Arc<Scene>, f32)>,
-}
-
-impl<'a> FrameSequence<'a> {
-    /// The frames of `desc` (read from `path`, which relative files are resolved against) at
-    /// `fps` frames per second; `None` when the description has no animation.
-    pub fn new(desc: &'a SceneDesc, path: &'a Path, fps: f32) -> Option<Self> {
-        Some(Self {
-            anim: desc.animation.as_ref()?,
-            desc,
-            path,
-            fps,
-            previous: None,
-        })
-    }
-
-    /// The time frame `frame` shows, in seconds.
-    pub fn time(&self, frame: u32) -> f32 {
-        frame_time(frame, self.fps)
-    }
-
-    /// The scene of frame `frame`.
-    pub fn build(&self, frame: u32) -> Result<Scene, SceneError> {
-        build_at(self.desc, self.path, self.time(frame))
-    }
-
-    /// Makes `scene` (frame `frame`, from [`Self::build`]) the current frame: `estimator`,
-    /// which rendered the previous frame entered (if any), is told how the scene moved since.
-    pub fn enter(&mut self, estimator: &dyn Integrator, scene: Arc<Scene>, frame: u32) {
-        let time = self.time(frame);
-        if let Some((prev, t_prev)) = self.previous.take() {
-            estimator.next_frame(Arc::new(FrameMotion::new(
-                prev, &scene, self.anim, t_prev, time,
-            )));
-        }
-        self.previous = Some((scene, time));
-    }
-
-    /// The seed frame `frame` renders with, from the sequence's `seed`: its own random streams,
-    /// so the noise of consecutive frames is independent rather than the same pattern.
-    pub fn seed(seed: u64, frame: u32) -> u64 {
-        seed ^ u64::from(frame).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+    /// The rigid map taking a point of shape `shape` in the current frame to where it was in
+    /// the previous frame (`None` for an index past the shapes).
+    #[inline]
+    pub fn shape_to_prev(&self, shape: u32) -> Option<&Mat4> {
+        self.to_prev.get(shape as usize)
     }
 }

@@ -1,0 +1,289 @@
+//! One pass of an estimator: what it is told ([`PassContext`]: seed, pass index, pixel filter,
+//! and the window of the film it renders when a render is split, [`PixelWindow`]) and what it
+//! is ([`Integrator`]). The render loop (`render.rs`), the reuse passes (`reuse/`) and every
+//! estimator stand on this file.
+
+use std::sync::Arc;
+
+use glam::{DVec3, Vec2};
+use restir_sampling::Pcg32;
+use restir_scene::Scene;
+
+use crate::Image;
+use crate::film::Filter;
+use crate::motion::FrameMotion;
+
+/// What an integrator needs to know about the current pass.
+#[derive(Debug)]
+pub struct PassContext<'a> {
+    /// The render's seed.
+    pub seed: u64,
+    /// Index of this pass (0-based).
+    pub pass: u32,
+    /// The pixel filter, for jittering camera rays.
+    pub filter: &'a Filter,
+    /// The part of the film this pass renders, if not all of it: pixel indices and coordinates
+    /// the integrator sees are then the region's, and the random streams and camera rays are
+    /// those of the same pixels in the whole film.
+    pub crop: Option<Crop>,
+}
+
+/// A rectangle of film pixels: columns `x0..x0 + width`, rows `y0..y0 + height`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PixelWindow {
+    /// First column.
+    pub x0: u32,
+    /// First row.
+    pub y0: u32,
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+}
+
+/// Rendered regions of a cropped render start and end on multiples of this many pixels (or at
+/// the film's edge), so that ReSTIR DI's 16×16 light tiles are the whole film's tiles.
+pub const CROP_ALIGN: u32 = 16;
+
+impl PixelWindow {
+    /// The whole of a `width × height` film.
+    pub fn full((width, height): (u32, u32)) -> Self {
+        Self {
+            x0: 0,
+            y0: 0,
+            width,
+            height,
+        }
+    }
+
+    /// One past the last column and row.
+    pub fn end(&self) -> (u32, u32) {
+        (self.x0 + self.width, self.y0 + self.height)
+    }
+
+    /// Pixels in the window.
+    pub fn pixels(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+
+    /// Whether the window is non-empty and lies inside a film of `(width, height)`.
+    pub fn fits(&self, (width, height): (u32, u32)) -> bool {
+        self.width > 0
+            && self.height > 0
+            && u64::from(self.x0) + u64::from(self.width) <= u64::from(width)
+            && u64::from(self.y0) + u64::from(self.height) <= u64::from(height)
+    }
+
+    /// The region to render for this window: grown by `halo` pixels on every side, its edges
+    /// then moved out to multiples of [`CROP_ALIGN`], all clipped to the `film`.
+    pub fn with_halo(&self, halo: u32, film: (u32, u32)) -> Self {
+        let (x1, y1) = self.end();
+        let down = |v: u32| v.saturating_sub(halo) / CROP_ALIGN * CROP_ALIGN;
+        let up = |v: u32, max: u32| {
+            v.saturating_add(halo)
+                .div_ceil(CROP_ALIGN)
+                .saturating_mul(CROP_ALIGN)
+                .min(max)
+        };
+        let (x0, y0) = (down(self.x0), down(self.y0));
+        let (x1, y1) = (up(x1, film.0), up(y1, film.1));
+        Self {
+            x0,
+            y0,
+            width: x1 - x0,
+            height: y1 - y0,
+        }
+    }
+
+    /// The pixels of `inner` (a window inside this one, both in film coordinates) out of
+    /// `image`, this window's pixels, row-major.
+    pub fn extract(&self, image: &Image, inner: &PixelWindow) -> Image {
+        let (dx, dy) = ((inner.x0 - self.x0) as usize, (inner.y0 - self.y0) as usize);
+        let w = self.width as usize;
+        let pixels = (0..inner.height as usize)
+            .flat_map(|y| {
+                let row = (dy + y) * w + dx;
+                image.pixels[row..row + inner.width as usize]
+                    .iter()
+                    .copied()
+            })
+            .collect();
+        Image {
+            width: inner.width,
+            height: inner.height,
+            pixels,
+        }
+    }
+}
+
+/// Where a cropped pass sits in the film.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Crop {
+    /// The region rendered.
+    pub region: PixelWindow,
+    /// The whole film's width.
+    pub film_width: u32,
+}
+
+impl PassContext<'_> {
+    /// The `(width, height)` of the pixels this pass renders: the film's, or the crop region's.
+    #[inline]
+    pub fn resolution(&self, scene: &Scene) -> (u32, u32) {
+        match &self.crop {
+            None => scene.camera.resolution(),
+            Some(c) => (c.region.width, c.region.height),
+        }
+    }
+
+    /// The film's index of pixel `index` of this pass.
+    #[inline]
+    fn film_index(&self, index: usize) -> u64 {
+        match &self.crop {
+            None => index as u64,
+            Some(c) => {
+                let w = c.region.width as usize;
+                let (x, y) = (
+                    index % w + c.region.x0 as usize,
+                    index / w + c.region.y0 as usize,
+                );
+                (y * c.film_width as usize + x) as u64
+            }
+        }
+    }
+
+    /// The random stream of pixel `index` in this pass, the same whatever thread renders it.
+    #[inline]
+    pub fn pixel_rng(&self, index: usize) -> Pcg32 {
+        Pcg32::for_pixel_sample(self.seed, self.film_index(index), self.pass as u64)
+    }
+
+    /// A second, independent stream of pixel `index` in this pass, for estimator stage `stage`
+    /// (stage 0 is [`PassContext::pixel_rng`]'s stream).
+    #[inline]
+    pub fn stage_rng(&self, index: usize, stage: u64) -> Pcg32 {
+        let seed = if stage == 0 {
+            self.seed
+        } else {
+            restir_sampling::mix64(self.seed ^ stage.wrapping_mul(0xa076_1d64_78bd_642f))
+        };
+        Pcg32::for_pixel_sample(seed, self.film_index(index), self.pass as u64)
+    }
+
+    /// A stream of the whole pass for estimator stage `stage`: the same for every pixel, and for
+    /// every crop of the film (choices made once per pass, like shared neighbour offsets).
+    #[inline]
+    pub fn pass_rng(&self, stage: u64) -> Pcg32 {
+        self.pass_stream(stage, u64::MAX)
+    }
+
+    /// Stream `stream` of the whole pass for estimator stage `stage`, one of many (one per tile
+    /// of a pool drawn once per pass, say): like [`PassContext::pass_rng`], the same for every
+    /// pixel and every crop.
+    #[inline]
+    pub fn pass_stream(&self, stage: u64, stream: u64) -> Pcg32 {
+        let seed = restir_sampling::mix64(self.seed ^ stage.wrapping_mul(0xe703_7ed1_a0b4_28db));
+        Pcg32::for_pixel_sample(seed, stream, self.pass as u64)
+    }
+
+    /// The film coordinates of pixel `index` of this pass's buffers, which are `width` pixels
+    /// wide (the film's, or the crop region's).
+    #[inline]
+    pub fn film_xy(&self, index: usize, width: usize) -> (u32, u32) {
+        let (x, y) = ((index % width) as u32, (index / width) as u32);
+        match &self.crop {
+            None => (x, y),
+            Some(c) => (x + c.region.x0, y + c.region.y0),
+        }
+    }
+
+    /// The film position (pixel units) of a filter-jittered camera ray through pixel `(x, y)`
+    /// of this pass.
+    #[inline]
+    pub fn film_position(&self, x: u32, y: u32, rng: &mut Pcg32) -> Vec2 {
+        let (x, y) = match &self.crop {
+            None => (x, y),
+            Some(c) => (x + c.region.x0, y + c.region.y0),
+        };
+        Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + self.filter.sample(rng.next_2d())
+    }
+}
+
+/// An estimator that renders whole passes.
+pub trait Integrator: Sync + Send + std::fmt::Debug {
+    /// Name as given on the command line.
+    fn name(&self) -> &'static str;
+    /// Renders one pass, adding one estimate per pixel to `accum` (row-major). Returns the number
+    /// of rays traced.
+    fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64;
+    /// The estimator's settings in one line, for logs and statistics.
+    fn describe(&self) -> String {
+        self.name().to_string()
+    }
+    /// Bytes per pixel of the per-pass buffers the estimator keeps besides the image (reservoirs,
+    /// primary hits).
+    fn buffer_bytes_per_pixel(&self) -> usize {
+        0
+    }
+    /// How far, in pixels, a pixel's estimate in one pass reaches for other pixels' samples
+    /// (spatial reuse: rounds × radius): the halo a cropped render needs around its window.
+    fn halo(&self) -> u32 {
+        0
+    }
+    /// Wall seconds spent in each stage of the passes so far, in the order the stages run
+    /// (empty for an estimator without stages, like the path tracer).
+    fn stage_seconds(&self) -> Vec<(&'static str, f64)> {
+        Vec::new()
+    }
+    /// The passes that follow render the next frame of a sequence, which moved from the frame
+    /// of the passes before as `motion` says. An estimator that keeps samples between passes
+    /// (temporal reuse) shifts them across the frames with it, or forgets them; the default
+    /// keeps nothing, so it does nothing.
+    fn next_frame(&self, motion: Arc<FrameMotion>) {
+        let _ = motion;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn win(x0: u32, y0: u32, x1: u32, y1: u32) -> PixelWindow {
+        PixelWindow {
+            x0,
+            y0,
+            width: x1 - x0,
+            height: y1 - y0,
+        }
+    }
+
+    /// The region grows by the halo, moves out to multiples of 16 and stops at the film.
+    #[test]
+    fn region_with_halo() {
+        let film = (100, 70);
+        assert_eq!(win(20, 40, 50, 50).with_halo(0, film), win(16, 32, 64, 64));
+        assert_eq!(win(20, 40, 50, 50).with_halo(5, film), win(0, 32, 64, 64));
+        assert_eq!(win(32, 32, 48, 48).with_halo(0, film), win(32, 32, 48, 48));
+        assert_eq!(win(32, 32, 48, 48).with_halo(1, film), win(16, 16, 64, 64));
+        assert_eq!(
+            win(90, 60, 100, 70).with_halo(8, film),
+            win(80, 48, 100, 70)
+        );
+        assert_eq!(win(0, 0, 100, 70).with_halo(30, film), win(0, 0, 100, 70));
+        assert!(win(0, 0, 100, 70).fits(film) && !win(1, 0, 101, 70).fits(film));
+    }
+
+    /// `extract` cuts an inner window out of a region's pixels.
+    #[test]
+    fn extract_window() {
+        let region = win(2, 3, 6, 6);
+        let image = Image {
+            width: 4,
+            height: 3,
+            pixels: (0..12).map(|i| glam::Vec3::splat(i as f32)).collect(),
+        };
+        let inner = region.extract(&image, &win(3, 4, 5, 6));
+        assert_eq!((inner.width, inner.height), (2, 2));
+        let v: Vec<f32> = inner.pixels.iter().map(|p| p.x).collect();
+        assert_eq!(v, [5.0, 6.0, 9.0, 10.0]);
+    }
+}

@@ -1,0 +1,99 @@
+//! Learning across passes (`--learn on`): what each light delivered to the receivers of a
+//! pass, once its shadow ray was traced, is recorded per cell of a world-space grid, and the
+//! next passes draw their candidates' lights from a mixture of those records and the power
+//! sampler ([`restir_lights::LearnedSampler`]).
+//!
+//! Pass `k`'s sampler is frozen from the records of passes `0..k` before pass `k` draws anything,
+//! so given the earlier passes each pass is the usual unbiased estimator with a fixed candidate
+//! distribution whose support is the power sampler's (the defensive share), and so is the
+//! average of the passes. Records are gathered per band of image rows and added band after band,
+//! so the sums, hence the sampler and the image, do not depend on the thread count.
+
+use std::sync::{Arc, Mutex};
+
+use glam::Vec3;
+use restir_lights::{CellKey, LearnGrid, LearnedSampler, LightRecords};
+use restir_scene::Scene;
+
+/// One record of a pass: a receiver's cell, the light of its shaded sample and what it
+/// delivered (luminance, shadow ray included).
+pub(super) type Record = (CellKey, u32, f32);
+
+/// The records of every pass so far and the sampler frozen from them.
+#[derive(Debug, Default)]
+pub(super) struct Learning {
+    state: Mutex<State>,
+}
+
+#[derive(Debug, Default)]
+struct State {
+    records: LightRecords,
+    /// The sampler of the records as they were after the last pass, built on demand.
+    sampler: Option<Arc<LearnedSampler>>,
+    /// Passes recorded.
+    passes: u32,
+}
+
+impl Learning {
+    /// The grid for `scene`: cubes of a `cells`th of the scene's diameter.
+    pub fn grid(scene: &Scene, cells: f32) -> LearnGrid {
+        let diameter = 2.0 * scene.lights.scene_radius();
+        LearnGrid {
+            cell: if diameter > 0.0 && diameter.is_finite() {
+                diameter / cells
+            } else {
+                1.0
+            },
+        }
+    }
+
+    /// The sampler this pass draws from: the records of the earlier passes only (`None` before
+    /// anything was recorded).
+    pub fn sampler(
+        &self,
+        scene: &Scene,
+        share: f32,
+        prior: f32,
+        cells: f32,
+    ) -> Option<Arc<LearnedSampler>> {
+        let mut s = self.state.lock().ok()?;
+        if s.records.records() == 0 {
+            return None;
+        }
+        if s.sampler.is_none() {
+            let sampler = LearnedSampler::new(Self::grid(scene, cells), share, prior, &s.records);
+            s.sampler = Some(Arc::new(sampler));
+        }
+        s.sampler.clone()
+    }
+
+    /// Adds a pass's records, band after band in image order.
+    pub fn record(&self, bands: Vec<Vec<Record>>) {
+        if let Ok(mut s) = self.state.lock() {
+            for (key, light, value) in bands.into_iter().flatten() {
+                s.records.add(key, light, value);
+            }
+            s.sampler = None;
+            s.passes += 1;
+        }
+    }
+
+    /// Forgets everything (a new frame: the lights and receivers have moved).
+    pub fn reset(&self) {
+        if let Ok(mut s) = self.state.lock() {
+            *s = State::default();
+        }
+    }
+}
+
+/// A record of the shaded sample of `light` at the receiver at `p` with normal `n`, which
+/// delivered `contribution` (its shadow ray found it visible). The record counts the selection
+/// (1), not the contribution: the final samples are distributed about as the target with
+/// visibility, so how often each light is selected and visible estimates its share of the
+/// receiver's direct light, with the bounded variance of a count, where the contributions'
+/// weights would carry the reservoirs' heavy tails into the tables.
+#[inline]
+pub(super) fn record(grid: &LearnGrid, p: Vec3, n: Vec3, light: u32, contribution: Vec3) -> Record {
+    let lit = restir_sampling::luminance(contribution) > 0.0;
+    (grid.key(p, n), light, if lit { 1.0 } else { 0.0 })
+}

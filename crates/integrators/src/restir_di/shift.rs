@@ -1,0 +1,192 @@
+//! ReSTIR DI's shift map: the identity between receivers (the light point stays where it is,
+//! `J = 1`; only the target changes), also across the frames of a moving sequence, and with
+//! the visibility of the sample in every target when the settings ask for it.
+
+use glam::Vec3;
+use restir_gris::{ShiftMap, Shifted};
+use restir_lights::{Contact, LightPoint, Resolved};
+use restir_scene::Scene;
+
+use super::DiReservoir;
+use super::target::{StrategyCounts, evaluate};
+use crate::motion::FrameMotion;
+use crate::reuse::gbuffer::{GBuffer, Receiver};
+use crate::reuse::passes::ReuseShift;
+use crate::shadow::{self, ShadowTarget};
+
+/// A receiver where ReSTIR DI's shift map works: a pixel's primary hit in this pass, or in the
+/// previous pass, which across frames lies in the previous frame's scene.
+#[derive(Clone, Copy)]
+pub(super) struct DiDomain<'a> {
+    r: &'a Receiver,
+    /// The receiver's geometric normal (shadow rays leave along it).
+    ng: Vec3,
+    /// The scene the receiver's target is evaluated in.
+    scene: &'a Scene,
+    /// Whether the receiver is the previous frame's (its light indices are that frame's).
+    earlier: bool,
+}
+
+/// The identity shift between pixels: the sample stays on the light, `J = 1`; only the target
+/// changes. Across frames the sample moves with its light, which the previous frame may name
+/// by another index ([`FrameMotion`]); a rigid motion keeps area, so `J = 1` still. It keeps
+/// the receiving pixel's own sample resolved, because pairwise MIS evaluates that sample at
+/// every neighbour. With [`Visibility::Target`] a target includes the visibility of the sample
+/// from the receiver it is evaluated at: one shadow ray per shift whose unshadowed target is
+/// positive, in the scene of the destination domain.
+pub(super) struct DiShift<'a> {
+    scene: &'a Scene,
+    counts: StrategyCounts,
+    motion: Option<&'a FrameMotion>,
+    canonical: Option<(LightPoint, Resolved)>,
+    visibility: bool,
+    rays: std::cell::Cell<u64>,
+}
+
+impl<'a> DiShift<'a> {
+    fn new(
+        scene: &'a Scene,
+        counts: StrategyCounts,
+        motion: Option<&'a FrameMotion>,
+        canonical: &DiReservoir,
+        visibility: bool,
+    ) -> Self {
+        Self {
+            scene,
+            counts,
+            motion,
+            canonical: canonical.sample.map(|x| (x, scene.lights.resolve(&x))),
+            visibility,
+            rays: std::cell::Cell::new(0),
+        }
+    }
+
+    #[inline(always)]
+    fn resolved(&self, x: &LightPoint) -> Resolved {
+        match &self.canonical {
+            Some((y, r)) if y == x => *r,
+            _ => self.scene.lights.resolve(x),
+        }
+    }
+}
+
+impl<'a> ShiftMap<LightPoint> for DiShift<'a> {
+    type Domain = DiDomain<'a>;
+
+    #[inline(always)]
+    fn shift(
+        &self,
+        from: &DiDomain<'a>,
+        to: &DiDomain<'a>,
+        x: &LightPoint,
+    ) -> Option<Shifted<LightPoint>> {
+        let mut y = *x;
+        if from.earlier != to.earlier
+            && let Some(m) = self.motion
+        {
+            y.light = if to.earlier {
+                m.light_to_prev(x.light)?
+            } else {
+                m.light_from_prev(x.light)?
+            };
+        }
+        let resolved = if std::ptr::eq(to.scene, self.scene) {
+            self.resolved(&y)
+        } else {
+            to.scene.lights.resolve(&y)
+        };
+        let Some(c) = resolved.contact(to.r.p) else {
+            return Some(Shifted::identity(y, 0.0));
+        };
+        let bsdf = to.r.resolve_bsdf(to.scene);
+        let mut p = evaluate(to.scene, to.r, &bsdf, &y, &c, None, self.counts).target;
+        if self.visibility && p > 0.0 {
+            self.rays.set(self.rays.get() + 1);
+            if !shadow::visible(to.scene, to.r.p, to.ng, shadow_target(&c)) {
+                p = 0.0;
+            }
+        }
+        Some(Shifted::identity(y, p))
+    }
+}
+
+/// ReSTIR DI's part in the reuse passes: the identity shift between receivers; a domain is a
+/// pixel's receiver in this pass or the previous one (across frames, with the previous
+/// frame's scene, or with this frame's for the negative control `temporal_current_scene`).
+pub(super) struct DiReuse<'p> {
+    pub(super) scene: &'p Scene,
+    pub(super) counts: StrategyCounts,
+    pub(super) gbuf: &'p GBuffer,
+    pub(super) prev: Option<&'p GBuffer>,
+    /// The previous pass's scene and the motion since, when it was the previous frame's.
+    pub(super) motion: Option<&'p FrameMotion>,
+    pub(super) prev_scene: &'p Scene,
+    /// Whether targets include visibility ([`Visibility::Target`]).
+    pub(super) visibility: bool,
+}
+
+impl<'p> ReuseShift for DiReuse<'p> {
+    type Sample = LightPoint;
+    type Domain = DiDomain<'p>;
+    type DomainRef<'d>
+        = DiDomain<'p>
+    where
+        Self: 'd;
+    type Map<'m>
+        = DiShift<'p>
+    where
+        Self: 'm;
+
+    #[inline]
+    fn map(&self, canonical: &DiReservoir) -> DiShift<'p> {
+        DiShift::new(
+            self.scene,
+            self.counts,
+            self.motion,
+            canonical,
+            self.visibility,
+        )
+    }
+
+    fn rays(map: &DiShift<'p>) -> u64 {
+        map.rays.get()
+    }
+
+    #[inline]
+    fn domain(&self, index: usize, previous: bool) -> DiDomain<'p> {
+        if previous {
+            let prev = self.prev.expect("temporal reuse has a previous pass");
+            DiDomain {
+                r: &prev.receivers[index],
+                ng: prev.ng[index],
+                scene: self.prev_scene,
+                earlier: self.motion.is_some(),
+            }
+        } else {
+            DiDomain {
+                r: &self.gbuf.receivers[index],
+                ng: self.gbuf.ng[index],
+                scene: self.scene,
+                earlier: false,
+            }
+        }
+    }
+
+    /// The identity shift keeps the light point.
+    #[inline]
+    fn same_sample(a: &LightPoint, b: &LightPoint) -> bool {
+        a == b
+    }
+}
+
+/// Whether the light point `c` is visible from receiver `r` (one shadow ray).
+#[inline]
+pub(super) fn visible(scene: &Scene, r: &Receiver, ng: Vec3, c: &Contact) -> bool {
+    shadow::visible(scene, r.p, ng, shadow_target(c))
+}
+
+/// The shadow ray's end at light point `c`.
+#[inline]
+pub(super) fn shadow_target(c: &Contact) -> ShadowTarget {
+    ShadowTarget::new(c.p, c.wi, c.dist)
+}

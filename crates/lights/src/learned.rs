@@ -1,0 +1,243 @@
+//! A light selection learned from what lights delivered: per cell of a world-space grid (over
+//! positions and the dominant axis of the receiver's normal), the sum of what each light
+//! contributed to receivers in that cell once its shadow ray was traced, turned into a
+//! distribution and sampled in a mixture with the power sampler.
+//!
+//! The grid is ReGIR's (Boksansky et al., *Ray Tracing Gems II*, 2021: cells of world space,
+//! each with its own light distribution); what fills it follows Vévoda, Kondapaneni and
+//! Křivánek, "Bayesian online regression for adaptive direct illumination sampling" (SIGGRAPH
+//! 2018): lights are weighted by their measured contribution with visibility, so lights that are
+//! blocked from a cell stop being drawn there.
+//!
+//! [`LightRecords`] gathers `(cell, light, contribution)` records in the order they are given;
+//! [`LearnedSampler::new`] freezes them into one alias table per cell. A selection at a receiver
+//! picks the cell's table with probability `share · n / (n + prior)` (`n` the cell's records,
+//! so a cell that has seen little leans on the power sampler) and the power sampler ([`LightSet::select`])
+//! otherwise, so every light with power keeps a positive probability whatever was learned (the
+//! defensive share, Hesterberg 1995), and [`LearnedSampler::pmf`] is the mixture's probability,
+//! exactly, for any receiver and light. A receiver whose cell has no records selects by power
+//! alone.
+
+use std::collections::{BTreeMap, HashMap};
+
+use glam::Vec3;
+use restir_sampling::{AliasTable, ONE_MINUS_EPSILON};
+
+use crate::LightSet;
+
+/// A cell of the grid: integer coordinates and the receiver normal's dominant axis and sign.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct CellKey {
+    x: i32,
+    y: i32,
+    z: i32,
+    face: u8,
+}
+
+/// The grid: cubes of side `cell` in world space, split by the receiver normal's dominant axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LearnGrid {
+    /// Side of a cell in world units.
+    pub cell: f32,
+}
+
+impl LearnGrid {
+    /// The cell of a receiver at `p` with normal `n` (zero if unknown).
+    #[inline]
+    pub fn key(&self, p: Vec3, n: Vec3) -> CellKey {
+        let q = (p / self.cell).floor();
+        let clamp = |v: f32| v.clamp(-1.0e9, 1.0e9) as i32;
+        let a = n.abs();
+        let (axis, sign) = if a.x >= a.y && a.x >= a.z {
+            (0, n.x < 0.0)
+        } else if a.y >= a.z {
+            (1, n.y < 0.0)
+        } else {
+            (2, n.z < 0.0)
+        };
+        CellKey {
+            x: clamp(q.x),
+            y: clamp(q.y),
+            z: clamp(q.z),
+            face: 2 * axis + u8::from(sign),
+        }
+    }
+}
+
+/// What lights delivered, per cell: the sum of the contributions recorded for each light.
+#[derive(Clone, Debug, Default)]
+pub struct LightRecords {
+    cells: BTreeMap<CellKey, BTreeMap<u32, f64>>,
+    /// Records per cell.
+    counts: BTreeMap<CellKey, u64>,
+    records: u64,
+}
+
+impl LightRecords {
+    /// Adds what `light` delivered to a receiver in cell `key` (non-positive and non-finite
+    /// values are ignored). Sums are `f64` and taken in the order of the calls, so the same
+    /// records in the same order give the same bits.
+    #[inline]
+    pub fn add(&mut self, key: CellKey, light: u32, value: f32) {
+        if value > 0.0 && value.is_finite() {
+            *self
+                .cells
+                .entry(key)
+                .or_default()
+                .entry(light)
+                .or_insert(0.0) += value as f64;
+            *self.counts.entry(key).or_insert(0) += 1;
+            self.records += 1;
+        }
+    }
+
+    /// Cells with records.
+    pub fn cells(&self) -> usize {
+        self.cells.len()
+    }
+
+    /// Records added.
+    pub fn records(&self) -> u64 {
+        self.records
+    }
+}
+
+/// One cell's distribution over the lights it recorded.
+#[derive(Clone, Debug)]
+struct CellTable {
+    /// The lights, ascending.
+    lights: Vec<u32>,
+    alias: AliasTable,
+    /// The share of selections the table takes in this cell: the sampler's share times
+    /// `n / (n + prior)` for `n` records, so a cell of few records leans on the power sampler.
+    share: f32,
+}
+
+impl CellTable {
+    /// The probability the table picks `light`.
+    #[inline]
+    fn pmf(&self, light: u32) -> f32 {
+        self.lights
+            .binary_search(&light)
+            .map_or(0.0, |i| self.alias.pmf(i))
+    }
+}
+
+/// The learned selection: per cell an alias table over the lights recorded there, mixed with the
+/// power sampler (module documentation).
+#[derive(Clone, Debug)]
+pub struct LearnedSampler {
+    grid: LearnGrid,
+    share: f32,
+    index: HashMap<CellKey, u32>,
+    tables: Vec<CellTable>,
+}
+
+impl LearnedSampler {
+    /// The sampler of `records` on `grid`, taking a cell's table with probability
+    /// `share · n / (n + prior)` for a cell of `n` records (`share` in `[0, 1)`: the rest goes
+    /// to the power sampler).
+    pub fn new(grid: LearnGrid, share: f32, prior: f32, records: &LightRecords) -> Self {
+        let share = share.clamp(0.0, ONE_MINUS_EPSILON);
+        let prior = prior.max(0.0);
+        let mut index = HashMap::with_capacity(records.cells.len());
+        let mut tables = Vec::with_capacity(records.cells.len());
+        for (key, sums) in &records.cells {
+            let weights: Vec<f32> = sums.values().map(|&v| v as f32).collect();
+            let n = records.counts.get(key).copied().unwrap_or(0) as f32;
+            if let Some(alias) = AliasTable::new(&weights) {
+                index.insert(*key, tables.len() as u32);
+                tables.push(CellTable {
+                    lights: sums.keys().copied().collect(),
+                    alias,
+                    share: share * n / (n + prior),
+                });
+            }
+        }
+        Self {
+            grid,
+            share,
+            index,
+            tables,
+        }
+    }
+
+    /// The largest share of selections a cell's table takes (the share of a cell of very many
+    /// records).
+    pub fn share(&self) -> f32 {
+        self.share
+    }
+
+    /// The share of selections that go to `cell`'s table (0 for no cell).
+    #[inline]
+    pub fn cell_share(&self, cell: Option<u32>) -> f32 {
+        cell.map_or(0.0, |c| self.tables[c as usize].share)
+    }
+
+    /// Cells with a table.
+    pub fn cells(&self) -> usize {
+        self.tables.len()
+    }
+
+    /// Approximate heap bytes of the tables and the cell index.
+    pub fn bytes(&self) -> usize {
+        let entries: usize = self.tables.iter().map(|t| t.lights.len()).sum();
+        // Per entry a light index and an alias bin (probability, alias, pmf); per cell its
+        // key, index slot and table header.
+        entries * (4 + 12) + self.tables.len() * (16 + 4 + 64)
+    }
+
+    /// The cell (its table) of a receiver at `p` with normal `n`, if it has one.
+    #[inline]
+    pub fn cell(&self, p: Vec3, n: Vec3) -> Option<u32> {
+        if self.tables.is_empty() {
+            return None;
+        }
+        self.index.get(&self.grid.key(p, n)).copied()
+    }
+
+    /// Picks a light for a receiver in `cell` ([`LearnedSampler::cell`]) with uniform `u`:
+    /// `(light, probability)`, the probability being [`LearnedSampler::pmf`]'s.
+    #[inline]
+    pub fn sample(&self, lights: &LightSet, cell: Option<u32>, u: f32) -> Option<(u32, f32)> {
+        let Some(table) = cell.map(|c| &self.tables[c as usize]) else {
+            return lights.select(u);
+        };
+        let share = table.share;
+        let light = if u < share {
+            let v = (u / share).min(ONE_MINUS_EPSILON);
+            table.lights[table.alias.sample(v).0]
+        } else {
+            let v = ((u - share) / (1.0 - share)).min(ONE_MINUS_EPSILON);
+            lights.select(v)?.0
+        };
+        Some((light, self.pmf(lights, cell, light)))
+    }
+
+    /// The probability that [`LearnedSampler::sample`] picks `light` for a receiver in `cell`:
+    /// `share · table(light) + (1 − share) · power(light)`, or the power sampler's alone in a
+    /// cell without a table.
+    #[inline]
+    pub fn pmf(&self, lights: &LightSet, cell: Option<u32>, light: u32) -> f32 {
+        match cell.map(|c| &self.tables[c as usize]) {
+            None => lights.pmf(light),
+            Some(t) => t.share * t.pmf(light) + (1.0 - t.share) * lights.pmf(light),
+        }
+    }
+
+    /// The probability of the cell's table alone, without the power sampler's share: what a
+    /// mixture forgetting its defensive part would claim (the tests' negative control; a light
+    /// the table lacks falls back to its power probability).
+    #[doc(hidden)]
+    pub fn pmf_without_defensive_share(
+        &self,
+        lights: &LightSet,
+        cell: Option<u32>,
+        light: u32,
+    ) -> f32 {
+        match cell.map(|c| self.tables[c as usize].pmf(light)) {
+            Some(p) if p > 0.0 => p,
+            _ => lights.pmf(light),
+        }
+    }
+}
