@@ -41,7 +41,16 @@ fn read_exr_pixels(path: &Path) -> Result<(usize, usize, Vec<Vec3>), exr::error:
         }
     }
     file.rewind()?;
-    let img = exr::prelude::read()
+    decode_first_rgb_layer(file)
+}
+
+/// Decodes the first RGB(A) layer of an EXR file read from its start, whose header sizes were
+/// checked already: `(width, height, pixels)`.
+pub(crate) fn decode_first_rgb_layer(
+    file: std::io::BufReader<std::fs::File>,
+) -> Result<(usize, usize, Vec<Vec3>), exr::error::Error> {
+    use exr::prelude::*;
+    let img = read()
         .no_deep_data()
         .largest_resolution_level()
         .rgba_channels(

@@ -94,7 +94,6 @@ impl Image {
     /// sit with the text attributes. Files without attributes read as parts with none. The
     /// header is checked as [`Image::read_exr_part_header`] does before pixels are allocated.
     pub fn read_exr_part(path: &Path) -> Result<(Self, ExrPart), ImageError> {
-        use exr::prelude::*;
         use std::io::Seek;
         let err = |source| ImageError::ReadExr {
             path: path.to_path_buf(),
@@ -105,26 +104,11 @@ impl Image {
         let meta = exr::meta::MetaData::read_from_buffered(&mut file, false).map_err(err)?;
         let (_, part) = part_of_header(&meta).map_err(err)?;
         file.rewind().map_err(|e| err(e.into()))?;
-        let img = exr::prelude::read()
-            .no_deep_data()
-            .largest_resolution_level()
-            .rgba_channels(
-                |res, _| (res.width(), vec![Vec3::ZERO; res.width() * res.height()]),
-                |(w, px): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-                    if let Some(t) = px.get_mut(pos.y() * *w + pos.x()) {
-                        *t = Vec3::new(r, g, b);
-                    }
-                },
-            )
-            .first_valid_layer()
-            .all_attributes()
-            .from_buffered(file)
-            .map_err(err)?;
-        let layer = img.layer_data;
+        let (width, height, pixels) = crate::io::decode_first_rgb_layer(file).map_err(err)?;
         let image = Self {
-            width: layer.size.width() as u32,
-            height: layer.size.height() as u32,
-            pixels: layer.channel_data.pixels.1,
+            width: width as u32,
+            height: height as u32,
+            pixels,
         };
         Ok((image, part))
     }
