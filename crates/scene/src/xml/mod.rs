@@ -19,7 +19,7 @@
 //! `emitters`, `sensor` (camera, film, sampler) and `integrator` turn them into descriptions.
 //! This module walks the document: `<default>` variables, top-level ids and references.
 //!
-//! The other direction is [`to_mitsuba_xml`] (`write.rs`): a description as a Mitsuba 3 scene
+//! The other direction is [`to_mitsuba_xml`] (`write/`): a description as a Mitsuba 3 scene
 //! file, which this importer reads back to the same scene.
 
 mod bsdfs;

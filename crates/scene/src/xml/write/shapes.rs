@@ -1,0 +1,177 @@
+//! Shapes and emitters as Mitsuba 3 spells them.
+
+use super::*;
+
+impl Writer<'_> {
+    pub(super) fn shape(
+        &mut self,
+        s: &ShapeDesc,
+        index: usize,
+        materials: &HashSet<&str>,
+        material_id: &dyn Fn(&str) -> String,
+    ) -> Result<()> {
+        let item = match &s.id {
+            Some(id) => format!("shape {index} ('{id}')"),
+            None => format!("shape {index}"),
+        };
+        if let Some(id) = &s.id {
+            literal(&item, "id", id)?;
+        }
+        let id_attr =
+            s.id.as_ref()
+                .map_or(String::new(), |i| format!(r#" id="{}""#, esc(i)));
+        let mut mesh_file = false;
+        match &s.geometry {
+            GeometryDesc::Rectangle => self.open(&format!(r#"<shape type="rectangle"{id_attr}>"#)),
+            GeometryDesc::Cube => self.open(&format!(r#"<shape type="cube"{id_attr}>"#)),
+            GeometryDesc::Disk => self.open(&format!(r#"<shape type="disk"{id_attr}>"#)),
+            GeometryDesc::Sphere { center, radius } => {
+                let (c, r) =
+                    world_sphere(*center, *radius, &s.to_world).or_else(|e| refuse(&item, e))?;
+                self.open(&format!(r#"<shape type="sphere"{id_attr}>"#));
+                self.line(&format!(
+                    r#"<point name="center" x="{}" y="{}" z="{}"/>"#,
+                    num(c[0]),
+                    num(c[1]),
+                    num(c[2])
+                ));
+                self.float("radius", r);
+            }
+            GeometryDesc::Obj { filename } | GeometryDesc::Ply { filename } => {
+                let ty = if matches!(s.geometry, GeometryDesc::Obj { .. }) {
+                    "obj"
+                } else {
+                    "ply"
+                };
+                self.open(&format!(r#"<shape type="{ty}"{id_attr}>"#));
+                let f = self.file(filename, &item)?;
+                self.string("filename", &f);
+                mesh_file = true;
+            }
+            GeometryDesc::Serialized {
+                filename,
+                shape_index,
+            } => {
+                self.open(&format!(r#"<shape type="serialized"{id_attr}>"#));
+                let f = self.file(filename, &item)?;
+                self.string("filename", &f);
+                self.line(&format!(
+                    r#"<integer name="shape_index" value="{shape_index}"/>"#
+                ));
+                mesh_file = true;
+            }
+            GeometryDesc::Mesh { .. } => {
+                return refuse(
+                    item,
+                    "an inline triangle mesh: Mitsuba 3 XML has none (write the triangles to a PLY or OBJ file and name it)",
+                );
+            }
+        }
+        if !matches!(s.geometry, GeometryDesc::Sphere { .. }) {
+            self.transform("to_world", &s.to_world, &item)?;
+        }
+        if s.flip_normals {
+            self.boolean("flip_normals", true);
+        }
+        if s.face_normals && mesh_file {
+            self.boolean("face_normals", true);
+        }
+        match &s.material {
+            Some(MaterialRef::Ref(name)) => {
+                if !materials.contains(name.as_str()) {
+                    return refuse(item, format!("it refers to an undefined material '{name}'"));
+                }
+                self.line(&format!(r#"<ref id="{}"/>"#, esc(&material_id(name))));
+            }
+            Some(MaterialRef::Inline(m)) => self.bsdf(m, None, None, &item)?,
+            // Mitsuba's rule is this renderer's: a shape without a bsdf is diffuse 0.5, an
+            // area light without one is black.
+            None => {}
+        }
+        if let Some(e) = &s.emission {
+            finite(&item, "emission", e)?;
+            self.open(r#"<emitter type="area">"#);
+            self.rgb("radiance", e);
+            self.close("</emitter>");
+        }
+        self.close("</shape>");
+        Ok(())
+    }
+
+    pub(super) fn emitter(&mut self, l: &LightDesc) -> Result<()> {
+        match l {
+            LightDesc::Point {
+                position,
+                intensity,
+            } => {
+                finite("a point light", "intensity", intensity)?;
+                self.open(r#"<emitter type="point">"#);
+                self.line(&format!(
+                    r#"<point name="position" x="{}" y="{}" z="{}"/>"#,
+                    num(position[0]),
+                    num(position[1]),
+                    num(position[2])
+                ));
+                self.rgb("intensity", intensity);
+            }
+            LightDesc::Directional {
+                direction,
+                irradiance,
+            } => {
+                finite("a directional light", "irradiance", irradiance)?;
+                finite("a directional light", "direction", direction)?;
+                self.open(r#"<emitter type="directional">"#);
+                self.line(&format!(
+                    r#"<vector name="direction" x="{}" y="{}" z="{}"/>"#,
+                    num(direction[0]),
+                    num(direction[1]),
+                    num(direction[2])
+                ));
+                self.rgb("irradiance", irradiance);
+            }
+            LightDesc::Constant { radiance } => {
+                finite("the constant environment", "radiance", radiance)?;
+                self.open(r#"<emitter type="constant">"#);
+                self.rgb("radiance", radiance);
+            }
+            LightDesc::Envmap {
+                filename,
+                scale,
+                to_world,
+                ..
+            } => {
+                finite("the environment map", "scale", &[*scale])?;
+                self.open(r#"<emitter type="envmap">"#);
+                let f = self.file(filename, "the environment map")?;
+                self.string("filename", &f);
+                if *scale != defaults::ENVMAP_SCALE {
+                    self.float("scale", *scale);
+                }
+                self.transform("to_world", to_world, "the environment map")?;
+            }
+        }
+        self.close("</emitter>");
+        Ok(())
+    }
+}
+
+/// A sphere's world-space centre and radius, exactly as the builder computes them (so that the
+/// sphere written without a transform builds to the same bits).
+fn world_sphere(
+    center: V3,
+    radius: f32,
+    to_world: &[TransformOp],
+) -> core::result::Result<(V3, f32), String> {
+    if to_world.is_empty() {
+        return Ok((center, radius));
+    }
+    let m = transform_matrix(to_world).map_err(|e| format!("to_world: {e}"))?;
+    let a = glam::Affine3A::from_mat4(m);
+    let c = a.transform_point3(Vec3::from(center));
+    let scale = a.matrix3.x_axis.length();
+    let (sy, sz) = (a.matrix3.y_axis.length(), a.matrix3.z_axis.length());
+    if (sy - scale).abs() > 1e-4 * scale || (sz - scale).abs() > 1e-4 * scale {
+        return Err("spheres take only uniform scales".into());
+    }
+    Ok((c.to_array(), radius * scale))
+}
