@@ -112,8 +112,8 @@ pub struct CameraDesc {
     pub focus_distance: f32,
     /// Mitsuba's `orthographic` sensor: parallel rays, the film spanning `[−1, 1]` across
     /// (and `1/aspect` up and down) in camera space before `to_world` (`fov` and the lens are
-    /// unused).
-    #[serde(default)]
+    /// unused). Written only when set, so perspective scenes read as before.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub orthographic: bool,
 }
 
