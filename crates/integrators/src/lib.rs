@@ -35,7 +35,7 @@
 
 #![deny(missing_docs)]
 
-mod bands;
+use restir_reuse::bands;
 pub mod fallback;
 pub mod film;
 pub mod motion;

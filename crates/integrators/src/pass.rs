@@ -6,6 +6,7 @@
 use std::sync::Arc;
 
 use glam::{DVec3, Vec2};
+use restir_reuse::{SeededStreams, Streams};
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
@@ -151,29 +152,33 @@ impl PassContext<'_> {
         }
     }
 
+    /// The seed and pass as the reuse passes' streams see them.
+    #[inline]
+    fn streams(&self) -> SeededStreams {
+        SeededStreams {
+            seed: self.seed,
+            pass: self.pass,
+        }
+    }
+
     /// The random stream of pixel `index` in this pass, the same whatever thread renders it.
     #[inline]
     pub fn pixel_rng(&self, index: usize) -> Pcg32 {
-        Pcg32::for_pixel_sample(self.seed, self.film_index(index), self.pass as u64)
+        self.stage_rng(index, 0)
     }
 
     /// A second, independent stream of pixel `index` in this pass, for estimator stage `stage`
     /// (stage 0 is [`PassContext::pixel_rng`]'s stream).
     #[inline]
     pub fn stage_rng(&self, index: usize, stage: u64) -> Pcg32 {
-        let seed = if stage == 0 {
-            self.seed
-        } else {
-            restir_sampling::mix64(self.seed ^ stage.wrapping_mul(0xa076_1d64_78bd_642f))
-        };
-        Pcg32::for_pixel_sample(seed, self.film_index(index), self.pass as u64)
+        self.streams().pixel(self.film_index(index) as usize, stage)
     }
 
     /// A stream of the whole pass for estimator stage `stage`: the same for every pixel, and for
     /// every crop of the film (choices made once per pass, like shared neighbour offsets).
     #[inline]
     pub fn pass_rng(&self, stage: u64) -> Pcg32 {
-        self.pass_stream(stage, u64::MAX)
+        self.streams().pass(stage)
     }
 
     /// Stream `stream` of the whole pass for estimator stage `stage`, one of many (one per tile
@@ -181,8 +186,7 @@ impl PassContext<'_> {
     /// pixel and every crop.
     #[inline]
     pub fn pass_stream(&self, stage: u64, stream: u64) -> Pcg32 {
-        let seed = restir_sampling::mix64(self.seed ^ stage.wrapping_mul(0xe703_7ed1_a0b4_28db));
-        Pcg32::for_pixel_sample(seed, stream, self.pass as u64)
+        self.streams().pass_stream(stage, stream)
     }
 
     /// The film coordinates of pixel `index` of this pass's buffers, which are `width` pixels
@@ -243,6 +247,20 @@ pub trait Integrator: Sync + Send + std::fmt::Debug {
     }
 }
 
+/// The reuse passes draw from the pass's streams, pixel indices of a cropped render mapped to the
+/// film's.
+impl Streams for PassContext<'_> {
+    #[inline]
+    fn pixel(&self, index: usize, stage: u64) -> Pcg32 {
+        self.stage_rng(index, stage)
+    }
+
+    #[inline]
+    fn pass(&self, stage: u64) -> Pcg32 {
+        self.pass_rng(stage)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -287,3 +305,4 @@ mod tests {
         assert_eq!(v, [5.0, 6.0, 9.0, 10.0]);
     }
 }
+

@@ -30,6 +30,15 @@ impl StageClock {
         }
     }
 
+    /// Adds the temporal and spatial steps of a pass's reuse; returns their rays.
+    pub fn add_reuse(&self, report: &restir_reuse::ReuseReport) -> u64 {
+        if let Some((_, t)) = report.temporal {
+            self.add("temporal", t);
+        }
+        self.add("spatial", report.spatial.1);
+        report.rays()
+    }
+
     /// Every stage's total in seconds, in the order the stages first ran.
     pub fn seconds(&self) -> Vec<(&'static str, f64)> {
         let totals = self.totals.lock().unwrap_or_else(|e| e.into_inner());

@@ -343,7 +343,7 @@ fn motion_vectors_find_the_previous_hit() {
         .collect();
     let same = hits
         .iter()
-        .filter(|&&i| now.previous_pixel(i, &still, &before, &settings) == Some(i))
+        .filter(|&&i| now.previous_pixel_moved(i, &still, &before, &settings.similarity()) == Some(i))
         .count();
     assert!(
         same * 100 >= hits.len() * 95,
@@ -357,7 +357,7 @@ fn motion_vectors_find_the_previous_hit() {
     let mut box_missed = 0;
     for &i in &hits {
         let r = now.receiver(i).unwrap();
-        match now.previous_pixel(i, &motion, &prev, &settings) {
+        match now.previous_pixel_moved(i, &motion, &prev, &settings.similarity()) {
             Some(q) => {
                 found += 1;
                 let moved = motion.point_to_prev(now.shape[i], r.p);

@@ -55,9 +55,8 @@ use crate::motion::FrameMotion;
 use crate::pass::{Integrator, PassContext};
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
 use crate::reuse::gbuffer::{GBuffer, Receiver};
-use crate::reuse::neighbors::NeighborPattern;
-use crate::reuse::passes::{self, HistorySlot};
 use crate::reuse::reciprocal;
+use restir_reuse::{ScreenReuse, Stages};
 use crate::reuse::settings::mis_name;
 use crate::stages::StageClock;
 use candidates::Candidates;
@@ -66,10 +65,12 @@ use target::{StrategyCounts, evaluate};
 
 /// Random-stream stages (see [`PassContext::stage_rng`]).
 const STAGE_INITIAL: u64 = 1;
-const STAGE_TEMPORAL: u64 = 2;
 const STAGE_SHADE: u64 = 3;
-const STAGE_SPATIAL: u64 = 16;
 const STAGE_POOL: u64 = 4;
+const STAGES: Stages = Stages {
+    temporal: 2,
+    spatial: 16,
+};
 
 /// The reservoir type: 16-byte sample, `W`, `M`, `p̂`.
 pub type DiReservoir = Reservoir<LightPoint>;
@@ -79,8 +80,8 @@ pub type DiReservoir = Reservoir<LightPoint>;
 pub struct RestirDiIntegrator {
     settings: RestirDiSettings,
     counts: StrategyCounts,
-    pattern: NeighborPattern,
-    history: HistorySlot<LightPoint>,
+    /// The neighbour pattern and the history of temporal reuse.
+    reuse: ScreenReuse<LightPoint, GBuffer>,
     clock: StageClock,
     /// The path tracer that renders instead, and why (a scene with one dominant light).
     fallback: Option<PathFallback>,
@@ -97,8 +98,7 @@ impl RestirDiIntegrator {
                 bsdf: settings.bsdf_candidates as f32,
             },
             settings,
-            pattern: NeighborPattern::new(),
-            history: HistorySlot::default(),
+            reuse: ScreenReuse::default(),
             clock: StageClock::default(),
             fallback: None,
             learning: learn::Learning::default(),
@@ -263,7 +263,7 @@ impl Integrator for RestirDiIntegrator {
     /// their lights, receivers are found by motion vectors, targets of previous domains are
     /// evaluated in the previous frame's scene.
     fn next_frame(&self, motion: std::sync::Arc<FrameMotion>) {
-        self.history.next_frame(Some(motion));
+        self.reuse.next_frame(Some(motion));
         self.learning.reset();
     }
 
@@ -364,13 +364,13 @@ impl Integrator for RestirDiIntegrator {
             self.clock.add("initial", start.elapsed());
 
             // Temporal and spatial reuse.
-            let history = self.history.take(reuse, n);
+            let history = self.reuse.take_history(reuse, n);
             let motion = history.as_ref().and_then(|h| h.motion.as_deref());
             let shift = DiReuse {
                 scene,
                 counts: self.counts,
                 gbuf: &gbuf,
-                prev: history.as_ref().map(|h| &h.gbuffer),
+                prev: history.as_ref().map(|h| &h.surfaces),
                 motion,
                 prev_scene: match motion {
                     Some(m) if !reuse.temporal_current_scene => &m.prev_scene,
@@ -378,30 +378,16 @@ impl Integrator for RestirDiIntegrator {
                 },
                 visibility: s.visibility == Visibility::Target,
             };
-            if let Some(history) = &history {
-                rays += self.clock.time("temporal", || {
-                    passes::temporal(
-                        &shift,
-                        reuse,
-                        ctx,
-                        &gbuf,
-                        history,
-                        STAGE_TEMPORAL,
-                        &mut current,
-                    )
-                });
-            }
-            rays += self.clock.time("spatial", || {
-                passes::spatial(
-                    &shift,
-                    reuse,
-                    &self.pattern,
-                    ctx,
-                    &gbuf,
-                    STAGE_SPATIAL,
-                    &mut current,
-                )
-            });
+            let report = self.reuse.reuse(
+                &shift,
+                reuse,
+                ctx,
+                &gbuf,
+                history.as_ref(),
+                STAGES,
+                &mut current,
+            );
+            rays += self.clock.add_reuse(&report);
 
             // Shading.
             let start = std::time::Instant::now();
@@ -443,7 +429,7 @@ impl Integrator for RestirDiIntegrator {
                 self.clock.time("learn", || self.learning.record(records));
             }
 
-            self.history.store(reuse, gbuf, current);
+            self.reuse.keep(reuse, gbuf, current);
         }
         accum
             .par_iter_mut()

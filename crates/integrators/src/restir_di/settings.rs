@@ -5,6 +5,7 @@
 //! above [`HIERARCHY_MIN_EMITTERS`] emitters) and the path tracer in place of ReSTIR DI when one
 //! light dominates ([`DOMINANT_LIGHT_SHARE`]).
 
+use crate::reuse::params::ReuseParams;
 use restir_scene::SceneFeatures;
 
 pub use crate::fallback::Fallback;

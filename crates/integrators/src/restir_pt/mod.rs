@@ -46,8 +46,7 @@ pub use shift::{Frames, PtShift};
 use crate::bands::Bands;
 use crate::motion::FrameMotion;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
-use crate::reuse::neighbors::NeighborPattern;
-use crate::reuse::passes::{self, HistorySlot};
+use restir_reuse::{ScreenReuse, Stages};
 use crate::reuse::reciprocal;
 
 use crate::fallback::PathFallback;
@@ -61,8 +60,10 @@ use walk::{ScatterVertex, Walker};
 
 /// Random-stream stages (see [`PassContext::stage_rng`]).
 const STAGE_INITIAL: u64 = 101;
-const STAGE_TEMPORAL: u64 = 102;
-const STAGE_SPATIAL: u64 = 116;
+const STAGES: Stages = Stages {
+    temporal: 102,
+    spatial: 116,
+};
 
 /// The reservoir type.
 pub type PtReservoir = Reservoir<PathSample>;
@@ -73,8 +74,8 @@ pub struct RestirPtIntegrator {
     settings: RestirPtSettings,
     /// The ReSTIR DI pass that takes the direct light with `direct = restir-di`.
     di: Option<RestirDiIntegrator>,
-    pattern: NeighborPattern,
-    history: HistorySlot<PathSample>,
+    /// The neighbour pattern and the history of temporal reuse.
+    reuse: ScreenReuse<PathSample, GBuffer>,
     clock: StageClock,
     /// The path tracer that renders instead, and why ([`RestirPtIntegrator::with_fallback`]).
     fallback: Option<PathFallback>,
@@ -97,8 +98,7 @@ impl RestirPtIntegrator {
         Self {
             settings,
             di,
-            pattern: NeighborPattern::new(),
-            history: HistorySlot::default(),
+            reuse: ScreenReuse::default(),
             clock: StageClock::default(),
             fallback: None,
         }
@@ -388,7 +388,7 @@ impl Integrator for RestirPtIntegrator {
         if let Some(di) = &self.di {
             di.next_frame(motion.clone()); // its light samples move with their lights
         }
-        self.history.next_frame(Some(motion));
+        self.reuse.next_frame(Some(motion));
     }
 
     fn buffer_bytes_per_pixel(&self) -> usize {
@@ -423,7 +423,7 @@ impl Integrator for RestirPtIntegrator {
         let (gbuf, mut current, mut radiance, nr) = self.initial_reservoirs(scene, ctx);
         rays += nr;
         if self.max_depth() >= 2 {
-            let history = self.history.take(s, n);
+            let history = self.reuse.take_history(s, n);
             // The previous frame, when the history is its last pass and more than the camera
             // moved.
             let frames = history
@@ -435,34 +435,28 @@ impl Integrator for RestirPtIntegrator {
                 walker: self.walker(scene),
                 settings: &self.settings,
                 gbuf: &gbuf,
-                prev: history.as_ref().map(|h| &h.gbuffer),
+                prev: history.as_ref().map(|h| &h.surfaces),
                 frames,
                 // Domains: pixel `i` of this pass is `i`, of the previous pass `n + i`.
                 pixels: n,
             };
-            if let Some(history) = &history {
-                rays += self.clock.time("temporal", || {
-                    passes::temporal(&shift, s, ctx, &gbuf, history, STAGE_TEMPORAL, &mut current)
-                });
-            }
-            rays += self.clock.time("spatial", || {
-                passes::spatial(
-                    &shift,
-                    s,
-                    &self.pattern,
-                    ctx,
-                    &gbuf,
-                    STAGE_SPATIAL,
-                    &mut current,
-                )
-            });
+            let report = self.reuse.reuse(
+                &shift,
+                s,
+                ctx,
+                &gbuf,
+                history.as_ref(),
+                STAGES,
+                &mut current,
+            );
+            rays += self.clock.add_reuse(&report);
             self.clock.time("shade", || {
                 radiance
                     .par_iter_mut()
                     .zip(current.par_iter())
                     .for_each(|(l, res)| *l += Self::shade(res))
             });
-            self.history.store(s, gbuf, current);
+            self.reuse.keep(s, gbuf, current);
         }
         accum
             .par_iter_mut()

@@ -5,6 +5,7 @@
 //! paths reconnect at too few glossy surfaces ([`GLOSSY_VIEW_MIN`]) and too little of the light
 //! there is indirect ([`INDIRECT_VIEW_MIN`]).
 
+use crate::reuse::params::ReuseParams;
 use restir_scene::Scene;
 
 pub use crate::fallback::Fallback;

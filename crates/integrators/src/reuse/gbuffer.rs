@@ -11,7 +11,7 @@ use restir_scene::Scene;
 use crate::bands::Bands;
 use crate::motion::FrameMotion;
 use crate::pass::PassContext;
-use crate::reuse::settings::ReuseSettings;
+use restir_reuse::{Similarity, SimilarityKey, Surfaces};
 
 /// What a reuse pass needs to know about a pixel's primary hit: the shading point, its frame,
 /// its material and texture coordinates, the direction to the camera and what the
@@ -82,13 +82,6 @@ impl Receiver {
         }
     }
 
-    /// Whether `other` is similar enough to be a reuse neighbour ([`SimilarityKey::is_similar`]).
-    #[inline]
-    pub fn is_similar(&self, other: &Receiver, normal_cos: f32, depth_tolerance: f32) -> bool {
-        self.key()
-            .is_similar(&other.key(), normal_cos, depth_tolerance)
-    }
-
     /// What the similarity tests compare.
     #[inline]
     pub fn key(&self) -> SimilarityKey {
@@ -100,41 +93,6 @@ impl Receiver {
                 self.depth
             },
         }
-    }
-}
-
-/// What the neighbour-similarity tests read of a primary hit, in 16 bytes: spatial reuse tries
-/// pixels at random within its radius, and testing this instead of the 64-byte [`Receiver`]
-/// touches a quarter of the memory (at 640×480 the receivers within a 30-pixel radius do not
-/// fit in a core's cache; the keys do).
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C, align(16))]
-pub struct SimilarityKey {
-    /// Shading normal.
-    pub n: Vec3,
-    /// Distance from the camera; [`SimilarityKey::NO_HIT`] without a primary hit.
-    pub depth: f32,
-}
-
-impl SimilarityKey {
-    /// `depth` of a pixel without a primary hit.
-    pub const NO_HIT: f32 = -1.0;
-
-    /// Whether the pixel has a primary hit.
-    #[inline]
-    pub fn hit(&self) -> bool {
-        self.depth >= 0.0
-    }
-
-    /// Whether `other` is similar enough to be a reuse neighbour: shading normals within
-    /// `normal_cos` (cosine of the largest angle) and camera distances within a relative
-    /// `depth_tolerance` (`docs/RESTIR_DI.md`, spatial reuse). These tests only pick
-    /// participating domains; the estimators stay unbiased whatever they decide. Both keys must
-    /// have a hit.
-    #[inline]
-    pub fn is_similar(&self, other: &SimilarityKey, normal_cos: f32, depth_tolerance: f32) -> bool {
-        self.n.dot(other.n) >= normal_cos
-            && (self.depth - other.depth).abs() <= depth_tolerance * self.depth.max(other.depth)
     }
 }
 
@@ -169,14 +127,6 @@ impl GBuffer {
     pub fn receiver(&self, index: usize) -> Option<&Receiver> {
         let r = &self.receivers[index];
         (r.bsdf != Receiver::NO_HIT).then_some(r)
-    }
-
-    /// Whether pixels `a` and `b` both have a primary hit and are similar enough to be reuse
-    /// neighbours ([`SimilarityKey::is_similar`]).
-    #[inline]
-    pub fn similar(&self, a: usize, b: usize, normal_cos: f32, depth_tolerance: f32) -> bool {
-        let (ka, kb) = (&self.keys[a], &self.keys[b]);
-        ka.hit() && kb.hit() && ka.is_similar(kb, normal_cos, depth_tolerance)
     }
 
     /// Traces the camera rays of pass `ctx`; with `hide_emitters` they pass through area lights
@@ -255,17 +205,17 @@ impl GBuffer {
     /// The pixel of the previous frame's `prev` G-buffer that saw pixel `index`'s primary hit
     /// of this one, after the scene moved as `motion` says: the hit moved back with its shape
     /// and projected by the previous camera. The hit found there must lie on the same shape,
-    /// face the same way (shading normals within `settings.normal_cos`) and lie at the expected
-    /// distance from the previous camera (within `settings.depth_tolerance`), or the pixel is
+    /// face the same way (shading normals within `rule.normal_cos`) and lie at the expected
+    /// distance from the previous camera (within `rule.depth_tolerance`), or the pixel is
     /// disoccluded and has no history (`None`, as for a point outside the previous film). These
     /// tests only choose which domain takes part; the estimators stay unbiased whatever they
     /// decide (`docs/ANIMATION.md`, "Across frames").
-    pub fn previous_pixel(
+    pub fn previous_pixel_moved(
         &self,
         index: usize,
         motion: &FrameMotion,
         prev: &GBuffer,
-        settings: &ReuseSettings,
+        rule: &Similarity,
     ) -> Option<usize> {
         let r = self.receiver(index)?;
         let shape = self.shape[index];
@@ -284,8 +234,51 @@ impl GBuffer {
         }
         let n = m.transform_vector3(r.n).normalize_or_zero();
         let depth = (p - camera.origin()).length();
-        let similar = pr.n.dot(n) >= settings.normal_cos
-            && (pr.depth - depth).abs() <= settings.depth_tolerance * pr.depth.max(depth);
-        similar.then_some(q)
+        let moved = SimilarityKey { n, depth };
+        pr.key().is_similar(&moved, rule).then_some(q)
+    }
+}
+
+/// The reuse passes see this renderer's primary hits through the crate's interface.
+impl Surfaces for GBuffer {
+    type Motion = FrameMotion;
+
+    #[inline]
+    fn width(&self) -> usize {
+        self.width
+    }
+
+    #[inline]
+    fn height(&self) -> usize {
+        self.height
+    }
+
+    #[inline]
+    fn has_surface(&self, index: usize) -> bool {
+        self.keys[index].hit()
+    }
+
+    #[inline]
+    fn similar(&self, a: usize, b: usize, rule: &Similarity) -> bool {
+        let (ka, kb) = (&self.keys[a], &self.keys[b]);
+        ka.hit() && kb.hit() && ka.is_similar(kb, rule)
+    }
+
+    /// The same pixel in the same frame; across frames [`GBuffer::previous_pixel_moved`].
+    #[inline]
+    fn previous_pixel(
+        &self,
+        index: usize,
+        previous: &Self,
+        motion: Option<&FrameMotion>,
+        rule: &Similarity,
+    ) -> Option<usize> {
+        match motion {
+            Some(m) => self.previous_pixel_moved(index, m, previous, rule),
+            None => {
+                let (a, b) = (&self.keys[index], &previous.keys[index]);
+                (a.hit() && b.hit() && a.is_similar(b, rule)).then_some(index)
+            }
+        }
     }
 }

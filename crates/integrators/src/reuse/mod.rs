@@ -1,16 +1,12 @@
-//! What the screen-space ReSTIR estimators (ReSTIR DI and ReSTIR PT) share, one floor below
-//! them: the per-pixel primary hits ([`gbuffer`]), neighbour selection ([`neighbors`]) and
-//! the reuse settings ([`settings`]) and the reuse
-//! passes themselves ([`passes`]: temporal reuse, the spatial rounds and the history, generic
-//! over the estimator's sample and shift map, as pbrt-v4's `ImageTileIntegrator` is over its
-//! `RayIntegrator`; [`reciprocal`]: spatial rounds over reciprocal neighbour pairs, which share
-//! their shifts; [`duplication`]: the history's confidence cap for duplicated samples).
+//! The screen-space reuse of ReSTIR DI and ReSTIR PT: the passes themselves are the
+//! `restir-reuse` crate (re-exported here), which this renderer hosts like any other: its
+//! G-buffer ([`gbuffer`]) is the crate's [`Surfaces`](restir_reuse::Surfaces), its
+//! [`PassContext`](crate::PassContext) the crate's [`Streams`](restir_reuse::Streams), and
+//! [`params`] reads the reuse settings from scene files and the command line.
 
-pub mod duplication;
 pub mod gbuffer;
-pub mod neighbors;
-pub mod passes;
-pub mod reciprocal;
-pub mod settings;
+pub mod params;
 
-pub use settings::{MIS_NAMES, ReuseSettings, mis_name};
+pub use restir_reuse::{
+    MIS_NAMES, ReuseSettings, duplication, mis_name, neighbors, passes, reciprocal, settings,
+};

@@ -8,7 +8,7 @@ use rayon::slice::ChunksMut;
 
 /// Image rows per parallel work item: small enough to balance the threads, large enough to
 /// amortise the per-item setup.
-pub(crate) const BAND_ROWS: usize = 2;
+pub const BAND_ROWS: usize = 2;
 
 /// The bands of an image `width` pixels wide.
 #[derive(Clone, Copy, Debug)]

@@ -4,9 +4,10 @@
 //! history kept for the next pass.
 //!
 //! An estimator plugs in through [`ReuseShift`]: its sample type, the domain its shift map
-//! works on (DI: the receiver; PT: a pixel index) and the map itself. Every pixel's random
-//! numbers come from its own stage stream ([`PassContext::stage_rng`]), drawn in the same order
-//! whatever the estimator: the neighbour pattern's start, then resampling.
+//! works on (a light sample's receiver; a path's pixel) and the map itself; the host's image
+//! through [`Surfaces`]. Every pixel's random numbers come from its own stage stream
+//! ([`Streams::pixel`]), drawn in the same order whatever the estimator: the neighbour
+//! pattern's start, then resampling.
 
 use std::sync::{Arc, Mutex};
 
@@ -15,13 +16,11 @@ use std::borrow::Borrow;
 use restir_gris::{Reservoir, ShiftMap, resample};
 
 use crate::bands::Bands;
-use crate::motion::FrameMotion;
-use crate::pass::PassContext;
-use crate::reuse::duplication;
-use crate::reuse::gbuffer::GBuffer;
-use crate::reuse::neighbors::NeighborPattern;
-use crate::reuse::reciprocal;
-use crate::reuse::settings::ReuseSettings;
+use crate::duplication;
+use crate::neighbors::NeighborPattern;
+use crate::reciprocal;
+use crate::settings::ReuseSettings;
+use crate::surfaces::{Streams, Surfaces};
 
 /// What an estimator's reuse needs for one pass: its shift map between the pixels of this pass
 /// and the previous one.
@@ -60,53 +59,65 @@ pub trait ReuseShift: Sync {
 }
 
 /// What temporal reuse keeps from the previous pass.
-#[derive(Debug)]
-pub struct History<S> {
-    /// The previous pass's primary hits.
-    pub gbuffer: GBuffer,
+pub struct History<S, G: Surfaces> {
+    /// The previous pass's surfaces.
+    pub surfaces: G,
     /// Its final reservoirs.
     pub reservoirs: Vec<Reservoir<S>>,
     /// How the scene moved since that pass, if it was the previous frame's last pass (`None`:
     /// a pass of this frame, in this scene).
-    pub motion: Option<Arc<FrameMotion>>,
+    pub motion: Option<Arc<G::Motion>>,
 }
 
-impl<S> History<S> {
-    /// The previous pass's pixel that saw pixel `index`'s primary hit of `gbuf`, if it saw a
+impl<S, G: Surfaces> History<S, G> {
+    /// The previous pass's pixel that saw pixel `index`'s surface of `surfaces`, if it saw a
     /// similar one: the same pixel in the same frame, or the motion vector's pixel in the
-    /// previous frame ([`GBuffer::previous_pixel`]).
+    /// previous frame ([`Surfaces::previous_pixel`]).
     #[inline]
     pub fn previous_pixel(
         &self,
-        gbuf: &GBuffer,
+        surfaces: &G,
         index: usize,
         settings: &ReuseSettings,
     ) -> Option<usize> {
-        match &self.motion {
-            Some(m) => gbuf.previous_pixel(index, m, &self.gbuffer, settings),
-            None => {
-                let (r, prev) = (gbuf.receiver(index)?, self.gbuffer.receiver(index)?);
-                r.is_similar(prev, settings.normal_cos, settings.depth_tolerance)
-                    .then_some(index)
-            }
-        }
+        surfaces.previous_pixel(
+            index,
+            &self.surfaces,
+            self.motion.as_deref(),
+            &settings.similarity(),
+        )
+    }
+}
+
+impl<S, G: Surfaces> std::fmt::Debug for History<S, G> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("History")
+            .field("pixels", &self.reservoirs.len())
+            .field("moved", &self.motion.is_some())
+            .finish()
     }
 }
 
 /// The history slot an integrator keeps between passes.
-#[derive(Debug)]
-pub struct HistorySlot<S>(Mutex<Option<History<S>>>);
+pub struct HistorySlot<S, G: Surfaces>(Mutex<Option<History<S, G>>>);
 
-impl<S> Default for HistorySlot<S> {
+impl<S, G: Surfaces> std::fmt::Debug for HistorySlot<S, G> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let kept = self.0.lock().map(|h| h.is_some()).unwrap_or(false);
+        f.debug_struct("HistorySlot").field("kept", &kept).finish()
+    }
+}
+
+impl<S, G: Surfaces> Default for HistorySlot<S, G> {
     fn default() -> Self {
         Self(Mutex::new(None))
     }
 }
 
-impl<S> HistorySlot<S> {
+impl<S, G: Surfaces> HistorySlot<S, G> {
     /// Takes the previous pass's history when temporal reuse is on and it matches a pass of
     /// `pixels` pixels.
-    pub fn take(&self, settings: &ReuseSettings, pixels: usize) -> Option<History<S>> {
+    pub fn take(&self, settings: &ReuseSettings, pixels: usize) -> Option<History<S, G>> {
         if !settings.temporal {
             return None;
         }
@@ -117,13 +128,13 @@ impl<S> HistorySlot<S> {
             .filter(|h| h.reservoirs.len() == pixels)
     }
 
-    /// Keeps this pass's primary hits and final reservoirs when temporal reuse is on.
-    pub fn store(&self, settings: &ReuseSettings, gbuffer: GBuffer, reservoirs: Vec<Reservoir<S>>) {
+    /// Keeps this pass's surfaces and final reservoirs when temporal reuse is on.
+    pub fn store(&self, settings: &ReuseSettings, surfaces: G, reservoirs: Vec<Reservoir<S>>) {
         if settings.temporal
             && let Ok(mut h) = self.0.lock()
         {
             *h = Some(History {
-                gbuffer,
+                surfaces,
                 reservoirs,
                 motion: None,
             });
@@ -134,7 +145,7 @@ impl<S> HistorySlot<S> {
     /// frame's last pass) is kept with `motion`, how the scene moved since, or dropped when
     /// `motion` is `None` (an estimator that cannot shift its samples across frames) or when
     /// the history is older than one frame.
-    pub fn next_frame(&self, motion: Option<Arc<FrameMotion>>) {
+    pub fn next_frame(&self, motion: Option<Arc<G::Motion>>) {
         if let Ok(mut h) = self.0.lock() {
             match (h.as_mut(), motion) {
                 (Some(hist), Some(m)) if hist.motion.is_none() => hist.motion = Some(m),
@@ -144,17 +155,17 @@ impl<S> HistorySlot<S> {
     }
 }
 
-/// Temporal reuse: every pixel whose primary hit was seen by a similar one in the previous pass
+/// Temporal reuse: every pixel whose surface was seen by a similar one in the previous pass
 /// ([`History::previous_pixel`]: the same pixel, or across frames the motion vector's)
 /// resamples its reservoir with that pixel's (confidence capped at `mcap`, or lower where its
-/// sample is duplicated with `duplication` on: [`super::duplication`]); the previous domain
+/// sample is duplicated with `duplication` on: [`crate::duplication`]); the previous domain
 /// is `reuse.domain(previous pixel, true)`. Returns the rays traced.
-pub fn temporal<R: ReuseShift>(
+pub fn temporal<R: ReuseShift, G: Surfaces>(
     reuse: &R,
     settings: &ReuseSettings,
-    ctx: &PassContext,
-    gbuf: &GBuffer,
-    history: &History<R::Sample>,
+    streams: &impl Streams,
+    surfaces: &G,
+    history: &History<R::Sample, G>,
     stage: u64,
     current: &mut [Reservoir<R::Sample>],
 ) -> u64 {
@@ -162,24 +173,24 @@ pub fn temporal<R: ReuseShift>(
     let caps = (settings.duplication > 0.0).then(|| {
         duplication::history_caps(
             &history.reservoirs,
-            history.gbuffer.width,
+            history.surfaces.width(),
             settings.halo().max(1) as usize,
             settings.duplication,
             settings.mcap,
             R::same_sample,
         )
     });
-    let bands = Bands::new(gbuf.width);
+    let bands = Bands::new(surfaces.width());
     bands.run(current, |first, out| {
         let mut rays = 0;
         for (i, res) in out.iter_mut().enumerate() {
             let index = first + i;
-            let Some(q) = history.previous_pixel(gbuf, index, settings) else {
+            let Some(q) = history.previous_pixel(surfaces, index, settings) else {
                 continue;
             };
             let cap = caps.as_ref().map_or(settings.mcap, |c| c[q]);
             let prev = history.reservoirs[q].with_confidence_cap(cap);
-            let mut rng = ctx.stage_rng(index, stage);
+            let mut rng = streams.pixel(index, stage);
             let map = reuse.map(res);
             *res = resample(
                 &map,
@@ -196,15 +207,15 @@ pub fn temporal<R: ReuseShift>(
     })
 }
 
-/// `R` spatial rounds: each pixel with a primary hit resamples its reservoir with up to `k`
+/// `R` spatial rounds: each pixel with a surface resamples its reservoir with up to `k`
 /// similar neighbours of the previous round's buffer, writing a new buffer. Returns the rays
 /// traced.
-pub fn spatial<R: ReuseShift>(
+pub fn spatial<R: ReuseShift, G: Surfaces>(
     reuse: &R,
     settings: &ReuseSettings,
     pattern: &NeighborPattern,
-    ctx: &PassContext,
-    gbuf: &GBuffer,
+    streams: &impl Streams,
+    surfaces: &G,
     first_stage: u64,
     current: &mut Vec<Reservoir<R::Sample>>,
 ) -> u64 {
@@ -212,10 +223,10 @@ pub fn spatial<R: ReuseShift>(
         return 0;
     }
     if settings.reciprocal && reciprocal::shares_pair_shifts(settings.mis) {
-        return reciprocal::spatial(reuse, settings, ctx, gbuf, first_stage, current);
+        return reciprocal::spatial(reuse, settings, streams, surfaces, first_stage, current);
     }
     let rule = settings.neighbor_rule();
-    let bands = Bands::new(gbuf.width);
+    let bands = Bands::new(surfaces.width());
     let mut next = vec![Reservoir::empty(); current.len()];
     let mut rays = 0;
     for round in 0..settings.spatial_rounds {
@@ -227,12 +238,12 @@ pub fn spatial<R: ReuseShift>(
             for (i, res) in out.iter_mut().enumerate() {
                 let index = first + i;
                 let canonical = &input[index];
-                if gbuf.receiver(index).is_none() {
+                if !surfaces.has_surface(index) {
                     *res = *canonical;
                     continue;
                 }
-                let mut rng = ctx.stage_rng(index, first_stage + u64::from(round));
-                pattern.select(gbuf, index, &rule, &mut rng, &mut picked);
+                let mut rng = streams.pixel(index, first_stage + u64::from(round));
+                pattern.select(surfaces, index, &rule, &mut rng, &mut picked);
                 neighbors.clear();
                 neighbors.extend(picked.iter().map(|&q| (reuse.domain(q, false), &input[q])));
                 let map = reuse.map(canonical);

@@ -10,8 +10,8 @@
 //!
 //! Each round draws `⌈k/2⌉` offsets `o_j` in the disk of the reuse radius, the same for every
 //! pixel of the pass (from a stream of the pass and round alone, so a cropped render draws the
-//! same ones); pixel `p`'s neighbours are `p + o_j` and `p − o_j` that exist, have a primary hit
-//! and pass the similarity test (which is symmetric). The choice depends on the G-buffer and the
+//! same ones); pixel `p`'s neighbours are `p + o_j` and `p − o_j` that exist, have a surface
+//! and pass the similarity test (which is symmetric). The choice depends on the surfaces and the
 //! pass's stream only, never on reservoirs, so the reuse stays unbiased. A round runs in two
 //! phases: the shifts of every pair `(p, p + o_j)`, stored per pixel and offset, then each
 //! pixel's resampling with a [`ShiftMap`] that reads them.
@@ -22,10 +22,9 @@ use restir_gris::{MisScheme, Reservoir, ShiftMap, Shifted, resample};
 use restir_sampling::Pcg32;
 
 use crate::bands::Bands;
-use crate::pass::PassContext;
-use crate::reuse::gbuffer::GBuffer;
-use crate::reuse::passes::ReuseShift;
-use crate::reuse::settings::ReuseSettings;
+use crate::passes::ReuseShift;
+use crate::settings::ReuseSettings;
+use crate::surfaces::{Streams, Surfaces};
 
 /// Whether `scheme` uses only shifts between the canonical pixel and each neighbour (the
 /// pairwise family), the shifts a reciprocal pair shares.
@@ -137,17 +136,18 @@ fn round_offsets(radius: f32, count: usize, rng: &mut Pcg32) -> Vec<(i64, i64)> 
 
 /// `R` reciprocal spatial rounds (see the module docs); the settings must use a pairwise MIS
 /// ([`shares_pair_shifts`]). Returns the rays traced.
-pub fn spatial<R: ReuseShift>(
+pub fn spatial<R: ReuseShift, G: Surfaces>(
     reuse: &R,
     settings: &ReuseSettings,
-    ctx: &PassContext,
-    gbuf: &GBuffer,
+    streams: &impl Streams,
+    surfaces: &G,
     first_stage: u64,
     current: &mut Vec<Reservoir<R::Sample>>,
 ) -> u64 {
     debug_assert!(shares_pair_shifts(settings.mis));
-    let (w, h) = (gbuf.width as i64, gbuf.height as i64);
-    let bands = Bands::new(gbuf.width);
+    let (w, h) = (surfaces.width() as i64, surfaces.height() as i64);
+    let bands = Bands::new(surfaces.width());
+    let similarity = settings.similarity();
     let n = current.len();
     let mut next = vec![Reservoir::empty(); n];
     let mut rays = 0;
@@ -158,7 +158,7 @@ pub fn spatial<R: ReuseShift>(
         let offsets = round_offsets(
             settings.radius,
             pairs_per_round,
-            &mut ctx.pass_rng(stage ^ 0x5eed_0ff5),
+            &mut streams.pass(stage ^ 0x5eed_0ff5),
         );
         let m = offsets.len();
         if m == 0 {
@@ -173,8 +173,7 @@ pub fn spatial<R: ReuseShift>(
         // The partner `a + o` of pixel `a`, when the pair exists (both hit, similar).
         let partner = |a: usize, o: (i64, i64)| -> Option<usize> {
             let b = step(a, o)?;
-            gbuf.similar(a, b, settings.normal_cos, settings.depth_tolerance)
-                .then_some(b)
+            surfaces.similar(a, b, &similarity).then_some(b)
         };
 
         // Phase 1: the shifts of every pair (a, a + o_j), at entry a·m + j.
@@ -215,7 +214,7 @@ pub fn spatial<R: ReuseShift>(
             for (i, res) in out.iter_mut().enumerate() {
                 let p = first + i;
                 let canonical = &input[p];
-                if gbuf.receiver(p).is_none() {
+                if !surfaces.has_surface(p) {
                     *res = *canonical;
                     continue;
                 }
@@ -241,7 +240,7 @@ pub fn spatial<R: ReuseShift>(
                         neighbors.push((slot, &input[q]));
                     }
                 }
-                let mut rng = ctx.stage_rng(p, stage);
+                let mut rng = streams.pixel(p, stage);
                 *res = resample(
                     &CachedShifts {
                         table,

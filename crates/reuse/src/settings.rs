@@ -1,11 +1,11 @@
 //! The settings every screen-space reuse pass shares (ReSTIR DI and ReSTIR PT): neighbours,
 //! radius, rounds, MIS, confidence cap, temporal reuse and the similarity thresholds, their
-//! names in scene files and on the command line, and their parsing.
+//! names on the command line.
 
 use restir_gris::MisScheme;
 
-use crate::params::{Param, ParamError, ParamProblem};
-use crate::reuse::neighbors::NeighborRule;
+use crate::neighbors::NeighborRule;
+use crate::surfaces::Similarity;
 
 /// How spatial and temporal reuse weight their inputs (`--mis`).
 pub const MIS_NAMES: &[(&str, MisScheme)] = &[
@@ -25,14 +25,6 @@ pub fn mis_name(scheme: MisScheme) -> &'static str {
         .iter()
         .find(|(_, s)| *s == scheme)
         .map_or("?", |(n, _)| n)
-}
-
-impl Param {
-    /// An MIS scheme by one of [`MIS_NAMES`].
-    pub fn mis(&self) -> Result<MisScheme, ParamError> {
-        let names: Vec<&str> = MIS_NAMES.iter().map(|(n, _)| *n).collect();
-        self.choice(MIS_NAMES, &format!("one of {}", names.join(", ")))
-    }
 }
 
 /// Spatial and temporal reuse settings.
@@ -57,7 +49,7 @@ pub struct ReuseSettings {
     pub normal_cos: f32,
     /// Largest relative difference of camera distances (default 0.1).
     pub depth_tolerance: f32,
-    /// Spatial neighbours in reciprocal pairs that share their shifts ([`super::reciprocal`];
+    /// Spatial neighbours in reciprocal pairs that share their shifts ([`crate::reciprocal`];
     /// pairwise MIS only, default on).
     pub reciprocal: bool,
     /// Negative control only: reciprocal pairs read the wrong one of a pair's two shifts
@@ -65,7 +57,7 @@ pub struct ReuseSettings {
     pub reciprocal_mismatched: bool,
     /// Duplication-aware history confidence, strength from 0 (off, the default) to 1: temporal
     /// reuse caps the previous pixel's confidence lower the more of its neighbours hold the
-    /// same sample ([`super::duplication`]). Biased: the cap depends on the sample it weighs.
+    /// same sample ([`crate::duplication`]). Biased: the cap depends on the sample it weighs.
     pub duplication: f32,
     /// Negative control only: temporal reuse across frames evaluates the previous frame's
     /// domains in the current frame's scene (lights where they are now; biased).
@@ -122,6 +114,13 @@ impl ReuseSettings {
         NeighborRule {
             count: self.neighbors as usize,
             radius: self.radius,
+            similarity: self.similarity(),
+        }
+    }
+
+    /// The similarity test's thresholds.
+    pub fn similarity(&self) -> Similarity {
+        Similarity {
             normal_cos: self.normal_cos,
             depth_tolerance: self.depth_tolerance,
         }
@@ -160,45 +159,6 @@ impl ReuseSettings {
         } else {
             "temporal=false".into()
         }
-    }
-
-    /// Reads parameter `p` (normalized name `key`) if it is a reuse setting; returns whether
-    /// it was. The names Lajolla ReSTIR ports use are accepted too.
-    pub fn apply(&mut self, key: &str, p: &Param) -> Result<bool, ParamError> {
-        match key {
-            "neighbors"
-            | "neighbours"
-            | "neighbors_per_pixel"
-            | "neighbours_per_pixel"
-            | "neighbor_select"
-            | "neighbour_select"
-            | "num_neighbors"
-            | "spatial_neighbors" => self.neighbors = p.count(0)?,
-            "radius" | "max_radius" | "spatial_radius" => self.radius = p.positive()?,
-            "spatial_rounds" | "spatial_iteration" | "spatial_iterations" | "spatial_passes" => {
-                self.spatial_rounds = p.count(0)?;
-            }
-            "mis" | "bias_correction" => self.mis = p.mis()?,
-            "mcap" | "m_cap" | "m_capping" | "max_history" => self.mcap = p.positive()?,
-            "temporal" | "temporal_reuse" => self.temporal = p.boolean()?,
-            "temporal_mis" => self.temporal_scheme = Some(p.mis()?),
-            "reciprocal" | "reciprocal_neighbors" => self.reciprocal = p.boolean()?,
-            "reciprocal_mismatched" => self.reciprocal_mismatched = p.boolean()?,
-            "temporal_current_scene" => self.temporal_current_scene = p.boolean()?,
-            "duplication" | "duplication_map" | "duplication_strength" => {
-                self.duplication = p.fraction()?;
-            }
-            "normal_threshold" => {
-                let deg = p.positive()?;
-                if deg > 180.0 {
-                    return Err(p.error(ParamProblem::AngleTooLarge));
-                }
-                self.normal_cos = deg.to_radians().cos();
-            }
-            "depth_threshold" => self.depth_tolerance = p.positive()?,
-            _ => return Ok(false),
-        }
-        Ok(true)
     }
 }
 

@@ -17,10 +17,10 @@
 //!
 //! **Biased.** The cap is a function of the history sample itself (whether its neighbours hold
 //! the same one), so the MIS weight of the history depends on the sample it weighs, which the
-//! unbiasedness argument of GRIS excludes (`docs/GRIS.md` §5). [`ReuseSettings::is_unbiased`]
+//! unbiasedness argument of GRIS excludes (Lin et al. 2022, GRIS, §5). [`ReuseSettings::is_unbiased`]
 //! says so, and the estimators' descriptions label it.
 //!
-//! [`ReuseSettings::is_unbiased`]: super::settings::ReuseSettings::is_unbiased
+//! [`ReuseSettings::is_unbiased`]: crate::settings::ReuseSettings::is_unbiased
 
 use rayon::prelude::*;
 use restir_gris::Reservoir;

@@ -1,17 +1,17 @@
 //! Spatial-reuse neighbour selection shared by the screen-space ReSTIR estimators
-//! (`docs/RESTIR_DI.md`, spatial reuse).
+//! (Bitterli et al. 2020, §6).
 //!
 //! A fixed table of points of the R2 low-discrepancy sequence inside the unit disk; each pixel
 //! walks it from its own random start, so neighbour sets differ between pixels (no correlation
 //! aliasing) while staying well spread. Candidates off the image, on the pixel itself, without a
-//! primary hit or failing the normal/depth similarity test are skipped; up to `2k` points are
-//! tried for `k` neighbours. The choice depends only on the G-buffer and the pixel's random
+//! surface or failing the host's similarity test are skipped; up to `2k` points are
+//! tried for `k` neighbours. The choice depends only on the surfaces and the pixel's random
 //! stream, never on reservoirs, so it does not bias the reuse.
 
 use glam::Vec2;
 use restir_sampling::{Pcg32, sequences::r2};
 
-use crate::reuse::gbuffer::GBuffer;
+use crate::surfaces::{Similarity, Surfaces};
 
 /// Points in the table; a power of two, so that indices wrap with a mask.
 const OFFSET_COUNT: usize = 8192;
@@ -23,10 +23,8 @@ pub struct NeighborRule {
     pub count: usize,
     /// Disk radius in pixels.
     pub radius: f32,
-    /// Cosine of the largest angle between shading normals.
-    pub normal_cos: f32,
-    /// Largest relative difference of camera distances.
-    pub depth_tolerance: f32,
+    /// Which pixels may be neighbours.
+    pub similarity: Similarity,
 }
 
 /// The table of disk offsets.
@@ -58,21 +56,20 @@ impl NeighborPattern {
     }
 
     /// Writes into `out` the pixel indices of up to `rule.count` neighbours of pixel `index`
-    /// (which must have a primary hit), drawing the start point from `rng`.
-    pub fn select(
+    /// (none when it has no surface), drawing the start point from `rng`.
+    pub fn select<G: Surfaces>(
         &self,
-        gbuf: &GBuffer,
+        surfaces: &G,
         index: usize,
         rule: &NeighborRule,
         rng: &mut Pcg32,
         out: &mut Vec<usize>,
     ) {
         out.clear();
-        let r = &gbuf.keys[index];
-        if !r.hit() {
+        if !surfaces.has_surface(index) {
             return;
         }
-        let (w, h) = (gbuf.width as i64, gbuf.height as i64);
+        let (w, h) = (surfaces.width() as i64, surfaces.height() as i64);
         let (x, y) = ((index as i64) % w, (index as i64) / w);
         let mask = self.offsets.len() - 1;
         let start = rng.next_u32() as usize;
@@ -86,8 +83,7 @@ impl NeighborPattern {
                 continue;
             }
             let q = (ny * w + nx) as usize;
-            let rq = &gbuf.keys[q];
-            if rq.hit() && r.is_similar(rq, rule.normal_cos, rule.depth_tolerance) {
+            if surfaces.similar(index, q, &rule.similarity) {
                 out.push(q);
             }
         }

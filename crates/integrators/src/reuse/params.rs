@@ -1,0 +1,60 @@
+//! The reuse settings' names in scene files and on the command line, and their parsing.
+
+use restir_gris::MisScheme;
+use restir_reuse::{MIS_NAMES, ReuseSettings};
+
+use crate::params::{Param, ParamError, ParamProblem};
+
+impl Param {
+    /// An MIS scheme by one of [`MIS_NAMES`].
+    pub fn mis(&self) -> Result<MisScheme, ParamError> {
+        let names: Vec<&str> = MIS_NAMES.iter().map(|(n, _)| *n).collect();
+        self.choice(MIS_NAMES, &format!("one of {}", names.join(", ")))
+    }
+}
+
+/// Reading [`ReuseSettings`] from an estimator's parameters.
+pub trait ReuseParams {
+    /// Reads parameter `p` (normalized name `key`) if it is a reuse setting; returns whether
+    /// it was. The names Lajolla ReSTIR ports use are accepted too.
+    fn apply(&mut self, key: &str, p: &Param) -> Result<bool, ParamError>;
+}
+
+impl ReuseParams for ReuseSettings {
+    fn apply(&mut self, key: &str, p: &Param) -> Result<bool, ParamError> {
+        match key {
+            "neighbors"
+            | "neighbours"
+            | "neighbors_per_pixel"
+            | "neighbours_per_pixel"
+            | "neighbor_select"
+            | "neighbour_select"
+            | "num_neighbors"
+            | "spatial_neighbors" => self.neighbors = p.count(0)?,
+            "radius" | "max_radius" | "spatial_radius" => self.radius = p.positive()?,
+            "spatial_rounds" | "spatial_iteration" | "spatial_iterations" | "spatial_passes" => {
+                self.spatial_rounds = p.count(0)?;
+            }
+            "mis" | "bias_correction" => self.mis = p.mis()?,
+            "mcap" | "m_cap" | "m_capping" | "max_history" => self.mcap = p.positive()?,
+            "temporal" | "temporal_reuse" => self.temporal = p.boolean()?,
+            "temporal_mis" => self.temporal_scheme = Some(p.mis()?),
+            "reciprocal" | "reciprocal_neighbors" => self.reciprocal = p.boolean()?,
+            "reciprocal_mismatched" => self.reciprocal_mismatched = p.boolean()?,
+            "temporal_current_scene" => self.temporal_current_scene = p.boolean()?,
+            "duplication" | "duplication_map" | "duplication_strength" => {
+                self.duplication = p.fraction()?;
+            }
+            "normal_threshold" => {
+                let deg = p.positive()?;
+                if deg > 180.0 {
+                    return Err(p.error(ParamProblem::AngleTooLarge));
+                }
+                self.normal_cos = deg.to_radians().cos();
+            }
+            "depth_threshold" => self.depth_tolerance = p.positive()?,
+            _ => return Ok(false),
+        }
+        Ok(true)
+    }
+}
