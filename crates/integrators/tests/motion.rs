@@ -343,7 +343,9 @@ fn motion_vectors_find_the_previous_hit() {
         .collect();
     let same = hits
         .iter()
-        .filter(|&&i| now.previous_pixel_moved(i, &still, &before, &settings.similarity()) == Some(i))
+        .filter(|&&i| {
+            now.previous_pixel_moved(i, &still, &before, &settings.similarity()) == Some(i)
+        })
         .count();
     assert!(
         same * 100 >= hits.len() * 95,

@@ -7,9 +7,9 @@
 //! The shift between pixels is the identity: a light sample (a point on a light, or a
 //! direction for a distant light) names where the light comes from without its receiver, so it
 //! means the same at every pixel and the Jacobian is 1; only the target changes
-//! ([`DirectShift`]). Hosts whose samples need a real shift (paths, or light samples stored in
+//! (the map of the private `DirectShift`). Hosts whose samples need a real shift (paths, or light samples stored in
 //! a receiver's solid angle) implement [`ReuseShift`] themselves and run
-//! [`ScreenReuse`](crate::ScreenReuse) directly, as this crate's renderer does.
+//! [`ScreenReuse`] directly, as this project's renderer does.
 //!
 //! # Contract
 //!
@@ -109,7 +109,7 @@ const STAGES: Stages = Stages {
     spatial: 16,
 };
 
-/// A pixel's surface in this pass or in the previous one: where a [`DirectShift`] works.
+/// A pixel's surface in this pass or in the previous one: where the identity shift works.
 #[derive(Debug)]
 pub struct Pixel<'a, G> {
     /// The pass's surfaces.

@@ -67,7 +67,8 @@ pub struct ReuseSettings {
 impl Default for ReuseSettings {
     /// One round of four neighbours in two reciprocal pairs within 3 pixels, defensive pairwise
     /// MIS, `M` capped at 20, no temporal reuse, 25° and 10 % similarity: chosen for ReSTIR DI
-    /// and ReSTIR PT on their training families (`docs/studies/2026-12-02-restir-di-light-pool-and-defaults.md`,
+    /// and ReSTIR PT on their training families (the project repository's
+    /// `docs/studies/2026-12-02-restir-di-light-pool-and-defaults.md` and
     /// `docs/studies/2026-12-02-restir-pt-defaults.md`; ReSTIR PT runs three rounds).
     fn default() -> Self {
         Self {
@@ -131,8 +132,8 @@ impl ReuseSettings {
     /// which carries up to `mcap` passes of history): like the balance heuristic it lets the
     /// history weigh by its confidence where the two targets agree (defensive pairwise would keep
     /// half the weight on the fresh sample), and it bounds what a history sample brings where
-    /// the receiver's target has grown (motion; `docs/GRIS.md` §4.4′). Chosen over the balance
-    /// heuristic on the moving training family (`docs/studies/2026-12-02-temporal-reuse.md`). Biased schemes stay as chosen.
+    /// the receiver's target has grown (motion; the repository's `docs/GRIS.md` §4.4′). Chosen over the balance
+    /// heuristic on the moving training family (the repository's `docs/studies/2026-12-02-temporal-reuse.md`). Biased schemes stay as chosen.
     pub fn temporal_mis(&self) -> MisScheme {
         if let Some(scheme) = self.temporal_scheme {
             scheme

@@ -77,7 +77,8 @@ impl SimilarityKey {
     #[inline]
     pub fn is_similar(&self, other: &SimilarityKey, rule: &Similarity) -> bool {
         self.n.dot(other.n) >= rule.normal_cos
-            && (self.depth - other.depth).abs() <= rule.depth_tolerance * self.depth.max(other.depth)
+            && (self.depth - other.depth).abs()
+                <= rule.depth_tolerance * self.depth.max(other.depth)
     }
 }
 

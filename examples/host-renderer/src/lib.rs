@@ -279,7 +279,13 @@ pub fn render_restir(
 /// The host's own direct-lighting estimator: per pixel and pass, one jittered camera ray, one
 /// light sample from the same sampler ([`Lights::sample`], with the true density) and one shadow
 /// ray. The mean of `passes` passes.
-pub fn render_reference(scene: &Scene, width: usize, height: usize, passes: u32, seed: u64) -> Image {
+pub fn render_reference(
+    scene: &Scene,
+    width: usize,
+    height: usize,
+    passes: u32,
+    seed: u64,
+) -> Image {
     let lights = Lights {
         scene,
         wrong_pdf: false,

@@ -33,7 +33,10 @@ fn main() {
     let start = Instant::now();
     let reference = render_reference(&scene, width, height, passes, 1);
     let t_reference = start.elapsed().as_secs_f64();
-    for (image, name) in [(&restir, "restir-di.png"), (&reference, "light-sampling.png")] {
+    for (image, name) in [
+        (&restir, "restir-di.png"),
+        (&reference, "light-sampling.png"),
+    ] {
         let path = out.join(name);
         if let Err(e) = image.write_png(&path) {
             eprintln!("error: cannot write {}: {e}", path.display());

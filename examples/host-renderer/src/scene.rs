@@ -213,7 +213,8 @@ impl Scene {
         let origin = p + n * 1e-3;
         let d = q - origin;
         let dist = d.length();
-        self.intersect(origin, d / dist, dist * (1.0 - 1e-4)).is_none()
+        self.intersect(origin, d / dist, dist * (1.0 - 1e-4))
+            .is_none()
     }
 
     /// The camera ray through film position `(fx, fy)` (pixels from the top left) of a

@@ -56,10 +56,10 @@ use crate::pass::{Integrator, PassContext};
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::reciprocal;
-use restir_reuse::{ScreenReuse, Stages};
 use crate::reuse::settings::mis_name;
 use crate::stages::StageClock;
 use candidates::Candidates;
+use restir_reuse::{ScreenReuse, Stages};
 use shift::{DiReuse, visible};
 use target::{StrategyCounts, evaluate};
 

@@ -46,8 +46,8 @@ pub use shift::{Frames, PtShift};
 use crate::bands::Bands;
 use crate::motion::FrameMotion;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
-use restir_reuse::{ScreenReuse, Stages};
 use crate::reuse::reciprocal;
+use restir_reuse::{ScreenReuse, Stages};
 
 use crate::fallback::PathFallback;
 use crate::pass::{Integrator, PassContext};
