@@ -51,3 +51,9 @@ pub use driver::{ReuseReport, ScreenReuse, Stages};
 pub use passes::{History, HistorySlot, ReuseShift};
 pub use settings::{MIS_NAMES, ReuseSettings, mis_name};
 pub use surfaces::{SeededStreams, Similarity, SimilarityKey, Streams, Surfaces};
+
+/// The reservoir type and the MIS schemes, re-exported from `restir-gris`.
+pub use restir_gris::{MisScheme, Reservoir};
+/// The random number generator of the streams (PCG32), re-exported so that a host needs no
+/// other crate of this project.
+pub use restir_sampling::Pcg32;

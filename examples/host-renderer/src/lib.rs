@@ -16,8 +16,7 @@ pub mod scene;
 use glam::Vec3;
 use rayon::prelude::*;
 use restir_reuse::direct::{DirectLighting, DirectSettings, RestirDi};
-use restir_reuse::{SeededStreams, Similarity, SimilarityKey, Streams, Surfaces};
-use restir_sampling::Pcg32;
+use restir_reuse::{Pcg32, SeededStreams, Similarity, SimilarityKey, Streams, Surfaces};
 
 pub use scene::Scene;
 

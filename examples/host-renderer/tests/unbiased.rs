@@ -7,9 +7,8 @@
 
 use glam::Vec3;
 use host_renderer::{Lights, Scene, render_reference, render_restir};
-use restir_reuse::ReuseSettings;
 use restir_reuse::direct::{DirectSettings, Visibility};
-use restir_sampling::Pcg32;
+use restir_reuse::{Pcg32, ReuseSettings};
 use restir_testkit::blocks::{block_means, block_statistics, max_z};
 
 const W: usize = 64;
@@ -62,7 +61,7 @@ fn restir_di_through_the_host_traits_is_unbiased() {
             "balance heuristic, two rounds, no reciprocal pairs",
             DirectSettings {
                 reuse: ReuseSettings {
-                    mis: restir_gris::MisScheme::GeneralizedBalance,
+                    mis: restir_reuse::MisScheme::GeneralizedBalance,
                     reciprocal: false,
                     spatial_rounds: 2,
                     ..ReuseSettings::default()
