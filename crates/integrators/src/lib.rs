@@ -64,13 +64,13 @@ pub mod sequence;
 pub mod shadow;
 pub mod stages;
 
+pub use auto::AutoIntegrator;
 /// The vector types of images and scenes (`Image::pixels` is a `Vec<glam::Vec3>`).
 pub use glam;
 pub use motion::FrameMotion;
 pub use params::{Param, ParamError, ParamSet, ParamSource, ParamValue};
 pub use pass::{CROP_ALIGN, Crop, Integrator, PassContext, PixelWindow};
 pub use path::PathIntegrator;
-pub use auto::AutoIntegrator;
 pub use render::{EstimatorReport, RenderJob, RenderOutput, RenderPart, render, render_part};
 pub use renderer::{RenderError, Renderer};
 pub use restir_di::{RestirDiIntegrator, RestirDiSettings};
