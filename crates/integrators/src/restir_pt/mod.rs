@@ -307,7 +307,7 @@ impl RestirPtIntegrator {
 /// be scattered from.
 pub fn has_near_specular(scene: &Scene) -> bool {
     scene
-        .bsdfs
+        .bsdfs()
         .iter()
         .any(|b| !connectible(b) && b.flags() != LobeFlags::NONE)
 }
