@@ -104,7 +104,7 @@ fn bsdf_at_costs(budget: f64) {
     };
     let per_call = |t: f64| t / (REPS * uvs.len()) as f64 * 1e9;
     println!("Scene::bsdf_at + one diffuse eval, ns per call (median of interleaved batches):");
-    let untextured = scene.shape_bsdf[0];
+    let untextured = scene.shape_bsdf()[0];
     // The constant material with the flag as built (false: the scene has textures, so force it).
     let [flag_off, flag_on] = interleaved(budget / 3.0, |c| {
         scene.features.has_textures = c == 1;
@@ -117,7 +117,7 @@ fn bsdf_at_costs(budget: f64) {
         flag_on.0 / flag_off.0
     );
     scene.features.has_textures = true;
-    let [checker, bitmap] = interleaved(budget / 3.0, |c| calls(&scene, scene.shape_bsdf[1 + c]));
+    let [checker, bitmap] = interleaved(budget / 3.0, |c| calls(&scene, scene.shape_bsdf()[1 + c]));
     println!(
         "  checkerboard reflectance:                {:7.2} ns\n  256×256 bitmap reflectance (bilinear):   {:7.2} ns",
         per_call(checker.0),
@@ -164,34 +164,33 @@ fn sponza(budget: f64) {
         println!("sponza: skipped (no corpus at {})", path.display());
         return;
     }
-    let mut scene = load(&path, (128, 96));
-    assert!(scene.features.has_textures);
-    // The constant variant: each textured material's BSDF at its textures' means.
-    let mut constant = scene.bsdfs.clone();
-    for (b, t) in constant.iter_mut().zip(&scene.bsdf_textures) {
-        if let Some(t) = t {
+    let textured_scene = load(&path, (128, 96));
+    assert!(textured_scene.features.has_textures);
+    // The constant variant, a second copy: each textured material's BSDF at its textures' means.
+    let mut constant = load(&path, (128, 96));
+    for m in 0..constant.bsdfs().len() {
+        if let Some(t) = constant.bsdf_textures()[m] {
             let mut p = t.base;
             if let Some(i) = t.diffuse {
-                p.diffuse = scene.textures[i as usize].mean();
+                p.diffuse = constant.textures()[i as usize].mean();
             }
-            *b = b.with_params(&p);
+            let b = constant.bsdfs()[m].with_params(&p);
+            constant.set_material(m as u32, b).unwrap();
         }
     }
+    assert!(!constant.features.has_textures);
+    let scene = &textured_scene;
     let options = IntegratorOptions {
         name: Some("path".into()),
         ..Default::default()
     };
-    let integrator = make_integrator(&scene, &options).unwrap().integrator;
+    let integrator = make_integrator(scene, &options).unwrap().integrator;
     let filter = Filter::new(scene.filter);
     let mut pass = 0u32;
     let (w, h) = scene.camera.resolution();
     let mut accum = vec![DVec3::ZERO; (w * h) as usize];
     let [tex, con] = interleaved(budget, |c| {
-        let textured = c == 0;
-        if scene.features.has_textures != textured {
-            std::mem::swap(&mut scene.bsdfs, &mut constant);
-            scene.features.has_textures = textured;
-        }
+        let scene = if c == 0 { &textured_scene } else { &constant };
         let ctx = PassContext {
             seed: 0,
             pass: pass / 2,
@@ -199,7 +198,7 @@ fn sponza(budget: f64) {
             crop: None,
         };
         pass += 1;
-        integrator.render_pass(&scene, &ctx, &mut accum)
+        integrator.render_pass(scene, &ctx, &mut accum)
     });
     let mrays = |m: (f64, u64, usize)| m.1 as f64 / m.2 as f64 / m.0 / 1e6;
     println!(

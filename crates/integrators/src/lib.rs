@@ -12,6 +12,19 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
+//! A named estimator runs as named. The never-worse choice is an estimator of its own, `auto`
+//! ([`auto`]): it decides from the scene which of the path tracer, ReSTIR DI and ReSTIR PT
+//! renders, and [`RenderOutput::estimator`] says what ran and why:
+//!
+//! ```no_run
+//! # use restir_integrators::Renderer;
+//! # use restir_scene::{LoadOptions, load_scene};
+//! # let loaded = load_scene("scenes/cornell-box.xml".as_ref(), &LoadOptions::default())?;
+//! let out = Renderer::new(&loaded.scene).integrator("auto").render()?;
+//! println!("{}", out.estimator); // ran path (chosen by auto: ... one light takes 100% ...)
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 //! Images are `Vec<glam::Vec3>`; this crate re-exports [`glam`] so a caller need not depend on
 //! a matching version. A complete program: `examples/library-render` in the repository.
 //!
@@ -35,8 +48,8 @@
 
 #![deny(missing_docs)]
 
+pub mod auto;
 use restir_reuse::bands;
-pub mod fallback;
 pub mod film;
 pub mod motion;
 pub mod params;
@@ -51,23 +64,30 @@ pub mod sequence;
 pub mod shadow;
 pub mod stages;
 
+pub use auto::AutoIntegrator;
 /// The vector types of images and scenes (`Image::pixels` is a `Vec<glam::Vec3>`).
 pub use glam;
 pub use motion::FrameMotion;
 pub use params::{Param, ParamError, ParamSet, ParamSource, ParamValue};
 pub use pass::{CROP_ALIGN, Crop, Integrator, PassContext, PixelWindow};
 pub use path::PathIntegrator;
-pub use render::{RenderJob, RenderOutput, RenderPart, render, render_part};
+pub use render::{EstimatorReport, RenderJob, RenderOutput, RenderPart, render, render_part};
 pub use renderer::{RenderError, Renderer};
 pub use restir_di::{RestirDiIntegrator, RestirDiSettings};
 pub use restir_image::{ErrorMetrics, Image, ImageError, compare};
 pub use restir_pt::{RestirPtIntegrator, RestirPtSettings};
 pub use sequence::FrameSequence;
 
+use params::ParamProblem;
 use restir_scene::Scene;
 
-/// The integrators this crate provides, by command-line name.
-pub const INTEGRATORS: &[&str] = &["path", "restir-di", "restir-pt"];
+/// The integrators this crate provides, by command-line name: three estimators, and `auto`,
+/// which chooses one of them from the scene ([`auto`]).
+pub const INTEGRATORS: &[&str] = &["path", "restir-di", "restir-pt", "auto"];
+
+/// What `fallback`, a parameter of ReSTIR DI and ReSTIR PT until they ran as named, became.
+const FALLBACK_REMOVED: &str = "a named integrator runs as named; the integrator auto chooses the \
+     path tracer where ReSTIR does not pay (integrators: path, restir-di, restir-pt, auto)";
 
 /// Command-line choices that override the scene's integrator settings.
 #[derive(Clone, Debug, Default)]
@@ -148,6 +168,13 @@ pub fn make_integrator(
         ParamSet::new()
     };
     params.extend(&options.params);
+    if let Some(p) = params.iter().find(|p| p.key() == "fallback") {
+        return Err(p
+            .error(ParamProblem::Removed {
+                instead: FALLBACK_REMOVED.into(),
+            })
+            .into());
+    }
     let mut notes = Vec::new();
     let (integrator, unused_params): (Box<dyn Integrator>, _) = match name {
         "path" => (
@@ -157,26 +184,25 @@ pub fn make_integrator(
         "restir-di" => {
             let mut s = RestirDiSettings::new(settings);
             let unused = s.apply(&params)?;
-            let fallback = s.resolve(&scene.features);
-            if let Some(why) = &fallback {
-                notes.push(format!("restir-di: {why}"));
-            }
-            (
-                Box::new(RestirDiIntegrator::new(s).with_fallback(fallback)),
-                unused,
-            )
+            s.resolve(&scene.features);
+            (Box::new(RestirDiIntegrator::new(s)), unused)
         }
         "restir-pt" => {
             let mut s = RestirPtSettings::new(settings);
             let unused = s.apply(&params)?;
-            let fallback = s.resolve(scene);
-            if let Some(why) = &fallback {
-                notes.push(format!("restir-pt: {why}"));
+            (Box::new(RestirPtIntegrator::new(s)), unused)
+        }
+        "auto" => {
+            if let Some(p) = params.iter().next() {
+                return Err(p.error(ParamProblem::NotForAuto).into());
             }
-            (
-                Box::new(RestirPtIntegrator::new(s).with_fallback(fallback)),
-                unused,
-            )
+            let auto = AutoIntegrator::new(scene, settings);
+            notes.push(format!(
+                "auto: {} renders it: {}",
+                auto.choice().name(),
+                auto.why()
+            ));
+            (Box::new(auto), Vec::new())
         }
         other => return Err(IntegratorError::Unknown(other.to_string())),
     };

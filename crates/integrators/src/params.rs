@@ -131,6 +131,13 @@ pub enum ParamProblem {
     NotFraction,
     /// Not a number from 0 up to, but not including, 1.
     NotBelowOne,
+    /// A parameter that no longer exists; `instead` says what does its work now.
+    Removed {
+        /// What to use instead.
+        instead: String,
+    },
+    /// A parameter given to the `auto` estimator, which takes none.
+    NotForAuto,
 }
 
 /// A parameter that could not be read: its name, its value as given and where it came from.
@@ -177,6 +184,14 @@ impl fmt::Display for ParamError {
             ParamProblem::NotBelowOne => {
                 write!(f, "{name} = {v}: expected a number from 0 to below 1")
             }
+            ParamProblem::Removed { instead } => {
+                write!(f, "{name} = '{v}': no such parameter any more: {instead}")
+            }
+            ParamProblem::NotForAuto => write!(
+                f,
+                "{name} = '{v}': the integrator auto takes no estimator parameters (it runs \
+                 path, restir-di or restir-pt at its defaults); name the integrator to configure it"
+            ),
         }
     }
 }

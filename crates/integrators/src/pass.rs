@@ -214,7 +214,7 @@ impl PassContext<'_> {
 
 /// An estimator that renders whole passes.
 pub trait Integrator: Sync + Send + std::fmt::Debug {
-    /// Name as given on the command line.
+    /// The command-line name of the estimator that renders (for `auto`, the one it chose).
     fn name(&self) -> &'static str;
     /// Renders one pass, adding one estimate per pixel to `accum` (row-major). Returns the number
     /// of rays traced.
@@ -244,6 +244,11 @@ pub trait Integrator: Sync + Send + std::fmt::Debug {
     /// keeps nothing, so it does nothing.
     fn next_frame(&self, motion: Arc<FrameMotion>) {
         let _ = motion;
+    }
+    /// Why this estimator renders when the `auto` estimator chose it (what its rules measured
+    /// of the scene, one line); `None` (the default) when it was asked for by name.
+    fn auto_choice(&self) -> Option<&str> {
+        None
     }
 }
 

@@ -55,9 +55,49 @@ impl RenderJob {
     }
 }
 
+/// Which estimator rendered, what was asked for, and why that one ran.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct EstimatorReport {
+    /// What was asked for: an estimator's name, or `auto`.
+    pub asked: String,
+    /// The estimator that rendered every pass: `path`, `restir-di` or `restir-pt`.
+    pub ran: String,
+    /// Its settings in one line ([`Integrator::describe`]).
+    pub settings: String,
+    /// Why it ran: `asked for by name`, or what `auto`'s rules measured of the scene.
+    pub why: String,
+}
+
+impl EstimatorReport {
+    /// What `integrator` is: the estimator that renders, and whether `auto` chose it and why
+    /// ([`Integrator::auto_choice`]).
+    pub fn of(integrator: &dyn Integrator) -> Self {
+        let ran = integrator.name().to_string();
+        let (asked, why) = match integrator.auto_choice() {
+            Some(why) => ("auto".to_string(), format!("chosen by auto: {why}")),
+            None => (ran.clone(), "asked for by name".to_string()),
+        };
+        Self {
+            asked,
+            ran,
+            settings: integrator.describe(),
+            why,
+        }
+    }
+}
+
+/// One line: `ran restir-di (asked for by name)` or `ran path (chosen by auto: …)`.
+impl std::fmt::Display for EstimatorReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "ran {} ({})", self.ran, self.why)
+    }
+}
+
 /// The result of a render.
 #[derive(Clone, Debug)]
 pub struct RenderOutput {
+    /// The estimator that rendered it, and why that one.
+    pub estimator: EstimatorReport,
     /// The average of the passes.
     pub image: Image,
     /// Passes made.
@@ -158,6 +198,7 @@ pub fn render_part(
     };
     let nonfinite_pixels = image.nonfinite_count();
     RenderOutput {
+        estimator: EstimatorReport::of(integrator),
         image,
         passes: film.passes(),
         seconds,

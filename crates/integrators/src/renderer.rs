@@ -127,7 +127,9 @@ impl<'a> Renderer<'a> {
     }
 
     /// The integrator by command-line name (one of [`crate::INTEGRATORS`]); the scene's own
-    /// parameters then apply only if it names the same one.
+    /// parameters then apply only if it names the same one. A named estimator runs as named;
+    /// `"auto"` chooses one from the scene ([`crate::auto`]), and [`RenderOutput::estimator`]
+    /// says which ran and why.
     #[must_use]
     pub fn integrator(mut self, name: &str) -> Self {
         self.options.name = Some(name.to_string());
@@ -152,7 +154,8 @@ impl<'a> Renderer<'a> {
     }
 
     /// Renders: builds the integrator, then every pass. The image is in
-    /// [`RenderOutput::image`] (linear RGB, row-major `Vec<glam::Vec3>`).
+    /// [`RenderOutput::image`] (linear RGB, row-major `Vec<glam::Vec3>`); what rendered it, and
+    /// why, in [`RenderOutput::estimator`].
     pub fn render(&self) -> Result<RenderOutput, RenderError> {
         let made = make_integrator(self.scene, &self.options)?;
         if let Some(p) = made

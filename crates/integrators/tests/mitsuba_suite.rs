@@ -13,7 +13,7 @@
 //!    non-finite value fails. The scene passes when at least 99.75 % of its pixel-channels pass.
 //!
 //! Each scene is rendered with the path tracer, with ReSTIR DI where it asks for direct lighting
-//! only (`max_depth` 2) and with ReSTIR PT, both with `fallback = off` so that they really run.
+//! only (`max_depth` 2) and with ReSTIR PT, each asked for by name (so each runs as named).
 //! The test prints a table (scene, loads, pass fraction per estimator, verdict).
 //!
 //! Mitsuba's budget is 2 000 000 samples per scene. The path tracer renders all of it; the ReSTIR
@@ -36,7 +36,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use restir_integrators::{Image, IntegratorOptions, Param, ParamSource, make_integrator};
+use restir_integrators::{Image, IntegratorOptions, make_integrator};
 use restir_scene::{LoadOptions, load_scene};
 
 /// Mitsuba's sample budget per scene.
@@ -282,15 +282,10 @@ fn mitsuba_render_suite() {
             let outcome = if est == "restir-di" && !direct_only {
                 Outcome::Skipped
             } else {
-                let params = if est == "path" {
-                    Vec::new()
-                } else {
-                    vec![Param::new("fallback", "off", ParamSource::Caller)]
-                };
                 let opts = IntegratorOptions {
                     name: Some(est.into()),
                     max_depth: None,
-                    params: params.into_iter().collect(),
+                    params: Default::default(),
                 };
                 match make_integrator(scene, &opts) {
                     Err(e) => Outcome::Refused(e.to_string()),

@@ -1,5 +1,6 @@
 //! The one-line library API: `Renderer` gives the same image as the full `render` driver, and
-//! its errors are typed.
+//! its errors are typed. What is asked for is what runs: a named estimator renders as named,
+//! `auto` chooses one from the scene, and the output says which ran and why.
 
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
@@ -78,7 +79,7 @@ fn errors_are_typed() {
     let e = unknown.unwrap_err();
     assert_eq!(
         e.to_string(),
-        "unknown integrator 'restirdii' (available: path, restir-di, restir-pt)"
+        "unknown integrator 'restirdii' (available: path, restir-di, restir-pt, auto)"
     );
     assert!(std::error::Error::source(&e).is_some());
 
@@ -104,4 +105,164 @@ fn errors_are_typed() {
         bad,
         Err(RenderError::Integrator(IntegratorError::MaxDepth(-2)))
     ));
+}
+
+fn many_lights(size: u32) -> LoadedScene {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/many-lights.ron");
+    let options = LoadOptions {
+        width: Some(size),
+        height: Some(size),
+        ..LoadOptions::default()
+    };
+    load_scene(&path, &options).unwrap()
+}
+
+/// On the Cornell box (one light, two emitter-table entries, no glossy surface) `auto` renders
+/// with the path tracer, bit for bit its image, and says so; `restir-di` asked for by name runs
+/// ReSTIR DI (another image) and says that it was asked for.
+#[test]
+fn auto_picks_the_path_tracer_on_the_cornell_box_and_restir_di_runs_as_named() {
+    let loaded = cornell(16);
+    let scene = &loaded.scene;
+    let run = |name: &str| {
+        Renderer::new(scene)
+            .spp(2)
+            .seed(3)
+            .integrator(name)
+            .render()
+            .unwrap()
+    };
+    let (auto, path, di) = (run("auto"), run("path"), run("restir-di"));
+
+    assert_eq!(
+        (auto.estimator.asked.as_str(), auto.estimator.ran.as_str()),
+        ("auto", "path")
+    );
+    assert!(
+        auto.estimator.settings.starts_with("path "),
+        "{:?}",
+        auto.estimator
+    );
+    assert!(
+        auto.estimator.why.starts_with("chosen by auto: ")
+            && auto
+                .estimator
+                .why
+                .contains("one light takes 100% of the light selections"),
+        "{:?}",
+        auto.estimator
+    );
+    assert!(
+        auto.estimator
+            .to_string()
+            .starts_with("ran path (chosen by auto: ")
+    );
+    assert_eq!(bits(&auto.image.pixels), bits(&path.image.pixels));
+
+    assert_eq!(
+        (
+            di.estimator.asked.as_str(),
+            di.estimator.ran.as_str(),
+            di.estimator.why.as_str()
+        ),
+        ("restir-di", "restir-di", "asked for by name")
+    );
+    assert!(
+        di.estimator.settings.starts_with("restir-di "),
+        "{:?}",
+        di.estimator
+    );
+    assert_ne!(bits(&di.image.pixels), bits(&path.image.pixels));
+    assert_eq!(path.estimator.why, "asked for by name");
+}
+
+/// On the many-lights scene (400 small lamps, none dominating, direct light only) `auto`
+/// renders with ReSTIR DI, bit for bit its image, and says why.
+#[test]
+fn auto_picks_restir_di_on_many_lights() {
+    let loaded = many_lights(16);
+    let scene = &loaded.scene;
+    let run = |name: &str| {
+        Renderer::new(scene)
+            .spp(1)
+            .integrator(name)
+            .render()
+            .unwrap()
+    };
+    let (auto, di) = (run("auto"), run("restir-di"));
+    assert_eq!(
+        (auto.estimator.asked.as_str(), auto.estimator.ran.as_str()),
+        ("auto", "restir-di")
+    );
+    assert!(
+        auto.estimator
+            .why
+            .contains("no light dominates the selections"),
+        "{:?}",
+        auto.estimator
+    );
+    assert_eq!(auto.estimator.settings, di.estimator.settings);
+    assert_eq!(bits(&auto.image.pixels), bits(&di.image.pixels));
+    let made = make_integrator(
+        scene,
+        &IntegratorOptions {
+            name: Some("auto".into()),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(made.integrator.name(), "restir-di");
+    assert!(
+        made.notes[0].starts_with("auto: restir-di renders it: "),
+        "{:?}",
+        made.notes
+    );
+}
+
+/// `fallback`, the parameter that let ReSTIR DI and PT hand a scene to the path tracer, is an
+/// error naming what replaced it, from the caller and from a scene file (with its line); `auto`
+/// takes no estimator parameters.
+#[test]
+fn the_removed_fallback_parameter_and_parameters_of_auto_are_errors() {
+    let loaded = cornell(8);
+    for name in ["restir-di", "restir-pt", "path"] {
+        let e = Renderer::new(&loaded.scene)
+            .integrator(name)
+            .param("fallback", "off")
+            .render()
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "fallback = 'off': no such parameter any more: a named integrator runs as named; the \
+             integrator auto chooses the path tracer where ReSTIR does not pay (integrators: \
+             path, restir-di, restir-pt, auto)"
+        );
+    }
+    let xml = r#"<scene version="3.0.0">
+        <integrator type="restir">
+            <string name="fallback" value="auto"/>
+        </integrator>
+        <sensor type="perspective"><float name="fov" value="40"/>
+            <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film>
+        </sensor>
+        <shape type="rectangle"><bsdf type="diffuse"/></shape>
+    </scene>"#;
+    let (desc, _) = restir_scene::xml::parse_xml(xml, "old.xml".as_ref(), &[]).unwrap();
+    let scene = restir_scene::Scene::build(&desc, ".".as_ref(), "old.xml".as_ref()).unwrap();
+    let e = make_integrator(&scene, &IntegratorOptions::default()).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("old.xml:2: integrator: fallback = 'auto': no such parameter any more"),
+        "{e}"
+    );
+    let e = Renderer::new(&loaded.scene)
+        .integrator("auto")
+        .param("temporal", true)
+        .render()
+        .unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("the integrator auto takes no estimator parameters"),
+        "{e}"
+    );
 }

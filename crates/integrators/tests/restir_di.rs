@@ -5,8 +5,8 @@
 //! *across seeds* (spatial reuse correlates the pixels of one render). The biased options
 //! (constant 1/M weights, visibility reuse) must fail the same test. The light hierarchy as
 //! the candidate source (`light_sampler = bvh`) passes it, and its negative control (the
-//! hierarchy's candidates weighted by the power table's pmf) fails it. The fallback to the path
-//! tracer (one dominant light, ReSTIR DI at its defaults) passes it too.
+//! hierarchy's candidates weighted by the power table's pmf) fails it, and so does ReSTIR DI at
+//! its defaults on this scene of one dominant light, where `auto` takes the path tracer.
 
 use std::sync::atomic::AtomicBool;
 
@@ -404,43 +404,46 @@ fn light_hierarchy_is_unbiased_and_a_wrong_pmf_is_caught() {
     );
 }
 
-/// At its defaults on this scene (the small bright sphere takes more than half of the light
-/// selections) ReSTIR DI hands the scene to the path tracer, says so, and stays unbiased;
-/// any ReSTIR DI parameter, or `fallback = off`, keeps ReSTIR DI.
+/// On this scene (the small bright sphere takes more than half of the light selections among a
+/// few emitters) `auto` renders with the path tracer, bit for bit its image, and says why;
+/// `restir-di` asked for by name runs ReSTIR DI at its defaults (another image), which passes
+/// the statistic too.
 #[test]
-fn dominant_light_falls_back_to_the_path_tracer() {
+fn dominant_light_auto_takes_the_path_tracer_and_restir_di_runs_as_named() {
     let scene = scene();
     assert!(
         scene.features.largest_light_share >= 0.5,
         "{:?}",
         scene.features
     );
-    let made = |params: &[(&str, &str)]| {
+    let made = |name: &str| {
         let options = IntegratorOptions {
-            params: params.into(),
-            name: Some("restir-di".into()),
+            name: Some(name.into()),
             ..Default::default()
         };
         make_integrator(&scene, &options).unwrap()
     };
-    let m = made(&[]);
-    let d = m.integrator.describe();
-    assert!(d.contains("; estimator: path max_depth=2"), "{d}");
-    assert_eq!(m.notes.len(), 1, "{:?}", m.notes);
+    let auto = made("auto");
+    assert_eq!(auto.integrator.name(), "path");
+    assert!(auto.integrator.describe().starts_with("path max_depth=2"));
+    let why = auto.integrator.auto_choice().unwrap();
+    assert!(why.contains("one light takes"), "{why}");
+    assert_eq!(auto.notes.len(), 1, "{:?}", auto.notes);
     assert!(
-        m.notes[0].contains("the path tracer renders it"),
+        auto.notes[0].starts_with("auto: path renders it: "),
         "{:?}",
-        m.notes
+        auto.notes
     );
-    for params in [&[("fallback", "off")][..], &[("candidates", "8")][..]] {
-        let m = made(params);
-        assert!(m.notes.is_empty(), "{params:?}: {:?}", m.notes);
-        assert!(!m.integrator.describe().contains("estimator:"));
-    }
+    let di = made("restir-di");
+    assert_eq!(di.integrator.name(), "restir-di");
+    assert!(di.integrator.auto_choice().is_none() && di.notes.is_empty());
+    let image = |name: &str| common::render_image(&scene, name, &[], 2, 7).pixels;
+    assert_eq!(image("auto"), image("path"));
+    assert_ne!(image("restir-di"), image("path"));
     let reference = direct_reference(&scene);
     let z = max_z(&statistics(&scene, "restir-di", &[], 1, 200), &reference);
-    eprintln!("fallback: max |z| = {z:.2}");
-    assert!(z < Z_MAX, "fallback: max |z| = {z:.2}");
+    eprintln!("restir-di at its defaults: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "restir-di at its defaults: max |z| = {z:.2}");
 }
 
 /// Learning across passes (`learn = on`): from the second pass of a render on, candidates come

@@ -88,16 +88,8 @@ fn estimate(scene: &Scene, integrator: &str, seeds: u64, spp: u32) -> [[(f64, f6
         let n = checks.iter().filter(|c| **c == Some(k)).count();
         assert!(n >= 40, "region {k} has only {n} whole pixels");
     }
-    // The ReSTIR estimators themselves, not the path tracer they hand this scene to at their
-    // defaults (one light; no glossy surface).
-    let params: &[(&str, &str)] = if integrator == "path" {
-        &[]
-    } else {
-        &[("fallback", "off")]
-    };
     let options = IntegratorOptions {
         name: Some(integrator.into()),
-        params: params.into(),
         ..Default::default()
     };
     let made = make_integrator(scene, &options).unwrap();

@@ -16,6 +16,27 @@
 //!
 //! Measures: `pdf_sa` is per unit solid angle at the receiving point; for delta lights (point,
 //! directional) it is the discrete selection probability and `delta` is set.
+//!
+//! # The set of lights is closed
+//!
+//! A program using this crate cannot add a kind of light of its own: [`Light`] is an enum of
+//! the kinds above (area, point, directional, constant and image environment), and sampling,
+//! densities, power and the emitter table dispatch with one `match` over it. This is
+//! deliberate: light sampling runs for every candidate of every pixel, and an enum keeps those
+//! calls monomorphised and inlinable, keeps a [`LightPoint`] a 16-byte value a reservoir can
+//! hold, and lets the emitter table and the light hierarchy know every light's power and
+//! bounds when they are built. pbrt-v4 closes its set of lights the same way (a tagged union
+//! over a fixed list of light types, dispatched by a `switch`).
+//!
+//! What a user does instead:
+//! - **Use the nearest light through its parameters**: any emissive shape (a mesh of any
+//!   shape with a radiance), a point or directional light, a constant or image environment
+//!   (an HDR image with a rotation and a scale).
+//! - **Fork** and add a variant to [`Light`]: the compiler then lists every `match` that must
+//!   learn it (sampling, density, power, bounds for the hierarchy).
+//! - **Bring your own renderer**: the `restir-reuse` crate runs the reuse passes generically
+//!   over host traits (the host's own light samples, densities and target function), and
+//!   `restir-gris` holds the maths; neither needs this crate.
 
 #![deny(missing_docs)]
 

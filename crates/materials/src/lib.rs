@@ -48,6 +48,29 @@
 //!   starting point (CDF residual below 1e-5), so the rough plastic tables (integrated through
 //!   it) agree with Mitsuba's to ~1e-4, not 1e-6.
 //!
+//! # The set of models is closed
+//!
+//! A program using this crate cannot add a BSDF model of its own: [`Bsdf`] holds a
+//! [`BsdfKind`], an enum of the models above, and every method dispatches with one `match` over
+//! it. This is deliberate. The estimators evaluate and sample BSDFs in their innermost loops
+//! (every candidate, every shift, every bounce); an enum keeps those calls monomorphised, lets
+//! the compiler inline each model's code into the `match`, and keeps a material a small `Copy`
+//! value with no allocation, where a trait object would add an indirect call per evaluation
+//! and hide the model from the optimiser. pbrt-v4 makes the same choice (its BxDF type is a
+//! tagged union over a fixed list of models, dispatched by a `switch` on the tag, for the same
+//! reason, and adding a model there also means editing that list).
+//!
+//! What a user does instead:
+//! - **Use the nearest model through its parameters**: the eight models with Mitsuba 3's
+//!   parameters cover diffuse, metals (any IOR, anisotropic roughness, GGX or Beckmann),
+//!   glass (smooth or rough), coated diffuse (plastic, smooth or rough), and textures reach the
+//!   colour parameters (see `restir-scene`).
+//! - **Fork** and add a variant to [`BsdfKind`] with a file in `src/models/`: the compiler then
+//!   lists every `match` that must learn the new model.
+//! - **Bring your own renderer**: the reuse passes are offered generically over host traits by
+//!   the `restir-reuse` crate, and the GRIS maths by `restir-gris`; a renderer with its own
+//!   materials implements their target function and gets ReSTIR without this crate.
+//!
 //! ```
 //! use restir_materials::{Bsdf, LobeFlags};
 //! use glam::{Vec2, Vec3};

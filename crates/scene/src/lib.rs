@@ -35,6 +35,7 @@ pub mod spectrum;
 pub mod texture;
 pub mod xml;
 
+pub use build::EditError;
 pub use desc::*;
 pub use error::{SceneError, SceneWarning};
 pub use light_share::EnvironmentShare;
@@ -75,18 +76,26 @@ pub struct SceneFeatures {
 }
 
 /// The runtime scene.
+///
+/// The materials are read with [`Scene::bsdfs`], [`Scene::shape_bsdf`], [`Scene::bsdf_textures`]
+/// and [`Scene::textures`], and changed only through [`Scene::set_material`],
+/// [`Scene::add_material`] and [`Scene::set_shape_material`], which keep the feature summary
+/// ([`Scene::features`]) true to them. Shapes, lights, the BVH and the camera are built together
+/// from the description (the BVH over the shapes, area lights on them, the environment's share
+/// from the camera's view): to change them, change the [`SceneDesc`] and build again. Make the
+/// integrator after editing: it decides its code paths from the summary when it is made.
 #[derive(Debug)]
 pub struct Scene {
     /// World-space shapes.
     pub shapes: std::sync::Arc<[Shape]>,
     /// For each shape, the index of its BSDF in `bsdfs`.
-    pub shape_bsdf: Vec<u32>,
+    shape_bsdf: Vec<u32>,
     /// The materials (with their constant parameters; see [`Scene::bsdf_at`]).
-    pub bsdfs: Vec<Bsdf>,
+    bsdfs: Vec<Bsdf>,
     /// For each entry of `bsdfs`, the textures of its parameters, if it has any.
-    pub bsdf_textures: Vec<Option<TexturedParams>>,
+    bsdf_textures: Vec<Option<TexturedParams>>,
     /// The decoded textures that `bsdf_textures` refer to.
-    pub textures: Vec<Texture>,
+    textures: Vec<Texture>,
     /// The BVH over `shapes`.
     pub accel: Accel,
     /// Lights and light selection.
@@ -97,7 +106,8 @@ pub struct Scene {
     pub filter: FilterDesc,
     /// The scene's integrator settings.
     pub integrator: IntegratorDesc,
-    /// What the scene contains.
+    /// What the scene contains, decided when it was built and kept up to date by the material
+    /// edits. Written directly only to measure or test a code path the summary selects.
     pub features: SceneFeatures,
 }
 

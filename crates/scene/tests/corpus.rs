@@ -69,7 +69,7 @@ fn textured_corpus_scenes_load() {
     // Checkerboard reflectance (1000 × 1000 checks of 1 and 0) on an OBJ floor.
     let pft = load(&dir, "lajolla/pixel_filter_test/pixel_filter_test.xml").scene;
     assert!(pft.features.has_textures);
-    assert_eq!(pft.textures.len(), 1);
+    assert_eq!(pft.textures().len(), 1);
     let mut si = centre_hit(&pft);
     let mut seen = [false; 2];
     for k in 0..64 {
@@ -84,7 +84,7 @@ fn textured_corpus_scenes_load() {
     let sponza = load(&dir, "lajolla/sponza/sponza.xml").scene;
     assert!(sponza.features.has_textures);
     assert_eq!(
-        sponza.textures.len(),
+        sponza.textures().len(),
         10,
         "each distinct bitmap decoded once"
     );

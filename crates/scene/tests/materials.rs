@@ -29,8 +29,8 @@ fn material(bsdf: &str) -> MaterialDesc {
 fn built(bsdf: &str) -> BsdfKind {
     let (desc, _) = load(bsdf).unwrap();
     let scene = Scene::build(&desc, ".".as_ref(), "t.xml".as_ref()).unwrap();
-    let i = scene.shape_bsdf[0] as usize;
-    scene.bsdfs[i].kind
+    let i = scene.shape_bsdf()[0] as usize;
+    scene.bsdfs()[i].kind
 }
 
 fn error(bsdf: &str) -> String {
@@ -268,4 +268,65 @@ fn ron_materials() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("unknown conductor material 'Fe'"), "{e}");
+}
+
+/// Editing a built scene's materials keeps its feature summary true: swapping a material for
+/// glass or a rough conductor sets the lobe flags, giving a shape a new material or swapping a
+/// textured one for a constant one updates them, and a bad index is an error naming the range.
+#[test]
+fn material_edits_keep_the_feature_summary() {
+    use glam::Vec3;
+    use restir_materials::Bsdf;
+    let ron = r#"(
+        camera: (fov: 40, to_world: [LookAt(origin: (0, 0, 4), target: (0, 0, 0), up: (0, 1, 0))]),
+        film: (width: 8, height: 8, filter: Box),
+        shapes: [
+            (geometry: Rectangle, material: Some(Inline(Diffuse(reflectance: (0.5, 0.5, 0.5))))),
+            (geometry: Sphere(center: (0, 0, 2), radius: 0.1), emission: Some((10, 10, 10))),
+        ],
+    )"#;
+    let desc = restir_scene::parse_ron(ron, "edit.ron".as_ref()).unwrap();
+    let mut scene = Scene::build(&desc, ".".as_ref(), "edit.ron".as_ref()).unwrap();
+    let f = scene.features;
+    assert!(!f.has_delta_lobes && !f.has_glossy_lobes && !f.has_textures);
+    let wall = scene.shape_bsdf()[0];
+
+    scene
+        .set_material(wall, Bsdf::dielectric(1.5, Vec3::ONE, Vec3::ONE))
+        .unwrap();
+    assert!(scene.features.has_delta_lobes && !scene.features.has_glossy_lobes);
+    let gold = scene.add_material(Bsdf::rough_conductor(
+        Vec3::splat(0.2),
+        Vec3::splat(3.0),
+        Vec3::ONE,
+        restir_materials::Microfacet::new(Distribution::Ggx, 0.3),
+    ));
+    assert!(!scene.features.has_glossy_lobes, "no shape uses it yet");
+    scene.set_shape_material(0, gold).unwrap();
+    assert!(scene.features.has_glossy_lobes && !scene.features.has_delta_lobes);
+    scene.set_shape_material(0, wall).unwrap();
+    assert!(scene.features.has_delta_lobes && !scene.features.has_glossy_lobes);
+
+    // The summary after the edits is the one a build of the edited scene would decide.
+    let diffuse = scene.add_material(Bsdf::diffuse(Vec3::splat(0.5)));
+    scene.set_shape_material(0, diffuse).unwrap();
+    let rebuilt = Scene::build(&desc, ".".as_ref(), "edit.ron".as_ref()).unwrap();
+    assert_eq!(scene.features, rebuilt.features);
+
+    let n = scene.bsdfs().len();
+    assert_eq!(
+        scene
+            .set_material(n as u32, Bsdf::diffuse(Vec3::ONE))
+            .unwrap_err()
+            .to_string(),
+        format!(
+            "no material {n}: the scene has {n} (indices 0 to {})",
+            n - 1
+        )
+    );
+    assert_eq!(
+        scene.set_shape_material(2, 0).unwrap_err().to_string(),
+        "no shape 2: the scene has 2 (indices 0 to 1)"
+    );
+    assert!(scene.set_shape_material(0, n as u32 + 5).is_err());
 }

@@ -70,7 +70,7 @@ fn xml_nested_and_referenced_textures() {
     let loaded = load_scene(&path, &LoadOptions::default()).unwrap();
     let scene = &loaded.scene;
     assert!(scene.features.has_textures);
-    assert_eq!(scene.textures.len(), 2);
+    assert_eq!(scene.textures().len(), 2);
     // Mitsuba's rectangle: uv = ((x + 1)/2, (y + 1)/2); uv (0.25, 0.25) is the top-left texel.
     assert_eq!(diffuse_reflectance(seen_at(scene, -0.5, -0.5)), Vec3::X);
     assert_eq!(diffuse_reflectance(seen_at(scene, 0.5, -0.5)), Vec3::Y);
@@ -175,6 +175,20 @@ fn ron_textured_materials() {
         } => assert_eq!(specular_reflectance, Vec3::splat(0.4), "Mitsuba's color0"),
         k => panic!("{k:?}"),
     }
+    // Swapping the textured materials for constant ones drops their textures and the flag
+    // with them (the summary follows the edit; a constant material then reads no texture).
+    let mut scene = scene;
+    for shape in 0..2 {
+        let m = scene.shape_bsdf()[shape];
+        let constant = scene.bsdfs()[m as usize];
+        scene.set_material(m, constant).unwrap();
+        assert_eq!(scene.features.has_textures, shape == 0, "shape {shape}");
+    }
+    assert!(scene.features.has_delta_lobes);
+    assert_eq!(
+        diffuse_reflectance(seen_at(&scene, 0.5, -0.5)),
+        Vec3::splat(0.5)
+    );
     // Strict: unknown fields, and parameters the material does not have, are errors.
     let typo = ron.replace("raw: true", "raw: true, filter: 1");
     assert!(parse_ron(&typo, "t.ron".as_ref()).is_err());

@@ -12,7 +12,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use restir_integrators::FrameSequence;
-use restir_integrators::{Integrator, IntegratorOptions, RenderJob, make_integrator, render};
+use restir_integrators::{
+    EstimatorReport, Integrator, IntegratorOptions, RenderJob, make_integrator, render,
+};
 use restir_scene::SceneDesc;
 use restir_scene::animation::FRAME_REBUILDS;
 
@@ -256,6 +258,9 @@ pub struct SequenceStats {
     pub scene: String,
     /// The estimator's settings.
     pub integrator_settings: String,
+    /// What was asked for, what ran and why.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub estimator: Option<crate::EstimatorStats>,
     /// What was rebuilt for each frame.
     pub rebuilt: &'static str,
     /// Frames per second.
@@ -352,6 +357,9 @@ pub fn render_frames(
                 .into_iter()
                 .map(|(stage, seconds)| crate::StageSeconds { stage, seconds })
                 .collect(),
+            estimator: integrator
+                .as_ref()
+                .map(|e| (&EstimatorReport::of(e.as_ref())).into()),
             integrator_settings: integrator.map(|e| e.describe()).unwrap_or_default(),
             rebuilt: FRAME_REBUILDS,
             fps: plan.fps,
@@ -445,8 +453,9 @@ pub fn run(
     if !quiet {
         let passes: u32 = stats_out.frames.iter().map(|f| f.passes).sum();
         crate::say::say!(
-            "{}: {written} frames ({} to {}) at {} fps, {passes} passes in {:.2} s -> {} …{}",
+            "{} [{}]: {written} frames ({} to {}) at {} fps, {passes} passes in {:.2} s -> {} …{}",
             stats_out.integrator_settings,
+            stats_out.estimator.as_ref().map_or("", |e| e.why.as_str()),
             plan.first,
             plan.first + written.saturating_sub(1) as u32,
             plan.fps,

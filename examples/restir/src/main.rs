@@ -15,7 +15,7 @@ use clap::{Parser, Subcommand};
 use restir_geometry::Shape;
 use restir_image::Image;
 use restir_integrators::{
-    IntegratorOptions, Param, ParamSet, ParamValue, RenderJob, make_integrator,
+    EstimatorReport, IntegratorOptions, Param, ParamSet, ParamValue, RenderJob, make_integrator,
 };
 use restir_scene::{LoadOptions, load_scene};
 
@@ -86,7 +86,8 @@ struct RenderArgs {
     /// filename from the scene, else <scene name>.exr.
     #[arg(short = 'o', long = "output")]
     output: Option<PathBuf>,
-    /// Estimator: path, restir-di or restir-pt (default: the scene's, else path).
+    /// Estimator: path, restir-di, restir-pt, or auto, which chooses one of them from the scene
+    /// and says which and why (default: the scene's, else path).
     #[arg(long)]
     integrator: Option<String>,
     /// Passes (samples per pixel); overrides the scene.
@@ -162,11 +163,9 @@ struct RestirArgs {
     /// from its table (n records: learn_share·n/(n + learn_prior)) [default: 64].
     #[arg(long)]
     learn_prior: Option<f32>,
-    /// auto hands a scene that does not suit the estimator to the path tracer when no other
-    /// option of it is given (restir-di: a few emitters with one dominant light; restir-pt:
-    /// fewer than 5% of the camera's paths reconnect at a glossy surface); off never does
-    /// [default: auto].
-    #[arg(long)]
+    /// Removed: a named integrator runs as named, and --integrator auto makes the never-worse
+    /// choice. Kept hidden so that old command lines get an error saying so.
+    #[arg(long, hide = true)]
     fallback: Option<String>,
     /// BSDF samples per pixel, MIS-combined with the reservoirs [default: 1].
     #[arg(long)]
@@ -290,8 +289,11 @@ impl RestirArgs {
 #[derive(serde::Serialize)]
 struct Stats<'a> {
     scene: String,
+    /// The estimator that rendered (for `auto`, the one it chose).
     integrator: &'a str,
     integrator_settings: String,
+    /// What was asked for, what ran and why.
+    estimator: EstimatorStats,
     buffer_bytes_per_pixel: usize,
     /// Triangles and analytic spheres in the scene.
     triangles: usize,
@@ -316,6 +318,25 @@ struct Stats<'a> {
     /// The part of a split render this process rendered (--chain, --crop).
     #[serde(skip_serializing_if = "Option::is_none")]
     part: Option<cluster::PartStats>,
+}
+
+/// What `--stats` says of the estimator: what was asked for (a name or `auto`), what ran and
+/// why.
+#[derive(serde::Serialize, Debug)]
+pub(crate) struct EstimatorStats {
+    pub(crate) asked: String,
+    pub(crate) ran: String,
+    pub(crate) why: String,
+}
+
+impl From<&EstimatorReport> for EstimatorStats {
+    fn from(r: &EstimatorReport) -> Self {
+        Self {
+            asked: r.asked.clone(),
+            ran: r.ran.clone(),
+            why: r.why.clone(),
+        }
+    }
 }
 
 /// One stage's summed wall time in `--stats`.
@@ -595,6 +616,7 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
             scene: args.scene.display().to_string(),
             integrator: integrator.name(),
             integrator_settings: integrator.describe(),
+            estimator: (&out.estimator).into(),
             buffer_bytes_per_pixel: integrator.buffer_bytes_per_pixel(),
             triangles: scene
                 .shapes
@@ -644,8 +666,9 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
     if !args.quiet {
         let stopped = if interrupted { " (interrupted)" } else { "" };
         say!(
-            "{}: {} passes in {:.2} s{stopped}, {:.1} Mrays/s, {} threads, loaded in {:.2} s -> {}",
-            integrator.describe(),
+            "{} [{}]: {} passes in {:.2} s{stopped}, {:.1} Mrays/s, {} threads, loaded in {:.2} s -> {}",
+            out.estimator.settings,
+            out.estimator.why,
             out.passes,
             out.seconds,
             mrays,

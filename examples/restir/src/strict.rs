@@ -6,7 +6,8 @@ use restir_integrators::{
 };
 use restir_scene::Scene;
 
-/// The estimators `--integrator` accepts.
+/// The estimators that take parameters (`auto`, the fourth name `--integrator` accepts, takes
+/// none).
 pub const INTEGRATORS: [&str; 3] = ["path", "restir-di", "restir-pt"];
 
 /// A command-line flag the chosen estimator does not use is an error naming the estimators that

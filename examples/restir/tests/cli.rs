@@ -486,3 +486,62 @@ fn tiny_render_writes_images_stats_and_compares() {
     assert!(restir(&args).status.success());
     fails(&["compare", s(&small), s(&exr)], &[s(&small), "differs"]);
 }
+
+/// What is asked for is what runs: `--integrator auto` says on the summary line and in
+/// `--stats` which estimator it chose and why; a named one says it was asked for by name; the
+/// removed `--fallback` is an error naming what replaced it.
+#[test]
+fn auto_says_what_ran_and_why() {
+    let dir = temp_dir("auto");
+    let out = dir.join("o.exr");
+    let stats = dir.join("s.json");
+    for (name, ran, why) in [
+        ("auto", "path", "chosen by auto: "),
+        ("restir-di", "restir-di", "asked for by name"),
+    ] {
+        let o = restir(&[
+            "render",
+            s(&cornell()),
+            "--integrator",
+            name,
+            "--spp",
+            "1",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "-o",
+            s(&out),
+            "--stats",
+            s(&stats),
+        ]);
+        let stdout = String::from_utf8_lossy(&o.stdout);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(
+            stdout.starts_with(&format!("{ran} ")) && stdout.contains(&format!(" [{why}")),
+            "{stdout}"
+        );
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+        assert_eq!(json["integrator"], ran);
+        assert_eq!(json["estimator"]["asked"], name);
+        assert_eq!(json["estimator"]["ran"], ran);
+        assert!(
+            json["estimator"]["why"].as_str().unwrap().starts_with(why),
+            "{json}"
+        );
+    }
+    fails(
+        &[
+            "render",
+            s(&cornell()),
+            "--integrator",
+            "restir-di",
+            "--fallback",
+            "off",
+            "-o",
+            s(&out),
+        ],
+        &["fallback = 'off': no such parameter any more", "auto"],
+    );
+}

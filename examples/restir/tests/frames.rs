@@ -240,7 +240,7 @@ fn temporal_reuse_crosses_frames() {
             })
             .collect()
     };
-    let di = ["--integrator", "restir-di", "--fallback", "off"];
+    let di = ["--integrator", "restir-di"];
     let spatial = render("di", &di);
     let temporal = render("di-t", &[&di[..], &["--temporal"]].concat());
     assert_eq!(spatial[0].pixels, temporal[0].pixels);

@@ -23,10 +23,6 @@
 //!    weighted by the balance heuristic against the light strategy (the exact split is explained
 //!    in [`mod@target`]); the first BSDF sample continues as a path-traced path when
 //!    `max_depth > 2` (indirect light) or when it followed a delta lobe.
-//!
-//! A scene of a few emitters where one light takes most light selections goes to the path
-//! tracer instead (`fallback = auto`, [`RestirDiSettings::resolve`]): the estimator is then
-//! exactly the path tracer's, and `describe` (hence `--stats`) says so.
 
 mod candidates;
 pub mod learn;
@@ -44,13 +40,9 @@ use restir_lights::LightPoint;
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
-pub use settings::{
-    DOMINANT_LIGHT_SHARE, FEW_EMITTERS, Fallback, HIERARCHY_MIN_EMITTERS, Learn, LightSampler,
-    RestirDiSettings, Visibility,
-};
+pub use settings::{HIERARCHY_MIN_EMITTERS, Learn, LightSampler, RestirDiSettings, Visibility};
 
 use crate::bands::Bands;
-use crate::fallback::PathFallback;
 use crate::motion::FrameMotion;
 use crate::pass::{Integrator, PassContext};
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
@@ -83,8 +75,6 @@ pub struct RestirDiIntegrator {
     /// The neighbour pattern and the history of temporal reuse.
     reuse: ScreenReuse<LightPoint, GBuffer>,
     clock: StageClock,
-    /// The path tracer that renders instead, and why (a scene with one dominant light).
-    fallback: Option<PathFallback>,
     /// What earlier passes recorded, with `learn` on.
     learning: learn::Learning,
 }
@@ -100,21 +90,8 @@ impl RestirDiIntegrator {
             settings,
             reuse: ScreenReuse::default(),
             clock: StageClock::default(),
-            fallback: None,
             learning: learn::Learning::default(),
         }
-    }
-
-    /// The same integrator rendering with the path tracer instead when `why` says so (what
-    /// [`RestirDiSettings::resolve`] returned).
-    pub fn with_fallback(mut self, why: Option<String>) -> Self {
-        self.fallback = PathFallback::new(self.settings.path, why);
-        self
-    }
-
-    /// Whether the path tracer renders in place of ReSTIR DI.
-    pub fn falls_back(&self) -> bool {
-        self.fallback.is_some()
     }
 
     /// The settings.
@@ -249,10 +226,7 @@ impl Integrator for RestirDiIntegrator {
             s.reuse.describe_temporal(),
             s.visibility.name(),
             if s.is_unbiased() { "" } else { " (biased)" }
-        ) + &self
-            .fallback
-            .as_ref()
-            .map_or(String::new(), PathFallback::describe)
+        )
     }
 
     fn stage_seconds(&self) -> Vec<(&'static str, f64)> {
@@ -268,16 +242,10 @@ impl Integrator for RestirDiIntegrator {
     }
 
     fn halo(&self) -> u32 {
-        if self.fallback.is_some() {
-            return 0;
-        }
         self.settings.reuse.halo()
     }
 
     fn buffer_bytes_per_pixel(&self) -> usize {
-        if self.fallback.is_some() {
-            return 0;
-        }
         let reservoirs = if self.settings.reuse.temporal { 3 } else { 2 };
         let hits = if self.settings.reuse.temporal { 2 } else { 1 };
         let hit_bytes = GBuffer::BYTES_PER_PIXEL;
@@ -288,9 +256,6 @@ impl Integrator for RestirDiIntegrator {
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
-        if let Some(path) = &self.fallback {
-            return path.render_pass(scene, ctx, accum);
-        }
         let s = &self.settings;
         let reuse = &s.reuse;
         let n = accum.len();

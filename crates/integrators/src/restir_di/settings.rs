@@ -1,14 +1,12 @@
 //! ReSTIR DI settings and their parsing from named parameters (XML scenes and the command line
 //! use the same names; the names Lajolla ReSTIR ports use are accepted too). The reuse settings
-//! are [`ReuseSettings`]. Two defaults are rules of the scene summary, decided once when the
+//! are [`ReuseSettings`]. One default is a rule of the scene summary, decided once when the
 //! integrator is made ([`RestirDiSettings::resolve`]): the candidate source (the light hierarchy
-//! above [`HIERARCHY_MIN_EMITTERS`] emitters) and the path tracer in place of ReSTIR DI when one
-//! light dominates ([`DOMINANT_LIGHT_SHARE`]).
+//! above [`HIERARCHY_MIN_EMITTERS`] emitters).
 
 use crate::reuse::params::ReuseParams;
 use restir_scene::SceneFeatures;
 
-pub use crate::fallback::Fallback;
 use crate::params::{Param, ParamError, ParamSet};
 use crate::path::PathSettings;
 use crate::reuse::settings::ReuseSettings;
@@ -20,17 +18,6 @@ use crate::reuse::settings::ReuseSettings;
 /// qualifies (`None`): `auto` is the power table everywhere until the descent gets cheaper,
 /// and this bound is where the rule lives.
 pub const HIERARCHY_MIN_EMITTERS: Option<usize> = None;
-
-/// The share of light selections one light must hold for ReSTIR DI to hand the scene to the
-/// path tracer at its defaults (`fallback = auto`), when the emitter table also holds at most
-/// [`FEW_EMITTERS`] entries: with one dominant light made of a few surfaces the reservoirs have
-/// little to choose from and their cost is not repaid (`docs/studies/2026-12-02-never-worse.md`).
-/// A dominant mesh light of thousands of small triangles is a many-light problem and keeps
-/// ReSTIR DI.
-pub const DOMINANT_LIGHT_SHARE: f32 = 0.5;
-
-/// At most this many emitter-table entries for the fallback ([`DOMINANT_LIGHT_SHARE`]).
-pub const FEW_EMITTERS: usize = 64;
 
 /// Where initial candidates' lights come from (`--light-sampler`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -196,11 +183,6 @@ pub struct RestirDiSettings {
     /// Where visibility is tested (default in every target: chosen on the training family with
     /// the reuse defaults, `docs/studies/2026-12-02-restir-di-light-pool-and-defaults.md`).
     pub visibility: Visibility,
-    /// Whether a scene with one dominant light goes to the path tracer (default auto).
-    pub fallback: Fallback,
-    /// Whether some ReSTIR DI parameter was given ([`RestirDiSettings::apply`]): then
-    /// `fallback = auto` keeps ReSTIR DI (the user asked for a configured ReSTIR DI).
-    pub configured: bool,
 }
 
 impl RestirDiSettings {
@@ -219,18 +201,13 @@ impl RestirDiSettings {
             learn_prior: 64.0,
             bsdf_candidates: 1,
             visibility: Visibility::Target,
-            fallback: Fallback::Auto,
-            configured: false,
         }
     }
 
-    /// Decides the scene-dependent defaults from the scene summary: an `auto` light sampler
+    /// Decides the scene-dependent default from the scene summary: an `auto` light sampler
     /// becomes the hierarchy from [`HIERARCHY_MIN_EMITTERS`] emitters on (else the power
-    /// table). Returns why the path tracer should render the scene instead: when `fallback` is
-    /// auto, no other ReSTIR DI parameter was given (ReSTIR DI at its defaults), the emitter
-    /// table holds at most [`FEW_EMITTERS`] entries and one light holds at least
-    /// [`DOMINANT_LIGHT_SHARE`] of the light selections.
-    pub fn resolve(&mut self, features: &SceneFeatures) -> Option<String> {
+    /// table).
+    pub fn resolve(&mut self, features: &SceneFeatures) {
         if self.light_sampler == LightSampler::Auto {
             self.light_sampler =
                 if HIERARCHY_MIN_EMITTERS.is_some_and(|m| features.emitter_count >= m) {
@@ -239,19 +216,6 @@ impl RestirDiSettings {
                     LightSampler::Power
                 };
         }
-        let share = features.largest_light_share;
-        let applies = self.fallback == Fallback::Auto && !self.configured;
-        let few = features.emitter_count <= FEW_EMITTERS;
-        (applies && few && share >= DOMINANT_LIGHT_SHARE).then(|| {
-            format!(
-                "one light takes {:.0}% of the light selections (>= {:.0}% with {} emitters <= {}): \
-                 the path tracer renders it (fallback = off keeps ReSTIR DI)",
-                100.0 * share,
-                100.0 * DOMINANT_LIGHT_SHARE,
-                features.emitter_count,
-                FEW_EMITTERS
-            )
-        })
     }
 
     /// Whether the estimator is unbiased with these settings.
@@ -267,7 +231,7 @@ impl RestirDiSettings {
     /// the same. Returns the parameters it did not know, for the caller to warn about.
     pub fn apply(&mut self, params: &ParamSet) -> Result<Vec<Param>, ParamError> {
         params.apply(|key, p| {
-            let used = match key {
+            Ok(match key {
                 "candidates" | "light_candidates" | "initial_candidates" | "num_candidates"
                 | "reservoir_size" | "reservior_size" => {
                     self.candidates = p.count(1)?;
@@ -299,10 +263,6 @@ impl RestirDiSettings {
                     self.learn_cells = p.positive()?;
                     true
                 }
-                "fallback" => {
-                    self.fallback = p.choice(Fallback::NAMES, "auto or off")?;
-                    return Ok(true);
-                }
                 "bsdf_candidates" | "brdf_candidates" => {
                     self.bsdf_candidates = p.count(0)?;
                     true
@@ -320,10 +280,7 @@ impl RestirDiSettings {
                     true
                 }
                 _ => self.reuse.apply(key, p)?,
-            };
-            // A ReSTIR DI parameter given: the user configured ReSTIR DI, keep it.
-            self.configured |= used;
-            Ok(used)
+            })
         })
     }
 }

@@ -18,13 +18,9 @@
 //!    ([`shift::PtShift`]). Confidence is capped at `mcap` after every round. Steps 3 and 4
 //!    are the shared [`crate::reuse::passes`].
 //! 5. **Shading**: the selected path's integrand at the pixel (kept in the sample) times `W`.
-//!
-//! A scene where too few of the camera's paths reconnect at a glossy surface or at one lit
-//! mostly indirectly goes to the path tracer instead (`fallback = auto`, [`RestirPtSettings::resolve`], [`fallback`]): the
-//! estimator is then exactly the path tracer's, and `describe` (hence `--stats`) says so.
 
 mod candidate;
-pub mod fallback;
+pub mod pilot;
 pub mod sample;
 mod settings;
 pub mod shift;
@@ -37,9 +33,9 @@ use restir_materials::LobeFlags;
 use restir_sampling::{Pcg32, luminance};
 use restir_scene::Scene;
 
-pub use fallback::{GLOSSY_VIEW_MIN, INDIRECT_VIEW_MIN, ViewPilot, view_pilot};
+pub use pilot::{GLOSSY_VIEW_MIN, INDIRECT_VIEW_MIN, ViewPilot, view_pilot};
 pub use sample::{Kind, PathSample, Reconnection, ShiftKind};
-pub use settings::{DirectLight, Fallback, RestirPtSettings, SHIFT_NAMES};
+pub use settings::{DirectLight, RestirPtSettings, SHIFT_NAMES};
 use shift::PtReuse;
 pub use shift::{Frames, PtShift};
 
@@ -49,7 +45,6 @@ use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::reciprocal;
 use restir_reuse::{ScreenReuse, Stages};
 
-use crate::fallback::PathFallback;
 use crate::pass::{Integrator, PassContext};
 use crate::path::PathSettings;
 use crate::restir_di::{RestirDiIntegrator, RestirDiSettings};
@@ -77,8 +72,6 @@ pub struct RestirPtIntegrator {
     /// The neighbour pattern and the history of temporal reuse.
     reuse: ScreenReuse<PathSample, GBuffer>,
     clock: StageClock,
-    /// The path tracer that renders instead, and why ([`RestirPtIntegrator::with_fallback`]).
-    fallback: Option<PathFallback>,
 }
 
 impl RestirPtIntegrator {
@@ -100,20 +93,7 @@ impl RestirPtIntegrator {
             di,
             reuse: ScreenReuse::default(),
             clock: StageClock::default(),
-            fallback: None,
         }
-    }
-
-    /// The same integrator rendering with the path tracer instead when `why` says so (what
-    /// [`RestirPtSettings::resolve`] returned).
-    pub fn with_fallback(mut self, why: Option<String>) -> Self {
-        self.fallback = PathFallback::new(self.settings.path, why);
-        self
-    }
-
-    /// Whether the path tracer renders in place of ReSTIR PT.
-    pub fn falls_back(&self) -> bool {
-        self.fallback.is_some()
     }
 
     /// The settings.
@@ -327,7 +307,7 @@ impl RestirPtIntegrator {
 /// be scattered from.
 pub fn has_near_specular(scene: &Scene) -> bool {
     scene
-        .bsdfs
+        .bsdfs()
         .iter()
         .any(|b| !connectible(b) && b.flags() != LobeFlags::NONE)
 }
@@ -360,16 +340,10 @@ impl Integrator for RestirPtIntegrator {
             s.max_jacobian,
             s.direct.name(),
             if s.is_unbiased() { "" } else { " (biased)" }
-        ) + &self
-            .fallback
-            .as_ref()
-            .map_or(String::new(), PathFallback::describe)
+        )
     }
 
     fn halo(&self) -> u32 {
-        if self.fallback.is_some() {
-            return 0;
-        }
         self.settings.reuse.halo()
     }
 
@@ -392,9 +366,6 @@ impl Integrator for RestirPtIntegrator {
     }
 
     fn buffer_bytes_per_pixel(&self) -> usize {
-        if self.fallback.is_some() {
-            return 0;
-        }
         let hit_bytes = GBuffer::BYTES_PER_PIXEL;
         let (reservoirs, hits) = if self.settings.reuse.temporal {
             (3, 2)
@@ -409,9 +380,6 @@ impl Integrator for RestirPtIntegrator {
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
-        if let Some(path) = &self.fallback {
-            return path.render_pass(scene, ctx, accum);
-        }
         let s = &self.settings.reuse;
         let n = accum.len();
         // Emitters seen by the camera and the direct light at the primary hit (paths of one and

@@ -1,19 +1,11 @@
 //! ReSTIR PT settings and their parsing from named parameters (XML scenes and the command line
-//! use the same names; the reuse settings are [`ReuseSettings`], shared with ReSTIR DI). One
-//! default is a rule of the scene, decided once when the integrator is made
-//! ([`RestirPtSettings::resolve`]): the path tracer in place of ReSTIR PT where the camera's
-//! paths reconnect at too few glossy surfaces ([`GLOSSY_VIEW_MIN`]) and too little of the light
-//! there is indirect ([`INDIRECT_VIEW_MIN`]).
+//! use the same names; the reuse settings are [`ReuseSettings`], shared with ReSTIR DI).
 
 use crate::reuse::params::ReuseParams;
-use restir_scene::Scene;
-
-pub use crate::fallback::Fallback;
 use crate::params::{Param, ParamError, ParamProblem, ParamSet};
 use crate::path::PathSettings;
 use crate::reuse::settings::ReuseSettings;
 
-use super::fallback::{GLOSSY_VIEW_MIN, INDIRECT_VIEW_MIN, view_pilot};
 use super::sample::{Reconnection, ShiftKind};
 
 /// The shifts `--shift` accepts.
@@ -109,12 +101,6 @@ pub struct RestirPtSettings {
     pub shift: ShiftKind,
     /// Negative control only: skip the hybrid shift's invertibility checks (biased).
     pub skip_invertibility: bool,
-    /// Whether a scene without glossy or indirectly lit surfaces in view goes to the path tracer
-    /// (default auto).
-    pub fallback: Fallback,
-    /// Whether some ReSTIR PT parameter was given ([`RestirPtSettings::apply`]): then
-    /// `fallback = auto` keeps ReSTIR PT (the user asked for a configured ReSTIR PT).
-    pub configured: bool,
 }
 
 impl RestirPtSettings {
@@ -140,34 +126,7 @@ impl RestirPtSettings {
             temporal_stale_suffix: false,
             shift: ShiftKind::Hybrid,
             skip_invertibility: false,
-            fallback: Fallback::Auto,
-            configured: false,
         }
-    }
-
-    /// Returns why the path tracer should render `scene` instead of ReSTIR PT: when `fallback`
-    /// is auto, no other ReSTIR PT parameter was given (ReSTIR PT at its defaults) and the
-    /// camera's paths reach too few glossy surfaces ([`GLOSSY_VIEW_MIN`]) and the light there is
-    /// too little indirect ([`INDIRECT_VIEW_MIN`]), as a pilot of 1024 camera paths sees them
-    /// ([`super::fallback`]; not run otherwise).
-    pub fn resolve(&self, scene: &Scene) -> Option<String> {
-        if self.fallback != Fallback::Auto || self.configured {
-            return None;
-        }
-        let view = view_pilot(scene);
-        // No commas: the bench CSV's settings column is split on them.
-        (!view.keeps_restir_pt()).then(|| {
-            format!(
-                "of {} camera paths {:.1}% first reconnect at a glossy surface (< {:.0}%) and \
-                 {:.0}% of their light is indirect (< {:.0}%): the path tracer renders it \
-                 (fallback = off keeps ReSTIR PT)",
-                view.reached,
-                100.0 * view.glossy_share(),
-                100.0 * GLOSSY_VIEW_MIN,
-                100.0 * view.indirect_share(),
-                100.0 * INDIRECT_VIEW_MIN
-            )
-        })
     }
 
     /// Whether the estimator is unbiased with these settings.
@@ -183,13 +142,7 @@ impl RestirPtSettings {
     /// Applies `params` in order (later ones win). Names are case-insensitive, `-` and `_` are
     /// the same. Returns the parameters it did not know, for the caller to warn about.
     pub fn apply(&mut self, params: &ParamSet) -> Result<Vec<Param>, ParamError> {
-        params.apply(|key, p| {
-            let used = self.apply_one(key, p)?;
-            // A ReSTIR PT parameter given (other than `fallback`): the user configured ReSTIR
-            // PT, keep it.
-            self.configured |= used && key != "fallback";
-            Ok(used)
-        })
+        params.apply(|key, p| self.apply_one(key, p))
     }
 
     /// One parameter; whether it is one of ReSTIR PT's.
@@ -222,7 +175,6 @@ impl RestirPtSettings {
             "temporal_ignore_motion" => self.temporal_ignore_motion = p.boolean()?,
             "temporal_stale_suffix" => self.temporal_stale_suffix = p.boolean()?,
             "skip_invertibility" => self.skip_invertibility = p.boolean()?,
-            "fallback" => self.fallback = p.choice(Fallback::NAMES, "auto or off")?,
             _ => return self.reuse.apply(key, p),
         }
         Ok(true)
@@ -294,36 +246,5 @@ mod tests {
         assert!(s.is_unbiased(), "no rejection: nothing one-sided");
         s.apply(&p("max_jacobian", "2")).unwrap();
         assert!(!s.is_unbiased());
-    }
-
-    /// `fallback` takes auto or off and is the one parameter that does not count as
-    /// configuring ReSTIR PT; every other one does, including the shared reuse parameters.
-    #[test]
-    fn fallback_and_configured() {
-        let new = || {
-            RestirPtSettings::new(PathSettings {
-                max_depth: 4,
-                rr_depth: 5,
-                hide_emitters: false,
-            })
-        };
-        let p = |a: &str, b: &str| ParamSet::from(&[(a, b)][..]);
-        let mut s = new();
-        assert_eq!((s.fallback, s.configured), (Fallback::Auto, false));
-        s.apply(&p("fallback", "OFF")).unwrap();
-        assert_eq!((s.fallback, s.configured), (Fallback::Off, false));
-        assert_eq!(
-            s.apply(&p("fallback", "never")).unwrap_err().to_string(),
-            "fallback = 'never': expected auto or off"
-        );
-        for (name, value) in [("candidates", "2"), ("radius", "3"), ("shift", "hybrid")] {
-            let mut s = new();
-            s.apply(&p(name, value)).unwrap();
-            assert!(s.configured, "{name}");
-        }
-        let mut s = new();
-        let unknown = s.apply(&p("foo", "1")).unwrap();
-        assert_eq!(unknown.len(), 1);
-        assert!(!s.configured);
     }
 }

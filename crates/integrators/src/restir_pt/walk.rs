@@ -90,7 +90,7 @@ impl ScatterVertex {
     /// A surface hit, reached along `-to_prev`, `reach` from the camera along the path.
     #[inline]
     fn at(scene: &Scene, si: &SurfaceInteraction, to_prev: Vec3, reach: f32) -> Self {
-        let bsdf = scene.shape_bsdf[si.shape as usize];
+        let bsdf = scene.shape_bsdf()[si.shape as usize];
         let resolved = scene.bsdf_at(bsdf, si.uv);
         Self {
             r: Receiver::new(si.p, &si.shading, si.uv, to_prev, bsdf, 0.0),

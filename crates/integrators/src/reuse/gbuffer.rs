@@ -179,7 +179,7 @@ impl GBuffer {
                         &si.shading,
                         si.uv,
                         -ray.d,
-                        scene.shape_bsdf[si.shape as usize],
+                        scene.shape_bsdf()[si.shape as usize],
                         si.t,
                     );
                     ngs[i] = si.ng;

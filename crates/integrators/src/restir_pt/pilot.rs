@@ -1,5 +1,6 @@
-//! When ReSTIR PT at its defaults hands a scene to the path tracer (`fallback = auto`), decided
-//! once when the integrator is made from a pilot at the camera's paths.
+//! Whether ReSTIR PT at its defaults is expected to pay on a scene, from a pilot at the camera's
+//! paths: the rule by which the `auto` estimator ([`crate::auto`]) chooses ReSTIR PT, decided
+//! once when the integrator is made.
 //!
 //! ReSTIR PT pays where the path tracer's estimate at the vertex a path reconnects from is poor
 //! and the neighbours' paths are good candidates for it:
@@ -35,13 +36,13 @@ use super::sample::connectible;
 use crate::shadow::{ShadowTarget, visible};
 
 /// The share of the pilot's camera paths (among those that reach a surface a path can
-/// reconnect at) whose first such surface must be glossy for ReSTIR PT to keep a scene at its
-/// defaults, unless [`INDIRECT_VIEW_MIN`] keeps it (`docs/studies/2026-12-02-never-worse.md`).
+/// reconnect at) whose first such surface must be glossy for `auto` to choose ReSTIR PT,
+/// unless [`INDIRECT_VIEW_MIN`] does (`docs/studies/2026-12-02-restir-pt-defaults.md`).
 pub const GLOSSY_VIEW_MIN: f32 = 0.05;
 
 /// The mean indirect share (one more bounce over direct plus one more bounce) of the light at
-/// the camera paths' first reconnectable surfaces for ReSTIR PT to keep a scene without glossy
-/// surfaces in view at its defaults (`docs/studies/2026-12-02-never-worse.md`).
+/// the camera paths' first reconnectable surfaces for `auto` to choose ReSTIR PT on a scene
+/// without glossy surfaces in view (`docs/studies/2026-12-02-restir-pt-defaults.md`).
 pub const INDIRECT_VIEW_MIN: f32 = 0.65;
 
 /// Camera rays per side of the pilot grid.
