@@ -6,7 +6,8 @@
 //!
 //! The rules, in order ([`choose`]):
 //!
-//! 1. **No lights**: the path tracer (nothing for reservoirs to choose among).
+//! 1. **No lights, or no reflected light** (`max_depth` below 2: only emitters seen by the
+//!    camera): the path tracer (nothing for reservoirs to choose among).
 //! 2. **ReSTIR PT** when paths longer than two segments are asked for and the view pilot
 //!    ([`crate::restir_pt::view_pilot`]) finds at least [`GLOSSY_VIEW_MIN`] of the camera's
 //!    paths first reconnecting at a glossy surface, or a mean indirect share of their light of
@@ -94,6 +95,15 @@ pub fn choose(scene: &Scene, path: &PathSettings) -> (Choice, String) {
     let f = &scene.features;
     if f.light_count == 0 {
         return (Choice::Path, "the scene has no lights".into());
+    }
+    if path.max_segments() < 2 {
+        return (
+            Choice::Path,
+            format!(
+                "max_depth {}: no reflected light (emitters seen by the camera only)",
+                path.max_depth
+            ),
+        );
     }
     let pilot = (path.max_segments() > 2).then(|| view_pilot(scene));
     let view = pilot.map(|v| {

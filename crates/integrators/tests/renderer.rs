@@ -174,6 +174,22 @@ fn auto_picks_the_path_tracer_on_the_cornell_box_and_restir_di_runs_as_named() {
     );
     assert_ne!(bits(&di.image.pixels), bits(&path.image.pixels));
     assert_eq!(path.estimator.why, "asked for by name");
+
+    // Emitters only: nothing for reservoirs to choose among.
+    let emitters = Renderer::new(scene)
+        .integrator("auto")
+        .max_depth(1)
+        .render()
+        .unwrap();
+    assert_eq!(emitters.estimator.ran, "path");
+    assert!(
+        emitters
+            .estimator
+            .why
+            .contains("max_depth 1: no reflected light"),
+        "{:?}",
+        emitters.estimator
+    );
 }
 
 /// On the many-lights scene (400 small lamps, none dominating, direct light only) `auto`
