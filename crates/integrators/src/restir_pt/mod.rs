@@ -24,6 +24,7 @@
 //! estimator is then exactly the path tracer's, and `describe` (hence `--stats`) says so.
 
 mod candidate;
+mod diag;
 pub mod fallback;
 pub mod sample;
 mod settings;
@@ -78,6 +79,8 @@ pub struct RestirPtIntegrator {
     clock: StageClock,
     /// The path tracer that renders instead, and why ([`RestirPtIntegrator::with_fallback`]).
     fallback: Option<PathFallback>,
+    /// Where the brightest pixels come from (`RESTIR_PT_DIAG`, [`diag`]); `None` unless asked.
+    diag: Option<diag::Diag>,
 }
 
 impl RestirPtIntegrator {
@@ -101,6 +104,7 @@ impl RestirPtIntegrator {
             history: HistorySlot::default(),
             clock: StageClock::default(),
             fallback: None,
+            diag: diag::Diag::from_env(),
         }
     }
 
@@ -440,6 +444,7 @@ impl Integrator for RestirPtIntegrator {
                 // Domains: pixel `i` of this pass is `i`, of the previous pass `n + i`.
                 pixels: n,
             };
+            let initial = self.diag.as_ref().map(|_| current.clone());
             if let Some(history) = &history {
                 rays += self.clock.time("temporal", || {
                     passes::temporal(&shift, s, ctx, &gbuf, history, STAGE_TEMPORAL, &mut current)
@@ -456,6 +461,10 @@ impl Integrator for RestirPtIntegrator {
                     &mut current,
                 )
             });
+            if let (Some(d), Some(initial)) = (&self.diag, &initial) {
+                let reach = s.radius.ceil() as i32 * s.spatial_rounds as i32;
+                d.record(scene, &gbuf, initial, &current, reach);
+            }
             self.clock.time("shade", || {
                 radiance
                     .par_iter_mut()
