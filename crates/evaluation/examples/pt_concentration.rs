@@ -3,8 +3,12 @@
 //!
 //! ```text
 //! RESTIR_PT_DIAG=diag.csv restir render SCENE --integrator restir-pt --fallback off --spp N -o img.exr
-//! cargo run --release -p restir-evaluation --example pt_concentration -- diag.csv img.exr ref.exr
+//! cargo run --release -p restir-evaluation --example pt_concentration -- diag.csv img.exr ref.exr [other.exr]
 //! ```
+//!
+//! With a fourth image (another estimator at the same passes, the path tracer's), it also says
+//! how that image's squared error compares on the same pixels. It writes `img.top1.png`, the
+//! image with the top 1 % painted magenta.
 //!
 //! `diag.csv` is what `RESTIR_PT_DIAG` writes (`crates/integrators/src/restir_pt/diag.rs`). For
 //! each property (shift, path kind, which pixel found the path, the Jacobian of the shifts that
@@ -44,8 +48,14 @@ fn bin(v: f64, edges: &[(f64, &'static str)], nan: &'static str) -> &'static str
 
 fn main() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let [diag, image, reference] = args.as_slice() else {
-        return Err("usage: pt_concentration DIAG.csv IMAGE.exr REFERENCE.exr".into());
+    let (diag, image, reference, other) = match args.as_slice() {
+        [d, i, r] => (d, i, r, None),
+        [d, i, r, o] => (d, i, r, Some(o)),
+        _ => {
+            return Err(
+                "usage: pt_concentration DIAG.csv IMAGE.exr REFERENCE.exr [OTHER.exr]".into(),
+            );
+        }
     };
     let text = std::fs::read_to_string(diag).map_err(|e| format!("{diag}: {e}"))?;
     let mut lines = text.lines();
@@ -87,8 +97,34 @@ fn main() -> Result<(), String> {
         100.0 * top_share(&errors, 0.01),
         100.0 * brighter / top_total
     );
+    if let Some(o) = other {
+        let oe = squared_errors(&read(o)?, &r).ok_or("the other image differs in size")?;
+        let on_top: f64 = top.iter().map(|&i| oe[i]).sum();
+        let o_total: f64 = order.iter().map(|&i| oe[i]).sum();
+        println!(
+            "{o} on the same pixels: squared error {:.3}× this image's there, {:.3}× elsewhere; \
+             its own top 1 % share {:.1} %",
+            on_top / top_total,
+            (o_total - on_top) / (total - top_total),
+            100.0 * top_share(&oe, 0.01)
+        );
+    }
+    let mut marked = img.clone();
+    for &i in top {
+        marked.pixels[i] = glam::Vec3::new(1.0, 0.0, 1.0);
+    }
+    let png = image.trim_end_matches(".exr").to_string() + ".top1.png";
+    marked.write(Path::new(&png)).map_err(|e| format!("{png}: {e}"))?;
     type Classify = fn(&Row) -> String;
-    let props: [(&str, Classify); 10] = [
+    let props: [(&str, Classify); 11] = [
+        ("camera sees an emitter", |r| {
+            match (r.f("seen_passes"), r.f("passes")) {
+                (s, _) if s == 0.0 => "in no pass",
+                (s, p) if s == p => "in every pass",
+                _ => "in some passes (its silhouette)",
+            }
+            .into()
+        }),
         ("shift", |r| r.s("shift").to_string()),
         ("kind", |r| r.s("kind").to_string()),
         ("found by", |r| match (r.s("origin_dx"), r.s("origin_dy")) {

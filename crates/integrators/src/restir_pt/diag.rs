@@ -5,8 +5,9 @@
 //! holds `None`).
 //!
 //! Per pixel: the passes, the mean and the largest luminance of the reservoir's shaded value
-//! (`value · W`, the part of the pixel ReSTIR PT adds; what the camera sees directly is not in
-//! it), and for the brightest pass
+//! (`value · W`, the part of the pixel ReSTIR PT adds), in how many passes the camera ray saw
+//! an emitter (a pixel that sees one in some passes only is on its silhouette) and the mean
+//! luminance of what it saw, and for the brightest pass
 //!
 //! * the shift that moves the path (`reconnection` for `k = 2`, `hybrid` for `k ≥ 3`, `replay`
 //!   for a path without a reconnection vertex), its kind, `k` and length;
@@ -27,6 +28,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::sync::Mutex;
 
+use glam::Vec3;
 use restir_lights::Light;
 use restir_sampling::luminance;
 use restir_scene::Scene;
@@ -60,6 +62,8 @@ struct PixelDiag {
     passes: u32,
     sum: f64,
     max: f32,
+    seen_passes: u32,
+    seen_sum: f64,
     record: Option<Record>,
 }
 
@@ -80,12 +84,15 @@ impl Diag {
         })
     }
 
-    /// Records one pass: `initial` the reservoirs after initial sampling, `last` after reuse,
-    /// `reach` the farthest (Chebyshev) distance in pixels a path can have moved.
+    /// Records one pass: `seen` what the camera rays saw directly (before shading), `initial`
+    /// the reservoirs after initial sampling, `last` after reuse, `reach` the farthest
+    /// (Chebyshev) distance in pixels a path can have moved.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn record(
         &self,
         scene: &Scene,
         gbuf: &GBuffer,
+        seen: &[Vec3],
         initial: &[PtReservoir],
         last: &[PtReservoir],
         reach: i32,
@@ -101,6 +108,11 @@ impl Diag {
         let radius = scene.lights.scene_radius();
         for (i, (px, res)) in pixels.iter_mut().zip(last).enumerate() {
             px.passes += 1;
+            let l = luminance(seen[i]);
+            if l > 0.0 && l.is_finite() {
+                px.seen_passes += 1;
+                px.seen_sum += f64::from(l);
+            }
             let Some(s) = res.sample.as_ref() else {
                 continue;
             };
@@ -221,12 +233,17 @@ fn shift_name(r: &Record) -> &'static str {
 /// The CSV text.
 fn csv(pixels: &[PixelDiag], w: i32) -> String {
     let mut s = String::from(
-        "x,y,passes,mean,max,pass,shift,kind,rc,length,origin_dx,origin_dy,jacobian,distance,cos,lamp,ucw,target,origin_value\n",
+        "x,y,passes,seen_passes,seen_mean,mean,max,pass,shift,kind,rc,length,origin_dx,origin_dy,jacobian,distance,cos,lamp,ucw,target,origin_value\n",
     );
     for (i, p) in pixels.iter().enumerate() {
         let (x, y) = ((i as i32) % w, (i as i32) / w);
         let mean = p.sum / f64::from(p.passes.max(1));
-        let _ = write!(s, "{x},{y},{},{mean:e},{:e},", p.passes, p.max);
+        let seen = p.seen_sum / f64::from(p.passes.max(1));
+        let _ = write!(
+            s,
+            "{x},{y},{},{},{seen:e},{mean:e},{:e},",
+            p.passes, p.seen_passes, p.max
+        );
         match &p.record {
             Some(r) => {
                 let (dx, dy) = r.origin.map_or((String::new(), String::new()), |(a, b)| {

@@ -25,6 +25,7 @@
 
 mod candidate;
 mod diag;
+mod seen;
 pub mod fallback;
 pub mod sample;
 mod settings;
@@ -81,6 +82,8 @@ pub struct RestirPtIntegrator {
     fallback: Option<PathFallback>,
     /// Where the brightest pixels come from (`RESTIR_PT_DIAG`, [`diag`]); `None` unless asked.
     diag: Option<diag::Diag>,
+    /// More camera rays for the seen emission on emitter silhouettes (`edge_rays > 1`).
+    seen: Option<seen::SeenEmission>,
 }
 
 impl RestirPtIntegrator {
@@ -105,6 +108,7 @@ impl RestirPtIntegrator {
             clock: StageClock::default(),
             fallback: None,
             diag: diag::Diag::from_env(),
+            seen: (settings.edge_rays > 1).then(|| seen::SeenEmission::new(settings.edge_rays, settings.edge_mask_from_pass)),
         }
     }
 
@@ -230,6 +234,16 @@ impl RestirPtIntegrator {
                 &mut radiance,
             )
         });
+        // The seen emission on emitter silhouettes from more camera rays (`radiance` holds the
+        // G-buffer's seen emission only, nothing else yet).
+        if let Some(seen) = &self.seen
+            && s.direct != DirectLight::RestirDi
+            && !s.path.hide_emitters
+        {
+            rays += self.clock.time("silhouettes", || {
+                seen.supersample(scene, ctx, &mut radiance)
+            });
+        }
         let mut current = vec![PtReservoir::empty(); n];
         if keep {
             let bands = Bands::new(gbuf.width);
@@ -346,7 +360,7 @@ impl Integrator for RestirPtIntegrator {
         format!(
             "restir-pt max_depth={} candidates={} neighbors={} radius={} spatial_rounds={} \
              reciprocal={} mis={} mcap={} {} shift={} reconnection={} max_jacobian={} \
-             direct={}{}",
+             direct={}{}{}",
             s.path.max_depth,
             s.candidates,
             s.reuse.neighbors,
@@ -363,6 +377,11 @@ impl Integrator for RestirPtIntegrator {
             },
             s.max_jacobian,
             s.direct.name(),
+            if s.edge_rays > 1 {
+                format!(" edge_rays={}", s.edge_rays)
+            } else {
+                String::new()
+            },
             if s.is_unbiased() { "" } else { " (biased)" }
         ) + &self
             .fallback
@@ -393,6 +412,9 @@ impl Integrator for RestirPtIntegrator {
             di.next_frame(motion.clone()); // its light samples move with their lights
         }
         self.history.next_frame(Some(motion));
+        if let Some(seen) = &self.seen {
+            seen.clear();
+        }
     }
 
     fn buffer_bytes_per_pixel(&self) -> usize {
@@ -463,7 +485,7 @@ impl Integrator for RestirPtIntegrator {
             });
             if let (Some(d), Some(initial)) = (&self.diag, &initial) {
                 let reach = s.radius.ceil() as i32 * s.spatial_rounds as i32;
-                d.record(scene, &gbuf, initial, &current, reach);
+                d.record(scene, &gbuf, &radiance, initial, &current, reach);
             }
             self.clock.time("shade", || {
                 radiance
