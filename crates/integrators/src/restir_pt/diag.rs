@@ -84,15 +84,31 @@ impl Diag {
         })
     }
 
-    /// Records one pass: `seen` what the camera rays saw directly (before shading), `initial`
-    /// the reservoirs after initial sampling, `last` after reuse, `reach` the farthest
-    /// (Chebyshev) distance in pixels a path can have moved.
-    #[allow(clippy::too_many_arguments)]
+    /// Notes what the G-buffer's camera rays saw directly this pass (`seen`, before anything
+    /// else is added and before the silhouettes' extra camera rays).
+    pub(super) fn seen(&self, seen: &[Vec3]) {
+        let Ok(mut state) = self.state.lock() else {
+            return;
+        };
+        let pixels = &mut state.1;
+        if pixels.len() != seen.len() {
+            *pixels = vec![PixelDiag::default(); seen.len()];
+        }
+        for (px, l) in pixels.iter_mut().zip(seen) {
+            let l = luminance(*l);
+            if l > 0.0 && l.is_finite() {
+                px.seen_passes += 1;
+                px.seen_sum += f64::from(l);
+            }
+        }
+    }
+
+    /// Records one pass: `initial` the reservoirs after initial sampling, `last` after reuse,
+    /// `reach` the farthest (Chebyshev) distance in pixels a path can have moved.
     pub(super) fn record(
         &self,
         scene: &Scene,
         gbuf: &GBuffer,
-        seen: &[Vec3],
         initial: &[PtReservoir],
         last: &[PtReservoir],
         reach: i32,
@@ -108,11 +124,6 @@ impl Diag {
         let radius = scene.lights.scene_radius();
         for (i, (px, res)) in pixels.iter_mut().zip(last).enumerate() {
             px.passes += 1;
-            let l = luminance(seen[i]);
-            if l > 0.0 && l.is_finite() {
-                px.seen_passes += 1;
-                px.seen_sum += f64::from(l);
-            }
             let Some(s) = res.sample.as_ref() else {
                 continue;
             };

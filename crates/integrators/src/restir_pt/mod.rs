@@ -234,6 +234,9 @@ impl RestirPtIntegrator {
                 &mut radiance,
             )
         });
+        if let Some(d) = &self.diag {
+            d.seen(&radiance);
+        }
         // The seen emission on emitter silhouettes from more camera rays (`radiance` holds the
         // G-buffer's seen emission only, nothing else yet).
         if let Some(seen) = &self.seen
@@ -485,7 +488,7 @@ impl Integrator for RestirPtIntegrator {
             });
             if let (Some(d), Some(initial)) = (&self.diag, &initial) {
                 let reach = s.radius.ceil() as i32 * s.spatial_rounds as i32;
-                d.record(scene, &gbuf, &radiance, initial, &current, reach);
+                d.record(scene, &gbuf, initial, &current, reach);
             }
             self.clock.time("shade", || {
                 radiance
