@@ -66,7 +66,13 @@ fn main() -> Result<(), String> {
         .map(String::from)
         .collect();
     let rows: Vec<Row> = lines
-        .map(|l| Row(header.iter().cloned().zip(l.split(',').map(String::from)).collect()))
+        .map(|l| {
+            Row(header
+                .iter()
+                .cloned()
+                .zip(l.split(',').map(String::from))
+                .collect())
+        })
         .collect();
     let read = |p: &str| Image::read_exr(Path::new(p)).map_err(|e| format!("{p}: {e}"));
     let (img, r) = (read(image)?, read(reference)?);
@@ -78,7 +84,9 @@ fn main() -> Result<(), String> {
             errors.len()
         ));
     }
-    let mut order: Vec<usize> = (0..errors.len()).filter(|&i| errors[i].is_finite()).collect();
+    let mut order: Vec<usize> = (0..errors.len())
+        .filter(|&i| errors[i].is_finite())
+        .collect();
     order.sort_by(|&a, &b| errors[b].total_cmp(&errors[a]));
     let total: f64 = order.iter().map(|&i| errors[i]).sum();
     let n = (order.len() as f64 * 0.01).ceil() as usize;
@@ -114,7 +122,9 @@ fn main() -> Result<(), String> {
         marked.pixels[i] = glam::Vec3::new(1.0, 0.0, 1.0);
     }
     let png = image.trim_end_matches(".exr").to_string() + ".top1.png";
-    marked.write(Path::new(&png)).map_err(|e| format!("{png}: {e}"))?;
+    marked
+        .write(Path::new(&png))
+        .map_err(|e| format!("{png}: {e}"))?;
     type Classify = fn(&Row) -> String;
     let props: [(&str, Classify); 11] = [
         ("camera sees an emitter", |r| {

@@ -462,7 +462,10 @@ fn edge_rays_unbiased() {
         &reference,
     );
     eprintln!("edge rays where the pass's own ray saw the lamp: max |z| = {z:.2}");
-    assert!(z > Z_MAX, "a mask from the pass's own rays should be biased: {z:.2}");
+    assert!(
+        z > Z_MAX,
+        "a mask from the pass's own rays should be biased: {z:.2}"
+    );
 }
 
 /// The defaults (two candidates, three rounds of two reciprocal pairs within 3 pixels).

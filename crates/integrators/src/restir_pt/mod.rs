@@ -25,9 +25,9 @@
 
 mod candidate;
 mod diag;
-mod seen;
 pub mod fallback;
 pub mod sample;
+mod seen;
 mod settings;
 pub mod shift;
 pub mod walk;
@@ -108,7 +108,8 @@ impl RestirPtIntegrator {
             clock: StageClock::default(),
             fallback: None,
             diag: diag::Diag::from_env(),
-            seen: (settings.edge_rays > 1).then(|| seen::SeenEmission::new(settings.edge_rays, settings.edge_mask_from_pass)),
+            seen: (settings.edge_rays > 1)
+                .then(|| seen::SeenEmission::new(settings.edge_rays, settings.edge_mask_from_pass)),
         }
     }
 

@@ -81,7 +81,10 @@ impl SeenEmission {
     /// it and the rays traced.
     fn mask(&self, scene: &Scene, ctx: &PassContext) -> (Vec<bool>, u64) {
         let (w, h) = ctx.resolution(scene);
-        let (x0, y0) = ctx.crop.as_ref().map_or((0, 0), |c| (c.region.x0, c.region.y0));
+        let (x0, y0) = ctx
+            .crop
+            .as_ref()
+            .map_or((0, 0), |c| (c.region.x0, c.region.y0));
         let key = (w, h, x0, y0);
         if let Ok(m) = self.mask.lock()
             && let Some((k, mask)) = m.as_ref()
@@ -97,10 +100,7 @@ impl SeenEmission {
             .into_par_iter()
             .map(|i| {
                 let (x, y) = ((i as i32 % bw) - reach, (i as i32 / bw) - reach);
-                let film = Vec2::new(
-                    (x + x0 as i32) as f32 + 0.5,
-                    (y + y0 as i32) as f32 + 0.5,
-                );
+                let film = Vec2::new((x + x0 as i32) as f32 + 0.5, (y + y0 as i32) as f32 + 0.5);
                 seen_id(scene, film)
             })
             .collect();
@@ -133,7 +133,12 @@ impl SeenEmission {
     /// Replaces the seen emission in `radiance` (what the G-buffer's camera rays added, and
     /// nothing else yet) by the mean over this many camera rays on the silhouette pixels.
     /// Returns the rays traced.
-    pub(super) fn supersample(&self, scene: &Scene, ctx: &PassContext, radiance: &mut [Vec3]) -> u64 {
+    pub(super) fn supersample(
+        &self,
+        scene: &Scene,
+        ctx: &PassContext,
+        radiance: &mut [Vec3],
+    ) -> u64 {
         let (mask, mut rays) = if self.from_pass {
             (radiance.iter().map(|l| l.max_element() > 0.0).collect(), 0)
         } else {
