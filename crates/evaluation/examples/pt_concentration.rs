@@ -128,12 +128,14 @@ fn main() -> Result<(), String> {
     type Classify = fn(&Row) -> String;
     let props: [(&str, Classify); 11] = [
         ("camera sees an emitter", |r| {
-            match (r.f("seen_passes"), r.f("passes")) {
-                (s, _) if s == 0.0 => "in no pass",
-                (s, p) if s == p => "in every pass",
-                _ => "in some passes (its silhouette)",
+            let (seen, passes) = (r.f("seen_passes"), r.f("passes"));
+            if seen == 0.0 {
+                "in no pass".into()
+            } else if seen == passes {
+                "in every pass".into()
+            } else {
+                "in some passes (its silhouette)".into()
             }
-            .into()
         }),
         ("shift", |r| r.s("shift").to_string()),
         ("kind", |r| r.s("kind").to_string()),

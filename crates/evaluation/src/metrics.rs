@@ -167,9 +167,9 @@ mod tests {
         one[17] = 5.0;
         assert_eq!(top_share(&one, 0.01), 1.0);
         // 10 of 1000 entries: the 10 largest of 1..=1000 over their sum.
-        let ramp: Vec<f64> = (1..=1000).map(f64::from).chain([f64::NAN]).collect();
+        let rising: Vec<f64> = (1..=1000).map(f64::from).chain([f64::NAN]).collect();
         let expected = (991..=1000).sum::<i32>() as f64 / 500_500.0;
-        assert!((top_share(&ramp, 0.01) - expected).abs() < 1e-12);
+        assert!((top_share(&rising, 0.01) - expected).abs() < 1e-12);
         assert!(top_share(&[0.0, 0.0], 0.01).is_nan());
         let (r, mut t) = (ramp(8, 8), ramp(8, 8));
         t.pixels[3] += Vec3::splat(1.0);

@@ -120,10 +120,7 @@ impl Diag {
         if pixels.len() != last.len() {
             *pixels = vec![PixelDiag::default(); last.len()];
         }
-        let (w, h) = (
-            gbuf.width as i32,
-            (last.len() / gbuf.width.max(1) as usize) as i32,
-        );
+        let (w, h) = (gbuf.width as i32, (last.len() / gbuf.width.max(1)) as i32);
         let radius = scene.lights.scene_radius();
         for (i, (px, res)) in pixels.iter_mut().zip(last).enumerate() {
             px.passes += 1;

@@ -23,6 +23,9 @@ use restir_scene::Scene;
 use crate::film::Filter;
 use crate::pass::PassContext;
 
+/// A film window (width, height, x0, y0) and its silhouette mask.
+type WindowMask = ((u32, u32, u32, u32), Vec<bool>);
+
 /// Random-stream stage of the extra camera rays.
 const STAGE_SEEN: u64 = 117;
 
@@ -34,7 +37,7 @@ pub(super) struct SeenEmission {
     /// Negative control: the pixels whose own camera ray saw emission instead of the mask.
     from_pass: bool,
     /// The mask and the window it was made for: (width, height, x0, y0).
-    mask: Mutex<Option<((u32, u32, u32, u32), Vec<bool>)>>,
+    mask: Mutex<Option<WindowMask>>,
 }
 
 /// What a camera ray sees, for the mask: 0 a surface that does not emit, `1 + light` an
