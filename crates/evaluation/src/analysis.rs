@@ -39,6 +39,8 @@ pub struct Summary {
     pub flip: f64,
     /// Median mean ratio.
     pub mean_ratio: f64,
+    /// Median share of the squared error in the top 1 % of pixels.
+    pub top1_share: f64,
     /// Non-finite pixels over all runs.
     pub nonfinite: usize,
     /// Largest peak resident memory, MiB.
@@ -93,6 +95,7 @@ pub fn sequence_runs(records: &[RunRecord]) -> Vec<RunRecord> {
             mape: m(|r| r.mape),
             flip: m(|r| r.flip),
             mean_ratio: m(|r| r.mean_ratio),
+            top1_share: m(|r| r.top1_share),
             nonfinite: group.iter().map(|r| r.nonfinite).sum(),
             rss_before_mib: group
                 .iter()
@@ -172,6 +175,7 @@ pub fn summarize(results: &BenchResults) -> Vec<Summary> {
                     mape: col(|x| x.mape),
                     flip: col(|x| x.flip),
                     mean_ratio: col(|x| x.mean_ratio),
+                    top1_share: col(|x| x.top1_share),
                     nonfinite: runs.iter().map(|x| x.nonfinite).sum(),
                     peak_rss_mib: runs.iter().map(|x| x.peak_rss_mib).fold(0.0, f64::max),
                     flicker: col(|x| x.flicker),

@@ -11,6 +11,10 @@
 //!   sRGB-encoded to 8 bits (NaN and infinities become 0) — and compared at FLIP's default
 //!   67.02 pixels per degree (a 0.7 m wide 4K monitor seen from 0.7 m). [`Metrics::flip`] is the
 //!   mean of the per-pixel FLIP map, in [0, 1]; [`flip_map`] returns the map itself.
+//! - **Top-1 % share**: the share of the squared error (the sum over pixels of MSE's per-pixel
+//!   terms) held by the 1 % of pixels with the largest squared error ([`top_share`]). Noise
+//!   spread evenly gives a few percent; an image whose error sits in blotches or fireflies gives
+//!   most of it. MSE counts those pixels fully, relMSE divides them by their reference.
 
 use restir_image::{Image, compare, srgb};
 
@@ -27,6 +31,8 @@ pub struct Metrics {
     pub flip: f64,
     /// Mean of the test image over mean of the reference.
     pub mean_ratio: f64,
+    /// Share of the squared error in the 1 % of pixels with the most ([`top_share`]).
+    pub top1_share: f64,
     /// Pixels of the test image with a NaN or infinite channel (left out of relMSE, MSE, MAPE).
     pub nonfinite: usize,
     /// Pixels of the reference with a NaN or infinite channel (left out likewise).
@@ -89,6 +95,43 @@ pub fn mean(map: &[f32]) -> f64 {
     map.iter().map(|&v| v as f64).sum::<f64>() / map.len().max(1) as f64
 }
 
+/// Per-pixel squared error, the mean over RGB of `(x − r)²` (MSE's terms), NaN where a channel
+/// of either image is not finite; `None` if the sizes differ.
+pub fn squared_errors(test: &Image, reference: &Image) -> Option<Vec<f64>> {
+    if (test.width, test.height) != (reference.width, reference.height) {
+        return None;
+    }
+    Some(
+        test.pixels
+            .iter()
+            .zip(&reference.pixels)
+            .map(|(x, r)| {
+                if !(x.is_finite() && r.is_finite()) {
+                    return f64::NAN;
+                }
+                (0..3)
+                    .map(|c| (f64::from(x[c]) - f64::from(r[c])).powi(2))
+                    .sum::<f64>()
+                    / 3.0
+            })
+            .collect(),
+    )
+}
+
+/// The share of the total of `errors` (NaN entries left out) held by its `fraction` largest
+/// entries (at least one): 1 for an error in one pixel, `fraction` for an error spread evenly.
+/// NaN when nothing is finite or the total is 0.
+pub fn top_share(errors: &[f64], fraction: f64) -> f64 {
+    let mut e: Vec<f64> = errors.iter().copied().filter(|v| v.is_finite()).collect();
+    let total: f64 = e.iter().sum();
+    if e.is_empty() || total <= 0.0 {
+        return f64::NAN;
+    }
+    let n = ((e.len() as f64 * fraction).ceil() as usize).clamp(1, e.len());
+    e.select_nth_unstable_by(n - 1, |a, b| b.total_cmp(a));
+    e[..n].iter().sum::<f64>() / total
+}
+
 /// All metrics of `test` against `reference`; `None` if their sizes differ.
 pub fn evaluate(test: &Image, reference: &Image) -> Option<Metrics> {
     let m = compare(test, reference)?;
@@ -105,6 +148,7 @@ pub fn evaluate(test: &Image, reference: &Image) -> Option<Metrics> {
         mape: mape(test, reference)?,
         flip,
         mean_ratio: m.mean_ratio,
+        top1_share: top_share(&squared_errors(test, reference)?, 0.01),
         nonfinite: m.nonfinite,
         reference_nonfinite: m.reference_nonfinite,
     })
@@ -114,6 +158,24 @@ pub fn evaluate(test: &Image, reference: &Image) -> Option<Metrics> {
 mod tests {
     use super::*;
     use glam::Vec3;
+
+    #[test]
+    fn top_share_of_spread_and_concentrated_error() {
+        let even = vec![1.0; 1000];
+        assert!((top_share(&even, 0.01) - 0.01).abs() < 1e-12);
+        let mut one = vec![0.0; 1000];
+        one[17] = 5.0;
+        assert_eq!(top_share(&one, 0.01), 1.0);
+        // 10 of 1000 entries: the 10 largest of 1..=1000 over their sum.
+        let rising: Vec<f64> = (1..=1000).map(f64::from).chain([f64::NAN]).collect();
+        let expected = (991..=1000).sum::<i32>() as f64 / 500_500.0;
+        assert!((top_share(&rising, 0.01) - expected).abs() < 1e-12);
+        assert!(top_share(&[0.0, 0.0], 0.01).is_nan());
+        let (r, mut t) = (ramp(8, 8), ramp(8, 8));
+        t.pixels[3] += Vec3::splat(1.0);
+        let m = evaluate(&t, &r).unwrap();
+        assert_eq!(m.top1_share, 1.0);
+    }
 
     fn ramp(w: u32, h: u32) -> Image {
         let mut img = Image::new(w, h);

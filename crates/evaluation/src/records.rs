@@ -42,6 +42,8 @@ pub struct RunRecord {
     pub flip: f64,
     /// Mean of the image over mean of the reference.
     pub mean_ratio: f64,
+    /// Share of the squared error in the 1 % of pixels with the most ([`crate::metrics::top_share`]).
+    pub top1_share: f64,
     /// Pixels with NaN or infinite values.
     pub nonfinite: usize,
     /// Resident memory just before the render, MiB (`VmHWM` right after the reset).

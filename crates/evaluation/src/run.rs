@@ -129,6 +129,7 @@ fn render_entry(
                 mape: e.mape,
                 flip: e.flip,
                 mean_ratio: e.mean_ratio,
+                top1_share: e.top1_share,
                 nonfinite: e.nonfinite,
                 rss_before_mib: mib(m.before),
                 peak_rss_mib: mib(m.after),

@@ -217,6 +217,7 @@ fn synthetic_results() -> BenchResults {
                         mape: m.mape,
                         flip: m.flip,
                         mean_ratio: m.mean_ratio,
+                        top1_share: m.top1_share,
                         nonfinite: m.nonfinite,
                         rss_before_mib: 10.0,
                         peak_rss_mib: 12.0,

@@ -438,6 +438,36 @@ fn jacobian_rejection_and_footprint_rule_unbiased() {
     assert!(z > Z_MAX, "J = 1 should be biased: {z:.2}");
 }
 
+/// The emission seen on emitter silhouettes from more camera rays (`edge_rays`): a small lamp in
+/// view, whose edge crosses a few pixels of one block. Unbiased with the mask made from
+/// pixel-centre rays; choosing the pixels by what the pass's own camera ray saw (the negative
+/// control) darkens the edge (a pixel whose ray missed the lamp never gets the extra rays).
+#[test]
+fn edge_rays_unbiased() {
+    let scene = scene_with(
+        r#"(geometry: Sphere(center: (0.6, 1.45, 0.4), radius: 0.25), emission: Some((20, 20, 20))),"#,
+    );
+    let reference = statistics(&scene, "path", &[], 128, 64);
+    for rays in ["1", "8"] {
+        let z = max_z(
+            &statistics(&scene, "restir-pt", &[("edge_rays", rays)], 1, 300),
+            &reference,
+        );
+        eprintln!("edge_rays = {rays}: max |z| = {z:.2}");
+        assert!(z < Z_MAX, "edge_rays = {rays}: max |z| = {z:.2}");
+    }
+    let control = [("edge_rays", "8"), ("edge_mask_from_pass", "true")];
+    let z = max_z(
+        &statistics(&scene, "restir-pt", &control, 1, 300),
+        &reference,
+    );
+    eprintln!("edge rays where the pass's own ray saw the lamp: max |z| = {z:.2}");
+    assert!(
+        z > Z_MAX,
+        "a mask from the pass's own rays should be biased: {z:.2}"
+    );
+}
+
 /// The defaults (two candidates, three rounds of two reciprocal pairs within 3 pixels).
 #[test]
 fn unbiased_at_the_defaults() {

@@ -743,14 +743,15 @@ fn run_compare(test: &Path, reference: &Path, html: Option<&Path>) -> Result<(),
         restir_image::write_file_atomically(out, page.as_bytes()).map_err(|e| e.to_string())?;
     }
     say!(
-        "relmse={:.6e} mse={:.6e} mean_ratio={:.6} nonfinite={} reference_nonfinite={} mape={:.6e} flip={:.6}",
+        "relmse={:.6e} mse={:.6e} mean_ratio={:.6} nonfinite={} reference_nonfinite={} mape={:.6e} flip={:.6} top1_share={:.4}",
         m.relmse,
         m.mse,
         m.mean_ratio,
         m.nonfinite,
         m.reference_nonfinite,
         m.mape,
-        m.flip
+        m.flip,
+        m.top1_share
     );
     Ok(())
 }

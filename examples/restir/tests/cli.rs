@@ -432,7 +432,7 @@ fn tiny_render_writes_images_stats_and_compares() {
     assert!(json["seconds"].as_f64().unwrap() >= 0.0);
 
     // compare: one line `relmse=… mse=… mean_ratio=… nonfinite=… reference_nonfinite=… mape=…
-    // flip=…`.
+    // flip=… top1_share=…`.
     let o = restir(&["compare", s(&exr), s(&exr2)]);
     assert!(o.status.success());
     let stdout = String::from_utf8(o.stdout).unwrap();
@@ -451,7 +451,8 @@ fn tiny_render_writes_images_stats_and_compares() {
             "nonfinite",
             "reference_nonfinite",
             "mape",
-            "flip"
+            "flip",
+            "top1_share"
         ]
     );
     let relmse: f64 = fields[0].1.parse().unwrap();
@@ -471,7 +472,7 @@ fn tiny_render_writes_images_stats_and_compares() {
     assert_eq!(
         stdout,
         "relmse=0.000000e0 mse=0.000000e0 mean_ratio=1.000000 nonfinite=0 reference_nonfinite=0 mape=0.000000e0 \
-         flip=0.000000\n"
+         flip=0.000000 top1_share=NaN\n"
     );
     let html = std::fs::read_to_string(&page).unwrap();
     assert!(html.starts_with("<!DOCTYPE html>") && html.contains("\"hdr_f16\""));

@@ -15,7 +15,7 @@ pub(crate) fn csv_field(s: &str) -> String {
 
 /// The CSV header: one row per render, a sequence's frames one row each (`frame` empty for a
 /// still render; `flicker` empty for it and for a sequence's first frame).
-pub const CSV_HEADER: &str = "scene,label,integrator_settings,width,height,budget_s,seed,seconds,passes,rays,mrays_per_s,relmse,mse,mape,flip,mean_ratio,nonfinite_pixels,rss_before_mib,peak_rss_mib,reference_noise_relmse,frame,flicker,cpu_seconds";
+pub const CSV_HEADER: &str = "scene,label,integrator_settings,width,height,budget_s,seed,seconds,passes,rays,mrays_per_s,relmse,mse,mape,flip,mean_ratio,nonfinite_pixels,rss_before_mib,peak_rss_mib,reference_noise_relmse,frame,flicker,cpu_seconds,top1_share";
 
 pub(crate) fn csv(results: &BenchResults) -> String {
     let mut s = String::from(CSV_HEADER);
@@ -24,7 +24,7 @@ pub(crate) fn csv(results: &BenchResults) -> String {
         let noise = reference_noise(results, &r.scene).map_or(String::new(), |n| format!("{n:e}"));
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{:.4},{},{},{:.3},{:e},{:e},{:e},{:.6},{:.6},{},{:.1},{:.1},{},{},{},{:.4}",
+            "{},{},{},{},{},{},{},{:.4},{},{},{:.3},{:e},{:e},{:e},{:.6},{:.6},{},{:.1},{:.1},{},{},{},{:.4},{:.4}",
             csv_field(&r.scene),
             csv_field(&r.label),
             csv_field(&r.describe),
@@ -51,7 +51,8 @@ pub(crate) fn csv(results: &BenchResults) -> String {
             } else {
                 format!("{:e}", r.flicker)
             },
-            r.cpu_seconds
+            r.cpu_seconds,
+            r.top1_share
         );
     }
     s

@@ -179,12 +179,12 @@ pub fn report_markdown(results: &BenchResults, h: &str, link: &str) -> String {
         );
         let _ = writeln!(
             s,
-            "| configuration | budget (s) | median time (s) | passes | Mrays/s | relMSE median [min, max] | MSE | MAPE | FLIP | mean ratio | non-finite | peak MiB |\n|---|---|---|---|---|---|---|---|---|---|---|---|"
+            "| configuration | budget (s) | median time (s) | passes | Mrays/s | relMSE median [min, max] | MSE | MAPE | FLIP | top-1 % share of squared error | mean ratio | non-finite | peak MiB |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|"
         );
         for x in &rows {
             let _ = writeln!(
                 s,
-                "| {} | {} | {:.2} | {:.0} | {:.2} | {} [{}, {}] | {} | {:.4} | {:.4} | {:.4} | {} | {:.0} |",
+                "| {} | {} | {:.2} | {:.0} | {:.2} | {} [{}, {}] | {} | {:.4} | {:.4} | {:.0} % | {:.4} | {} | {:.0} |",
                 x.label,
                 x.budget,
                 x.seconds,
@@ -196,6 +196,7 @@ pub fn report_markdown(results: &BenchResults, h: &str, link: &str) -> String {
                 sci(x.mse),
                 x.mape,
                 x.flip,
+                100.0 * x.top1_share,
                 x.mean_ratio,
                 x.nonfinite,
                 x.peak_rss_mib

@@ -20,8 +20,10 @@
 //! 5. **Shading**: the selected path's integrand at the pixel (kept in the sample) times `W`.
 
 mod candidate;
+mod diag;
 pub mod pilot;
 pub mod sample;
+mod seen;
 mod settings;
 pub mod shift;
 pub mod walk;
@@ -72,6 +74,10 @@ pub struct RestirPtIntegrator {
     /// The neighbour pattern and the history of temporal reuse.
     reuse: ScreenReuse<PathSample, GBuffer>,
     clock: StageClock,
+    /// Where the brightest pixels come from (`RESTIR_PT_DIAG`, [`diag`]); `None` unless asked.
+    diag: Option<diag::Diag>,
+    /// More camera rays for the seen emission on emitter silhouettes (`edge_rays > 1`).
+    seen: Option<seen::SeenEmission>,
 }
 
 impl RestirPtIntegrator {
@@ -93,6 +99,9 @@ impl RestirPtIntegrator {
             di,
             reuse: ScreenReuse::default(),
             clock: StageClock::default(),
+            diag: diag::Diag::from_env(),
+            seen: (settings.edge_rays > 1)
+                .then(|| seen::SeenEmission::new(settings.edge_rays, settings.edge_mask_from_pass)),
         }
     }
 
@@ -206,6 +215,19 @@ impl RestirPtIntegrator {
                 &mut radiance,
             )
         });
+        if let Some(d) = &self.diag {
+            d.seen(&radiance);
+        }
+        // The seen emission on emitter silhouettes from more camera rays (`radiance` holds the
+        // G-buffer's seen emission only, nothing else yet).
+        if let Some(seen) = &self.seen
+            && s.direct != DirectLight::RestirDi
+            && !s.path.hide_emitters
+        {
+            rays += self.clock.time("silhouettes", || {
+                seen.supersample(scene, ctx, &mut radiance)
+            });
+        }
         let mut current = vec![PtReservoir::empty(); n];
         if keep {
             let bands = Bands::new(gbuf.width);
@@ -322,7 +344,7 @@ impl Integrator for RestirPtIntegrator {
         format!(
             "restir-pt max_depth={} candidates={} neighbors={} radius={} spatial_rounds={} \
              reciprocal={} mis={} mcap={} {} shift={} reconnection={} max_jacobian={} \
-             direct={}{}",
+             direct={}{}{}",
             s.path.max_depth,
             s.candidates,
             s.reuse.neighbors,
@@ -339,6 +361,11 @@ impl Integrator for RestirPtIntegrator {
             },
             s.max_jacobian,
             s.direct.name(),
+            if s.edge_rays > 1 {
+                format!(" edge_rays={}", s.edge_rays)
+            } else {
+                String::new()
+            },
             if s.is_unbiased() { "" } else { " (biased)" }
         )
     }
@@ -363,6 +390,9 @@ impl Integrator for RestirPtIntegrator {
             di.next_frame(motion.clone()); // its light samples move with their lights
         }
         self.reuse.next_frame(Some(motion));
+        if let Some(seen) = &self.seen {
+            seen.clear();
+        }
     }
 
     fn buffer_bytes_per_pixel(&self) -> usize {
@@ -377,6 +407,8 @@ impl Integrator for RestirPtIntegrator {
             + std::mem::size_of::<Vec3>()
             + reciprocal::table_bytes_per_pixel::<PathSample>(&self.settings.reuse)
             + self.di.as_ref().map_or(0, |d| d.buffer_bytes_per_pixel())
+            // The silhouette mask, one byte per pixel.
+            + self.seen.as_ref().map_or(0, |_| std::mem::size_of::<bool>())
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
@@ -408,6 +440,7 @@ impl Integrator for RestirPtIntegrator {
                 // Domains: pixel `i` of this pass is `i`, of the previous pass `n + i`.
                 pixels: n,
             };
+            let initial = self.diag.as_ref().map(|_| current.clone());
             let report = self.reuse.reuse(
                 &shift,
                 s,
@@ -418,6 +451,10 @@ impl Integrator for RestirPtIntegrator {
                 &mut current,
             );
             rays += self.clock.add_reuse(&report);
+            if let (Some(d), Some(initial)) = (&self.diag, &initial) {
+                let reach = s.radius.ceil() as i32 * s.spatial_rounds as i32;
+                d.record(scene, &gbuf, initial, &current, reach);
+            }
             self.clock.time("shade", || {
                 radiance
                     .par_iter_mut()

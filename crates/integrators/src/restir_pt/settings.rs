@@ -83,6 +83,12 @@ pub struct RestirPtSettings {
     pub max_jacobian: f32,
     /// Where the direct light at the primary hit comes from (default the reservoirs).
     pub direct: DirectLight,
+    /// Camera rays for the emission seen on emitter silhouettes, the G-buffer's included
+    /// (default 8; 1: the G-buffer's only).
+    pub edge_rays: u32,
+    /// Negative control only: choose the pixels that get `edge_rays` by what the pass's own
+    /// camera ray saw (an emitter) instead of a mask made without the pass's samples (biased).
+    pub edge_mask_from_pass: bool,
     /// Negative control only: use Jacobian 1 in every shift (biased).
     pub unit_jacobian: bool,
     /// Negative control only: with `max_jacobian`, reject only `J > τ`, not `1/J > τ` (a
@@ -120,6 +126,8 @@ impl RestirPtSettings {
             footprint: 30.0,
             max_jacobian: 0.0,
             direct: DirectLight::Reservoir,
+            edge_rays: 8,
+            edge_mask_from_pass: false,
             unit_jacobian: false,
             one_sided_jacobian: false,
             temporal_ignore_motion: false,
@@ -133,6 +141,7 @@ impl RestirPtSettings {
     pub fn is_unbiased(&self) -> bool {
         self.reuse.is_unbiased()
             && !self.unit_jacobian
+            && (!self.edge_mask_from_pass || self.edge_rays <= 1)
             && (!self.one_sided_jacobian || self.max_jacobian <= 0.0)
             && !self.skip_invertibility
             && (!self.reuse.temporal
@@ -170,6 +179,8 @@ impl RestirPtSettings {
             "direct" => {
                 self.direct = p.choice(DirectLight::CHOICES, "reservoir, path or restir-di")?;
             }
+            "edge_rays" | "silhouette_rays" => self.edge_rays = p.count(1)?,
+            "edge_mask_from_pass" => self.edge_mask_from_pass = p.boolean()?,
             "unit_jacobian" => self.unit_jacobian = p.boolean()?,
             "one_sided_jacobian" => self.one_sided_jacobian = p.boolean()?,
             "temporal_ignore_motion" => self.temporal_ignore_motion = p.boolean()?,
