@@ -79,6 +79,7 @@ fn material(
         specular: None,
         transmittance: None,
         opacity: None,
+        normal: None,
     };
     for b in bindings {
         let id = Some(cache.get(&b.texture, base_dir)?);
@@ -87,6 +88,7 @@ fn material(
             ColorParam::SpecularReflectance => t.specular = id,
             ColorParam::SpecularTransmittance => t.transmittance = id,
             ColorParam::Opacity => t.opacity = id,
+            ColorParam::NormalMap => t.normal = id,
         }
     }
     Ok((bsdf, Some(t)))

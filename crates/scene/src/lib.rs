@@ -190,10 +190,13 @@ pub struct TexturedParams {
     pub transmittance: Option<u32>,
     /// Texture of a `mask`'s `opacity` (its luminance, as Mitsuba's scalar lookup).
     pub opacity: Option<u32>,
+    /// Texture of a `normalmap`'s normal (raw values, not clamped).
+    pub normal: Option<u32>,
 }
 
 impl TexturedParams {
-    /// The parameters at `uv`; texture values are clamped to `[0, 1]` (reflectances).
+    /// The parameters at `uv`; texture values are clamped to `[0, 1]` (reflectances), but for
+    /// the normal map's.
     #[inline]
     pub fn eval(&self, textures: &[Texture], uv: Vec2) -> ReflectanceParams {
         let look = |slot: Option<u32>, constant: Vec3| match slot {
@@ -208,6 +211,10 @@ impl TexturedParams {
             opacity: match self.opacity {
                 Some(i) => restir_sampling::luminance(textures[i as usize].eval(uv)),
                 None => self.base.opacity,
+            },
+            normal: match self.normal {
+                Some(i) => textures[i as usize].eval(uv),
+                None => self.base.normal,
             },
         }
     }

@@ -20,6 +20,7 @@ const BSDF_TYPES: &[&str] = &[
     "roughplastic",
     "null",
     "mask",
+    "normalmap",
 ];
 
 impl<'a> Importer<'a> {
@@ -27,6 +28,13 @@ impl<'a> Importer<'a> {
     pub(super) fn bsdf<'i>(&self, node: Node<'a, 'i>) -> Result<MaterialDesc> {
         let ty = self.plugin_type(node)?;
         let props = self.props(node, format!("bsdf '{ty}'"))?;
+        if ty == "normalmap" {
+            return self.normalmap(node, props);
+        }
+        // An unknown plugin is named before its parameters are looked at.
+        if !BSDF_TYPES.contains(&ty.as_str()) && ty != "thindielectric" {
+            return Err(self.unknown_type(node, "bsdf", &ty, BSDF_TYPES));
+        }
         let textured = self.texture_bindings(node, &ty, &props)?;
         let m = match ty.as_str() {
             "diffuse" => MaterialDesc::Diffuse {
@@ -157,6 +165,12 @@ impl<'a> Importer<'a> {
             // thousands of nested twosided elements would overflow the stack).
             Some(n) if n.attribute("type").map(snake_case).as_deref() == Some("twosided") => {
                 return Err(self.err(*n, "bsdf 'twosided' wraps another twosided"));
+            }
+            Some(n) if n.attribute("type").map(snake_case).as_deref() == Some("normalmap") => {
+                return Err(self.err(
+                    *n,
+                    "bsdf 'twosided' cannot wrap a normalmap (the normalmap may wrap the twosided instead)",
+                ));
             }
             Some(n) => self.bsdf(*n)?,
             None => {

@@ -55,6 +55,36 @@ impl Writer<'_> {
                 self.close("</bsdf>");
                 return Ok(());
             }
+            MaterialDesc::NormalMap {
+                normal,
+                flip_invalid_normals,
+                use_shadowing_function,
+                material,
+            } => {
+                self.open(&format!(r#"<bsdf type="normalmap"{id_attr}>"#));
+                match bound(ColorParam::NormalMap) {
+                    Some(b) => self.texture(&b.texture, "normalmap", item)?,
+                    None => {
+                        self.open(r#"<texture name="normalmap" type="rawconstant">"#);
+                        self.line(&format!(
+                            r#"<vector name="value" value="{}"/>"#,
+                            nums(normal)
+                        ));
+                        self.close("</texture>");
+                    }
+                }
+                self.boolean("flip_invalid_normals", *flip_invalid_normals);
+                self.boolean("use_shadowing_function", *use_shadowing_function);
+                let rest: Option<Vec<TextureBinding>> = textures.map(|t| {
+                    t.iter()
+                        .filter(|b| b.param != ColorParam::NormalMap)
+                        .cloned()
+                        .collect()
+                });
+                self.bsdf(material, None, rest.as_deref(), item)?;
+                self.close("</bsdf>");
+                return Ok(());
+            }
             _ => {}
         }
         // The colour parameters, constant or textured.
@@ -192,7 +222,8 @@ impl Writer<'_> {
             }
             MaterialDesc::Textured { .. }
             | MaterialDesc::TwoSided(_)
-            | MaterialDesc::Mask { .. } => {
+            | MaterialDesc::Mask { .. }
+            | MaterialDesc::NormalMap { .. } => {
                 unreachable!()
             }
         }
