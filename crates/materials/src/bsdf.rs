@@ -131,6 +131,9 @@ pub struct ReflectanceParams {
     pub opacity: f32,
     /// The raw texel of a `normalmap` (ignored by a BSDF without one).
     pub normal: Vec3,
+    /// Roughness `(alpha_u, alpha_v)` replacing a rough conductor's or rough dielectric's
+    /// (`None` keeps the model's; each clamped to at least [`crate::microfacet::MIN_ALPHA`]).
+    pub alpha: Option<(f32, f32)>,
 }
 
 impl Bsdf {
@@ -241,6 +244,10 @@ impl Bsdf {
     /// these parameters in the first place.
     #[inline]
     pub fn with_params(&self, p: &ReflectanceParams) -> Self {
+        let rough = |m: Microfacet| match p.alpha {
+            Some((u, v)) => Microfacet::anisotropic(m.distribution, u, v),
+            None => m,
+        };
         let kind = match self.kind {
             BsdfKind::Diffuse { .. } => BsdfKind::Diffuse {
                 reflectance: p.diffuse,
@@ -256,7 +263,7 @@ impl Bsdf {
                 eta,
                 k,
                 specular_reflectance: p.specular,
-                microfacet,
+                microfacet: rough(microfacet),
             },
             BsdfKind::Dielectric { eta, .. } => BsdfKind::Dielectric {
                 eta,
@@ -269,7 +276,7 @@ impl Bsdf {
                 eta,
                 specular_reflectance: p.specular,
                 specular_transmittance: p.transmittance,
-                microfacet,
+                microfacet: rough(microfacet),
             },
             BsdfKind::Plastic(q) => {
                 BsdfKind::Plastic(q.with_reflectance(p.diffuse, p.specular, p.nonlinear))
@@ -584,6 +591,7 @@ mod tests {
                 nonlinear,
                 opacity: 1.0,
                 normal: Vec3::new(0.5, 0.5, 1.0),
+                alpha: None,
             };
             let pairs = [
                 (Bsdf::diffuse(d0), Bsdf::diffuse(d1)),

@@ -192,6 +192,10 @@ pub struct TexturedParams {
     pub opacity: Option<u32>,
     /// Texture of a `normalmap`'s normal (raw values, not clamped).
     pub normal: Option<u32>,
+    /// Texture of a microfacet roughness `alpha_u` (its luminance, as Mitsuba's scalar lookup).
+    pub alpha_u: Option<u32>,
+    /// Texture of `alpha_v`.
+    pub alpha_v: Option<u32>,
 }
 
 impl TexturedParams {
@@ -209,12 +213,23 @@ impl TexturedParams {
             transmittance: look(self.transmittance, self.base.transmittance),
             nonlinear: self.base.nonlinear,
             opacity: match self.opacity {
-                Some(i) => restir_sampling::luminance(textures[i as usize].eval(uv)),
+                Some(i) => textures[i as usize].eval_1(uv),
                 None => self.base.opacity,
             },
             normal: match self.normal {
                 Some(i) => textures[i as usize].eval(uv),
                 None => self.base.normal,
+            },
+            alpha: match (self.alpha_u, self.alpha_v, self.base.alpha) {
+                (None, None, a) => a,
+                (u, v, a) => {
+                    let (au, av) = a.unwrap_or((0.1, 0.1));
+                    let scalar = |slot: Option<u32>, constant: f32| match slot {
+                        Some(i) => textures[i as usize].eval_1(uv),
+                        None => constant,
+                    };
+                    Some((scalar(u, au), scalar(v, av)))
+                }
             },
         }
     }

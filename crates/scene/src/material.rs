@@ -389,12 +389,16 @@ pub(crate) fn color_params(m: &MaterialDesc) -> &'static [ColorParam] {
     use ColorParam::*;
     match m {
         MaterialDesc::Diffuse { .. } => &[Reflectance],
-        MaterialDesc::Conductor { .. } | MaterialDesc::RoughConductor { .. } => {
-            &[SpecularReflectance]
-        }
-        MaterialDesc::Dielectric { .. } | MaterialDesc::RoughDielectric { .. } => {
-            &[SpecularReflectance, SpecularTransmittance]
-        }
+        MaterialDesc::Conductor { .. } => &[SpecularReflectance],
+        MaterialDesc::RoughConductor { .. } => &[SpecularReflectance, Alpha, AlphaU, AlphaV],
+        MaterialDesc::Dielectric { .. } => &[SpecularReflectance, SpecularTransmittance],
+        MaterialDesc::RoughDielectric { .. } => &[
+            SpecularReflectance,
+            SpecularTransmittance,
+            Alpha,
+            AlphaU,
+            AlphaV,
+        ],
         MaterialDesc::Plastic { .. } | MaterialDesc::RoughPlastic { .. } => {
             &[DiffuseReflectance, SpecularReflectance]
         }
@@ -450,6 +454,7 @@ pub(crate) fn colors(m: &MaterialDesc) -> (ReflectanceParams, &[TextureBinding])
         nonlinear: false,
         opacity: 1.0,
         normal: v3(&defaults::FLAT_NORMAL),
+        alpha: None,
     };
     let mut bindings: &[TextureBinding] = &[];
     let mut m = m;
@@ -513,6 +518,14 @@ pub(crate) fn colors(m: &MaterialDesc) -> (ReflectanceParams, &[TextureBinding])
             p.nonlinear = *nonlinear;
         }
         _ => {}
+    }
+    if let MaterialDesc::RoughConductor { roughness, .. }
+    | MaterialDesc::RoughDielectric { roughness, .. } = m
+    {
+        p.alpha = Some((
+            roughness.alpha_u.unwrap_or(roughness.alpha),
+            roughness.alpha_v.unwrap_or(roughness.alpha),
+        ));
     }
     (p, bindings)
 }

@@ -234,6 +234,13 @@ pub enum ColorParam {
     Opacity,
     /// A `normalmap`'s `normalmap` (raw values, not clamped).
     NormalMap,
+    /// A rough conductor's or rough dielectric's isotropic `alpha` (a scalar: a colour texture
+    /// gives its luminance).
+    Alpha,
+    /// Their `alpha_u` (with `alpha_v`, given as a value or a texture).
+    AlphaU,
+    /// Their `alpha_v` (with `alpha_u`).
+    AlphaV,
 }
 
 impl ColorParam {
@@ -246,6 +253,9 @@ impl ColorParam {
             ColorParam::SpecularTransmittance => "specular_transmittance",
             ColorParam::Opacity => "opacity",
             ColorParam::NormalMap => "normalmap",
+            ColorParam::Alpha => "alpha",
+            ColorParam::AlphaU => "alpha_u",
+            ColorParam::AlphaV => "alpha_v",
         }
     }
 
@@ -258,6 +268,9 @@ impl ColorParam {
             ColorParam::SpecularTransmittance,
             ColorParam::Opacity,
             ColorParam::NormalMap,
+            ColorParam::Alpha,
+            ColorParam::AlphaU,
+            ColorParam::AlphaV,
         ]
         .into_iter()
         .find(|p| p.name() == name)

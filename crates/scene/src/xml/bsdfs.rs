@@ -96,7 +96,7 @@ impl<'a> Importer<'a> {
                 self.err(
                     c,
                     format!(
-                        "bsdf '{ty}': '{name}' cannot be a texture (only reflectances can: reflectance, diffuse_reflectance, specular_reflectance, specular_transmittance)"
+                        "bsdf '{ty}': '{name}' cannot be a texture (only these can: reflectance, diffuse_reflectance, specular_reflectance, specular_transmittance, a mask's opacity, a normalmap's normalmap, and the rough conductor's and rough dielectric's alpha, alpha_u, alpha_v)"
                     ),
                 )
             })?;
@@ -433,9 +433,24 @@ impl<'a> Importer<'a> {
                 a => Ok(a),
             }
         };
-        let a = alpha("alpha")?;
-        let au = alpha("alpha_u")?;
-        let av = alpha("alpha_v")?;
+        // A roughness given as a texture counts as given (its value here is a placeholder the
+        // texture replaces at every shading point).
+        let textured = |name: &str| {
+            elements(node).any(|c| {
+                ["texture", "ref"].contains(&c.tag_name().name())
+                    && c.attribute("name").map(snake_case).as_deref() == Some(name)
+            })
+        };
+        let given = |name: &str| -> Result<Option<f32>> {
+            if textured(name) {
+                Ok(Some(defaults::ALPHA))
+            } else {
+                alpha(name)
+            }
+        };
+        let a = given("alpha")?;
+        let au = given("alpha_u")?;
+        let av = given("alpha_v")?;
         match (au, av) {
             (None, None) => r.alpha = a.unwrap_or(defaults::ALPHA),
             (Some(u), Some(v)) => {

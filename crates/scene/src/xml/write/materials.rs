@@ -148,7 +148,7 @@ impl Writer<'_> {
                 }
                 colour(self, ColorParam::SpecularReflectance, specular_reflectance)?;
                 if let Some(r) = rough {
-                    self.roughness(r);
+                    self.roughness_textured(r, textures.unwrap_or(&[]), item)?;
                 }
             }
             MaterialDesc::Dielectric {
@@ -183,7 +183,7 @@ impl Writer<'_> {
                     specular_transmittance,
                 )?;
                 if let Some(r) = rough {
-                    self.roughness(r);
+                    self.roughness_textured(r, textures.unwrap_or(&[]), item)?;
                 }
             }
             MaterialDesc::Plastic {
@@ -228,6 +228,41 @@ impl Writer<'_> {
             }
         }
         self.close("</bsdf>");
+        Ok(())
+    }
+
+    /// [`Self::roughness`] where some of `alpha`, `alpha_u`, `alpha_v` may be textures.
+    fn roughness_textured(
+        &mut self,
+        r: &RoughnessDesc,
+        textures: &[TextureBinding],
+        item: &str,
+    ) -> Result<()> {
+        let bound = |p: ColorParam| textures.iter().find(|b| b.param == p);
+        let alpha_params = [ColorParam::Alpha, ColorParam::AlphaU, ColorParam::AlphaV];
+        if alpha_params.iter().all(|p| bound(*p).is_none()) {
+            self.roughness(r);
+            return Ok(());
+        }
+        self.string(
+            "distribution",
+            match r.distribution {
+                MicrofacetDesc::Beckmann => "beckmann",
+                MicrofacetDesc::Ggx => "ggx",
+            },
+        );
+        if let Some(b) = bound(ColorParam::Alpha) {
+            return self.texture(&b.texture, "alpha", item);
+        }
+        for (p, v) in [
+            (ColorParam::AlphaU, r.alpha_u.unwrap_or(r.alpha)),
+            (ColorParam::AlphaV, r.alpha_v.unwrap_or(r.alpha)),
+        ] {
+            match bound(p) {
+                Some(b) => self.texture(&b.texture, p.name(), item)?,
+                None => self.float(p.name(), v),
+            }
+        }
         Ok(())
     }
 
