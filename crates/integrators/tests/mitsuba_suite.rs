@@ -50,13 +50,25 @@ const PASS_FRACTION: f64 = 0.9975;
 /// The smallest variance the criterion divides by.
 const MIN_VARIANCE: f64 = 1e-4;
 /// Scenes that must load (of the 29).
-const MIN_LOADING: usize = 12;
+const MIN_LOADING: usize = 16;
 /// `(scene, estimator, reason)`: failures that are known and explained in docs/VALIDATION.md.
-const KNOWN_FAILURES: &[(&str, &str, &str)] = &[(
-    "bsdf_spheres/test_constant_path.xml",
-    "restir-di",
-    "fails narrowly (0.9973 of 0.9975, a few pixels far off); the cause is not found yet",
-)];
+const KNOWN_FAILURES: &[(&str, &str, &str)] = &[
+    (
+        "bsdf_spheres/test_constant_path.xml",
+        "restir-di",
+        "unbiased but, on the Beckmann alpha 0.05 conductor under a constant environment, about 25 \
+         times the path tracer's per-sample variance (light sampling misses the narrow lobe), more \
+         than Mitsuba's variance image allows in a few pixels",
+    ),
+    (
+        "bsdf_spheres/test_constant_path.xml",
+        "restir-pt",
+        "at Mitsuba's full budget only: unbiased, but behind fully transparent mask texels, where \
+         the path tracer is exact (variance 0, so the criterion uses its floor 1e-4), reuse with \
+         the neighbours' paths through the partly opaque leaf gives a per-sample variance of \
+         3-5e-3",
+    ),
+];
 
 /// Rows of the linear sRGB → CIE XYZ matrix (D65), as Mitsuba's `srgb_to_xyz`.
 const SRGB_TO_XYZ: [[f64; 3]; 3] = [

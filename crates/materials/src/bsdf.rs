@@ -9,6 +9,7 @@ use glam::{Vec2, Vec3};
 use crate::LobeFlags;
 use crate::lobe::{REFLECT_DELTA, REFLECT_DIFFUSE, REFLECT_GLOSSY, TRANSMIT_DELTA};
 use crate::microfacet::{Distribution, Microfacet};
+use crate::models::normalmap::{self, NormalMap};
 use crate::models::plastic::{Plastic, RoughPlastic};
 use crate::models::{
     BsdfSample, conductor, delta, dielectric, diffuse, finite_or_zero, finite_pdf, plastic,
@@ -99,6 +100,10 @@ pub struct Bsdf {
     /// unchanged otherwise (a delta transmission of weight `1 − opacity`, from both sides). 1 for
     /// an opaque surface; in `[0, 1]`. See [`Bsdf::masked`].
     pub opacity: f32,
+    /// Mitsuba's `normalmap`: the model (two-sided mirroring included, inside the mask's
+    /// pass-through) is evaluated in the frame this normal perturbs. See
+    /// [`Bsdf::normal_mapped`].
+    pub normal_map: Option<NormalMap>,
 }
 
 fn one_sided(kind: BsdfKind) -> Bsdf {
@@ -106,6 +111,7 @@ fn one_sided(kind: BsdfKind) -> Bsdf {
         kind,
         two_sided: false,
         opacity: 1.0,
+        normal_map: None,
     }
 }
 
@@ -123,6 +129,11 @@ pub struct ReflectanceParams {
     pub nonlinear: bool,
     /// The opacity of a `mask` (1 for an opaque surface).
     pub opacity: f32,
+    /// The raw texel of a `normalmap` (ignored by a BSDF without one).
+    pub normal: Vec3,
+    /// Roughness `(alpha_u, alpha_v)` replacing a rough conductor's or rough dielectric's
+    /// (`None` keeps the model's; each clamped to at least [`crate::microfacet::MIN_ALPHA`]).
+    pub alpha: Option<(f32, f32)>,
 }
 
 impl Bsdf {
@@ -233,6 +244,10 @@ impl Bsdf {
     /// these parameters in the first place.
     #[inline]
     pub fn with_params(&self, p: &ReflectanceParams) -> Self {
+        let rough = |m: Microfacet| match p.alpha {
+            Some((u, v)) => Microfacet::anisotropic(m.distribution, u, v),
+            None => m,
+        };
         let kind = match self.kind {
             BsdfKind::Diffuse { .. } => BsdfKind::Diffuse {
                 reflectance: p.diffuse,
@@ -248,7 +263,7 @@ impl Bsdf {
                 eta,
                 k,
                 specular_reflectance: p.specular,
-                microfacet,
+                microfacet: rough(microfacet),
             },
             BsdfKind::Dielectric { eta, .. } => BsdfKind::Dielectric {
                 eta,
@@ -261,7 +276,7 @@ impl Bsdf {
                 eta,
                 specular_reflectance: p.specular,
                 specular_transmittance: p.transmittance,
-                microfacet,
+                microfacet: rough(microfacet),
             },
             BsdfKind::Plastic(q) => {
                 BsdfKind::Plastic(q.with_reflectance(p.diffuse, p.specular, p.nonlinear))
@@ -274,7 +289,18 @@ impl Bsdf {
         Self {
             kind,
             opacity: crate::models::mask::clamp_opacity(p.opacity),
+            normal_map: self.normal_map.map(|m| m.with_texel(p.normal)),
             ..*self
+        }
+    }
+
+    /// The same model behind Mitsuba's `normalmap` (`map` holds the perturbed normal and the
+    /// switches; textured maps replace the normal per shading point through
+    /// [`ReflectanceParams::normal`]).
+    pub fn normal_mapped(self, map: NormalMap) -> Self {
+        Self {
+            normal_map: Some(map),
+            ..self
         }
     }
 
@@ -355,9 +381,23 @@ impl Bsdf {
         self.eval_model(wo, wi)
     }
 
-    /// [`Bsdf::eval`] of the model alone.
+    /// [`Bsdf::eval`] of the model alone (in the normal map's frame, if there is one).
     #[inline]
     fn eval_model(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        let Some(map) = &self.normal_map else {
+            return self.eval_shaded(wo, wi);
+        };
+        let frame = map.frame(wo);
+        let wi_p = frame.to_local(wi);
+        if !normalmap::same_side(wi, wi_p) {
+            return Vec3::ZERO;
+        }
+        finite_or_zero(self.eval_shaded(frame.to_local(wo), wi_p) * map.shadowing(frame.n, wi))
+    }
+
+    /// [`Bsdf::eval`] of the model in its own shading frame.
+    #[inline]
+    fn eval_shaded(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         let (v, l) = self.orient(wo, wi);
         finite_or_zero(match &self.kind {
             BsdfKind::Diffuse { reflectance } => diffuse::eval(*reflectance, v, l),
@@ -398,9 +438,23 @@ impl Bsdf {
         self.pdf_model(wo, wi)
     }
 
-    /// [`Bsdf::pdf_sa`] of the model alone.
+    /// [`Bsdf::pdf_sa`] of the model alone (in the normal map's frame, if there is one).
     #[inline]
     fn pdf_model(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let Some(map) = &self.normal_map else {
+            return self.pdf_shaded(wo, wi);
+        };
+        let frame = map.frame(wo);
+        let wi_p = frame.to_local(wi);
+        if !normalmap::same_side(wi, wi_p) {
+            return 0.0;
+        }
+        self.pdf_shaded(frame.to_local(wo), wi_p)
+    }
+
+    /// [`Bsdf::pdf_sa`] of the model in its own shading frame.
+    #[inline]
+    fn pdf_shaded(&self, wo: Vec3, wi: Vec3) -> f32 {
         let (v, l) = self.orient(wo, wi);
         finite_pdf(match &self.kind {
             BsdfKind::Diffuse { .. } => diffuse::pdf(v, l),
@@ -429,9 +483,26 @@ impl Bsdf {
         self.sample_model(wo, u_lobe, u)
     }
 
-    /// [`Bsdf::sample`] of the model alone.
+    /// [`Bsdf::sample`] of the model alone (in the normal map's frame, if there is one).
     #[inline]
     fn sample_model(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        let Some(map) = &self.normal_map else {
+            return self.sample_shaded(wo, u_lobe, u);
+        };
+        let frame = map.frame(wo);
+        let mut s = self.sample_shaded(frame.to_local(wo), u_lobe, u)?;
+        let wi = frame.to_shading(s.wi);
+        if !normalmap::same_side(wi, s.wi) {
+            return None;
+        }
+        s.f = finite_or_zero(s.f * map.shadowing(frame.n, wi));
+        s.wi = wi;
+        Some(s)
+    }
+
+    /// [`Bsdf::sample`] of the model in its own shading frame.
+    #[inline]
+    fn sample_shaded(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         let flip = self.flips(wo);
         let v = if flip {
             Vec3::new(wo.x, wo.y, -wo.z)
@@ -519,6 +590,8 @@ mod tests {
                 transmittance: t1,
                 nonlinear,
                 opacity: 1.0,
+                normal: Vec3::new(0.5, 0.5, 1.0),
+                alpha: None,
             };
             let pairs = [
                 (Bsdf::diffuse(d0), Bsdf::diffuse(d1)),
@@ -550,11 +623,12 @@ mod tests {
         }
     }
 
-    /// The enum stays small (it is copied into path vertices and reservoirs).
+    /// The enum stays small (it is copied into path vertices and reservoirs): the largest
+    /// model, the two-sided flag, the opacity and a quantised normal map.
     #[test]
     fn bsdf_is_small() {
         assert!(
-            core::mem::size_of::<Bsdf>() <= 64,
+            core::mem::size_of::<Bsdf>() <= 72,
             "{}",
             core::mem::size_of::<Bsdf>()
         );

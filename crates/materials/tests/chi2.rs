@@ -25,7 +25,7 @@
 //! p < 1e-6.
 
 use glam::Vec3;
-use restir_materials::{Bsdf, Distribution, LobeFlags, Microfacet, ior};
+use restir_materials::{Bsdf, Distribution, LobeFlags, Microfacet, NormalMap, ior};
 use restir_sampling::{Pcg32, warp};
 use restir_testkit::{Chi2Error, Chi2Outcome, Histogram, Quadrature, SphereGrid, sidak_level};
 
@@ -147,6 +147,49 @@ fn cases() -> Vec<Case> {
         )
         .two_sided()
         .masked(0.6),
+        mass: Mass::AtMostOne,
+        albedo: None,
+        eta: 1.0,
+    });
+    // Normal maps: the model in a perturbed frame; samples that cross between the frames fail,
+    // and the shadowing term lowers the albedo.
+    let tilted = NormalMap::new(Vec3::new(0.75, 0.4, 0.85), true, true);
+    v.push(Case {
+        name: "normal-mapped two-sided diffuse",
+        bsdf: Bsdf::diffuse(Vec3::new(0.8, 0.5, 0.2))
+            .two_sided()
+            .normal_mapped(tilted),
+        mass: Mass::AtMostOne,
+        albedo: None,
+        eta: 1.0,
+    });
+    v.push(Case {
+        name: "normal-mapped two-sided anisotropic rough conductor, no flip, no shadowing",
+        bsdf: Bsdf::rough_conductor(
+            gold.0,
+            gold.1,
+            Vec3::ONE,
+            Microfacet::anisotropic(Distribution::Ggx, 0.25, 0.05),
+        )
+        .two_sided()
+        .normal_mapped(NormalMap::new(Vec3::new(0.3, 0.6, 0.8), false, false)),
+        mass: Mass::AtMostOne,
+        albedo: None,
+        eta: 1.0,
+    });
+    v.push(Case {
+        name: "mask 0.5 of a normal-mapped two-sided rough plastic",
+        bsdf: Bsdf::rough_plastic(
+            pp,
+            Vec3::new(0.2, 0.5, 0.8),
+            Vec3::ONE,
+            false,
+            Distribution::Beckmann,
+            0.2,
+        )
+        .two_sided()
+        .normal_mapped(tilted)
+        .masked(0.5),
         mass: Mass::AtMostOne,
         albedo: None,
         eta: 1.0,
@@ -533,6 +576,21 @@ fn control_mask_vs_unmasked_pdf() {
     let hist = sample_histogram(&grid, &inner.masked(0.8), wo, 98, SAMPLES);
     rejected(
         "mask samples vs the unmasked pdf",
+        hist.chi2(&pdf_cells(&grid, &inner, wo)),
+    );
+}
+
+/// A normal-mapped diffuse's samples against the unperturbed model's pdf, as if `pdf_sa` had
+/// forgotten the normal map.
+#[test]
+fn control_normal_map_vs_unperturbed_pdf() {
+    let grid = SphereGrid::default();
+    let inner = Bsdf::diffuse(Vec3::ONE);
+    let mapped = inner.normal_mapped(NormalMap::new(Vec3::new(0.75, 0.4, 0.85), true, true));
+    let wo = Vec3::new(0.3, 0.2, 0.93).normalize();
+    let hist = sample_histogram(&grid, &mapped, wo, 97, SAMPLES);
+    rejected(
+        "normal-mapped samples vs the unperturbed pdf",
         hist.chi2(&pdf_cells(&grid, &inner, wo)),
     );
 }

@@ -80,6 +80,9 @@ fn material(
         specular: None,
         transmittance: None,
         opacity: None,
+        normal: None,
+        alpha_u: None,
+        alpha_v: None,
     };
     for b in bindings {
         let id = Some(cache.get(&b.texture, base_dir)?);
@@ -88,6 +91,13 @@ fn material(
             ColorParam::SpecularReflectance => t.specular = id,
             ColorParam::SpecularTransmittance => t.transmittance = id,
             ColorParam::Opacity => t.opacity = id,
+            ColorParam::NormalMap => t.normal = id,
+            ColorParam::Alpha => {
+                t.alpha_u = id;
+                t.alpha_v = id;
+            }
+            ColorParam::AlphaU => t.alpha_u = id,
+            ColorParam::AlphaV => t.alpha_v = id,
         }
     }
     Ok((bsdf, Some(t)))

@@ -200,10 +200,17 @@ pub struct TexturedParams {
     pub transmittance: Option<u32>,
     /// Texture of a `mask`'s `opacity` (its luminance, as Mitsuba's scalar lookup).
     pub opacity: Option<u32>,
+    /// Texture of a `normalmap`'s normal (raw values, not clamped).
+    pub normal: Option<u32>,
+    /// Texture of a microfacet roughness `alpha_u` (its luminance, as Mitsuba's scalar lookup).
+    pub alpha_u: Option<u32>,
+    /// Texture of `alpha_v`.
+    pub alpha_v: Option<u32>,
 }
 
 impl TexturedParams {
-    /// The parameters at `uv`; texture values are clamped to `[0, 1]` (reflectances).
+    /// The parameters at `uv`; texture values are clamped to `[0, 1]` (reflectances), but for
+    /// the normal map's.
     #[inline]
     pub fn eval(&self, textures: &[Texture], uv: Vec2) -> ReflectanceParams {
         let look = |slot: Option<u32>, constant: Vec3| match slot {
@@ -216,8 +223,23 @@ impl TexturedParams {
             transmittance: look(self.transmittance, self.base.transmittance),
             nonlinear: self.base.nonlinear,
             opacity: match self.opacity {
-                Some(i) => restir_sampling::luminance(textures[i as usize].eval(uv)),
+                Some(i) => textures[i as usize].eval_1(uv),
                 None => self.base.opacity,
+            },
+            normal: match self.normal {
+                Some(i) => textures[i as usize].eval(uv),
+                None => self.base.normal,
+            },
+            alpha: match (self.alpha_u, self.alpha_v, self.base.alpha) {
+                (None, None, a) => a,
+                (u, v, a) => {
+                    let (au, av) = a.unwrap_or((0.1, 0.1));
+                    let scalar = |slot: Option<u32>, constant: f32| match slot {
+                        Some(i) => textures[i as usize].eval_1(uv),
+                        None => constant,
+                    };
+                    Some((scalar(u, au), scalar(v, av)))
+                }
             },
         }
     }

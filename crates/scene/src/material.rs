@@ -78,6 +78,13 @@ pub enum MaterialError {
         /// Its value.
         value: f32,
     },
+    /// A `normalmap` around a `mask` or another `normalmap`, or inside a `twosided`.
+    NormalMapNesting,
+    /// A `normalmap` value that is not finite.
+    BadNormal {
+        /// Its value.
+        value: V3,
+    },
 }
 
 impl core::fmt::Display for MaterialError {
@@ -138,6 +145,12 @@ impl core::fmt::Display for MaterialError {
             MaterialError::NestedMask => f.write_str("a mask cannot wrap another mask"),
             MaterialError::BadOpacity { value } => {
                 write!(f, "mask opacity {value} must lie in [0, 1]")
+            }
+            MaterialError::NormalMapNesting => f.write_str(
+                "a normalmap may wrap any material but a mask or a normalmap, and only a mask may wrap it (write mask(normalmap(twosided(...))))",
+            ),
+            MaterialError::BadNormal { value } => {
+                write!(f, "normalmap value {value:?} must be finite")
             }
         }
     }
@@ -305,7 +318,32 @@ pub(crate) fn bsdf(m: &MaterialDesc) -> Result<Bsdf> {
             )
         }
         MaterialDesc::Null => Bsdf::null(),
+        MaterialDesc::NormalMap {
+            normal,
+            flip_invalid_normals,
+            use_shadowing_function,
+            material,
+        } => {
+            if matches!(
+                **material,
+                MaterialDesc::Mask { .. } | MaterialDesc::NormalMap { .. }
+            ) {
+                return Err(MaterialError::NormalMapNesting);
+            }
+            let n = Vec3::from(*normal);
+            if !n.is_finite() {
+                return Err(MaterialError::BadNormal { value: *normal });
+            }
+            bsdf(material)?.normal_mapped(restir_materials::NormalMap::new(
+                n,
+                *flip_invalid_normals,
+                *use_shadowing_function,
+            ))
+        }
         MaterialDesc::TwoSided(inner) => {
+            if matches!(**inner, MaterialDesc::NormalMap { .. }) {
+                return Err(MaterialError::NormalMapNesting);
+            }
             let b = bsdf(inner)?;
             if b.kind.transmits() {
                 return Err(MaterialError::TwoSidedTransmitting);
@@ -330,7 +368,8 @@ pub(crate) fn bsdf(m: &MaterialDesc) -> Result<Bsdf> {
             }
             for (i, t) in textures.iter().enumerate() {
                 let mask_opacity = t.param == ColorParam::Opacity && is_mask(material);
-                if !(allowed.contains(&t.param) || mask_opacity) {
+                let normal_map = t.param == ColorParam::NormalMap && has_normal_map(material);
+                if !(allowed.contains(&t.param) || mask_opacity || normal_map) {
                     return Err(MaterialError::NoSuchParameter {
                         param: t.param,
                         allowed,
@@ -350,18 +389,24 @@ pub(crate) fn color_params(m: &MaterialDesc) -> &'static [ColorParam] {
     use ColorParam::*;
     match m {
         MaterialDesc::Diffuse { .. } => &[Reflectance],
-        MaterialDesc::Conductor { .. } | MaterialDesc::RoughConductor { .. } => {
-            &[SpecularReflectance]
-        }
-        MaterialDesc::Dielectric { .. } | MaterialDesc::RoughDielectric { .. } => {
-            &[SpecularReflectance, SpecularTransmittance]
-        }
+        MaterialDesc::Conductor { .. } => &[SpecularReflectance],
+        MaterialDesc::RoughConductor { .. } => &[SpecularReflectance, Alpha, AlphaU, AlphaV],
+        MaterialDesc::Dielectric { .. } => &[SpecularReflectance, SpecularTransmittance],
+        MaterialDesc::RoughDielectric { .. } => &[
+            SpecularReflectance,
+            SpecularTransmittance,
+            Alpha,
+            AlphaU,
+            AlphaV,
+        ],
         MaterialDesc::Plastic { .. } | MaterialDesc::RoughPlastic { .. } => {
             &[DiffuseReflectance, SpecularReflectance]
         }
         MaterialDesc::TwoSided(inner) => color_params(inner),
         MaterialDesc::Textured { material, .. } => color_params(material),
-        MaterialDesc::Mask { material, .. } => color_params(material),
+        MaterialDesc::Mask { material, .. } | MaterialDesc::NormalMap { material, .. } => {
+            color_params(material)
+        }
         MaterialDesc::Null | MaterialDesc::Black => &[],
     }
 }
@@ -372,6 +417,9 @@ fn contains_textured(m: &MaterialDesc) -> bool {
         MaterialDesc::Textured { .. } => true,
         MaterialDesc::TwoSided(inner)
         | MaterialDesc::Mask {
+            material: inner, ..
+        }
+        | MaterialDesc::NormalMap {
             material: inner, ..
         } => contains_textured(inner),
         _ => false,
@@ -387,6 +435,15 @@ pub(crate) fn is_mask(m: &MaterialDesc) -> bool {
     }
 }
 
+/// Whether `m` is a `normalmap` (perhaps inside a `mask`), whose normal a texture may give.
+pub(crate) fn has_normal_map(m: &MaterialDesc) -> bool {
+    match m {
+        MaterialDesc::NormalMap { .. } => true,
+        MaterialDesc::Mask { material, .. } => has_normal_map(material),
+        _ => false,
+    }
+}
+
 /// The constant colour parameters of a material as written (defaults where a model has none)
 /// and the textures that replace some of them.
 pub(crate) fn colors(m: &MaterialDesc) -> (ReflectanceParams, &[TextureBinding]) {
@@ -396,6 +453,8 @@ pub(crate) fn colors(m: &MaterialDesc) -> (ReflectanceParams, &[TextureBinding])
         transmittance: v3(&defaults::SPECULAR),
         nonlinear: false,
         opacity: 1.0,
+        normal: v3(&defaults::FLAT_NORMAL),
+        alpha: None,
     };
     let mut bindings: &[TextureBinding] = &[];
     let mut m = m;
@@ -404,6 +463,12 @@ pub(crate) fn colors(m: &MaterialDesc) -> (ReflectanceParams, &[TextureBinding])
             MaterialDesc::TwoSided(inner) => m = inner,
             MaterialDesc::Mask { opacity, material } => {
                 p.opacity = *opacity;
+                m = material;
+            }
+            MaterialDesc::NormalMap {
+                normal, material, ..
+            } => {
+                p.normal = v3(normal);
                 m = material;
             }
             MaterialDesc::Textured { material, textures } => {
@@ -453,6 +518,14 @@ pub(crate) fn colors(m: &MaterialDesc) -> (ReflectanceParams, &[TextureBinding])
             p.nonlinear = *nonlinear;
         }
         _ => {}
+    }
+    if let MaterialDesc::RoughConductor { roughness, .. }
+    | MaterialDesc::RoughDielectric { roughness, .. } = m
+    {
+        p.alpha = Some((
+            roughness.alpha_u.unwrap_or(roughness.alpha),
+            roughness.alpha_v.unwrap_or(roughness.alpha),
+        ));
     }
     (p, bindings)
 }

@@ -230,6 +230,30 @@ impl Texture {
         }
     }
 
+    /// The texture's scalar value at `uv`, as Mitsuba's `eval_1` (what a mask's opacity or a
+    /// microfacet roughness reads): the luminance of [`Texture::eval`], except that Mitsuba's
+    /// checkerboard puts its colours the other way round in its scalar lookup (`color0` where
+    /// exactly one of `u`, `v` has a fractional part above ½), which is followed here.
+    pub fn eval_1(&self, uv: Vec2) -> f32 {
+        match self {
+            Texture::Checkerboard {
+                color0,
+                color1,
+                uv: t,
+            } => {
+                let p = t.apply(uv);
+                let (u, v) = (p.x - p.x.floor(), p.y - p.y.floor());
+                let c = if (u > 0.5) != (v > 0.5) {
+                    color0
+                } else {
+                    color1
+                };
+                restir_sampling::luminance(*c)
+            }
+            Texture::Bitmap { .. } => restir_sampling::luminance(self.eval(uv)),
+        }
+    }
+
     /// The mean texel value (the average reflectance of a bitmap, or the checkerboard's).
     pub fn mean(&self) -> Vec3 {
         match self {

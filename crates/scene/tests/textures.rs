@@ -224,8 +224,8 @@ fn xml_texture_errors_name_file_and_line() {
         ),
         (
             r#"<bsdf type="roughconductor" id="m">
-<texture type="checkerboard" name="alpha"/></bsdf>"#,
-            "s.xml:4: bsdf 'roughconductor': 'alpha' cannot be a texture",
+<texture type="checkerboard" name="eta"/></bsdf>"#,
+            "s.xml:4: bsdf 'roughconductor': 'eta' cannot be a texture",
         ),
         (
             r#"<bsdf type="diffuse" id="m">

@@ -18,6 +18,7 @@ pub(crate) mod conductor;
 pub(crate) mod dielectric;
 pub(crate) mod diffuse;
 pub(crate) mod mask;
+pub mod normalmap;
 pub(crate) mod plastic;
 
 /// A sampled scattering direction.

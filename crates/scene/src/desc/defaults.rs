@@ -47,6 +47,9 @@ pub const RR_DEPTH: u32 = 5;
 pub const DIFFUSE_REFLECTANCE: V3 = [0.5; 3];
 /// `specular_reflectance` and `specular_transmittance` multipliers.
 pub const SPECULAR: V3 = [1.0; 3];
+/// A `normalmap` value that leaves the shading frame as it is.
+pub const FLAT_NORMAL: V3 = [0.5, 0.5, 1.0];
+
 /// `mask`'s `opacity`.
 pub const MASK_OPACITY: f32 = 0.5;
 /// Isotropic microfacet roughness `alpha`.
@@ -97,6 +100,14 @@ pub(crate) fn rr_depth() -> u32 {
 pub(crate) fn alpha() -> f32 {
     ALPHA
 }
+pub(crate) fn flat_normal() -> V3 {
+    FLAT_NORMAL
+}
+
+pub(crate) fn yes() -> bool {
+    true
+}
+
 pub(crate) fn mask_opacity() -> f32 {
     MASK_OPACITY
 }

@@ -191,6 +191,22 @@ pub enum MaterialDesc {
         /// The material where the surface is there.
         material: Box<MaterialDesc>,
     },
+    /// Mitsuba's `normalmap`: `material` in the shading frame perturbed by the normal
+    /// `2·normal − 1` (relative to the shading frame; `(0.5, 0.5, 1)` changes nothing); a texture
+    /// may give it (`Textured` with the parameter `NormalMap` around this).
+    NormalMap {
+        /// The raw map value (what a `rawconstant` texture gives).
+        #[serde(default = "defaults::flat_normal")]
+        normal: V3,
+        /// Mirror normals that face away from the viewer (default true).
+        #[serde(default = "defaults::yes")]
+        flip_invalid_normals: bool,
+        /// Apply the shadowing term against the bump terminator (default true).
+        #[serde(default = "defaults::yes")]
+        use_shadowing_function: bool,
+        /// The perturbed material.
+        material: Box<MaterialDesc>,
+    },
     /// `material` with some of its colour parameters given by textures, looked up at each
     /// shading point's texture coordinates; the constant values in `material` are unused for
     /// those parameters. In RON: `Textured(material: Diffuse(reflectance: (0.5, 0.5, 0.5)),
@@ -216,6 +232,15 @@ pub enum ColorParam {
     SpecularTransmittance,
     /// A `mask`'s `opacity` (a scalar: a colour texture gives its luminance).
     Opacity,
+    /// A `normalmap`'s `normalmap` (raw values, not clamped).
+    NormalMap,
+    /// A rough conductor's or rough dielectric's isotropic `alpha` (a scalar: a colour texture
+    /// gives its luminance).
+    Alpha,
+    /// Their `alpha_u` (with `alpha_v`, given as a value or a texture).
+    AlphaU,
+    /// Their `alpha_v` (with `alpha_u`).
+    AlphaV,
 }
 
 impl ColorParam {
@@ -227,6 +252,10 @@ impl ColorParam {
             ColorParam::SpecularReflectance => "specular_reflectance",
             ColorParam::SpecularTransmittance => "specular_transmittance",
             ColorParam::Opacity => "opacity",
+            ColorParam::NormalMap => "normalmap",
+            ColorParam::Alpha => "alpha",
+            ColorParam::AlphaU => "alpha_u",
+            ColorParam::AlphaV => "alpha_v",
         }
     }
 
@@ -238,6 +267,10 @@ impl ColorParam {
             ColorParam::SpecularReflectance,
             ColorParam::SpecularTransmittance,
             ColorParam::Opacity,
+            ColorParam::NormalMap,
+            ColorParam::Alpha,
+            ColorParam::AlphaU,
+            ColorParam::AlphaV,
         ]
         .into_iter()
         .find(|p| p.name() == name)

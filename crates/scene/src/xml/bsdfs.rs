@@ -20,6 +20,7 @@ const BSDF_TYPES: &[&str] = &[
     "roughplastic",
     "null",
     "mask",
+    "normalmap",
 ];
 
 impl<'a> Importer<'a> {
@@ -27,6 +28,13 @@ impl<'a> Importer<'a> {
     pub(super) fn bsdf<'i>(&self, node: Node<'a, 'i>) -> Result<MaterialDesc> {
         let ty = self.plugin_type(node)?;
         let props = self.props(node, format!("bsdf '{ty}'"))?;
+        if ty == "normalmap" {
+            return self.normalmap(node, props);
+        }
+        // An unknown plugin is named before its parameters are looked at.
+        if !BSDF_TYPES.contains(&ty.as_str()) && ty != "thindielectric" {
+            return Err(self.unknown_type(node, "bsdf", &ty, BSDF_TYPES));
+        }
         let textured = self.texture_bindings(node, &ty, &props)?;
         let m = match ty.as_str() {
             "diffuse" => MaterialDesc::Diffuse {
@@ -88,7 +96,7 @@ impl<'a> Importer<'a> {
                 self.err(
                     c,
                     format!(
-                        "bsdf '{ty}': '{name}' cannot be a texture (only reflectances can: reflectance, diffuse_reflectance, specular_reflectance, specular_transmittance)"
+                        "bsdf '{ty}': '{name}' cannot be a texture (only these can: reflectance, diffuse_reflectance, specular_reflectance, specular_transmittance, a mask's opacity, a normalmap's normalmap, and the rough conductor's and rough dielectric's alpha, alpha_u, alpha_v)"
                     ),
                 )
             })?;
@@ -157,6 +165,12 @@ impl<'a> Importer<'a> {
             // thousands of nested twosided elements would overflow the stack).
             Some(n) if n.attribute("type").map(snake_case).as_deref() == Some("twosided") => {
                 return Err(self.err(*n, "bsdf 'twosided' wraps another twosided"));
+            }
+            Some(n) if n.attribute("type").map(snake_case).as_deref() == Some("normalmap") => {
+                return Err(self.err(
+                    *n,
+                    "bsdf 'twosided' cannot wrap a normalmap (the normalmap may wrap the twosided instead)",
+                ));
             }
             Some(n) => self.bsdf(*n)?,
             None => {
@@ -419,9 +433,24 @@ impl<'a> Importer<'a> {
                 a => Ok(a),
             }
         };
-        let a = alpha("alpha")?;
-        let au = alpha("alpha_u")?;
-        let av = alpha("alpha_v")?;
+        // A roughness given as a texture counts as given (its value here is a placeholder the
+        // texture replaces at every shading point).
+        let textured = |name: &str| {
+            elements(node).any(|c| {
+                ["texture", "ref"].contains(&c.tag_name().name())
+                    && c.attribute("name").map(snake_case).as_deref() == Some(name)
+            })
+        };
+        let given = |name: &str| -> Result<Option<f32>> {
+            if textured(name) {
+                Ok(Some(defaults::ALPHA))
+            } else {
+                alpha(name)
+            }
+        };
+        let a = given("alpha")?;
+        let au = given("alpha_u")?;
+        let av = given("alpha_v")?;
         match (au, av) {
             (None, None) => r.alpha = a.unwrap_or(defaults::ALPHA),
             (Some(u), Some(v)) => {

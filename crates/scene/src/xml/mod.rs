@@ -25,6 +25,7 @@
 mod bsdfs;
 mod emitters;
 mod integrator;
+mod normalmap;
 mod props;
 mod resolve;
 mod sensor;

@@ -55,6 +55,36 @@ impl Writer<'_> {
                 self.close("</bsdf>");
                 return Ok(());
             }
+            MaterialDesc::NormalMap {
+                normal,
+                flip_invalid_normals,
+                use_shadowing_function,
+                material,
+            } => {
+                self.open(&format!(r#"<bsdf type="normalmap"{id_attr}>"#));
+                match bound(ColorParam::NormalMap) {
+                    Some(b) => self.texture(&b.texture, "normalmap", item)?,
+                    None => {
+                        self.open(r#"<texture name="normalmap" type="rawconstant">"#);
+                        self.line(&format!(
+                            r#"<vector name="value" value="{}"/>"#,
+                            nums(normal)
+                        ));
+                        self.close("</texture>");
+                    }
+                }
+                self.boolean("flip_invalid_normals", *flip_invalid_normals);
+                self.boolean("use_shadowing_function", *use_shadowing_function);
+                let rest: Option<Vec<TextureBinding>> = textures.map(|t| {
+                    t.iter()
+                        .filter(|b| b.param != ColorParam::NormalMap)
+                        .cloned()
+                        .collect()
+                });
+                self.bsdf(material, None, rest.as_deref(), item)?;
+                self.close("</bsdf>");
+                return Ok(());
+            }
             _ => {}
         }
         // The colour parameters, constant or textured.
@@ -118,7 +148,7 @@ impl Writer<'_> {
                 }
                 colour(self, ColorParam::SpecularReflectance, specular_reflectance)?;
                 if let Some(r) = rough {
-                    self.roughness(r);
+                    self.roughness_textured(r, textures.unwrap_or(&[]), item)?;
                 }
             }
             MaterialDesc::Dielectric {
@@ -153,7 +183,7 @@ impl Writer<'_> {
                     specular_transmittance,
                 )?;
                 if let Some(r) = rough {
-                    self.roughness(r);
+                    self.roughness_textured(r, textures.unwrap_or(&[]), item)?;
                 }
             }
             MaterialDesc::Plastic {
@@ -192,11 +222,47 @@ impl Writer<'_> {
             }
             MaterialDesc::Textured { .. }
             | MaterialDesc::TwoSided(_)
-            | MaterialDesc::Mask { .. } => {
+            | MaterialDesc::Mask { .. }
+            | MaterialDesc::NormalMap { .. } => {
                 unreachable!()
             }
         }
         self.close("</bsdf>");
+        Ok(())
+    }
+
+    /// [`Self::roughness`] where some of `alpha`, `alpha_u`, `alpha_v` may be textures.
+    fn roughness_textured(
+        &mut self,
+        r: &RoughnessDesc,
+        textures: &[TextureBinding],
+        item: &str,
+    ) -> Result<()> {
+        let bound = |p: ColorParam| textures.iter().find(|b| b.param == p);
+        let alpha_params = [ColorParam::Alpha, ColorParam::AlphaU, ColorParam::AlphaV];
+        if alpha_params.iter().all(|p| bound(*p).is_none()) {
+            self.roughness(r);
+            return Ok(());
+        }
+        self.string(
+            "distribution",
+            match r.distribution {
+                MicrofacetDesc::Beckmann => "beckmann",
+                MicrofacetDesc::Ggx => "ggx",
+            },
+        );
+        if let Some(b) = bound(ColorParam::Alpha) {
+            return self.texture(&b.texture, "alpha", item);
+        }
+        for (p, v) in [
+            (ColorParam::AlphaU, r.alpha_u.unwrap_or(r.alpha)),
+            (ColorParam::AlphaV, r.alpha_v.unwrap_or(r.alpha)),
+        ] {
+            match bound(p) {
+                Some(b) => self.texture(&b.texture, p.name(), item)?,
+                None => self.float(p.name(), v),
+            }
+        }
         Ok(())
     }
 
