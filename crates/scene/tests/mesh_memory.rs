@@ -2,7 +2,9 @@
 //! global allocator (this test binary's own; the library allocates normally): the mesh file read
 //! and parsed, the runtime mesh with its area tables, the BVH (its build peak, obvhs's temporary
 //! memory included, and what it keeps), the light tables of an emissive mesh, and a whole scene
-//! load. Run with `--nocapture` to see the table.
+//! load. Run with `--nocapture` to see the table; the whole load must stay under
+//! `restir_scene::desc::limits::MESH_BYTES_PER_TRIANGLE`, the estimate `--max-memory` checks
+//! meshes with.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::io::Write;
@@ -172,4 +174,10 @@ fn bytes_per_triangle_at_each_stage() {
     for (name, kept, peak) in &rows {
         println!("{name:<34} {:>12.1} {:>12.1}", per(*kept), per(*peak));
     }
+    let estimate = restir_scene::desc::limits::MESH_BYTES_PER_TRIANGLE as f64;
+    assert!(
+        per(scene_peak) <= estimate,
+        "a scene load peaks at {:.1} bytes per triangle, above the estimate of {estimate}",
+        per(scene_peak)
+    );
 }
