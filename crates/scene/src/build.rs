@@ -94,14 +94,26 @@ impl Budget {
         )
     }
 
-    /// Counts a mesh of `triangles` before its tables and BVH are built.
-    fn take_mesh(&mut self, triangles: usize, what: impl FnOnce() -> String) -> Result<(), String> {
+    /// Counts a mesh of `triangles` with `vertex_bytes` of vertex data before its tables and
+    /// BVH are built.
+    fn take_mesh(
+        &mut self,
+        triangles: usize,
+        vertex_bytes: usize,
+        what: impl FnOnce() -> String,
+    ) -> Result<(), String> {
         self.take(
-            triangles as u64 * limits::MESH_BYTES_PER_TRIANGLE,
+            (triangles as u64 * limits::MESH_BYTES_PER_TRIANGLE)
+                .saturating_add(vertex_bytes as u64),
             0,
             || format!("{} ({triangles} triangles)", what()),
         )
     }
+}
+
+/// The bytes of a mesh's positions, normals and uvs.
+fn vertex_bytes(p: &[Vec3], n: &Option<Vec<Vec3>>, uv: &Option<Vec<Vec2>>) -> usize {
+    12 * p.len() + n.as_ref().map_or(0, |n| 12 * n.len()) + uv.as_ref().map_or(0, |u| 8 * u.len())
 }
 
 /// Decoded textures, each distinct description loaded once, and the memory budget.
@@ -225,7 +237,9 @@ fn build_shape(
         GeometryDesc::Obj { filename } => {
             let path = base_dir.join(filename);
             let (p, n, uv, idx) = crate::meshio::load_obj(&path).map_err(|e| e.to_string())?;
-            budget.take_mesh(idx.len(), || format!("mesh '{}'", path.display()))?;
+            budget.take_mesh(idx.len(), vertex_bytes(&p, &n, &uv), || {
+                format!("mesh '{}'", path.display())
+            })?;
             let n = if desc.face_normals { None } else { n };
             mesh(
                 TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
@@ -235,7 +249,9 @@ fn build_shape(
         GeometryDesc::Ply { filename } => {
             let path = base_dir.join(filename);
             let (p, n, uv, idx) = crate::meshio::load_ply(&path).map_err(|e| e.to_string())?;
-            budget.take_mesh(idx.len(), || format!("mesh '{}'", path.display()))?;
+            budget.take_mesh(idx.len(), vertex_bytes(&p, &n, &uv), || {
+                format!("mesh '{}'", path.display())
+            })?;
             let n = if desc.face_normals { None } else { n };
             mesh(
                 TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
@@ -249,7 +265,9 @@ fn build_shape(
             let path = base_dir.join(filename);
             let (p, n, uv, idx) = crate::meshio::load_serialized(&path, *shape_index as usize)
                 .map_err(|e| e.to_string())?;
-            budget.take_mesh(idx.len(), || format!("mesh '{}'", path.display()))?;
+            budget.take_mesh(idx.len(), vertex_bytes(&p, &n, &uv), || {
+                format!("mesh '{}'", path.display())
+            })?;
             let n = if desc.face_normals { None } else { n };
             mesh(
                 TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
@@ -261,7 +279,8 @@ fn build_shape(
             indices,
             normals,
         } => {
-            budget.take_mesh(indices.len(), || "the inline mesh".into())?;
+            let vertices = positions.len() + normals.as_ref().map_or(0, Vec::len);
+            budget.take_mesh(indices.len(), 12 * vertices, || "the inline mesh".into())?;
             let p = positions.iter().map(|v| Vec3::from(*v)).collect();
             let n = if desc.face_normals {
                 None

@@ -24,12 +24,13 @@ pub const MAX_FILTER_WIDTH: f32 = 1e4;
 /// The most vertices, and the most triangles, one mesh (file or inline) may have: 2^25.
 pub const MAX_MESH_ELEMENTS: u64 = 1 << 25;
 
-/// What one triangle of a mesh costs while the scene is built, in bytes: the mesh (positions,
-/// indices, per-triangle faces and area table), the BVH while obvhs builds it (its temporary
-/// memory included) and the light tables of an emissive mesh. Measured at 394 bytes per triangle
-/// at the peak of loading a 1M-triangle emissive PLY (`crates/scene/tests/mesh_memory.rs`);
-/// meshes are checked against `--max-memory` with this before the BVH is built.
-pub const MESH_BYTES_PER_TRIANGLE: u64 = 400;
+/// What one triangle of a mesh costs while the scene is built, in bytes, beside its vertices:
+/// its indices, per-triangle faces and area table, the BVH while obvhs builds it (its temporary
+/// memory included) and the light tables of an emissive mesh. A 1M-triangle emissive PLY (half
+/// a vertex per triangle, positions only) peaks at 394 bytes per triangle, 388 beside its
+/// positions (`crates/scene/tests/mesh_memory.rs`); meshes are checked against `--max-memory`
+/// with this and their vertex data before the BVH is built.
+pub const MESH_BYTES_PER_TRIANGLE: u64 = 390;
 
 /// What a texel of a bitmap texture keeps, in bytes, at most (a float texel; 8-bit images keep
 /// 4).
