@@ -233,12 +233,24 @@ impl SuiteError {
 
 impl std::fmt::Display for SuiteError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        // One line whatever the suite's strings hold (a path or label with a newline in it).
+        let message: String = self
+            .message
+            .chars()
+            .flat_map(|c| {
+                let escaped = c.is_control().then(|| c.escape_default());
+                escaped
+                    .into_iter()
+                    .flatten()
+                    .chain((!c.is_control()).then_some(c))
+            })
+            .collect();
         match (&self.file, self.position) {
             (Some(file), Some((line, col))) => {
-                write!(f, "{}:{line}:{col}: {}", file.display(), self.message)
+                write!(f, "{}:{line}:{col}: {message}", file.display())
             }
-            (Some(file), None) => write!(f, "{}: {}", file.display(), self.message),
-            (None, _) => f.write_str(&self.message),
+            (Some(file), None) => write!(f, "{}: {message}", file.display()),
+            (None, _) => f.write_str(&message),
         }
     }
 }

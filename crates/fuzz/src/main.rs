@@ -1,6 +1,9 @@
 //! `restir-fuzz`: deterministic mutation fuzzing of the scene loader, one target per input format
-//! (`xml`, `ron`, `obj`, `ply`, `serialized`, `exr`, `hdr`, `png`), and the reader of the parts
-//! of a split render that `restir merge` reads (`part`: `restir_image::Image::read_exr_part`).
+//! (`xml`, `ron`, `obj`, `ply`, `serialized`, `exr`, `hdr`, `png`), the reader of the parts
+//! of a split render that `restir merge` reads (`part`: `restir_image::Image::read_exr_part`),
+//! `restir bench` suite files (`suite`: `restir_evaluation::Suite::load_located`) and animation
+//! files (`anim`: an XML scene's `NAME.anim.ron` sidecar, loaded with the scene and built at a
+//! few times).
 //!
 //! Coverage-guided fuzzers need nightly Rust (cargo-fuzz) or an AFL++ toolchain; this workspace
 //! builds on one stable toolchain, so the harness mutates the checked-in seeds in
@@ -22,8 +25,10 @@ use std::process::{Command, ExitCode, Stdio};
 use std::time::{Duration, Instant};
 
 /// The formats, with how an input of each is placed into a scene.
-const TARGETS: [&str; 9] = [
+const TARGETS: [&str; 11] = [
     "part",
+    "suite",
+    "anim",
     "xml",
     "ron",
     "obj",
@@ -189,6 +194,44 @@ fn wrapper_scene(target: &str, asset: &str) -> String {
     format!("<scene version=\"3.0.0\">{sensor}{body}</scene>")
 }
 
+/// The scene an animation input (`anim`) is the sidecar of: shapes with the ids its seed names.
+const ANIM_SCENE: &str = r#"<scene version="3.0.0"><sensor type="perspective"><film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor><shape type="sphere" id="copper"><point name="center" x="-1.1" y="0.38" z="-0.6"/><float name="radius" value="0.38"/></shape><shape type="rectangle" id="light_small"><emitter type="area"><rgb name="radiance" value="20"/></emitter></shape></scene>"#;
+
+/// Reports a loader's answer as the child does: success, or an error that must be one line and
+/// must not happen for a seed.
+fn answer(result: Result<(), String>) -> ExitCode {
+    match result {
+        Ok(()) => println!("ok"),
+        Err(msg) => {
+            if std::env::var_os("RESTIR_FUZZ_SEED").is_some() {
+                eprintln!("a seed must load: {msg}");
+                return ExitCode::from(4);
+            }
+            if msg.contains('\n') {
+                eprintln!("error message spans several lines: {msg}");
+                return ExitCode::from(3);
+            }
+            println!("error: {msg}");
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+/// An animation input: the sidecar of [`ANIM_SCENE`], the scene loaded with it and built at a
+/// few times (inside, before, after and far beyond its keys).
+fn load_animated(input: &Path) -> Result<(), String> {
+    let dir = input.parent().unwrap_or(Path::new("."));
+    let scene = dir.join("anim-scene.xml");
+    std::fs::write(&scene, ANIM_SCENE).map_err(|e| e.to_string())?;
+    std::fs::copy(input, restir_scene::sidecar_path(&scene)).map_err(|e| e.to_string())?;
+    let loaded = restir_scene::load_scene(&scene, &restir_scene::LoadOptions::default())
+        .map_err(|e| e.to_string())?;
+    for t in [0.0, 1.3, -1.0, 1e6] {
+        restir_scene::animation::build_at(&loaded.desc, &scene, t).map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
 /// The child: loads one input of `target` (`input` is the mutated file) and exits 0 whatever the
 /// loader says, so that only panics, aborts, signals and hangs count as failures.
 fn run_one(target: &str, input: &Path) -> ExitCode {
@@ -206,6 +249,17 @@ fn run_one(target: &str, input: &Path) -> ExitCode {
         }
         return ExitCode::SUCCESS;
     }
+    match target {
+        "suite" => {
+            return answer(
+                restir_evaluation::Suite::load_located(input)
+                    .map(|_| ())
+                    .map_err(|e| e.to_string()),
+            );
+        }
+        "anim" => return answer(load_animated(input)),
+        _ => {}
+    }
     let scene = match target {
         "xml" | "ron" => input.to_path_buf(),
         _ => {
@@ -221,22 +275,11 @@ fn run_one(target: &str, input: &Path) -> ExitCode {
             scene
         }
     };
-    match restir_scene::load_scene(&scene, &restir_scene::LoadOptions::default()) {
-        Ok(_) => println!("ok"),
-        Err(e) => {
-            let msg = e.to_string();
-            if std::env::var_os("RESTIR_FUZZ_SEED").is_some() {
-                eprintln!("a seed must load: {msg}");
-                return ExitCode::from(4);
-            }
-            if msg.contains('\n') {
-                eprintln!("error message spans several lines: {msg}");
-                return ExitCode::from(3);
-            }
-            println!("error: {msg}");
-        }
-    }
-    ExitCode::SUCCESS
+    answer(
+        restir_scene::load_scene(&scene, &restir_scene::LoadOptions::default())
+            .map(|_| ())
+            .map_err(|e| e.to_string()),
+    )
 }
 
 /// How one input went.
@@ -432,6 +475,24 @@ fn main() -> ExitCode {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A suite whose scene path and label hold a newline and a NUL (found by the `suite`
+    /// target) gets a one-line error with them escaped.
+    #[test]
+    fn suite_errors_stay_on_one_line() {
+        let seed = include_str!("../corpus/suite/smoke.ron");
+        let text = seed
+            .replacen("../cornell-box.xml", "../cornell-box.x\nml", 1)
+            .replacen("\"restir-di tuned\"]", "\"resti\0r-di tuned\"]", 1);
+        assert_ne!(text, seed);
+        let e = restir_evaluation::Suite::parse(&text, Path::new("s.ron"))
+            .unwrap_err()
+            .to_string();
+        assert!(!e.contains('\n') && !e.contains('\0'), "{e}");
+        assert!(e.contains("x\\nml") && e.contains("resti\\u{0}r-di"), "{e}");
+        // The seed itself loads.
+        restir_evaluation::Suite::parse(seed, Path::new("s.ron")).unwrap();
+    }
 
     /// The mutator is deterministic and does change its input.
     #[test]

@@ -157,6 +157,42 @@ impl Image {
         })
     }
 
+    /// The size in pixels of an image [`Image::read`] would read, from its header alone (EXR:
+    /// the largest layer), so that callers can account for the memory before decoding.
+    pub fn read_dimensions(path: &Path) -> Result<(usize, usize), ImageError> {
+        let fail = |reason| ImageError::Read {
+            path: path.to_path_buf(),
+            reason,
+        };
+        if extension(path).as_deref() == Some("exr") {
+            let file = input::open_regular(path)
+                .map_err(|e| fail(ReadFailure::Exr(exr::error::Error::from(e))))?;
+            let meta =
+                exr::meta::MetaData::read_from_buffered(std::io::BufReader::new(file), false)
+                    .map_err(|e| fail(ReadFailure::Exr(e)))?;
+            Ok(meta.headers.iter().fold((0, 0), |(w, h), header| {
+                let size = header.layer_size;
+                if size.area() > w * h {
+                    (size.width(), size.height())
+                } else {
+                    (w, h)
+                }
+            }))
+        } else {
+            let file = input::open_regular(path).map_err(|e| fail(ReadFailure::Io(e)))?;
+            let mut reader = image::ImageReader::new(std::io::BufReader::new(file));
+            if let Ok(format) = image::ImageFormat::from_path(path) {
+                reader.set_format(format);
+            }
+            let (w, h) = reader
+                .with_guessed_format()
+                .map_err(|e| fail(ReadFailure::Io(e)))?
+                .into_dimensions()
+                .map_err(|e| fail(ReadFailure::Decode(e)))?;
+            Ok((w as usize, h as usize))
+        }
+    }
+
     /// Reads an image a scene refers to as linear RGB, the first row at the top: EXR (by
     /// extension) and Radiance HDR hold linear values; PNG/JPEG (8- or 16-bit, format guessed from
     /// the contents) are decoded as `encoding` says. Empty images and non-finite values are errors.

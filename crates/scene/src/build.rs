@@ -44,17 +44,94 @@ fn affine(m: Mat4) -> Result<Affine3A, String> {
     Ok(a)
 }
 
-/// Decoded textures, each distinct description loaded once.
+/// The memory the build may use (`--max-memory`) and what meshes and images already take of it;
+/// each is counted before it is built or decoded, so the one that crosses the limit is named.
+#[derive(Default)]
+struct Budget {
+    limit: Option<u64>,
+    used: u64,
+}
+
+impl Budget {
+    /// Counts `kept` bytes more, refusing when they and `transient` bytes on top of what is used
+    /// exceed the limit; `what` names the input.
+    fn take(
+        &mut self,
+        kept: u64,
+        transient: u64,
+        what: impl FnOnce() -> String,
+    ) -> Result<(), String> {
+        let need = self.used.saturating_add(kept).saturating_add(transient);
+        if let Some(limit) = self.limit
+            && need > limit
+        {
+            let size = |b: u64| match b as f64 / (1u64 << 30) as f64 {
+                g if g >= 1.0 => format!("{g:.2} GiB"),
+                g => format!("{:.1} MiB", g * 1024.0),
+            };
+            return Err(format!(
+                "{} would bring the scene's meshes and images to about {}, more than the limit \
+                 of {}: raise --max-memory",
+                what(),
+                size(need),
+                size(limit)
+            ));
+        }
+        self.used = self.used.saturating_add(kept);
+        Ok(())
+    }
+
+    /// Counts an image file's texels (read from its header) before it is decoded.
+    fn take_image(&mut self, path: &Path) -> Result<(), String> {
+        if self.limit.is_none() {
+            return Ok(());
+        }
+        let (w, h) = restir_image::Image::read_dimensions(path).map_err(|e| e.to_string())?;
+        let texels = w as u64 * h as u64;
+        self.take(
+            texels * limits::TEXTURE_BYTES_PER_TEXEL,
+            texels * limits::DECODE_BYTES_PER_TEXEL,
+            || format!("image '{}' ({w}×{h} texels)", path.display()),
+        )
+    }
+
+    /// Counts a mesh of `triangles` with `vertex_bytes` of vertex data before its tables and
+    /// BVH are built.
+    fn take_mesh(
+        &mut self,
+        triangles: usize,
+        vertex_bytes: usize,
+        what: impl FnOnce() -> String,
+    ) -> Result<(), String> {
+        self.take(
+            (triangles as u64 * limits::MESH_BYTES_PER_TRIANGLE)
+                .saturating_add(vertex_bytes as u64),
+            0,
+            || format!("{} ({triangles} triangles)", what()),
+        )
+    }
+}
+
+/// The bytes of a mesh's positions, normals and uvs.
+fn vertex_bytes(p: &[Vec3], n: &Option<Vec<Vec3>>, uv: &Option<Vec<Vec2>>) -> usize {
+    12 * p.len() + n.as_ref().map_or(0, |n| 12 * n.len()) + uv.as_ref().map_or(0, |u| 8 * u.len())
+}
+
+/// Decoded textures, each distinct description loaded once, and the memory budget.
 #[derive(Default)]
 struct TextureCache {
     descs: Vec<TextureDesc>,
     textures: Vec<Texture>,
+    budget: Budget,
 }
 
 impl TextureCache {
     fn get(&mut self, d: &TextureDesc, base_dir: &Path) -> Result<u32, String> {
         if let Some(i) = self.descs.iter().position(|e| e == d) {
             return Ok(i as u32);
+        }
+        if let TextureDesc::Bitmap { filename, .. } = d {
+            self.budget.take_image(&base_dir.join(filename))?;
         }
         let t = Texture::load(d, base_dir).map_err(|e| e.to_string())?;
         self.descs.push(d.clone());
@@ -109,8 +186,10 @@ fn build_envmap(
     scale: f32,
     to_world: &[TransformOp],
     base_dir: &Path,
+    budget: &mut Budget,
 ) -> Result<EnvMap, String> {
     let m = transform_matrix(to_world).map_err(|e| e.to_string())?;
+    budget.take_image(&base_dir.join(filename))?;
     let (w, h, texels) =
         crate::texture::read_image(&base_dir.join(filename), false).map_err(|e| e.to_string())?;
     EnvMap::new(w, h, texels, scale, glam::Mat3::from_mat4(m)).map_err(|e| e.to_string())
@@ -137,7 +216,11 @@ fn extent_problem(shape: &Shape) -> Option<String> {
 }
 
 /// A shape in world space and how many zero-area triangles were dropped from it.
-fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<(Shape, usize), String> {
+fn build_shape(
+    desc: &ShapeDesc,
+    base_dir: &Path,
+    budget: &mut Budget,
+) -> Result<(Shape, usize), String> {
     let m = transform_matrix(&desc.to_world).map_err(|e| e.to_string())?;
     let dropped = std::cell::Cell::new(0);
     let mesh = |mut mesh: TriangleMesh| -> Result<Shape, String> {
@@ -165,6 +248,9 @@ fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<(Shape, usize), Stri
         GeometryDesc::Obj { filename } => {
             let path = base_dir.join(filename);
             let (p, n, uv, idx) = crate::meshio::load_obj(&path).map_err(|e| e.to_string())?;
+            budget.take_mesh(idx.len(), vertex_bytes(&p, &n, &uv), || {
+                format!("mesh '{}'", path.display())
+            })?;
             let n = if desc.face_normals { None } else { n };
             mesh(
                 TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
@@ -174,6 +260,9 @@ fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<(Shape, usize), Stri
         GeometryDesc::Ply { filename } => {
             let path = base_dir.join(filename);
             let (p, n, uv, idx) = crate::meshio::load_ply(&path).map_err(|e| e.to_string())?;
+            budget.take_mesh(idx.len(), vertex_bytes(&p, &n, &uv), || {
+                format!("mesh '{}'", path.display())
+            })?;
             let n = if desc.face_normals { None } else { n };
             mesh(
                 TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
@@ -187,6 +276,9 @@ fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<(Shape, usize), Stri
             let path = base_dir.join(filename);
             let (p, n, uv, idx) = crate::meshio::load_serialized(&path, *shape_index as usize)
                 .map_err(|e| e.to_string())?;
+            budget.take_mesh(idx.len(), vertex_bytes(&p, &n, &uv), || {
+                format!("mesh '{}'", path.display())
+            })?;
             let n = if desc.face_normals { None } else { n };
             mesh(
                 TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
@@ -198,6 +290,8 @@ fn build_shape(desc: &ShapeDesc, base_dir: &Path) -> Result<(Shape, usize), Stri
             indices,
             normals,
         } => {
+            let vertices = positions.len() + normals.as_ref().map_or(0, Vec::len);
+            budget.take_mesh(indices.len(), 12 * vertices, || "the inline mesh".into())?;
             let p = positions.iter().map(|v| Vec3::from(*v)).collect();
             let n = if desc.face_normals {
                 None
@@ -259,6 +353,20 @@ impl Scene {
         desc: &SceneDesc,
         base_dir: &Path,
         source: &Path,
+    ) -> Result<(Scene, Vec<SceneWarning>), SceneError> {
+        Self::build_within(desc, base_dir, source, None)
+    }
+
+    /// [`Scene::build_noting`] within `max_bytes` of memory for meshes and images (`None`:
+    /// unbounded): each mesh ([`limits::MESH_BYTES_PER_TRIANGLE`]) and image (its texels, read
+    /// from the header, [`limits::TEXTURE_BYTES_PER_TEXEL`] kept and
+    /// [`limits::DECODE_BYTES_PER_TEXEL`] while decoding) is counted before it is built or
+    /// decoded, and the one that would cross the limit is an error at its line.
+    pub fn build_within(
+        desc: &SceneDesc,
+        base_dir: &Path,
+        source: &Path,
+        max_bytes: Option<u64>,
     ) -> Result<(Scene, Vec<SceneWarning>), SceneError> {
         let mut warnings = Vec::new();
         let at = |loc: &Location, msg: String| {
@@ -333,7 +441,13 @@ impl Scene {
             Bsdf::black(),
         ];
         let mut bsdf_textures = vec![None, None];
-        let mut cache = TextureCache::default();
+        let mut cache = TextureCache {
+            budget: Budget {
+                limit: max_bytes,
+                used: 0,
+            },
+            ..TextureCache::default()
+        };
         let mut names = std::collections::HashMap::new();
         for nm in &desc.materials {
             let (b, t) = material(&nm.material, &mut cache, base_dir)
@@ -348,7 +462,7 @@ impl Scene {
         let mut shape_bsdf = Vec::with_capacity(desc.shapes.len());
         let mut lights = Vec::new();
         for (i, sd) in desc.shapes.iter().enumerate() {
-            let (shape, dropped) = build_shape(sd, base_dir)
+            let (shape, dropped) = build_shape(sd, base_dir, &mut cache.budget)
                 .map_err(|e| at(&sd.location, format!("shape {i}: {e}")))?;
             if dropped > 0 {
                 let location = at(&sd.location, String::new()).location;
@@ -445,7 +559,7 @@ impl Scene {
                                 .into(),
                         ));
                     }
-                    let map = build_envmap(filename, *scale, to_world, base_dir)
+                    let map = build_envmap(filename, *scale, to_world, base_dir, &mut cache.budget)
                         .map_err(|e| at(location, format!("envmap: {e}")))?;
                     envmap = Some(map);
                     Light::Envmap

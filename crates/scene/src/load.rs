@@ -20,6 +20,9 @@ pub struct LoadOptions {
     pub height: Option<u32>,
     /// Whether a scene without light sources adds a warning (default: yes).
     pub warn_no_lights: bool,
+    /// The most memory, in bytes, the scene's meshes and images may need (`--max-memory`),
+    /// checked before each is built or decoded; `None` (the default): unbounded.
+    pub max_memory: Option<u64>,
 }
 
 impl Default for LoadOptions {
@@ -29,6 +32,7 @@ impl Default for LoadOptions {
             width: None,
             height: None,
             warn_no_lights: true,
+            max_memory: None,
         }
     }
 }
@@ -138,7 +142,7 @@ pub fn load_scene(path: &Path, options: &LoadOptions) -> Result<LoadedScene, Sce
         desc.integrator.location.file = path.to_path_buf();
     }
     let base: PathBuf = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let (scene, noted) = Scene::build_noting(&desc, &base, path)?;
+    let (scene, noted) = Scene::build_within(&desc, &base, path, options.max_memory)?;
     warnings.extend(noted);
     if options.warn_no_lights && scene.lights.is_empty() {
         warnings.push(SceneWarning {

@@ -375,6 +375,7 @@ fn run_render(args: RenderArgs) -> Result<Rendered, String> {
         height: args.height,
         // The command line has never warned about unlit scenes.
         warn_no_lights: false,
+        max_memory: Some((strict::max_memory(args.max_memory)? * (1u64 << 30) as f64) as u64),
     };
     let spinner = progress::load_spinner(&args.scene, args.quiet);
     let loaded = load_scene(&args.scene, &options);

@@ -67,18 +67,60 @@ pub const MAX_SHARED_BOUNDS: usize = 8;
 pub struct Accel {
     /// The decoded CWBVH with the triangles inline; `None` for an empty scene.
     wide: Option<Wide>,
-    prims: Vec<Prim>,
+    /// The primitives tested one at a time (spheres, members of groups); single triangles live
+    /// only inline in `wide`.
+    scalar: ScalarPrims,
     /// (shape, primitive within shape) of each BVH-ordered primitive.
     ids: Vec<(u32, u32)>,
-    /// With groups, BVH entry `e` holds `prims[groups[e]..groups[e + 1]]`; without, entry `e` is
-    /// primitive `e`.
+    /// With groups, BVH entry `e` holds primitives `groups[e]..groups[e + 1]`; without, entry
+    /// `e` is primitive `e`.
     groups: Option<Vec<u32>>,
     bounds: (Vec3, Vec3),
     /// Whether the AVX2 kernel is used (the CPU was checked once, at build).
     avx2: bool,
+    /// Every primitive in BVH order, kept by the tests for brute-force checks.
+    #[cfg(test)]
+    prims: Vec<Prim>,
     /// obvhs's tree, kept by the tests to run obvhs's own traversal as the reference.
     #[cfg(test)]
     reference: Option<obvhs::cwbvh::CwBvh>,
+}
+
+/// The primitives of the BVH entries tested one at a time, by BVH-ordered primitive index.
+#[derive(Debug, Default)]
+struct ScalarPrims {
+    /// Where primitive `id` is in `prims`; `None` when `prims` holds every primitive in order
+    /// (or none is tested one at a time).
+    slot: Option<Vec<u32>>,
+    prims: Vec<Prim>,
+}
+
+impl ScalarPrims {
+    #[inline(always)]
+    fn get(&self, id: usize) -> &Prim {
+        match &self.slot {
+            Some(slot) => &self.prims[slot[id] as usize],
+            None => &self.prims[id],
+        }
+    }
+}
+
+/// Primitive `ti` of shape `si` as the traversal stores it.
+fn prim_of(shapes: &[Shape], (si, ti): (u32, u32)) -> Prim {
+    match &shapes[si as usize] {
+        Shape::Mesh(m) => {
+            let [a, b, c] = m.triangle(ti as usize);
+            Prim::Triangle {
+                v0: a.into(),
+                e1: (b - a).into(),
+                e2: (c - a).into(),
+            }
+        }
+        Shape::Sphere(s) => Prim::Sphere {
+            center: s.center.into(),
+            radius: s.radius,
+        },
+    }
 }
 
 /// Whether this CPU runs the AVX2 kernel.
@@ -108,29 +150,31 @@ impl Entries for Accel {
 
 impl Accel {
     /// Builds the BVH over all shapes.
+    ///
+    /// Memory: the input-order boxes and ids live only until obvhs has built its tree, the
+    /// triangles are read from the shapes where they are needed (the groups' keys, the inline
+    /// blocks), and a triangle that is its own BVH entry is kept only inline, so the structure
+    /// keeps the tree, the inline blocks and 8 bytes of ids per primitive.
     pub fn build(shapes: &[Shape]) -> Self {
-        let mut prims = Vec::new();
-        let mut ids = Vec::new();
-        let mut aabbs = Vec::new();
+        let count: usize = shapes
+            .iter()
+            .map(|s| match s {
+                Shape::Mesh(m) => m.triangle_count(),
+                Shape::Sphere(_) => 1,
+            })
+            .sum();
+        let mut ids = Vec::with_capacity(count);
+        let mut aabbs = Vec::with_capacity(count);
         for (si, shape) in shapes.iter().enumerate() {
             match shape {
                 Shape::Mesh(m) => {
                     for ti in 0..m.triangle_count() {
                         let [a, b, c] = m.triangle(ti);
-                        prims.push(Prim::Triangle {
-                            v0: a.into(),
-                            e1: (b - a).into(),
-                            e2: (c - a).into(),
-                        });
                         ids.push((si as u32, ti as u32));
                         aabbs.push(Aabb::from_points(&[a.into(), b.into(), c.into()]));
                     }
                 }
                 Shape::Sphere(s) => {
-                    prims.push(Prim::Sphere {
-                        center: s.center.into(),
-                        radius: s.radius,
-                    });
                     ids.push((si as u32, 0));
                     let r = Vec3A::splat(s.radius);
                     aabbs.push(Aabb::new(
@@ -146,35 +190,40 @@ impl Accel {
             bounds.1 = bounds.1.max(b.max.into());
         }
         let avx2 = detect_avx2();
-        if prims.is_empty() {
+        if ids.is_empty() {
             return Self {
                 wide: None,
-                prims,
+                scalar: ScalarPrims::default(),
                 ids,
                 groups: None,
                 bounds: (Vec3::ZERO, Vec3::ZERO),
                 avx2,
                 #[cfg(test)]
+                prims: Vec::new(),
+                #[cfg(test)]
                 reference: None,
             };
         }
-        let (bvh, prims, ids, groups) = match group_entries(&prims, &aabbs) {
+        let grouped = group_entries(&aabbs, |i| prim_of(shapes, ids[i]));
+        let (bvh, ids, groups) = match grouped {
             Some((entries, boxes)) => {
+                drop(aabbs);
                 let bvh = build_cwbvh(
                     &boxes,
                     BvhBuildParams::medium_build(),
                     &mut Duration::default(),
                 );
-                let mut starts = vec![0];
-                let (mut out_prims, mut out_ids) = (Vec::new(), Vec::new());
+                drop(boxes);
+                let mut starts = Vec::with_capacity(entries.len() + 1);
+                starts.push(0);
+                let mut out_ids = Vec::with_capacity(ids.len());
                 for &e in &bvh.primitive_indices {
                     for &i in &entries[e as usize] {
-                        out_prims.push(prims[i]);
                         out_ids.push(ids[i]);
                     }
-                    starts.push(out_prims.len() as u32);
+                    starts.push(out_ids.len() as u32);
                 }
-                (bvh, out_prims, out_ids, Some(starts))
+                (bvh, out_ids, Some(starts))
             }
             None => {
                 let bvh = build_cwbvh(
@@ -182,26 +231,60 @@ impl Accel {
                     BvhBuildParams::medium_build(),
                     &mut Duration::default(),
                 );
+                drop(aabbs);
                 // Lay primitives out in BVH order so the traversal indexes them directly.
-                let order = &bvh.primitive_indices;
-                let p = order.iter().map(|&i| prims[i as usize]).collect();
-                let d = order.iter().map(|&i| ids[i as usize]).collect();
-                (bvh, p, d, None)
+                let d = bvh
+                    .primitive_indices
+                    .iter()
+                    .map(|&i| ids[i as usize])
+                    .collect();
+                (bvh, d, None)
             }
         };
+        let members = |e: usize| match &groups {
+            Some(s) => s[e] as usize..s[e + 1] as usize,
+            None => e..e + 1,
+        };
+        let is_mesh = |id: usize| matches!(shapes[ids[id].0 as usize], Shape::Mesh(_));
         let wide = Wide::build(&bvh, |e| {
-            let members = match &groups {
-                Some(s) => s[e] as usize..s[e + 1] as usize,
-                None => e..e + 1,
-            };
-            match (members.len(), prims[members.start]) {
-                (1, Prim::Triangle { v0, e1, e2 }) => Some([v0, e1, e2]),
+            let m = members(e);
+            match prim_of(shapes, ids[m.start]) {
+                Prim::Triangle { v0, e1, e2 } if m.len() == 1 => Some([v0, e1, e2]),
                 _ => None,
             }
         });
+        // The primitives tested one at a time: spheres and members of groups.
+        let entry_count = groups.as_ref().map_or(ids.len(), |s| s.len() - 1);
+        let scalar_ids: Vec<usize> = (0..entry_count)
+            .map(members)
+            .filter(|m| m.len() > 1 || !is_mesh(m.start))
+            .flatten()
+            .collect();
+        let scalar = if scalar_ids.len() == ids.len() {
+            ScalarPrims {
+                slot: None,
+                prims: ids.iter().map(|&id| prim_of(shapes, id)).collect(),
+            }
+        } else if scalar_ids.is_empty() {
+            ScalarPrims::default()
+        } else {
+            let mut slot = vec![u32::MAX; ids.len()];
+            for (k, &id) in scalar_ids.iter().enumerate() {
+                slot[id] = k as u32;
+            }
+            ScalarPrims {
+                slot: Some(slot),
+                prims: scalar_ids
+                    .iter()
+                    .map(|&id| prim_of(shapes, ids[id]))
+                    .collect(),
+            }
+        };
         Self {
             wide: Some(wide),
-            prims,
+            scalar,
+            #[cfg(test)]
+            prims: ids.iter().map(|&id| prim_of(shapes, id)).collect(),
             ids,
             groups,
             bounds,
@@ -218,7 +301,7 @@ impl Accel {
 
     /// Number of primitives (triangles and spheres).
     pub fn primitive_count(&self) -> usize {
-        self.prims.len()
+        self.ids.len()
     }
 
     /// Whether traversal uses the AVX2 kernel (decided by the CPU at build).
@@ -232,8 +315,23 @@ impl Accel {
         self.avx2 = false;
     }
 
-    /// Primitive `id`'s distance along `r` if below `t_max`, else infinity.
+    /// Primitive `id`'s distance along `r` if below `t_max`, else infinity (a primitive of an
+    /// entry tested one at a time).
     #[inline(always)]
+    fn intersect_scalar(&self, id: usize, r: &TRay, t_max: f32) -> f32 {
+        // The tests' reference traversal tests inline triangles through here too.
+        #[cfg(test)]
+        if self.scalar.slot.as_ref().is_some_and(|s| s[id] == u32::MAX)
+            || (self.scalar.slot.is_none() && self.scalar.prims.is_empty())
+        {
+            return self.intersect_prim(id, r, t_max);
+        }
+        self.scalar.get(id).intersect(r.o, r.d, t_max)
+    }
+
+    /// Any primitive `id`'s distance along `r` if below `t_max`, else infinity (brute force for
+    /// the tests).
+    #[cfg(test)]
     fn intersect_prim(&self, id: usize, r: &TRay, t_max: f32) -> f32 {
         self.prims[id].intersect(r.o, r.d, t_max)
     }
@@ -243,11 +341,11 @@ impl Accel {
     #[inline(always)]
     fn intersect_entry(&self, e: usize, r: &TRay, t_max: f32) -> (f32, u32) {
         let Some(starts) = &self.groups else {
-            return (self.intersect_prim(e, r, t_max), e as u32);
+            return (self.intersect_scalar(e, r, t_max), e as u32);
         };
         let mut best = (f32::INFINITY, 0);
         for id in starts[e] as usize..starts[e + 1] as usize {
-            let t = self.intersect_prim(id, r, t_max);
+            let t = self.intersect_scalar(id, r, t_max);
             if t < best.0 && t < t_max {
                 best = (t, id as u32);
             }
@@ -276,15 +374,18 @@ impl Accel {
             (u32::MAX, None) => f.entry,
             (m, _) => m,
         };
-        let bary = match (f.member, self.prims[id as usize]) {
+        let bary = match f.member {
+            // An inline triangle: the block test's barycentrics.
+            u32::MAX => f.bary,
             // A triangle tested one at a time (in a group): the same test again, for its
             // barycentrics.
-            (u32::MAX, _) => f.bary,
-            (_, Prim::Triangle { v0, e1, e2 }) => {
-                prims::triangle_hit(v0, e1, e2, r.o, r.d, f32::INFINITY)
-                    .map_or([0.0; 2], |(_, u, v)| [u, v])
-            }
-            (_, Prim::Sphere { .. }) => [0.0; 2],
+            _ => match *self.scalar.get(id as usize) {
+                Prim::Triangle { v0, e1, e2 } => {
+                    prims::triangle_hit(v0, e1, e2, r.o, r.d, f32::INFINITY)
+                        .map_or([0.0; 2], |(_, u, v)| [u, v])
+                }
+                Prim::Sphere { .. } => [0.0; 2],
+            },
         };
         let (shape, prim) = self.ids[id as usize];
         Some(Hit {

@@ -37,10 +37,11 @@ fn prim_key(p: &Prim) -> [u32; 9] {
 
 /// BVH entries when more than [`MAX_SHARED_BOUNDS`] primitives share bounds: each entry's
 /// members (indices into the input primitives, exact duplicates left out) and its box. `None`
-/// when no bounds are shared that often.
+/// when no bounds are shared that often. `prim(i)` is input primitive `i` (asked only for those
+/// that share their bounds too often).
 pub(super) fn group_entries(
-    prims: &[Prim],
     aabbs: &[Aabb],
+    prim: impl Fn(usize) -> Prim,
 ) -> Option<(Vec<Vec<usize>>, Vec<Aabb>)> {
     let mut counts: HashMap<[u32; 6], usize> = HashMap::new();
     for b in aabbs {
@@ -60,7 +61,7 @@ pub(super) fn group_entries(
             boxes.push(*b);
             continue;
         }
-        if !seen.insert(prim_key(&prims[i])) {
+        if !seen.insert(prim_key(&prim(i))) {
             continue;
         }
         match entry_of.get(&key) {

@@ -24,6 +24,23 @@ pub const MAX_FILTER_WIDTH: f32 = 1e4;
 /// The most vertices, and the most triangles, one mesh (file or inline) may have: 2^25.
 pub const MAX_MESH_ELEMENTS: u64 = 1 << 25;
 
+/// What one triangle of a mesh costs while the scene is built, in bytes, beside its vertices:
+/// its indices, per-triangle faces and area table, the BVH while obvhs builds it (its temporary
+/// memory included) and the light tables of an emissive mesh. A 1M-triangle emissive PLY (half
+/// a vertex per triangle, positions only) peaks at 394 bytes per triangle, 388 beside its
+/// positions (`crates/scene/tests/mesh_memory.rs`); meshes are checked against `--max-memory`
+/// with this and their vertex data before the BVH is built.
+pub const MESH_BYTES_PER_TRIANGLE: u64 = 390;
+
+/// What a texel of a bitmap texture keeps, in bytes, at most (a float texel; 8-bit images keep
+/// 4).
+pub const TEXTURE_BYTES_PER_TEXEL: u64 = 12;
+
+/// What decoding a texel of an image file needs at its peak, in bytes, beside what the texture
+/// keeps: the decoder's own buffer (up to 16 bytes, RGBA `f32`) and its conversion to RGB `f32`
+/// (12).
+pub const DECODE_BYTES_PER_TEXEL: u64 = 28;
+
 /// The largest file the loader reads (scene, mesh, texture or environment map): 2 GiB.
 pub const MAX_FILE_BYTES: u64 = 2 << 30;
 
