@@ -75,7 +75,7 @@ fn unknown_plugin_types_list_the_valid_ones() {
         &["render", s(&sc), "-o", s(&dir.0.join("o.exr"))],
         &format!(
             "error: {}:2: unknown bsdf type 'velvet' (known: diffuse, twosided, conductor, \
-             roughconductor, dielectric, roughdielectric, plastic, roughplastic, null, mask)",
+             roughconductor, dielectric, roughdielectric, plastic, roughplastic, null, mask, normalmap)",
             s(&sc)
         ),
     );
