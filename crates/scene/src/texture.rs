@@ -211,9 +211,7 @@ impl Texture {
                 color1,
                 uv: t,
             } => {
-                let p = t.apply(uv);
-                let (u, v) = (p.x - p.x.floor(), p.y - p.y.floor());
-                if (u > 0.5) == (v > 0.5) {
+                if same_half(t.apply(uv)) {
                     *color0
                 } else {
                     *color1
@@ -241,9 +239,7 @@ impl Texture {
                 color1,
                 uv: t,
             } => {
-                let p = t.apply(uv);
-                let (u, v) = (p.x - p.x.floor(), p.y - p.y.floor());
-                let c = if (u > 0.5) != (v > 0.5) {
+                let c = if !same_half(t.apply(uv)) {
                     color0
                 } else {
                     color1
@@ -370,6 +366,14 @@ pub(crate) fn read_image(
     };
     let img = Image::read(path, encoding)?;
     Ok((img.width as usize, img.height as usize, img.pixels))
+}
+
+/// Whether the fractional parts of both coordinates of `p` lie on the same side of ½ (the
+/// checkerboard's `color0` squares in its colour lookup).
+#[inline]
+fn same_half(p: Vec2) -> bool {
+    let (u, v) = (p.x - p.x.floor(), p.y - p.y.floor());
+    (u > 0.5) == (v > 0.5)
 }
 
 #[cfg(test)]

@@ -219,6 +219,36 @@ pub enum MaterialDesc {
     },
 }
 
+impl MaterialDesc {
+    /// The material without its textures, and the textures: a wrapper (a mask, a normal map)
+    /// around a textured material holds the textures outside itself, also through a
+    /// `TwoSided`.
+    pub fn split_textures(self) -> (MaterialDesc, Vec<TextureBinding>) {
+        match self {
+            MaterialDesc::Textured { material, textures } => (*material, textures),
+            MaterialDesc::TwoSided(t) => match *t {
+                MaterialDesc::Textured { material, textures } => {
+                    (MaterialDesc::TwoSided(material), textures)
+                }
+                t => (MaterialDesc::TwoSided(Box::new(t)), Vec::new()),
+            },
+            m => (m, Vec::new()),
+        }
+    }
+
+    /// The material with `textures` bound (itself when there are none).
+    pub fn with_textures(self, textures: Vec<TextureBinding>) -> MaterialDesc {
+        if textures.is_empty() {
+            self
+        } else {
+            MaterialDesc::Textured {
+                material: Box::new(self),
+                textures,
+            }
+        }
+    }
+}
+
 /// A colour parameter of a material that a texture can provide.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum ColorParam {

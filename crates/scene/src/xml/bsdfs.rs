@@ -255,29 +255,13 @@ impl<'a> Importer<'a> {
             ));
         }
         // A textured nested bsdf: its textures join the opacity's outside the mask.
-        let (inner, mut textures) = match inner {
-            MaterialDesc::Textured { material, textures } => (*material, textures),
-            MaterialDesc::TwoSided(t) => match *t {
-                MaterialDesc::Textured { material, textures } => {
-                    (MaterialDesc::TwoSided(material), textures)
-                }
-                t => (MaterialDesc::TwoSided(Box::new(t)), Vec::new()),
-            },
-            m => (m, Vec::new()),
-        };
+        let (inner, mut textures) = inner.split_textures();
         textures.extend(textured.into_iter().map(|(_, b)| b));
         let mask = MaterialDesc::Mask {
             opacity,
             material: Box::new(inner),
         };
-        let m = if textures.is_empty() {
-            mask
-        } else {
-            MaterialDesc::Textured {
-                material: Box::new(mask),
-                textures,
-            }
-        };
+        let m = mask.with_textures(textures);
         crate::material::check(&m).map_err(|e| self.err(node, format!("bsdf 'mask': {e}")))?;
         self.check_bsdf_children(node, "mask")?;
         props.finish();

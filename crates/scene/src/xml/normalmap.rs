@@ -98,16 +98,7 @@ impl<'a> Importer<'a> {
         let flip_invalid_normals = props.bool("flip_invalid_normals")?.unwrap_or(true);
         let use_shadowing_function = props.bool("use_shadowing_function")?.unwrap_or(true);
         // A textured nested bsdf: its textures join the map's outside the normal map.
-        let (inner, mut textures) = match inner {
-            MaterialDesc::Textured { material, textures } => (*material, textures),
-            MaterialDesc::TwoSided(t) => match *t {
-                MaterialDesc::Textured { material, textures } => {
-                    (MaterialDesc::TwoSided(material), textures)
-                }
-                t => (MaterialDesc::TwoSided(Box::new(t)), Vec::new()),
-            },
-            m => (m, Vec::new()),
-        };
+        let (inner, mut textures) = inner.split_textures();
         if let Some(texture) = bound {
             textures.push(TextureBinding {
                 param: ColorParam::NormalMap,
@@ -120,14 +111,7 @@ impl<'a> Importer<'a> {
             use_shadowing_function,
             material: Box::new(inner),
         };
-        let m = if textures.is_empty() {
-            map
-        } else {
-            MaterialDesc::Textured {
-                material: Box::new(map),
-                textures,
-            }
-        };
+        let m = map.with_textures(textures);
         crate::material::check(&m).map_err(|e| self.err(node, format!("bsdf 'normalmap': {e}")))?;
         props.finish();
         Ok(m)
