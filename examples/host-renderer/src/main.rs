@@ -16,7 +16,7 @@ fn main() {
             None => default,
             Some(a) => a.parse().unwrap_or_else(|_| {
                 eprintln!("error: argument {} ({a:?}) is not a whole number", i + 1);
-                std::process::exit(2)
+                std::process::exit(1)
             }),
         }
     };
