@@ -9,6 +9,7 @@
 //! | `point.rs` | a light sample named without its receiver ([`LightPoint`], what a reservoir holds), resolved in world space ([`LightSet::resolve`], [`Resolved`]) and seen from a receiver ([`Contact`]) |
 //! | `learned.rs` | a selection learned across passes: per cell of a world-space grid, what each light delivered after its shadow ray ([`LightRecords`]), sampled in a mixture with the power sampler with its exact probability ([`LearnedSampler`]) |
 //! | `presample.rs` | samples drawn without a receiver ([`LightSet::presample`], [`Presampled`]), for pools of presampled candidates |
+//! | `sampler.rs` | one interface over all of these for a receiver's candidates ([`LightSampler`]: power, hierarchy, presampled pool, a table mixed with the power sampler, the learned cell), each candidate with the density that drew it and the power sampler's ([`LightCandidate`]) |
 //!
 //! [`LightSet::sample`] returns a [`LightSample`] whose `pdf_sa` already includes the selection
 //! probability; [`LightSet::pdf_sa`] returns exactly that density for a point reached another
@@ -46,6 +47,7 @@ mod learned;
 mod light;
 mod point;
 mod presample;
+mod sampler;
 mod select;
 mod set;
 mod table;
@@ -55,6 +57,10 @@ pub use learned::{CellKey, LearnGrid, LearnedSampler, LightRecords};
 pub use light::{Light, LightSample};
 pub use point::{Contact, LightPoint, Resolved};
 pub use presample::Presampled;
+pub use sampler::{
+    At, CandidateU, HierarchySampler, LearnedCellSampler, LightCandidate, LightSampler,
+    PoolSampler, PowerSampler, TableSampler,
+};
 pub use set::{LightError, LightSet};
 
 /// The largest emission any light may have, in each channel of its radiance, intensity or

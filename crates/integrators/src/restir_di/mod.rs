@@ -36,7 +36,9 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use restir_geometry::{Ray, offset_ray_origin};
 use restir_gris::Reservoir;
-use restir_lights::LightPoint;
+use restir_lights::{
+    HierarchySampler, LearnedCellSampler, LightPoint, PoolSampler, PowerSampler, TableSampler,
+};
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
@@ -50,7 +52,6 @@ use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::reciprocal;
 use crate::reuse::settings::mis_name;
 use crate::stages::StageClock;
-use candidates::Candidates;
 use restir_reuse::{ScreenReuse, Stages};
 use shift::{DiReuse, visible};
 use target::{StrategyCounts, evaluate};
@@ -297,29 +298,46 @@ impl Integrator for RestirDiIntegrator {
                     if let Some(r) = gbuf.receiver(index) {
                         let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
                         let cell = learned.as_ref().and_then(|l| l.cell(r.p, r.n));
-                        let source = if let (Some(learned), Some(cell)) = (&learned, cell) {
-                            Candidates::Learned {
-                                learned,
-                                cell,
-                                pool: pool.as_ref().map(|p| {
-                                    let (x, y) = ctx.film_xy(index, w);
-                                    p.tile_of(ctx, x, y)
-                                }),
-                            }
-                        } else if let Some(pool) = &pool {
-                            let (x, y) = ctx.film_xy(index, w);
-                            Candidates::Pool(pool.tile_of(ctx, x, y))
-                        } else if let Some(t) = light_tiles
+                        let ng = gbuf.ng[index];
+                        let pool_tile = || {
+                            pool.as_ref().map(|p| {
+                                let (x, y) = ctx.film_xy(index, w);
+                                p.tile_of(ctx, x, y)
+                            })
+                        };
+                        let (init, nr) = if let (Some(learned), Some(cell)) = (&learned, cell) {
+                            let sampler = LearnedCellSampler::new(learned, cell, pool_tile());
+                            let sampler = if s.learn == Learn::WithoutDefensiveShare {
+                                sampler.without_defensive_share()
+                            } else {
+                                sampler
+                            };
+                            self.initial(scene, r, ng, sampler, &mut rng)
+                        } else if let Some(tile) = pool_tile() {
+                            let sampler = if s.light_sampler == LightSampler::PoolWithoutSelection {
+                                PoolSampler::without_selection(tile)
+                            } else {
+                                PoolSampler::new(tile)
+                            };
+                            self.initial(scene, r, ng, sampler, &mut rng)
+                        } else if let Some(table) = light_tiles
                             .as_ref()
                             .and_then(|t| t.table(index % w, index / w))
                         {
-                            Candidates::Tile(t)
+                            let sampler = TableSampler {
+                                table,
+                                share: tiles::TILE_SHARE,
+                            };
+                            self.initial(scene, r, ng, sampler, &mut rng)
                         } else if s.light_sampler.is_hierarchy() {
-                            Candidates::Hierarchy
+                            let sampler = HierarchySampler {
+                                claim_power_density: s.light_sampler
+                                    == LightSampler::BvhWithPowerPmf,
+                            };
+                            self.initial(scene, r, ng, sampler, &mut rng)
                         } else {
-                            Candidates::Power
+                            self.initial(scene, r, ng, PowerSampler, &mut rng)
                         };
-                        let (init, nr) = self.initial(scene, r, gbuf.ng[index], source, &mut rng);
                         *res = init;
                         rays += nr;
                     }

@@ -26,7 +26,7 @@
 //! the film, so a cropped render (`--crop`) and any thread count give the same image.
 
 use rayon::prelude::*;
-use restir_lights::{Presampled, Resolved};
+use restir_lights::Presampled;
 use restir_sampling::ONE_MINUS_EPSILON;
 use restir_scene::Scene;
 
@@ -90,36 +90,5 @@ impl LightPool {
             restir_sampling::mix64(block ^ (ctx.pass as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
         let t = (h % self.tiles as u64) as usize;
         &self.entries[t * TILE_SIZE..(t + 1) * TILE_SIZE]
-    }
-}
-
-/// The negative control of the tests ([`super::LightSampler::PoolWithoutSelection`]): `e` with
-/// the selection probability of a whole light (sphere, point light, environment or directional
-/// light) left out of its density, as a pool that forgot it would weigh it.
-pub(crate) fn without_selection(scene: &Scene, e: Presampled) -> Presampled {
-    match e {
-        Presampled::Light { light, .. } => Presampled::Light { light, pmf: 1.0 },
-        Presampled::Fixed {
-            point,
-            resolved: resolved @ Resolved::Point { .. },
-            ..
-        } => Presampled::Fixed {
-            point,
-            resolved,
-            pdf: 1.0,
-        },
-        Presampled::Fixed {
-            point,
-            resolved: Resolved::Direction { wi, le, delta, pdf },
-            ..
-        } => {
-            let pdf = pdf / scene.lights.pmf(point.light).max(f32::MIN_POSITIVE);
-            Presampled::Fixed {
-                point,
-                resolved: Resolved::Direction { wi, le, delta, pdf },
-                pdf,
-            }
-        }
-        surface @ Presampled::Fixed { .. } => surface,
     }
 }

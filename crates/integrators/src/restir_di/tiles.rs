@@ -103,19 +103,3 @@ impl LightTiles {
         self.tables[(y / TILE) * self.tiles_x + x / TILE].as_ref()
     }
 }
-
-/// Picks a light for a candidate from the mixture of `table` and the power sampler with uniform
-/// `u`. Returns `(light, mixture probability, power-sampler probability)`.
-#[inline]
-pub fn select(scene: &Scene, table: &AliasTable, u: f32) -> Option<(u32, f32, f32)> {
-    let lights = &scene.lights;
-    let light = if u < TILE_SHARE {
-        table.sample(u / TILE_SHARE).0 as u32
-    } else {
-        let v = ((u - TILE_SHARE) / (1.0 - TILE_SHARE)).min(restir_sampling::ONE_MINUS_EPSILON);
-        lights.select(v)?.0
-    };
-    let power_pmf = lights.pmf(light);
-    let pmf = TILE_SHARE * table.pmf(light as usize) + (1.0 - TILE_SHARE) * power_pmf;
-    Some((light, pmf, power_pmf))
-}

@@ -1,0 +1,421 @@
+//! One interface over every way of choosing a receiver's light candidates: [`LightSampler`].
+//!
+//! A candidate is a light sample seen from a receiver ([`LightCandidate`]) with two densities:
+//! the density of the sampler that drew it (which initial resampling divides by) and the power
+//! sampler's density of the same point (which the light/BSDF split of a light-sampled estimate
+//! weighs by, whatever drew the candidate). The samplers:
+//!
+//! | sampler | which light | where on it |
+//! |---|---|---|
+//! | [`PowerSampler`] | the emitter table by power ([`LightSet::sample`]) | a uniform point of the picked triangle, or the light's own sampling |
+//! | [`HierarchySampler`] | the light hierarchy, receiver-aware ([`LightSet::sample_hierarchy`]) | the same |
+//! | [`PoolSampler`] | the power sampler's draws made once for a block of pixels ([`LightSet::presample`]) | fixed with the draw (a sphere's point per receiver) |
+//! | [`TableSampler`] | a table over the lights mixed with the power sampler (screen tiles) | [`LightSet::sample_light`] |
+//! | [`LearnedCellSampler`] | the learned table of the receiver's cell mixed with the power sampler ([`LearnedSampler`]) | [`LightSet::sample_light`], or the pool's draw for the power share |
+//!
+//! Each is a small value made per receiver from tables built per pass, so the candidate loop is
+//! monomorphised for each.
+
+use glam::{Vec2, Vec3};
+use restir_sampling::{AliasTable, ONE_MINUS_EPSILON, Pcg32};
+
+use crate::{Contact, LearnedSampler, LightPoint, LightSample, LightSet, Presampled, Resolved};
+
+/// A receiver as light selection sees it: its position and shading normal (zero if unknown).
+#[derive(Clone, Copy, Debug)]
+pub struct At {
+    /// Position.
+    pub p: Vec3,
+    /// Shading normal, or zero.
+    pub n: Vec3,
+}
+
+/// The numbers of candidate `i` of a receiver's `n`: the stratified selection number
+/// `(i + u0) / n` and a point on the light.
+#[derive(Clone, Copy, Debug)]
+pub struct CandidateU {
+    /// Index of the candidate.
+    pub i: u32,
+    /// Candidates of the receiver.
+    pub n: u32,
+    /// The receiver's stratum offset in `[0, 1)`.
+    pub u0: f32,
+    /// `(i + u0) / n`, below 1.
+    pub select: f32,
+    /// For the point on the light.
+    pub point: Vec2,
+}
+
+impl CandidateU {
+    /// Candidate `i` of `n` with stratum offset `u0` and point numbers `point`.
+    #[inline]
+    pub fn new(i: u32, n: u32, u0: f32, point: Vec2) -> Self {
+        Self {
+            i,
+            n,
+            u0,
+            select: ((i as f32 + u0) / n as f32).min(ONE_MINUS_EPSILON),
+            point,
+        }
+    }
+}
+
+/// A light sample seen from a receiver, with the densities initial resampling needs.
+#[derive(Clone, Copy, Debug)]
+pub struct LightCandidate {
+    /// The sample's name (what a reservoir holds).
+    pub point: LightPoint,
+    /// The sample seen from the receiver.
+    pub contact: Contact,
+    /// The density that drew it, in the sample's own measure (area, counting or solid angle),
+    /// the selection included.
+    pub source_pdf: f32,
+    /// The power sampler's solid-angle density of the same point.
+    pub power_pdf_sa: f32,
+}
+
+impl LightCandidate {
+    /// A light sample drawn with solid-angle density `source_pdf_sa`, whose power-sampler
+    /// density is `power_pdf_sa`.
+    #[inline]
+    pub fn from_sample(ls: &LightSample, source_pdf_sa: f32, power_pdf_sa: f32) -> Option<Self> {
+        let measure = if ls.delta || !ls.dist.is_finite() {
+            1.0
+        } else {
+            ls.ng.dot(ls.wi).abs() / (ls.dist * ls.dist)
+        };
+        Some(Self {
+            point: LightPoint::from_light_sample(ls),
+            contact: Contact {
+                wi: ls.wi,
+                p: ls.p,
+                dist: ls.dist,
+                le: ls.le,
+                measure,
+                delta: ls.delta,
+                ng: ls.ng,
+                pdf_sa: Some(power_pdf_sa),
+            },
+            source_pdf: if ls.delta {
+                source_pdf_sa
+            } else {
+                source_pdf_sa * measure
+            },
+            power_pdf_sa,
+        })
+    }
+
+    /// A presampled draw seen from `x` (a sphere light gets its point here, with `u`).
+    #[inline]
+    pub fn presampled(lights: &LightSet, e: &Presampled, x: Vec3, u: Vec2) -> Option<Self> {
+        let (point, resolved, pdf) = match *e {
+            Presampled::Fixed {
+                point,
+                resolved,
+                pdf,
+            } => (point, resolved, pdf),
+            Presampled::Light { light, pmf } => {
+                let ls = lights.sample_light(light, x, u)?;
+                return Self::from_sample(&ls, ls.pdf_sa * pmf, ls.pdf_sa * pmf);
+            }
+        };
+        let contact = resolved.contact(x)?;
+        // Area lights: the area density over the measure factor is the solid-angle density.
+        if contact.measure <= 0.0 {
+            return None;
+        }
+        Some(Self {
+            point,
+            contact,
+            source_pdf: pdf,
+            power_pdf_sa: pdf / contact.measure,
+        })
+    }
+}
+
+/// A way of drawing a receiver's light candidates.
+pub trait LightSampler {
+    /// Called once per receiver before its `n` candidates, after the stratum offset is drawn
+    /// from `rng`: draws what the sampler decides per receiver.
+    #[inline]
+    fn begin(&mut self, _rng: &mut Pcg32, _n: u32) {}
+
+    /// Candidate `u.i` for a receiver `at`, or `None` where nothing was drawn (no light, a back
+    /// face). `rng` gives any further numbers the sampler needs.
+    fn candidate(
+        &self,
+        lights: &LightSet,
+        at: At,
+        u: &CandidateU,
+        rng: &mut Pcg32,
+    ) -> Option<LightCandidate>;
+}
+
+/// The power sampler, drawn per receiver ([`LightSet::sample`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PowerSampler;
+
+impl LightSampler for PowerSampler {
+    #[inline]
+    fn candidate(
+        &self,
+        lights: &LightSet,
+        at: At,
+        u: &CandidateU,
+        _rng: &mut Pcg32,
+    ) -> Option<LightCandidate> {
+        let ls = lights.sample(at.p, u.select, u.point)?;
+        LightCandidate::from_sample(&ls, ls.pdf_sa, ls.pdf_sa)
+    }
+}
+
+/// The light hierarchy ([`LightSet::sample_hierarchy`]): 48 bits for the descent, the
+/// stratified number and 24 more from the generator.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct HierarchySampler {
+    /// Claim the power sampler's density instead of the hierarchy's (a negative control of the
+    /// tests: biased).
+    #[doc(hidden)]
+    pub claim_power_density: bool,
+}
+
+impl LightSampler for HierarchySampler {
+    #[inline]
+    fn candidate(
+        &self,
+        lights: &LightSet,
+        at: At,
+        u: &CandidateU,
+        rng: &mut Pcg32,
+    ) -> Option<LightCandidate> {
+        let v = (u.i as f64 + u.u0 as f64 + rng.next_f32() as f64 / 16_777_216.0) / u.n as f64;
+        let (ls, power_pdf_sa) =
+            lights.sample_hierarchy(at.p, at.n, v.min(1.0 - f64::EPSILON), u.point)?;
+        let source = if self.claim_power_density {
+            power_pdf_sa
+        } else {
+            ls.pdf_sa
+        };
+        LightCandidate::from_sample(&ls, source, power_pdf_sa)
+    }
+}
+
+/// A tile of presampled power-sampler draws shared by a block of pixels: a receiver takes the
+/// entries `start + i·S/n` (mod `S`) for a uniform `start`, one from each of `n` strata of the
+/// tile's selection numbers.
+#[derive(Clone, Copy, Debug)]
+pub struct PoolSampler<'a> {
+    tile: &'a [Option<Presampled>],
+    start: usize,
+    stride: usize,
+    drop_selection: bool,
+}
+
+impl<'a> PoolSampler<'a> {
+    /// The sampler over `tile` (not empty).
+    pub fn new(tile: &'a [Option<Presampled>]) -> Self {
+        Self {
+            tile,
+            start: 0,
+            stride: 1,
+            drop_selection: false,
+        }
+    }
+
+    /// The pool that forgets a whole light's selection probability in its density (a negative
+    /// control of the tests: biased).
+    #[doc(hidden)]
+    pub fn without_selection(tile: &'a [Option<Presampled>]) -> Self {
+        Self {
+            drop_selection: true,
+            ..Self::new(tile)
+        }
+    }
+
+    /// The entry candidate `i` takes.
+    #[inline]
+    fn entry(&self, i: u32) -> Option<Presampled> {
+        self.tile[(self.start + i as usize * self.stride) % self.tile.len()]
+    }
+}
+
+impl LightSampler for PoolSampler<'_> {
+    #[inline]
+    fn begin(&mut self, rng: &mut Pcg32, n: u32) {
+        self.start = rng.next_u32() as usize % self.tile.len();
+        self.stride = (self.tile.len() / n as usize).max(1);
+    }
+
+    #[inline]
+    fn candidate(
+        &self,
+        lights: &LightSet,
+        at: At,
+        u: &CandidateU,
+        _rng: &mut Pcg32,
+    ) -> Option<LightCandidate> {
+        let mut e = self.entry(u.i)?;
+        if self.drop_selection {
+            e = without_selection(lights, e);
+        }
+        LightCandidate::presampled(lights, &e, at.p, u.point)
+    }
+}
+
+/// `e` with the selection probability of a whole light (sphere, point light, environment or
+/// directional light) left out of its density, as a pool that forgot it would weigh it.
+fn without_selection(lights: &LightSet, e: Presampled) -> Presampled {
+    match e {
+        Presampled::Light { light, .. } => Presampled::Light { light, pmf: 1.0 },
+        Presampled::Fixed {
+            point,
+            resolved: resolved @ Resolved::Point { .. },
+            ..
+        } => Presampled::Fixed {
+            point,
+            resolved,
+            pdf: 1.0,
+        },
+        Presampled::Fixed {
+            point,
+            resolved: Resolved::Direction { wi, le, delta, pdf },
+            ..
+        } => {
+            let pdf = pdf / lights.pmf(point.light).max(f32::MIN_POSITIVE);
+            Presampled::Fixed {
+                point,
+                resolved: Resolved::Direction { wi, le, delta, pdf },
+                pdf,
+            }
+        }
+        surface @ Presampled::Fixed { .. } => surface,
+    }
+}
+
+/// A table over the lights mixed with the power sampler: the light is the table's with
+/// probability `share`, else the power sampler's, and its probability is the mixture's,
+/// `share · table + (1 − share) · power`, so every light with power keeps its support whatever
+/// the table got wrong.
+#[derive(Clone, Copy, Debug)]
+pub struct TableSampler<'a> {
+    /// The table, indexed by light.
+    pub table: &'a AliasTable,
+    /// The table's share of selections, in `[0, 1)`.
+    pub share: f32,
+}
+
+impl TableSampler<'_> {
+    /// Picks a light with uniform `u`: `(light, mixture probability, power probability)`.
+    #[inline]
+    pub fn select(&self, lights: &LightSet, u: f32) -> Option<(u32, f32, f32)> {
+        let share = self.share;
+        let light = if u < share {
+            self.table.sample(u / share).0 as u32
+        } else {
+            let v = ((u - share) / (1.0 - share)).min(ONE_MINUS_EPSILON);
+            lights.select(v)?.0
+        };
+        let power_pmf = lights.pmf(light);
+        let pmf = share * self.table.pmf(light as usize) + (1.0 - share) * power_pmf;
+        Some((light, pmf, power_pmf))
+    }
+}
+
+impl LightSampler for TableSampler<'_> {
+    #[inline]
+    fn candidate(
+        &self,
+        lights: &LightSet,
+        at: At,
+        u: &CandidateU,
+        _rng: &mut Pcg32,
+    ) -> Option<LightCandidate> {
+        let (light, pmf, power_pmf) = self.select(lights, u.select)?;
+        let ls = lights.sample_light(light, at.p, u.point)?;
+        LightCandidate::from_sample(&ls, pmf * ls.pdf_sa, power_pmf * ls.pdf_sa)
+    }
+}
+
+/// The learned selection at a receiver's cell ([`LearnedSampler`]); its power share drawn from a
+/// pool of presampled draws when there is one.
+#[derive(Clone, Copy, Debug)]
+pub struct LearnedCellSampler<'a> {
+    learned: &'a LearnedSampler,
+    cell: u32,
+    pool: Option<PoolSampler<'a>>,
+    defensive: bool,
+}
+
+impl<'a> LearnedCellSampler<'a> {
+    /// The sampler of `learned` in `cell` ([`LearnedSampler::cell`]), the power share from
+    /// `pool` if given.
+    pub fn new(
+        learned: &'a LearnedSampler,
+        cell: u32,
+        pool: Option<&'a [Option<Presampled>]>,
+    ) -> Self {
+        Self {
+            learned,
+            cell,
+            pool: pool.map(PoolSampler::new),
+            defensive: true,
+        }
+    }
+
+    /// The sampler that claims the cell's table alone as its probability, forgetting the
+    /// power sampler's share (a negative control of the tests: biased).
+    #[doc(hidden)]
+    pub fn without_defensive_share(mut self) -> Self {
+        self.defensive = false;
+        self
+    }
+
+    /// The mixture's probability of `light` (or the control's).
+    #[inline]
+    fn pmf(&self, lights: &LightSet, light: u32) -> f32 {
+        if self.defensive {
+            self.learned.pmf(lights, Some(self.cell), light)
+        } else {
+            self.learned
+                .pmf_without_defensive_share(lights, Some(self.cell), light)
+        }
+    }
+}
+
+impl LightSampler for LearnedCellSampler<'_> {
+    #[inline]
+    fn begin(&mut self, rng: &mut Pcg32, n: u32) {
+        if let Some(pool) = &mut self.pool {
+            pool.begin(rng, n);
+        }
+    }
+
+    #[inline]
+    fn candidate(
+        &self,
+        lights: &LightSet,
+        at: At,
+        u: &CandidateU,
+        _rng: &mut Pcg32,
+    ) -> Option<LightCandidate> {
+        if let Some(pool) = &self.pool
+            && u.select >= self.learned.cell_share(Some(self.cell))
+        {
+            // The power sampler's share, from the pool: its density times the mixture's
+            // probability of the light over the power sampler's.
+            let mut c = LightCandidate::presampled(lights, &pool.entry(u.i)?, at.p, u.point)?;
+            let light = c.point.light;
+            let power_pmf = lights.pmf(light);
+            if power_pmf <= 0.0 {
+                return None;
+            }
+            c.source_pdf *= self.pmf(lights, light) / power_pmf;
+            return Some(c);
+        }
+        let (light, _) = self.learned.sample(lights, Some(self.cell), u.select)?;
+        let ls = lights.sample_light(light, at.p, u.point)?;
+        let pmf = self.pmf(lights, light);
+        let power_pmf = lights.pmf(light);
+        LightCandidate::from_sample(&ls, pmf * ls.pdf_sa, power_pmf * ls.pdf_sa)
+    }
+}

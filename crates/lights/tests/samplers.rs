@@ -1,0 +1,268 @@
+//! Every [`LightSampler`] draws candidates whose densities are the ones it reports: the
+//! importance-sampled estimate `Σ g(x) / source_pdf(x)` of the same integral (the receiver's
+//! unoccluded irradiance-like sum `∫ L_e max(0, n·ω) dω` over every light) agrees between the
+//! power sampler and each other sampler (|z| < 4, fixed seeds), and the power sampler's
+//! solid-angle density it reports with every candidate is the power sampler's own.
+//!
+//! Negative controls, each rejected (|z| > 8): the hierarchy claiming the power sampler's
+//! density, a pool forgetting a whole light's selection probability, the learned cell forgetting
+//! its defensive share.
+//!
+//! The scene: 30 emissive spheres over two decades of radiance, two emissive rectangles (mesh
+//! triangles), a point light, a directional light and a constant environment.
+
+use glam::{Affine3A, Quat, Vec2, Vec3};
+use restir_geometry::{Shape, Sphere};
+use restir_lights::{
+    At, CandidateU, HierarchySampler, LearnGrid, LearnedCellSampler, LearnedSampler, Light,
+    LightCandidate, LightRecords, LightSampler, LightSet, PoolSampler, PowerSampler, Presampled,
+    TableSampler,
+};
+use restir_sampling::{AliasTable, ONE_MINUS_EPSILON, Pcg32, luminance};
+
+fn scene() -> LightSet {
+    let mut rng = Pcg32::new(11, 5);
+    let mut shapes = Vec::new();
+    let mut lights = Vec::new();
+    for i in 0..30 {
+        let c = Vec3::new(
+            8.0 * rng.next_f32() - 4.0,
+            8.0 * rng.next_f32() - 4.0,
+            1.0 + 2.0 * rng.next_f32(),
+        );
+        shapes.push(Shape::Sphere(Sphere::new(c, 0.15, false)));
+        lights.push(Light::Area {
+            shape: i,
+            radiance: Vec3::splat(10f32.powf(2.0 * rng.next_f32())),
+        });
+    }
+    for (k, x) in [-2.0f32, 2.5].into_iter().enumerate() {
+        let mut quad = Shape::rectangle();
+        quad.transform(&Affine3A::from_scale_rotation_translation(
+            Vec3::splat(0.5),
+            Quat::from_rotation_x(std::f32::consts::PI),
+            Vec3::new(x, 0.5, 2.5),
+        ));
+        shapes.push(Shape::Mesh(quad));
+        lights.push(Light::Area {
+            shape: 30 + k as u32,
+            radiance: Vec3::splat(3.0 + k as f32),
+        });
+    }
+    lights.push(Light::Point {
+        position: Vec3::new(0.5, -1.0, 2.0),
+        intensity: Vec3::splat(4.0),
+    });
+    lights.push(Light::Directional {
+        direction: Vec3::new(0.2, 0.1, -1.0),
+        irradiance: Vec3::splat(0.5),
+    });
+    lights.push(Light::Constant {
+        radiance: Vec3::splat(0.05),
+    });
+    LightSet::new(lights, &shapes[..], (Vec3::splat(-5.0), Vec3::splat(5.0))).unwrap()
+}
+
+const AT: At = At {
+    p: Vec3::new(0.3, -0.2, 0.0),
+    n: Vec3::Z,
+};
+
+/// The summand of candidate `c`: its emission times the receiver's cosine over its density.
+fn g(c: &LightCandidate) -> f64 {
+    let cos = AT.n.dot(c.contact.wi).max(0.0);
+    (luminance(c.contact.le) * cos * c.contact.measure / c.source_pdf) as f64
+}
+
+const RECEIVERS: usize = 40_000;
+const CANDIDATES: u32 = 8;
+
+/// Mean and standard error of the per-receiver estimates `(1/N) Σ g` of `sampler`, made anew
+/// for each receiver by `make` (so per-pass tables, such as a pool's tile, are redrawn).
+fn estimate<S: LightSampler>(
+    lights: &LightSet,
+    seed: u64,
+    mut make: impl FnMut(&mut Pcg32) -> S,
+) -> (f64, f64) {
+    let mut rng = Pcg32::new(seed, 3);
+    let (mut sum, mut sum2) = (0.0, 0.0);
+    for _ in 0..RECEIVERS {
+        let mut sampler = make(&mut rng);
+        let u0 = rng.next_f32();
+        sampler.begin(&mut rng, CANDIDATES);
+        let mut est = 0.0;
+        for i in 0..CANDIDATES {
+            let u = CandidateU::new(i, CANDIDATES, u0, rng.next_2d());
+            if let Some(c) = sampler.candidate(lights, AT, &u, &mut rng) {
+                assert!(c.source_pdf > 0.0 && c.power_pdf_sa > 0.0);
+                est += g(&c);
+            }
+        }
+        est /= CANDIDATES as f64;
+        sum += est;
+        sum2 += est * est;
+    }
+    let n = RECEIVERS as f64;
+    let mean = sum / n;
+    (mean, ((sum2 / n - mean * mean) / (n - 1.0)).sqrt())
+}
+
+fn z((a, sa): (f64, f64), (b, sb): (f64, f64)) -> f64 {
+    (a - b) / (sa * sa + sb * sb).sqrt()
+}
+
+/// A tile of presampled power-sampler draws, stratified as the renderer's pools are.
+fn tile(lights: &LightSet, rng: &mut Pcg32) -> Vec<Option<Presampled>> {
+    const S: usize = 64;
+    let u0 = rng.next_f32();
+    (0..S)
+        .map(|j| {
+            let u = ((j as f32 + u0) / S as f32).min(ONE_MINUS_EPSILON);
+            lights.presample(u, rng.next_2d())
+        })
+        .collect()
+}
+
+fn learned(lights: &LightSet) -> (LearnedSampler, u32) {
+    let grid = LearnGrid { cell: 0.5 };
+    let key = grid.key(AT.p, AT.n);
+    let mut records = LightRecords::default();
+    let mut rng = Pcg32::new(9, 0);
+    for _ in 0..400 {
+        let light = (rng.next_u32() % 10) * 3;
+        records.add(key, light, rng.next_f32() * (light as f32 + 1.0));
+    }
+    let sampler = LearnedSampler::new(grid, 0.5, 16.0, &records);
+    let cell = sampler.cell(AT.p, AT.n).unwrap();
+    assert!(lights.len() > 30);
+    (sampler, cell)
+}
+
+/// A skewed table over the lights (every third light, growing weights).
+fn table(lights: &LightSet) -> AliasTable {
+    let w: Vec<f32> = (0..lights.len())
+        .map(|l| if l % 3 == 0 { 1.0 + l as f32 } else { 0.0 })
+        .collect();
+    AliasTable::new(&w).unwrap()
+}
+
+#[test]
+fn every_sampler_estimates_the_same_integral() {
+    let lights = scene();
+    let power = estimate(&lights, 1, |_| PowerSampler);
+    eprintln!("power: {:.6} ± {:.6}", power.0, power.1);
+    let (learned, cell) = learned(&lights);
+    let table = table(&lights);
+    let mut tiles: Vec<Vec<Option<Presampled>>> = Vec::new();
+    let mut rng = Pcg32::new(4, 4);
+    for _ in 0..RECEIVERS {
+        tiles.push(tile(&lights, &mut rng));
+    }
+    let mut k = 0;
+    let mut next_tile = || {
+        k += 1;
+        &tiles[k - 1][..]
+    };
+    let cases: Vec<(&str, (f64, f64))> = vec![
+        (
+            "hierarchy",
+            estimate(&lights, 2, |_| HierarchySampler::default()),
+        ),
+        (
+            "pool",
+            estimate(&lights, 3, |_| PoolSampler::new(next_tile())),
+        ),
+        (
+            "table",
+            estimate(&lights, 14, |_| TableSampler {
+                table: &table,
+                share: 0.5,
+            }),
+        ),
+        (
+            "learned",
+            estimate(&lights, 5, |_| {
+                LearnedCellSampler::new(&learned, cell, None)
+            }),
+        ),
+    ];
+    let mut k = 0;
+    let mut next_tile = || {
+        k += 1;
+        &tiles[k - 1][..]
+    };
+    let learned_pool = estimate(&lights, 6, |_| {
+        LearnedCellSampler::new(&learned, cell, Some(next_tile()))
+    });
+    for (name, e) in cases
+        .into_iter()
+        .chain(std::iter::once(("learned with a pool", learned_pool)))
+    {
+        let z = z(e, power);
+        eprintln!("{name}: {:.6} ± {:.6}, z {z:.2}", e.0, e.1);
+        assert!(z.abs() < 4.0, "{name}: z {z}");
+    }
+}
+
+#[test]
+fn negative_controls_are_rejected() {
+    let lights = scene();
+    let power = estimate(&lights, 1, |_| PowerSampler);
+    let (learned, cell) = learned(&lights);
+    let mut rng = Pcg32::new(4, 4);
+    let tiles: Vec<_> = (0..RECEIVERS).map(|_| tile(&lights, &mut rng)).collect();
+    let mut k = 0;
+    let controls = [
+        (
+            "hierarchy claiming the power density",
+            estimate(&lights, 2, |_| HierarchySampler {
+                claim_power_density: true,
+            }),
+        ),
+        (
+            "pool without the selection",
+            estimate(&lights, 3, |_| {
+                k += 1;
+                PoolSampler::without_selection(&tiles[k - 1])
+            }),
+        ),
+        (
+            "learned without its defensive share",
+            estimate(&lights, 5, |_| {
+                LearnedCellSampler::new(&learned, cell, None).without_defensive_share()
+            }),
+        ),
+    ];
+    for (name, e) in controls {
+        let z = z(e, power);
+        eprintln!("{name}: {:.6} ± {:.6}, z {z:.2}", e.0, e.1);
+        assert!(z.abs() > 8.0, "{name}: z {z}");
+    }
+}
+
+#[test]
+fn candidates_carry_the_power_samplers_density() {
+    let lights = scene();
+    let mut rng = Pcg32::new(8, 1);
+    let sampler = HierarchySampler::default();
+    let mut checked = 0;
+    for i in 0..2000 {
+        let u = CandidateU::new(
+            i % 8,
+            8,
+            rng.next_f32(),
+            Vec2::new(rng.next_f32(), rng.next_f32()),
+        );
+        let Some(c) = sampler.candidate(&lights, AT, &u, &mut rng) else {
+            continue;
+        };
+        if c.contact.delta || !c.contact.dist.is_finite() {
+            continue;
+        }
+        let want = lights.pdf_sa(c.point.light, AT.p, c.contact.p, c.contact.ng);
+        let rel = (c.power_pdf_sa - want).abs() / want;
+        assert!(rel < 1e-3, "candidate {i}: {} vs {want}", c.power_pdf_sa);
+        checked += 1;
+    }
+    assert!(checked > 1000);
+}
