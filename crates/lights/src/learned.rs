@@ -1,7 +1,9 @@
-//! A light selection learned from what lights delivered: per cell of a world-space grid (over
-//! positions and the dominant axis of the receiver's normal), the sum of what each light
+//! A light selection learned from what emitters delivered: per cell of a world-space grid (over
+//! positions and the dominant axis of the receiver's normal), the sum of what each emitter (an
+//! emissive triangle, another light, the environment: [`LightSet::pick_emitter`]'s numbering)
 //! contributed to receivers in that cell once its shadow ray was traced, turned into a
-//! distribution and sampled in a mixture with the power sampler.
+//! distribution and sampled in a mixture with the power sampler. Emitters rather than lights, so
+//! that of a mesh light only the triangles a cell sees are drawn there.
 //!
 //! The grid is ReGIR's (Boksansky et al., *Ray Tracing Gems II*, 2021: cells of world space,
 //! each with its own light distribution); what fills it follows Vévoda, Kondapaneni and
@@ -9,13 +11,13 @@
 //! 2018): lights are weighted by their measured contribution with visibility, so lights that are
 //! blocked from a cell stop being drawn there.
 //!
-//! [`LightRecords`] gathers `(cell, light, contribution)` records in the order they are given;
+//! [`LightRecords`] gathers `(cell, emitter, contribution)` records in the order they are given;
 //! [`LearnedSampler::new`] freezes them into one alias table per cell. A selection at a receiver
 //! picks the cell's table with probability `share · n / (n + prior)` (`n` the cell's records,
-//! so a cell that has seen little leans on the power sampler) and the power sampler ([`LightSet::select`])
-//! otherwise, so every light with power keeps a positive probability whatever was learned (the
-//! defensive share, Hesterberg 1995), and [`LearnedSampler::pmf`] is the mixture's probability,
-//! exactly, for any receiver and light. A receiver whose cell has no records selects by power
+//! so a cell that has seen little leans on the power sampler) and the power sampler
+//! ([`LightSet::pick_emitter`]) otherwise, so every emitter with power keeps a positive
+//! probability whatever was learned (the defensive share, Hesterberg 1995), and
+//! [`LearnedSampler::pmf`] is the mixture's probability, exactly, for any receiver and emitter. A receiver whose cell has no records selects by power
 //! alone.
 
 use std::collections::{BTreeMap, HashMap};
@@ -64,7 +66,7 @@ impl LearnGrid {
     }
 }
 
-/// What lights delivered, per cell: the sum of the contributions recorded for each light.
+/// What emitters delivered, per cell: the sum of the contributions recorded for each emitter.
 #[derive(Clone, Debug, Default)]
 pub struct LightRecords {
     cells: BTreeMap<CellKey, BTreeMap<u32, f64>>,
@@ -74,17 +76,17 @@ pub struct LightRecords {
 }
 
 impl LightRecords {
-    /// Adds what `light` delivered to a receiver in cell `key` (non-positive and non-finite
+    /// Adds what `emitter` delivered to a receiver in cell `key` (non-positive and non-finite
     /// values are ignored). Sums are `f64` and taken in the order of the calls, so the same
     /// records in the same order give the same bits.
     #[inline]
-    pub fn add(&mut self, key: CellKey, light: u32, value: f32) {
+    pub fn add(&mut self, key: CellKey, emitter: u32, value: f32) {
         if value > 0.0 && value.is_finite() {
             *self
                 .cells
                 .entry(key)
                 .or_default()
-                .entry(light)
+                .entry(emitter)
                 .or_insert(0.0) += value as f64;
             *self.counts.entry(key).or_insert(0) += 1;
             self.records += 1;
@@ -102,11 +104,11 @@ impl LightRecords {
     }
 }
 
-/// One cell's distribution over the lights it recorded.
+/// One cell's distribution over the emitters it recorded.
 #[derive(Clone, Debug)]
 struct CellTable {
-    /// The lights, ascending.
-    lights: Vec<u32>,
+    /// The emitters, ascending.
+    emitters: Vec<u32>,
     alias: AliasTable,
     /// The share of selections the table takes in this cell: the sampler's share times
     /// `n / (n + prior)` for `n` records, so a cell of few records leans on the power sampler.
@@ -114,11 +116,11 @@ struct CellTable {
 }
 
 impl CellTable {
-    /// The probability the table picks `light`.
+    /// The probability the table picks `emitter`.
     #[inline]
-    fn pmf(&self, light: u32) -> f32 {
-        self.lights
-            .binary_search(&light)
+    fn pmf(&self, emitter: u32) -> f32 {
+        self.emitters
+            .binary_search(&emitter)
             .map_or(0.0, |i| self.alias.pmf(i))
     }
 }
@@ -148,7 +150,7 @@ impl LearnedSampler {
             if let Some(alias) = AliasTable::new(&weights) {
                 index.insert(*key, tables.len() as u32);
                 tables.push(CellTable {
-                    lights: sums.keys().copied().collect(),
+                    emitters: sums.keys().copied().collect(),
                     alias,
                     share: share * n / (n + prior),
                 });
@@ -181,8 +183,8 @@ impl LearnedSampler {
 
     /// Approximate heap bytes of the tables and the cell index.
     pub fn bytes(&self) -> usize {
-        let entries: usize = self.tables.iter().map(|t| t.lights.len()).sum();
-        // Per entry a light index and an alias bin (probability, alias, pmf); per cell its
+        let entries: usize = self.tables.iter().map(|t| t.emitters.len()).sum();
+        // Per entry an emitter index and an alias bin (probability, alias, pmf); per cell its
         // key, index slot and table header.
         entries * (4 + 12) + self.tables.len() * (16 + 4 + 64)
     }
@@ -196,48 +198,49 @@ impl LearnedSampler {
         self.index.get(&self.grid.key(p, n)).copied()
     }
 
-    /// Picks a light for a receiver in `cell` ([`LearnedSampler::cell`]) with uniform `u`:
-    /// `(light, probability)`, the probability being [`LearnedSampler::pmf`]'s.
+    /// Picks an emitter for a receiver in `cell` ([`LearnedSampler::cell`]) with uniform `u`:
+    /// `(emitter, probability)`, the probability being [`LearnedSampler::pmf`]'s.
     #[inline]
-    pub fn sample(&self, lights: &LightSet, cell: Option<u32>, u: f32) -> Option<(u32, f32)> {
+    pub fn sample(&self, lights: &LightSet, cell: Option<u32>, u: f32) -> Option<(usize, f32)> {
         let Some(table) = cell.map(|c| &self.tables[c as usize]) else {
-            return lights.select(u);
+            return lights.pick_emitter(u);
         };
         let share = table.share;
-        let light = if u < share {
+        let emitter = if u < share {
             let v = (u / share).min(ONE_MINUS_EPSILON);
-            table.lights[table.alias.sample(v).0]
+            table.emitters[table.alias.sample(v).0] as usize
         } else {
             let v = ((u - share) / (1.0 - share)).min(ONE_MINUS_EPSILON);
-            lights.select(v)?.0
+            lights.pick_emitter(v)?.0
         };
-        Some((light, self.pmf(lights, cell, light)))
+        Some((emitter, self.pmf(lights, cell, emitter)))
     }
 
-    /// The probability that [`LearnedSampler::sample`] picks `light` for a receiver in `cell`:
-    /// `share · table(light) + (1 − share) · power(light)`, or the power sampler's alone in a
-    /// cell without a table.
+    /// The probability that [`LearnedSampler::sample`] picks `emitter` for a receiver in
+    /// `cell`: `share · table(emitter) + (1 − share) · power(emitter)`, or the power sampler's
+    /// alone ([`LightSet::emitter_pmf`]) in a cell without a table.
     #[inline]
-    pub fn pmf(&self, lights: &LightSet, cell: Option<u32>, light: u32) -> f32 {
+    pub fn pmf(&self, lights: &LightSet, cell: Option<u32>, emitter: usize) -> f32 {
+        let power = lights.emitter_pmf(emitter);
         match cell.map(|c| &self.tables[c as usize]) {
-            None => lights.pmf(light),
-            Some(t) => t.share * t.pmf(light) + (1.0 - t.share) * lights.pmf(light),
+            None => power,
+            Some(t) => t.share * t.pmf(emitter as u32) + (1.0 - t.share) * power,
         }
     }
 
     /// The probability of the cell's table alone, without the power sampler's share: what a
-    /// mixture forgetting its defensive part would claim (the tests' negative control; a light
-    /// the table lacks falls back to its power probability).
+    /// mixture forgetting its defensive part would claim (the tests' negative control; an
+    /// emitter the table lacks falls back to its power probability).
     #[doc(hidden)]
     pub fn pmf_without_defensive_share(
         &self,
         lights: &LightSet,
         cell: Option<u32>,
-        light: u32,
+        emitter: usize,
     ) -> f32 {
-        match cell.map(|c| self.tables[c as usize].pmf(light)) {
+        match cell.map(|c| self.tables[c as usize].pmf(emitter as u32)) {
             Some(p) if p > 0.0 => p,
-            _ => lights.pmf(light),
+            _ => lights.emitter_pmf(emitter),
         }
     }
 }

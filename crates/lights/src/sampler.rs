@@ -11,7 +11,7 @@
 //! | [`HierarchySampler`] | the light hierarchy, receiver-aware ([`LightSet::sample_hierarchy`]) | the same |
 //! | [`PoolSampler`] | the power sampler's draws made once for a block of pixels ([`LightSet::presample`]) | fixed with the draw (a sphere's point per receiver) |
 //! | [`TableSampler`] | a table over the lights mixed with the power sampler (screen tiles) | [`LightSet::sample_light`] |
-//! | [`LearnedCellSampler`] | the learned table of the receiver's cell mixed with the power sampler ([`LearnedSampler`]) | [`LightSet::sample_light`], or the pool's draw for the power share |
+//! | [`LearnedCellSampler`] | the learned table of the receiver's cell over emitters (triangles, other lights, the environment) mixed with the power sampler ([`LearnedSampler`]) | [`LightSet::sample_entry`], or the pool's draw for the power share |
 //!
 //! Each is a small value made per receiver from tables built per pass, so the candidate loop is
 //! monomorphised for each.
@@ -370,14 +370,14 @@ impl<'a> LearnedCellSampler<'a> {
         self
     }
 
-    /// The mixture's probability of `light` (or the control's).
+    /// The mixture's probability of `emitter` (or the control's).
     #[inline]
-    fn pmf(&self, lights: &LightSet, light: u32) -> f32 {
+    fn pmf(&self, lights: &LightSet, emitter: usize) -> f32 {
         if self.defensive {
-            self.learned.pmf(lights, Some(self.cell), light)
+            self.learned.pmf(lights, Some(self.cell), emitter)
         } else {
             self.learned
-                .pmf_without_defensive_share(lights, Some(self.cell), light)
+                .pmf_without_defensive_share(lights, Some(self.cell), emitter)
         }
     }
 }
@@ -402,20 +402,18 @@ impl LightSampler for LearnedCellSampler<'_> {
             && u.select >= self.learned.cell_share(Some(self.cell))
         {
             // The power sampler's share, from the pool: its density times the mixture's
-            // probability of the light over the power sampler's.
+            // probability of the emitter over the power sampler's.
             let mut c = LightCandidate::presampled(lights, &pool.entry(u.i)?, at.p, u.point)?;
-            let light = c.point.light;
-            let power_pmf = lights.pmf(light);
+            let e = lights.emitter_of(c.point.light, c.point.prim)?;
+            let power_pmf = lights.emitter_pmf(e);
             if power_pmf <= 0.0 {
                 return None;
             }
-            c.source_pdf *= self.pmf(lights, light) / power_pmf;
+            c.source_pdf *= self.pmf(lights, e) / power_pmf;
             return Some(c);
         }
-        let (light, _) = self.learned.sample(lights, Some(self.cell), u.select)?;
-        let ls = lights.sample_light(light, at.p, u.point)?;
-        let pmf = self.pmf(lights, light);
-        let power_pmf = lights.pmf(light);
-        LightCandidate::from_sample(&ls, pmf * ls.pdf_sa, power_pmf * ls.pdf_sa)
+        let (e, _) = self.learned.sample(lights, Some(self.cell), u.select)?;
+        let (ls, power_pdf_sa) = lights.sample_entry(e, self.pmf(lights, e), at.p, u.point)?;
+        LightCandidate::from_sample(&ls, ls.pdf_sa, power_pdf_sa)
     }
 }

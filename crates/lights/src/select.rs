@@ -104,8 +104,41 @@ impl LightSet {
             u_select
         };
         let (entry, pmf) = self.hierarchy().sample(ref_p, ref_n, v)?;
-        let pmf = pmf * (1.0 - self.table.env_share());
-        match self.table.entries()[entry as usize] {
+        self.sample_entry(
+            entry as usize,
+            pmf * (1.0 - self.table.env_share()),
+            ref_p,
+            u,
+        )
+    }
+
+    /// A point on emitter `entry` ([`LightSet::pick_emitter`]'s numbering: a local entry, or the
+    /// environment after them) picked with probability `pmf`, as seen from `ref_p`: the sample,
+    /// whose `pdf_sa` is `pmf` times the density of the point on the entry (uniform on a
+    /// triangle, [`LightSet::sample_light`]'s otherwise), and the density [`LightSet::sample`]
+    /// (power selection) gives the same point.
+    #[inline]
+    pub fn sample_entry(
+        &self,
+        entry: usize,
+        pmf: f32,
+        ref_p: Vec3,
+        u: Vec2,
+    ) -> Option<(LightSample, f32)> {
+        let Some(e) = self.table.entries().get(entry) else {
+            // The environment.
+            let env = self.environment.filter(|_| entry == self.table.len())?;
+            let s = self.sample_light(env, ref_p, u)?;
+            let power_pdf = s.pdf_sa * self.table.pmf(env);
+            return Some((
+                LightSample {
+                    pdf_sa: s.pdf_sa * pmf,
+                    ..s
+                },
+                power_pdf,
+            ));
+        };
+        match *e {
             Emitter::Triangle {
                 light,
                 prim,
@@ -145,6 +178,74 @@ impl LightSet {
                     },
                     power_pdf,
                 ))
+            }
+        }
+    }
+
+    /// Emitters [`LightSet::pick_emitter`] numbers: the [`LightSet::emitter_count`] local
+    /// entries of the emitter table (every emissive triangle of a mesh and every other light but
+    /// the environment, ordered by light, then by triangle), then the environment if there is
+    /// one.
+    pub fn emitters_with_environment(&self) -> usize {
+        self.table.len() + usize::from(self.environment.is_some())
+    }
+
+    /// Picks an emitter by power with uniform `u`: `(emitter, probability)`, the probability
+    /// being [`LightSet::emitter_pmf`]'s.
+    #[inline]
+    pub fn pick_emitter(&self, u: f32) -> Option<(usize, f32)> {
+        let e = match self.table.pick_index(u)? {
+            Ok(e) => e,
+            Err(_) => self.table.len(),
+        };
+        Some((e, self.emitter_pmf(e)))
+    }
+
+    /// The probability that [`LightSet::pick_emitter`] (and the power sampler) picks emitter
+    /// `e`.
+    #[inline]
+    pub fn emitter_pmf(&self, e: usize) -> f32 {
+        let s = self.table.env_share();
+        if e < self.table.len() {
+            (1.0 - s) * self.table.local_entry_pmf(e)
+        } else if e == self.table.len() && self.environment.is_some() {
+            s
+        } else {
+            0.0
+        }
+    }
+
+    /// The emitter holding the point `light`/`prim` of a light sample (`prim` is ignored for a
+    /// light that is not a triangle mesh): `None` for a light without power.
+    #[inline]
+    pub fn emitter_of(&self, light: u32, prim: u32) -> Option<usize> {
+        if Some(light) == self.environment {
+            return Some(self.table.len());
+        }
+        let entries = self.table.entries();
+        let first = entries.partition_point(|e| e.light() < light);
+        match entries.get(first)? {
+            Emitter::Whole { light: l } => (*l == light).then_some(first),
+            Emitter::Triangle { light: l, .. } if *l != light => None,
+            Emitter::Triangle { .. } => {
+                // Triangles of one mesh are in order; most meshes keep all of theirs.
+                if let Some(Emitter::Triangle {
+                    light: l, prim: q, ..
+                }) = entries.get(first + prim as usize)
+                    && *l == light
+                    && *q == prim
+                {
+                    return Some(first + prim as usize);
+                }
+                let rest = &entries[first..];
+                let n = rest.partition_point(|e| e.light() == light);
+                rest[..n]
+                    .binary_search_by_key(&prim, |e| match *e {
+                        Emitter::Triangle { prim, .. } => prim,
+                        Emitter::Whole { .. } => 0,
+                    })
+                    .ok()
+                    .map(|i| first + i)
             }
         }
     }

@@ -304,6 +304,16 @@ impl EmitterTable {
         &self.entries
     }
 
+    /// The probability that the local selection (the environment aside) picks entry `e`.
+    #[inline]
+    pub fn local_entry_pmf(&self, e: usize) -> f32 {
+        match &self.selection {
+            Selection::Empty => 0.0,
+            Selection::Single => f32::from(e == 0),
+            Selection::Alias(t) => t.pmf(e),
+        }
+    }
+
     /// Each local entry's selection weight (its power).
     pub fn weights(&self) -> &[f32] {
         &self.weights
@@ -323,6 +333,12 @@ impl EmitterTable {
     /// `Ok(entry)`.
     #[inline]
     pub fn pick(&self, u: f32) -> Option<Result<&Emitter, u32>> {
+        Some(self.pick_index(u)?.map(|e| &self.entries[e]))
+    }
+
+    /// [`EmitterTable::pick`] by index: `Err(environment light)` or `Ok(entry index)`.
+    #[inline]
+    pub fn pick_index(&self, u: f32) -> Option<Result<usize, u32>> {
         let s = self.env_share;
         if let Some(env) = self.environment
             && u < s
@@ -336,8 +352,8 @@ impl EmitterTable {
         };
         match &self.selection {
             Selection::Empty => None,
-            Selection::Single => Some(Ok(&self.entries[0])),
-            Selection::Alias(t) => Some(Ok(&self.entries[t.sample(v).0])),
+            Selection::Single => Some(Ok(0)),
+            Selection::Alias(t) => Some(Ok(t.sample(v).0)),
         }
     }
 }

@@ -1,4 +1,5 @@
-//! The learned light selection (`LearnedSampler`):
+//! The learned light selection (`LearnedSampler`), over emitters (here one per light: spheres,
+//! a point and a directional light, the environment last):
 //!
 //! - at receivers in cells with records, in a cell without records and where nothing was
 //!   recorded at all, its picks follow `pmf` (chi-square over every light), and the probability
@@ -88,12 +89,12 @@ const SAMPLES: usize = 400_000;
 
 fn histogram(learned: &LearnedSampler, set: &LightSet, cell: Option<u32>, seed: u64) -> Histogram {
     let mut rng = Pcg32::new(seed, 1);
-    let mut hist = Histogram::new(set.len());
+    let mut hist = Histogram::new(set.emitters_with_environment());
     for _ in 0..SAMPLES {
-        let (light, pmf) = learned.sample(set, cell, rng.next_f32()).unwrap();
-        assert_eq!(pmf, learned.pmf(set, cell, light), "light {light}");
+        let (e, pmf) = learned.sample(set, cell, rng.next_f32()).unwrap();
+        assert_eq!(pmf, learned.pmf(set, cell, e), "emitter {e}");
         assert!(pmf > 0.0);
-        hist.record(Some(light as usize));
+        hist.record(Some(e));
     }
     hist
 }
@@ -111,14 +112,14 @@ fn picks_follow_the_pmf_and_keep_every_light() {
     for (i, (sampler, p, n)) in cases.into_iter().enumerate() {
         let cell = sampler.cell(p, n);
         assert_eq!(cell.is_some(), i < 3, "case {i}");
-        let pmf: Vec<f64> = (0..set.len() as u32)
-            .map(|l| sampler.pmf(&set, cell, l) as f64)
+        let pmf: Vec<f64> = (0..set.emitters_with_environment())
+            .map(|e| sampler.pmf(&set, cell, e) as f64)
             .collect();
         assert!((pmf.iter().sum::<f64>() - 1.0).abs() < 1e-4, "case {i}");
         for (l, &q) in pmf.iter().enumerate() {
             // The defensive share: at least half the power sampler's probability.
             assert!(
-                q >= 0.5 * set.pmf(l as u32) as f64 * (1.0 - 1e-5),
+                q >= 0.5 * set.emitter_pmf(l) as f64 * (1.0 - 1e-5),
                 "case {i} light {l}"
             );
         }
@@ -139,7 +140,7 @@ fn same_records_same_sampler() {
     );
     let (p, n) = RECEIVERS[0];
     let (ca, cb) = (a.cell(p, n), b.cell(p, n));
-    for l in 0..set.len() as u32 {
+    for l in 0..set.emitters_with_environment() {
         assert_eq!(a.pmf(&set, ca, l).to_bits(), b.pmf(&set, cb, l).to_bits());
     }
 }
@@ -152,7 +153,7 @@ fn negative_control_pmf_without_defensive_share_is_rejected() {
     let learned = LearnedSampler::new(GRID, 0.5, 16.0, &records(1));
     let (p, n) = RECEIVERS[0];
     let cell = learned.cell(p, n);
-    let wrong: Vec<f64> = (0..set.len() as u32)
+    let wrong: Vec<f64> = (0..set.emitters_with_environment())
         .map(|l| learned.pmf_without_defensive_share(&set, cell, l) as f64)
         .collect();
     let total: f64 = wrong.iter().sum();

@@ -129,12 +129,13 @@ fn learned(lights: &LightSet) -> (LearnedSampler, u32) {
     let mut records = LightRecords::default();
     let mut rng = Pcg32::new(9, 0);
     for _ in 0..400 {
-        let light = (rng.next_u32() % 10) * 3;
-        records.add(key, light, rng.next_f32() * (light as f32 + 1.0));
+        // Spheres, triangles of both rectangles (30–33), the environment (36).
+        let e = (rng.next_u32() % 13) * 3;
+        records.add(key, e, rng.next_f32() * (e as f32 + 1.0));
     }
     let sampler = LearnedSampler::new(grid, 0.5, 16.0, &records);
     let cell = sampler.cell(AT.p, AT.n).unwrap();
-    assert!(lights.len() > 30);
+    assert_eq!(lights.emitters_with_environment(), 37);
     (sampler, cell)
 }
 
@@ -265,4 +266,29 @@ fn candidates_carry_the_power_samplers_density() {
         checked += 1;
     }
     assert!(checked > 1000);
+}
+
+/// Every emitter's samples name it back: `emitter_of` of a point drawn on emitter `e` is `e`, and
+/// the power probabilities of the emitters sum to 1.
+#[test]
+fn emitters_are_named_back() {
+    let lights = scene();
+    let mut total = 0.0f64;
+    let mut named = 0;
+    for e in 0..lights.emitters_with_environment() {
+        total += lights.emitter_pmf(e) as f64;
+        for k in 0..4 {
+            let u = Vec2::new(0.1 + 0.2 * k as f32, 0.7 - 0.15 * k as f32);
+            // From above and from below, so one-sided emitters are seen from their front.
+            for p in [AT.p, Vec3::new(0.0, 0.0, 9.0)] {
+                if let Some((ls, _)) = lights.sample_entry(e, 1.0, p, u) {
+                    let point = restir_lights::LightPoint::from_light_sample(&ls);
+                    assert_eq!(lights.emitter_of(point.light, point.prim), Some(e));
+                    named += 1;
+                }
+            }
+        }
+    }
+    assert!((total - 1.0).abs() < 1e-5, "{total}");
+    assert!(named >= 4 * lights.emitters_with_environment(), "{named}");
 }

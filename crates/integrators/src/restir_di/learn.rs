@@ -1,7 +1,7 @@
-//! Learning across passes (`--learn on`): what each light delivered to the receivers of a
-//! pass, once its shadow ray was traced, is recorded per cell of a world-space grid, and the
-//! next passes draw their candidates' lights from a mixture of those records and the power
-//! sampler ([`restir_lights::LearnedSampler`]).
+//! Learning across passes (`--learn on`): what each emitter (an emissive triangle, another
+//! light, the environment) delivered to the receivers of a pass, once its shadow ray was traced,
+//! is recorded per cell of a world-space grid, and the next passes draw their candidates from a
+//! mixture of those records and the power sampler ([`restir_lights::LearnedSampler`]).
 //!
 //! Pass `k`'s sampler is frozen from the records of passes `0..k` before pass `k` draws anything,
 //! so given the earlier passes each pass is the usual unbiased estimator with a fixed candidate
@@ -15,8 +15,8 @@ use glam::Vec3;
 use restir_lights::{CellKey, LearnGrid, LearnedSampler, LightRecords};
 use restir_scene::Scene;
 
-/// One record of a pass: a receiver's cell, the light of its shaded sample and what it
-/// delivered (luminance, shadow ray included).
+/// One record of a pass: a receiver's cell, the emitter of its shaded sample
+/// ([`restir_lights::LightSet::emitter_of`]) and what it delivered (shadow ray included).
 pub(super) type Record = (CellKey, u32, f32);
 
 /// The records of every pass so far and the sampler frozen from them.
@@ -70,8 +70,8 @@ impl Learning {
     /// Adds a pass's records, band after band in image order.
     pub fn record(&self, bands: Vec<Vec<Record>>) {
         if let Ok(mut s) = self.state.lock() {
-            for (key, light, value) in bands.into_iter().flatten() {
-                s.records.add(key, light, value);
+            for (key, emitter, value) in bands.into_iter().flatten() {
+                s.records.add(key, emitter, value);
             }
             s.sampler = None;
             s.passes += 1;
@@ -86,14 +86,20 @@ impl Learning {
     }
 }
 
-/// A record of the shaded sample of `light` at the receiver at `p` with normal `n`, which
+/// A record of the shaded sample on `emitter` at the receiver at `p` with normal `n`, which
 /// delivered `contribution` (its shadow ray found it visible). The record counts the selection
 /// (1), not the contribution: the final samples are distributed about as the target with
-/// visibility, so how often each light is selected and visible estimates its share of the
+/// visibility, so how often each emitter is selected and visible estimates its share of the
 /// receiver's direct light, with the bounded variance of a count, where the contributions'
 /// weights would carry the reservoirs' heavy tails into the tables.
 #[inline]
-pub(super) fn record(grid: &LearnGrid, p: Vec3, n: Vec3, light: u32, contribution: Vec3) -> Record {
+pub(super) fn record(
+    grid: &LearnGrid,
+    p: Vec3,
+    n: Vec3,
+    emitter: u32,
+    contribution: Vec3,
+) -> Record {
     let lit = restir_sampling::luminance(contribution) > 0.0;
-    (grid.key(p, n), light, if lit { 1.0 } else { 0.0 })
+    (grid.key(p, n), emitter, if lit { 1.0 } else { 0.0 })
 }

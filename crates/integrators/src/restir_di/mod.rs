@@ -104,8 +104,8 @@ impl RestirDiIntegrator {
     pub const RESERVOIR_BYTES: usize = std::mem::size_of::<DiReservoir>();
 
     /// Shading at receiver `r` with its final reservoir: the reservoir's sample with a shadow
-    /// ray, the BSDF samples, and the continuation. Returns radiance, rays, and the light of the
-    /// reservoir's sample with what it delivered (when it was visible and lit the receiver).
+    /// ray, the BSDF samples, and the continuation. Returns radiance, rays, and the reservoir's
+    /// sample with what it delivered (when it was visible and lit the receiver).
     fn shade(
         &self,
         scene: &Scene,
@@ -113,7 +113,7 @@ impl RestirDiIntegrator {
         ng: Vec3,
         res: &DiReservoir,
         rng: &mut Pcg32,
-    ) -> (Vec3, u64, Option<(u32, Vec3)>) {
+    ) -> (Vec3, u64, Option<(LightPoint, Vec3)>) {
         let mut l = Vec3::ZERO;
         let mut delivered = None;
         let mut rays = 0;
@@ -131,7 +131,7 @@ impl RestirDiIntegrator {
                     visible(scene, r, ng, &c)
                 } {
                     l += e.contribution * res.ucw;
-                    delivered = Some((y.light, e.contribution * res.ucw));
+                    delivered = Some((*y, e.contribution * res.ucw));
                 }
             }
         }
@@ -393,8 +393,10 @@ impl Integrator for RestirDiIntegrator {
                                 self.shade(scene, r, ng, &current[index], &mut rng);
                             *l += li;
                             rays += nr;
-                            if let (Some(g), Some((light, c))) = (&grid, delivered) {
-                                records.push(learn::record(g, r.p, r.n, light, c));
+                            if let (Some(g), Some((y, c))) = (&grid, delivered)
+                                && let Some(e) = scene.lights.emitter_of(y.light, y.prim)
+                            {
+                                records.push(learn::record(g, r.p, r.n, e as u32, c));
                             }
                         }
                     }
