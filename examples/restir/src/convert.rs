@@ -25,7 +25,7 @@ pub struct ConvertArgs {
 
 /// Runs `restir convert`.
 pub fn run(args: ConvertArgs) -> Result<(), String> {
-    let defines = crate::parse_defines(&args.defines)?;
+    let defines = crate::args::parse_defines(&args.defines)?;
     if args.output.extension().and_then(|e| e.to_str()) != Some("xml") {
         return Err(format!(
             "{}: the output must end in .xml",

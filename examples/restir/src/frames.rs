@@ -260,7 +260,7 @@ pub struct SequenceStats {
     pub integrator_settings: String,
     /// What was asked for, what ran and why.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub estimator: Option<crate::EstimatorStats>,
+    pub estimator: Option<crate::stats::EstimatorStats>,
     /// What was rebuilt for each frame.
     pub rebuilt: &'static str,
     /// Frames per second.
@@ -272,7 +272,7 @@ pub struct SequenceStats {
     /// Wall seconds of each stage of the estimator's passes, summed over the frames (empty for
     /// the path tracer).
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub stage_seconds: Vec<crate::StageSeconds>,
+    pub stage_seconds: Vec<crate::stats::StageSeconds>,
 }
 
 /// Renders the frames of `plan`: per frame, the scene at its time, rendered with `job`'s passes
@@ -355,7 +355,7 @@ pub fn render_frames(
                 .as_ref()
                 .map_or(Vec::new(), |e| e.stage_seconds())
                 .into_iter()
-                .map(|(stage, seconds)| crate::StageSeconds { stage, seconds })
+                .map(|(stage, seconds)| crate::stats::StageSeconds { stage, seconds })
                 .collect(),
             estimator: integrator
                 .as_ref()

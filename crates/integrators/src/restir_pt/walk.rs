@@ -30,31 +30,32 @@
 //! a function of the path (its vertices, materials, directions and length), so a shifted path
 //! has the same `k` iff the shift checks it (the invertibility checks of [`Walker::walk`] in
 //! replay mode, and of the reconnection from `y_{k−1}` in the shift).
+//!
+//! The rule and the reconnection live in `reconnect.rs`, the light connections (light sampling,
+//! the emitter a BSDF ray reaches) in `light_connect.rs`; this file holds the walk itself.
 
 use glam::{Vec2, Vec3};
 use restir_geometry::{Frame, Ray, SurfaceInteraction, offset_ray_origin};
-use restir_gris::jacobian::geometry_term;
 use restir_materials::{Bsdf, LobeFlags};
-use restir_sampling::{Pcg32, warp::power_heuristic};
+use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
-use super::sample::{
-    Kind, PathSample, Reconnection, ShiftKind, Vertex, connectible, evaluate_unshadowed,
-    resolve_vertex, smooth,
-};
+use super::sample::{Kind, PathSample, Reconnection, ShiftKind, connectible, smooth};
 use crate::path::{EmissionMis, PrevVertex};
 use crate::reuse::gbuffer::Receiver;
 use crate::shadow::{ShadowTarget, visible};
-use restir_lights::LightPoint;
 
-use super::candidate::{Connection, Rc};
+use super::candidate::Rc;
 
 pub use crate::path::RANDOMS_PER_BOUNCE;
 
-/// A vertex a walk scatters from (`x1`, the primary hit, or a later surface hit; [`Vertex`] is
-/// the reconnection vertex `x_k` resolved from a sample): the shading point as a [`Receiver`]
-/// (frame, `wo`, material), its geometric normal, its BSDF with textures resolved, and whether
-/// it is connectible.
+mod light_connect;
+mod reconnect;
+
+/// A vertex a walk scatters from (`x1`, the primary hit, or a later surface hit;
+/// [`Vertex`](super::sample::Vertex) is the reconnection vertex `x_k` resolved from a sample):
+/// the shading point as a [`Receiver`] (frame, `wo`, material), its geometric normal, its BSDF
+/// with textures resolved, and whether it is connectible.
 #[derive(Clone, Copy, Debug)]
 pub struct ScatterVertex {
     /// Shading point, frame, direction back along the path, material.
@@ -151,99 +152,6 @@ fn lobe_bits(l: LobeFlags) -> u32 {
 }
 
 impl Walker<'_> {
-    /// Whether vertex index `k` may be a reconnection vertex under this shift.
-    #[inline]
-    fn may_rc(&self, k: u32) -> bool {
-        match self.shift {
-            ShiftKind::Reconnection => k == 2,
-            ShiftKind::Hybrid => true,
-            ShiftKind::Replay => false,
-        }
-    }
-
-    /// Whether `q` (if at a finite distance) is at least `d_near` from `p`.
-    #[inline]
-    fn far(&self, p: Vec3, q: Option<Vec3>) -> bool {
-        q.is_none_or(|q| (q - p).length_squared() >= self.near2)
-    }
-
-    /// Whether `prev → v` may be a path's reconnection segment under [`Walker::rule`] (the
-    /// test of `v` itself, [`connectible`] for a surface, is separate). Used alike by initial
-    /// sampling, by replays and by the shift's reconnection from `y_{k−1}`, so it is one
-    /// function of the path.
-    #[inline]
-    pub fn segment_ok(&self, prev: &ScatterVertex, v: &Vertex) -> bool {
-        match self.rule {
-            Reconnection::Fixed => prev.conn && self.far(prev.r.p, v.position()),
-            Reconnection::Footprint => prev.smooth && self.footprint_ok(prev, v),
-        }
-    }
-
-    /// The footprint test of `prev → v` (module doc).
-    #[inline]
-    fn footprint_ok(&self, prev: &ScatterVertex, v: &Vertex) -> bool {
-        let (p, n) = match (v.area_point(), v.position()) {
-            (Some((p, n)), _) => (p, Some(n)),
-            (None, Some(p)) => (p, None),
-            // A direction (the environment): no distance to judge by.
-            (None, None) => return prev.conn,
-        };
-        let to = p - prev.r.p;
-        let d2 = to.length_squared();
-        if !(d2 > 0.0 && d2.is_finite()) {
-            return false;
-        }
-        let wi = to / d2.sqrt();
-        let cos = n.map_or(1.0, |n| n.dot(wi).abs());
-        let pdf = prev.bsdf.pdf_sa(prev.r.wo, prev.r.frame().to_local(wi));
-        d2 * cos >= self.footprint2 * prev.reach * prev.reach * pdf
-    }
-
-    /// Whether the light vertex `v` (index `k`, the path's last) is the reconnection vertex of a
-    /// path arriving from `prev`, given that no earlier vertex was.
-    #[inline]
-    fn end_eligible(&self, k: u32, prev: &ScatterVertex, v: &Vertex) -> bool {
-        self.may_rc(k) && self.segment_ok(prev, v)
-    }
-
-    /// Whether the surface vertex `next` (index `k`, not the path's last) is the reconnection
-    /// vertex of a path arriving from `prev`, given that no earlier vertex was. `shape`, `prim`,
-    /// `param` name it (its position is taken from them, as the shifts do).
-    #[inline]
-    fn mid_eligible(
-        &self,
-        k: u32,
-        prev: &ScatterVertex,
-        next: &ScatterVertex,
-        si: &SurfaceInteraction,
-    ) -> Option<Vertex> {
-        if !(self.may_rc(k) && next.conn) {
-            return None;
-        }
-        let at = restir_geometry::surface_at(&self.scene.shapes, si.shape, si.prim, si.param);
-        let v = Vertex::Surface(at);
-        self.segment_ok(prev, &v).then_some(v)
-    }
-
-    /// The reconnection of sample `s` from `prev` (throughput `beta` before it): the geometry
-    /// term of `x_k` seen from `prev`, and the integrand without the visibility of
-    /// `prev → x_k`, with where the shadow ray goes.
-    #[inline]
-    pub fn reconnect(
-        &self,
-        prev: &ScatterVertex,
-        beta: Vec3,
-        s: &PathSample,
-        v: &Vertex,
-    ) -> (f32, Vec3, Option<ShadowTarget>) {
-        let geometry = match v.area_point() {
-            Some((p, n)) => geometry_term(prev.r.p.into(), p.into(), n.into()),
-            None => 0.0,
-        };
-        let (f, target) = evaluate_unshadowed(self.scene, &prev.r, &prev.bsdf, s, v);
-        (geometry, beta * f, target)
-    }
-
     /// One random walk from `x1` with the generator `seed`.
     ///
     /// * `replay = None`: initial sampling. Every light connection is passed to `sink` as
@@ -345,59 +253,6 @@ impl Walker<'_> {
         self.advance(w, &step, &si)
     }
 
-    /// Light sampling at `w.cur` with the bounce's numbers `u`: a candidate for `sink`, or, in a
-    /// replay whose light connection this is (`nee_here`), the outcome.
-    fn sample_light(
-        &self,
-        w: &mut Walk,
-        bsdf: &Bsdf,
-        frame: &Frame,
-        u: &BounceRandoms,
-        nee_here: bool,
-        sink: &mut dyn FnMut(PathSample, Vec3),
-    ) -> Option<Replayed> {
-        let scene = self.scene;
-        let cur = w.cur;
-        let ls = scene.lights.sample(cur.r.p, u.select, u.light)?;
-        let direct = PathSample::direct(LightPoint::from_light_sample(&ls), Kind::DirectNee);
-        let eligible =
-            w.rc.is_none() && self.end_eligible(w.j + 1, &cur, &resolve_vertex(scene, &direct));
-        if nee_here && eligible && w.check {
-            return Some(Replayed::Fail);
-        }
-        let wi = frame.to_local(ls.wi);
-        let f = bsdf.eval(cur.r.wo, wi);
-        if f == Vec3::ZERO {
-            return None;
-        }
-        w.rays += 1;
-        if !visible(
-            scene,
-            cur.r.p,
-            cur.ng,
-            ShadowTarget::new(ls.p, ls.wi, ls.dist),
-        ) {
-            return None;
-        }
-        let mis = if ls.delta {
-            1.0
-        } else {
-            power_heuristic(ls.pdf_sa, bsdf.pdf_sa(cur.r.wo, wi))
-        };
-        let connection = Connection::Nee {
-            wi: ls.wi,
-            le: ls.le,
-            light_pdf_sa: if ls.delta { 0.0 } else { ls.pdf_sa },
-            l: f * ls.le * (mis / ls.pdf_sa),
-        };
-        if nee_here {
-            return Some(Replayed::Value(connection.value(w.beta)));
-        }
-        let sample = self.candidate(w, &connection, direct, eligible);
-        sink(sample, connection.contribution(w.beta, w.inv_q));
-        None
-    }
-
     /// BSDF sampling at `w.cur` with the bounce's numbers `u`: the lobe check of a replay,
     /// Russian roulette (initial sampling only) and the throughput update of the reconnection
     /// vertex's suffix. `None` when the walk fails here.
@@ -453,75 +308,6 @@ impl Walker<'_> {
                 mis: EmissionMis::Power,
             },
         })
-    }
-
-    /// The emitter (or the environment) the BSDF ray of `step` reached (`hit`, `None` for a
-    /// miss): a candidate for `sink`, or, in a replay whose light connection this is
-    /// (`hit_here`), the outcome.
-    fn hit_emitter(
-        &self,
-        w: &mut Walk,
-        step: &BsdfStep,
-        hit: Option<&SurfaceInteraction>,
-        hit_here: bool,
-        sink: &mut dyn FnMut(PathSample, Vec3),
-    ) -> Option<Replayed> {
-        let scene = self.scene;
-        let (y, le, light_pdf_sa) = self.emission(w.cur.r.p, step.d, hit)?;
-        let mis = step.prev.emission_weight(light_pdf_sa);
-        let direct = PathSample::direct(y, Kind::DirectHit);
-        let eligible =
-            w.rc.is_none() && self.end_eligible(w.j + 1, &w.cur, &resolve_vertex(scene, &direct));
-        let connection = Connection::Hit {
-            le,
-            mis,
-            light_pdf_sa: if step.prev.delta { 0.0 } else { light_pdf_sa },
-            next_beta: step.next_beta,
-        };
-        if hit_here {
-            if eligible && w.check {
-                return Some(Replayed::Fail);
-            }
-            return Some(Replayed::Value(connection.value(w.beta)));
-        }
-        let sample = self.candidate(w, &connection, direct, eligible);
-        sink(sample, connection.contribution(w.beta, w.inv_q));
-        None
-    }
-
-    /// The emitter (or the environment) a ray from `p` along `d` reached (`hit`, `None` for a
-    /// miss): the light point, its radiance towards `p` and the light-sampling density of that
-    /// point from `p` (solid angle); `None` when it emits nothing towards `p`.
-    fn emission(
-        &self,
-        p: Vec3,
-        d: Vec3,
-        hit: Option<&SurfaceInteraction>,
-    ) -> Option<(LightPoint, Vec3, f32)> {
-        let lights = &self.scene.lights;
-        match hit {
-            None => lights.environment().map(|env| {
-                let le = lights.environment_radiance(d);
-                let lp = lights.pdf_sa(env, p, p + d, -d);
-                (
-                    LightPoint::environment(env, lights.environment_param(d)),
-                    le,
-                    lp,
-                )
-            }),
-            Some(si) => lights.light_on_shape(si.shape).and_then(|light| {
-                let le = lights.area_radiance(light, si.shading.n, -d);
-                (le != Vec3::ZERO).then(|| {
-                    let lp = lights.pdf_sa(light, p, si.p, si.ng);
-                    let y = LightPoint {
-                        light,
-                        prim: si.prim,
-                        param: si.param,
-                    };
-                    (y, le, lp)
-                })
-            }),
-        }
     }
 
     /// What follows the reconnection vertex `x_k` of `s` (a sample whose `x_k` is a surface:

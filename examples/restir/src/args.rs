@@ -1,0 +1,230 @@
+//! The `render` command's arguments: the flags, the ReSTIR settings as typed parameters, and
+//! `-D NAME=VALUE` scene variables.
+
+use std::path::PathBuf;
+
+use restir_integrators::{Param, ParamSet, ParamValue};
+
+use crate::{cluster, frames};
+
+#[derive(clap::Args, Debug)]
+pub(crate) struct RenderArgs {
+    /// Scene file.
+    pub(crate) scene: PathBuf,
+    /// Output image: .exr (linear float32 RGB) or .png (8-bit sRGB). Default: the film's
+    /// filename from the scene, else <scene name>.exr.
+    #[arg(short = 'o', long = "output")]
+    pub(crate) output: Option<PathBuf>,
+    /// Estimator: path, restir-di, restir-pt, or auto, which chooses one of them from the scene
+    /// and says which and why (default: the scene's, else path).
+    #[arg(long)]
+    pub(crate) integrator: Option<String>,
+    /// Passes (samples per pixel); overrides the scene.
+    #[arg(long)]
+    pub(crate) spp: Option<u32>,
+    /// Render whole passes until this many seconds have passed (at least one pass).
+    #[arg(long, value_name = "SECONDS")]
+    pub(crate) time_limit: Option<f64>,
+    /// Longest path in segments from the camera (1 = emitters only, 2 = direct light, -1 = no limit).
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) max_depth: Option<i32>,
+    /// Random seed.
+    #[arg(long, default_value_t = 0)]
+    pub(crate) seed: u64,
+    /// Worker threads, 1 to 256 (0 or absent: one per core).
+    #[arg(long)]
+    pub(crate) threads: Option<usize>,
+    /// Refuse films whose estimated memory (film, images and the estimator's per-pixel
+    /// buffers) exceeds this many GiB, before allocating anything [default: 8].
+    #[arg(long, value_name = "GIB")]
+    pub(crate) max_memory: Option<f64>,
+    /// Image width; overrides the scene.
+    #[arg(long)]
+    pub(crate) width: Option<u32>,
+    /// Image height; overrides the scene.
+    #[arg(long)]
+    pub(crate) height: Option<u32>,
+    /// Set a scene <default> variable (XML scenes).
+    #[arg(short = 'D', value_name = "NAME=VALUE")]
+    pub(crate) defines: Vec<String>,
+    /// Write render statistics as JSON.
+    #[arg(long, value_name = "FILE.json")]
+    pub(crate) stats: Option<PathBuf>,
+    /// No progress bar, no warnings, no summary.
+    #[arg(long)]
+    pub(crate) quiet: bool,
+    #[command(flatten)]
+    pub(crate) restir: RestirArgs,
+    #[command(flatten)]
+    pub(crate) cluster: cluster::ClusterArgs,
+    #[command(flatten)]
+    pub(crate) frames: frames::FrameArgs,
+}
+
+/// ReSTIR settings; each overrides the scene's `<integrator>` parameter of the same name.
+#[derive(clap::Args, Debug)]
+#[command(next_help_heading = "ReSTIR")]
+pub(crate) struct RestirArgs {
+    /// Initial candidates per pixel: light samples for restir-di [default: 8], paths for
+    /// restir-pt [default: 2].
+    #[arg(long)]
+    candidates: Option<u32>,
+    /// Where candidates' lights come from: power (the power-based sampler), tiles (per
+    /// 16×16-pixel tile, mixed with a distance-aware table), bvh (the light hierarchy: per
+    /// receiver, by power, distance and orientation) or auto (decided from the scene; power at
+    /// every light count measured so far) [default: auto].
+    #[arg(long)]
+    light_sampler: Option<String>,
+    /// restir-di: on draws candidates' lights, from the second pass on, from a mixture of the
+    /// power sampler and what each light delivered (after its shadow ray) to a cell of a
+    /// world-space grid in earlier passes; off uses the light sampler alone [default: off].
+    #[arg(long)]
+    learn: Option<String>,
+    /// restir-di with --learn on: the share of candidate selections drawn from the learned
+    /// tables, from 0 to below 1 (the rest from the power sampler) [default: 0.5].
+    #[arg(long)]
+    learn_share: Option<f32>,
+    /// restir-di with --learn on: cells of the learning grid per scene diameter, along each
+    /// axis [default: 16].
+    #[arg(long)]
+    learn_cells: Option<f32>,
+    /// restir-di with --learn on: a cell with this many records draws half of --learn-share
+    /// from its table (n records: learn_share·n/(n + learn_prior)) [default: 64].
+    #[arg(long)]
+    learn_prior: Option<f32>,
+    /// Removed: a named integrator runs as named, and --integrator auto makes the never-worse
+    /// choice. Kept hidden so that old command lines get an error saying so.
+    #[arg(long, hide = true)]
+    fallback: Option<String>,
+    /// BSDF samples per pixel, MIS-combined with the reservoirs [default: 1].
+    #[arg(long)]
+    bsdf_candidates: Option<u32>,
+    /// Spatial neighbours per round [default: 4].
+    #[arg(long, alias = "neighbours")]
+    neighbors: Option<u32>,
+    /// Spatial reuse radius in pixels [default: 3].
+    #[arg(long)]
+    radius: Option<f32>,
+    /// Spatial reuse rounds [default: 1 for restir-di, 3 for restir-pt].
+    #[arg(long)]
+    spatial_rounds: Option<u32>,
+    /// Reuse MIS: defensive-pairwise, pairwise, confidence-pairwise, balance, power,
+    /// contribution, one-over-z, or uniform (biased) [default: defensive-pairwise].
+    #[arg(long)]
+    mis: Option<String>,
+    /// Temporal reuse's MIS between the pixel and its previous pixel: one of the --mis names
+    /// [default: power, or the --mis scheme when it is biased].
+    #[arg(long)]
+    temporal_mis: Option<String>,
+    /// Confidence cap after every reuse step [default: 20].
+    #[arg(long)]
+    mcap: Option<f32>,
+    /// Reuse the previous pass's reservoirs (and across the frames of a sequence, the
+    /// previous frame's): `--temporal` or `--temporal true`; `--temporal false` turns off what a
+    /// scene file turned on.
+    #[arg(long, value_name = "BOOL", num_args = 0..=1, default_missing_value = "true")]
+    temporal: Option<bool>,
+    /// With --temporal: cap the history's confidence lower where neighbouring pixels hold the
+    /// same sample, strength 0 (off) to 1 (biased) [default: 0].
+    #[arg(long, value_name = "S")]
+    duplication: Option<f32>,
+    /// restir-di: where light samples' visibility is tested: shading (once, for the selected
+    /// sample), target (in every target, a shadow ray per shift; unbiased) or reuse (the
+    /// initial selection only; biased) [default: target].
+    #[arg(long)]
+    visibility: Option<String>,
+    /// restir-di: the same as --visibility reuse (biased at shadow edges).
+    #[arg(long)]
+    visibility_reuse: bool,
+    /// Spatial neighbours in reciprocal pairs that share their shifts (pairwise MIS):
+    /// true or false [default: true].
+    #[arg(long)]
+    reciprocal: Option<bool>,
+    /// restir-pt shift map: reconnection, replay or hybrid [default: hybrid; reconnection in
+    /// scenes without delta or near-specular materials].
+    #[arg(long)]
+    shift: Option<String>,
+    /// restir-pt: reject shifts with max(J, 1/J) above this (unbiased) [default: none].
+    #[arg(long)]
+    max_jacobian: Option<f32>,
+    /// restir-pt: the rule for a path's reconnection vertex: fixed (roughness and distance
+    /// thresholds) or footprint (the lobe's footprint against the pixel's ray cone)
+    /// [default: fixed].
+    #[arg(long)]
+    reconnection: Option<String>,
+    /// restir-pt: the footprint rule's threshold T (lobe footprint over squared cone width)
+    /// [default: 30].
+    #[arg(long)]
+    footprint: Option<f32>,
+    /// restir-pt: direct light in the reservoirs (reservoir), path traced per pixel (path) or
+    /// from a ReSTIR DI pass (restir-di)
+    /// [default: reservoir].
+    #[arg(long)]
+    direct: Option<String>,
+}
+
+impl RestirArgs {
+    /// The flags given, as typed parameters (the integrator checks their ranges).
+    pub(crate) fn params(&self) -> ParamSet {
+        let mut p = ParamSet::new();
+        let mut put = |k: &str, v: Option<ParamValue>| {
+            if let Some(v) = v {
+                p.push(Param::flag(k, v));
+            }
+        };
+        put("candidates", self.candidates.map(ParamValue::Count));
+        put(
+            "light_sampler",
+            self.light_sampler.clone().map(ParamValue::Text),
+        );
+        put("learn", self.learn.clone().map(ParamValue::Text));
+        put("learn_share", self.learn_share.map(ParamValue::Number));
+        put("learn_cells", self.learn_cells.map(ParamValue::Number));
+        put("learn_prior", self.learn_prior.map(ParamValue::Number));
+        put("fallback", self.fallback.clone().map(ParamValue::Text));
+        put(
+            "bsdf_candidates",
+            self.bsdf_candidates.map(ParamValue::Count),
+        );
+        put("neighbors", self.neighbors.map(ParamValue::Count));
+        put("radius", self.radius.map(ParamValue::Number));
+        put("spatial_rounds", self.spatial_rounds.map(ParamValue::Count));
+        put("mis", self.mis.clone().map(ParamValue::Text));
+        put(
+            "temporal_mis",
+            self.temporal_mis.clone().map(ParamValue::Text),
+        );
+        put("mcap", self.mcap.map(ParamValue::Number));
+        put("duplication", self.duplication.map(ParamValue::Number));
+        put("temporal", self.temporal.map(ParamValue::Bool));
+        put("reciprocal", self.reciprocal.map(ParamValue::Bool));
+        put("visibility", self.visibility.clone().map(ParamValue::Text));
+        put(
+            "visibility_reuse",
+            self.visibility_reuse.then_some(ParamValue::Bool(true)),
+        );
+        put("shift", self.shift.clone().map(ParamValue::Text));
+        put("max_jacobian", self.max_jacobian.map(ParamValue::Number));
+        put(
+            "reconnection",
+            self.reconnection.clone().map(ParamValue::Text),
+        );
+        put("footprint", self.footprint.map(ParamValue::Number));
+        put("direct", self.direct.clone().map(ParamValue::Text));
+        p
+    }
+}
+
+/// `-D NAME=VALUE` flags as (name, value) pairs for the XML loader's `<default>` variables.
+pub(crate) fn parse_defines(flags: &[String]) -> Result<Vec<(String, String)>, String> {
+    flags
+        .iter()
+        .map(|d| {
+            let (k, v) = d
+                .split_once('=')
+                .filter(|(k, _)| !k.trim().is_empty())
+                .ok_or_else(|| format!("-D {d}: expected NAME=VALUE"))?;
+            Ok((k.trim().to_string(), v.trim().to_string()))
+        })
+        .collect()
+}
