@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 use restir_gris::{Reservoir, StreamingReservoir};
-use restir_lights::{At, CandidateU, LightSampler};
+use restir_lights::{At, CandidateU, LightPoint, LightSampler, Resolved};
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
@@ -15,8 +15,8 @@ use super::{DiReservoir, RestirDiIntegrator};
 use crate::reuse::gbuffer::Receiver;
 
 impl RestirDiIntegrator {
-    /// Initial resampling at receiver `r`, with candidates from `source`. Returns the reservoir
-    /// and the rays traced.
+    /// Initial resampling at receiver `r`, with candidates from `sampler`. Returns the
+    /// reservoir, the rays traced, and the reservoir's sample resolved in world space.
     #[inline(never)]
     pub(super) fn initial<S: LightSampler>(
         &self,
@@ -25,7 +25,7 @@ impl RestirDiIntegrator {
         ng: Vec3,
         mut sampler: S,
         rng: &mut Pcg32,
-    ) -> (DiReservoir, u64) {
+    ) -> (DiReservoir, u64, Option<(LightPoint, Resolved)>) {
         let bsdf = &r.resolve_bsdf(scene);
         if !bsdf.has_smooth_lobe() || scene.lights.is_empty() {
             return (
@@ -34,6 +34,7 @@ impl RestirDiIntegrator {
                     ..Reservoir::empty()
                 },
                 0,
+                None,
             );
         }
         let n = self.settings.candidates;
@@ -64,10 +65,11 @@ impl RestirDiIntegrator {
         let mut res = stream.finalize_recorded();
         res.confidence = 1.0;
         let mut rays = 0;
+        let resolved = res.sample.map(|y| (y, scene.lights.resolve(&y)));
         if self.settings.visibility.tests_initial()
-            && let Some(y) = res.sample
+            && let Some((_, y)) = &resolved
         {
-            let visible = scene.lights.contact(&y, r.p).is_some_and(|c| {
+            let visible = y.contact(r.p).is_some_and(|c| {
                 rays += 1;
                 visible(scene, r, ng, &c)
             });
@@ -75,8 +77,9 @@ impl RestirDiIntegrator {
                 res.sample = None;
                 res.ucw = 0.0;
                 res.own_target = 0.0;
+                return (res, rays, None);
             }
         }
-        (res, rays)
+        (res, rays, resolved)
     }
 }

@@ -37,7 +37,8 @@ use rayon::prelude::*;
 use restir_geometry::{Ray, offset_ray_origin};
 use restir_gris::Reservoir;
 use restir_lights::{
-    HierarchySampler, LearnedCellSampler, LightPoint, PoolSampler, PowerSampler, TableSampler,
+    HierarchySampler, LearnedCellSampler, LightPoint, PoolSampler, PowerSampler, Resolved,
+    TableSampler,
 };
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
@@ -112,6 +113,7 @@ impl RestirDiIntegrator {
         r: &Receiver,
         ng: Vec3,
         res: &DiReservoir,
+        cached: &Option<(LightPoint, Resolved)>,
         rng: &mut Pcg32,
     ) -> (Vec3, u64, Option<(LightPoint, Vec3)>) {
         let mut l = Vec3::ZERO;
@@ -119,7 +121,11 @@ impl RestirDiIntegrator {
         let mut rays = 0;
         let bsdf = &r.resolve_bsdf(scene);
         if let Some(y) = &res.sample
-            && let Some(c) = scene.lights.contact(y, r.p)
+            && let Some(c) = match cached {
+                Some((x, resolved)) if x == y => *resolved,
+                _ => scene.lights.resolve(y),
+            }
+            .contact(r.p)
         {
             let e = evaluate(scene, r, bsdf, y, &c, None, self.counts);
             if e.target > 0.0 {
@@ -254,6 +260,7 @@ impl Integrator for RestirDiIntegrator {
             + hits * hit_bytes
             + std::mem::size_of::<Vec3>()
             + reciprocal::table_bytes_per_pixel::<LightPoint>(&self.settings.reuse)
+            + std::mem::size_of::<Option<(LightPoint, Resolved)>>()
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
@@ -291,59 +298,69 @@ impl Integrator for RestirDiIntegrator {
                 None
             };
             let mut current = vec![DiReservoir::empty(); n];
-            rays += bands.run(&mut current[..], |first, out| {
-                let mut rays = 0;
-                for (i, res) in out.iter_mut().enumerate() {
-                    let index = first + i;
-                    if let Some(r) = gbuf.receiver(index) {
-                        let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
-                        let cell = learned.as_ref().and_then(|l| l.cell(r.p, r.n));
-                        let ng = gbuf.ng[index];
-                        let pool_tile = || {
-                            pool.as_ref().map(|p| {
-                                let (x, y) = ctx.film_xy(index, w);
-                                p.tile_of(ctx, x, y)
-                            })
-                        };
-                        let (init, nr) = if let (Some(learned), Some(cell)) = (&learned, cell) {
-                            let sampler = LearnedCellSampler::new(learned, cell, pool_tile());
-                            let sampler = if s.learn == Learn::WithoutDefensiveShare {
-                                sampler.without_defensive_share()
+            // Each pixel's initial sample resolved in world space, which the shifts into its
+            // neighbours and its own shading would otherwise resolve again.
+            let mut resolved = vec![None; n];
+            rays += bands.run(
+                (&mut current[..], &mut resolved[..]),
+                |first, (out, cache)| {
+                    let mut rays = 0;
+                    for (i, (res, cached)) in out.iter_mut().zip(cache).enumerate() {
+                        let index = first + i;
+                        if let Some(r) = gbuf.receiver(index) {
+                            let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
+                            let cell = learned.as_ref().and_then(|l| l.cell(r.p, r.n));
+                            let ng = gbuf.ng[index];
+                            let pool_tile = || {
+                                pool.as_ref().map(|p| {
+                                    let (x, y) = ctx.film_xy(index, w);
+                                    p.tile_of(ctx, x, y)
+                                })
+                            };
+                            let (init, nr, y) = if let (Some(learned), Some(cell)) =
+                                (&learned, cell)
+                            {
+                                let sampler = LearnedCellSampler::new(learned, cell, pool_tile());
+                                let sampler = if s.learn == Learn::WithoutDefensiveShare {
+                                    sampler.without_defensive_share()
+                                } else {
+                                    sampler
+                                };
+                                self.initial(scene, r, ng, sampler, &mut rng)
+                            } else if let Some(tile) = pool_tile() {
+                                let sampler =
+                                    if s.light_sampler == LightSampler::PoolWithoutSelection {
+                                        PoolSampler::without_selection(tile)
+                                    } else {
+                                        PoolSampler::new(tile)
+                                    };
+                                self.initial(scene, r, ng, sampler, &mut rng)
+                            } else if let Some(table) = light_tiles
+                                .as_ref()
+                                .and_then(|t| t.table(index % w, index / w))
+                            {
+                                let sampler = TableSampler {
+                                    table,
+                                    share: tiles::TILE_SHARE,
+                                };
+                                self.initial(scene, r, ng, sampler, &mut rng)
+                            } else if s.light_sampler.is_hierarchy() {
+                                let sampler = HierarchySampler {
+                                    claim_power_density: s.light_sampler
+                                        == LightSampler::BvhWithPowerPmf,
+                                };
+                                self.initial(scene, r, ng, sampler, &mut rng)
                             } else {
-                                sampler
+                                self.initial(scene, r, ng, PowerSampler, &mut rng)
                             };
-                            self.initial(scene, r, ng, sampler, &mut rng)
-                        } else if let Some(tile) = pool_tile() {
-                            let sampler = if s.light_sampler == LightSampler::PoolWithoutSelection {
-                                PoolSampler::without_selection(tile)
-                            } else {
-                                PoolSampler::new(tile)
-                            };
-                            self.initial(scene, r, ng, sampler, &mut rng)
-                        } else if let Some(table) = light_tiles
-                            .as_ref()
-                            .and_then(|t| t.table(index % w, index / w))
-                        {
-                            let sampler = TableSampler {
-                                table,
-                                share: tiles::TILE_SHARE,
-                            };
-                            self.initial(scene, r, ng, sampler, &mut rng)
-                        } else if s.light_sampler.is_hierarchy() {
-                            let sampler = HierarchySampler {
-                                claim_power_density: s.light_sampler
-                                    == LightSampler::BvhWithPowerPmf,
-                            };
-                            self.initial(scene, r, ng, sampler, &mut rng)
-                        } else {
-                            self.initial(scene, r, ng, PowerSampler, &mut rng)
-                        };
-                        *res = init;
-                        rays += nr;
+                            *res = init;
+                            *cached = y;
+                            rays += nr;
+                        }
                     }
-                }
-                rays
-            });
+                    rays
+                },
+            );
             self.clock.add("initial", start.elapsed());
 
             // Temporal and spatial reuse.
@@ -360,6 +377,7 @@ impl Integrator for RestirDiIntegrator {
                     _ => scene,
                 },
                 visibility: s.visibility == Visibility::Target,
+                resolved: &resolved,
             };
             let report = self.reuse.reuse(
                 &shift,
@@ -389,8 +407,14 @@ impl Integrator for RestirDiIntegrator {
                         if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_SHADE);
                             let ng = gbuf.ng[index];
-                            let (li, nr, delivered) =
-                                self.shade(scene, r, ng, &current[index], &mut rng);
+                            let (li, nr, delivered) = self.shade(
+                                scene,
+                                r,
+                                ng,
+                                &current[index],
+                                &resolved[index],
+                                &mut rng,
+                            );
                             *l += li;
                             rays += nr;
                             if let (Some(g), Some((y, c))) = (&grid, delivered)

@@ -25,20 +25,25 @@ pub(super) struct DiDomain<'a> {
     scene: &'a Scene,
     /// Whether the receiver is the previous frame's (its light indices are that frame's).
     earlier: bool,
+    /// The receiver's initial sample resolved in this pass's scene, if it has one.
+    resolved: Option<&'a (LightPoint, Resolved)>,
 }
 
 /// The identity shift between pixels: the sample stays on the light, `J = 1`; only the target
 /// changes. Across frames the sample moves with its light, which the previous frame may name
-/// by another index ([`FrameMotion`]); a rigid motion keeps area, so `J = 1` still. It keeps
-/// the receiving pixel's own sample resolved, because pairwise MIS evaluates that sample at
-/// every neighbour. With [`Visibility::Target`] a target includes the visibility of the sample
+/// by another index ([`FrameMotion`]); a rigid motion keeps area, so `J = 1` still. A sample is
+/// resolved in world space once: each pixel's initial sample after initial resampling
+/// ([`DiReuse::resolved`]), the receiving pixel's own sample when a shift first needs it
+/// (pairwise MIS evaluates it at every neighbour). With [`Visibility::Target`] a target includes the visibility of the sample
 /// from the receiver it is evaluated at: one shadow ray per shift whose unshadowed target is
 /// positive, in the scene of the destination domain.
 pub(super) struct DiShift<'a> {
     scene: &'a Scene,
     counts: StrategyCounts,
     motion: Option<&'a FrameMotion>,
-    canonical: Option<(LightPoint, Resolved)>,
+    /// The canonical sample, resolved when a shift first needs it.
+    canonical: Option<LightPoint>,
+    canonical_resolved: std::cell::OnceCell<Resolved>,
     visibility: bool,
     rays: std::cell::Cell<u64>,
 }
@@ -55,16 +60,23 @@ impl<'a> DiShift<'a> {
             scene,
             counts,
             motion,
-            canonical: canonical.sample.map(|x| (x, scene.lights.resolve(&x))),
+            canonical: canonical.sample,
+            canonical_resolved: std::cell::OnceCell::new(),
             visibility,
             rays: std::cell::Cell::new(0),
         }
     }
 
+    /// `x` resolved in this pass's scene: the canonical sample's or the source receiver's
+    /// initial sample's when it is one of them (resolving is a function of the sample, so
+    /// either is exactly what resolving again would give).
     #[inline(always)]
-    fn resolved(&self, x: &LightPoint) -> Resolved {
-        match &self.canonical {
+    fn resolved(&self, from: &DiDomain<'a>, x: &LightPoint) -> Resolved {
+        match from.resolved {
             Some((y, r)) if y == x => *r,
+            _ if self.canonical.as_ref() == Some(x) => *self
+                .canonical_resolved
+                .get_or_init(|| self.scene.lights.resolve(x)),
             _ => self.scene.lights.resolve(x),
         }
     }
@@ -91,7 +103,7 @@ impl<'a> ShiftMap<LightPoint> for DiShift<'a> {
             };
         }
         let resolved = if std::ptr::eq(to.scene, self.scene) {
-            self.resolved(&y)
+            self.resolved(from, &y)
         } else {
             to.scene.lights.resolve(&y)
         };
@@ -123,6 +135,8 @@ pub(super) struct DiReuse<'p> {
     pub(super) prev_scene: &'p Scene,
     /// Whether targets include visibility ([`Visibility::Target`]).
     pub(super) visibility: bool,
+    /// Each pixel's initial sample resolved in `scene`.
+    pub(super) resolved: &'p [Option<(LightPoint, Resolved)>],
 }
 
 impl<'p> ReuseShift for DiReuse<'p> {
@@ -161,6 +175,7 @@ impl<'p> ReuseShift for DiReuse<'p> {
                 ng: prev.ng[index],
                 scene: self.prev_scene,
                 earlier: self.motion.is_some(),
+                resolved: None,
             }
         } else {
             DiDomain {
@@ -168,6 +183,7 @@ impl<'p> ReuseShift for DiReuse<'p> {
                 ng: self.gbuf.ng[index],
                 scene: self.scene,
                 earlier: false,
+                resolved: self.resolved[index].as_ref(),
             }
         }
     }
