@@ -5,9 +5,10 @@
 //! - **The hall**: 10–14 m wide, 18–26 m long, 5–7 m high; a checkerboard floor (squares of
 //!   0.5–1 m), pale walls and ceiling. Two colonnades of 5–8 square pillars (half width
 //!   0.22–0.35 m, floor to ceiling) run along it, 2–3 m from the side walls.
-//! - **Occluders** (with `occluders`): the pillars; two or three transverse partitions at pillar
-//!   rows (not the two nearest the camera), wall to wall, each with a doorway in the nave (1.6–2.6 m wide, 2.2–2.8 m high), one
-//!   in three full height and the rest 0.45–0.7 of it (the garlands of the next bay shine over
+//! - **Occluders** (with `occluders`): the pillars; two or three transverse partitions at inner
+//!   pillar rows (not the two nearest the camera, so that its bay and the next are open), wall to
+//!   wall, each with a doorway in the nave (1.6–2.6 m wide, 2.2–2.8 m high), one in three full
+//!   height and the rest 0.45–0.7 of it (the garlands of the next bay shine over
 //!   them onto the vault, not the floor); open shelf units (two uprights, four boards) against
 //!   the side walls, about one per bay and side. Without occluders they are left out and the
 //!   garlands keep their places.
@@ -613,6 +614,116 @@ fn materials(seed: u64, receivers: Receivers, l: &Layout) -> Vec<NamedMaterial> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::{GenerateError, Kind, Params, generate};
+
+    fn options(lights: u32, occluders: bool, envmap: bool) -> DiOptions {
+        DiOptions {
+            lights,
+            receivers: Receivers::Mixed,
+            occluders,
+            envmap,
+            ..DiOptions::default()
+        }
+    }
+
+    /// Faces in the OBJ assets, and how many OBJ files.
+    fn triangles(generated: &Generated) -> (usize, usize) {
+        let objs: Vec<&str> = generated
+            .assets
+            .iter()
+            .filter_map(|a| match &a.contents {
+                AssetContents::Text(t) if a.filename.ends_with(".obj") => Some(t.as_str()),
+                _ => None,
+            })
+            .collect();
+        let faces = objs
+            .iter()
+            .map(|t| t.lines().filter(|l| l.starts_with("f ")).count())
+            .sum();
+        (faces, objs.len())
+    }
+
+    #[test]
+    fn a_hall_has_its_triangles_in_tens_of_garlands_and_builds() {
+        for (seed, lights) in [(11, 4_000), (111, 8_000), (3, 100)] {
+            let params = Params::Di(Kind::Hall, options(lights, true, true));
+            let a = generate(&params, seed).unwrap();
+            assert_eq!(a, generate(&params, seed).unwrap(), "deterministic");
+            let (faces, meshes) = triangles(&a);
+            assert_eq!(faces, lights as usize, "seed {seed}");
+            if lights >= 24 * GARLANDS.1 {
+                assert!((GARLANDS.0 as usize..=GARLANDS.1 as usize).contains(&meshes));
+            } else {
+                assert!(meshes >= 1 && meshes as u32 <= lights / 24);
+            }
+            let emitters = a.desc.shapes.iter().filter(|s| s.emission.is_some());
+            assert_eq!(emitters.count(), meshes);
+            assert_eq!(a.desc.lights.len(), 1, "the sky");
+            assert!(!a.desc.integrator.hide_emitters);
+            assert_eq!(a.desc.integrator.max_depth, 2);
+            // The RON text reads back and builds (OBJ meshes and sky written beside it).
+            let dir =
+                std::env::temp_dir().join(format!("restir-hall-{}-{seed}", std::process::id()));
+            let path = a.write(&dir, "hall").unwrap();
+            let text = std::fs::read_to_string(&path).unwrap();
+            let desc = restir_scene::parse_ron(&text, &path).unwrap();
+            assert_eq!(desc, a.desc);
+            let scene = restir_scene::Scene::build(&desc, &dir, &path).unwrap();
+            assert_eq!(scene.features.light_count, meshes + 1);
+            std::fs::remove_dir_all(&dir).unwrap();
+        }
+        let other = generate(&Params::Di(Kind::Hall, options(4_000, true, true)), 12).unwrap();
+        let first = generate(&Params::Di(Kind::Hall, options(4_000, true, true)), 11).unwrap();
+        assert_ne!(other.desc, first.desc, "another seed, another hall");
+    }
+
+    #[test]
+    fn the_options_change_what_they_name_and_nothing_else() {
+        let with = generate(&Params::Di(Kind::Hall, options(2_000, true, true)), 5).unwrap();
+        let closed = generate(&Params::Di(Kind::Hall, options(2_000, true, false)), 5).unwrap();
+        let open = generate(&Params::Di(Kind::Hall, options(2_000, false, true)), 5).unwrap();
+        // The garlands are the same meshes whatever the occluders and the sky.
+        let objs = |g: &Generated| -> Vec<Asset> {
+            g.assets
+                .iter()
+                .filter(|a| a.filename.ends_with(".obj"))
+                .cloned()
+                .collect()
+        };
+        assert_eq!(objs(&with), objs(&closed));
+        assert_eq!(objs(&with), objs(&open));
+        assert!(closed.desc.lights.is_empty());
+        assert!(closed.assets.iter().all(|a| !a.filename.ends_with(".exr")));
+        // Windows and the far doorway cut the walls into more pieces.
+        let walls = |g: &Generated| {
+            g.desc
+                .shapes
+                .iter()
+                .filter(|s| {
+                    matches!(&s.material, Some(restir_scene::MaterialRef::Ref(n)) if n == "wall")
+                })
+                .count()
+        };
+        assert!(walls(&with) > walls(&closed));
+        let occluders = |g: &Generated| {
+            g.desc
+                .shapes
+                .iter()
+                .filter(|s| {
+                    matches!(&s.material, Some(restir_scene::MaterialRef::Ref(n))
+                        if n == "partition" || n == "shelf")
+                })
+                .count()
+        };
+        assert!(occluders(&with) >= 2 && occluders(&open) == 0);
+    }
+
+    #[test]
+    fn a_hall_is_not_animated() {
+        let mut hall = generate(&Params::Di(Kind::Hall, options(500, true, false)), 1).unwrap();
+        let err = crate::animate(&mut hall, Kind::Hall, 1).unwrap_err();
+        assert!(matches!(err, GenerateError::Animation(_)), "{err}");
+    }
 
     #[test]
     fn solid_pieces_leave_the_holes_open() {

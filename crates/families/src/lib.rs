@@ -12,10 +12,10 @@
 //!
 //! The rectangles, spheres and meshes share their stage (`stage.rs`: a floor, receivers,
 //! occluders between lights and receivers, an optional environment map); the hall builds its
-//! own. All four many-light kinds are direct-light scenes (max depth 2). `envmap.rs` makes the environment images, `family.rs` the training and test
-//! families (lists of kinds, seeds and parameters), `motion.rs` the animations of the moving
-//! families ([`animate`]: camera, objects and lights in motion, from the seed), `util.rs` the
-//! shared helpers.
+//! own. All four many-light kinds are direct-light scenes (max depth 2). `envmap.rs` makes the
+//! environment images, `family.rs` the training and test families (lists of kinds, seeds and
+//! parameters), `motion.rs` the animations of the moving families ([`animate`]: camera, objects
+//! and lights in motion, from the seed), `util.rs` the shared helpers.
 //!
 //! A generated scene is a [`Generated`]: the description plus the files it names (OBJ meshes,
 //! EXR environment maps), which [`Generated::write`] puts beside the RON file. Asset names are a
