@@ -523,7 +523,13 @@ fn lights(seed: u64, options: &DiOptions, strands: &[Strand]) -> (Vec<ShapeDesc>
         if round_no > 0 {
             let along = (strand.b - strand.a).with_y(0.0).normalize_or(Vec3::X);
             let across = along.cross(Vec3::Y);
-            let shift = 0.3 * round_no as f32 * if round_no % 2 == 0 { 1.0 } else { -1.0 };
+            let shift = 0.3
+                * round_no as f32
+                * if round_no.is_multiple_of(2) {
+                    1.0
+                } else {
+                    -1.0
+                };
             strand.a += shift * across;
             strand.b += shift * across;
         }
