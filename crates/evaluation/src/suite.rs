@@ -628,8 +628,8 @@ mod tests {
                 "family split 'validation': expected train or test",
             ),
             (
-                "members: [0, 10]",
-                "the di test family has members 0 to 9, not 10",
+                "members: [0, 12]",
+                "the di test family has members 0 to 11, not 12",
             ),
         ] {
             let key = bad.split(':').next().unwrap();

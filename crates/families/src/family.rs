@@ -5,7 +5,11 @@
 //!
 //! - [`Family::Di`] (ReSTIR DI, direct light only): rectangles, spheres and emissive meshes at
 //!   10³, 10⁴ and 10⁵ lights, radiances spread over 1000×, occluders between lights and receivers,
-//!   diffuse, checkerboard, glossy and mixed receivers, four members with a sky beside the lights.
+//!   diffuse, checkerboard, glossy and mixed receivers, four members with a sky beside the lights;
+//!   and two halls (garlands of emissive triangles among pillars and partitions, a dim sky through
+//!   windows, a checkerboard floor, a rough gold statue), whose light counts differ between the
+//!   splits (training 4000 and 12000 triangles, test 8000 and 20000), so that a default chosen on
+//!   training halls is checked on halls of other sizes as well as other layouts.
 //! - [`Family::Pt`] (ReSTIR PT): glossy rooms without glass, with smooth and with rough glass,
 //!   each with and without a window to a sky.
 //! - [`Family::DiMotion`] (ReSTIR DI under motion): rectangles, spheres and emissive
@@ -88,7 +92,8 @@ pub struct FamilyMember {
     pub family: Family,
     /// The split.
     pub split: Split,
-    /// Position in the family (the same parameters in both splits).
+    /// Position in the family (the same kind and options in both splits, apart from the halls'
+    /// light counts).
     pub index: usize,
     /// Kind and options.
     pub params: Params,
@@ -123,8 +128,9 @@ impl FamilyMember {
     }
 }
 
-/// The DI family's parameters: every kind at every light count, every receiver choice, sky in four.
-fn di_params() -> Vec<Params> {
+/// The DI family's parameters: every stage kind at every light count, every receiver choice, sky
+/// in four; two halls with a sky, whose triangle counts depend on the split.
+fn di_params(split: Split) -> Vec<Params> {
     let di = |kind, lights, receivers, envmap| {
         Params::Di(
             kind,
@@ -137,8 +143,12 @@ fn di_params() -> Vec<Params> {
             },
         )
     };
-    use Kind::{Meshes, Rects, Spheres};
+    use Kind::{Hall, Meshes, Rects, Spheres};
     use Receivers::{Diffuse, Glossy, Mixed, Textured};
+    let halls = match split {
+        Split::Train => [4_000, 12_000],
+        Split::Test => [8_000, 20_000],
+    };
     vec![
         di(Rects, 1_000, Diffuse, false),
         di(Rects, 10_000, Textured, false),
@@ -150,6 +160,8 @@ fn di_params() -> Vec<Params> {
         di(Meshes, 10_000, Glossy, true),
         di(Meshes, 100_000, Mixed, false),
         di(Rects, 1_000, Mixed, true),
+        di(Hall, halls[0], Mixed, true),
+        di(Hall, halls[1], Glossy, true),
     ]
 }
 
@@ -205,7 +217,7 @@ fn pt_motion_params() -> Vec<Params> {
 /// The members of `family` for `split`.
 pub fn members(family: Family, split: Split) -> Vec<FamilyMember> {
     let params = match family {
-        Family::Di => di_params(),
+        Family::Di => di_params(split),
         Family::Pt => pt_params(),
         Family::DiMotion => di_motion_params(),
         Family::PtMotion => pt_motion_params(),

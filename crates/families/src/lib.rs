@@ -8,13 +8,14 @@
 //! | [`Kind::Spheres`] | `spheres.rs` | small emissive spheres over receivers |
 //! | [`Kind::Meshes`] | `meshes.rs` | a few emissive OBJ meshes of thousands of small triangles over receivers |
 //! | [`Kind::Room`] | `room.rs` | a glossy room lit mostly indirectly by one hidden area light |
+//! | [`Kind::Hall`] | `hall.rs`, `garlands.rs` | a hall of tens of emissive garlands (thousands of triangles) among pillars, partitions and shelves, a dim sky through its windows |
 //!
-//! The three many-light kinds share their stage (`stage.rs`: a floor, receivers, occluders
-//! between lights and receivers, an optional environment map) and are direct-light scenes (max
-//! depth 2). `envmap.rs` makes the environment images, `family.rs` the training and test
-//! families (lists of kinds, seeds and parameters), `motion.rs` the animations of the moving
-//! families ([`animate`]: camera, objects and lights in motion, from the seed), `util.rs` the
-//! shared helpers.
+//! The rectangles, spheres and meshes share their stage (`stage.rs`: a floor, receivers,
+//! occluders between lights and receivers, an optional environment map); the hall builds its
+//! own. All four many-light kinds are direct-light scenes (max depth 2). `envmap.rs` makes the
+//! environment images, `family.rs` the training and test families (lists of kinds, seeds and
+//! parameters), `motion.rs` the animations of the moving families ([`animate`]: camera, objects
+//! and lights in motion, from the seed), `util.rs` the shared helpers.
 //!
 //! A generated scene is a [`Generated`]: the description plus the files it names (OBJ meshes,
 //! EXR environment maps), which [`Generated::write`] puts beside the RON file. Asset names are a
@@ -23,6 +24,8 @@
 
 pub mod envmap;
 mod family;
+mod garlands;
+mod hall;
 mod many_lights;
 mod meshes;
 mod motion;
@@ -55,11 +58,19 @@ pub enum Kind {
     Meshes,
     /// A glossy room lit mostly indirectly.
     Room,
+    /// A hall of emissive garlands (OBJ meshes), pillars, partitions and a sky through openings.
+    Hall,
 }
 
 impl Kind {
     /// Every kind.
-    pub const ALL: [Kind; 4] = [Kind::Rects, Kind::Spheres, Kind::Meshes, Kind::Room];
+    pub const ALL: [Kind; 5] = [
+        Kind::Rects,
+        Kind::Spheres,
+        Kind::Meshes,
+        Kind::Room,
+        Kind::Hall,
+    ];
 
     /// The name on the command line and in file names.
     pub fn name(self) -> &'static str {
@@ -68,6 +79,7 @@ impl Kind {
             Kind::Spheres => "spheres",
             Kind::Meshes => "meshes",
             Kind::Room => "room",
+            Kind::Hall => "hall",
         }
     }
 }
@@ -75,7 +87,7 @@ impl Kind {
 /// The parameters of one generated scene: the kind's options.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Params {
-    /// A many-light direct-lighting scene of kind `Rects`, `Spheres` or `Meshes`.
+    /// A many-light direct-lighting scene of kind `Rects`, `Spheres`, `Meshes` or `Hall`.
     Di(Kind, DiOptions),
     /// A glossy room.
     Room(RoomOptions),
@@ -121,7 +133,7 @@ impl core::fmt::Display for GenerateError {
             }
             GenerateError::NotManyLights(kind) => write!(
                 f,
-                "{} is not a many-light kind (expected rects, spheres or meshes)",
+                "{} is not a many-light kind (expected rects, spheres, meshes or hall)",
                 kind.name()
             ),
             GenerateError::Ron(e) => write!(f, "serialising the scene: {e}"),
@@ -209,6 +221,7 @@ pub fn generate(params: &Params, seed: u64) -> Result<Generated, GenerateError> 
                 Kind::Rects => Ok(rects::rects(seed, options)),
                 Kind::Spheres => Ok(spheres::spheres(seed, options)),
                 Kind::Meshes => Ok(meshes::meshes(seed, options)),
+                Kind::Hall => Ok(hall::hall(seed, options)),
                 Kind::Room => Err(GenerateError::NotManyLights(Kind::Room)),
             }
         }
@@ -242,7 +255,7 @@ mod tests {
         let room = Params::Di(Kind::Room, DiOptions::default());
         assert_eq!(
             generate(&room, 1).unwrap_err().to_string(),
-            "room is not a many-light kind (expected rects, spheres or meshes)"
+            "room is not a many-light kind (expected rects, spheres, meshes or hall)"
         );
     }
 }

@@ -133,7 +133,7 @@ impl Stage {
 }
 
 /// A receiver material of the kind `receivers` asks for.
-fn receiver_material(rng: &mut Pcg32, receivers: Receivers) -> MaterialDesc {
+pub(super) fn receiver_material(rng: &mut Pcg32, receivers: Receivers) -> MaterialDesc {
     let receivers = if receivers == Receivers::Mixed {
         [Receivers::Diffuse, Receivers::Textured, Receivers::Glossy][rng.next_bounded(3) as usize]
     } else {

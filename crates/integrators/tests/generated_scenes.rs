@@ -1,7 +1,7 @@
 //! The generated scene kinds of `restir_families` (the ReSTIR DI and PT families): every
 //! kind builds, renders a tiny image with the path tracer and its ReSTIR estimator without a
 //! non-finite pixel and not black, the same seed gives the same scene, the families' splits are
-//! disjoint and cover every kind and light count, and the 10⁵-light members build (the time is
+//! disjoint and cover every kind and light count (halls of other sizes in each split), and the 10⁵-light members build (the time is
 //! printed: `cargo test --release -p restir-integrators --test generated_scenes -- --nocapture`).
 
 mod common;
@@ -94,6 +94,11 @@ fn every_kind_builds_and_renders_finite_and_lit() {
             di(Kind::Meshes, 2000, Receivers::Textured, true),
             "restir-di",
         ),
+        (
+            "hall",
+            di(Kind::Hall, 1200, Receivers::Mixed, true),
+            "restir-di",
+        ),
         ("room", room(Glass::None, false), "restir-pt"),
         ("room-smooth-window", room(Glass::Smooth, true), "restir-pt"),
         ("room-rough", room(Glass::Rough, false), "restir-pt"),
@@ -140,6 +145,7 @@ fn same_seed_same_scene_other_seed_other_scene() {
         di(Kind::Rects, 50, Receivers::Mixed, true),
         di(Kind::Spheres, 50, Receivers::Diffuse, false),
         di(Kind::Meshes, 500, Receivers::Glossy, false),
+        di(Kind::Hall, 500, Receivers::Mixed, true),
         room(Glass::Rough, true),
     ] {
         let a = generate(&params, 5).unwrap();
@@ -193,6 +199,23 @@ fn families_are_disjoint_and_cover_every_kind_and_light_count() {
             );
         }
     }
+    // Halls in both splits, of other sizes in each (a default chosen on training halls is
+    // checked on halls it was not chosen on).
+    let halls = |split| -> Vec<u32> {
+        members(Family::Di, split)
+            .iter()
+            .filter_map(|m| match &m.params {
+                Params::Di(Kind::Hall, o) if o.envmap => Some(o.lights),
+                _ => None,
+            })
+            .collect()
+    };
+    let (train_halls, test_halls) = (halls(Split::Train), halls(Split::Test));
+    assert!(train_halls.len() >= 2 && test_halls.len() >= 2);
+    assert!(
+        train_halls.iter().all(|n| !test_halls.contains(n)),
+        "{train_halls:?} {test_halls:?}"
+    );
     for receivers in Receivers::ALL {
         assert!(
             di.iter()

@@ -318,6 +318,13 @@ pub fn animate(generated: &mut Generated, kind: Kind, seed: u64) -> Result<(), G
             many_lights(generated, kind, &mut rng, &mut summary)?
         }
         Kind::Room => room(generated, &mut rng, &mut summary)?,
+        Kind::Hall => {
+            return Err(GenerateError::Animation(
+                "the hall is not animated (the moving families are rects, spheres, meshes and \
+                 rooms)"
+                    .into(),
+            ));
+        }
     };
     restir_scene::animation::attach(&mut generated.desc, anim, "", 0)
         .map_err(|e| GenerateError::Animation(e.message))?;
