@@ -6,6 +6,7 @@
 use glam::Vec3;
 use restir_gris::{Reservoir, StreamingReservoir};
 use restir_lights::{At, CandidateU, LightPoint, LightSampler, Resolved};
+use restir_materials::Bsdf;
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
@@ -15,18 +16,18 @@ use super::{DiReservoir, RestirDiIntegrator};
 use crate::reuse::gbuffer::Receiver;
 
 impl RestirDiIntegrator {
-    /// Initial resampling at receiver `r`, with candidates from `sampler`. Returns the
+    /// Initial resampling at receiver `r` with BSDF `bsdf`, with candidates from `sampler`. Returns the
     /// reservoir, the rays traced, and the reservoir's sample resolved in world space.
     #[inline(never)]
     pub(super) fn initial<S: LightSampler>(
         &self,
         scene: &Scene,
         r: &Receiver,
+        bsdf: &Bsdf,
         ng: Vec3,
         mut sampler: S,
         rng: &mut Pcg32,
     ) -> (DiReservoir, u64, Option<(LightPoint, Resolved)>) {
-        let bsdf = &r.resolve_bsdf(scene);
         if !bsdf.has_smooth_lobe() || scene.lights.is_empty() {
             return (
                 Reservoir {

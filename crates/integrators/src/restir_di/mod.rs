@@ -40,6 +40,7 @@ use restir_lights::{
     HierarchySampler, LearnedCellSampler, LightPoint, PoolSampler, PowerSampler, Resolved,
     TableSampler,
 };
+use restir_materials::Bsdf;
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
@@ -111,6 +112,7 @@ impl RestirDiIntegrator {
         &self,
         scene: &Scene,
         r: &Receiver,
+        bsdf: &Bsdf,
         ng: Vec3,
         res: &DiReservoir,
         cached: &Option<(LightPoint, Resolved)>,
@@ -119,7 +121,6 @@ impl RestirDiIntegrator {
         let mut l = Vec3::ZERO;
         let mut delivered = None;
         let mut rays = 0;
-        let bsdf = &r.resolve_bsdf(scene);
         if let Some(y) = &res.sample
             && let Some(c) = match cached {
                 Some((x, resolved)) if x == y => *resolved,
@@ -261,6 +262,7 @@ impl Integrator for RestirDiIntegrator {
             + std::mem::size_of::<Vec3>()
             + reciprocal::table_bytes_per_pixel::<LightPoint>(&self.settings.reuse)
             + std::mem::size_of::<Option<(LightPoint, Resolved)>>()
+            + std::mem::size_of::<Option<Bsdf>>()
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
@@ -301,13 +303,17 @@ impl Integrator for RestirDiIntegrator {
             // Each pixel's initial sample resolved in world space, which the shifts into its
             // neighbours and its own shading would otherwise resolve again.
             let mut resolved = vec![None; n];
+            // And each pixel's BSDF, textures looked up.
+            let mut bsdfs = vec![None; n];
             rays += bands.run(
-                (&mut current[..], &mut resolved[..]),
-                |first, (out, cache)| {
+                (&mut current[..], (&mut resolved[..], &mut bsdfs[..])),
+                |first, (out, (cache, bsdfs))| {
                     let mut rays = 0;
-                    for (i, (res, cached)) in out.iter_mut().zip(cache).enumerate() {
+                    let pixels = out.iter_mut().zip(cache).zip(bsdfs);
+                    for (i, ((res, cached), pixel_bsdf)) in pixels.enumerate() {
                         let index = first + i;
                         if let Some(r) = gbuf.receiver(index) {
+                            let bsdf = r.resolve_bsdf(scene);
                             let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
                             let cell = learned.as_ref().and_then(|l| l.cell(r.p, r.n));
                             let ng = gbuf.ng[index];
@@ -326,7 +332,7 @@ impl Integrator for RestirDiIntegrator {
                                 } else {
                                     sampler
                                 };
-                                self.initial(scene, r, ng, sampler, &mut rng)
+                                self.initial(scene, r, &bsdf, ng, sampler, &mut rng)
                             } else if let Some(tile) = pool_tile() {
                                 let sampler =
                                     if s.light_sampler == LightSampler::PoolWithoutSelection {
@@ -334,7 +340,7 @@ impl Integrator for RestirDiIntegrator {
                                     } else {
                                         PoolSampler::new(tile)
                                     };
-                                self.initial(scene, r, ng, sampler, &mut rng)
+                                self.initial(scene, r, &bsdf, ng, sampler, &mut rng)
                             } else if let Some(table) = light_tiles
                                 .as_ref()
                                 .and_then(|t| t.table(index % w, index / w))
@@ -343,18 +349,19 @@ impl Integrator for RestirDiIntegrator {
                                     table,
                                     share: tiles::TILE_SHARE,
                                 };
-                                self.initial(scene, r, ng, sampler, &mut rng)
+                                self.initial(scene, r, &bsdf, ng, sampler, &mut rng)
                             } else if s.light_sampler.is_hierarchy() {
                                 let sampler = HierarchySampler {
                                     claim_power_density: s.light_sampler
                                         == LightSampler::BvhWithPowerPmf,
                                 };
-                                self.initial(scene, r, ng, sampler, &mut rng)
+                                self.initial(scene, r, &bsdf, ng, sampler, &mut rng)
                             } else {
-                                self.initial(scene, r, ng, PowerSampler, &mut rng)
+                                self.initial(scene, r, &bsdf, ng, PowerSampler, &mut rng)
                             };
                             *res = init;
                             *cached = y;
+                            *pixel_bsdf = Some(bsdf);
                             rays += nr;
                         }
                     }
@@ -378,6 +385,7 @@ impl Integrator for RestirDiIntegrator {
                 },
                 visibility: s.visibility == Visibility::Target,
                 resolved: &resolved,
+                bsdfs: &bsdfs,
             };
             let report = self.reuse.reuse(
                 &shift,
@@ -407,9 +415,18 @@ impl Integrator for RestirDiIntegrator {
                         if let Some(r) = gbuf.receiver(index) {
                             let mut rng = ctx.stage_rng(index, STAGE_SHADE);
                             let ng = gbuf.ng[index];
+                            let looked_up;
+                            let bsdf = match &bsdfs[index] {
+                                Some(b) => b,
+                                None => {
+                                    looked_up = r.resolve_bsdf(scene);
+                                    &looked_up
+                                }
+                            };
                             let (li, nr, delivered) = self.shade(
                                 scene,
                                 r,
+                                bsdf,
                                 ng,
                                 &current[index],
                                 &resolved[index],

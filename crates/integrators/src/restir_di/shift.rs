@@ -5,6 +5,7 @@
 use glam::Vec3;
 use restir_gris::{ShiftMap, Shifted};
 use restir_lights::{Contact, LightPoint, Resolved};
+use restir_materials::Bsdf;
 use restir_scene::Scene;
 
 use super::DiReservoir;
@@ -27,6 +28,8 @@ pub(super) struct DiDomain<'a> {
     earlier: bool,
     /// The receiver's initial sample resolved in this pass's scene, if it has one.
     resolved: Option<&'a (LightPoint, Resolved)>,
+    /// The receiver's BSDF, if this pass looked it up already.
+    bsdf: Option<&'a Bsdf>,
 }
 
 /// The identity shift between pixels: the sample stays on the light, `J = 1`; only the target
@@ -110,8 +113,15 @@ impl<'a> ShiftMap<LightPoint> for DiShift<'a> {
         let Some(c) = resolved.contact(to.r.p) else {
             return Some(Shifted::identity(y, 0.0));
         };
-        let bsdf = to.r.resolve_bsdf(to.scene);
-        let mut p = evaluate(to.scene, to.r, &bsdf, &y, &c, None, self.counts).target;
+        let looked_up;
+        let bsdf = match to.bsdf {
+            Some(b) => b,
+            None => {
+                looked_up = to.r.resolve_bsdf(to.scene);
+                &looked_up
+            }
+        };
+        let mut p = evaluate(to.scene, to.r, bsdf, &y, &c, None, self.counts).target;
         if self.visibility && p > 0.0 {
             self.rays.set(self.rays.get() + 1);
             if !shadow::visible(to.scene, to.r.p, to.ng, shadow_target(&c)) {
@@ -137,6 +147,8 @@ pub(super) struct DiReuse<'p> {
     pub(super) visibility: bool,
     /// Each pixel's initial sample resolved in `scene`.
     pub(super) resolved: &'p [Option<(LightPoint, Resolved)>],
+    /// Each pixel's BSDF in `scene`.
+    pub(super) bsdfs: &'p [Option<Bsdf>],
 }
 
 impl<'p> ReuseShift for DiReuse<'p> {
@@ -176,6 +188,7 @@ impl<'p> ReuseShift for DiReuse<'p> {
                 scene: self.prev_scene,
                 earlier: self.motion.is_some(),
                 resolved: None,
+                bsdf: None,
             }
         } else {
             DiDomain {
@@ -184,6 +197,7 @@ impl<'p> ReuseShift for DiReuse<'p> {
                 scene: self.scene,
                 earlier: false,
                 resolved: self.resolved[index].as_ref(),
+                bsdf: self.bsdfs[index].as_ref(),
             }
         }
     }
