@@ -8,6 +8,7 @@
 //! | `select.rs` | which light: the power sampler ([`LightSet::sample`], [`LightSet::select`], [`LightSet::pmf`]) over one flat emitter table (`table.rs`: every emissive triangle, every other light), and the light hierarchy over the same entries (`bvh.rs`: [`LightSet::sample_hierarchy`], [`LightSet::hierarchy_pmf`]) |
 //! | `point.rs` | a light sample named without its receiver ([`LightPoint`], what a reservoir holds), resolved in world space ([`LightSet::resolve`], [`Resolved`]) and seen from a receiver ([`Contact`]) |
 //! | `learned.rs` | a selection learned across passes: per cell of a world-space grid, what each light delivered after its shadow ray ([`LightRecords`]), sampled in a mixture with the power sampler with its exact probability ([`LearnedSampler`]) |
+//! | `spot.rs` | [`Spot`], Mitsuba's `spot` emitter (a point light with an angular falloff and an optional projected [`SpotTexture`]) |
 //! | `presample.rs` | samples drawn without a receiver ([`LightSet::presample`], [`Presampled`]), for pools of presampled candidates |
 //!
 //! [`LightSet::sample`] returns a [`LightSample`] whose `pdf_sa` already includes the selection
@@ -20,7 +21,7 @@
 //! # The set of lights is closed
 //!
 //! A program using this crate cannot add a kind of light of its own: [`Light`] is an enum of
-//! the kinds above (area, point, directional, constant and image environment), and sampling,
+//! the kinds above (area, point, spot, directional, constant and image environment), and sampling,
 //! densities, power and the emitter table dispatch with one `match` over it. This is
 //! deliberate: light sampling runs for every candidate of every pixel, and an enum keeps those
 //! calls monomorphised and inlinable, keeps a [`LightPoint`] a 16-byte value a reservoir can
@@ -48,6 +49,7 @@ mod point;
 mod presample;
 mod select;
 mod set;
+mod spot;
 mod table;
 
 pub use envmap::{EnvMap, EnvMapError};
@@ -56,6 +58,7 @@ pub use light::{Light, LightSample};
 pub use point::{Contact, LightPoint, Resolved};
 pub use presample::Presampled;
 pub use set::{LightError, LightSet};
+pub use spot::{Spot, SpotError, SpotTexture};
 
 /// The largest emission any light may have, in each channel of its radiance, intensity or
 /// irradiance and in its power: 10²⁶. The estimators multiply emission by BSDF values,

@@ -88,7 +88,7 @@ impl Candidate {
                 return Self::from_sample(&ls, ls.pdf_sa * pmf, ls.pdf_sa * pmf);
             }
         };
-        let contact = resolved.contact(x)?;
+        let contact = resolved.contact(&scene.lights, x)?;
         // Area lights: the area density over the measure factor is the solid-angle density.
         let power_pdf_sa = if contact.measure > 0.0 {
             pdf / contact.measure
