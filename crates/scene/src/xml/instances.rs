@@ -165,3 +165,69 @@ impl<'a> Importer<'a> {
             .collect())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use crate::desc::{GeometryDesc, TransformOp, limits};
+    use crate::xml::parse_xml;
+
+    const SENSOR: &str = r#"<sensor type="perspective"/>"#;
+
+    /// Each instance places a copy of every shape of its group, the shape's transform first and
+    /// the instance's after it; the group alone places nothing.
+    #[test]
+    fn instances_copy_the_group_with_their_transform() {
+        let xml = format!(
+            r#"<scene>{SENSOR}
+            <shape type="shapegroup" id="g">
+                <shape type="sphere"><float name="radius" value="0.5"/></shape>
+                <shape type="rectangle" id="r">
+                    <transform name="to_world"><scale value="2"/></transform>
+                </shape>
+            </shape>
+            <shape type="instance"><ref id="g"/></shape>
+            <shape type="instance"><ref id="g"/>
+                <transform name="to_world"><translate x="3"/></transform>
+            </shape>
+            </scene>"#
+        );
+        let (desc, warnings) = parse_xml(&xml, Path::new("i.xml"), &[]).unwrap();
+        assert!(warnings.is_empty(), "{warnings:?}");
+        assert_eq!(desc.shapes.len(), 4);
+        assert!(matches!(desc.shapes[0].geometry, GeometryDesc::Sphere { .. }));
+        assert!(desc.shapes[0].to_world.is_empty());
+        assert_eq!(
+            desc.shapes[3].to_world,
+            vec![
+                TransformOp::Scale([2.0; 3]),
+                TransformOp::Translate([3.0, 0.0, 0.0])
+            ]
+        );
+        // Copies carry no id (an animation could not tell them apart) and are located at their
+        // instance.
+        assert!(desc.shapes.iter().all(|s| s.id.is_none()));
+        assert_eq!(desc.shapes[2].location.line, 9);
+    }
+
+    /// Many instances of a large group are refused before they are copied.
+    #[test]
+    fn too_many_copies_are_refused() {
+        let group = 1000;
+        let instances = limits::MAX_INSTANCED_SHAPES as usize / group + 1;
+        let mut xml = format!("<scene>{SENSOR}\n<shape type=\"shapegroup\" id=\"g\">\n");
+        xml.push_str(&"<shape type=\"sphere\"/>\n".repeat(group));
+        xml.push_str("</shape>\n");
+        xml.push_str(&"<shape type=\"instance\"><ref id=\"g\"/></shape>\n".repeat(instances));
+        xml.push_str("</scene>\n");
+        let e = parse_xml(&xml, Path::new("many.xml"), &[])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("many.xml:{}:", group + 3 + instances))
+                && e.contains("more than the limit of 262144"),
+            "{e}"
+        );
+    }
+}
