@@ -3,7 +3,7 @@
 //!
 //! | file | what it holds |
 //! |---|---|
-//! | `light.rs` | [`Light`] (diffuse area lights on shapes, one-sided as in Mitsuba; point, directional, constant and image environment lights, [`EnvMap`] being Mitsuba's `envmap`), [`LightSample`] (a point on one light drawn for a receiver, [`LightSet::sample_light`]) and the densities of points reached another way ([`LightSet::pdf_sa`]) |
+//! | `light.rs` | [`Light`] (diffuse area lights on shapes, one-sided as in Mitsuba; point, spot ([`Spot`]), directional, constant and image environment lights, [`EnvMap`] being Mitsuba's `envmap`), [`LightSample`] (a point on one light drawn for a receiver, [`LightSet::sample_light`]) and the densities of points reached another way ([`LightSet::pdf_sa`]) |
 //! | `set.rs` | [`LightSet`]: every light of a scene with the shapes area lights lie on (emitters know their shapes, as in Mitsuba 3's scene, so no caller hands the shape list around), each light's power, the environment's share of selections |
 //! | `select.rs` | which light: the power sampler ([`LightSet::sample`], [`LightSet::select`], [`LightSet::pmf`]) over one flat emitter table (`table.rs`: every emissive triangle, every other light), and the light hierarchy over the same entries (`bvh.rs`: [`LightSet::sample_hierarchy`], [`LightSet::hierarchy_pmf`]) |
 //! | `point.rs` | a light sample named without its receiver ([`LightPoint`], what a reservoir holds), resolved in world space ([`LightSet::resolve`], [`Resolved`]) and seen from a receiver ([`Contact`]) |
@@ -31,7 +31,7 @@
 //!
 //! What a user does instead:
 //! - **Use the nearest light through its parameters**: any emissive shape (a mesh of any
-//!   shape with a radiance), a point or directional light, a constant or image environment
+//!   shape with a radiance), a point, spot or directional light, a constant or image environment
 //!   (an HDR image with a rotation and a scale).
 //! - **Fork** and add a variant to [`Light`]: the compiler then lists every `match` that must
 //!   learn it (sampling, density, power, bounds for the hierarchy).
