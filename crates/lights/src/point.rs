@@ -241,7 +241,7 @@ impl Resolved {
                 })
             }
             Resolved::Spot { p, light } => {
-                let Light::Spot(spot) = lights.lights()[light as usize] else {
+                let Some(Light::Spot(spot)) = lights.lights().get(light as usize) else {
                     return None;
                 };
                 let to = p - x;
@@ -249,7 +249,7 @@ impl Resolved {
                 if d2.is_nan() || d2 <= 0.0 {
                     return None;
                 }
-                let intensity = lights.spot_intensity(&spot, -to);
+                let intensity = lights.spot_intensity(spot, -to);
                 if intensity == Vec3::ZERO {
                     return None;
                 }

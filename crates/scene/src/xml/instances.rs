@@ -196,7 +196,10 @@ mod tests {
         let (desc, warnings) = parse_xml(&xml, Path::new("i.xml"), &[]).unwrap();
         assert!(warnings.is_empty(), "{warnings:?}");
         assert_eq!(desc.shapes.len(), 4);
-        assert!(matches!(desc.shapes[0].geometry, GeometryDesc::Sphere { .. }));
+        assert!(matches!(
+            desc.shapes[0].geometry,
+            GeometryDesc::Sphere { .. }
+        ));
         assert!(desc.shapes[0].to_world.is_empty());
         assert_eq!(
             desc.shapes[3].to_world,
