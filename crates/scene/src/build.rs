@@ -547,19 +547,8 @@ impl Scene {
                 LightDesc::Constant { radiance } => Light::Constant {
                     radiance: v3(radiance),
                 },
-                LightDesc::Spot {
-                    intensity,
-                    cutoff_angle,
-                    beam_width,
-                    to_world,
-                    texture,
-                    location,
-                } => crate::spot::spot_light(
-                    intensity,
-                    *cutoff_angle,
-                    *beam_width,
-                    to_world,
-                    texture.as_ref(),
+                LightDesc::Spot { location, .. } => crate::spot::spot_light(
+                    l,
                     base_dir,
                     &mut |p| cache.budget.take_image(p),
                     &mut spot_textures,

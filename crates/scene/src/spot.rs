@@ -8,7 +8,7 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3};
 use restir_lights::{Light, Spot, SpotTexture};
 
-use crate::desc::{TextureDesc, TransformOp, V3, defaults, transform_matrix};
+use crate::desc::{LightDesc, TextureDesc, defaults, transform_matrix};
 use crate::texture::Texture;
 
 impl SpotTexture for Texture {
@@ -17,19 +17,26 @@ impl SpotTexture for Texture {
     }
 }
 
-/// The light of a spot description; its texture, if any, is loaded (after `take_image` counts
-/// a bitmap against the memory limit) and appended to `textures`, which the light names by
-/// index. Errors are the message without the location.
+/// The light of spot description `desc` (a [`LightDesc::Spot`]); its texture, if any, is loaded
+/// (after `take_image` counts a bitmap against the memory limit) and appended to `textures`,
+/// which the light names by index. Errors are the message without the location.
 pub(crate) fn spot_light(
-    intensity: &V3,
-    cutoff_angle: f32,
-    beam_width: Option<f32>,
-    to_world: &[TransformOp],
-    texture: Option<&TextureDesc>,
+    desc: &LightDesc,
     base_dir: &Path,
     take_image: &mut dyn FnMut(&Path) -> Result<(), String>,
     textures: &mut Vec<Arc<dyn SpotTexture>>,
 ) -> Result<Light, String> {
+    let LightDesc::Spot {
+        intensity,
+        cutoff_angle,
+        beam_width,
+        to_world,
+        texture,
+        ..
+    } = desc
+    else {
+        return Err("not a spot light".into());
+    };
     let m = transform_matrix(to_world).map_err(|e| format!("spot emitter: to_world: {e}"))?;
     let index = match texture {
         Some(t) => {
@@ -43,7 +50,7 @@ pub(crate) fn spot_light(
         None => None,
     };
     let beam = beam_width.unwrap_or(cutoff_angle * defaults::SPOT_BEAM_FRACTION);
-    let spot = Spot::new(m, Vec3::from(*intensity), cutoff_angle, beam, index)
+    let spot = Spot::new(m, Vec3::from(*intensity), *cutoff_angle, beam, index)
         .map_err(|e| format!("spot emitter: {e}"))?;
     Ok(Light::Spot(spot))
 }
