@@ -466,7 +466,11 @@ mod lights {
                 let Some(table) = t.table((i * 13) % 128, (i * 7) % 128) else {
                     continue;
                 };
-                if let Some((_, pmf, _)) = tiles::select(&scene, table, us) {
+                let mixture = restir_lights::TableSampler {
+                    table,
+                    share: tiles::TILE_SHARE,
+                };
+                if let Some((_, pmf, _)) = mixture.select(&scene.lights, us) {
                     acc += pmf;
                 }
             }

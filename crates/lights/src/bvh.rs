@@ -231,13 +231,15 @@ impl LightBvh {
                             power: w,
                         })
                     }
-                    Light::Point { position, .. } => Some(Item {
-                        entry,
-                        lo: position,
-                        hi: position,
-                        cone: Cone::ALL,
-                        power: w,
-                    }),
+                    Light::Point { position, .. } | Light::Spot(crate::Spot { position, .. }) => {
+                        Some(Item {
+                            entry,
+                            lo: position,
+                            hi: position,
+                            cone: Cone::ALL,
+                            power: w,
+                        })
+                    }
                     _ => None,
                 },
             };

@@ -8,7 +8,7 @@ use restir_geometry::{PositionSample, Shape, area_to_solid_angle};
 use restir_sampling::warp;
 
 use crate::table::Emitter;
-use crate::{EnvMap, LightSet};
+use crate::{EnvMap, LightSet, Spot};
 
 /// An emitter.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,6 +27,9 @@ pub enum Light {
         /// Radiant intensity.
         intensity: Vec3,
     },
+    /// Mitsuba's `spot`: a point light whose intensity falls off with the angle from its axis,
+    /// optionally projecting a texture ([`Spot`]).
+    Spot(Spot),
     /// A directional light.
     Directional {
         /// Unit direction in which the light travels.
@@ -185,6 +188,31 @@ impl LightSet {
                     param: Vec2::ZERO,
                 })
             }
+            Light::Spot(spot) => {
+                let to = spot.position - ref_p;
+                let d2 = to.length_squared();
+                if d2.is_nan() || d2 <= 0.0 {
+                    return None;
+                }
+                let intensity = self.spot_intensity(&spot, -to);
+                if intensity == Vec3::ZERO {
+                    return None; // outside the cone
+                }
+                let dist = d2.sqrt();
+                Some(LightSample {
+                    light,
+                    p: spot.position,
+                    n: Vec3::ZERO,
+                    ng: Vec3::ZERO,
+                    wi: to / dist,
+                    dist,
+                    le: intensity / d2,
+                    pdf_sa: 1.0,
+                    delta: true,
+                    prim: 0,
+                    param: Vec2::ZERO,
+                })
+            }
             Light::Directional {
                 direction,
                 irradiance,
@@ -258,8 +286,19 @@ impl LightSet {
                 .envmap
                 .as_ref()
                 .map_or(0.0, |m| pmf * m.pdf(-n.normalize_or_zero())),
-            Light::Point { .. } | Light::Directional { .. } => 0.0,
+            Light::Point { .. } | Light::Spot(_) | Light::Directional { .. } => 0.0,
         }
+    }
+
+    /// The intensity spot light `spot` (one of this set's) sends in world direction `w` (from
+    /// the light, any length), its texture included.
+    #[inline]
+    pub fn spot_intensity(&self, spot: &Spot, w: Vec3) -> Vec3 {
+        spot.intensity_towards(
+            w,
+            spot.texture
+                .and_then(|t| self.spot_textures.get(t as usize)),
+        )
     }
 }
 

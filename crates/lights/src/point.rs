@@ -4,7 +4,7 @@
 //!
 //! # Sample space and measure
 //!
-//! A sample is a point on an area light (area measure), a point light (counting measure), a
+//! A sample is a point on an area light (area measure), a point or spot light (counting measure), a
 //! directional light (counting measure) or a direction towards the environment (solid-angle
 //! measure on the sphere at infinity). None of these depend on the receiver, so the shift
 //! between pixels is the identity with Jacobian 1 (GRIS, Lin et al. 2022, §6: a shift that keeps the sample has Jacobian 1); each pixel's target and
@@ -103,6 +103,14 @@ pub enum Resolved {
         /// Radiant intensity.
         intensity: Vec3,
     },
+    /// A spot light (its intensity depends on the direction to the receiver: the set's light
+    /// `light` says how).
+    Spot {
+        /// Position.
+        p: Vec3,
+        /// Index of the light.
+        light: u32,
+    },
     /// A light at infinity seen in direction `wi` (towards the light).
     Direction {
         /// Unit direction towards the light.
@@ -144,6 +152,10 @@ impl LightSet {
                 p: position,
                 intensity,
             },
+            Light::Spot(spot) => Resolved::Spot {
+                p: spot.position,
+                light: sample.light,
+            },
             Light::Directional {
                 direction,
                 irradiance,
@@ -170,15 +182,16 @@ impl LightSet {
     /// Where `sample` lies as seen from `x` ([`LightSet::resolve`] then [`Resolved::contact`]).
     #[inline]
     pub fn contact(&self, sample: &LightPoint, x: Vec3) -> Option<Contact> {
-        self.resolve(sample).contact(x)
+        self.resolve(sample).contact(self, x)
     }
 }
 
 impl Resolved {
     /// The sample as seen from `x`, or `None` if it cannot contribute there (behind a one-sided
-    /// emitter, at zero distance).
+    /// emitter, outside a spot light's cone, at zero distance). `lights` is the set that resolved
+    /// it (a spot light's profile and texture are read there).
     #[inline]
-    pub fn contact(&self, x: Vec3) -> Option<Contact> {
+    pub fn contact(&self, lights: &LightSet, x: Vec3) -> Option<Contact> {
         match *self {
             Resolved::Surface {
                 p,
@@ -213,6 +226,31 @@ impl Resolved {
                 let to = p - x;
                 let d2 = to.length_squared();
                 if d2.is_nan() || d2 <= 0.0 {
+                    return None;
+                }
+                let dist = d2.sqrt();
+                Some(Contact {
+                    wi: to / dist,
+                    p,
+                    dist,
+                    le: intensity / d2,
+                    measure: 1.0,
+                    delta: true,
+                    ng: Vec3::ZERO,
+                    pdf_sa: None,
+                })
+            }
+            Resolved::Spot { p, light } => {
+                let Some(Light::Spot(spot)) = lights.lights().get(light as usize) else {
+                    return None;
+                };
+                let to = p - x;
+                let d2 = to.length_squared();
+                if d2.is_nan() || d2 <= 0.0 {
+                    return None;
+                }
+                let intensity = lights.spot_intensity(spot, -to);
+                if intensity == Vec3::ZERO {
                     return None;
                 }
                 let dist = d2.sqrt();

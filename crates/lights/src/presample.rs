@@ -75,7 +75,7 @@ impl LightSet {
         };
         let pmf = self.table.pmf(light);
         match self.lights[light as usize] {
-            Light::Area { .. } => Some(Presampled::Light { light, pmf }),
+            Light::Area { .. } | Light::Spot(_) => Some(Presampled::Light { light, pmf }),
             Light::Point {
                 position,
                 intensity,

@@ -119,7 +119,7 @@ impl LightCandidate {
                 return Self::from_sample(&ls, ls.pdf_sa * pmf, ls.pdf_sa * pmf);
             }
         };
-        let contact = resolved.contact(x)?;
+        let contact = resolved.contact(lights, x)?;
         // Area lights: the area density over the measure factor is the solid-angle density.
         if contact.measure <= 0.0 {
             return None;

@@ -12,7 +12,7 @@ use restir_sampling::luminance;
 use crate::bvh::LightBvh;
 use crate::light::bounding_sphere;
 use crate::table::EmitterTable;
-use crate::{EnvMap, Light};
+use crate::{EnvMap, Light, SpotTexture};
 
 /// Why a light set could not be built.
 #[derive(Clone, Debug, PartialEq)]
@@ -27,6 +27,8 @@ pub enum LightError {
     TooBright(usize, &'static str, f32),
     /// An `Envmap` light without an [`EnvMap`], or an [`EnvMap`] without an `Envmap` light.
     EnvmapMismatch,
+    /// A spot light names a texture the set was not given (light, texture index).
+    MissingSpotTexture(usize, u32),
 }
 
 impl core::fmt::Display for LightError {
@@ -47,6 +49,12 @@ impl core::fmt::Display for LightError {
             ),
             LightError::EnvmapMismatch => {
                 write!(f, "an envmap light needs exactly one environment image")
+            }
+            LightError::MissingSpotTexture(i, t) => {
+                write!(
+                    f,
+                    "light {i}: spot texture {t} was not given to the light set"
+                )
             }
         }
     }
@@ -77,6 +85,8 @@ pub struct LightSet {
     pub(crate) environment: Option<u32>,
     /// The image of the `Envmap` light, if there is one.
     pub(crate) envmap: Option<Arc<EnvMap>>,
+    /// The textures spot lights project ([`crate::Spot::texture`] indexes them).
+    pub(crate) spot_textures: Vec<Arc<dyn SpotTexture>>,
     pub(crate) scene_radius: f32,
     /// The light hierarchy over the table's entries, built on first use.
     pub(crate) hierarchy: OnceLock<LightBvh>,
@@ -105,6 +115,19 @@ impl LightSet {
         shapes: impl Into<Arc<[Shape]>>,
         scene_bounds: (Vec3, Vec3),
     ) -> Result<Self, LightError> {
+        Self::with_textures(lights, envmap, Vec::new(), shapes, scene_bounds)
+    }
+
+    /// Builds the set with the image of its [`Light::Envmap`] and the textures its spot lights
+    /// project ([`crate::Spot::texture`] indexes `spot_textures`; an error if one names a texture
+    /// beyond them).
+    pub fn with_textures(
+        lights: Vec<Light>,
+        envmap: Option<EnvMap>,
+        spot_textures: Vec<Arc<dyn SpotTexture>>,
+        shapes: impl Into<Arc<[Shape]>>,
+        scene_bounds: (Vec3, Vec3),
+    ) -> Result<Self, LightError> {
         let shapes: Arc<[Shape]> = shapes.into();
         let envmap_lights = lights.iter().filter(|l| **l == Light::Envmap).count();
         if envmap_lights != envmap.is_some() as usize {
@@ -128,6 +151,7 @@ impl LightSet {
             spheres.push(match *l {
                 Light::Area { shape, .. } => shapes.get(shape as usize).map(bounding_sphere),
                 Light::Point { position, .. } => Some((position, 0.0)),
+                Light::Spot(s) => Some((s.position, 0.0)),
                 Light::Directional { .. } | Light::Constant { .. } | Light::Envmap => None,
             });
             let power = match *l {
@@ -152,6 +176,19 @@ impl LightSet {
                         return Err(LightError::BadParameter(i, "intensity"));
                     }
                     4.0 * PI * luminance(intensity)
+                }
+                Light::Spot(s) => {
+                    if !valid(s.intensity) || !s.position.is_finite() {
+                        return Err(LightError::BadParameter(i, "intensity"));
+                    }
+                    if let Some(t) = s.texture
+                        && t as usize >= spot_textures.len()
+                    {
+                        return Err(LightError::MissingSpotTexture(i, t));
+                    }
+                    // The untextured power: a texture's mean is not counted (a selection
+                    // weight only).
+                    s.solid_angle() * luminance(s.intensity)
                 }
                 Light::Directional {
                     direction,
@@ -183,6 +220,7 @@ impl LightSet {
             let emission = match *l {
                 Light::Area { radiance: v, .. }
                 | Light::Point { intensity: v, .. }
+                | Light::Spot(crate::Spot { intensity: v, .. })
                 | Light::Directional { irradiance: v, .. }
                 | Light::Constant { radiance: v } => v.max_element(),
                 Light::Envmap => 0.0,
@@ -219,6 +257,7 @@ impl LightSet {
             shape_light,
             environment,
             envmap: envmap.map(Arc::new),
+            spot_textures,
             scene_radius,
             mesh_areas,
             hierarchy: OnceLock::new(),

@@ -527,6 +527,7 @@ impl Scene {
             shape_bsdf.push(bsdf);
         }
         let mut envmap = None;
+        let mut spot_textures = Vec::new();
         for l in &desc.lights {
             let light = match l {
                 LightDesc::Point {
@@ -546,6 +547,13 @@ impl Scene {
                 LightDesc::Constant { radiance } => Light::Constant {
                     radiance: v3(radiance),
                 },
+                LightDesc::Spot { location, .. } => crate::spot::spot_light(
+                    l,
+                    base_dir,
+                    &mut |p| cache.budget.take_image(p),
+                    &mut spot_textures,
+                )
+                .map_err(|e| at(location, e))?,
                 LightDesc::Envmap {
                     filename,
                     scale,
@@ -570,8 +578,14 @@ impl Scene {
 
         let accel = Accel::build(&shapes);
         let shapes: std::sync::Arc<[Shape]> = shapes.into();
-        let light_set = LightSet::with_envmap(lights, envmap, shapes.clone(), accel.bounds())
-            .map_err(|e| whole(e.to_string()))?;
+        let light_set = LightSet::with_textures(
+            lights,
+            envmap,
+            spot_textures,
+            shapes.clone(),
+            accel.bounds(),
+        )
+        .map_err(|e| whole(e.to_string()))?;
 
         // Feature summary, decided once (the material flags by `update_material_features`).
         let features = SceneFeatures {
@@ -579,10 +593,12 @@ impl Scene {
             has_glossy_lobes: false,
             has_textures: false,
             has_environment: light_set.environment().is_some(),
-            has_delta_lights: light_set
-                .lights()
-                .iter()
-                .any(|l| matches!(l, Light::Point { .. } | Light::Directional { .. })),
+            has_delta_lights: light_set.lights().iter().any(|l| {
+                matches!(
+                    l,
+                    Light::Point { .. } | Light::Spot(_) | Light::Directional { .. }
+                )
+            }),
             light_count: light_set.len(),
             emitter_count: light_set.emitter_count(),
             largest_light_share: 0.0,

@@ -32,6 +32,7 @@ mod load;
 mod material;
 mod meshio;
 pub mod spectrum;
+mod spot;
 pub mod texture;
 pub mod xml;
 

@@ -259,6 +259,10 @@ const EVERYTHING: &str = r#"(
     ],
     lights: [
         Point(position: (1, 2, 1), intensity: (3, 2, 1)),
+        Spot(intensity: (4, 4, 4)),
+        Spot(intensity: (5, 4, 3), cutoff_angle: 35, beam_width: Some(10),
+             to_world: [LookAt(origin: (0, 3, 0), target: (0, 0, 0), up: (0, 0, 1))],
+             texture: Some(Bitmap(filename: "textured/tex.png", wrap: Clamp))),
         Directional(direction: (0.2, -1, 0.1), irradiance: (0.5, 0.5, 0.5)),
         Envmap(filename: "envmap/sky.exr", scale: 0.7, to_world: [Rotate(axis: (0, 1, 0), angle: 40)]),
     ],
@@ -288,6 +292,10 @@ fn every_model_filter_camera_and_light_round_trips() {
         r#"<bsdf type="diffuse" id="sphere-bsdf">"#,
         r#"<ref id="sphere-bsdf"/>"#,
         r#"<emitter type="envmap">"#,
+        r#"<emitter type="spot">"#,
+        r#"<float name="cutoff_angle" value="35"/>"#,
+        r#"<float name="beam_width" value="10"/>"#,
+        r#"<texture type="bitmap" name="texture">"#,
         r#"<boolean name="hide_emitters" value="true"/>"#,
         "<!-- output file: out.exr -->",
     ] {

@@ -70,7 +70,7 @@ impl RestirDiIntegrator {
         if self.settings.visibility.tests_initial()
             && let Some((_, y)) = &resolved
         {
-            let visible = y.contact(r.p).is_some_and(|c| {
+            let visible = y.contact(&scene.lights, r.p).is_some_and(|c| {
                 rays += 1;
                 visible(scene, r, ng, &c)
             });

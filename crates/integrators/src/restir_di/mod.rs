@@ -108,6 +108,7 @@ impl RestirDiIntegrator {
     /// Shading at receiver `r` with its final reservoir: the reservoir's sample with a shadow
     /// ray, the BSDF samples, and the continuation. Returns radiance, rays, and the reservoir's
     /// sample with what it delivered (when it was visible and lit the receiver).
+    #[allow(clippy::too_many_arguments)] // the pixel and what the pass looked up for it
     fn shade(
         &self,
         scene: &Scene,
@@ -126,7 +127,7 @@ impl RestirDiIntegrator {
                 Some((x, resolved)) if x == y => *resolved,
                 _ => scene.lights.resolve(y),
             }
-            .contact(r.p)
+            .contact(&scene.lights, r.p)
         {
             let e = evaluate(scene, r, bsdf, y, &c, None, self.counts);
             if e.target > 0.0 {

@@ -110,7 +110,7 @@ impl<'a> ShiftMap<LightPoint> for DiShift<'a> {
         } else {
             to.scene.lights.resolve(&y)
         };
-        let Some(c) = resolved.contact(to.r.p) else {
+        let Some(c) = resolved.contact(&to.scene.lights, to.r.p) else {
             return Some(Shifted::identity(y, 0.0));
         };
         let looked_up;

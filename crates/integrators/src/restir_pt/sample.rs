@@ -241,7 +241,9 @@ impl Vertex {
     #[inline]
     pub fn position(&self) -> Option<Vec3> {
         match *self {
-            Vertex::Light(Resolved::Surface { p, .. } | Resolved::Point { p, .. }) => Some(p),
+            Vertex::Light(
+                Resolved::Surface { p, .. } | Resolved::Point { p, .. } | Resolved::Spot { p, .. },
+            ) => Some(p),
             Vertex::Surface(si) => Some(si.p),
             Vertex::Light(Resolved::Direction { .. }) => None,
         }
@@ -284,7 +286,7 @@ pub fn evaluate_unshadowed(
     let frame1 = r.frame();
     match v {
         Vertex::Light(resolved) => {
-            let Some(c) = resolved.contact(r.p) else {
+            let Some(c) = resolved.contact(&scene.lights, r.p) else {
                 return (Vec3::ZERO, None);
             };
             let wi = frame1.to_local(c.wi);

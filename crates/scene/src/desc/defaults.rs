@@ -69,6 +69,10 @@ pub const CONDUCTOR_K: V3 = [1.0; 3];
 pub const EMISSION: V3 = [1.0; 3];
 /// An envmap's radiance multiplier.
 pub const ENVMAP_SCALE: f32 = 1.0;
+/// A spot light's `cutoff_angle`, in degrees.
+pub const SPOT_CUTOFF_ANGLE: f32 = 20.0;
+/// A spot light's `beam_width` as a fraction of its `cutoff_angle`.
+pub const SPOT_BEAM_FRACTION: f32 = 0.75;
 
 /// A sphere's centre.
 pub const SPHERE_CENTER: V3 = [0.0; 3];
@@ -128,6 +132,9 @@ pub(crate) fn polypropylene_ior() -> f32 {
 }
 pub(crate) fn envmap_scale() -> f32 {
     ENVMAP_SCALE
+}
+pub(crate) fn spot_cutoff_angle() -> f32 {
+    SPOT_CUTOFF_ANGLE
 }
 
 #[cfg(test)]

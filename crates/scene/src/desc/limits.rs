@@ -24,6 +24,12 @@ pub const MAX_FILTER_WIDTH: f32 = 1e4;
 /// The most vertices, and the most triangles, one mesh (file or inline) may have: 2^25.
 pub const MAX_MESH_ELEMENTS: u64 = 1 << 25;
 
+/// The most shapes Mitsuba `instance`s may place in one scene: 2^18. Instances are copied into
+/// the scene when it is read (each copy a shape of its own, an instanced mesh loaded once per
+/// copy and counted against `--max-memory`), so a small file of many instances of a large group
+/// is refused here before any copy is made.
+pub const MAX_INSTANCED_SHAPES: u64 = 1 << 18;
+
 /// What one triangle of a mesh costs while the scene is built, in bytes, beside its vertices:
 /// its indices, per-triangle faces and area table, the BVH while obvhs builds it (its temporary
 /// memory included) and the light tables of an emissive mesh. A 1M-triangle emissive PLY (half

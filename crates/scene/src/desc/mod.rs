@@ -313,6 +313,29 @@ pub enum LightDesc {
         /// Intensity (W/sr).
         intensity: V3,
     },
+    /// Mitsuba's `spot`: a point light at the origin of `to_world`, shining along its `+z`, full
+    /// within `beam_width` of the axis, falling linearly in angle to zero at `cutoff_angle`,
+    /// optionally projecting a texture (docs/SCENES.md).
+    Spot {
+        /// Intensity on the axis (W/sr).
+        intensity: V3,
+        /// Angle from the axis beyond which nothing is emitted, in degrees (default 20).
+        #[serde(default = "defaults::spot_cutoff_angle")]
+        cutoff_angle: f32,
+        /// Angle of the full-intensity beam, in degrees (default ¾ of `cutoff_angle`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        beam_width: Option<f32>,
+        /// Position and orientation (the light at the origin, shining along `+z`).
+        #[serde(default)]
+        to_world: Vec<TransformOp>,
+        /// A texture projected along the axis (the cone's cutoff circle touches the edges of its
+        /// unit square).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        texture: Option<TextureDesc>,
+        /// Where the emitter was declared (set by importers, not part of the RON format).
+        #[serde(skip)]
+        location: Location,
+    },
     /// Light arriving from one direction.
     Directional {
         /// Direction the light travels in.

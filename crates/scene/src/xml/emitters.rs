@@ -1,10 +1,10 @@
-//! Top-level `<emitter>`s: point, directional, constant and envmap (area emitters belong to
-//! shapes).
+//! Top-level `<emitter>`s: point, spot, directional, constant and envmap (area emitters belong
+//! to shapes).
 
 use roxmltree::Node;
 
-use super::props::ColorUse;
-use super::{Importer, Result};
+use super::props::{ColorUse, Props};
+use super::{Importer, Result, elements};
 use crate::desc::*;
 
 impl<'a> Importer<'a> {
@@ -29,6 +29,7 @@ impl<'a> Importer<'a> {
                     intensity,
                 }
             }
+            "spot" => self.spot(node, &props)?,
             "directional" => {
                 let irradiance = props
                     .color("irradiance", ColorUse::Emission)?
@@ -85,6 +86,7 @@ impl<'a> Importer<'a> {
                     other,
                     &[
                         "point",
+                        "spot",
                         "directional",
                         "constant",
                         "envmap",
@@ -95,5 +97,93 @@ impl<'a> Importer<'a> {
         };
         props.finish();
         Ok(light)
+    }
+
+    /// Mitsuba's `spot` (plugin page "Spot light source"): `intensity` (a colour, not a
+    /// texture), `cutoff_angle` (20°), `beam_width` (¾ of the cutoff), `to_world`, and an
+    /// optional `texture` (nested or by reference) projected along the axis.
+    fn spot<'i>(&self, node: Node<'a, 'i>, props: &Props) -> Result<LightDesc> {
+        let intensity = props
+            .color("intensity", ColorUse::Emission)?
+            .unwrap_or(defaults::EMISSION);
+        let cutoff_angle = props
+            .float("cutoff_angle")?
+            .unwrap_or(defaults::SPOT_CUTOFF_ANGLE);
+        let beam_width = props.float("beam_width")?;
+        if let Some(p) = props.get("texture") {
+            return Err(props.err(
+                p,
+                "spot emitter: 'texture' must be a spatially varying texture (a nested or \
+                 referenced <texture>: bitmap or checkerboard), as in Mitsuba 3",
+            ));
+        }
+        let mut texture = None;
+        for c in elements(node) {
+            let tag = c.tag_name().name();
+            let found = match tag {
+                "texture" => Some((self.req_attr(c, "name")?, self.texture(c)?)),
+                "ref" => {
+                    let id = self.req_attr(c, "id")?;
+                    let (t, _) = self.textures.get(&id).ok_or_else(|| {
+                        self.err(
+                            c,
+                            format!("spot emitter: reference to undefined texture '{id}'"),
+                        )
+                    })?;
+                    Some((self.attr(c, "name")?.unwrap_or_default(), t.clone()))
+                }
+                _ => None,
+            };
+            let Some((name, t)) = found else { continue };
+            match name.as_str() {
+                "texture" if texture.is_none() => texture = Some(t),
+                "texture" => return Err(self.err(c, "spot emitter: a second 'texture'")),
+                "intensity" => {
+                    return Err(self.err(
+                        c,
+                        "spot emitter: 'intensity' cannot be a texture (give a colour; a \
+                         spatially varying pattern goes in 'texture'), as in Mitsuba 3",
+                    ));
+                }
+                other => {
+                    return Err(self.err(
+                        c,
+                        format!("spot emitter: '{other}' cannot be a texture (only 'texture' can)"),
+                    ));
+                }
+            }
+        }
+        let max_cutoff = if texture.is_some() { 90.0 } else { 180.0 };
+        if !(cutoff_angle > 0.0 && cutoff_angle < max_cutoff) {
+            return Err(self.err(
+                props.node_or("cutoff_angle", node),
+                format!(
+                    "spot emitter: cutoff_angle {cutoff_angle}° must be in (0°, {max_cutoff}°){}",
+                    if texture.is_some() {
+                        " with a texture (its projection needs tan(cutoff_angle) > 0)"
+                    } else {
+                        ""
+                    }
+                ),
+            ));
+        }
+        let beam = beam_width.unwrap_or(cutoff_angle * defaults::SPOT_BEAM_FRACTION);
+        if !(beam >= 0.0 && beam <= cutoff_angle) {
+            return Err(self.err(
+                props.node_or("beam_width", node),
+                format!(
+                    "spot emitter: beam_width {beam}° must be in [0°, cutoff_angle] = [0°, \
+                     {cutoff_angle}°]"
+                ),
+            ));
+        }
+        Ok(LightDesc::Spot {
+            intensity,
+            cutoff_angle,
+            beam_width,
+            to_world: props.transform("to_world")?,
+            texture,
+            location: self.loc(node),
+        })
     }
 }

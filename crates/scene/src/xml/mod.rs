@@ -24,6 +24,7 @@
 
 mod bsdfs;
 mod emitters;
+mod instances;
 mod integrator;
 mod normalmap;
 mod props;
@@ -83,6 +84,10 @@ struct Importer<'a> {
     saw_sensor: bool,
     /// How deep in `<include>`s this file is (0: the scene file).
     depth: u32,
+    /// Shapegroups by id, with the line that declares them.
+    groups: HashMap<String, (instances::ShapeGroup, u32)>,
+    /// How many shapes instances have placed so far.
+    instanced: usize,
 }
 
 /// The importer reads attributes and reports errors through its source.
@@ -145,6 +150,8 @@ pub fn parse_xml(
         declared: declared.into_iter().map(|(k, _)| k).collect(),
         saw_sensor: false,
         depth: 0,
+        groups: HashMap::new(),
+        instanced: 0,
     };
 
     let mut desc = SceneDesc {
@@ -258,10 +265,18 @@ impl<'a> Importer<'a> {
                     let line = self.loc(c).line;
                     self.textures.insert(id, (t, line));
                 }
-                "shape" => {
-                    let s = self.shape(c)?;
-                    desc.shapes.push(s);
-                }
+                "shape" => match self.plugin_type(c)?.as_str() {
+                    "shapegroup" => self.shapegroup(c)?,
+                    "instance" => {
+                        let placed = self.instance(c, self.instanced)?;
+                        self.instanced += placed.len();
+                        desc.shapes.extend(placed);
+                    }
+                    _ => {
+                        let s = self.shape(c)?;
+                        desc.shapes.push(s);
+                    }
+                },
                 "emitter" => {
                     let l = self.emitter(c)?;
                     // Mitsuba allows one environment emitter per scene.

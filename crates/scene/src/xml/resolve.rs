@@ -187,6 +187,8 @@ impl<'a> Importer<'a> {
             declared: std::mem::take(&mut self.declared),
             saw_sensor: self.saw_sensor,
             depth: self.depth + 1,
+            groups: std::mem::take(&mut self.groups),
+            instanced: self.instanced,
         };
         let result = nested.walk(root, desc);
         self.bsdf_ids = nested.bsdf_ids;
@@ -195,6 +197,8 @@ impl<'a> Importer<'a> {
         self.files = nested.files;
         self.declared = nested.declared;
         self.saw_sensor = nested.saw_sensor;
+        self.groups = nested.groups;
+        self.instanced = nested.instanced;
         self.warnings.borrow_mut().extend(src.warnings.into_inner());
         result.map_err(context)
     }

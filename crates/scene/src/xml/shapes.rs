@@ -67,6 +67,8 @@ impl<'a> Importer<'a> {
                         "obj",
                         "ply",
                         "serialized",
+                        "shapegroup",
+                        "instance",
                     ],
                 ));
             }

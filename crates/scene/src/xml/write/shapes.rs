@@ -114,6 +114,30 @@ impl Writer<'_> {
                 ));
                 self.rgb("intensity", intensity);
             }
+            LightDesc::Spot {
+                intensity,
+                cutoff_angle,
+                beam_width,
+                to_world,
+                texture,
+                ..
+            } => {
+                finite("a spot light", "intensity", intensity)?;
+                finite("a spot light", "cutoff_angle", &[*cutoff_angle])?;
+                self.open(r#"<emitter type="spot">"#);
+                self.rgb("intensity", intensity);
+                if *cutoff_angle != defaults::SPOT_CUTOFF_ANGLE {
+                    self.float("cutoff_angle", *cutoff_angle);
+                }
+                if let Some(b) = beam_width {
+                    finite("a spot light", "beam_width", &[*b])?;
+                    self.float("beam_width", *b);
+                }
+                self.transform("to_world", to_world, "a spot light")?;
+                if let Some(t) = texture {
+                    self.texture(t, "texture", "a spot light")?;
+                }
+            }
             LightDesc::Directional {
                 direction,
                 irradiance,
