@@ -26,7 +26,7 @@ use glam::Vec3;
 use restir_geometry::Shape;
 
 use crate::Light;
-use crate::table::Emitter;
+use crate::table::{Emitter, EmitterTable};
 
 /// A cone of directions: `axis`, `cos θo` (every normal within `θo` of it) and `cos θe` (the
 /// emission spread beyond a normal).
@@ -186,8 +186,10 @@ pub(crate) struct LightBvh {
 }
 
 impl LightBvh {
-    /// Builds the tree over `entries` with their selection weights `weights` (power).
-    pub fn new(lights: &[Light], shapes: &[Shape], entries: &[Emitter], weights: &[f32]) -> Self {
+    /// Builds the tree over the entries of `table` with their selection weights `weights`
+    /// (power).
+    pub fn new(lights: &[Light], shapes: &[Shape], table: &EmitterTable, weights: &[f32]) -> Self {
+        let entries = table.entries();
         let mut items = Vec::with_capacity(entries.len());
         let mut unbounded = Vec::new();
         let (mut bounded_power, mut unbounded_power) = (0.0f64, 0.0f64);
@@ -198,19 +200,18 @@ impl LightBvh {
             let entry = i as u32;
             let item = match *e {
                 Emitter::Triangle {
-                    ref p, n, smooth, ..
+                    ref p, ng, shading, ..
                 } => Some(Item {
                     entry,
                     lo: p[0].min(p[1]).min(p[2]),
                     hi: p[0].max(p[1]).max(p[2]),
-                    cone: if smooth {
-                        Cone::ALL
-                    } else {
-                        Cone {
+                    cone: match table.constant_normal(ng, shading) {
+                        None => Cone::ALL,
+                        Some(n) => Cone {
                             axis: n,
                             cos_o: 1.0,
                             cos_e: 0.0,
-                        }
+                        },
                     },
                     power: w,
                 }),
