@@ -26,8 +26,9 @@
 //! reference or render needs it and dropped after, and each frame's reference is read back from
 //! its cached file when the frame is compared, so memory does not grow with the frame count.
 //!
-//! **Memory and errors.** Before anything of the size of an image is allocated, each scene's
-//! renders are estimated ([`BYTES_PER_PIXEL`], the largest estimator buffers, the images kept for
+//! **Memory and errors.** Each scene's meshes and images are checked against the same limit
+//! while it loads, before each is built or decoded, as `restir render` checks them. Before
+//! anything of the size of an image is allocated, each scene's renders are estimated ([`BYTES_PER_PIXEL`], the largest estimator buffers, the images kept for
 //! the page) against [`RunOptions::max_memory_gib`]. Errors about one entry of the suite name
 //! its line in the suite file ([`suite::SuiteLines`]).
 //!

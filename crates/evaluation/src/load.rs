@@ -63,17 +63,21 @@ impl LoadedSuiteScene {
     }
 }
 
-/// Loads a suite scene. Every frame of a sequence is built once here, so that a bad frame fails
-/// before any rendering, and dropped before the next is built.
+/// Loads a suite scene, its meshes and images checked against `max_memory` bytes
+/// (`--max-memory`, as `restir render` checks them) before each is built. Every frame of a
+/// sequence is built once here, so that a bad frame fails before any rendering, and dropped
+/// before the next is built.
 pub(crate) fn load_suite_scene(
     entry: &SuiteScene,
     suite_dir: &Path,
+    max_memory: Option<u64>,
 ) -> Result<LoadedSuiteScene, BenchError> {
     let path = suite_dir.join(&entry.path);
     let file_bytes = read_regular(&path).map_err(BenchError::io(&path, "cannot read scene: "))?;
     let options = LoadOptions {
         width: entry.width,
         height: entry.height,
+        max_memory,
         ..LoadOptions::default()
     };
     let loaded = load_scene(&path, &options)?;
@@ -183,7 +187,7 @@ mod tests {
     /// no one else (memory independent of the frame count), the same scene the sequence builds.
     #[test]
     fn a_sequence_builds_its_frames_one_at_a_time() {
-        let loaded = load_suite_scene(&still_life(Some((0, 5))), &scenes_dir()).unwrap();
+        let loaded = load_suite_scene(&still_life(Some((0, 5))), &scenes_dir(), None).unwrap();
         assert_eq!(loaded.view_count(), 6);
         assert_eq!(loaded.views().first(), Some(&Some(0)));
         let first = loaded.frame(Some(0)).unwrap();
@@ -205,7 +209,7 @@ mod tests {
 
     #[test]
     fn a_still_scene_has_one_view() {
-        let loaded = load_suite_scene(&still_life(None), &scenes_dir()).unwrap();
+        let loaded = load_suite_scene(&still_life(None), &scenes_dir(), None).unwrap();
         assert_eq!(loaded.views(), vec![None]);
         assert_eq!(loaded.view_count(), 1);
     }

@@ -173,7 +173,8 @@ pub struct RunOptions {
     /// The command line, for the report.
     pub command_line: String,
     /// The most memory a scene's renders may need, in GiB (`--max-memory`), estimated before
-    /// anything of the size of the image is allocated ([`crate::BYTES_PER_PIXEL`]).
+    /// anything of the size of the image is allocated ([`crate::BYTES_PER_PIXEL`]); a scene's
+    /// meshes and images are checked against it while it loads.
     pub max_memory_gib: f64,
     /// Where the suite's entries are in its file, so that errors name the line.
     pub lines: SuiteLines,

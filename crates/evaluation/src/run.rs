@@ -234,7 +234,9 @@ pub fn run_suite(
     let mut scenes = Vec::new();
     for (si, entry) in suite.scenes.iter().enumerate() {
         let at_scene = |e: BenchError| e.at(file, scene_line(si));
-        let loaded = load_suite_scene(entry, &opts.suite_dir).map_err(at_scene)?;
+        let max_bytes = opts.max_memory_gib * (1u64 << 30) as f64;
+        let loaded =
+            load_suite_scene(entry, &opts.suite_dir, Some(max_bytes as u64)).map_err(at_scene)?;
         let mut largest_buffers = 0u64;
         let mut configs = 0u64;
         for (ci, config) in suite.integrators.iter().enumerate() {

@@ -1,9 +1,10 @@
 //! `restir-fuzz`: deterministic mutation fuzzing of the scene loader, one target per input format
 //! (`xml`, `ron`, `obj`, `ply`, `serialized`, `exr`, `hdr`, `png`), the reader of the parts
 //! of a split render that `restir merge` reads (`part`: `restir_image::Image::read_exr_part`),
-//! `restir bench` suite files (`suite`: `restir_evaluation::Suite::load_located`) and animation
+//! `restir bench` suite files (`suite`: `restir_evaluation::Suite::load_located`), animation
 //! files (`anim`: an XML scene's `NAME.anim.ron` sidecar, loaded with the scene and built at a
-//! few times).
+//! few times) and the rough-plastic table cache (`cache`: a file at a table's name in the cache
+//! directory, read when a scene with that material loads).
 //!
 //! Coverage-guided fuzzers need nightly Rust (cargo-fuzz) or an AFL++ toolchain; this workspace
 //! builds on one stable toolchain, so the harness mutates the checked-in seeds in
@@ -25,8 +26,9 @@ use std::process::{Command, ExitCode, Stdio};
 use std::time::{Duration, Instant};
 
 /// The formats, with how an input of each is placed into a scene.
-const TARGETS: [&str; 11] = [
+const TARGETS: [&str; 12] = [
     "part",
+    "cache",
     "suite",
     "anim",
     "xml",
@@ -197,6 +199,10 @@ fn wrapper_scene(target: &str, asset: &str) -> String {
 /// The scene an animation input (`anim`) is the sidecar of: shapes with the ids its seed names.
 const ANIM_SCENE: &str = r#"<scene version="3.0.0"><sensor type="perspective"><film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor><shape type="sphere" id="copper"><point name="center" x="-1.1" y="0.38" z="-0.6"/><float name="radius" value="0.38"/></shape><shape type="rectangle" id="light_small"><emitter type="area"><rgb name="radiance" value="20"/></emitter></shape></scene>"#;
 
+/// The scene a table cache input (`cache`) is read by: a rough plastic whose table is the one
+/// the seed holds (GGX, α = 0.3, η = 1.5).
+const CACHE_SCENE: &str = r#"<scene version="3.0.0"><sensor type="perspective"><film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor><bsdf type="roughplastic" id="m"><string name="distribution" value="ggx"/><float name="alpha" value="0.3"/><float name="int_ior" value="1.5"/><float name="ext_ior" value="1"/></bsdf><shape type="rectangle"><ref id="m"/></shape><emitter type="constant"/></scene>"#;
+
 /// Reports a loader's answer as the child does: success, or an error that must be one line and
 /// must not happen for a seed.
 fn answer(result: Result<(), String>) -> ExitCode {
@@ -232,6 +238,30 @@ fn load_animated(input: &Path) -> Result<(), String> {
     Ok(())
 }
 
+/// A table cache input: `input` lies in a directory of its own under the name of the table the
+/// seed holds; that directory is the cache while [`CACHE_SCENE`] loads. A seed must be read as
+/// it is (the loader rebuilding and replacing it would mean its name or contents went stale, and
+/// the target no longer reached the reader).
+fn load_cached(input: &Path) -> Result<(), String> {
+    use std::os::unix::fs::MetadataExt as _;
+    let cache = input.parent().ok_or("the input has no directory")?;
+    let work = cache.parent().unwrap_or(Path::new("."));
+    let scene = work.join("cache-scene.xml");
+    std::fs::write(&scene, CACHE_SCENE).map_err(|e| e.to_string())?;
+    let inode = std::fs::metadata(input).map_err(|e| e.to_string())?.ino();
+    restir_materials::table_cache::set_cache_dir(Some(cache.to_path_buf()));
+    restir_scene::load_scene(&scene, &restir_scene::LoadOptions::default())
+        .map_err(|e| e.to_string())?;
+    let replaced = std::fs::metadata(input).map_or(true, |m| m.ino() != inode);
+    if replaced && std::env::var_os("RESTIR_FUZZ_SEED").is_some() {
+        return Err(format!(
+            "{}: the cache did not read the seed (stale name or table version?)",
+            input.display()
+        ));
+    }
+    Ok(())
+}
+
 /// The child: loads one input of `target` (`input` is the mutated file) and exits 0 whatever the
 /// loader says, so that only panics, aborts, signals and hangs count as failures.
 fn run_one(target: &str, input: &Path) -> ExitCode {
@@ -258,6 +288,7 @@ fn run_one(target: &str, input: &Path) -> ExitCode {
             );
         }
         "anim" => return answer(load_animated(input)),
+        "cache" => return answer(load_cached(input)),
         _ => {}
     }
     let scene = match target {
@@ -419,7 +450,18 @@ fn run(o: &Options) -> ExitCode {
                 .extension()
                 .and_then(|e| e.to_str())
                 .unwrap_or(target);
-            let input = dir.join(format!("input.{ext}"));
+            // A cache input keeps its seed's name (the table's), in a directory of its own.
+            let input = if target == "cache" {
+                dir.join("cache").join(name)
+            } else {
+                dir.join(format!("input.{ext}"))
+            };
+            if let Some(parent) = input.parent()
+                && std::fs::create_dir_all(parent).is_err()
+            {
+                eprintln!("cannot create {}", parent.display());
+                return ExitCode::FAILURE;
+            }
             if std::fs::File::create(&input)
                 .and_then(|mut f| f.write_all(&bytes))
                 .is_err()
@@ -492,6 +534,25 @@ mod tests {
         assert!(e.contains("x\\nml") && e.contains("resti\\u{0}r-di"), "{e}");
         // The seed itself loads.
         restir_evaluation::Suite::parse(seed, Path::new("s.ron")).unwrap();
+    }
+
+    /// The cache seed is named for the table version the cache reads, so that the target
+    /// reaches the reader (a stale name would only be rebuilt; the seed run catches that too).
+    #[test]
+    fn the_cache_seed_has_a_current_name() {
+        let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("corpus");
+        let prefix = format!(
+            "roughplastic-v{}-",
+            restir_materials::table_cache::TABLE_VERSION
+        );
+        let seeds = seeds(&corpus, "cache");
+        assert!(!seeds.is_empty());
+        for (name, _) in seeds {
+            assert!(
+                name.starts_with(&prefix),
+                "{name} does not start with {prefix}"
+            );
+        }
     }
 
     /// The mutator is deterministic and does change its input.

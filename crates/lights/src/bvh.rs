@@ -26,7 +26,7 @@ use glam::Vec3;
 use restir_geometry::Shape;
 
 use crate::Light;
-use crate::table::Emitter;
+use crate::table::{Emitter, EmitterTable};
 
 /// A cone of directions: `axis`, `cos θo` (every normal within `θo` of it) and `cos θe` (the
 /// emission spread beyond a normal).
@@ -117,7 +117,8 @@ impl Node {
     /// The receiver-aware importance of the node at `p` with normal `n` (zero `n`: no receiver
     /// term).
     #[inline(always)]
-    fn importance(&self, p: Vec3, n: Vec3) -> f32 {
+    /// `d2_floor` bounds the squared distance below (see [`LightBvh::d2_floor`]).
+    fn importance(&self, p: Vec3, n: Vec3, d2_floor: f32) -> f32 {
         if self.power <= 0.0 {
             return 0.0;
         }
@@ -125,7 +126,7 @@ impl Node {
         let r2 = 0.25 * (self.hi - self.lo).length_squared();
         let to = p - c;
         let dist2 = to.length_squared();
-        let d2 = dist2.max(r2).max(1e-12);
+        let d2 = dist2.max(r2).max(d2_floor);
         let wi = if dist2 > 0.0 {
             to / dist2.sqrt()
         } else {
@@ -183,11 +184,18 @@ pub(crate) struct LightBvh {
     /// Share of local selections that go to `unbounded` (their power share).
     unbounded_share: f32,
     unbounded_power: f32,
+    /// The least squared distance importance divides by: `(10⁻⁶ · extent)²` of the tree's box
+    /// (10⁻¹² for a scene of unit extent), so that a receiver on a point-like node does not
+    /// divide by zero, and the same scene in any unit weighs its nodes alike (an absolute floor
+    /// would flatten the importance of every node in a scene of 10⁻⁶ units).
+    d2_floor: f32,
 }
 
 impl LightBvh {
-    /// Builds the tree over `entries` with their selection weights `weights` (power).
-    pub fn new(lights: &[Light], shapes: &[Shape], entries: &[Emitter], weights: &[f32]) -> Self {
+    /// Builds the tree over the entries of `table` with their selection weights `weights`
+    /// (power).
+    pub fn new(lights: &[Light], shapes: &[Shape], table: &EmitterTable, weights: &[f32]) -> Self {
+        let entries = table.entries();
         let mut items = Vec::with_capacity(entries.len());
         let mut unbounded = Vec::new();
         let (mut bounded_power, mut unbounded_power) = (0.0f64, 0.0f64);
@@ -198,19 +206,18 @@ impl LightBvh {
             let entry = i as u32;
             let item = match *e {
                 Emitter::Triangle {
-                    ref p, n, smooth, ..
+                    ref p, ng, shading, ..
                 } => Some(Item {
                     entry,
                     lo: p[0].min(p[1]).min(p[2]),
                     hi: p[0].max(p[1]).max(p[2]),
-                    cone: if smooth {
-                        Cone::ALL
-                    } else {
-                        Cone {
+                    cone: match table.constant_normal(ng, shading) {
+                        None => Cone::ALL,
+                        Some(n) => Cone {
                             axis: n,
                             cos_o: 1.0,
                             cos_e: 0.0,
-                        }
+                        },
                     },
                     power: w,
                 }),
@@ -261,13 +268,32 @@ impl LightBvh {
             unbounded_share: (unbounded_power / (unbounded_power + bounded_power).max(1e-300))
                 as f32,
             unbounded_power: unbounded_power as f32,
+            d2_floor: 1e-12,
         };
         if items.is_empty() {
             bvh.unbounded_share = if bvh.unbounded.is_empty() { 0.0 } else { 1.0 };
         } else {
             bvh.build(&mut items, 0, 0);
+            bvh.d2_floor = Self::d2_floor(bvh.nodes[0].lo, bvh.nodes[0].hi);
         }
         bvh
+    }
+
+    /// `(10⁻⁶ · e)²` for the box `lo..hi` of largest side `e`; where the box is a point, its
+    /// largest coordinate magnitude stands for `e`, and 1 where that is zero too.
+    fn d2_floor(lo: Vec3, hi: Vec3) -> f32 {
+        let extent = (hi - lo).max_element();
+        let magnitude = lo.abs().max(hi.abs()).max_element();
+        let e = [extent, magnitude, 1.0]
+            .into_iter()
+            .find(|e| e.is_finite() && *e > 0.0)
+            .unwrap_or(1.0);
+        let floor = (1e-6 * e) * (1e-6 * e);
+        if floor.is_normal() {
+            floor
+        } else {
+            f32::MIN_POSITIVE
+        }
     }
 
     /// Builds the subtree over `items` (non-empty) at `depth` whose path is `trail`; returns its
@@ -357,13 +383,13 @@ impl LightBvh {
         }
         let mut node = 0usize;
         let mut current = self.nodes.get(node)?;
-        if current.importance(p, n) <= 0.0 {
+        if current.importance(p, n, self.d2_floor) <= 0.0 {
             return None;
         }
         while !current.leaf {
             let (a, b) = (node + 1, current.index as usize);
-            let ia = self.nodes[a].importance(p, n) as f64;
-            let ib = self.nodes[b].importance(p, n) as f64;
+            let ia = self.nodes[a].importance(p, n, self.d2_floor) as f64;
+            let ib = self.nodes[b].importance(p, n, self.d2_floor) as f64;
             let total = ia + ib;
             if total <= 0.0 {
                 return None;
@@ -402,14 +428,14 @@ impl LightBvh {
             1.0 - self.unbounded_share
         };
         let mut node = 0usize;
-        if self.nodes[0].importance(p, n) <= 0.0 {
+        if self.nodes[0].importance(p, n, self.d2_floor) <= 0.0 {
             return 0.0;
         }
         let mut depth = 0;
         while !self.nodes[node].leaf {
             let (a, b) = (node + 1, self.nodes[node].index as usize);
-            let ia = self.nodes[a].importance(p, n) as f64;
-            let ib = self.nodes[b].importance(p, n) as f64;
+            let ia = self.nodes[a].importance(p, n, self.d2_floor) as f64;
+            let ib = self.nodes[b].importance(p, n, self.d2_floor) as f64;
             let total = ia + ib;
             if total <= 0.0 {
                 return 0.0;

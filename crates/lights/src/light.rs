@@ -145,12 +145,8 @@ impl LightSet {
     pub fn area_point(&self, shape: &Shape, light: u32, prim: u32, param: Vec2) -> PositionSample {
         match self.table.triangle_entry(light, prim) {
             Some(&Emitter::Triangle {
-                ref p,
-                ng,
-                n,
-                smooth,
-                ..
-            }) => Emitter::point_at(p, ng, n, smooth, shape, prim, param),
+                ref p, ng, shading, ..
+            }) => self.table.point_at(p, ng, shading, shape, prim, param),
             _ => shape.position_at(prim, param),
         }
     }

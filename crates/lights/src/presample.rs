@@ -45,14 +45,13 @@ impl LightSet {
                 prim,
                 ref p,
                 ng,
-                n,
-                smooth,
+                shading,
             }) => {
                 let Light::Area { shape, radiance } = self.lights[light as usize] else {
                     return None;
                 };
                 let shape = &self.shapes[shape as usize];
-                let ps = Emitter::triangle_point(p, ng, n, smooth, shape, prim, u);
+                let ps = self.table.triangle_point(p, ng, shading, shape, prim, u);
                 let pdf_area = self.area_pdf[light as usize];
                 return Some(Presampled::Fixed {
                     point: LightPoint {

@@ -45,8 +45,7 @@ impl LightSet {
             prim,
             ref p,
             ng,
-            n,
-            smooth,
+            shading,
         } = *e
         else {
             return None;
@@ -54,7 +53,8 @@ impl LightSet {
         let Light::Area { shape, radiance } = self.lights[light as usize] else {
             return None;
         };
-        let ps = Emitter::triangle_point(p, ng, n, smooth, &self.shapes[shape as usize], prim, u);
+        let shape = &self.shapes[shape as usize];
+        let ps = self.table.triangle_point(p, ng, shading, shape, prim, u);
         let pdf_sa = area_to_solid_angle(self.area_pdf[light as usize], ref_p, ps.p, ps.ng)?;
         area_light_sample(light, radiance, ref_p, ps, pdf_sa)
     }
@@ -62,12 +62,8 @@ impl LightSet {
     /// The light hierarchy over the table's entries (built on the first call).
     fn hierarchy(&self) -> &LightBvh {
         self.hierarchy.get_or_init(|| {
-            LightBvh::new(
-                &self.lights,
-                &self.shapes,
-                self.table.entries(),
-                self.table.weights(),
-            )
+            let weights = self.table.weights(&self.lights, &self.shapes, &self.powers);
+            LightBvh::new(&self.lights, &self.shapes, &self.table, &weights)
         })
     }
 
@@ -144,21 +140,13 @@ impl LightSet {
                 prim,
                 ref p,
                 ng,
-                n,
-                smooth,
+                shading,
             } => {
                 let Light::Area { shape, radiance } = self.lights[light as usize] else {
                     return None;
                 };
-                let ps = Emitter::triangle_point(
-                    p,
-                    ng,
-                    n,
-                    smooth,
-                    &self.shapes[shape as usize],
-                    prim,
-                    u,
-                );
+                let shape = &self.shapes[shape as usize];
+                let ps = self.table.triangle_point(p, ng, shading, shape, prim, u);
                 let area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
                 let pdf_sa = area_to_solid_angle(pmf / area, ref_p, ps.p, ps.ng)?;
                 let power_pdf =
@@ -207,7 +195,7 @@ impl LightSet {
     pub fn emitter_pmf(&self, e: usize) -> f32 {
         let s = self.table.env_share();
         if e < self.table.len() {
-            (1.0 - s) * self.table.local_entry_pmf(e)
+            (1.0 - s) * self.table.entry_pmf(e)
         } else if e == self.table.len() && self.environment.is_some() {
             s
         } else {
@@ -267,9 +255,7 @@ impl LightSet {
 
     /// The probability that the power table picks local entry `entry` among the local entries.
     pub fn entry_power_pmf(&self, entry: usize) -> f32 {
-        let w = self.table.weights();
-        let total: f64 = w.iter().map(|&x| x as f64).sum();
-        w.get(entry).map_or(0.0, |&x| (x as f64 / total) as f32)
+        self.table.entry_pmf(entry)
     }
 
     /// The light local entry `entry` belongs to.

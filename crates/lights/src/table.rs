@@ -22,6 +22,11 @@ use restir_geometry::{PositionSample, Shape};
 use restir_sampling::{AliasTable, warp};
 
 /// One entry of the table.
+///
+/// A triangle entry keeps what sampling a point on it reads (its corners and geometric normal
+/// inline, its shading normal by [`Shading`]) and nothing else: 64 bytes, and 12 more for its bin
+/// of the alias table. Its selection weight is not kept: [`EmitterTable::weights`] recomputes it
+/// (the same bits) for the light hierarchy, the one reader.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Emitter {
     /// An emissive triangle of a mesh area light, corners inline.
@@ -34,17 +39,27 @@ pub(crate) enum Emitter {
         p: [Vec3; 3],
         /// Unit geometric normal, oriented as the mesh orients it.
         ng: Vec3,
-        /// The shading normal where it is the same over the whole triangle (no vertex normals,
-        /// or three equal ones: a rectangle's).
-        n: Vec3,
-        /// Whether the shading normal varies over the triangle (then it is interpolated).
-        smooth: bool,
+        /// Where the shading normal comes from.
+        shading: Shading,
     },
     /// A light sampled as a whole (sphere, point and directional lights).
     Whole {
         /// The light.
         light: u32,
     },
+}
+
+/// The shading normal of a triangle entry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Shading {
+    /// The geometric normal: the mesh has no vertex normals, or three equal ones that give the
+    /// geometric normal to the bit.
+    Flat,
+    /// The same over the whole triangle (three equal vertex normals, a rectangle's), other than
+    /// the geometric normal: the table's constant normal of this index.
+    Constant(u32),
+    /// Varying over the triangle: interpolated from the mesh's vertex normals.
+    Smooth,
 }
 
 impl Emitter {
@@ -55,77 +70,38 @@ impl Emitter {
             Emitter::Triangle { light, .. } | Emitter::Whole { light } => light,
         }
     }
-
-    /// A uniform point on a triangle entry, computed exactly as
-    /// [`restir_geometry::TriangleMesh::point_at`] computes it (so a point named by its
-    /// barycentrics resolves to the same bits later); `shapes` only for smooth meshes.
-    #[inline]
-    pub fn triangle_point(
-        p: &[Vec3; 3],
-        ng: Vec3,
-        n: Vec3,
-        smooth: bool,
-        shape: &Shape,
-        prim: u32,
-        u: Vec2,
-    ) -> PositionSample {
-        Self::point_at(
-            p,
-            ng,
-            n,
-            smooth,
-            shape,
-            prim,
-            warp::sample_uniform_triangle(u),
-        )
-    }
-
-    /// The point of a triangle entry at barycentrics `b`, the same bits as
-    /// [`restir_geometry::TriangleMesh::point_at`]; `shape` is read only for smooth meshes.
-    #[inline]
-    pub fn point_at(
-        p: &[Vec3; 3],
-        ng: Vec3,
-        n: Vec3,
-        smooth: bool,
-        shape: &Shape,
-        prim: u32,
-        b: Vec2,
-    ) -> PositionSample {
-        let b0 = 1.0 - b.x - b.y;
-        let point = b0 * p[0] + b.x * p[1] + b.y * p[2];
-        let n = match (smooth, shape) {
-            (true, Shape::Mesh(m)) => m.point_at(prim as usize, b).2,
-            _ => n,
-        };
-        PositionSample {
-            p: point,
-            n,
-            ng,
-            prim,
-            param: b,
-        }
-    }
 }
 
-/// Triangle `t`'s shading normal if it is the same everywhere on it (`(n, false)`), as
-/// [`restir_geometry::TriangleMesh::point_at`] orients it, else `(ng, true)`.
-fn constant_shading_normal(m: &restir_geometry::TriangleMesh, t: usize, ng: Vec3) -> (Vec3, bool) {
+/// Triangle `t`'s shading normal: `Some(n)` where it is the same everywhere on it, as
+/// [`restir_geometry::TriangleMesh::point_at`] orients it (`ng` without vertex normals), `None`
+/// where it varies.
+fn constant_shading_normal(m: &restir_geometry::TriangleMesh, t: usize, ng: Vec3) -> Option<Vec3> {
     let Some(normals) = m.normals() else {
-        return (ng, false);
+        return Some(ng);
     };
     let [a, b, c] = m.indices()[t].map(|i| normals[i as usize]);
     if a != b || a != c {
-        return (ng, true);
+        return None;
     }
     let n = a.normalize_or_zero();
-    if n == Vec3::ZERO {
-        (ng, false)
+    Some(if n == Vec3::ZERO {
+        ng
     } else if m.flip_normals() {
-        (-n, false)
+        -n
     } else {
-        (n, false)
-    }
+        n
+    })
+}
+
+/// Whether two vectors have the same bits (`==` takes `-0.0` for `0.0`).
+fn same_bits(a: Vec3, b: Vec3) -> bool {
+    a.to_array().map(f32::to_bits) == b.to_array().map(f32::to_bits)
+}
+
+/// The selection weight of triangle `t` of a mesh light of radiance `radiance`: its power
+/// `π·A·lum(L)`.
+fn triangle_weight(radiance: Vec3, m: &restir_geometry::TriangleMesh, t: usize) -> f32 {
+    core::f32::consts::PI * restir_sampling::luminance(radiance) * m.triangle_area(t)
 }
 
 /// How an entry is picked, decided once when the table is built: one entry skips the alias
@@ -141,8 +117,8 @@ enum Selection {
 #[derive(Clone, Debug)]
 pub(crate) struct EmitterTable {
     entries: Vec<Emitter>,
-    /// Each entry's selection weight (its power).
-    weights: Vec<f32>,
+    /// The shading normals of [`Shading::Constant`] entries.
+    normals: Vec<Vec3>,
     selection: Selection,
     /// Per light, the probability that a local selection picks one of its entries.
     local_pmf: Vec<f32>,
@@ -166,8 +142,22 @@ impl EmitterTable {
         powers: &[f32],
         environment: Option<u32>,
     ) -> Self {
-        let mut entries = Vec::new();
-        let mut weights = Vec::new();
+        // Sized once: a growing table would hold two copies at its peak.
+        let capacity: usize = lights
+            .iter()
+            .zip(powers)
+            .map(|(l, &power)| match (*l, power > 0.0) {
+                (crate::Light::Area { shape, .. }, true) => match shapes.get(shape as usize) {
+                    Some(Shape::Mesh(m)) => m.triangle_count(),
+                    _ => 1,
+                },
+                (_, true) => 1,
+                (_, false) => 0,
+            })
+            .sum();
+        let mut entries = Vec::with_capacity(capacity);
+        let mut weights = Vec::with_capacity(capacity);
+        let mut normals = Vec::new();
         let mut first_triangle_entry = vec![Self::NO_ENTRIES; lights.len()];
         for (i, (l, &power)) in lights.iter().zip(powers).enumerate() {
             let light = i as u32;
@@ -183,23 +173,27 @@ impl EmitterTable {
             };
             match mesh {
                 Some((m, radiance)) => {
-                    let per_area = core::f32::consts::PI * restir_sampling::luminance(radiance);
                     let first = entries.len();
                     for t in 0..m.triangle_count() {
-                        let p = m.triangle(t);
-                        let w = per_area * m.triangle_area(t);
+                        let w = triangle_weight(radiance, m, t);
                         if !(w > 0.0 && w.is_finite()) {
                             continue;
                         }
                         let ng = m.face_normal(t);
-                        let (n, smooth) = constant_shading_normal(m, t, ng);
+                        let shading = match constant_shading_normal(m, t, ng) {
+                            None => Shading::Smooth,
+                            Some(n) if same_bits(n, ng) => Shading::Flat,
+                            Some(n) => {
+                                normals.push(n);
+                                Shading::Constant(normals.len() as u32 - 1)
+                            }
+                        };
                         entries.push(Emitter::Triangle {
                             light,
                             prim: t as u32,
-                            p,
+                            p: m.triangle(t),
                             ng,
-                            n,
-                            smooth,
+                            shading,
                         });
                         weights.push(w);
                     }
@@ -213,6 +207,7 @@ impl EmitterTable {
                 }
             }
         }
+        entries.shrink_to_fit();
         let selection = match entries.len() {
             0 => Selection::Empty,
             1 => Selection::Single,
@@ -237,9 +232,10 @@ impl EmitterTable {
                 (pe / (pe + total)) as f32
             }
         };
+        drop(weights);
         let mut table = Self {
             entries,
-            weights,
+            normals,
             selection,
             local_pmf,
             environment,
@@ -304,19 +300,96 @@ impl EmitterTable {
         &self.entries
     }
 
-    /// The probability that the local selection (the environment aside) picks entry `e`.
-    #[inline]
-    pub fn local_entry_pmf(&self, e: usize) -> f32 {
+    /// Each local entry's selection weight (its power), recomputed from the lights, their
+    /// shapes and `powers` as [`EmitterTable::new`] computed it (the same bits).
+    pub fn weights(&self, lights: &[crate::Light], shapes: &[Shape], powers: &[f32]) -> Vec<f32> {
+        self.entries
+            .iter()
+            .map(|e| match *e {
+                Emitter::Triangle { light, prim, .. } => match lights[light as usize] {
+                    crate::Light::Area { shape, radiance } => match &shapes[shape as usize] {
+                        Shape::Mesh(m) => triangle_weight(radiance, m, prim as usize),
+                        Shape::Sphere(_) => 0.0,
+                    },
+                    _ => 0.0,
+                },
+                Emitter::Whole { light } => powers[light as usize],
+            })
+            .collect()
+    }
+
+    /// The probability that a local selection picks entry `entry` (among the local entries).
+    pub fn entry_pmf(&self, entry: usize) -> f32 {
         match &self.selection {
             Selection::Empty => 0.0,
-            Selection::Single => f32::from(e == 0),
-            Selection::Alias(t) => t.pmf(e),
+            Selection::Single => (entry == 0) as u32 as f32,
+            Selection::Alias(t) => t.pmf(entry),
         }
     }
 
-    /// Each local entry's selection weight (its power).
-    pub fn weights(&self) -> &[f32] {
-        &self.weights
+    /// The shading normal of a triangle entry where it is the same over the whole triangle;
+    /// `None` where it varies.
+    #[inline]
+    pub fn constant_normal(&self, ng: Vec3, shading: Shading) -> Option<Vec3> {
+        match shading {
+            Shading::Flat => Some(ng),
+            Shading::Constant(i) => self.normals.get(i as usize).copied(),
+            Shading::Smooth => None,
+        }
+    }
+
+    /// A uniform point on a triangle entry, computed exactly as
+    /// [`restir_geometry::TriangleMesh::point_at`] computes it (so a point named by its
+    /// barycentrics resolves to the same bits later, through the table); `shape` is read only
+    /// for smooth meshes.
+    #[inline]
+    pub fn triangle_point(
+        &self,
+        p: &[Vec3; 3],
+        ng: Vec3,
+        shading: Shading,
+        shape: &Shape,
+        prim: u32,
+        u: Vec2,
+    ) -> PositionSample {
+        self.point_at(
+            p,
+            ng,
+            shading,
+            shape,
+            prim,
+            warp::sample_uniform_triangle(u),
+        )
+    }
+
+    /// The point of a triangle entry at barycentrics `b`, the same bits as
+    /// [`restir_geometry::TriangleMesh::point_at`] except a [`Shading::Constant`] normal, which
+    /// is the vertex normal itself (the mesh interpolates three copies of it, which may differ in
+    /// the last bit); `shape` is read only for smooth meshes.
+    #[inline]
+    pub fn point_at(
+        &self,
+        p: &[Vec3; 3],
+        ng: Vec3,
+        shading: Shading,
+        shape: &Shape,
+        prim: u32,
+        b: Vec2,
+    ) -> PositionSample {
+        let b0 = 1.0 - b.x - b.y;
+        let point = b0 * p[0] + b.x * p[1] + b.y * p[2];
+        let n = match (self.constant_normal(ng, shading), shape) {
+            (Some(n), _) => n,
+            (None, Shape::Mesh(m)) => m.point_at(prim as usize, b).2,
+            (None, Shape::Sphere(_)) => ng,
+        };
+        PositionSample {
+            p: point,
+            n,
+            ng,
+            prim,
+            param: b,
+        }
     }
 
     /// Probability that a selection picks light `light` (any of its entries).
@@ -355,5 +428,118 @@ impl EmitterTable {
             Selection::Single => Some(Ok(0)),
             Selection::Alias(t) => Some(Ok(t.sample(v).0)),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Light;
+    use restir_geometry::TriangleMesh;
+
+    /// Two triangles of a quad with the given vertex normals.
+    fn quad(normals: Option<Vec<Vec3>>, flip: bool) -> Shape {
+        let p = vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.1, 0.0),
+            Vec3::new(1.0, 1.0, 0.2),
+            Vec3::new(0.0, 1.0, 0.1),
+        ];
+        Shape::Mesh(TriangleMesh::new(p, normals, None, vec![[0, 1, 2], [0, 2, 3]], flip).unwrap())
+    }
+
+    fn table(shape: &Shape) -> EmitterTable {
+        let lights = [Light::Area {
+            shape: 0,
+            radiance: Vec3::ONE,
+        }];
+        EmitterTable::new(&lights, std::slice::from_ref(shape), &[1.0], None)
+    }
+
+    /// Every kind of shading normal resolves to the bits the mesh gives the same point, and is
+    /// stored as the kind it is.
+    #[test]
+    fn entries_give_the_meshs_points() {
+        // What the type documentation promises a triangle entry costs.
+        assert_eq!(size_of::<Emitter>(), 64);
+        let tilted = Vec3::new(0.1, -0.2, 1.0);
+        let cases = [
+            (None, Shading::Flat),
+            (Some(vec![tilted; 4]), Shading::Constant(0)),
+            (
+                Some(vec![tilted, Vec3::Z, Vec3::X + Vec3::Z, Vec3::Y + Vec3::Z]),
+                Shading::Smooth,
+            ),
+        ];
+        for (normals, kind) in cases {
+            for flip in [false, true] {
+                let shape = quad(normals.clone(), flip);
+                let Shape::Mesh(m) = &shape else {
+                    unreachable!()
+                };
+                let t = table(&shape);
+                assert_eq!(t.len(), 2);
+                for (prim, e) in t.entries().iter().enumerate() {
+                    let Emitter::Triangle {
+                        ref p, ng, shading, ..
+                    } = *e
+                    else {
+                        panic!("a triangle entry");
+                    };
+                    assert_eq!(
+                        std::mem::discriminant(&shading),
+                        std::mem::discriminant(&kind)
+                    );
+                    for b in [
+                        Vec2::new(0.2, 0.3),
+                        Vec2::new(0.0, 1.0),
+                        Vec2::new(0.5, 0.5),
+                    ] {
+                        let got = t.point_at(p, ng, shading, &shape, prim as u32, b);
+                        let (wp, wng, wn) = m.point_at(prim, b);
+                        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                        assert_eq!(bits(got.p), bits(wp), "{kind:?} flip {flip}");
+                        if kind == Shading::Constant(0) {
+                            // The vertex normal itself, not the mesh's interpolation of three
+                            // copies of it (which may round differently in the last bit).
+                            let n = tilted.normalize();
+                            let n = if flip { -n } else { n };
+                            assert_eq!(bits(got.n), bits(n), "flip {flip}");
+                            assert!((got.n - wn).length() < 1e-6, "flip {flip}");
+                        } else {
+                            assert_eq!(bits(got.n), bits(wn), "{kind:?} flip {flip}");
+                        }
+                        assert_eq!(bits(got.ng), bits(wng), "{kind:?} flip {flip}");
+                    }
+                }
+                // Negative control: reading a constant normal as the geometric one moves it.
+                if let Some(Emitter::Triangle { ng, .. }) = t.entries().first()
+                    && kind == Shading::Constant(0)
+                {
+                    assert_ne!(
+                        t.constant_normal(*ng, Shading::Flat),
+                        Some(m.point_at(0, Vec2::ZERO).2)
+                    );
+                }
+            }
+        }
+    }
+
+    /// The weights recomputed for the light hierarchy are the ones the table was built with:
+    /// the entry probabilities follow from them to the bit.
+    #[test]
+    fn recomputed_weights_match_the_selection() {
+        let shape = quad(None, false);
+        let lights = [Light::Area {
+            shape: 0,
+            radiance: Vec3::new(1.0, 2.0, 0.5),
+        }];
+        let t = EmitterTable::new(&lights, std::slice::from_ref(&shape), &[1.0], None);
+        let w = t.weights(&lights, std::slice::from_ref(&shape), &[1.0]);
+        let total: f64 = w.iter().map(|&x| x as f64).sum();
+        for (i, &x) in w.iter().enumerate() {
+            assert_eq!(t.entry_pmf(i), (x as f64 / total) as f32);
+        }
+        assert_eq!(t.entry_pmf(2), 0.0);
     }
 }

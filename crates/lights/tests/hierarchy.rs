@@ -235,3 +235,51 @@ fn pmf_sums_to_one_over_omnidirectional_lights() {
         assert_eq!(hist.remainder(), 0);
     }
 }
+
+/// Point lights at `s` times the positions of a unit layout (intensities times `s²`, the same
+/// irradiance at the same relative places), in a box of side `s`.
+fn point_lights(s: f32) -> LightSet {
+    let mut rng = Pcg32::new(11, 5);
+    let lights = (0..64)
+        .map(|_| Light::Point {
+            position: s * Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()),
+            intensity: Vec3::splat(s * s * (0.5 + rng.next_f32())),
+        })
+        .collect();
+    LightSet::new(lights, Vec::<Shape>::new(), (Vec3::ZERO, Vec3::splat(s))).unwrap()
+}
+
+/// The hierarchy weighs the same layout alike in any unit: its probabilities at 10⁻⁶ and 10³
+/// are those at unit scale, for receivers among the lights (an absolute floor of 10⁻¹² on the
+/// squared distance flattened every node near a receiver at 10⁻⁶, where squared distances are
+/// near 10⁻¹²).
+#[test]
+fn probabilities_do_not_depend_on_the_unit() {
+    let unit = point_lights(1.0);
+    let receivers = [
+        Vec3::new(0.5, 0.5, 0.5),
+        Vec3::new(0.1, 0.9, 0.3),
+        Vec3::new(0.7, 0.2, 0.95),
+    ];
+    for s in [1e-6f32, 1e3] {
+        let scaled = point_lights(s);
+        let mut worst = 0.0f32;
+        for p in receivers {
+            for e in 0..64 {
+                let a = unit.hierarchy_pmf(p, Vec3::ZERO, e);
+                let b = scaled.hierarchy_pmf(s * p, Vec3::ZERO, e);
+                worst = worst.max((a - b).abs() / a.max(1e-30));
+            }
+        }
+        assert!(
+            worst < 1e-3,
+            "scale {s:e}: probabilities differ by {worst:e}"
+        );
+    }
+    // Negative control: moving the receiver changes the probabilities by far more.
+    let (a, b) = (
+        unit.hierarchy_pmf(receivers[0], Vec3::ZERO, 0),
+        unit.hierarchy_pmf(receivers[1], Vec3::ZERO, 0),
+    );
+    assert!((a - b).abs() / a > 1e-2, "{a} {b}");
+}
