@@ -80,6 +80,15 @@ pub struct RestirDiIntegrator {
     clock: StageClock,
     /// What earlier passes recorded, with `learn` on.
     learning: learn::Learning,
+    /// The per-pixel lookups of the last pass, kept so the next pass reuses their memory.
+    lookups: std::sync::Mutex<Lookups>,
+}
+
+/// What a pass looks up once per pixel: the initial sample resolved in world space and the BSDF.
+#[derive(Debug, Default)]
+struct Lookups {
+    resolved: Vec<Option<(LightPoint, Resolved)>>,
+    bsdfs: Vec<Option<Bsdf>>,
 }
 
 impl RestirDiIntegrator {
@@ -94,6 +103,7 @@ impl RestirDiIntegrator {
             reuse: ScreenReuse::default(),
             clock: StageClock::default(),
             learning: learn::Learning::default(),
+            lookups: Default::default(),
         }
     }
 
@@ -301,11 +311,22 @@ impl Integrator for RestirDiIntegrator {
                 None
             };
             let mut current = vec![DiReservoir::empty(); n];
-            // Each pixel's initial sample resolved in world space, which the shifts into its
-            // neighbours and its own shading would otherwise resolve again.
-            let mut resolved = vec![None; n];
-            // And each pixel's BSDF, textures looked up.
-            let mut bsdfs = vec![None; n];
+            // Each pixel's initial sample resolved in world space and its BSDF (textures looked
+            // up), which the shifts into its neighbours and its shading would otherwise look up
+            // again; the buffers of the last pass are reused.
+            let mut lookups = self
+                .lookups
+                .lock()
+                .map(|mut l| std::mem::take(&mut *l))
+                .unwrap_or_default();
+            lookups.resolved.clear();
+            lookups.resolved.resize(n, None);
+            lookups.bsdfs.clear();
+            lookups.bsdfs.resize(n, None);
+            let Lookups {
+                mut resolved,
+                mut bsdfs,
+            } = lookups;
             rays += bands.run(
                 (&mut current[..], (&mut resolved[..], &mut bsdfs[..])),
                 |first, (out, (cache, bsdfs))| {
@@ -457,6 +478,9 @@ impl Integrator for RestirDiIntegrator {
             }
 
             self.reuse.keep(reuse, gbuf, current);
+            if let Ok(mut l) = self.lookups.lock() {
+                *l = Lookups { resolved, bsdfs };
+            }
         }
         accum
             .par_iter_mut()
