@@ -3,60 +3,13 @@
 //! table (what every estimator keeps), and the light hierarchy (built when a light sampler
 //! asks for it). Run with `--nocapture` to see the numbers.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use glam::Vec3;
 use restir_geometry::{Shape, TriangleMesh};
 use restir_lights::{Light, LightSet};
-
-struct Counting;
-
-static LIVE: AtomicUsize = AtomicUsize::new(0);
-static PEAK: AtomicUsize = AtomicUsize::new(0);
-
-// SAFETY: every call is forwarded to the system allocator unchanged; only counters are updated.
-#[allow(unsafe_code)]
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        let p = unsafe { System.alloc(l) };
-        if !p.is_null() {
-            let now = LIVE.fetch_add(l.size(), Ordering::Relaxed) + l.size();
-            PEAK.fetch_max(now, Ordering::Relaxed);
-        }
-        p
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        unsafe { System.dealloc(p, l) };
-        LIVE.fetch_sub(l.size(), Ordering::Relaxed);
-    }
-    unsafe fn realloc(&self, p: *mut u8, l: Layout, new: usize) -> *mut u8 {
-        let q = unsafe { System.realloc(p, l, new) };
-        if !q.is_null() {
-            if new >= l.size() {
-                let now = LIVE.fetch_add(new - l.size(), Ordering::Relaxed) + new - l.size();
-                PEAK.fetch_max(now, Ordering::Relaxed);
-            } else {
-                LIVE.fetch_sub(l.size() - new, Ordering::Relaxed);
-            }
-        }
-        q
-    }
-}
+use restir_testkit::{CountingAllocator, measure};
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
-
-/// Runs `f`, returning its result, the bytes still allocated after it beyond those before, and
-/// the peak above the start while it ran.
-fn measure<T>(f: impl FnOnce() -> T) -> (T, usize, usize) {
-    let start = LIVE.load(Ordering::Relaxed);
-    PEAK.store(start, Ordering::Relaxed);
-    let out = f();
-    let kept = LIVE.load(Ordering::Relaxed).saturating_sub(start);
-    let peak = PEAK.load(Ordering::Relaxed) - start;
-    (out, kept, peak)
-}
+static GLOBAL: CountingAllocator = CountingAllocator;
 
 /// A bumpy height field of `n × n` quads (`2n²` triangles).
 fn grid(n: usize) -> TriangleMesh {

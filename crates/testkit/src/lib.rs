@@ -15,6 +15,7 @@
 //! - [`blocks`]: per-block means of images and their mean and standard error over independent
 //!   renders ([`block_statistics`], [`max_z`]), for comparing two estimators of the same image.
 //! - [`tempdir`]: a fresh temporary directory per test, removed when dropped ([`TempDir`]).
+//! - [`alloc`]: a counting global allocator and [`measure`] for tests of memory ([`CountingAllocator`]).
 //!
 //! # Chi-square tests of samplers
 //!
@@ -62,6 +63,7 @@
 //! The tests of the libraries' samplers (`restir-sampling`, `restir-materials`, `restir-lights`)
 //! use exactly this recipe with their own generators.
 
+pub mod alloc;
 pub mod blocks;
 pub mod chi2;
 pub mod corpus;
@@ -70,6 +72,7 @@ pub mod running;
 pub mod special;
 pub mod tempdir;
 
+pub use alloc::{CountingAllocator, measure};
 pub use blocks::{block_means, block_statistics, max_z};
 pub use chi2::{
     Chi2Error, Chi2Outcome, Histogram, POOL_THRESHOLD, WorstCell, chi_square, chi_square_critical,
