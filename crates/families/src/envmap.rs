@@ -11,6 +11,8 @@ use restir_image::Image;
 use restir_sampling::Pcg32;
 
 use super::util::uniform;
+use super::{Asset, AssetContents};
+use restir_scene::LightDesc;
 
 /// The unit direction of the centre of texel-space point `(u, v)` in `[0, 1]²`.
 pub fn direction(u: f32, v: f32) -> Vec3 {
@@ -51,6 +53,28 @@ pub fn sky_sun(seed: u64) -> Vec3 {
     let elevation = uniform(&mut rng, 15.0, 45.0);
     let azimuth = uniform(&mut rng, 0.0, 360.0);
     direction_at(elevation, azimuth)
+}
+
+/// A scene's sky: a 512×256 [`sky`] image written beside the scene as `filename`, and the
+/// environment light that shows it at `scale`.
+pub fn sky_light(
+    filename: String,
+    seed: u64,
+    sun: Vec3,
+    sun_radiance: f32,
+    scale: f32,
+) -> (Asset, LightDesc) {
+    let asset = Asset {
+        filename: filename.clone(),
+        contents: AssetContents::Image(sky(seed, 512, 256, sun, sun_radiance)),
+    };
+    let light = LightDesc::Envmap {
+        filename,
+        scale,
+        to_world: Vec::new(),
+        location: Default::default(),
+    };
+    (asset, light)
 }
 
 /// A clear sky with a sun in direction `sun` (unit, above the horizon): radiance about 0.3–0.6

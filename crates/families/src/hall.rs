@@ -41,8 +41,8 @@ use super::util::{
 };
 use super::{Asset, AssetContents, DiOptions, Generated, Receivers, envmap};
 use restir_scene::{
-    CameraDesc, FilmDesc, FilterDesc, GeometryDesc, IntegratorDesc, LightDesc, MaterialDesc,
-    MicrofacetDesc, NamedMaterial, SceneDesc, ShapeDesc, TransformOp,
+    CameraDesc, FilmDesc, FilterDesc, GeometryDesc, IntegratorDesc, MaterialDesc, MicrofacetDesc,
+    NamedMaterial, SceneDesc, ShapeDesc, TransformOp,
 };
 
 /// Total emitted power of the garlands (W), whatever their number.
@@ -387,17 +387,10 @@ pub(super) fn hall(seed: u64, options: &DiOptions) -> Generated {
     let mut assets = assets_meshes;
     let mut lights = Vec::new();
     if options.envmap {
-        let filename = format!("hall-sky-s{seed}.exr");
-        assets.push(Asset {
-            filename: filename.clone(),
-            contents: AssetContents::Image(envmap::sky(seed, 512, 256, sun, 40.0)),
-        });
-        lights.push(LightDesc::Envmap {
-            filename,
-            scale: 0.5,
-            to_world: Vec::new(),
-            location: Default::default(),
-        });
+        let (asset, light) =
+            envmap::sky_light(format!("hall-sky-s{seed}.exr"), seed, sun, 40.0, 0.5);
+        assets.push(asset);
+        lights.push(light);
     }
     let desc = SceneDesc {
         camera: CameraDesc {

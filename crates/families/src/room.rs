@@ -11,10 +11,10 @@ use super::util::{
     METALS, checkerboard, distribution, emitter, hue_colour, named, rect_transform,
     rough_conductor, rough_plastic, round, round3, shape, uniform,
 };
-use super::{Asset, AssetContents, Generated, envmap};
+use super::{Generated, envmap};
 use restir_scene::{
-    CameraDesc, FilmDesc, FilterDesc, GeometryDesc, IntegratorDesc, LightDesc, MaterialDesc,
-    MaterialRef, NamedMaterial, RoughnessDesc, SceneDesc, ShapeDesc, TransformOp,
+    CameraDesc, FilmDesc, FilterDesc, GeometryDesc, IntegratorDesc, MaterialDesc, MaterialRef,
+    NamedMaterial, RoughnessDesc, SceneDesc, ShapeDesc, TransformOp,
 };
 
 /// The glass object of a room, if any.
@@ -197,17 +197,10 @@ pub fn room(seed: u64, options: &RoomOptions) -> Generated {
             uniform(&mut rng, 20.0, 40.0),
             uniform(&mut rng, 60.0, 120.0),
         );
-        let filename = format!("window-sky-s{seed}.exr");
-        assets.push(Asset {
-            filename: filename.clone(),
-            contents: AssetContents::Image(envmap::sky(seed, 512, 256, sun, 60.0)),
-        });
-        lights.push(LightDesc::Envmap {
-            filename,
-            scale: 1.0,
-            to_world: Vec::new(),
-            location: Default::default(),
-        });
+        let (asset, light) =
+            envmap::sky_light(format!("window-sky-s{seed}.exr"), seed, sun, 60.0, 1.0);
+        assets.push(asset);
+        lights.push(light);
     } else {
         shapes.push(wall(
             hd,

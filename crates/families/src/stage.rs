@@ -13,10 +13,10 @@ use super::util::{
     METALS, checkerboard, distribution, hue_colour, named, rect_transform, rough_conductor,
     rough_plastic, round, round3, shape, uniform,
 };
-use super::{Asset, AssetContents, envmap};
+use super::{Asset, envmap};
 use restir_scene::{
-    CameraDesc, FilmDesc, FilterDesc, GeometryDesc, IntegratorDesc, LightDesc, MaterialDesc,
-    NamedMaterial, SceneDesc, ShapeDesc, TransformOp,
+    CameraDesc, FilmDesc, FilterDesc, GeometryDesc, IntegratorDesc, MaterialDesc, NamedMaterial,
+    SceneDesc, ShapeDesc, TransformOp,
 };
 
 /// Half the side of the square the receivers and lights cover.
@@ -300,18 +300,10 @@ pub(super) fn stage(seed: u64, options: &DiOptions) -> Stage {
     let mut lights = Vec::new();
     let mut assets = Vec::new();
     if options.envmap {
-        let filename = format!("sky-s{seed}.exr");
         let sun = envmap::sky_sun(seed);
-        assets.push(Asset {
-            filename: filename.clone(),
-            contents: AssetContents::Image(envmap::sky(seed, 512, 256, sun, 300.0)),
-        });
-        lights.push(LightDesc::Envmap {
-            filename,
-            scale: 0.3,
-            to_world: Vec::new(),
-            location: Default::default(),
-        });
+        let (asset, light) = envmap::sky_light(format!("sky-s{seed}.exr"), seed, sun, 300.0, 0.3);
+        assets.push(asset);
+        lights.push(light);
     }
 
     let desc = SceneDesc {
