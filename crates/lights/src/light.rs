@@ -7,8 +7,9 @@ use glam::{Vec2, Vec3};
 use restir_geometry::{PositionSample, Shape, area_to_solid_angle};
 use restir_sampling::warp;
 
+use crate::point::point_contact;
 use crate::table::Emitter;
-use crate::{EnvMap, LightSet, Spot};
+use crate::{Contact, EnvMap, LightSet, Spot};
 
 /// An emitter.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -163,52 +164,14 @@ impl LightSet {
             Light::Point {
                 position,
                 intensity,
-            } => {
-                let to = position - ref_p;
-                let d2 = to.length_squared();
-                if d2 <= 0.0 {
-                    return None;
-                }
-                let dist = d2.sqrt();
-                Some(LightSample {
-                    light,
-                    p: position,
-                    n: Vec3::ZERO,
-                    ng: Vec3::ZERO,
-                    wi: to / dist,
-                    dist,
-                    le: intensity / d2,
-                    pdf_sa: 1.0,
-                    delta: true,
-                    prim: 0,
-                    param: Vec2::ZERO,
-                })
-            }
-            Light::Spot(spot) => {
-                let to = spot.position - ref_p;
-                let d2 = to.length_squared();
-                if d2.is_nan() || d2 <= 0.0 {
-                    return None;
-                }
-                let intensity = self.spot_intensity(&spot, -to);
-                if intensity == Vec3::ZERO {
-                    return None; // outside the cone
-                }
-                let dist = d2.sqrt();
-                Some(LightSample {
-                    light,
-                    p: spot.position,
-                    n: Vec3::ZERO,
-                    ng: Vec3::ZERO,
-                    wi: to / dist,
-                    dist,
-                    le: intensity / d2,
-                    pdf_sa: 1.0,
-                    delta: true,
-                    prim: 0,
-                    param: Vec2::ZERO,
-                })
-            }
+            } => point_light_sample(light, point_contact(position, ref_p, |_| Some(intensity))?),
+            Light::Spot(spot) => point_light_sample(
+                light,
+                point_contact(spot.position, ref_p, |out| {
+                    let intensity = self.spot_intensity(&spot, out);
+                    (intensity != Vec3::ZERO).then_some(intensity) // outside the cone: none
+                })?,
+            ),
             Light::Directional {
                 direction,
                 irradiance,
@@ -351,4 +314,22 @@ pub(crate) fn bounding_sphere(shape: &Shape) -> (Vec3, f32) {
             }
         }
     }
+}
+
+/// The sample of a point emitter (a point or spot light) as seen from a receiver.
+#[inline]
+fn point_light_sample(light: u32, c: Contact) -> Option<LightSample> {
+    Some(LightSample {
+        light,
+        p: c.p,
+        n: Vec3::ZERO,
+        ng: Vec3::ZERO,
+        wi: c.wi,
+        dist: c.dist,
+        le: c.le,
+        pdf_sa: 1.0,
+        delta: true,
+        prim: 0,
+        param: Vec2::ZERO,
+    })
 }

@@ -222,47 +222,14 @@ impl Resolved {
                     pdf_sa: pdf_area.filter(|_| measure > 0.0).map(|a| a / measure),
                 })
             }
-            Resolved::Point { p, intensity } => {
-                let to = p - x;
-                let d2 = to.length_squared();
-                if d2.is_nan() || d2 <= 0.0 {
-                    return None;
-                }
-                let dist = d2.sqrt();
-                Some(Contact {
-                    wi: to / dist,
-                    p,
-                    dist,
-                    le: intensity / d2,
-                    measure: 1.0,
-                    delta: true,
-                    ng: Vec3::ZERO,
-                    pdf_sa: None,
-                })
-            }
+            Resolved::Point { p, intensity } => point_contact(p, x, |_| Some(intensity)),
             Resolved::Spot { p, light } => {
                 let Some(Light::Spot(spot)) = lights.lights().get(light as usize) else {
                     return None;
                 };
-                let to = p - x;
-                let d2 = to.length_squared();
-                if d2.is_nan() || d2 <= 0.0 {
-                    return None;
-                }
-                let intensity = lights.spot_intensity(spot, -to);
-                if intensity == Vec3::ZERO {
-                    return None;
-                }
-                let dist = d2.sqrt();
-                Some(Contact {
-                    wi: to / dist,
-                    p,
-                    dist,
-                    le: intensity / d2,
-                    measure: 1.0,
-                    delta: true,
-                    ng: Vec3::ZERO,
-                    pdf_sa: None,
+                point_contact(p, x, |out| {
+                    let intensity = lights.spot_intensity(spot, out);
+                    (intensity != Vec3::ZERO).then_some(intensity)
                 })
             }
             Resolved::Direction { wi, le, delta, pdf } => Some(Contact {
@@ -277,4 +244,31 @@ impl Resolved {
             }),
         }
     }
+}
+
+/// A point emitter at `p` seen from `x`, sending `intensity(direction from p to x, unnormalised)`
+/// toward it (`None` where it sends nothing, or where `x` is at `p`).
+#[inline]
+pub(crate) fn point_contact(
+    p: Vec3,
+    x: Vec3,
+    intensity: impl FnOnce(Vec3) -> Option<Vec3>,
+) -> Option<Contact> {
+    let to = p - x;
+    let d2 = to.length_squared();
+    if d2.is_nan() || d2 <= 0.0 {
+        return None;
+    }
+    let intensity = intensity(-to)?;
+    let dist = d2.sqrt();
+    Some(Contact {
+        wi: to / dist,
+        p,
+        dist,
+        le: intensity / d2,
+        measure: 1.0,
+        delta: true,
+        ng: Vec3::ZERO,
+        pdf_sa: None,
+    })
 }

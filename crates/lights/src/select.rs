@@ -262,21 +262,4 @@ impl LightSet {
     pub fn entry_light(&self, entry: usize) -> u32 {
         self.table.entries()[entry].light()
     }
-
-    /// The local entry of light `light`'s primitive `prim` (a triangle of a mesh light; `prim`
-    /// is ignored for other lights): entries are ordered by light, then by triangle.
-    pub fn entry_of(&self, light: u32, prim: u32) -> Option<usize> {
-        let key = |e: &Emitter| match *e {
-            Emitter::Triangle { light, prim, .. } => (light, prim),
-            Emitter::Whole { light } => (light, 0),
-        };
-        let prim = match self.table.entries().iter().find(|e| e.light() == light)? {
-            Emitter::Triangle { .. } => prim,
-            Emitter::Whole { .. } => 0,
-        };
-        self.table
-            .entries()
-            .binary_search_by(|e| key(e).cmp(&(light, prim)))
-            .ok()
-    }
 }

@@ -176,7 +176,7 @@ fn sample_densities_agree() {
             );
             // Hierarchy density / power density = hierarchy pmf / power pmf of the entry (a
             // triangle's power weight is its area's share of its mesh's).
-            let e = set.entry_of(s.light, s.prim).unwrap();
+            let e = set.emitter_of(s.light, s.prim).unwrap();
             let ratio = s.pdf_sa / power_pdf;
             let want = set.hierarchy_pmf(p, n, e) / set.entry_power_pmf(e);
             assert!((ratio - want).abs() <= 1e-3 * want, "{ratio} vs {want}");
