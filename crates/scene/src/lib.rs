@@ -26,6 +26,7 @@
 pub mod animation;
 mod build;
 pub mod desc;
+mod edit;
 mod error;
 mod light_share;
 mod load;
@@ -36,8 +37,8 @@ mod spot;
 pub mod texture;
 pub mod xml;
 
-pub use build::EditError;
 pub use desc::*;
+pub use edit::EditError;
 pub use error::{SceneError, SceneWarning};
 pub use light_share::EnvironmentShare;
 pub use load::{LoadOptions, LoadedScene, load_desc, load_scene, parse_ron, sidecar_path};
