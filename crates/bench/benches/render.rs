@@ -16,7 +16,7 @@ use std::time::Instant;
 use glam::DVec3;
 use restir_integrators::film::Filter;
 use restir_integrators::{Integrator, IntegratorOptions, PassContext, make_integrator};
-use restir_scene::{Scene, load_desc};
+use restir_scene::{IntegratorDesc, Scene, load_desc};
 
 const SIZE: u32 = 128;
 
@@ -26,12 +26,15 @@ fn scene_path(name: &str) -> PathBuf {
         .join(name)
 }
 
-fn load(name: &str) -> Scene {
+/// The scene `name` at `SIZE`², with its file's integrator settings.
+fn load(name: &str) -> (Scene, IntegratorDesc) {
     let path = scene_path(name);
     let (mut desc, _) = load_desc(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
     desc.film.width = SIZE;
     desc.film.height = SIZE;
-    Scene::build(&desc, path.parent().unwrap(), &path).unwrap_or_else(|e| panic!("{e}"))
+    let scene =
+        Scene::build(&desc, path.parent().unwrap(), &path).unwrap_or_else(|e| panic!("{e}"));
+    (scene, desc.integrator)
 }
 
 struct Measurement {
@@ -101,15 +104,18 @@ fn main() {
         ),
     ];
     for name in ["cornell-box.xml", "many-lights.ron"] {
-        let scene = load(name);
+        let (scene, scene_integrator) = load(name);
         for (label, kind, params) in configs {
             let options = IntegratorOptions {
                 name: Some(kind.into()),
                 max_depth: None,
                 params: params.into(),
             };
-            let integrator = make_integrator(&scene, &options).unwrap().integrator;
-            bench_rows(&scene, name, label, integrator.as_ref(), budget, all);
+            let integrator = make_integrator(&scene, &scene_integrator, &options)
+                .unwrap()
+                .integrator;
+            let depth = scene_integrator.max_depth;
+            bench_rows(&scene, name, label, integrator.as_ref(), depth, budget, all);
         }
     }
 }
@@ -126,6 +132,7 @@ fn bench_rows(
     name: &str,
     label: &str,
     integrator: &dyn Integrator,
+    max_depth: i32,
     budget: f64,
     all: usize,
 ) {
@@ -141,7 +148,7 @@ fn bench_rows(
                 name,
                 label,
                 threads,
-                scene.integrator.max_depth,
+                max_depth,
                 m.median_seconds * 1e3,
                 1.0 / m.median_seconds,
                 m.mean_rays / m.median_seconds / 1e6,

@@ -21,7 +21,7 @@ use glam::{DVec3, Vec2, Vec3};
 use restir_integrators::film::Filter;
 use restir_integrators::{IntegratorOptions, PassContext, make_integrator};
 use restir_materials::Bsdf;
-use restir_scene::{Scene, load_desc, parse_ron};
+use restir_scene::{IntegratorDesc, Scene, load_desc, parse_ron};
 
 fn budget() -> f64 {
     std::env::var("RESTIR_BENCH_SECONDS")
@@ -35,11 +35,13 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-fn load(path: &Path, size: (u32, u32)) -> Scene {
+/// The scene at `path` at `size`, with its file's integrator settings.
+fn load(path: &Path, size: (u32, u32)) -> (Scene, IntegratorDesc) {
     let (mut desc, _) = load_desc(path, &[]).unwrap_or_else(|e| panic!("{e}"));
     desc.film.width = size.0;
     desc.film.height = size.1;
-    Scene::build(&desc, path.parent().unwrap(), path).unwrap_or_else(|e| panic!("{e}"))
+    let scene = Scene::build(&desc, path.parent().unwrap(), path).unwrap_or_else(|e| panic!("{e}"));
+    (scene, desc.integrator)
 }
 
 /// Times `run(config)` for configs 0 and 1 alternately until `budget` seconds have passed (at
@@ -127,13 +129,15 @@ fn bsdf_at_costs(budget: f64) {
 
 fn cornell_flag(budget: f64) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml");
-    let mut scene = load(&path, (128, 128));
+    let (mut scene, scene_integrator) = load(&path, (128, 128));
     assert!(!scene.features.has_textures);
     let options = IntegratorOptions {
         name: Some("path".into()),
         ..Default::default()
     };
-    let integrator = make_integrator(&scene, &options).unwrap().integrator;
+    let integrator = make_integrator(&scene, &scene_integrator, &options)
+        .unwrap()
+        .integrator;
     let filter = Filter::new(scene.filter);
     let mut pass = 0u32;
     let mut accum = vec![DVec3::ZERO; 128 * 128];
@@ -164,10 +168,10 @@ fn sponza(budget: f64) {
         println!("sponza: skipped (no corpus at {})", path.display());
         return;
     }
-    let textured_scene = load(&path, (128, 96));
+    let (textured_scene, scene_integrator) = load(&path, (128, 96));
     assert!(textured_scene.features.has_textures);
     // The constant variant, a second copy: each textured material's BSDF at its textures' means.
-    let mut constant = load(&path, (128, 96));
+    let (mut constant, _) = load(&path, (128, 96));
     for m in 0..constant.bsdfs().len() {
         if let Some(t) = constant.bsdf_textures()[m] {
             let mut p = t.base;
@@ -184,7 +188,9 @@ fn sponza(budget: f64) {
         name: Some("path".into()),
         ..Default::default()
     };
-    let integrator = make_integrator(scene, &options).unwrap().integrator;
+    let integrator = make_integrator(scene, &scene_integrator, &options)
+        .unwrap()
+        .integrator;
     let filter = Filter::new(scene.filter);
     let mut pass = 0u32;
     let (w, h) = scene.camera.resolution();

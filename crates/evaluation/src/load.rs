@@ -118,14 +118,16 @@ pub(crate) fn options_for(config: &IntegratorConfig, entry: &SuiteScene) -> Inte
     }
 }
 
-/// Builds a configuration's integrator for a scene; parameters it does not use are an error
-/// (a typo would otherwise benchmark the defaults under the wrong label).
+/// Builds a configuration's integrator for a loaded scene (its file's integrator settings under
+/// the configuration's); parameters it does not use are an error (a typo would otherwise
+/// benchmark the defaults under the wrong label).
 pub(crate) fn build_integrator(
-    scene: &Scene,
+    loaded: &LoadedSuiteScene,
     config: &IntegratorConfig,
     entry: &SuiteScene,
 ) -> Result<Box<dyn Integrator>, BenchError> {
-    let made = make_integrator(scene, &options_for(config, entry)).map_err(|e| {
+    let options = options_for(config, entry);
+    let made = make_integrator(&loaded.scene, &loaded.desc.integrator, &options).map_err(|e| {
         BenchError::Integrator {
             label: config.label.clone(),
             message: e.to_string(),

@@ -120,7 +120,7 @@ pub(crate) fn reference_for(
         integrator: "path".into(),
         params: Vec::new(),
     };
-    let integrator = build_integrator(scene, &path_config, entry)?;
+    let integrator = build_integrator(loaded, &path_config, entry)?;
     let start = Instant::now();
     let halves: Vec<Image> = REFERENCE_SEEDS
         .iter()

@@ -149,7 +149,7 @@ fn render_entry(
         });
     };
     // A fresh estimator per sequence: its history starts empty at the first frame.
-    let estimator = build_integrator(&loaded.scene, config, entry)?;
+    let estimator = build_integrator(loaded, config, entry)?;
     let mut records = Vec::with_capacity(loaded.view_count());
     // The previous frame's image and reference, for the flicker; each frame's scene is built
     // here and dropped once the next one has entered the sequence.
@@ -243,7 +243,7 @@ pub fn run_suite(
             if !entry.runs(&config.label) {
                 continue;
             }
-            let integrator = build_integrator(&loaded.scene, config, entry)
+            let integrator = build_integrator(&loaded, config, entry)
                 .map_err(|e| e.at(file, config_line(ci)))?;
             largest_buffers = largest_buffers.max(integrator.buffer_bytes_per_pixel() as u64);
             configs += 1;
@@ -333,7 +333,7 @@ pub fn run_suite(
             .iter()
             .map(|c| {
                 (entry.runs(&c.label) && loaded.frames.is_none())
-                    .then(|| build_integrator(&loaded.scene, c, entry))
+                    .then(|| build_integrator(loaded, c, entry))
                     .transpose()
             })
             .collect::<Result<Vec<_>, _>>()

@@ -105,7 +105,7 @@ pub fn choose(scene: &Scene, path: &PathSettings) -> (Choice, String) {
             ),
         );
     }
-    let pilot = (path.max_segments() > 2).then(|| view_pilot(scene));
+    let pilot = (path.max_segments() > 2).then(|| view_pilot(scene, path.hide_emitters));
     let view = pilot.map(|v| {
         format!(
             "of {} camera paths {:.1}% first reconnect at a glossy surface (ReSTIR PT from {:.0}%) \

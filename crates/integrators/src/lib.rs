@@ -7,7 +7,7 @@
 //! use restir_integrators::Renderer;
 //! use restir_scene::{LoadOptions, load_scene};
 //! let loaded = load_scene("scenes/cornell-box.xml".as_ref(), &LoadOptions::default())?;
-//! let out = Renderer::new(&loaded.scene).spp(16).integrator("restir-di").render()?;
+//! let out = Renderer::new(&loaded).spp(16).integrator("restir-di").render()?;
 //! out.image.write("cbox.exr".as_ref())?;
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -20,7 +20,7 @@
 //! # use restir_integrators::Renderer;
 //! # use restir_scene::{LoadOptions, load_scene};
 //! # let loaded = load_scene("scenes/cornell-box.xml".as_ref(), &LoadOptions::default())?;
-//! let out = Renderer::new(&loaded.scene).integrator("auto").render()?;
+//! let out = Renderer::new(&loaded).integrator("auto").render()?;
 //! println!("{}", out.estimator); // ran path (chosen by auto: ... one light takes 100% ...)
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -40,7 +40,7 @@
 //! use restir_scene::{LoadOptions, load_scene};
 //! let loaded = load_scene("scenes/cornell-box.xml".as_ref(), &LoadOptions::default()).unwrap();
 //! let options = IntegratorOptions { name: Some("restir-di".into()), ..Default::default() };
-//! let made = make_integrator(&loaded.scene, &options).unwrap();
+//! let made = make_integrator(&loaded.scene, &loaded.desc.integrator, &options).unwrap();
 //! let job = RenderJob { spp: 16, ..RenderJob::from_desc(&loaded.desc) };
 //! let out = render(&loaded.scene, made.integrator.as_ref(), &job, &AtomicBool::new(false), &mut |_, _| {});
 //! out.image.write("cbox.exr".as_ref()).unwrap();
@@ -79,7 +79,7 @@ pub use restir_pt::{RestirPtIntegrator, RestirPtSettings};
 pub use sequence::FrameSequence;
 
 use params::ParamProblem;
-use restir_scene::Scene;
+use restir_scene::{IntegratorDesc, Scene};
 
 /// The integrators this crate provides, by command-line name: three estimators, and `auto`,
 /// which chooses one of them from the scene ([`auto`]).
@@ -147,23 +147,25 @@ impl From<ParamError> for IntegratorError {
     }
 }
 
-/// Builds the integrator for `scene`: the scene's choice and parameters, overridden by `options`.
+/// Builds the integrator for `scene`: the choice and parameters of the scene file (`desc`, the
+/// [`LoadedScene`](restir_scene::LoadedScene)'s `desc.integrator`), overridden by `options`.
 pub fn make_integrator(
     scene: &Scene,
+    desc: &IntegratorDesc,
     options: &IntegratorOptions,
 ) -> Result<MadeIntegrator, IntegratorError> {
-    let mut settings = path::PathSettings::from_scene(scene);
+    let mut settings = path::PathSettings::from_desc(desc);
     if let Some(d) = options.max_depth {
         if d < -1 {
             return Err(IntegratorError::MaxDepth(d));
         }
         settings.max_depth = d;
     }
-    let scene_kind = canonical_name(&scene.integrator.kind);
+    let scene_kind = canonical_name(&desc.kind);
     let name = options.name.as_deref().map_or(scene_kind, canonical_name);
     // The scene's parameters belong to the scene's estimator; their errors name the scene file.
     let mut params = if name == scene_kind {
-        ParamSet::from_scene(&scene.integrator.params, &scene.integrator.location)
+        ParamSet::from_scene(&desc.params, &desc.location)
     } else {
         ParamSet::new()
     };

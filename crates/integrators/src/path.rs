@@ -8,7 +8,7 @@
 use glam::{DVec3, Vec2, Vec3};
 use restir_geometry::{Ray, offset_ray_origin};
 use restir_sampling::{Pcg32, warp::power_heuristic};
-use restir_scene::Scene;
+use restir_scene::{IntegratorDesc, Scene};
 
 use crate::bands::Bands;
 use crate::pass::{Integrator, PassContext};
@@ -26,12 +26,12 @@ pub struct PathSettings {
 }
 
 impl PathSettings {
-    /// Settings from the scene's integrator description.
-    pub fn from_scene(scene: &Scene) -> Self {
+    /// Settings from a scene's integrator description.
+    pub fn from_desc(desc: &IntegratorDesc) -> Self {
         Self {
-            max_depth: scene.integrator.max_depth,
-            rr_depth: scene.integrator.rr_depth.max(1),
-            hide_emitters: scene.integrator.hide_emitters,
+            max_depth: desc.max_depth,
+            rr_depth: desc.rr_depth.max(1),
+            hide_emitters: desc.hide_emitters,
         }
     }
 

@@ -1,4 +1,4 @@
-//! [`Renderer`]: the library's one-line render, `Renderer::new(&scene).spp(16).render()`.
+//! [`Renderer`]: the library's one-line render, `Renderer::new(&loaded).spp(16).render()`.
 //!
 //! A builder over the full driver ([`crate::render`], which the command line uses with its
 //! cancel flag and progress display): it picks the scene's integrator (or a named one), applies
@@ -8,7 +8,7 @@
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
-use restir_scene::{LoadedScene, Scene};
+use restir_scene::{IntegratorDesc, LoadedScene, Scene};
 
 use crate::params::{Param, ParamSource, ParamValue};
 use crate::{IntegratorError, IntegratorOptions, RenderJob, RenderOutput, make_integrator};
@@ -63,38 +63,41 @@ impl From<IntegratorError> for RenderError {
 /// use restir_scene::{LoadOptions, load_scene};
 ///
 /// let loaded = load_scene("scenes/cornell-box.xml".as_ref(), &LoadOptions::default())?;
-/// let out = Renderer::new(&loaded.scene).spp(16).render()?;
+/// let out = Renderer::new(&loaded).spp(16).render()?;
 /// let (w, h) = (out.image.width, out.image.height);
 /// let pixels: &[restir_integrators::glam::Vec3] = &out.image.pixels;
 /// assert_eq!(pixels.len(), (w * h) as usize);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 ///
-/// Defaults: the scene's integrator and its parameters, one pass, seed 0, no time limit
-/// ([`RenderJob::default`]); [`Renderer::for_loaded`] takes the scene file's sample count.
+/// Defaults: what the scene file asks for: its integrator and parameters, its sample count
+/// ([`RenderJob::from_desc`]); seed 0, no time limit. [`Renderer::of`] renders a scene built
+/// by the caller.
 #[derive(Clone, Debug)]
 pub struct Renderer<'a> {
     scene: &'a Scene,
+    integrator: &'a IntegratorDesc,
     options: IntegratorOptions,
     job: RenderJob,
 }
 
 impl<'a> Renderer<'a> {
-    /// A render of `scene` with its own integrator, one pass, seed 0.
-    pub fn new(scene: &'a Scene) -> Self {
+    /// A render of a loaded scene as its file asks: its integrator, its sample count.
+    pub fn new(loaded: &'a LoadedScene) -> Self {
         Self {
-            scene,
-            options: IntegratorOptions::default(),
-            job: RenderJob::default(),
+            job: RenderJob::from_desc(&loaded.desc),
+            ..Self::of(&loaded.scene, &loaded.desc.integrator)
         }
     }
 
-    /// A render of a loaded scene with the job its file asks for ([`RenderJob::from_desc`]: its
-    /// sample count and output name).
-    pub fn for_loaded(loaded: &'a LoadedScene) -> Self {
+    /// A render of `scene` (built with [`Scene::build`]) with `integrator`, the integrator
+    /// of the description it was built from; one pass, seed 0 ([`RenderJob::default`]).
+    pub fn of(scene: &'a Scene, integrator: &'a IntegratorDesc) -> Self {
         Self {
-            job: RenderJob::from_desc(&loaded.desc),
-            ..Self::new(&loaded.scene)
+            scene,
+            integrator,
+            options: IntegratorOptions::default(),
+            job: RenderJob::default(),
         }
     }
 
@@ -157,7 +160,7 @@ impl<'a> Renderer<'a> {
     /// [`RenderOutput::image`] (linear RGB, row-major `Vec<glam::Vec3>`); what rendered it, and
     /// why, in [`RenderOutput::estimator`].
     pub fn render(&self) -> Result<RenderOutput, RenderError> {
-        let made = make_integrator(self.scene, &self.options)?;
+        let made = make_integrator(self.scene, self.integrator, &self.options)?;
         if let Some(p) = made
             .unused_params
             .iter()

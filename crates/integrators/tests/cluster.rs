@@ -6,6 +6,8 @@
 //! statistics over independent seeds). Negative control: a tile rendered without its halo
 //! differs near the tile's edges, and only there.
 
+mod common;
+
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
@@ -18,15 +20,15 @@ use restir_scene::{Scene, load_desc};
 use restir_testkit::{block_means, block_statistics, max_z};
 
 /// The Cornell box at `w × h`.
-fn cornell(w: u32, h: u32) -> Scene {
+fn cornell(w: u32, h: u32) -> common::Built {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml");
     let (mut desc, _) = load_desc(&path, &[]).unwrap();
     desc.film.width = w;
     desc.film.height = h;
-    Scene::build(&desc, path.parent().unwrap(), &path).unwrap()
+    common::build(&desc, path.parent().unwrap(), &path)
 }
 
-fn integrator(scene: &Scene, name: &str, params: &[(&str, &str)]) -> Box<dyn Integrator> {
+fn integrator(scene: &common::Built, name: &str, params: &[(&str, &str)]) -> Box<dyn Integrator> {
     let options = IntegratorOptions {
         name: Some(name.into()),
         max_depth: Some(3),
@@ -35,7 +37,7 @@ fn integrator(scene: &Scene, name: &str, params: &[(&str, &str)]) -> Box<dyn Int
             .map(|(k, v)| Param::new(*k, *v, ParamSource::Caller))
             .collect(),
     };
-    let made = make_integrator(scene, &options).unwrap();
+    let made = make_integrator(scene, &scene.integrator, &options).unwrap();
     assert!(made.unused_params.is_empty());
     made.integrator
 }
@@ -43,7 +45,7 @@ fn integrator(scene: &Scene, name: &str, params: &[(&str, &str)]) -> Box<dyn Int
 /// Small spatial reuse: two rounds within 4 pixels, a halo of 8.
 const REUSE: &[(&str, &str)] = &[("radius", "4"), ("spatial_rounds", "2")];
 
-fn estimators(scene: &Scene) -> Vec<Box<dyn Integrator>> {
+fn estimators(scene: &common::Built) -> Vec<Box<dyn Integrator>> {
     vec![
         integrator(scene, "path", &[]),
         integrator(scene, "restir-di", REUSE),

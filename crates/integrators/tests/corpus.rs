@@ -9,18 +9,18 @@ mod common;
 use std::path::Path;
 
 use restir_integrators::Image;
-use restir_scene::{Scene, load_desc};
+use restir_scene::load_desc;
 
 const SIZE: u32 = 24;
 
 /// Loads `rel` with its film set to `SIZE`×`SIZE` (keeping the aspect ratio's orientation is not
 /// needed for these checks).
-fn small_scene(dir: &Path, rel: &str) -> Scene {
+fn small_scene(dir: &Path, rel: &str) -> common::Built {
     let path = dir.join(rel);
     let (mut desc, _) = load_desc(&path, &[]).unwrap_or_else(|e| panic!("{rel}: {e}"));
     desc.film.width = SIZE;
     desc.film.height = SIZE;
-    Scene::build(&desc, path.parent().unwrap(), &path).unwrap_or_else(|e| panic!("{rel}: {e}"))
+    common::try_build(&desc, path.parent().unwrap(), &path).unwrap_or_else(|e| panic!("{rel}: {e}"))
 }
 
 /// Mean and standard deviation of the pixels' channel averages.

@@ -2,13 +2,15 @@
 //! same seed gives a bit-identical image (and ray count) with 1, 2 or 3 worker threads, while a
 //! different seed gives a different image.
 
+mod common;
+
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
 use restir_integrators::{
     Image, IntegratorOptions, RenderJob, RenderOutput, make_integrator, render,
 };
-use restir_scene::{Scene, load_desc};
+use restir_scene::load_desc;
 
 fn scene_path(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -17,21 +19,21 @@ fn scene_path(name: &str) -> PathBuf {
 }
 
 /// Loads a shipped scene at `size`×`size` pixels.
-fn load(name: &str, size: u32) -> Scene {
+fn load(name: &str, size: u32) -> common::Built {
     let path = scene_path(name);
     let (mut desc, _) = load_desc(&path, &[]).unwrap();
     desc.film.width = size;
     desc.film.height = size;
-    Scene::build(&desc, path.parent().unwrap(), &path).unwrap()
+    common::build(&desc, path.parent().unwrap(), &path)
 }
 
-fn render_with_threads(scene: &Scene, threads: usize, seed: u64, spp: u32) -> RenderOutput {
+fn render_with_threads(scene: &common::Built, threads: usize, seed: u64, spp: u32) -> RenderOutput {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .unwrap();
     assert_eq!(pool.current_num_threads(), threads);
-    let integrator = make_integrator(scene, &IntegratorOptions::default())
+    let integrator = make_integrator(scene, &scene.integrator, &IntegratorOptions::default())
         .unwrap()
         .integrator;
     let settings = RenderJob {

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use restir_integrators::Image;
-use restir_scene::{Scene, parse_ron};
+use restir_scene::parse_ron;
 
 mod common;
 use common::{block_statistics, max_z, render_image};
@@ -38,16 +38,16 @@ fn write_exr(path: &Path, w: usize, h: usize, f: impl Fn(usize, usize) -> [f32; 
     img.write(path).unwrap();
 }
 
-fn build(ron: &str) -> Scene {
+fn build(ron: &str) -> common::Built {
     let desc = parse_ron(ron, "envmap-test.ron".as_ref()).unwrap();
-    Scene::build(&desc, ".".as_ref(), "envmap-test.ron".as_ref()).unwrap()
+    common::build(&desc, ".".as_ref(), "envmap-test.ron".as_ref())
 }
 
 // ------------------------------------------------------------------------------------------
 // Furnace
 // ------------------------------------------------------------------------------------------
 
-fn furnace_scene(light: &str) -> Scene {
+fn furnace_scene(light: &str) -> common::Built {
     build(&format!(
         r#"(
         camera: (fov: 20, to_world: [LookAt(origin: (0, 0, 5), target: (0, 0, 0), up: (0, 1, 0))]),
@@ -62,7 +62,7 @@ fn furnace_scene(light: &str) -> Scene {
 
 /// Largest |z| over four 4×4 blocks of the sphere's central 8×8 pixels and the three channels
 /// against `expected`, with each block's standard error estimated across `seeds` renders.
-fn furnace_z(scene: &Scene, expected: [f64; 3], seeds: u64) -> f64 {
+fn furnace_z(scene: &common::Built, expected: [f64; 3], seeds: u64) -> f64 {
     let blocks: Vec<[[f64; 3]; 4]> = (0..seeds)
         .map(|s| {
             let img = render_image(scene, "path", &[], 16, 300 + s);
@@ -138,7 +138,7 @@ const SIZE: u32 = 32;
 const BLOCK: u32 = 8;
 
 /// A floor, a wall and a cube lit only by a strongly varying envmap.
-fn sky_scene(map: &Path, scale: f32, max_depth: i32) -> Scene {
+fn sky_scene(map: &Path, scale: f32, max_depth: i32) -> common::Built {
     build(&sky_scene_text(map, scale, max_depth))
 }
 
@@ -179,7 +179,7 @@ fn sky_map(dir: &Path) -> PathBuf {
 }
 
 fn statistics(
-    scene: &Scene,
+    scene: &common::Built,
     name: &str,
     params: &[(&str, &str)],
     spp: u32,
@@ -300,7 +300,7 @@ fn matpreview_renders() {
     let path = dir.join("matpreview.xml");
     std::fs::write(&path, xml).unwrap();
     let loaded = restir_scene::load_scene(&path, &restir_scene::LoadOptions::default()).unwrap();
-    let scene = loaded.scene;
+    let scene = common::Built::from(loaded);
     assert!(scene.features.has_environment);
     for name in ["path", "restir-di", "restir-pt"] {
         let img = render_image(&scene, name, &[], 4, 1);

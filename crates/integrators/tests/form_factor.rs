@@ -11,10 +11,12 @@
 //! control requires the same statistic to reject an expected value 2 % too high, so the test
 //! has the power to see a 2 % bias.
 
+mod common;
+
 use std::sync::atomic::AtomicBool;
 
 use restir_integrators::{IntegratorOptions, RenderJob, make_integrator, render};
-use restir_scene::{Scene, parse_ron};
+use restir_scene::parse_ron;
 
 /// Form factor from a differential element at the origin (normal towards the rectangle) to the
 /// rectangle `[0, x] × [0, z]` in a parallel plane at distance `h`, for `x, z ≥ 0`:
@@ -49,7 +51,7 @@ impl Setup {
         [0, 1, 2].map(|c| self.albedo[c] * self.radiance[c] * f)
     }
 
-    fn scene(&self) -> Scene {
+    fn scene(&self) -> common::Built {
         let (cx, cz) = ((self.x.0 + self.x.1) / 2.0, (self.z.0 + self.z.1) / 2.0);
         let (sx, sz) = ((self.x.1 - self.x.0) / 2.0, (self.z.1 - self.z.0) / 2.0);
         let [lr, lg, lb] = self.radiance;
@@ -72,13 +74,13 @@ impl Setup {
         )"#
         );
         let desc = parse_ron(&ron, "form-factor.ron".as_ref()).unwrap();
-        Scene::build(&desc, ".".as_ref(), "form-factor.ron".as_ref()).unwrap()
+        common::build(&desc, ".".as_ref(), "form-factor.ron".as_ref())
     }
 
     /// Per channel: the mean of all pixel estimates over `seeds` renders and its standard error.
     fn estimate(&self, seeds: u64, spp: u32) -> [(f64, f64); 3] {
         let scene = self.scene();
-        let integrator = make_integrator(&scene, &IntegratorOptions::default())
+        let integrator = make_integrator(&scene, &scene.integrator, &IntegratorOptions::default())
             .unwrap()
             .integrator;
         let mut values: [Vec<f64>; 3] = Default::default();

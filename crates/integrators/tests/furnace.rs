@@ -10,10 +10,12 @@
 //!
 //! Pixel means are compared within 4 standard errors of the mean over the covered pixels.
 
+mod common;
+
 use std::sync::atomic::AtomicBool;
 
 use restir_integrators::{IntegratorOptions, RenderJob, make_integrator, render};
-use restir_scene::{Scene, parse_ron};
+use restir_scene::parse_ron;
 
 /// Mean and standard error over the pixels covered by a unit sphere of `material` (RON), seen
 /// under a constant environment of radiance 1.
@@ -28,8 +30,8 @@ fn furnace(material: &str, max_depth: i32, seed: u64) -> (f64, f64) {
     )"#
     );
     let desc = parse_ron(&ron, "furnace.ron".as_ref()).unwrap();
-    let scene = Scene::build(&desc, ".".as_ref(), "furnace.ron".as_ref()).unwrap();
-    let integrator = make_integrator(&scene, &IntegratorOptions::default())
+    let scene = common::build(&desc, ".".as_ref(), "furnace.ron".as_ref());
+    let integrator = make_integrator(&scene, &scene.integrator, &IntegratorOptions::default())
         .unwrap()
         .integrator;
     let settings = RenderJob {

@@ -13,7 +13,7 @@ use restir_families::{
     AssetContents, DiOptions, Family, Generated, Glass, Kind, Params, Receivers, RoomOptions,
     Split, generate, members,
 };
-use restir_scene::{LoadOptions, Scene, load_scene};
+use restir_scene::{LoadOptions, load_scene};
 
 /// A fresh directory for one test's files.
 fn temp_dir(name: &str) -> PathBuf {
@@ -23,7 +23,7 @@ fn temp_dir(name: &str) -> PathBuf {
 }
 
 /// Writes `generated` into a fresh directory and loads it at `width`×`height`.
-fn load(generated: &Generated, name: &str, width: u32, height: u32) -> (Scene, PathBuf) {
+fn load(generated: &Generated, name: &str, width: u32, height: u32) -> (common::Built, PathBuf) {
     let dir = temp_dir(name);
     let path = generated.write(&dir, name).unwrap();
     let options = LoadOptions {
@@ -31,7 +31,7 @@ fn load(generated: &Generated, name: &str, width: u32, height: u32) -> (Scene, P
         height: Some(height),
         ..LoadOptions::default()
     };
-    let scene = load_scene(&path, &options).unwrap().scene;
+    let scene = common::Built::from(load_scene(&path, &options).unwrap());
     (scene, dir)
 }
 

@@ -7,7 +7,7 @@
 //! same expected image, block by block, for the path tracer, ReSTIR DI and ReSTIR PT. The
 //! control: A with its emitters shown differs from B by far (the test sees the rectangle).
 
-use restir_scene::{Scene, parse_ron};
+use restir_scene::parse_ron;
 
 mod common;
 use common::{block_statistics, max_z, render_image};
@@ -16,7 +16,7 @@ const SIZE: u32 = 32;
 const BLOCK: u32 = 8;
 const Z_MAX: f64 = 4.5;
 
-fn scene(rectangle: bool, hide: bool) -> Scene {
+fn scene(rectangle: bool, hide: bool) -> common::Built {
     let lamp = if rectangle {
         // Faces +z (the camera); one-sided, so its back, towards the floor, is dark.
         "(geometry: Rectangle, to_world: [Scale((0.8, 0.8, 1)), Translate((0, 0, 1))], \
@@ -38,10 +38,15 @@ fn scene(rectangle: bool, hide: bool) -> Scene {
     )"#
     );
     let desc = parse_ron(&ron, "hidden.ron".as_ref()).unwrap();
-    Scene::build(&desc, ".".as_ref(), "hidden.ron".as_ref()).unwrap()
+    common::build(&desc, ".".as_ref(), "hidden.ron".as_ref())
 }
 
-fn stats(scene: &Scene, name: &str, params: &[(&str, &str)], seeds: u64) -> Vec<(f64, f64)> {
+fn stats(
+    scene: &common::Built,
+    name: &str,
+    params: &[(&str, &str)],
+    seeds: u64,
+) -> Vec<(f64, f64)> {
     block_statistics(
         |seed| render_image(scene, name, params, 2, seed),
         seeds,

@@ -304,7 +304,7 @@ fn mitsuba_render_suite() {
                     max_depth: None,
                     params: Default::default(),
                 };
-                match make_integrator(scene, &opts) {
+                match make_integrator(scene, &loaded.desc.integrator, &opts) {
                     Err(e) => Outcome::Refused(e.to_string()),
                     Ok(made) => {
                         assert!(made.unused_params.is_empty(), "{name} {est}");

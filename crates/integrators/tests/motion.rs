@@ -86,13 +86,13 @@ fn desc_with(box_material: &str, extra: &str) -> SceneDesc {
     parse_ron(&ron, "motion-test.ron".as_ref()).unwrap()
 }
 
-fn frames() -> (SceneDesc, Arc<Scene>, Scene) {
+fn frames() -> (SceneDesc, Arc<Scene>, common::Built) {
     frames_of(desc())
 }
 
 /// The same sequence with only the camera moving, and no environment (whose share of light
 /// samples the scene build decides from what the camera sees, so it changes with the camera).
-fn camera_only() -> (SceneDesc, Arc<Scene>, Scene) {
+fn camera_only() -> (SceneDesc, Arc<Scene>, common::Built) {
     let mut d = desc();
     d.animation.as_mut().unwrap().shapes.clear();
     d.lights.clear();
@@ -117,20 +117,23 @@ fn pt_desc(box_material: &str) -> SceneDesc {
     d
 }
 
-fn pt_frames() -> (SceneDesc, Arc<Scene>, Scene) {
+fn pt_frames() -> (SceneDesc, Arc<Scene>, common::Built) {
     frames_of(pt_desc("Diffuse(reflectance: (0.3, 0.6, 0.3))"))
 }
 
 /// [`pt_frames`] with a near-specular box (a rough conductor with alpha 0.01, which paths
 /// cannot reconnect at: the hybrid shift replays through it).
-fn pt_glossy_frames() -> (SceneDesc, Arc<Scene>, Scene) {
+fn pt_glossy_frames() -> (SceneDesc, Arc<Scene>, common::Built) {
     frames_of(pt_desc("RoughConductor(roughness: (alpha: 0.01))"))
 }
 
-fn frames_of(desc: SceneDesc) -> (SceneDesc, Arc<Scene>, Scene) {
+fn frames_of(desc: SceneDesc) -> (SceneDesc, Arc<Scene>, common::Built) {
     let path = std::path::Path::new("motion-test.ron");
     let s0 = Arc::new(build_at(&desc, path, T0).unwrap());
-    let s1 = build_at(&desc, path, T1).unwrap();
+    let s1 = common::Built {
+        scene: build_at(&desc, path, T1).unwrap(),
+        integrator: desc.integrator.clone(),
+    };
     (desc, s0, s1)
 }
 
@@ -148,12 +151,12 @@ fn options(name: &str, max_depth: Option<i32>, params: &[(&str, &str)]) -> Integ
 /// Frame 1 rendered with one pass after two passes of frame 0 (seed `seed`), the estimator
 /// told of the motion in between.
 fn frame_one(
-    (desc, s0, s1): &(SceneDesc, Arc<Scene>, Scene),
+    (desc, s0, s1): &(SceneDesc, Arc<Scene>, common::Built),
     (name, max_depth): (&str, Option<i32>),
     params: &[(&str, &str)],
     seed: u64,
 ) -> Image {
-    let made = make_integrator(s0, &options(name, max_depth, params)).unwrap();
+    let made = make_integrator(s0, &desc.integrator, &options(name, max_depth, params)).unwrap();
     assert!(made.unused_params.is_empty());
     let di = made.integrator;
     render_with(s0, di.as_ref(), 2, seed);
@@ -162,7 +165,10 @@ fn frame_one(
     render_with(s1, di.as_ref(), 1, seed ^ 0x5555)
 }
 
-fn statistics(frames: &(SceneDesc, Arc<Scene>, Scene), params: &[(&str, &str)]) -> Vec<(f64, f64)> {
+fn statistics(
+    frames: &(SceneDesc, Arc<Scene>, common::Built),
+    params: &[(&str, &str)],
+) -> Vec<(f64, f64)> {
     block_statistics(|s| frame_one(frames, DI, params, s), 200, 3000, BLOCK)
 }
 
@@ -171,7 +177,7 @@ const DI: (&str, Option<i32>) = ("restir-di", None);
 const PT: (&str, Option<i32>) = ("restir-pt", Some(3));
 
 fn pt_statistics(
-    frames: &(SceneDesc, Arc<Scene>, Scene),
+    frames: &(SceneDesc, Arc<Scene>, common::Built),
     pt: (&str, Option<i32>),
     params: &[(&str, &str)],
 ) -> Vec<(f64, f64)> {
@@ -179,7 +185,10 @@ fn pt_statistics(
 }
 
 /// Frame 1's path-traced reference: 48 renders of 256 passes.
-fn pt_reference(frames: &(SceneDesc, Arc<Scene>, Scene), max_depth: i32) -> Vec<(f64, f64)> {
+fn pt_reference(
+    frames: &(SceneDesc, Arc<Scene>, common::Built),
+    max_depth: i32,
+) -> Vec<(f64, f64)> {
     let depth = max_depth.to_string();
     block_statistics(
         |s| render_image(&frames.2, "path", &[("max_depth", &depth)], 256, s),

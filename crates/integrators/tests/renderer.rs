@@ -31,10 +31,14 @@ fn bits(pixels: &[restir_integrators::glam::Vec3]) -> Vec<[u32; 3]> {
 fn one_line_render_matches_the_full_driver() {
     let loaded = cornell(16);
     let scene = &loaded.scene;
-    let short = Renderer::new(scene).spp(3).seed(5).render().unwrap();
-    let integrator = make_integrator(scene, &IntegratorOptions::default())
-        .unwrap()
-        .integrator;
+    let short = Renderer::new(&loaded).spp(3).seed(5).render().unwrap();
+    let integrator = make_integrator(
+        scene,
+        &loaded.desc.integrator,
+        &IntegratorOptions::default(),
+    )
+    .unwrap()
+    .integrator;
     let job = RenderJob {
         spp: 3,
         seed: 5,
@@ -56,7 +60,7 @@ fn one_line_render_matches_the_full_driver() {
 #[test]
 fn named_integrator_and_parameters() {
     let loaded = cornell(8);
-    let out = Renderer::for_loaded(&loaded)
+    let out = Renderer::new(&loaded)
         .spp(1)
         .integrator("restir-di")
         .param("spatial-rounds", 1u32)
@@ -69,9 +73,7 @@ fn named_integrator_and_parameters() {
 #[test]
 fn errors_are_typed() {
     let loaded = cornell(8);
-    let unknown = Renderer::new(&loaded.scene)
-        .integrator("restirdii")
-        .render();
+    let unknown = Renderer::new(&loaded).integrator("restirdii").render();
     assert!(matches!(
         unknown,
         Err(RenderError::Integrator(IntegratorError::Unknown(ref name))) if name == "restirdii"
@@ -83,7 +85,7 @@ fn errors_are_typed() {
     );
     assert!(std::error::Error::source(&e).is_some());
 
-    let unused = Renderer::new(&loaded.scene)
+    let unused = Renderer::new(&loaded)
         .integrator("path")
         .param("spatial-rounds", 2u32)
         .render()
@@ -100,7 +102,7 @@ fn errors_are_typed() {
         "parameter 'spatial-rounds' is not used by integrator path"
     );
 
-    let bad = Renderer::new(&loaded.scene).max_depth(-2).render();
+    let bad = Renderer::new(&loaded).max_depth(-2).render();
     assert!(matches!(
         bad,
         Err(RenderError::Integrator(IntegratorError::MaxDepth(-2)))
@@ -123,9 +125,8 @@ fn many_lights(size: u32) -> LoadedScene {
 #[test]
 fn auto_picks_the_path_tracer_on_the_cornell_box_and_restir_di_runs_as_named() {
     let loaded = cornell(16);
-    let scene = &loaded.scene;
     let run = |name: &str| {
-        Renderer::new(scene)
+        Renderer::new(&loaded)
             .spp(2)
             .seed(3)
             .integrator(name)
@@ -176,7 +177,7 @@ fn auto_picks_the_path_tracer_on_the_cornell_box_and_restir_di_runs_as_named() {
     assert_eq!(path.estimator.why, "asked for by name");
 
     // Emitters only: nothing for reservoirs to choose among.
-    let emitters = Renderer::new(scene)
+    let emitters = Renderer::new(&loaded)
         .integrator("auto")
         .max_depth(1)
         .render()
@@ -199,7 +200,7 @@ fn auto_picks_restir_di_on_many_lights() {
     let loaded = many_lights(16);
     let scene = &loaded.scene;
     let run = |name: &str| {
-        Renderer::new(scene)
+        Renderer::new(&loaded)
             .spp(1)
             .integrator(name)
             .render()
@@ -221,6 +222,7 @@ fn auto_picks_restir_di_on_many_lights() {
     assert_eq!(bits(&auto.image.pixels), bits(&di.image.pixels));
     let made = make_integrator(
         scene,
+        &loaded.desc.integrator,
         &IntegratorOptions {
             name: Some("auto".into()),
             ..Default::default()
@@ -242,7 +244,7 @@ fn auto_picks_restir_di_on_many_lights() {
 fn the_removed_fallback_parameter_and_parameters_of_auto_are_errors() {
     let loaded = cornell(8);
     for name in ["restir-di", "restir-pt", "path"] {
-        let e = Renderer::new(&loaded.scene)
+        let e = Renderer::new(&loaded)
             .integrator(name)
             .param("fallback", "off")
             .render()
@@ -265,13 +267,13 @@ fn the_removed_fallback_parameter_and_parameters_of_auto_are_errors() {
     </scene>"#;
     let (desc, _) = restir_scene::xml::parse_xml(xml, "old.xml".as_ref(), &[]).unwrap();
     let scene = restir_scene::Scene::build(&desc, ".".as_ref(), "old.xml".as_ref()).unwrap();
-    let e = make_integrator(&scene, &IntegratorOptions::default()).unwrap_err();
+    let e = make_integrator(&scene, &desc.integrator, &IntegratorOptions::default()).unwrap_err();
     assert!(
         e.to_string()
             .starts_with("old.xml:2: integrator: fallback = 'auto': no such parameter any more"),
         "{e}"
     );
-    let e = Renderer::new(&loaded.scene)
+    let e = Renderer::new(&loaded)
         .integrator("auto")
         .param("temporal", true)
         .render()

@@ -15,7 +15,7 @@ use restir_integrators::reuse::MIS_NAMES;
 use restir_integrators::{
     IntegratorOptions, RenderJob, RestirDiIntegrator, RestirDiSettings, make_integrator, render,
 };
-use restir_scene::{Scene, parse_ron};
+use restir_scene::parse_ron;
 
 mod common;
 use common::{block_statistics, max_z, render_image};
@@ -23,7 +23,7 @@ use common::{block_statistics, max_z, render_image};
 const SIZE: u32 = 32;
 const BLOCK: u32 = 8;
 
-fn scene() -> Scene {
+fn scene() -> common::Built {
     let ron = format!(
         r#"(
         camera: (fov: 50, to_world: [LookAt(origin: (0, 5, 0.01), target: (0, 0, 0), up: (0, 0, -1))]),
@@ -49,12 +49,12 @@ fn scene() -> Scene {
     )"#
     );
     let desc = parse_ron(&ron, "di-test.ron".as_ref()).unwrap();
-    Scene::build(&desc, ".".as_ref(), "di-test.ron".as_ref()).unwrap()
+    common::build(&desc, ".".as_ref(), "di-test.ron".as_ref())
 }
 
 /// Per block: mean and standard error of the mean over `seeds` independent renders.
 fn statistics(
-    scene: &Scene,
+    scene: &common::Built,
     name: &str,
     params: &[(&str, &str)],
     spp: u32,
@@ -66,14 +66,18 @@ fn statistics(
 
 /// Per block, as [`statistics`], for settings no parameter string reaches (the hidden negative
 /// controls): one pass per render.
-fn settings_statistics(scene: &Scene, settings: RestirDiSettings, seeds: u64) -> Vec<(f64, f64)> {
+fn settings_statistics(
+    scene: &common::Built,
+    settings: RestirDiSettings,
+    seeds: u64,
+) -> Vec<(f64, f64)> {
     settings_statistics_spp(scene, settings, 1, seeds)
 }
 
 /// As [`settings_statistics`] with `spp` passes per render (a fresh integrator per render, so
 /// nothing learned carries from one render to the next).
 fn settings_statistics_spp(
-    scene: &Scene,
+    scene: &common::Built,
     settings: RestirDiSettings,
     spp: u32,
     seeds: u64,
@@ -97,7 +101,7 @@ fn settings_statistics_spp(
     block_statistics(render_one, seeds, seed_base(), BLOCK)
 }
 
-fn direct_reference(scene: &Scene) -> Vec<(f64, f64)> {
+fn direct_reference(scene: &common::Built) -> Vec<(f64, f64)> {
     statistics(scene, "path", &[], 256, 48)
 }
 
@@ -243,8 +247,9 @@ fn light_pool_and_visible_targets() {
     eprintln!("visibility target, temporal: max |z| = {z:.2}");
     assert!(z < Z_MAX, "visibility target, temporal: max |z| = {z:.2}");
 
-    let mut wrong =
-        RestirDiSettings::new(restir_integrators::path::PathSettings::from_scene(&scene));
+    let mut wrong = RestirDiSettings::new(restir_integrators::path::PathSettings::from_desc(
+        &scene.integrator,
+    ));
     wrong.light_sampler = LightSampler::PoolWithoutSelection;
     let z = max_z(&settings_statistics(&scene, wrong, 200), &reference);
     eprintln!("pool without the selection probability: max |z| = {z:.2}");
@@ -345,8 +350,8 @@ fn xml_restir_integrator_and_parameters() {
     </scene>"#;
     let (desc, warnings) = restir_scene::xml::parse_xml(xml, "restir.xml".as_ref(), &[]).unwrap();
     assert!(warnings.is_empty(), "{warnings:?}");
-    let scene = Scene::build(&desc, ".".as_ref(), "restir.xml".as_ref()).unwrap();
-    let made = make_integrator(&scene, &IntegratorOptions::default()).unwrap();
+    let scene = common::build(&desc, ".".as_ref(), "restir.xml".as_ref());
+    let made = make_integrator(&scene, &scene.integrator, &IntegratorOptions::default()).unwrap();
     assert!(made.unused_params.is_empty());
     let d = made.integrator.describe();
     assert!(d.starts_with("restir-di max_depth=2 candidates=16"), "{d}");
@@ -358,7 +363,7 @@ fn xml_restir_integrator_and_parameters() {
         params: vec![("neighbors", "2")].into(),
         ..Default::default()
     };
-    let d = make_integrator(&scene, &options)
+    let d = make_integrator(&scene, &scene.integrator, &options)
         .unwrap()
         .integrator
         .describe();
@@ -372,7 +377,10 @@ fn xml_restir_integrator_and_parameters() {
         ..Default::default()
     };
     assert_eq!(
-        make_integrator(&scene, &options).unwrap().integrator.name(),
+        make_integrator(&scene, &scene.integrator, &options)
+            .unwrap()
+            .integrator
+            .name(),
         "path"
     );
 }
@@ -392,8 +400,9 @@ fn light_hierarchy_is_unbiased_and_a_wrong_pmf_is_caught() {
         eprintln!("{params:?}: max |z| = {z:.2}");
         assert!(z < Z_MAX, "{params:?}: max |z| = {z:.2}");
     }
-    let mut wrong =
-        RestirDiSettings::new(restir_integrators::path::PathSettings::from_scene(&scene));
+    let mut wrong = RestirDiSettings::new(restir_integrators::path::PathSettings::from_desc(
+        &scene.integrator,
+    ));
     wrong.light_sampler = LightSampler::BvhWithPowerPmf;
     wrong.candidates = 4;
     let z = max_z(&settings_statistics(&scene, wrong, 200), &reference);
@@ -421,7 +430,7 @@ fn dominant_light_auto_takes_the_path_tracer_and_restir_di_runs_as_named() {
             name: Some(name.into()),
             ..Default::default()
         };
-        make_integrator(&scene, &options).unwrap()
+        make_integrator(&scene, &scene.integrator, &options).unwrap()
     };
     let auto = made("auto");
     assert_eq!(auto.integrator.name(), "path");
@@ -468,8 +477,9 @@ fn learning_across_passes_is_unbiased_and_a_pmf_without_the_defensive_share_is_c
         eprintln!("{params:?}: max |z| = {z:.2}");
         assert!(z < Z_MAX, "{params:?}: max |z| = {z:.2}");
     }
-    let mut wrong =
-        RestirDiSettings::new(restir_integrators::path::PathSettings::from_scene(&scene));
+    let mut wrong = RestirDiSettings::new(restir_integrators::path::PathSettings::from_desc(
+        &scene.integrator,
+    ));
     wrong.light_sampler = LightSampler::Power;
     wrong.learn = Learn::WithoutDefensiveShare;
     let z = max_z(&settings_statistics_spp(&scene, wrong, 8, 100), &reference);

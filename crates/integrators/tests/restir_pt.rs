@@ -15,7 +15,7 @@ use restir_integrators::{
     make_integrator,
 };
 use restir_sampling::Pcg32;
-use restir_scene::{Scene, parse_ron};
+use restir_scene::parse_ron;
 
 mod common;
 use common::{block_statistics, max_z};
@@ -23,13 +23,13 @@ use common::{block_statistics, max_z};
 const SIZE: u32 = 24;
 const BLOCK: u32 = 8;
 
-fn scene() -> Scene {
+fn scene() -> common::Built {
     scene_with("")
 }
 
 /// The room with a smooth glass sphere and a smooth plastic sphere: delta lobes at primary hits
 /// (path traced) and at reconnection vertices (paths that cannot be shifted).
-fn glass_scene() -> Scene {
+fn glass_scene() -> common::Built {
     scene_with(
         r#"(geometry: Sphere(center: (-0.6, 0.45, 0.6), radius: 0.4),
              material: Some(Inline(Dielectric()))),
@@ -38,13 +38,13 @@ fn glass_scene() -> Scene {
     )
 }
 
-fn scene_with(extra: &str) -> Scene {
+fn scene_with(extra: &str) -> common::Built {
     build(&scene_text(extra))
 }
 
-fn build(ron: &str) -> Scene {
+fn build(ron: &str) -> common::Built {
     let desc = parse_ron(ron, "pt-test.ron".as_ref()).unwrap();
-    Scene::build(&desc, ".".as_ref(), "pt-test.ron".as_ref()).unwrap()
+    common::build(&desc, ".".as_ref(), "pt-test.ron".as_ref())
 }
 
 fn scene_text(extra: &str) -> String {
@@ -89,7 +89,7 @@ fn scene_text(extra: &str) -> String {
 /// hangs under the ceiling facing down (the room lit mostly directly, as the Cornell box)
 /// instead of lying behind the partition facing up; its radiance is `emission` (20 in the other
 /// scenes).
-fn diffuse_glass_scene(ceiling_light: bool, emission: &str) -> Scene {
+fn diffuse_glass_scene(ceiling_light: bool, emission: &str) -> common::Built {
     let mut ron = scene_text(
         r#"(geometry: Sphere(center: (-0.6, 0.45, 0.6), radius: 0.4),
              material: Some(Inline(Dielectric()))),"#,
@@ -116,7 +116,13 @@ fn diffuse_glass_scene(ceiling_light: bool, emission: &str) -> Scene {
     build(&ron)
 }
 
-fn render_image(scene: &Scene, name: &str, params: &[(&str, &str)], spp: u32, seed: u64) -> Image {
+fn render_image(
+    scene: &common::Built,
+    name: &str,
+    params: &[(&str, &str)],
+    spp: u32,
+    seed: u64,
+) -> Image {
     // The reuse these tests were written for (one candidate, one round of three neighbours
     // within 8 pixels, independent neighbours: cheaper than the defaults, so each test affords
     // more renders); parameters given in `params` come later and win, and
@@ -136,7 +142,7 @@ fn render_image(scene: &Scene, name: &str, params: &[(&str, &str)], spp: u32, se
 }
 
 fn statistics(
-    scene: &Scene,
+    scene: &common::Built,
     name: &str,
     params: &[(&str, &str)],
     spp: u32,
@@ -218,7 +224,7 @@ struct ShiftStats {
 }
 
 /// Runs the shift checks on four passes of `scene`.
-fn check_shifts(scene: &Scene, pt: &RestirPtIntegrator) -> ShiftStats {
+fn check_shifts(scene: &common::Built, pt: &RestirPtIntegrator) -> ShiftStats {
     let filter = Filter::new(scene.filter);
     let mut stats = ShiftStats::default();
     let (mut identity, mut pairs, mut fwd_ok, mut visible, mut exact) = (0, 0, 0, 0, 0);
@@ -533,7 +539,7 @@ fn unbiased_with_glass() {
 /// alternating with diffuse ones, under most of the view: paths from neighbouring pixels often
 /// bounce off different kinds of strip, which is what the hybrid shift's invertibility checks
 /// are for. No delta lobes.
-fn striped_floor_scene(alpha: f32) -> Scene {
+fn striped_floor_scene(alpha: f32) -> common::Built {
     let conductor = format!("RoughConductor(roughness: (alpha: {alpha}))");
     let strips: String = (0..8)
         .map(|i| {
@@ -554,7 +560,7 @@ fn striped_floor_scene(alpha: f32) -> Scene {
 }
 
 /// Pixels brighter than 100× the image mean, summed over renders.
-fn fireflies(scene: &Scene, name: &str, params: &[(&str, &str)], renders: u64) -> usize {
+fn fireflies(scene: &common::Built, name: &str, params: &[(&str, &str)], renders: u64) -> usize {
     (0..renders)
         .map(|s| {
             let img = render_image(scene, name, params, 1, 5000 + s);
@@ -698,8 +704,8 @@ fn xml_restir_pt_integrator_and_parameters() {
     </scene>"#;
     let (desc, warnings) = restir_scene::xml::parse_xml(xml, "pt.xml".as_ref(), &[]).unwrap();
     assert!(warnings.is_empty(), "{warnings:?}");
-    let scene = Scene::build(&desc, ".".as_ref(), "pt.xml".as_ref()).unwrap();
-    let made = make_integrator(&scene, &IntegratorOptions::default()).unwrap();
+    let scene = common::build(&desc, ".".as_ref(), "pt.xml".as_ref());
+    let made = make_integrator(&scene, &scene.integrator, &IntegratorOptions::default()).unwrap();
     assert!(made.unused_params.is_empty());
     let d = made.integrator.describe();
     assert!(d.starts_with("restir-pt max_depth=6 candidates=4"), "{d}");
@@ -711,7 +717,7 @@ fn xml_restir_pt_integrator_and_parameters() {
         params: vec![("neighbors", "2")].into(),
         ..Default::default()
     };
-    let d = make_integrator(&scene, &options)
+    let d = make_integrator(&scene, &scene.integrator, &options)
         .unwrap()
         .integrator
         .describe();
@@ -723,7 +729,7 @@ fn xml_restir_pt_integrator_and_parameters() {
         params: vec![("shift", "replay")].into(),
         ..Default::default()
     };
-    let d = make_integrator(&scene, &options)
+    let d = make_integrator(&scene, &scene.integrator, &options)
         .unwrap()
         .integrator
         .describe();
@@ -732,7 +738,7 @@ fn xml_restir_pt_integrator_and_parameters() {
         params: vec![("shift", "manifold")].into(),
         ..Default::default()
     };
-    let err = make_integrator(&scene, &options).unwrap_err();
+    let err = make_integrator(&scene, &scene.integrator, &options).unwrap_err();
     assert!(
         err.to_string().contains("reconnection, replay, hybrid"),
         "{err}"
@@ -747,15 +753,15 @@ fn xml_restir_pt_integrator_and_parameters() {
 #[test]
 fn auto_chooses_restir_pt_by_the_view_pilot() {
     use restir_integrators::restir_pt::{GLOSSY_VIEW_MIN, INDIRECT_VIEW_MIN, view_pilot};
-    let made = |scene: &Scene, name: &str| {
+    let made = |scene: &common::Built, name: &str| {
         let options = IntegratorOptions {
             name: Some(name.into()),
             ..Default::default()
         };
-        make_integrator(scene, &options).unwrap()
+        make_integrator(scene, &scene.integrator, &options).unwrap()
     };
     let scene = diffuse_glass_scene(true, "20");
-    let view = view_pilot(&scene);
+    let view = view_pilot(&scene, scene.integrator.hide_emitters);
     eprintln!(
         "diffuse, lit directly: {view:?}, indirect share {:.3}",
         view.indirect_share()
@@ -778,11 +784,11 @@ fn auto_chooses_restir_pt_by_the_view_pilot() {
     // ReSTIR PT: the glossy room (its rough plastic back wall and rough gold wall in view), and
     // the diffuse room whose light shines at the ceiling from behind the partition.
     let glossy = scene_with("");
-    let view = view_pilot(&glossy);
+    let view = view_pilot(&glossy, glossy.integrator.hide_emitters);
     eprintln!("glossy room: {view:?}");
     assert!(view.glossy_share() >= GLOSSY_VIEW_MIN, "{view:?}");
     let hidden = diffuse_glass_scene(false, "20");
-    let view = view_pilot(&hidden);
+    let view = view_pilot(&hidden, hidden.integrator.hide_emitters);
     eprintln!(
         "diffuse, lit indirectly: {view:?}, indirect share {:.3}",
         view.indirect_share()

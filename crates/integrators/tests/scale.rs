@@ -15,7 +15,7 @@
 //! 2.5, 3.0 and 2.1: the comb's gaps are narrower than those epsilons were, and the finer blocks
 //! and the seeds resolve the change.
 
-use restir_scene::{Scene, parse_ron};
+use restir_scene::parse_ron;
 
 mod common;
 use common::{block_statistics, max_z, render_image};
@@ -33,7 +33,7 @@ const SCALES: [f32; 4] = [1e-6, 1e-3, 1e3, 1e6];
 /// cube around the world origin (the floor's triangles span it: points near the origin on
 /// primitives whose vertices are far from it), an area light, a small bright sphere light, a
 /// point light and a dim environment.
-fn scene(s: f32, dim: f32) -> Scene {
+fn scene(s: f32, dim: f32) -> common::Built {
     let p = |x: f32, y: f32, z: f32| format!("({}, {}, {})", x * s, y * s, z * s);
     let scale = format!("Scale(({s}, {s}, {s}))");
     let e = |v: f32| v * dim;
@@ -88,12 +88,18 @@ fn scene(s: f32, dim: f32) -> Scene {
         k = e(0.08),
     );
     let desc = parse_ron(&ron, "scale-test.ron".as_ref()).unwrap();
-    Scene::build(&desc, ".".as_ref(), "scale-test.ron".as_ref())
+    common::try_build(&desc, ".".as_ref(), "scale-test.ron".as_ref())
         .unwrap_or_else(|e| panic!("scale {s}: {e}"))
 }
 
 /// Per block: mean and standard error over `seeds` renders from `seed_base` on.
-fn statistics(scene: &Scene, name: &str, spp: u32, seeds: u64, seed_base: u64) -> Vec<(f64, f64)> {
+fn statistics(
+    scene: &common::Built,
+    name: &str,
+    spp: u32,
+    seeds: u64,
+    seed_base: u64,
+) -> Vec<(f64, f64)> {
     block_statistics(
         |seed| render_image(scene, name, &[], spp, seed),
         seeds,

@@ -14,6 +14,8 @@
 //! The negative control expects the colours swapped (what a flipped `v` or a texture lookup at
 //! the wrong point would give) and must fail.
 
+mod common;
+
 use std::sync::atomic::AtomicBool;
 
 use glam::{Vec2, Vec3};
@@ -27,7 +29,7 @@ const SIZE: u32 = 24;
 /// Checks per unit of uv along each axis (2 × 2 per unit square, Mitsuba's checkerboard).
 const UV_SCALE: f32 = 2.0;
 
-fn scene() -> Scene {
+fn scene() -> common::Built {
     let [a, b, c] = COLOR0;
     let [d, e, f] = COLOR1;
     let ron = format!(
@@ -47,7 +49,7 @@ fn scene() -> Scene {
     )"#
     );
     let desc = parse_ron(&ron, "textured-plane.ron".as_ref()).unwrap();
-    Scene::build(&desc, ".".as_ref(), "textured-plane.ron".as_ref()).unwrap()
+    common::build(&desc, ".".as_ref(), "textured-plane.ron".as_ref())
 }
 
 /// The check (0 → `color0`, 1 → `color1`) at a world point of the rectangle, by hand.
@@ -82,7 +84,7 @@ fn pixel_checks(scene: &Scene) -> Vec<Option<usize>> {
 
 /// Per region (check 0, check 1) and channel: mean over seeds of the region's pixel mean, and
 /// its standard error.
-fn estimate(scene: &Scene, integrator: &str, seeds: u64, spp: u32) -> [[(f64, f64); 3]; 2] {
+fn estimate(scene: &common::Built, integrator: &str, seeds: u64, spp: u32) -> [[(f64, f64); 3]; 2] {
     let checks = pixel_checks(scene);
     for k in 0..2 {
         let n = checks.iter().filter(|c| **c == Some(k)).count();
@@ -92,7 +94,7 @@ fn estimate(scene: &Scene, integrator: &str, seeds: u64, spp: u32) -> [[(f64, f6
         name: Some(integrator.into()),
         ..Default::default()
     };
-    let made = make_integrator(scene, &options).unwrap();
+    let made = make_integrator(scene, &scene.integrator, &options).unwrap();
     let mut seed_means: [[Vec<f64>; 3]; 2] = Default::default();
     for seed in 0..seeds {
         let settings = RenderJob {

@@ -615,11 +615,11 @@ impl Scene {
             lights: light_set,
             camera,
             filter: desc.film.filter,
-            integrator: desc.integrator.clone(),
             features,
         };
         scene.update_material_features();
-        scene.features.environment_share = scene.decide_environment_share();
+        scene.features.environment_share =
+            scene.decide_environment_share(desc.integrator.hide_emitters);
         scene.features.largest_light_share = (0..scene.lights.len() as u32)
             .map(|l| scene.lights.pmf(l))
             .fold(0.0, f32::max);

@@ -106,8 +106,6 @@ pub struct Scene {
     pub camera: Camera,
     /// Reconstruction filter (how camera rays are jittered within a pixel).
     pub filter: FilterDesc,
-    /// The scene's integrator settings.
-    pub integrator: IntegratorDesc,
     /// What the scene contains, decided when it was built and kept up to date by the material
     /// edits. Written directly only to measure or test a code path the summary selects.
     pub features: SceneFeatures,

@@ -63,8 +63,12 @@ impl Scene {
 
     /// Estimates the variance-optimal environment share at the camera's primary hits and sets
     /// it on the light set. `None` (nothing changed) without both an environment and local
-    /// lights, or when no camera ray hits a surface.
-    pub(crate) fn decide_environment_share(&mut self) -> Option<EnvironmentShare> {
+    /// lights, or when no camera ray hits a surface. `hide_emitters`: whether the camera sees
+    /// area emitters (the scene's integrator setting).
+    pub(crate) fn decide_environment_share(
+        &mut self,
+        hide_emitters: bool,
+    ) -> Option<EnvironmentShare> {
         let env = self.lights.environment()?;
         let power_share = self.lights.environment_power_share();
         if self.lights.pmf(env) == 0.0 || self.lights.emitter_count() == 0 {
@@ -83,7 +87,7 @@ impl Scene {
                     (j as f32 + rng.next_f32()) / GRID as f32 * h as f32,
                 );
                 let ray = self.camera.generate_ray(film, Vec2::splat(0.5));
-                let (hit, _) = self.camera_intersect(&ray, self.integrator.hide_emitters);
+                let (hit, _) = self.camera_intersect(&ray, hide_emitters);
                 let Some(si) = hit else {
                     continue;
                 };

@@ -18,13 +18,14 @@ fn temp_dir(test: &str) -> PathBuf {
     dir
 }
 
-/// The built scene as text, without where its integrator was declared (file and line differ
-/// between the two files by construction).
+/// The built scene and its integrator settings as text, without where the integrator was
+/// declared (file and line differ between the two files by construction).
 fn built(desc: &SceneDesc, file: &Path) -> String {
-    let mut scene = Scene::build(desc, file.parent().unwrap(), file)
+    let scene = Scene::build(desc, file.parent().unwrap(), file)
         .unwrap_or_else(|e| panic!("{}: {e}", file.display()));
-    scene.integrator.location = Default::default();
-    format!("{scene:?}")
+    let mut integrator = desc.integrator.clone();
+    integrator.location = Default::default();
+    format!("{scene:?}\n{integrator:?}")
 }
 
 /// `desc` with what the XML says differently but renders the same: `Black` is a diffuse bsdf of

@@ -1,5 +1,5 @@
 //! Renders a scene through the restir crates as a library, in a few lines: load the scene,
-//! `Renderer::new(&scene).spp(n).render()`, use the image.
+//! `Renderer::new(&loaded).spp(n).render()`, use the image.
 //!
 //! ```sh
 //! cargo run --release -p library-render -- scenes/cornell-box.xml 16 out.exr
@@ -33,7 +33,7 @@ fn run(args: &[String]) -> Result<(), Box<dyn std::error::Error>> {
     let loaded = load_scene(scene.as_ref(), &options)?;
 
     // The one line that renders.
-    let out = Renderer::new(&loaded.scene).spp(spp).render()?;
+    let out = Renderer::new(&loaded).spp(spp).render()?;
 
     let mean = out.image.mean();
     println!(

@@ -309,7 +309,7 @@ pub fn render_frames(
         let estimator = match &integrator {
             Some(e) => e,
             None => integrator.insert(
-                make_integrator(&scene, options)
+                make_integrator(&scene, &desc.integrator, options)
                     .map_err(|e| e.to_string())?
                     .integrator,
             ),

@@ -58,7 +58,7 @@ pub(crate) fn run(args: RenderArgs) -> Result<Rendered, String> {
         load_seconds,
     } = load(&args)?;
     let scene = &loaded.scene;
-    let (integrator, options) = make(&args, scene)?;
+    let (integrator, options) = make(&args, &loaded)?;
     let Settled {
         output,
         plan,
@@ -191,15 +191,16 @@ fn load(args: &RenderArgs) -> Result<Loaded, String> {
 /// it does not use.
 fn make(
     args: &RenderArgs,
-    scene: &Scene,
+    loaded: &LoadedScene,
 ) -> Result<(Box<dyn Integrator>, IntegratorOptions), String> {
     let options = IntegratorOptions {
         name: args.integrator.clone(),
         max_depth: args.max_depth,
         params: args.restir.params(),
     };
-    let made = make_integrator(scene, &options).map_err(|e| e.to_string())?;
-    strict::check_flags_used(scene, &made)?;
+    let (scene, integrator) = (&loaded.scene, &loaded.desc.integrator);
+    let made = make_integrator(scene, integrator, &options).map_err(|e| e.to_string())?;
+    strict::check_flags_used(scene, integrator, &made)?;
     if !args.quiet {
         for note in &made.notes {
             say_err!("{note}");

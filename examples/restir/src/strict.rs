@@ -4,7 +4,7 @@
 use restir_integrators::{
     Integrator, IntegratorOptions, MadeIntegrator, ParamSet, ParamSource, make_integrator,
 };
-use restir_scene::Scene;
+use restir_scene::{IntegratorDesc, Scene};
 
 /// The estimators that take parameters (`auto`, the fourth name `--integrator` accepts, takes
 /// none).
@@ -12,7 +12,11 @@ pub const INTEGRATORS: [&str; 3] = ["path", "restir-di", "restir-pt"];
 
 /// A command-line flag the chosen estimator does not use is an error naming the estimators that
 /// do (a scene file's unused parameters stay warnings with their line).
-pub fn check_flags_used(scene: &Scene, made: &MadeIntegrator) -> Result<(), String> {
+pub fn check_flags_used(
+    scene: &Scene,
+    integrator: &IntegratorDesc,
+    made: &MadeIntegrator,
+) -> Result<(), String> {
     let Some(p) = made
         .unused_params
         .iter()
@@ -31,7 +35,7 @@ pub fn check_flags_used(scene: &Scene, made: &MadeIntegrator) -> Result<(), Stri
                 max_depth: None,
                 params,
             };
-            match make_integrator(scene, &options) {
+            match make_integrator(scene, integrator, &options) {
                 Ok(m) => m.unused_params.is_empty(),
                 // It read the value (and disliked it): it uses the flag.
                 Err(_) => true,

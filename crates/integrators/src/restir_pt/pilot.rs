@@ -97,7 +97,7 @@ impl ViewPilot {
 /// reconnect at, counts those with a glossy lobe and sums the indirect share of their light
 /// (16 samples each of the direct and the one-bounce light). Deterministic (fixed
 /// seed); at most 32² · (8 + 1 + 3 · 16) rays.
-pub fn view_pilot(scene: &Scene) -> ViewPilot {
+pub fn view_pilot(scene: &Scene, hide_emitters: bool) -> ViewPilot {
     let (w, h) = scene.camera.resolution();
     let mut rng = Pcg32::new(0x9105_5e1e, 0);
     let mut view = ViewPilot {
@@ -116,8 +116,7 @@ pub fn view_pilot(scene: &Scene) -> ViewPilot {
             let mut ray = scene.camera.generate_ray(film, Vec2::splat(0.5));
             view.rays += 1;
             for bounce in 0..=MAX_BOUNCES {
-                let (hit, _) =
-                    scene.camera_intersect(&ray, bounce == 0 && scene.integrator.hide_emitters);
+                let (hit, _) = scene.camera_intersect(&ray, bounce == 0 && hide_emitters);
                 let Some(si) = hit else {
                     break;
                 };

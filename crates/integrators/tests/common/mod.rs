@@ -8,13 +8,61 @@ use std::sync::atomic::AtomicBool;
 use restir_integrators::{
     Image, Integrator, IntegratorOptions, Param, ParamSource, RenderJob, make_integrator, render,
 };
-use restir_scene::Scene;
+use restir_scene::{IntegratorDesc, LoadedScene, Scene, SceneDesc};
+
+/// A built scene with the integrator settings of the description it was built from (what a
+/// [`LoadedScene`] holds, for scenes the tests describe themselves). Dereferences to the scene.
+pub struct Built {
+    /// The scene.
+    pub scene: Scene,
+    /// Its description's integrator settings.
+    pub integrator: IntegratorDesc,
+}
+
+impl std::ops::Deref for Built {
+    type Target = Scene;
+    fn deref(&self) -> &Scene {
+        &self.scene
+    }
+}
+
+impl std::ops::DerefMut for Built {
+    fn deref_mut(&mut self) -> &mut Scene {
+        &mut self.scene
+    }
+}
+
+impl From<LoadedScene> for Built {
+    fn from(loaded: LoadedScene) -> Self {
+        Built {
+            scene: loaded.scene,
+            integrator: loaded.desc.integrator,
+        }
+    }
+}
+
+/// Builds `desc` (relative paths from `base`, errors naming `file`).
+pub fn try_build(
+    desc: &SceneDesc,
+    base: &std::path::Path,
+    file: &std::path::Path,
+) -> Result<Built, restir_scene::SceneError> {
+    Ok(Built {
+        scene: Scene::build(desc, base, file)?,
+        integrator: desc.integrator.clone(),
+    })
+}
+
+/// [`try_build`], panicking on an error.
+pub fn build(desc: &SceneDesc, base: &std::path::Path, file: &std::path::Path) -> Built {
+    try_build(desc, base, file).unwrap_or_else(|e| panic!("{e}"))
+}
 
 /// Renders `scene` with estimator `name`. `params` are the estimator's parameters, except
 /// `max_depth`, which is taken as the command line's `--max-depth`. Every parameter must be used
 /// and every pixel finite.
 pub fn render_image(
-    scene: &Scene,
+    scene: &Built,
     name: &str,
     params: &[(&str, &str)],
     spp: u32,
@@ -33,7 +81,7 @@ pub fn render_image(
             .map(|(k, v)| Param::new(*k, *v, ParamSource::Caller))
             .collect(),
     };
-    let made = make_integrator(scene, &options).unwrap();
+    let made = make_integrator(scene, &scene.integrator, &options).unwrap();
     assert!(made.unused_params.is_empty());
     render_with(scene, made.integrator.as_ref(), spp, seed)
 }
