@@ -119,6 +119,14 @@ pub enum IntegratorError {
     MaxDepth(i32),
     /// An estimator name this crate does not know.
     Unknown(String),
+    /// The scene asks for an estimator of another renderer that this crate does not have
+    /// (Mitsuba 3's particle tracer `ptracer`); one of [`INTEGRATORS`] renders the same image.
+    Unavailable {
+        /// The estimator the scene names.
+        name: String,
+        /// Where the scene names it.
+        at: restir_scene::Location,
+    },
     /// A parameter with a bad value.
     Param(ParamError),
 }
@@ -132,6 +140,13 @@ impl std::fmt::Display for IntegratorError {
             IntegratorError::Unknown(name) => write!(
                 f,
                 "unknown integrator '{name}' (available: {})",
+                INTEGRATORS.join(", ")
+            ),
+            IntegratorError::Unavailable { name, at } => write!(
+                f,
+                "{at}: the scene's integrator '{name}' is Mitsuba 3's particle tracer, which this \
+                 renderer does not have; every estimator here renders the same image: choose one \
+                 with --integrator ({})",
                 INTEGRATORS.join(", ")
             ),
             IntegratorError::Param(e) => e.fmt(f),
@@ -205,6 +220,12 @@ pub fn make_integrator(
                 auto.why()
             ));
             (Box::new(auto), Vec::new())
+        }
+        "ptracer" => {
+            return Err(IntegratorError::Unavailable {
+                name: name.to_string(),
+                at: desc.location.clone(),
+            });
         }
         other => return Err(IntegratorError::Unknown(other.to_string())),
     };

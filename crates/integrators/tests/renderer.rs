@@ -284,3 +284,51 @@ fn the_removed_fallback_parameter_and_parameters_of_auto_are_errors() {
         "{e}"
     );
 }
+
+/// A scene that asks for Mitsuba 3's particle tracer loads (its depth kept), but making its
+/// integrator is an error naming the file, the line and the estimators that render the same
+/// image; any of them asked for by name renders it with the scene's depth.
+#[test]
+fn mitsuba_particle_tracer_scenes_load_and_name_the_estimators_to_choose() {
+    let xml = r#"<scene version="3.0.0">
+        <integrator type="ptracer">
+            <integer name="max_depth" value="4"/>
+            <integer name="samples_per_pass" value="8"/>
+        </integrator>
+        <sensor type="perspective"><float name="fov" value="40"/>
+            <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film>
+        </sensor>
+        <shape type="rectangle"><bsdf type="diffuse"/></shape>
+    </scene>"#;
+    let (desc, warnings) = restir_scene::xml::parse_xml(xml, "pt.xml".as_ref(), &[]).unwrap();
+    assert_eq!(desc.integrator.kind, "ptracer");
+    assert_eq!(desc.integrator.max_depth, 4);
+    // What no estimator here reads is said, with its line.
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.to_string().contains("samples_per_pass")),
+        "{warnings:?}"
+    );
+    let scene = restir_scene::Scene::build(&desc, ".".as_ref(), "pt.xml".as_ref()).unwrap();
+    let e = make_integrator(&scene, &desc.integrator, &IntegratorOptions::default()).unwrap_err();
+    assert!(matches!(e, IntegratorError::Unavailable { .. }), "{e:?}");
+    assert_eq!(
+        e.to_string(),
+        "pt.xml:2: the scene's integrator 'ptracer' is Mitsuba 3's particle tracer, which this \
+         renderer does not have; every estimator here renders the same image: choose one with \
+         --integrator (path, restir-di, restir-pt, auto)"
+    );
+    for name in ["path", "restir-di", "restir-pt"] {
+        let options = IntegratorOptions {
+            name: Some(name.into()),
+            ..Default::default()
+        };
+        let made = make_integrator(&scene, &desc.integrator, &options).unwrap();
+        assert!(
+            made.integrator.describe().contains("max_depth=4"),
+            "{}",
+            made.integrator.describe()
+        );
+    }
+}

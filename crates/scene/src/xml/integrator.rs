@@ -8,11 +8,14 @@ use super::{Importer, Result, elements};
 use crate::desc::*;
 
 /// The `<integrator>` types the importer reads: Mitsuba's `path`, `volpath` (read as `path`) and
-/// `direct` (`path` with max_depth 2), `moment` around one of them, and this renderer's estimators
-/// under their spellings.
+/// `direct` (`path` with max_depth 2), `moment` around one of them, this renderer's estimators
+/// under their spellings, and Mitsuba's particle tracer `ptracer`, which is read (its depth
+/// settings kept) but which no estimator here is: making it is an error that names the
+/// estimators that render the same image, so such a scene renders when one is chosen.
 const INTEGRATOR_TYPES: &[&str] = &[
     "path",
     "moment",
+    "ptracer",
     "volpath",
     "direct",
     "restir-di",
@@ -35,6 +38,7 @@ impl<'a> Importer<'a> {
         let mut keep_params = false;
         match ty.as_str() {
             "path" | "volpath" => integ.kind = "path".into(),
+            "ptracer" => integ.kind = "ptracer".into(),
             "direct" => {
                 integ.kind = "path".into();
                 integ.max_depth = 2;

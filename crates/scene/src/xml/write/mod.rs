@@ -294,7 +294,9 @@ impl Writer<'_> {
     }
 
     fn integrator(&mut self, integ: &IntegratorDesc) -> Result<()> {
-        if integ.kind != "path" {
+        // Mitsuba 3's own estimators: its path tracer and its particle tracer.
+        let mitsuba_type = integ.kind.as_str();
+        if !matches!(mitsuba_type, "path" | "ptracer") {
             return refuse(
                 "the integrator",
                 format!(
@@ -311,7 +313,7 @@ impl Writer<'_> {
                 format!("the parameter '{name}' has no counterpart in Mitsuba 3's path tracer"),
             );
         }
-        self.open(r#"<integrator type="path">"#);
+        self.open(&format!(r#"<integrator type="{mitsuba_type}">"#));
         self.line(r#"<integer name="max_depth" value="$max_depth"/>"#);
         self.line(&format!(
             r#"<integer name="rr_depth" value="{}"/>"#,
