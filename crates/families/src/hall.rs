@@ -31,19 +31,23 @@
 //! only, the materials on the seed and the receivers, the garlands' triangles on the seed and the
 //! light count, so the OBJ names `hall-s<seed>-n<lights>-<i>-<style>.obj` say what they hold.
 
-use glam::Vec3;
 use restir_sampling::Pcg32;
 
-use super::garlands::{Strand, Style, garland, obj};
 use super::stage::receiver_material;
 use super::util::{
     hue_colour, named, rect_transform, rough_conductor, round, round3, shape, uniform,
 };
-use super::{Asset, AssetContents, DiOptions, Generated, Receivers, envmap};
+use super::{DiOptions, Generated, Receivers, envmap};
 use restir_scene::{
     CameraDesc, FilmDesc, FilterDesc, GeometryDesc, IntegratorDesc, MaterialDesc, MicrofacetDesc,
     NamedMaterial, SceneDesc, ShapeDesc, TransformOp,
 };
+
+mod garland_lights;
+#[cfg(test)]
+mod tests;
+
+use garland_lights::{lights, strands};
 
 /// Total emitted power of the garlands (W), whatever their number.
 pub(super) const HALL_POWER: f32 = 600.0;
@@ -451,112 +455,6 @@ pub(super) fn hall(seed: u64, options: &DiOptions) -> Generated {
     }
 }
 
-/// The strands garlands hang on: along each colonnade between neighbouring pillars, across the
-/// nave beside each row, and diagonally across each bay.
-fn strands(rng: &mut Pcg32, l: &Layout) -> Vec<Strand> {
-    let mut strands = Vec::new();
-    let hang = |rng: &mut Pcg32| uniform(rng, 0.6, 0.85) * l.h;
-    let off = l.half * 1.2;
-    // Sag 5–15 % of the span, 0.2–1 m, keeping the lowest point at least LOWEST up.
-    let sag = |rng: &mut Pcg32, a: Vec3, b: Vec3| {
-        (uniform(rng, 0.05, 0.15) * (b - a).length())
-            .clamp(0.2, 1.0)
-            .min((a.y.min(b.y) - LOWEST).max(0.1))
-    };
-    for pair in l.rows.windows(2) {
-        for side in [-1.0, 1.0] {
-            let a = Vec3::new(side * l.xc, hang(rng), pair[0] + off);
-            let b = Vec3::new(side * l.xc, hang(rng), pair[1] - off);
-            let s = sag(rng, a, b);
-            strands.push(Strand { a, b, sag: s });
-        }
-        let flip = if rng.next_bounded(2) == 0 { -1.0 } else { 1.0 };
-        let (a, b) = (
-            Vec3::new(-flip * l.xc, hang(rng), pair[0]),
-            Vec3::new(flip * l.xc, hang(rng), pair[1]),
-        );
-        let d = (b - a).with_y(0.0).normalize();
-        let (a, b) = (a + off * 1.2 * d, b - off * 1.2 * d);
-        let s = sag(rng, a, b);
-        strands.push(Strand { a, b, sag: s });
-    }
-    for &z in &l.rows {
-        let side = if rng.next_bounded(2) == 0 { -1.0 } else { 1.0 };
-        let z = z + side * (l.half + 0.15);
-        let a = Vec3::new(-l.xc + off, hang(rng), z);
-        let b = Vec3::new(l.xc - off, hang(rng), z);
-        let s = sag(rng, a, b);
-        strands.push(Strand { a, b, sag: s });
-    }
-    strands
-}
-
-/// The garlands on `strands`: meshes, their OBJ assets, and how many.
-fn lights(seed: u64, options: &DiOptions, strands: &[Strand]) -> (Vec<ShapeDesc>, Vec<Asset>, u32) {
-    let mut rng = Pcg32::new(seed, 0x6761_726c); // "garl"
-    let n = options.lights;
-    let wanted = GARLANDS.0 + rng.next_bounded(GARLANDS.1 - GARLANDS.0 + 1);
-    let garlands = wanted.min(n / 24).max(1);
-    let mut levels: Vec<f32> = (0..garlands)
-        .map(|i| {
-            let t = i as f32 / (garlands - 1).max(1) as f32;
-            options.power_ratio.powf(t.powf(2.5))
-        })
-        .collect();
-    for i in (1..levels.len()).rev() {
-        levels.swap(i, rng.next_bounded(i as u32 + 1) as usize);
-    }
-    let mut assets = Vec::new();
-    let mut parts = Vec::new();
-    for i in 0..garlands {
-        let count = n / garlands + u32::from(i < n % garlands);
-        let mut strand = strands[i as usize % strands.len()];
-        // Further rounds on the same strands hang beside the first, 0.3 m apart.
-        let round_no = i as usize / strands.len();
-        if round_no > 0 {
-            let along = (strand.b - strand.a).with_y(0.0).normalize_or(Vec3::X);
-            let across = along.cross(Vec3::Y);
-            let shift = 0.3
-                * round_no as f32
-                * if round_no.is_multiple_of(2) {
-                    1.0
-                } else {
-                    -1.0
-                };
-            strand.a += shift * across;
-            strand.b += shift * across;
-        }
-        let style =
-            [Style::Bulbs, Style::Bulbs, Style::Rope, Style::Strip][rng.next_bounded(4) as usize];
-        let (p, t, area) = garland(&mut rng, style, &strand, count as usize);
-        let warm = rng.next_bounded(3) != 0;
-        let tint = if warm {
-            hue_colour(uniform(&mut rng, 0.05, 0.12), uniform(&mut rng, 0.1, 0.4))
-        } else {
-            hue_colour(rng.next_f32(), uniform(&mut rng, 0.4, 0.8))
-        };
-        let filename = format!("hall-s{seed}-n{n}-{i}-{}.obj", style.name());
-        assets.push(Asset {
-            filename: filename.clone(),
-            contents: AssetContents::Text(obj(style.name(), &p, &t)),
-        });
-        parts.push((filename, levels[i as usize], tint, area));
-    }
-    let power: f64 = parts.iter().map(|p| p.1 as f64 * p.3 as f64).sum();
-    let scale = (HALL_POWER as f64 / (core::f64::consts::PI * power.max(1e-30))) as f32;
-    let shapes = parts
-        .into_iter()
-        .map(|(filename, level, tint, _)| {
-            super::util::emitter(
-                GeometryDesc::Obj { filename },
-                Vec::new(),
-                tint.map(|c| round(c * level * scale, 4)),
-            )
-        })
-        .collect();
-    (shapes, assets, garlands)
-}
-
 /// The hall's materials: a checkerboard floor, pale walls and ceiling, stone pillars, coloured
 /// partitions, wooden shelves, the statue and four object materials of the receivers' kind.
 fn materials(seed: u64, receivers: Receivers, l: &Layout) -> Vec<NamedMaterial> {
@@ -608,128 +506,4 @@ fn materials(seed: u64, receivers: Receivers, l: &Layout) -> Vec<NamedMaterial> 
         .into_iter()
         .map(|(name, material)| NamedMaterial { name, material })
         .collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::{GenerateError, Kind, Params, generate};
-
-    fn options(lights: u32, occluders: bool, envmap: bool) -> DiOptions {
-        DiOptions {
-            lights,
-            receivers: Receivers::Mixed,
-            occluders,
-            envmap,
-            ..DiOptions::default()
-        }
-    }
-
-    /// Faces in the OBJ assets, and how many OBJ files.
-    fn triangles(generated: &Generated) -> (usize, usize) {
-        let objs: Vec<&str> = generated
-            .assets
-            .iter()
-            .filter_map(|a| match &a.contents {
-                AssetContents::Text(t) if a.filename.ends_with(".obj") => Some(t.as_str()),
-                _ => None,
-            })
-            .collect();
-        let faces = objs
-            .iter()
-            .map(|t| t.lines().filter(|l| l.starts_with("f ")).count())
-            .sum();
-        (faces, objs.len())
-    }
-
-    #[test]
-    fn a_hall_has_its_triangles_in_tens_of_garlands_and_builds() {
-        for (seed, lights) in [(11, 4_000), (111, 8_000), (3, 100)] {
-            let params = Params::Di(Kind::Hall, options(lights, true, true));
-            let a = generate(&params, seed).unwrap();
-            assert_eq!(a, generate(&params, seed).unwrap(), "deterministic");
-            let (faces, meshes) = triangles(&a);
-            assert_eq!(faces, lights as usize, "seed {seed}");
-            if lights >= 24 * GARLANDS.1 {
-                assert!((GARLANDS.0 as usize..=GARLANDS.1 as usize).contains(&meshes));
-            } else {
-                assert!(meshes >= 1 && meshes as u32 <= lights / 24);
-            }
-            let emitters = a.desc.shapes.iter().filter(|s| s.emission.is_some());
-            assert_eq!(emitters.count(), meshes);
-            assert_eq!(a.desc.lights.len(), 1, "the sky");
-            assert!(!a.desc.integrator.hide_emitters);
-            assert_eq!(a.desc.integrator.max_depth, 2);
-            // The RON text reads back and builds (OBJ meshes and sky written beside it).
-            let dir =
-                std::env::temp_dir().join(format!("restir-hall-{}-{seed}", std::process::id()));
-            let path = a.write(&dir, "hall").unwrap();
-            let text = std::fs::read_to_string(&path).unwrap();
-            let desc = restir_scene::parse_ron(&text, &path).unwrap();
-            assert_eq!(desc, a.desc);
-            let scene = restir_scene::Scene::build(&desc, &dir, &path).unwrap();
-            assert_eq!(scene.features.light_count, meshes + 1);
-            std::fs::remove_dir_all(&dir).unwrap();
-        }
-        let other = generate(&Params::Di(Kind::Hall, options(4_000, true, true)), 12).unwrap();
-        let first = generate(&Params::Di(Kind::Hall, options(4_000, true, true)), 11).unwrap();
-        assert_ne!(other.desc, first.desc, "another seed, another hall");
-    }
-
-    #[test]
-    fn the_options_change_what_they_name_and_nothing_else() {
-        let with = generate(&Params::Di(Kind::Hall, options(2_000, true, true)), 5).unwrap();
-        let closed = generate(&Params::Di(Kind::Hall, options(2_000, true, false)), 5).unwrap();
-        let open = generate(&Params::Di(Kind::Hall, options(2_000, false, true)), 5).unwrap();
-        // The garlands are the same meshes whatever the occluders and the sky.
-        let objs = |g: &Generated| -> Vec<Asset> {
-            g.assets
-                .iter()
-                .filter(|a| a.filename.ends_with(".obj"))
-                .cloned()
-                .collect()
-        };
-        assert_eq!(objs(&with), objs(&closed));
-        assert_eq!(objs(&with), objs(&open));
-        assert!(closed.desc.lights.is_empty());
-        assert!(closed.assets.iter().all(|a| !a.filename.ends_with(".exr")));
-        // Windows and the far doorway cut the walls into more pieces.
-        let walls = |g: &Generated| {
-            g.desc
-                .shapes
-                .iter()
-                .filter(|s| {
-                    matches!(&s.material, Some(restir_scene::MaterialRef::Ref(n)) if n == "wall")
-                })
-                .count()
-        };
-        assert!(walls(&with) > walls(&closed));
-        let occluders = |g: &Generated| {
-            g.desc
-                .shapes
-                .iter()
-                .filter(|s| {
-                    matches!(&s.material, Some(restir_scene::MaterialRef::Ref(n))
-                        if n == "partition" || n == "shelf")
-                })
-                .count()
-        };
-        assert!(occluders(&with) >= 2 && occluders(&open) == 0);
-    }
-
-    #[test]
-    fn a_hall_is_not_animated() {
-        let mut hall = generate(&Params::Di(Kind::Hall, options(500, true, false)), 1).unwrap();
-        let err = crate::animate(&mut hall, Kind::Hall, 1).unwrap_err();
-        assert!(matches!(err, GenerateError::Animation(_)), "{err}");
-    }
-
-    #[test]
-    fn solid_pieces_leave_the_holes_open() {
-        assert_eq!(
-            solid(-5.0, 5.0, &[(-1.0, 1.0), (2.0, 3.0)]),
-            vec![(-5.0, -1.0), (1.0, 2.0), (3.0, 5.0)]
-        );
-        assert_eq!(solid(0.0, 1.0, &[]), vec![(0.0, 1.0)]);
-    }
 }
