@@ -32,8 +32,8 @@ use restir_sampling::Pcg32;
 
 use crate::bands::Bands;
 use crate::driver::{ReuseReport, ScreenReuse, Stages};
-use crate::passes::ReuseShift;
 use crate::settings::ReuseSettings;
+use crate::shift::ReuseShift;
 use crate::surfaces::{Streams, Surfaces};
 
 /// A host renderer's direct lighting, as ReSTIR DI asks for it. Every method gets the pass's

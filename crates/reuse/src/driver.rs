@@ -9,8 +9,9 @@ use std::time::{Duration, Instant};
 use restir_gris::Reservoir;
 
 use crate::neighbors::NeighborPattern;
-use crate::passes::{self, History, HistorySlot, ReuseShift};
+use crate::passes::{self, History, HistorySlot};
 use crate::settings::ReuseSettings;
+use crate::shift::ReuseShift;
 use crate::surfaces::{Streams, Surfaces};
 
 /// The random-stream stages of a pass's reuse ([`Streams::pixel`]): the temporal round draws

@@ -25,7 +25,8 @@
 //! |---|---|
 //! | [`surfaces`] | the host's image: [`Surfaces`], [`Streams`], the common similarity test |
 //! | [`settings`] | [`ReuseSettings`]: neighbours, radius, rounds, MIS, confidence cap, temporal reuse |
-//! | [`passes`] | [`ReuseShift`], temporal reuse, the spatial rounds, the history |
+//! | [`shift`] | [`ReuseShift`]: how an estimator plugs in (its sample, domain and shift map) |
+//! | [`passes`] | temporal reuse, the spatial rounds, the history |
 //! | [`reciprocal`], [`neighbors`], [`duplication`] | reciprocal pairs; the neighbour pattern; the duplication-aware history cap |
 //! | [`driver`] | [`ScreenReuse`]: one pass's reuse in order, and the state kept between passes |
 //! | [`direct`] | ReSTIR DI over a host's lights |
@@ -41,6 +42,7 @@ pub mod neighbors;
 pub mod passes;
 pub mod reciprocal;
 pub mod settings;
+pub mod shift;
 pub mod surfaces;
 
 pub mod guide {
@@ -48,8 +50,9 @@ pub mod guide {
 }
 
 pub use driver::{ReuseReport, ScreenReuse, Stages};
-pub use passes::{History, HistorySlot, ReuseShift};
+pub use passes::{History, HistorySlot};
 pub use settings::{MIS_NAMES, ReuseSettings, mis_name};
+pub use shift::ReuseShift;
 pub use surfaces::{SeededStreams, Similarity, SimilarityKey, Streams, Surfaces};
 
 /// The reservoir type and the MIS schemes, re-exported from `restir-gris`.

@@ -13,50 +13,15 @@ use std::sync::{Arc, Mutex};
 
 use std::borrow::Borrow;
 
-use restir_gris::{Reservoir, ShiftMap, resample};
+use restir_gris::{Reservoir, resample};
 
 use crate::bands::Bands;
 use crate::duplication;
 use crate::neighbors::NeighborPattern;
 use crate::reciprocal;
 use crate::settings::ReuseSettings;
+use crate::shift::ReuseShift;
 use crate::surfaces::{Streams, Surfaces};
-
-/// What an estimator's reuse needs for one pass: its shift map between the pixels of this pass
-/// and the previous one.
-pub trait ReuseShift: Sync {
-    /// The reservoirs' sample.
-    type Sample: Copy + Send + Sync;
-    /// What the shift map calls a domain.
-    type Domain: Sync + ?Sized;
-    /// The shift map resampling a pixel uses.
-    type Map<'m>: ShiftMap<Self::Sample, Domain = Self::Domain>
-    where
-        Self: 'm;
-
-    /// The shift map for resampling into a pixel whose reservoir is `canonical`.
-    fn map(&self, canonical: &Reservoir<Self::Sample>) -> Self::Map<'_>;
-
-    /// Rays `map`'s shifts traced.
-    fn rays(map: &Self::Map<'_>) -> u64 {
-        let _ = map;
-        0
-    }
-
-    /// How [`Self::domain`] hands a domain out: a reference into the estimator's buffers, or a
-    /// small value (a pixel index) that needs no buffer to lend it.
-    type DomainRef<'d>: Borrow<Self::Domain> + Copy
-    where
-        Self: 'd;
-
-    /// The domain of pixel `index` (which has a primary hit) in this pass, or in the previous
-    /// pass with `previous`.
-    fn domain(&self, index: usize, previous: bool) -> Self::DomainRef<'_>;
-
-    /// Whether two pixels hold the same sample (one of them shifted from the other, or both
-    /// from a common one), for the duplication-aware history cap ([`super::duplication`]).
-    fn same_sample(a: &Self::Sample, b: &Self::Sample) -> bool;
-}
 
 /// What temporal reuse keeps from the previous pass.
 pub struct History<S, G: Surfaces> {

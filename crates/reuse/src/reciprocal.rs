@@ -22,8 +22,8 @@ use restir_gris::{MisScheme, Reservoir, ShiftMap, Shifted, resample};
 use restir_sampling::Pcg32;
 
 use crate::bands::Bands;
-use crate::passes::ReuseShift;
 use crate::settings::ReuseSettings;
+use crate::shift::ReuseShift;
 use crate::surfaces::{Streams, Surfaces};
 
 /// Whether `scheme` uses only shifts between the canonical pixel and each neighbour (the

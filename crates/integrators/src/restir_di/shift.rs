@@ -12,7 +12,7 @@ use super::DiReservoir;
 use super::target::{StrategyCounts, evaluate};
 use crate::motion::FrameMotion;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
-use crate::reuse::passes::ReuseShift;
+use crate::reuse::shift::ReuseShift;
 use crate::shadow::{self, ShadowTarget};
 
 /// A receiver where ReSTIR DI's shift map works: a pixel's primary hit in this pass, or in the

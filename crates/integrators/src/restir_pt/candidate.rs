@@ -4,25 +4,8 @@
 
 use glam::Vec3;
 
-use super::sample::{Kind, PathSample, Vertex, resolve_vertex};
-use super::walk::{ScatterVertex, Walk, Walker};
-
-/// The reconnection vertex found along a walk.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Rc {
-    pub(super) k: u32,
-    /// `x_{k−1}` and the throughput of the bounces before it.
-    pub(super) prev: ScatterVertex,
-    pub(super) beta: Vec3,
-    /// The sample fields naming `x_k`.
-    pub(super) base: PathSample,
-    /// `x_k` resolved from them ([`resolve_vertex`]), once for all the walk's candidates.
-    pub(super) vertex: Vertex,
-    /// Direction leaving `x_k` (set once sampled).
-    pub(super) dir: Vec3,
-    /// Throughput of the bounces after `x_k`.
-    pub(super) rest: Vec3,
-}
+use super::sample::{Kind, PathSample, resolve_vertex};
+use super::walk::{Rc, Walk, Walker};
 
 /// A light connection found along a walk, and how its radiance enters the sample.
 pub(super) enum Connection {

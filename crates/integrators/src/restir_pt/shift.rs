@@ -23,7 +23,7 @@ use restir_scene::Scene;
 
 use crate::motion::FrameMotion;
 use crate::reuse::gbuffer::GBuffer;
-use crate::reuse::passes::ReuseShift;
+use crate::reuse::shift::ReuseShift;
 use crate::shadow::visible;
 
 use super::sample::{

@@ -40,12 +40,10 @@ use restir_materials::{Bsdf, LobeFlags};
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
-use super::sample::{Kind, PathSample, Reconnection, ShiftKind, connectible, smooth};
+use super::sample::{Kind, PathSample, Reconnection, ShiftKind, Vertex, connectible, smooth};
 use crate::path::{EmissionMis, PrevVertex};
 use crate::reuse::gbuffer::Receiver;
 use crate::shadow::{ShadowTarget, visible};
-
-use super::candidate::Rc;
 
 pub use crate::path::RANDOMS_PER_BOUNCE;
 
@@ -490,6 +488,23 @@ impl BounceRandoms {
             rr,
         }
     }
+}
+
+/// The reconnection vertex found along a walk.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Rc {
+    pub(super) k: u32,
+    /// `x_{k−1}` and the throughput of the bounces before it.
+    pub(super) prev: ScatterVertex,
+    pub(super) beta: Vec3,
+    /// The sample fields naming `x_k`.
+    pub(super) base: PathSample,
+    /// `x_k` resolved from them ([`resolve_vertex`](super::sample::resolve_vertex)), once for all the walk's candidates.
+    pub(super) vertex: Vertex,
+    /// Direction leaving `x_k` (set once sampled).
+    pub(super) dir: Vec3,
+    /// Throughput of the bounces after `x_k`.
+    pub(super) rest: Vec3,
 }
 
 /// The state of one walk.

@@ -8,5 +8,5 @@ pub mod gbuffer;
 pub mod params;
 
 pub use restir_reuse::{
-    MIS_NAMES, ReuseSettings, duplication, mis_name, neighbors, passes, reciprocal, settings,
+    MIS_NAMES, ReuseSettings, duplication, mis_name, neighbors, passes, reciprocal, settings, shift,
 };
