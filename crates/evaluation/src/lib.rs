@@ -2,7 +2,8 @@
 //!
 //! A [`Suite`] lists scenes, integrator configurations, time budgets and seeds. [`run_suite`]
 //! renders every combination with the library [`render`](restir_integrators::render) (`spp: u32::MAX`, the budget as time
-//! limit), compares each image with a reference and records time, passes, rays, errors and peak
+//! limit; with the suite's `clock: Cpu`, [`Clock::Cpu`], the budget counts the process's CPU
+//! seconds instead of wall seconds), compares each image with a reference and records time, passes, rays, errors and peak
 //! memory. [`write_outputs`] then writes the CSV, one log-log relMSE-versus-time plot per scene
 //! (SVG), one strip of crops per scene (PNG), a Markdown report and an interactive HTML page
 //! ([`html`]); [`update_doc`] puts the report into a marked section of another Markdown file.
@@ -78,4 +79,4 @@ pub use report::doc::{BEGIN_MARKER, END_MARKER, check_doc, update_doc};
 pub use report::files::write_outputs;
 pub use report::html;
 pub use run::{BYTES_PER_PIXEL, run_suite};
-pub use suite::{IntegratorConfig, Suite, SuiteError, SuiteLines, SuiteScene};
+pub use suite::{Clock, IntegratorConfig, Suite, SuiteError, SuiteLines, SuiteScene};

@@ -1,11 +1,12 @@
 //! Running a suite: every (scene, configuration, budget, seed) rendered and measured against its
 //! reference, a sequence frame after frame with one estimator.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use restir_image::Image;
 use restir_integrators::FrameSequence;
-use restir_integrators::{Integrator, RenderJob, RenderOutput};
+use restir_integrators::{Integrator, RenderJob, RenderOutput, render};
 use restir_scene::Scene;
 
 use crate::analysis::flicker;
@@ -19,7 +20,7 @@ use crate::records::{
     BenchResults, Machine, Progress, ReferenceInfo, RunOptions, RunRecord, SceneImages, Strip,
 };
 use crate::reference::{References, reference_for};
-use crate::suite::{IntegratorConfig, Suite, SuiteScene};
+use crate::suite::{Clock, IntegratorConfig, Suite, SuiteScene};
 
 fn crop_rect(
     entry: &SuiteScene,
@@ -66,12 +67,29 @@ struct Measured {
     after: Option<u64>,
 }
 
-/// Renders `job` with the peak memory reset before and the CPU time around it.
-fn measured_render(scene: &Scene, integrator: &dyn Integrator, job: &RenderJob) -> Measured {
+/// Renders `job` with the peak memory reset before and the CPU time around it; with
+/// `cpu_budget`, no further pass starts once the process has spent that many CPU seconds on it.
+fn measured_render(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    job: &RenderJob,
+    cpu_budget: Option<f64>,
+) -> Measured {
     reset_peak_rss();
     let before = vm_hwm_kib();
     let cpu = process_cpu_seconds();
-    let out = render_once(scene, integrator, job);
+    let out = match cpu_budget {
+        None => render_once(scene, integrator, job),
+        Some(budget) => {
+            let spent = AtomicBool::new(false);
+            let mut after_pass = |_, _| {
+                if process_cpu_seconds() - cpu >= budget {
+                    spent.store(true, Ordering::Relaxed);
+                }
+            };
+            render(scene, integrator, job, &spent, &mut after_pass)
+        }
+    };
     Measured {
         cpu_seconds: process_cpu_seconds() - cpu,
         after: vm_hwm_kib(),
@@ -98,16 +116,17 @@ fn render_entry(
     references: &References,
     config: &IntegratorConfig,
     integrator: Option<&dyn Integrator>,
-    budget: f64,
+    (budget, clock): (f64, Clock),
     seed: u64,
     step: &mut dyn FnMut(Option<u32>),
 ) -> Result<Rendered, BenchError> {
     let job = |seed| RenderJob {
         spp: u32::MAX,
-        time_limit: Some(Duration::from_secs_f64(budget)),
+        time_limit: (clock == Clock::Wall).then(|| Duration::from_secs_f64(budget)),
         seed,
         output: None,
     };
+    let cpu_budget = (clock == Clock::Cpu).then_some(budget);
     let record = |m: &Measured, reference: &Image, frame, flicker| {
         let (w, h) = (reference.width, reference.height);
         evaluate(&m.out.image, reference)
@@ -140,7 +159,7 @@ fn render_entry(
     let Some(mut sequence) = loaded.sequence().filter(|_| loaded.frames.is_some()) else {
         let integrator = integrator.expect("a still scene's integrator is built once");
         step(None);
-        let m = measured_render(&loaded.scene, integrator, &job(seed));
+        let m = measured_render(&loaded.scene, integrator, &job(seed), cpu_budget);
         let mut r = record(&m, &*references.get(0)?, None, f64::NAN)?;
         r.describe = integrator.describe();
         return Ok(Rendered {
@@ -163,6 +182,7 @@ fn render_entry(
             &scene,
             estimator.as_ref(),
             &job(FrameSequence::seed(seed, frame)),
+            cpu_budget,
         );
         drop(scene);
         let reference = references.get(i)?.into_owned();
@@ -352,7 +372,7 @@ pub fn run_suite(
                         &refs,
                         config,
                         integrators[ci].as_deref(),
-                        budget,
+                        (budget, suite.clock),
                         seed,
                         &mut |frame| {
                             progress(&Progress {

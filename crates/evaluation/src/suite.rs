@@ -22,6 +22,9 @@ pub struct Suite {
     pub integrators: Vec<IntegratorConfig>,
     /// Time budgets in seconds (each render stops starting passes once its budget is spent).
     pub budgets: Vec<f64>,
+    /// The clock the budgets count: `Wall` (default) or `Cpu`.
+    #[serde(default)]
+    pub clock: Clock,
     /// Seeds per (scene, configuration, budget): seeds `0..seeds`.
     #[serde(default = "one")]
     pub seeds: u32,
@@ -32,6 +35,18 @@ pub struct Suite {
     /// Budget whose first-seed renders go into the crop strips (default: the smallest budget).
     #[serde(default)]
     pub strip_budget: Option<f64>,
+}
+
+/// The clock a suite's time budgets count.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+pub enum Clock {
+    /// Elapsed (wall) seconds of the render.
+    #[default]
+    Wall,
+    /// The process's CPU seconds (user and system, all threads) while the render runs: equal
+    /// CPU time, which a shared machine that delivers fewer cores than it has does not skew.
+    /// Efficiency is `1 / (relMSE · CPU seconds)` with either clock.
+    Cpu,
 }
 
 /// One scene of a suite.

@@ -280,6 +280,7 @@ fn synthetic_results() -> BenchResults {
             seeds: 2,
             reference_spp: 64,
             strip_budget: None,
+            clock: Clock::Wall,
         },
         records,
         references,

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use crate::say::say;
 use restir_evaluation::{
-    Progress, RunOptions, Suite, check_doc, run_suite, suite, update_doc, write_outputs,
+    Clock, Progress, RunOptions, Suite, check_doc, run_suite, suite, update_doc, write_outputs,
 };
 
 /// Options of `restir bench`.
@@ -22,6 +22,10 @@ pub struct BenchArgs {
     /// Time budgets in seconds, comma-separated; override the suite's.
     #[arg(long, value_delimiter = ',', value_name = "SECONDS,...")]
     budgets: Option<Vec<f64>>,
+    /// The clock the budgets count, wall (elapsed seconds) or cpu (the process's CPU seconds:
+    /// equal CPU time on a shared machine); overrides the suite's `clock`.
+    #[arg(long, value_enum)]
+    clock: Option<ClockArg>,
     /// Seeds per budget; overrides the suite's.
     #[arg(long)]
     seeds: Option<u32>,
@@ -43,6 +47,13 @@ pub struct BenchArgs {
     quiet: bool,
 }
 
+/// `--clock`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum ClockArg {
+    Wall,
+    Cpu,
+}
+
 /// Runs `restir bench`.
 pub fn run(args: BenchArgs) -> Result<(), String> {
     let (mut suite, lines) = Suite::load_located(&args.suite).map_err(|e| e.to_string())?;
@@ -55,6 +66,12 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
         suite::check_budgets(b).map_err(|e| format!("--budgets: {e}"))?;
         suite.budgets = b.clone();
         suite.strip_budget = None;
+    }
+    if let Some(clock) = args.clock {
+        suite.clock = match clock {
+            ClockArg::Wall => Clock::Wall,
+            ClockArg::Cpu => Clock::Cpu,
+        };
     }
     if let Some(s) = args.seeds {
         suite.seeds = s;

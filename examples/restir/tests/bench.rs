@@ -390,3 +390,57 @@ fn suite_files_are_bounded_and_errors_name_the_line() {
     );
     assert!(!dir.join("o").exists());
 }
+
+/// With `--clock cpu` the budgets count the process's CPU seconds: every render spends at least
+/// its budget of CPU time, and the report says which clock the budgets counted.
+#[test]
+fn cpu_clock_budgets_count_cpu_seconds() {
+    let dir = temp_dir("cpu-clock");
+    let suite = dir.join("cpu.ron");
+    let cornell = repo("scenes/cornell-box.xml");
+    std::fs::write(
+        &suite,
+        format!(
+            "(scenes: [(path: {:?}, width: 16, height: 16, max_depth: 3)],\n \
+             integrators: [(label: \"path\", integrator: \"path\")],\n \
+             budgets: [0.3], seeds: 2, reference_spp: 16)\n",
+            s(&cornell)
+        ),
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let args = [
+        "bench",
+        s(&suite),
+        "--out",
+        s(&out_dir),
+        "--clock",
+        "cpu",
+        "--threads",
+        "2",
+        "--quiet",
+    ];
+    let out = restir(&args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "stderr:\n{stderr}");
+    let csv = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header = fields(lines.next().unwrap());
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<&str>> = lines.map(fields).collect();
+    assert_eq!(rows.len(), 2, "{csv}");
+    for r in &rows {
+        let cpu: f64 = r[col("cpu_seconds")].parse().unwrap();
+        assert!(cpu >= 0.3, "{r:?}");
+    }
+    let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    assert!(report.contains("in CPU seconds of the process"), "{report}");
+    // A clock that is not one: refused before anything renders, naming the choices.
+    let bad = restir(&["bench", s(&suite), "--out", s(&out_dir), "--clock", "sun"]);
+    let stderr = String::from_utf8_lossy(&bad.stderr);
+    assert!(!bad.status.success());
+    assert!(
+        stderr.contains("'sun'") && stderr.contains("wall, cpu"),
+        "{stderr}"
+    );
+}

@@ -6,6 +6,7 @@ use crate::analysis::{Summary, TimeToError, suite_entry, summarize, time_to_erro
 use crate::measure::utc;
 use crate::records::BenchResults;
 use crate::report::strip::{STRIP_GAP, strip_scale};
+use crate::suite::Clock;
 
 pub(crate) fn sci(v: f64) -> String {
     if v.is_finite() {
@@ -41,10 +42,14 @@ pub fn report_markdown(results: &BenchResults, h: &str, link: &str) -> String {
         .iter()
         .map(|b| b.to_string())
         .collect();
+    let clock = match results.suite.clock {
+        Clock::Wall => "wall-clock seconds",
+        Clock::Cpu => "CPU seconds of the process (`clock: Cpu`)",
+    };
     let _ = writeln!(
         s,
-        "Budgets {} s, {} seed(s) each; every render runs whole passes until its budget is spent \
-         (`spp = u32::MAX`, `time_limit = budget`), so its time is at least the budget. \
+        "Budgets {} s in {clock}, {} seed(s) each; every render runs whole passes until its \
+         budget is spent (`spp = u32::MAX`), so its time is at least the budget. \
          Data: [`results.csv`]({link}results.csv).\n",
         budgets.join(", "),
         results.suite.seeds
