@@ -38,7 +38,7 @@ use glam::{Vec2, Vec3};
 use restir_geometry::{Frame, Ray, SurfaceInteraction, offset_ray_origin};
 use restir_materials::{Bsdf, LobeFlags};
 use restir_sampling::Pcg32;
-use restir_scene::Scene;
+use restir_scene::{Scene, TexturePoint};
 
 use super::sample::{Kind, PathSample, Reconnection, ShiftKind, connectible, smooth};
 use crate::path::{EmissionMis, PrevVertex};
@@ -92,9 +92,10 @@ impl ScatterVertex {
     #[inline]
     fn at(scene: &Scene, si: &SurfaceInteraction, to_prev: Vec3, reach: f32) -> Self {
         let bsdf = scene.shape_bsdf()[si.shape as usize];
-        let resolved = scene.bsdf_at(bsdf, si.uv);
+        let at = TexturePoint::of(si);
+        let resolved = scene.bsdf_at(bsdf, &at);
         Self {
-            r: Receiver::new(si.p, &si.shading, si.uv, to_prev, bsdf, 0.0),
+            r: Receiver::new(si.p, &si.shading, at, to_prev, bsdf, 0.0),
             bsdf: resolved,
             ng: si.ng,
             conn: connectible(&resolved),
