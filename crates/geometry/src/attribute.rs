@@ -233,6 +233,9 @@ mod tests {
             Err(AttributeError::Channels { .. })
         ));
         let e = MeshAttribute::new("face_x", 1, vec![0., f32::NAN]).unwrap_err();
-        assert_eq!(e.to_string(), "mesh attribute \"face_x\": row 1 is not finite");
+        assert_eq!(
+            e.to_string(),
+            "mesh attribute \"face_x\": row 1 is not finite"
+        );
     }
 }

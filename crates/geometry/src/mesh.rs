@@ -240,7 +240,10 @@ impl TriangleMesh {
 
     /// The mesh with `attributes` attached (replacing any it had): each has one row per vertex
     /// or per triangle, as its name says, and names are distinct.
-    pub fn with_attributes(mut self, attributes: Vec<MeshAttribute>) -> Result<Self, AttributeError> {
+    pub fn with_attributes(
+        mut self,
+        attributes: Vec<MeshAttribute>,
+    ) -> Result<Self, AttributeError> {
         for (i, a) in attributes.iter().enumerate() {
             let rows = match a.rate() {
                 AttributeRate::Vertex => self.positions.len(),

@@ -272,9 +272,11 @@ fn build_shape(
             let ((p, n, uv, idx), attributes) =
                 crate::meshio::load_ply(&path).map_err(|e| e.to_string())?;
             let attribute_bytes: usize = attributes.iter().map(|a| a.bytes()).sum();
-            budget.take_mesh(idx.len(), vertex_bytes(&p, &n, &uv) + attribute_bytes, || {
-                format!("mesh '{}'", path.display())
-            })?;
+            budget.take_mesh(
+                idx.len(),
+                vertex_bytes(&p, &n, &uv) + attribute_bytes,
+                || format!("mesh '{}'", path.display()),
+            )?;
             let n = if desc.face_normals { None } else { n };
             mesh(
                 TriangleMesh::new(p, n, uv, idx, desc.flip_normals)

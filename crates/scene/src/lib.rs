@@ -216,7 +216,12 @@ impl TexturedParams {
     /// The parameters at `at` on `shapes` (the scene's, which mesh attributes read); texture
     /// values are clamped to `[0, 1]` (reflectances), but for the normal map's.
     #[inline]
-    pub fn eval(&self, textures: &[Texture], shapes: &[Shape], at: &TexturePoint) -> ReflectanceParams {
+    pub fn eval(
+        &self,
+        textures: &[Texture],
+        shapes: &[Shape],
+        at: &TexturePoint,
+    ) -> ReflectanceParams {
         let look = |slot: Option<u32>, constant: Vec3| match slot {
             Some(i) => textures[i as usize]
                 .eval_at(shapes, at)

@@ -107,6 +107,7 @@ impl ScatterVertex {
 
 /// What a replay ended with.
 #[derive(Clone, Copy, Debug)]
+#[allow(clippy::large_enum_variant)] // `Prefix` is the usual outcome; boxing it would allocate per replay
 pub enum Replayed {
     /// The replayed path leaves the sample's subspace (different lobes, an earlier connectible
     /// vertex, a miss, or a zero throughput): the shift fails.

@@ -168,7 +168,9 @@ impl Attributes {
 
     fn finish(self, out: &mut Vec<MeshAttribute>) -> Result<(), String> {
         for (g, values) in self.groups.into_iter().zip(self.values) {
-            out.push(MeshAttribute::new(&g.name, g.fields.len(), values).map_err(|e| e.to_string())?);
+            out.push(
+                MeshAttribute::new(&g.name, g.fields.len(), values).map_err(|e| e.to_string())?,
+            );
         }
         Ok(())
     }
@@ -454,7 +456,10 @@ mod tests {
         let ((_, _, _, idx), attrs) = read_ply(ply.as_bytes()).unwrap();
         assert_eq!(idx.len(), 3);
         let names: Vec<&str> = attrs.iter().map(|a| a.name()).collect();
-        assert_eq!(names, ["vertex_color", "vertex_temp", "face_weight", "face_n"]);
+        assert_eq!(
+            names,
+            ["vertex_color", "vertex_temp", "face_weight", "face_n"]
+        );
         let srgb = |c: f32| restir_image::srgb::decode(c / 255.0);
         let color = attrs[0].values();
         assert_eq!(attrs[0].channels(), 3);
@@ -472,7 +477,11 @@ mod tests {
     #[test]
     fn vertex_and_face_attributes_binary() {
         let mut b = b"ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty ushort k_0\nelement face 1\nproperty list uchar uint vertex_indices\nproperty uchar r\nproperty uchar g\nproperty uchar b\nend_header\n".to_vec();
-        for (v, k) in [([0.0f32, 0.0, 0.0], 0u16), ([1.0, 0.0, 0.0], 65535), ([0.0, 1.0, 0.0], 1000)] {
+        for (v, k) in [
+            ([0.0f32, 0.0, 0.0], 0u16),
+            ([1.0, 0.0, 0.0], 65535),
+            ([0.0, 1.0, 0.0], 1000),
+        ] {
             for x in v {
                 b.extend(x.to_be_bytes());
             }
@@ -495,6 +504,10 @@ mod tests {
             &[1.0, 0.0, restir_image::srgb::decode(64.0 / 255.0)]
         );
         // Truncated inside the face attributes: an error.
-        assert!(read_ply(&b[..b.len() - 1]).unwrap_err().contains("truncated"));
+        assert!(
+            read_ply(&b[..b.len() - 1])
+                .unwrap_err()
+                .contains("truncated")
+        );
     }
 }

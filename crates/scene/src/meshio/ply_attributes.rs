@@ -132,14 +132,22 @@ mod tests {
         assert_eq!(
             names(
                 "vertex_",
-                &["x", "y", "z", "nx", "ny", "nz", "u", "v", "color_0", "color_1", "color_2"]
+                &[
+                    "x", "y", "z", "nx", "ny", "nz", "u", "v", "color_0", "color_1", "color_2"
+                ]
             ),
             vec![("vertex_color".into(), vec![8, 9, 10])]
         );
         assert_eq!(
             names(
                 "face_",
-                &["vertex_indices", "color_0", "color_1", "color_2", "weight_0"]
+                &[
+                    "vertex_indices",
+                    "color_0",
+                    "color_1",
+                    "color_2",
+                    "weight_0"
+                ]
             ),
             vec![
                 ("face_color".into(), vec![1, 2, 3]),
@@ -150,7 +158,9 @@ mod tests {
         assert_eq!(
             names(
                 "vertex_",
-                &["x", "blue", "y", "z", "green", "red", "albedo_r", "albedo_g", "albedo_b"]
+                &[
+                    "x", "blue", "y", "z", "green", "red", "albedo_r", "albedo_g", "albedo_b"
+                ]
             ),
             vec![
                 ("vertex_color".into(), vec![5, 4, 1]),
@@ -158,7 +168,10 @@ mod tests {
             ]
         );
         assert_eq!(
-            names("vertex_", &["x", "r", "g", "b", "a", "n_x", "n_y", "n_z", "k_1"]),
+            names(
+                "vertex_",
+                &["x", "r", "g", "b", "a", "n_x", "n_y", "n_z", "k_1"]
+            ),
             vec![
                 ("vertex_color".into(), vec![1, 2, 3, 4]),
                 ("vertex_n".into(), vec![5, 6, 7]),

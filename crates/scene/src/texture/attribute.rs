@@ -89,7 +89,11 @@ impl AttributeTexture {
     /// scale; zero on a shape the texture is not bound to.
     #[inline]
     pub fn eval(&self, shapes: &[Shape], at: &TexturePoint) -> Vec3 {
-        let k = self.bound.get(at.shape as usize).copied().unwrap_or(UNBOUND);
+        let k = self
+            .bound
+            .get(at.shape as usize)
+            .copied()
+            .unwrap_or(UNBOUND);
         match shapes.get(at.shape as usize) {
             Some(Shape::Mesh(m)) if k != UNBOUND => {
                 m.eval_attribute(k as usize, at.prim, at.bary) * self.scale

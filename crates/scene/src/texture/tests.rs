@@ -100,9 +100,8 @@ fn checkerboard_matches_mitsuba_and_offsets() {
 fn bitmap_orientation_scale_offset_and_wrap() {
     let dir = temp_dir("orient");
     // Row 0 (top): red, green; row 1: blue, white. Raw, so values are exact.
-    let img =
-        image::RgbImage::from_raw(2, 2, vec![255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255])
-            .unwrap();
+    let img = image::RgbImage::from_raw(2, 2, vec![255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255])
+        .unwrap();
     img.save(dir.join("q.png")).unwrap();
     let load = |scale: Vec2, offset: Vec2| {
         let desc = TextureDesc::Bitmap {
@@ -143,9 +142,8 @@ fn bitmap_orientation_scale_offset_and_wrap() {
 #[test]
 fn bitmap_mirror_clamp_and_nearest() {
     let dir = temp_dir("modes");
-    let img =
-        image::RgbImage::from_raw(2, 2, vec![255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255])
-            .unwrap();
+    let img = image::RgbImage::from_raw(2, 2, vec![255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255])
+        .unwrap();
     img.save(dir.join("q.png")).unwrap();
     let load = |wrap: WrapMode, filter: FilterType| {
         let desc = TextureDesc::Bitmap {

@@ -287,7 +287,10 @@ impl Writer<'_> {
     pub(super) fn texture(&mut self, t: &TextureDesc, name: &str, item: &str) -> Result<()> {
         let uv = match t {
             TextureDesc::Bitmap { uv, .. } | TextureDesc::Checkerboard { uv, .. } => uv,
-            TextureDesc::MeshAttribute { name: attribute, scale } => {
+            TextureDesc::MeshAttribute {
+                name: attribute,
+                scale,
+            } => {
                 finite(item, "mesh_attribute scale", &[*scale])?;
                 literal(item, "mesh attribute name", attribute)?;
                 self.open(&format!(r#"<texture type="mesh_attribute" name="{name}">"#));
