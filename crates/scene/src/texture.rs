@@ -1,4 +1,4 @@
-//! Textures: `bitmap` (PNG, JPEG, EXR), `checkerboard` and `mesh_attribute` ([`attribute`]),
+//! Textures: `bitmap` (PNG, JPEG, EXR), `checkerboard` and `mesh_attribute` ([`AttributeTexture`]),
 //! decoded once when the scene is built and evaluated at a hit ([`TexturePoint`]: its texture
 //! coordinates, or for a mesh attribute its triangle and barycentrics) by
 //! [`crate::Scene::bsdf_at`].
@@ -321,7 +321,7 @@ impl Texture {
     }
 }
 
-/// A `mesh_attribute` texture, not yet bound to shapes ([`attribute`]).
+/// A `mesh_attribute` texture, not yet bound to shapes ([`AttributeTexture`]).
 fn mesh_attribute(name: &str, scale: f32) -> Result<Texture, TextureError> {
     if restir_geometry::AttributeRate::of_name(name).is_none() {
         return Err(TextureError::AttributeName(name.into()));
