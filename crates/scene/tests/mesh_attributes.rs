@@ -273,3 +273,29 @@ fn editing_a_shape_material_checks_its_attributes() {
     assert_eq!(reflectance(&scene, -5.9, 0.5), Vec3::new(0.1, 0.2, 0.3));
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// Attributes count against `--max-memory` with their mesh: the limit that holds the mesh's
+/// triangles, positions and attributes loads it, one byte less does not.
+#[test]
+fn attributes_count_against_the_memory_limit() {
+    let d = dir("memory");
+    let path = write_scene(&d, &shape_with(""));
+    // 2 triangles, 4 positions (48 bytes), vertex_color 4 × 3, face_color 2 × 3 and
+    // face_weight 2 floats (80 bytes).
+    let need = 2 * restir_scene::limits::MESH_BYTES_PER_TRIANGLE + 48 + 80;
+    let with_limit = |max_memory| {
+        load_scene(
+            &path,
+            &LoadOptions {
+                max_memory: Some(max_memory),
+                ..LoadOptions::default()
+            },
+        )
+    };
+    assert!(with_limit(need).is_ok());
+    match with_limit(need - 1) {
+        Ok(_) => panic!("loads within {} bytes", need - 1),
+        Err(e) => assert!(e.to_string().contains("m.ply"), "{e}"),
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
