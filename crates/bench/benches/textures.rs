@@ -21,7 +21,7 @@ use glam::{DVec3, Vec2, Vec3};
 use restir_integrators::film::Filter;
 use restir_integrators::{IntegratorOptions, PassContext, make_integrator};
 use restir_materials::Bsdf;
-use restir_scene::{IntegratorDesc, Scene, load_desc, parse_ron};
+use restir_scene::{IntegratorDesc, Scene, TexturePoint, load_desc, parse_ron};
 
 fn budget() -> f64 {
     std::env::var("RESTIR_BENCH_SECONDS")
@@ -84,19 +84,19 @@ fn bsdf_at_costs(budget: f64) {
     let desc = parse_ron(ron, "b.ron".as_ref()).unwrap();
     let mut scene = Scene::build(&desc, &dir, "b.ron".as_ref()).unwrap();
     let _ = std::fs::remove_dir_all(&dir);
-    let uvs: Vec<Vec2> = (0..4096)
+    let uvs: Vec<TexturePoint> = (0..4096)
         .map(|i| {
-            Vec2::new(
+            TexturePoint::at_uv(Vec2::new(
                 (i as f32 * 0.618_034).fract(),
                 (i as f32 * 0.414_214).fract(),
-            )
+            ))
         })
         .collect();
     const REPS: usize = 64;
     let calls = |scene: &Scene, bsdf: u32| -> u64 {
         let mut acc = Vec3::ZERO;
         for _ in 0..REPS {
-            for &uv in &uvs {
+            for uv in &uvs {
                 let b: Bsdf = scene.bsdf_at(std::hint::black_box(bsdf), uv);
                 acc += b.eval(Vec3::Z, Vec3::Z);
             }

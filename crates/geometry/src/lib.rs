@@ -20,6 +20,7 @@
 #![deny(missing_docs)]
 
 mod accel;
+mod attribute;
 mod camera;
 mod frame;
 mod mesh;
@@ -27,6 +28,7 @@ mod ray;
 mod shape;
 
 pub use accel::{Accel, Hit, SurfaceInteraction, surface_at};
+pub use attribute::{AttributeError, AttributeRate, MeshAttribute};
 pub use camera::{Camera, CameraError, FovAxis};
 pub use frame::Frame;
 pub use mesh::{MeshError, TriangleMesh};

@@ -4,6 +4,8 @@
 use glam::{Affine3A, Vec2, Vec3};
 use restir_sampling::Distribution1D;
 
+use crate::attribute::{AttributeError, AttributeRate, MeshAttribute};
+
 /// Why a mesh is unusable.
 #[derive(Clone, Debug, PartialEq)]
 pub enum MeshError {
@@ -86,6 +88,8 @@ pub struct TriangleMesh {
     area_distribution: Option<Distribution1D>,
     /// Per triangle, what a surface lookup needs that depends on the triangle alone.
     faces: Vec<Face>,
+    /// Named per-vertex and per-face values (Mitsuba's mesh attributes), usually none.
+    attributes: Vec<MeshAttribute>,
 }
 
 /// The per-triangle part of a surface lookup, computed once when the mesh is built, transformed
@@ -172,6 +176,7 @@ impl TriangleMesh {
             area: 0.0,
             area_distribution: None,
             faces: Vec::new(),
+            attributes: Vec::new(),
         };
         mesh.update_tables();
         Ok(mesh)
@@ -226,8 +231,50 @@ impl TriangleMesh {
         }
         let mut k = keep.iter();
         self.indices.retain(|_| *k.next().unwrap_or(&true));
+        for a in &mut self.attributes {
+            a.retain_faces(&keep);
+        }
         self.update_tables();
         Ok(dropped)
+    }
+
+    /// The mesh with `attributes` attached (replacing any it had): each has one row per vertex
+    /// or per triangle, as its name says, and names are distinct.
+    pub fn with_attributes(
+        mut self,
+        attributes: Vec<MeshAttribute>,
+    ) -> Result<Self, AttributeError> {
+        for (i, a) in attributes.iter().enumerate() {
+            let rows = match a.rate() {
+                AttributeRate::Vertex => self.positions.len(),
+                AttributeRate::Face => self.indices.len(),
+            };
+            if a.values().len() != rows * a.channels() {
+                return Err(AttributeError::Rows {
+                    name: a.name().into(),
+                    values: a.values().len(),
+                    channels: a.channels(),
+                    rows,
+                });
+            }
+            if attributes[..i].iter().any(|b| b.name() == a.name()) {
+                return Err(AttributeError::Duplicate(a.name().into()));
+            }
+        }
+        self.attributes = attributes;
+        Ok(self)
+    }
+
+    /// The mesh's named attributes.
+    pub fn attributes(&self) -> &[MeshAttribute] {
+        &self.attributes
+    }
+
+    /// Attribute `k` of [`TriangleMesh::attributes`] on triangle `prim` at barycentrics `b`
+    /// ([`MeshAttribute::eval`]).
+    #[inline]
+    pub fn eval_attribute(&self, k: usize, prim: u32, b: Vec2) -> Vec3 {
+        self.attributes[k].eval(self.indices[prim as usize], prim, b)
     }
 
     /// Vertex positions.

@@ -195,6 +195,16 @@ fn build_envmap(
     EnvMap::new(w, h, texels, scale, glam::Mat3::from_mat4(m)).map_err(|e| e.to_string())
 }
 
+/// ` (mesh 'file')` for a shape read from a file, else nothing.
+fn mesh_file(sd: &ShapeDesc) -> String {
+    match &sd.geometry {
+        GeometryDesc::Obj { filename }
+        | GeometryDesc::Ply { filename }
+        | GeometryDesc::Serialized { filename, .. } => format!(" (mesh '{filename}')"),
+        _ => String::new(),
+    }
+}
+
 /// Why a world-space shape lies beyond [`limits::MAX_COORDINATE`], or `None`.
 fn extent_problem(shape: &Shape) -> Option<String> {
     let (what, v) = match shape {
@@ -259,13 +269,19 @@ fn build_shape(
         }
         GeometryDesc::Ply { filename } => {
             let path = base_dir.join(filename);
-            let (p, n, uv, idx) = crate::meshio::load_ply(&path).map_err(|e| e.to_string())?;
-            budget.take_mesh(idx.len(), vertex_bytes(&p, &n, &uv), || {
-                format!("mesh '{}'", path.display())
-            })?;
+            let ((p, n, uv, idx), attributes) =
+                crate::meshio::load_ply(&path).map_err(|e| e.to_string())?;
+            let attribute_bytes: usize = attributes.iter().map(|a| a.bytes()).sum();
+            budget.take_mesh(
+                idx.len(),
+                vertex_bytes(&p, &n, &uv) + attribute_bytes,
+                || format!("mesh '{}'", path.display()),
+            )?;
             let n = if desc.face_normals { None } else { n };
             mesh(
                 TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
+                    .map_err(|e| e.to_string())
+                    .and_then(|m| m.with_attributes(attributes).map_err(|e| e.to_string()))
                     .map_err(|e| format!("mesh '{}': {e}", path.display()))?,
             )?
         }
@@ -320,6 +336,8 @@ fn build_shape(
                 m.indices().to_vec(),
                 true,
             )
+            .map_err(|e| e.to_string())?
+            .with_attributes(m.attributes().to_vec())
             .map_err(|e| e.to_string())?;
             *m = rebuilt;
         }
@@ -333,6 +351,8 @@ fn build_shape(
             m.indices().to_vec(),
             m.flip_normals(),
         )
+        .map_err(|e| e.to_string())?
+        .with_attributes(m.attributes().to_vec())
         .map_err(|e| e.to_string())?;
     }
     if let Some(problem) = extent_problem(&shape) {
@@ -491,6 +511,10 @@ impl Scene {
                 None if sd.emission.is_some() => 1,
                 None => 0,
             };
+            if let Some(t) = &bsdf_textures[bsdf as usize] {
+                crate::texture::bind(&mut cache.textures, t, i as u32, &shape)
+                    .map_err(|e| at(&sd.location, format!("shape {i}{}: {e}", mesh_file(sd))))?;
+            }
             if let Some(e) = &sd.emission {
                 let radiance = v3(e);
                 if !radiance.is_finite() || radiance.min_element() < 0.0 {

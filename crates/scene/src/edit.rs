@@ -23,6 +23,13 @@ pub enum EditError {
         /// How many shapes the scene has.
         count: usize,
     },
+    /// The material reads a mesh attribute that the shape does not have.
+    Attribute {
+        /// The shape.
+        shape: usize,
+        /// What is missing.
+        reason: String,
+    },
 }
 
 impl std::fmt::Display for EditError {
@@ -38,6 +45,7 @@ impl std::fmt::Display for EditError {
                 "no shape {index}: the scene has {count} (indices 0 to {})",
                 count.saturating_sub(1)
             ),
+            EditError::Attribute { shape, reason } => write!(f, "shape {shape}: {reason}"),
         }
     }
 }
@@ -108,7 +116,8 @@ impl Scene {
     }
 
     /// Gives shape `shape` material `material` (an index into [`Scene::bsdfs`]). Updates the
-    /// summary.
+    /// summary. A material whose `mesh_attribute` textures read an attribute the shape does not
+    /// have is refused.
     pub fn set_shape_material(&mut self, shape: usize, material: u32) -> Result<(), EditError> {
         if material as usize >= self.bsdfs.len() {
             return Err(EditError::NoMaterial {
@@ -117,11 +126,17 @@ impl Scene {
             });
         }
         let count = self.shape_bsdf.len();
-        let slot = self.shape_bsdf.get_mut(shape).ok_or(EditError::NoShape {
-            index: shape,
-            count,
-        })?;
-        *slot = material;
+        if shape >= count {
+            return Err(EditError::NoShape {
+                index: shape,
+                count,
+            });
+        }
+        if let Some(t) = &self.bsdf_textures[material as usize] {
+            crate::texture::bind(&mut self.textures, t, shape as u32, &self.shapes[shape])
+                .map_err(|reason| EditError::Attribute { shape, reason })?;
+        }
+        self.shape_bsdf[shape] = material;
         self.update_material_features();
         Ok(())
     }

@@ -43,11 +43,12 @@ pub use error::{SceneError, SceneWarning};
 pub use light_share::EnvironmentShare;
 pub use load::{LoadOptions, LoadedScene, load_desc, load_scene, parse_ron, sidecar_path};
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use restir_geometry::{Accel, Camera, Hit, Ray, Shape, SurfaceInteraction};
 use restir_lights::LightSet;
 use restir_materials::{Bsdf, ReflectanceParams};
 use texture::Texture;
+pub use texture::TexturePoint;
 
 /// What a scene contains, decided once at build time so that integrators can pick cheaper code
 /// paths instead of testing inside their loops.
@@ -164,24 +165,25 @@ impl Scene {
         self.accel.occluded(ray, t_max)
     }
 
-    /// The BSDF of a surface point (its material with textures looked up at `si.uv`).
+    /// The BSDF of a surface point (its material with textures looked up there).
     #[inline]
     pub fn bsdf(&self, si: &SurfaceInteraction) -> Bsdf {
-        self.bsdf_at(self.shape_bsdf[si.shape as usize], si.uv)
+        self.bsdf_at(self.shape_bsdf[si.shape as usize], &TexturePoint::of(si))
     }
 
-    /// Material `bsdf` (an index into `bsdfs`) at texture coordinates `uv`: the one place where
-    /// textures are resolved. A scene without textures (decided at build time,
-    /// [`SceneFeatures::has_textures`]) returns the stored BSDF without looking at `uv`.
+    /// Material `bsdf` (an index into `bsdfs`) at lookup point `at` (texture coordinates, and
+    /// the triangle and barycentrics a mesh attribute reads): the one place where textures are
+    /// resolved. A scene without textures (decided at build time,
+    /// [`SceneFeatures::has_textures`]) returns the stored BSDF without looking at `at`.
     #[inline]
-    pub fn bsdf_at(&self, bsdf: u32, uv: Vec2) -> Bsdf {
+    pub fn bsdf_at(&self, bsdf: u32, at: &TexturePoint) -> Bsdf {
         let base = self.bsdfs[bsdf as usize];
         if !self.features.has_textures {
             return base;
         }
         match &self.bsdf_textures[bsdf as usize] {
             None => base,
-            Some(t) => base.with_params(&t.eval(&self.textures, uv)),
+            Some(t) => base.with_params(&t.eval(&self.textures, &self.shapes, at)),
         }
     }
 }
@@ -209,12 +211,19 @@ pub struct TexturedParams {
 }
 
 impl TexturedParams {
-    /// The parameters at `uv`; texture values are clamped to `[0, 1]` (reflectances), but for
-    /// the normal map's.
+    /// The parameters at `at` on `shapes` (the scene's, which mesh attributes read); texture
+    /// values are clamped to `[0, 1]` (reflectances), but for the normal map's.
     #[inline]
-    pub fn eval(&self, textures: &[Texture], uv: Vec2) -> ReflectanceParams {
+    pub fn eval(
+        &self,
+        textures: &[Texture],
+        shapes: &[Shape],
+        at: &TexturePoint,
+    ) -> ReflectanceParams {
         let look = |slot: Option<u32>, constant: Vec3| match slot {
-            Some(i) => textures[i as usize].eval(uv).clamp(Vec3::ZERO, Vec3::ONE),
+            Some(i) => textures[i as usize]
+                .eval_at(shapes, at)
+                .clamp(Vec3::ZERO, Vec3::ONE),
             None => constant,
         };
         ReflectanceParams {
@@ -223,11 +232,11 @@ impl TexturedParams {
             transmittance: look(self.transmittance, self.base.transmittance),
             nonlinear: self.base.nonlinear,
             opacity: match self.opacity {
-                Some(i) => textures[i as usize].eval_1(uv),
+                Some(i) => textures[i as usize].eval_1_at(shapes, at),
                 None => self.base.opacity,
             },
             normal: match self.normal {
-                Some(i) => textures[i as usize].eval(uv),
+                Some(i) => textures[i as usize].eval_at(shapes, at),
                 None => self.base.normal,
             },
             alpha: match (self.alpha_u, self.alpha_v, self.base.alpha) {
@@ -235,7 +244,7 @@ impl TexturedParams {
                 (u, v, a) => {
                     let (au, av) = a.unwrap_or((0.1, 0.1));
                     let scalar = |slot: Option<u32>, constant: f32| match slot {
-                        Some(i) => textures[i as usize].eval_1(uv),
+                        Some(i) => textures[i as usize].eval_1_at(shapes, at),
                         None => constant,
                     };
                     Some((scalar(u, au), scalar(v, av)))

@@ -39,6 +39,12 @@ pub(crate) fn spot_light(
     };
     let m = transform_matrix(to_world).map_err(|e| format!("spot emitter: to_world: {e}"))?;
     let index = match texture {
+        Some(TextureDesc::MeshAttribute { name, .. }) => {
+            return Err(format!(
+                "spot emitter texture: a 'mesh_attribute' texture (\"{name}\") reads the mesh a \
+                 ray hits and cannot be projected by a light; use a bitmap or checkerboard"
+            ));
+        }
         Some(t) => {
             if let TextureDesc::Bitmap { filename, .. } = t {
                 take_image(&base_dir.join(filename))?;

@@ -38,7 +38,7 @@ use glam::{Vec2, Vec3};
 use restir_geometry::{Frame, Ray, SurfaceInteraction, offset_ray_origin};
 use restir_materials::{Bsdf, LobeFlags};
 use restir_sampling::Pcg32;
-use restir_scene::Scene;
+use restir_scene::{Scene, TexturePoint};
 
 use super::sample::{Kind, PathSample, Reconnection, ShiftKind, Vertex, connectible, smooth};
 use crate::path::{EmissionMis, PrevVertex};
@@ -90,9 +90,10 @@ impl ScatterVertex {
     #[inline]
     fn at(scene: &Scene, si: &SurfaceInteraction, to_prev: Vec3, reach: f32) -> Self {
         let bsdf = scene.shape_bsdf()[si.shape as usize];
-        let resolved = scene.bsdf_at(bsdf, si.uv);
+        let at = TexturePoint::of(si);
+        let resolved = scene.bsdf_at(bsdf, &at);
         Self {
-            r: Receiver::new(si.p, &si.shading, si.uv, to_prev, bsdf, 0.0),
+            r: Receiver::new(si.p, &si.shading, at, to_prev, bsdf, 0.0),
             bsdf: resolved,
             ng: si.ng,
             conn: connectible(&resolved),
@@ -104,6 +105,7 @@ impl ScatterVertex {
 
 /// What a replay ended with.
 #[derive(Clone, Copy, Debug)]
+#[allow(clippy::large_enum_variant)] // `Prefix` is the usual outcome; boxing it would allocate per replay
 pub enum Replayed {
     /// The replayed path leaves the sample's subspace (different lobes, an earlier connectible
     /// vertex, a miss, or a zero throughput): the shift fails.

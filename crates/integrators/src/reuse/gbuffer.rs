@@ -6,7 +6,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use restir_geometry::Frame;
 use restir_materials::Bsdf;
-use restir_scene::Scene;
+use restir_scene::{Scene, TexturePoint};
 
 use crate::bands::Bands;
 use crate::motion::FrameMotion;
@@ -14,9 +14,11 @@ use crate::pass::PassContext;
 use restir_reuse::{Similarity, SimilarityKey, Surfaces};
 
 /// What a reuse pass needs to know about a pixel's primary hit: the shading point, its frame,
-/// its material and texture coordinates, the direction to the camera and what the
-/// neighbour-similarity tests compare. One cache line (spatial reuse reads it at random neighbours); the second tangent of the
-/// shading frame is recomputed as `n × s`.
+/// its material and where its textures are looked up, the direction to the camera and what the
+/// neighbour-similarity tests compare. Cache-line aligned (spatial reuse reads it at random
+/// neighbours): two lines since it holds the texture lookup point of mesh attributes (the
+/// triangle and barycentrics) beside the texture coordinates; the second tangent of the shading
+/// frame is recomputed as `n × s`.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub struct Receiver {
@@ -32,8 +34,9 @@ pub struct Receiver {
     pub bsdf: u32,
     /// Distance from the camera.
     pub depth: f32,
-    /// Texture coordinates (where [`Scene::bsdf_at`] looks up the material's textures).
-    pub uv: Vec2,
+    /// Where [`Scene::bsdf_at`] looks up the material's textures (texture coordinates; the
+    /// shape, triangle and barycentrics for mesh attributes).
+    pub at: TexturePoint,
 }
 
 impl Receiver {
@@ -47,12 +50,24 @@ impl Receiver {
         wo: Vec3::Z,
         bsdf: Self::NO_HIT,
         depth: 0.0,
-        uv: Vec2::ZERO,
+        at: TexturePoint {
+            uv: Vec2::ZERO,
+            shape: 0,
+            prim: 0,
+            bary: Vec2::ZERO,
+        },
     };
 
-    /// A receiver at a surface point with shading frame `(s, ·, n)` and texture coordinates
-    /// `uv`, seen from direction `to_camera` (world space, unit) at distance `depth`.
-    pub fn new(p: Vec3, frame: &Frame, uv: Vec2, to_camera: Vec3, bsdf: u32, depth: f32) -> Self {
+    /// A receiver at a surface point with shading frame `(s, ·, n)` and texture lookup point
+    /// `at`, seen from direction `to_camera` (world space, unit) at distance `depth`.
+    pub fn new(
+        p: Vec3,
+        frame: &Frame,
+        at: TexturePoint,
+        to_camera: Vec3,
+        bsdf: u32,
+        depth: f32,
+    ) -> Self {
         let mut r = Self {
             p,
             n: frame.n,
@@ -60,7 +75,7 @@ impl Receiver {
             wo: Vec3::Z,
             bsdf,
             depth,
-            uv,
+            at,
         };
         r.wo = r.frame().to_local(to_camera);
         r
@@ -69,7 +84,7 @@ impl Receiver {
     /// The BSDF at this point, textures resolved ([`Scene::bsdf_at`]).
     #[inline]
     pub fn resolve_bsdf(&self, scene: &Scene) -> Bsdf {
-        scene.bsdf_at(self.bsdf, self.uv)
+        scene.bsdf_at(self.bsdf, &self.at)
     }
 
     /// The shading frame.
@@ -177,7 +192,7 @@ impl GBuffer {
                     recv[i] = Receiver::new(
                         si.p,
                         &si.shading,
-                        si.uv,
+                        TexturePoint::of(&si),
                         -ray.d,
                         scene.shape_bsdf()[si.shape as usize],
                         si.t,

@@ -1,19 +1,21 @@
 //! Mesh files: Wavefront OBJ ([`obj`]), PLY ([`ply`], ASCII and binary) and Mitsuba's
 //! `.serialized` ([`serialized`]).
 //!
-//! Each returns positions, optional normals, optional uvs and triangles in object space; the
-//! builder applies `to_world`, `flip_normals` and `face_normals`. Every malformed input is a
+//! Each returns positions, optional normals, optional uvs and triangles in object space (PLY
+//! also the mesh attributes its other properties hold); the builder applies `to_world`, `flip_normals` and `face_normals`. Every malformed input is a
 //! [`MeshError`] naming the file (the builder prefixes the scene file and line), never a panic;
 //! sizes read from a file are checked against the bytes actually present before anything is
 //! allocated.
 
 mod obj;
 mod ply;
+mod ply_attributes;
 mod serialized;
 
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
+use restir_geometry::MeshAttribute;
 
 /// Positions, optional normals, optional uvs and triangles of a mesh file.
 pub(crate) type MeshData = (
@@ -73,8 +75,8 @@ impl std::error::Error for MeshError {}
 
 pub(crate) use obj::load_obj;
 
-/// Reads a PLY file.
-pub(crate) fn load_ply(path: &Path) -> Result<MeshData, MeshError> {
+/// Reads a PLY file, with its mesh attributes (Mitsuba's `vertex_…` and `face_…`).
+pub(crate) fn load_ply(path: &Path) -> Result<(MeshData, Vec<MeshAttribute>), MeshError> {
     ply::read_ply(&read_file(path)?).map_err(|problem| malformed(path, problem))
 }
 

@@ -1,9 +1,12 @@
 //! PLY meshes, ASCII and binary (little- and big-endian): vertex positions, optional normals and
-//! uvs, and polygon faces fanned into triangles. Sizes read from the header are checked against
-//! the bytes present before anything is allocated.
+//! uvs, polygon faces fanned into triangles, and the other vertex and face properties as mesh
+//! attributes ([`super::ply_attributes`]). Sizes read from the header are checked against the
+//! bytes present before anything is allocated.
 
 use glam::{Vec2, Vec3};
+use restir_geometry::MeshAttribute;
 
+use super::ply_attributes::{Group, groups};
 use super::{MeshData, finish};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -31,6 +34,31 @@ impl Scalar {
             "double" | "float64" => Scalar::F64,
             _ => return None,
         })
+    }
+    fn is_integer(self) -> bool {
+        !matches!(self, Scalar::F32 | Scalar::F64)
+    }
+    /// The largest value of an integer type.
+    fn max(self) -> f64 {
+        match self {
+            Scalar::I8 => i8::MAX as f64,
+            Scalar::U8 => u8::MAX as f64,
+            Scalar::I16 => i16::MAX as f64,
+            Scalar::U16 => u16::MAX as f64,
+            Scalar::I32 => i32::MAX as f64,
+            Scalar::U32 | Scalar::F32 | Scalar::F64 => u32::MAX as f64,
+        }
+    }
+    /// A property value as a mesh attribute holds it. Mitsuba 3 reads every integer PLY
+    /// property as a normalised sRGB-encoded value: divided by the type's largest value, then
+    /// decoded to linear (so 8-bit colours mean what they mean in an 8-bit image); floats are
+    /// used as they are.
+    fn attribute_value(self, raw: f64) -> f32 {
+        if self.is_integer() {
+            restir_image::srgb::decode((raw / self.max()) as f32)
+        } else {
+            raw as f32
+        }
     }
     fn size(self) -> usize {
         match self {
@@ -107,10 +135,53 @@ impl Body<'_> {
     }
 }
 
+/// The attributes of one element being read: the groups and each one's values so far.
+struct Attributes {
+    groups: Vec<Group>,
+    values: Vec<Vec<f32>>,
+}
+
+impl Attributes {
+    fn of(kind: &str, e: &Element) -> Self {
+        let props: Vec<(&str, bool)> = e
+            .props
+            .iter()
+            .map(|p| (p.name.as_str(), p.list.is_some()))
+            .collect();
+        let groups = groups(kind, &props);
+        let values = groups.iter().map(|_| Vec::new()).collect();
+        Self { groups, values }
+    }
+
+    /// Appends one row per group from an element's values `vals`, `times` times.
+    fn push(&mut self, e: &Element, vals: &[f64], times: usize) {
+        for (g, out) in self.groups.iter().zip(&mut self.values) {
+            for _ in 0..times {
+                out.extend(
+                    g.fields
+                        .iter()
+                        .map(|&k| e.props[k].ty.attribute_value(vals[k])),
+                );
+            }
+        }
+    }
+
+    fn finish(self, out: &mut Vec<MeshAttribute>) -> Result<(), String> {
+        for (g, values) in self.groups.into_iter().zip(self.values) {
+            out.push(
+                MeshAttribute::new(&g.name, g.fields.len(), values).map_err(|e| e.to_string())?,
+            );
+        }
+        Ok(())
+    }
+}
+
 /// Reads a PLY file: vertex `x, y, z` with optional `nx, ny, nz` and `u, v` (or `s, t`,
 /// `texture_u, texture_v`), and faces as `vertex_indices` (or `vertex_index`) lists, polygons
-/// triangulated as fans. Other elements and properties are skipped.
-pub(crate) fn read_ply(bytes: &[u8]) -> Result<MeshData, String> {
+/// triangulated as fans (each triangle of a polygon gets the polygon's face attributes). The
+/// other vertex and face properties become mesh attributes as Mitsuba 3 groups them; other
+/// elements are skipped.
+pub(crate) fn read_ply(bytes: &[u8]) -> Result<(MeshData, Vec<MeshAttribute>), String> {
     // Header: ASCII lines up to `end_header`.
     let end = find(bytes, b"end_header").ok_or("not a PLY file (no end_header)")?;
     let mut body_start = end + b"end_header".len();
@@ -193,6 +264,7 @@ pub(crate) fn read_ply(bytes: &[u8]) -> Result<MeshData, String> {
     let mut normals = Vec::new();
     let mut uvs = Vec::new();
     let mut indices: Vec<[u32; 3]> = Vec::new();
+    let mut attributes = Vec::new();
     let mut saw_vertex = false;
     for e in &elements {
         if e.name == "vertex" {
@@ -222,6 +294,7 @@ pub(crate) fn read_ply(bytes: &[u8]) -> Result<MeshData, String> {
                 _ => None,
             };
             positions.reserve(cap(e.count));
+            let mut attrs = Attributes::of("vertex_", e);
             let mut vals = vec![0.0f64; e.props.len()];
             for _ in 0..e.count {
                 for (k, p) in e.props.iter().enumerate() {
@@ -243,7 +316,9 @@ pub(crate) fn read_ply(bytes: &[u8]) -> Result<MeshData, String> {
                 if let Some([a, b]) = t {
                     uvs.push(Vec2::new(vals[a] as f32, vals[b] as f32));
                 }
+                attrs.push(e, &vals, 1);
             }
+            attrs.finish(&mut attributes)?;
         } else if e.name == "face" {
             let list = e
                 .props
@@ -253,12 +328,14 @@ pub(crate) fn read_ply(bytes: &[u8]) -> Result<MeshData, String> {
                 })
                 .ok_or("PLY faces need a vertex_indices list")?;
             indices.reserve(cap(e.count));
+            let mut attrs = Attributes::of("face_", e);
+            let mut vals = vec![0.0f64; e.props.len()];
             let mut poly: Vec<u32> = Vec::new();
             for f in 0..e.count {
                 for (k, p) in e.props.iter().enumerate() {
                     match p.list {
                         None => {
-                            body.read(p.ty)?;
+                            vals[k] = body.read(p.ty)?;
                         }
                         Some(ct) => {
                             let len = list_len(body.read(ct)?)?;
@@ -286,7 +363,9 @@ pub(crate) fn read_ply(bytes: &[u8]) -> Result<MeshData, String> {
                         }
                     }
                 }
+                attrs.push(e, &vals, poly.len().saturating_sub(2));
             }
+            attrs.finish(&mut attributes)?;
         } else if !e.props.is_empty() {
             // (An element without properties occupies no bytes, whatever its count: skipping it
             // must not take `count` steps.)
@@ -306,7 +385,7 @@ pub(crate) fn read_ply(bytes: &[u8]) -> Result<MeshData, String> {
             }
         }
     }
-    finish(positions, normals, uvs, indices)
+    Ok((finish(positions, normals, uvs, indices)?, attributes))
 }
 
 fn list_len(v: f64) -> Result<usize, String> {
@@ -329,7 +408,8 @@ mod tests {
 
     #[test]
     fn ascii_quad_is_two_triangles() {
-        let (p, n, uv, idx) = read_ply(ASCII_QUAD.as_bytes()).unwrap();
+        let ((p, n, uv, idx), attrs) = read_ply(ASCII_QUAD.as_bytes()).unwrap();
+        assert!(attrs.is_empty());
         assert_eq!(p.len(), 4);
         assert!(n.is_none());
         assert_eq!(uv.unwrap()[2], Vec2::new(1.0, 1.0));
@@ -348,7 +428,7 @@ mod tests {
         for i in [0u32, 1, 2] {
             b.extend(i.to_le_bytes());
         }
-        let (p, n, _, idx) = read_ply(&b).unwrap();
+        let ((p, n, _, idx), _) = read_ply(&b).unwrap();
         assert_eq!(p[1], Vec3::X);
         assert_eq!(n.unwrap()[0], Vec3::Z);
         assert_eq!(idx, vec![[0, 1, 2]]);
@@ -365,5 +445,69 @@ mod tests {
         assert!(read_ply(b"hello").is_err());
         let huge = "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
         assert!(read_ply(huge.as_bytes()).is_err());
+    }
+
+    /// Vertex and face properties become attributes: 8-bit values normalised and sRGB-decoded
+    /// (Mitsuba's reading of integer properties), floats as they are; a polygon's face row is
+    /// repeated for each triangle of its fan.
+    #[test]
+    fn vertex_and_face_attributes_ascii() {
+        let ply = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nproperty float temp_0\nelement face 2\nproperty list uchar int vertex_indices\nproperty float weight_0\nproperty float n_x\nproperty float n_y\nproperty float n_z\nend_header\n0 0 0 255 0 128 0.5\n1 0 0 0 255 0 1.5\n1 1 0 0 0 255 2.5\n0 1 0 10 20 30 3.5\n4 0 1 2 3 0.25 1 2 3\n3 0 2 3 0.75 4 5 6\n";
+        let ((_, _, _, idx), attrs) = read_ply(ply.as_bytes()).unwrap();
+        assert_eq!(idx.len(), 3);
+        let names: Vec<&str> = attrs.iter().map(|a| a.name()).collect();
+        assert_eq!(
+            names,
+            ["vertex_color", "vertex_temp", "face_weight", "face_n"]
+        );
+        let srgb = |c: f32| restir_image::srgb::decode(c / 255.0);
+        let color = attrs[0].values();
+        assert_eq!(attrs[0].channels(), 3);
+        assert_eq!(&color[..3], &[1.0, 0.0, srgb(128.0)]);
+        assert_eq!(&color[9..], &[srgb(10.0), srgb(20.0), srgb(30.0)]);
+        assert!((srgb(128.0) - 0.2158605).abs() < 1e-6);
+        assert_eq!(attrs[1].values(), &[0.5, 1.5, 2.5, 3.5]);
+        // The quad is two triangles, each with the quad's row.
+        assert_eq!(attrs[2].values(), &[0.25, 0.25, 0.75]);
+        assert_eq!(attrs[3].channels(), 3);
+        assert_eq!(attrs[3].values()[6..], [4.0, 5.0, 6.0]);
+    }
+
+    /// The same in a binary file, with 16-bit and float values.
+    #[test]
+    fn vertex_and_face_attributes_binary() {
+        let mut b = b"ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty ushort k_0\nelement face 1\nproperty list uchar uint vertex_indices\nproperty uchar r\nproperty uchar g\nproperty uchar b\nend_header\n".to_vec();
+        for (v, k) in [
+            ([0.0f32, 0.0, 0.0], 0u16),
+            ([1.0, 0.0, 0.0], 65535),
+            ([0.0, 1.0, 0.0], 1000),
+        ] {
+            for x in v {
+                b.extend(x.to_be_bytes());
+            }
+            b.extend(k.to_be_bytes());
+        }
+        b.push(3);
+        for i in [0u32, 1, 2] {
+            b.extend(i.to_be_bytes());
+        }
+        b.extend([255, 0, 64]);
+        let ((_, _, _, idx), attrs) = read_ply(&b).unwrap();
+        assert_eq!(idx, vec![[0, 1, 2]]);
+        assert_eq!(attrs[0].name(), "vertex_k");
+        let k = attrs[0].values();
+        assert_eq!(k[..2], [0.0, 1.0]);
+        assert_eq!(k[2], restir_image::srgb::decode((1000.0 / 65535.0) as f32));
+        assert_eq!(attrs[1].name(), "face_color");
+        assert_eq!(
+            attrs[1].values(),
+            &[1.0, 0.0, restir_image::srgb::decode(64.0 / 255.0)]
+        );
+        // Truncated inside the face attributes: an error.
+        assert!(
+            read_ply(&b[..b.len() - 1])
+                .unwrap_err()
+                .contains("truncated")
+        );
     }
 }

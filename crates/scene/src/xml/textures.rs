@@ -1,4 +1,4 @@
-//! `<texture>`: `bitmap` and `checkerboard`, with their uv transform.
+//! `<texture>`: `bitmap` and `checkerboard`, with their uv transform, and `mesh_attribute`.
 
 use roxmltree::Node;
 
@@ -9,10 +9,40 @@ use crate::texture::{FilterType, TextureDesc, UvTransform, WrapMode};
 
 impl<'a> Importer<'a> {
     /// A `<texture>`: `bitmap` or `checkerboard`, with Mitsuba 0.6 `uscale`/`vscale`/
-    /// `uoffset`/`voffset` or Mitsuba 3 `to_uv` (scale and translation only).
+    /// `uoffset`/`voffset` or Mitsuba 3 `to_uv` (scale and translation only), or
+    /// `mesh_attribute` (`name`, `scale`).
     pub(super) fn texture<'i>(&self, node: Node<'a, 'i>) -> Result<TextureDesc> {
         let ty = self.plugin_type(node)?;
         let props = self.props(node, format!("texture '{ty}'"))?;
+        if ty == "mesh_attribute" {
+            // Mitsuba 3's plugin page "Mesh attribute texture": `name` (required), `scale` (1).
+            let name = props.string("name")?.ok_or_else(|| {
+                self.err(
+                    node,
+                    "texture 'mesh_attribute' needs a 'name' (an attribute of the mesh, \
+                     such as vertex_color or face_color)",
+                )
+            })?;
+            if restir_geometry::AttributeRate::of_name(&name).is_none() {
+                return Err(self.err(
+                    props.node_or("name", node),
+                    format!(
+                        "texture 'mesh_attribute': the name '{name}' must start with \
+                         'vertex_' or 'face_'"
+                    ),
+                ));
+            }
+            let scale = props.float("scale")?.unwrap_or(1.0);
+            if !scale.is_finite() {
+                return Err(self.err(
+                    props.node_or("scale", node),
+                    format!("texture 'mesh_attribute': scale {scale} is not finite"),
+                ));
+            }
+            self.only_properties(node)?;
+            props.finish();
+            return Ok(TextureDesc::MeshAttribute { name, scale });
+        }
         let mut uv = UvTransform::default();
         let to_uv = props.transform("to_uv")?;
         if !to_uv.is_empty() {
@@ -93,16 +123,27 @@ impl<'a> Importer<'a> {
                 uv,
             },
             other => {
-                return Err(self.unknown_type(node, "texture", other, &["bitmap", "checkerboard"]));
+                return Err(self.unknown_type(
+                    node,
+                    "texture",
+                    other,
+                    &["bitmap", "checkerboard", "mesh_attribute"],
+                ));
             }
         };
+        self.only_properties(node)?;
+        props.finish();
+        Ok(t)
+    }
+
+    /// Refuses a texture element that holds anything but properties.
+    fn only_properties(&self, node: Node<'a, '_>) -> Result<()> {
         for c in elements(node) {
             let tag = c.tag_name().name();
             if !PROPERTY_TAGS.contains(&tag) {
                 return Err(self.err(c, format!("unexpected <{tag}> inside a texture")));
             }
         }
-        props.finish();
-        Ok(t)
+        Ok(())
     }
 }

@@ -287,6 +287,20 @@ impl Writer<'_> {
     pub(super) fn texture(&mut self, t: &TextureDesc, name: &str, item: &str) -> Result<()> {
         let uv = match t {
             TextureDesc::Bitmap { uv, .. } | TextureDesc::Checkerboard { uv, .. } => uv,
+            TextureDesc::MeshAttribute {
+                name: attribute,
+                scale,
+            } => {
+                finite(item, "mesh_attribute scale", &[*scale])?;
+                literal(item, "mesh attribute name", attribute)?;
+                self.open(&format!(r#"<texture type="mesh_attribute" name="{name}">"#));
+                self.string("name", attribute);
+                if *scale != 1.0 {
+                    self.float("scale", *scale);
+                }
+                self.close("</texture>");
+                return Ok(());
+            }
         };
         finite(
             item,
@@ -319,6 +333,8 @@ impl Writer<'_> {
                 self.rgb("color0", color0);
                 self.rgb("color1", color1);
             }
+            // Written above, without a uv transform.
+            TextureDesc::MeshAttribute { .. } => return Ok(()),
         }
         if *uv != UvTransform::default() {
             self.open(r#"<transform name="to_uv">"#);

@@ -94,3 +94,12 @@ write("lying_count.serialized",
 write("empty_element.ply",
       "ply\nformat ascii 1.0\nelement junk 18000000000000000000\n"
       + ascii_ply(QUAD, [(0, 1, 2), (0, 2, 5)]).split("\n", 2)[2])
+
+# Mesh attributes: a quad with a vertex colour (8-bit) and a face weight; the same with a NaN
+# face weight.
+ATTR = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n" \
+       "property float z\nproperty uchar r\nproperty uchar g\nproperty uchar b\n" \
+       "element face 2\nproperty list uchar int vertex_indices\nproperty float weight_0\n" \
+       "end_header\n0 0 0 255 0 0\n1 0 0 0 255 0\n1 1 0 0 0 255\n0 1 0 9 9 9\n"
+write("attributes.ply", ATTR + "3 0 1 2 0.5\n3 0 2 3 0.25\n")
+write("nan_attribute.ply", ATTR + "3 0 1 2 0.5\n3 0 2 3 nan\n")
