@@ -13,7 +13,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use restir_evaluation::suite::{IntegratorConfig, Suite, SuiteScene};
+use restir_evaluation::suite::{Clock, IntegratorConfig, Suite, SuiteScene};
 use restir_evaluation::{
     BenchResults, Machine, ReferenceInfo, RunRecord, SceneImages, Strip, html, metrics,
     write_outputs,
