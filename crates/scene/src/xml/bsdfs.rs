@@ -21,6 +21,8 @@ const BSDF_TYPES: &[&str] = &[
     "null",
     "mask",
     "normalmap",
+    "principled",
+    "principledthin",
 ];
 
 impl<'a> Importer<'a> {
@@ -47,6 +49,7 @@ impl<'a> Importer<'a> {
             "dielectric" | "roughdielectric" => self.dielectric(node, &ty, &props)?,
             "plastic" | "roughplastic" => self.plastic(node, &ty, &props)?,
             "null" => MaterialDesc::Null,
+            "principled" | "principledthin" => self.principled(node, &ty, &props, &textured)?,
             "mask" => return self.mask(node, props, textured),
             "thindielectric" => {
                 return Err(self.err(
@@ -96,7 +99,7 @@ impl<'a> Importer<'a> {
                 self.err(
                     c,
                     format!(
-                        "bsdf '{ty}': '{name}' cannot be a texture (only these can: reflectance, diffuse_reflectance, specular_reflectance, specular_transmittance, a mask's opacity, a normalmap's normalmap, and the rough conductor's and rough dielectric's alpha, alpha_u, alpha_v)"
+                        "bsdf '{ty}': '{name}' cannot be a texture (only these can: reflectance, diffuse_reflectance, specular_reflectance, specular_transmittance, a mask's opacity, a normalmap's normalmap, the rough conductor's and rough dielectric's alpha, alpha_u, alpha_v, and the principled models' parameters but principled's eta and specular)"
                     ),
                 )
             })?;

@@ -396,4 +396,5 @@ impl Writer<'_> {
 }
 
 mod materials;
+mod principled;
 mod shapes;
