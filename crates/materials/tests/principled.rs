@@ -216,7 +216,11 @@ fn chi2_sampled_directions() {
 #[test]
 fn sample_agrees_with_eval_and_pdf() {
     for (ci, case) in cases().iter().enumerate() {
-        assert!(!case.bsdf.flags().contains(LobeFlags::DELTA), "{}", case.name);
+        assert!(
+            !case.bsdf.flags().contains(LobeFlags::DELTA),
+            "{}",
+            case.name
+        );
         for (wi_, wo) in wos().into_iter().enumerate() {
             let mut rng = Pcg32::new(seed(ci, wi_), 2);
             for _ in 0..20_000 {
@@ -227,7 +231,11 @@ fn sample_agrees_with_eval_and_pdf() {
                 let what = format!("{} at wo = {wo}, wi = {}", case.name, s.wi);
                 assert!(scatters(case, wo), "{what}: sampled from a black side");
                 assert!((s.wi.length() - 1.0).abs() < 1e-4, "{what}: not unit");
-                assert!(s.f.is_finite() && s.f.min_element() >= 0.0, "{what}: {}", s.f);
+                assert!(
+                    s.f.is_finite() && s.f.min_element() >= 0.0,
+                    "{what}: {}",
+                    s.f
+                );
                 let (eval, pdf) = (case.bsdf.eval(wo, s.wi), case.bsdf.pdf_sa(wo, s.wi));
                 assert!(
                     (pdf - s.pdf_sa).abs() <= 1e-4 * s.pdf_sa,
@@ -324,7 +332,10 @@ fn control_samples_vs_pdf_without_clearcoat() {
     };
     let wo = Vec3::new(0.3, 0.2, 0.93).normalize();
     let hist = sample_histogram(&grid, &Bsdf::principled(p), wo, 96, SAMPLES);
-    let wrong = Bsdf::principled(Principled { clearcoat: 0.0, ..p });
+    let wrong = Bsdf::principled(Principled {
+        clearcoat: 0.0,
+        ..p
+    });
     let o = hist
         .chi2(&pdf_cells(&grid, &wrong, wo))
         .unwrap_or_else(|e| panic!("expected a p-value, got {e}"));

@@ -146,7 +146,10 @@ impl std::fmt::Display for TextureError {
                 "texture uv transform (scale {scale}, offset {offset}) is not finite"
             ),
             TextureError::CheckerColor { name, color } => {
-                write!(f, "checkerboard {name} {color:?} must be finite and non-negative")
+                write!(
+                    f,
+                    "checkerboard {name} {color:?} must be finite and non-negative"
+                )
             }
             TextureError::Image(e) => write!(f, "{e}"),
         }
@@ -594,8 +597,9 @@ mod tests {
 
     #[test]
     fn bad_texture_parameters_are_errors() {
+        // Negative (above 1 is for the parameter it is bound to to judge).
         let bad = TextureDesc::Checkerboard {
-            color0: [1.5, 0.0, 0.0],
+            color0: [-0.5, 0.0, 0.0],
             color1: [0.0; 3],
             uv: UvTransform::default(),
         };

@@ -10,7 +10,8 @@ use restir_scene::{MaterialDesc, Scene, SceneDesc};
 
 /// The scene with `body` after a sensor, parsed from `t.xml`.
 fn xml(body: &str) -> Result<SceneDesc, String> {
-    let text = format!("<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n{body}\n</scene>");
+    let text =
+        format!("<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n{body}\n</scene>");
     parse_xml(&text, "t.xml".as_ref(), &[])
         .map(|(d, _)| d)
         .map_err(|e| e.to_string())
@@ -24,6 +25,12 @@ fn built(d: &SceneDesc) -> Scene {
     Scene::build(d, ".".as_ref(), "t.xml".as_ref()).unwrap()
 }
 
+/// The index in the built scene's materials of the description's `k`-th named material (they
+/// come last, after the built-in ones).
+fn named(s: &Scene, d: &SceneDesc, k: usize) -> usize {
+    s.bsdfs().len() - d.materials.len() + k
+}
+
 #[test]
 fn xml_and_ron_defaults_are_mitsubas() {
     let d = xml(r#"<bsdf type="principled" id="p"/><bsdf type="principledthin" id="t"/>"#).unwrap();
@@ -34,14 +41,15 @@ fn xml_and_ron_defaults_are_mitsubas() {
     .unwrap();
     assert_eq!(d.materials, ron.materials);
     let s = built(&d);
-    let BsdfKind::Principled(p) = s.bsdfs()[0].kind else {
-        panic!("{:?}", s.bsdfs()[0])
+    let (i, j) = (named(&s, &d, 0), named(&s, &d, 1));
+    let BsdfKind::Principled(p) = s.bsdfs()[i].kind else {
+        panic!("{:?}", s.bsdfs()[i])
     };
     assert_eq!(p, Principled::default());
     assert!((p.eta - eta_of_specular(0.5)).abs() < 1e-7);
-    assert!(!s.bsdfs()[0].kind.transmits());
-    let BsdfKind::PrincipledThin(t) = s.bsdfs()[1].kind else {
-        panic!("{:?}", s.bsdfs()[1])
+    assert!(!s.bsdfs()[i].kind.transmits());
+    let BsdfKind::PrincipledThin(t) = s.bsdfs()[j].kind else {
+        panic!("{:?}", s.bsdfs()[j])
     };
     assert_eq!(t, PrincipledThin::default());
 }
@@ -49,8 +57,9 @@ fn xml_and_ron_defaults_are_mitsubas() {
 #[test]
 fn mitsubas_adjustments_of_eta_for_transmission() {
     let eta = |body: &str| {
-        let s = built(&xml(body).unwrap());
-        match s.bsdfs()[0].kind {
+        let d = xml(body).unwrap();
+        let s = built(&d);
+        match s.bsdfs()[named(&s, &d, 0)].kind {
             BsdfKind::Principled(p) => p.eta,
             k => panic!("{k:?}"),
         }
@@ -122,7 +131,8 @@ fn bad_principled_materials_are_errors_at_their_line() {
     }
     // A twosided principled without transmission is allowed (and mirrored), as in Mitsuba.
     let d = xml(r#"<bsdf type="twosided" id="m"><bsdf type="principled"/></bsdf>"#).unwrap();
-    assert!(built(&d).bsdfs()[0].two_sided);
+    let s = built(&d);
+    assert!(s.bsdfs()[named(&s, &d, 0)].two_sided);
     // diff_trans up to 2 from a checkerboard (Mitsuba's test scene gives 1.4).
     xml(r#"<bsdf type="principledthin" id="m"><texture name="diff_trans" type="checkerboard"><float name="color1" value="1.4"/></texture></bsdf>"#)
         .unwrap();
@@ -137,12 +147,14 @@ fn textured_parameters_are_looked_up_per_point() {
             <texture name="base_color" type="checkerboard"><rgb name="color0" value="0.1,0.2,0.3"/><rgb name="color1" value="0.9,0.8,0.7"/></texture>
             <texture name="diff_trans" type="checkerboard"><float name="color0" value="0.4"/><float name="color1" value="1.4"/></texture>
             <texture name="sheen" type="checkerboard"><float name="color0" value="0.1"/><float name="color1" value="0.8"/></texture>
-        </bsdf>"#,
+        </bsdf>
+        <shape type="rectangle"><ref id="m"/></shape>"#,
     )
     .unwrap();
     let s = built(&d);
+    let m = named(&s, &d, 0) as u32;
     // u, v both in the lower half: eval gives color0, eval_1 gives color1.
-    let thin = |uv: Vec2| match s.bsdf_at(0, uv).kind {
+    let thin = |uv: Vec2| match s.bsdf_at(m, uv).kind {
         BsdfKind::PrincipledThin(t) => t,
         k => panic!("{k:?}"),
     };
@@ -159,7 +171,8 @@ fn textured_parameters_are_looked_up_per_point() {
     assert_eq!(t.roughness, 0.5);
 }
 
-/// RON → Mitsuba XML → description: the same materials, constant or textured.
+/// RON → Mitsuba XML → description: the same materials, constant or textured (textures listed
+/// in the order the writer writes the parameters).
 #[test]
 fn xml_writer_round_trips() {
     let ron = r#"(
@@ -171,18 +184,21 @@ fn xml_writer_round_trips() {
             (name: "b", material: Principled(spec_trans: 0.4, eta: Some(1.33))),
             (name: "c", material: PrincipledThin(base_color: (0.7, 0.1, 0.1), eta: 1.33, diff_trans: 1.2)),
             (name: "d", material: Textured(material: PrincipledThin(eta: 1.33), textures: [
-                (param: DiffTrans, texture: Checkerboard(color0: (0.4, 0.4, 0.4), color1: (1.4, 1.4, 1.4))),
                 (param: SpecTrans, texture: Checkerboard(color0: (0.2, 0.2, 0.2), color1: (0.8, 0.8, 0.8))),
+                (param: DiffTrans, texture: Checkerboard(color0: (0.4, 0.4, 0.4), color1: (1.4, 1.4, 1.4))),
             ])),
             (name: "e", material: Textured(material: Principled(), textures: [
-                (param: Metallic, texture: Checkerboard(color0: (0.7, 0.7, 0.7), color1: (0.1, 0.1, 0.1))),
                 (param: BaseColor, texture: Checkerboard(color0: (0.7, 0.2, 0.7), color1: (0.1, 0.3, 0.1))),
+                (param: Metallic, texture: Checkerboard(color0: (0.7, 0.7, 0.7), color1: (0.1, 0.1, 0.1))),
             ])),
         ],
     )"#;
     let desc = restir_scene::parse_ron(ron, "t.ron".as_ref()).unwrap();
     let text = to_mitsuba_xml(&desc, &XmlWriteOptions::default()).unwrap();
-    assert!(text.contains(r#"<bsdf type="principledthin" id="c">"#), "{text}");
+    assert!(
+        text.contains(r#"<bsdf type="principledthin" id="c">"#),
+        "{text}"
+    );
     let (back, warnings) = parse_xml(&text, "t.xml".as_ref(), &[]).unwrap();
     assert!(warnings.is_empty(), "{warnings:?}");
     assert_eq!(desc.materials, back.materials, "{text}");

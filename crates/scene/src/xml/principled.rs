@@ -61,7 +61,11 @@ impl<'a> Importer<'a> {
     ) -> Result<MaterialDesc> {
         let thin = ty == "principledthin";
         let known = if thin { PRINCIPLED_THIN } else { PRINCIPLED };
-        if let Some(p) = props.items.iter().find(|p| !known.contains(&p.name.as_str())) {
+        if let Some(p) = props
+            .items
+            .iter()
+            .find(|p| !known.contains(&p.name.as_str()))
+        {
             return Err(self.err(
                 p.node,
                 format!(
@@ -96,9 +100,8 @@ impl<'a> Importer<'a> {
                 }
             }
         }
-        let float = |name: &str, default: f32| -> Result<f32> {
-            Ok(props.float(name)?.unwrap_or(default))
-        };
+        let float =
+            |name: &str, default: f32| -> Result<f32> { Ok(props.float(name)?.unwrap_or(default)) };
         let base_color = props
             .color("base_color", ColorUse::Reflectance)?
             .unwrap_or(defaults::DIFFUSE_REFLECTANCE);
