@@ -6,7 +6,7 @@
 use glam::{Vec2, Vec3};
 use restir_materials::{BsdfKind, Principled, PrincipledThin, eta_of_specular};
 use restir_scene::xml::{XmlWriteOptions, parse_xml, to_mitsuba_xml};
-use restir_scene::{MaterialDesc, Scene, SceneDesc};
+use restir_scene::{Scene, SceneDesc};
 
 /// The scene with `body` after a sensor, parsed from `t.xml`.
 fn xml(body: &str) -> Result<SceneDesc, String> {
@@ -15,10 +15,6 @@ fn xml(body: &str) -> Result<SceneDesc, String> {
     parse_xml(&text, "t.xml".as_ref(), &[])
         .map(|(d, _)| d)
         .map_err(|e| e.to_string())
-}
-
-fn first_material(d: &SceneDesc) -> &MaterialDesc {
-    &d.materials[0].material
 }
 
 fn built(d: &SceneDesc) -> Scene {
@@ -110,7 +106,7 @@ fn bad_principled_materials_are_errors_at_their_line() {
         ),
         (
             r#"<bsdf type="principled"><texture name="eta" type="checkerboard"/></bsdf>"#,
-            "t.xml:3: bsdf 'principled': 'eta' is a float, not a texture",
+            "t.xml:3: bsdf 'principled': 'eta' cannot be a texture",
         ),
         (
             r#"<bsdf type="twosided"><bsdf type="principledthin"/></bsdf>"#,

@@ -49,7 +49,7 @@ impl<'a> Importer<'a> {
             "dielectric" | "roughdielectric" => self.dielectric(node, &ty, &props)?,
             "plastic" | "roughplastic" => self.plastic(node, &ty, &props)?,
             "null" => MaterialDesc::Null,
-            "principled" | "principledthin" => self.principled(node, &ty, &props, &textured)?,
+            "principled" | "principledthin" => self.principled(node, &ty, &props)?,
             "mask" => return self.mask(node, props, textured),
             "thindielectric" => {
                 return Err(self.err(
@@ -95,7 +95,10 @@ impl<'a> Importer<'a> {
                 continue;
             };
             let name = snake_case(&name);
-            let param = ColorParam::from_name(&name).ok_or_else(|| {
+            // `eta` is a texture for principledthin only (elsewhere a value, never a texture).
+            let param = ColorParam::from_name(&name)
+                .filter(|p| *p != ColorParam::Eta || ty == "principledthin");
+            let param = param.ok_or_else(|| {
                 self.err(
                     c,
                     format!(

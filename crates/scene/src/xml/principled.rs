@@ -52,13 +52,7 @@ const PRINCIPLED_THIN: &[&str] = &[
 impl<'a> Importer<'a> {
     /// A `principled` or `principledthin` bsdf's constant parameters (textured ones get their
     /// defaults here, replaced by the texture at every shading point).
-    pub(super) fn principled(
-        &self,
-        node: Node,
-        ty: &str,
-        props: &Props,
-        textured: &[(Node, TextureBinding)],
-    ) -> Result<MaterialDesc> {
+    pub(super) fn principled(&self, node: Node, ty: &str, props: &Props) -> Result<MaterialDesc> {
         let thin = ty == "principledthin";
         let known = if thin { PRINCIPLED_THIN } else { PRINCIPLED };
         if let Some(p) = props
@@ -73,12 +67,6 @@ impl<'a> Importer<'a> {
                     p.name,
                     known.join(", ")
                 ),
-            ));
-        }
-        if !thin && let Some((c, _)) = textured.iter().find(|(_, b)| b.param == ColorParam::Eta) {
-            return Err(self.err(
-                *c,
-                "bsdf 'principled': 'eta' is a float, not a texture (as in Mitsuba 3)",
             ));
         }
         for name in known.iter().filter(|n| n.ends_with("_sampling_rate")) {
