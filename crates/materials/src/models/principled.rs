@@ -274,7 +274,7 @@ pub(crate) fn sample(p: &Principled, v: Vec3, u_lobe: f32, u: Vec2) -> Option<Bs
         (l, REFLECT_GLOSSY, mf.alpha(), 1.0)
     };
     let pdf_sa = pdf(p, v, l);
-    if !(pdf_sa > 0.0) {
+    if pdf_sa.is_nan() || pdf_sa <= 0.0 {
         return None;
     }
     Some(smooth(l, eval(p, v, l), pdf_sa, lobe, roughness, eta))
@@ -290,6 +290,7 @@ mod tests {
     /// clearcoat_gloss 0.5, sheen 0.9, sheen_tint 0.9, spec_trans 0.5, flatness 0.5; and its
     /// `pdf` values, which this model's sampling density reproduces (the same mixture).
     #[test]
+    #[allow(clippy::excessive_precision)] // Mitsuba's values as its test prints them.
     fn matches_mitsuba_eval_and_pdf() {
         let want_pdf = [
             0.170_074_58,
