@@ -14,7 +14,6 @@ use crate::microfacet::{Distribution, Microfacet};
 use crate::models::normalmap::{self, NormalMap};
 use crate::models::plastic::{Plastic, RoughPlastic};
 use crate::models::principled::Principled;
-use crate::models::principled_params::{PrincipledParam, set_principled, set_principled_thin};
 use crate::models::principled_thin::PrincipledThin;
 use crate::models::{
     BsdfSample, conductor, delta, dielectric, diffuse, finite_or_zero, finite_pdf, plastic,
@@ -121,7 +120,7 @@ pub struct Bsdf {
     pub normal_map: Option<NormalMap>,
 }
 
-fn one_sided(kind: BsdfKind) -> Bsdf {
+pub(crate) fn one_sided(kind: BsdfKind) -> Bsdf {
     Bsdf {
         kind,
         two_sided: false,
@@ -310,29 +309,6 @@ impl Bsdf {
             normal_map: self.normal_map.map(|m| m.with_texel(p.normal)),
             ..*self
         }
-    }
-
-    /// Mitsuba's `principled` with parameters `p`.
-    pub fn principled(p: Principled) -> Self {
-        one_sided(BsdfKind::Principled(p))
-    }
-
-    /// Mitsuba's `principledthin` with parameters `p`.
-    pub fn principled_thin(p: PrincipledThin) -> Self {
-        one_sided(BsdfKind::PrincipledThin(p))
-    }
-
-    /// The same model with the principled parameter `param` replaced by `value` (its first
-    /// channel for a scalar), clamped to [`PrincipledParam::range`]; other models, and
-    /// parameters the model lacks, are unchanged.
-    #[inline]
-    pub fn with_principled(mut self, param: PrincipledParam, value: Vec3) -> Self {
-        match &mut self.kind {
-            BsdfKind::Principled(p) => set_principled(p, param, value),
-            BsdfKind::PrincipledThin(p) => set_principled_thin(p, param, value),
-            _ => {}
-        }
-        self
     }
 
     /// The same model behind Mitsuba's `normalmap` (`map` holds the perturbed normal and the

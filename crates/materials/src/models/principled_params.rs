@@ -1,10 +1,37 @@
-//! The parameters of the principled models by name, for replacing them per shading point with
-//! texture values ([`crate::Bsdf::with_principled`]).
+//! The principled models' constructors on [`Bsdf`], and their parameters by name, for replacing
+//! them per shading point with texture values ([`Bsdf::with_principled`]).
 
 use glam::Vec3;
 
 use super::principled::Principled;
 use super::principled_thin::PrincipledThin;
+use crate::bsdf::one_sided;
+use crate::{Bsdf, BsdfKind};
+
+impl Bsdf {
+    /// Mitsuba's `principled` with parameters `p`.
+    pub fn principled(p: Principled) -> Self {
+        one_sided(BsdfKind::Principled(p))
+    }
+
+    /// Mitsuba's `principledthin` with parameters `p`.
+    pub fn principled_thin(p: PrincipledThin) -> Self {
+        one_sided(BsdfKind::PrincipledThin(p))
+    }
+
+    /// The same model with the principled parameter `param` replaced by `value` (its first
+    /// channel for a scalar), clamped to [`PrincipledParam::range`]; other models, and
+    /// parameters the model lacks, are unchanged.
+    #[inline]
+    pub fn with_principled(mut self, param: PrincipledParam, value: Vec3) -> Self {
+        match &mut self.kind {
+            BsdfKind::Principled(p) => set_principled(p, param, value),
+            BsdfKind::PrincipledThin(p) => set_principled_thin(p, param, value),
+            _ => {}
+        }
+        self
+    }
+}
 
 /// A parameter of Mitsuba's `principled` or `principledthin` that a texture may give.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -68,7 +95,7 @@ impl PrincipledParam {
 
 /// `p` with `param` set to `value` (its first channel for a scalar), clamped to
 /// [`PrincipledParam::range`]; a parameter `principled` lacks is ignored.
-pub(crate) fn set_principled(p: &mut Principled, param: PrincipledParam, value: Vec3) {
+fn set_principled(p: &mut Principled, param: PrincipledParam, value: Vec3) {
     let (lo, hi) = param.range();
     let x = value.x.clamp(lo, hi);
     match param {
@@ -88,7 +115,7 @@ pub(crate) fn set_principled(p: &mut Principled, param: PrincipledParam, value: 
 }
 
 /// [`set_principled`] for `principledthin`.
-pub(crate) fn set_principled_thin(p: &mut PrincipledThin, param: PrincipledParam, value: Vec3) {
+fn set_principled_thin(p: &mut PrincipledThin, param: PrincipledParam, value: Vec3) {
     let (lo, hi) = param.range();
     let x = value.x.clamp(lo, hi);
     match param {
