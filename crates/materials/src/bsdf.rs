@@ -7,12 +7,17 @@
 use glam::{Vec2, Vec3};
 
 use crate::LobeFlags;
-use crate::lobe::{REFLECT_DELTA, REFLECT_DIFFUSE, REFLECT_GLOSSY, TRANSMIT_DELTA};
+use crate::lobe::{
+    REFLECT_DELTA, REFLECT_DIFFUSE, REFLECT_GLOSSY, TRANSMIT_DELTA, TRANSMIT_GLOSSY,
+};
 use crate::microfacet::{Distribution, Microfacet};
 use crate::models::normalmap::{self, NormalMap};
 use crate::models::plastic::{Plastic, RoughPlastic};
+use crate::models::principled::Principled;
+use crate::models::principled_thin::PrincipledThin;
 use crate::models::{
     BsdfSample, conductor, delta, dielectric, diffuse, finite_or_zero, finite_pdf, plastic,
+    principled, principled_thin,
 };
 
 /// The scattering models (Mitsuba 3's plugins of the same names). Construct them with the
@@ -70,6 +75,11 @@ pub enum BsdfKind {
     Plastic(Plastic),
     /// Diffuse base under a rough dielectric coating (Mitsuba `roughplastic`).
     RoughPlastic(RoughPlastic),
+    /// Burley's Disney BSDF (Mitsuba `principled`): two-sided by nature when it transmits
+    /// (`spec_trans > 0`), one-sided otherwise.
+    Principled(Principled),
+    /// Burley's thin-sheet variant (Mitsuba `principledthin`), the same from both sides.
+    PrincipledThin(PrincipledThin),
     /// A pass-through surface (Mitsuba `null`): light continues unchanged, as a delta
     /// transmission with weight 1.
     Null,
@@ -80,10 +90,14 @@ pub enum BsdfKind {
 impl BsdfKind {
     /// Whether the model transmits (and so is two-sided by nature).
     pub fn transmits(&self) -> bool {
-        matches!(
-            self,
-            BsdfKind::Dielectric { .. } | BsdfKind::RoughDielectric { .. } | BsdfKind::Null
-        )
+        match self {
+            BsdfKind::Dielectric { .. }
+            | BsdfKind::RoughDielectric { .. }
+            | BsdfKind::Null
+            | BsdfKind::PrincipledThin(_) => true,
+            BsdfKind::Principled(p) => p.transmits(),
+            _ => false,
+        }
     }
 }
 
@@ -106,7 +120,7 @@ pub struct Bsdf {
     pub normal_map: Option<NormalMap>,
 }
 
-fn one_sided(kind: BsdfKind) -> Bsdf {
+pub(crate) fn one_sided(kind: BsdfKind) -> Bsdf {
     Bsdf {
         kind,
         two_sided: false,
@@ -284,7 +298,10 @@ impl Bsdf {
             BsdfKind::RoughPlastic(q) => {
                 BsdfKind::RoughPlastic(q.with_reflectance(p.diffuse, p.specular, p.nonlinear))
             }
-            k @ (BsdfKind::Null | BsdfKind::Black) => k,
+            k @ (BsdfKind::Null
+            | BsdfKind::Black
+            | BsdfKind::Principled(_)
+            | BsdfKind::PrincipledThin(_)) => k,
         };
         Self {
             kind,
@@ -345,6 +362,16 @@ impl Bsdf {
             BsdfKind::RoughDielectric { .. } => REFLECT_GLOSSY | LobeFlags::TRANSMISSION,
             BsdfKind::Plastic(_) => REFLECT_DELTA | LobeFlags::DIFFUSE,
             BsdfKind::RoughPlastic(_) => REFLECT_GLOSSY | LobeFlags::DIFFUSE,
+            BsdfKind::Principled(p) if p.transmits() => {
+                REFLECT_DIFFUSE | REFLECT_GLOSSY | TRANSMIT_GLOSSY
+            }
+            BsdfKind::Principled(_) => REFLECT_DIFFUSE | REFLECT_GLOSSY,
+            BsdfKind::PrincipledThin(_) => {
+                LobeFlags::DIFFUSE
+                    | LobeFlags::GLOSSY
+                    | LobeFlags::REFLECTION
+                    | LobeFlags::TRANSMISSION
+            }
             BsdfKind::Null => TRANSMIT_DELTA,
             BsdfKind::Black => LobeFlags::NONE,
         }
@@ -422,6 +449,8 @@ impl Bsdf {
             ),
             BsdfKind::Plastic(p) => plastic::eval_smooth(p, v, l),
             BsdfKind::RoughPlastic(p) => plastic::eval_rough(p, v, l),
+            BsdfKind::Principled(p) => principled::eval(p, v, l),
+            BsdfKind::PrincipledThin(p) => principled_thin::eval(p, v, l),
             BsdfKind::Conductor { .. }
             | BsdfKind::Dielectric { .. }
             | BsdfKind::Null
@@ -464,6 +493,8 @@ impl Bsdf {
             } => dielectric::pdf_rough(microfacet, *eta, v, l),
             BsdfKind::Plastic(p) => plastic::pdf_smooth(p, v, l),
             BsdfKind::RoughPlastic(p) => plastic::pdf_rough(p, v, l),
+            BsdfKind::Principled(p) => principled::pdf(p, v, l),
+            BsdfKind::PrincipledThin(p) => principled_thin::pdf(p, v, l),
             BsdfKind::Conductor { .. }
             | BsdfKind::Dielectric { .. }
             | BsdfKind::Null
@@ -562,6 +593,8 @@ impl Bsdf {
             ),
             BsdfKind::Plastic(p) => plastic::sample_smooth(p, v, u_lobe, u),
             BsdfKind::RoughPlastic(p) => plastic::sample_rough(p, v, u_lobe, u),
+            BsdfKind::Principled(p) => principled::sample(p, v, u_lobe, u),
+            BsdfKind::PrincipledThin(p) => principled_thin::sample(p, v, u_lobe, u),
             BsdfKind::Null => Some(delta(-v, Vec3::ONE, 1.0, TRANSMIT_DELTA, 1.0)),
             BsdfKind::Black => None,
         }
@@ -623,12 +656,13 @@ mod tests {
         }
     }
 
-    /// The enum stays small (it is copied into path vertices and reservoirs): the largest
-    /// model, the two-sided flag, the opacity and a quantised normal map.
+    /// The enum stays small (it is copied into path vertices): the largest model (the
+    /// principled's twelve parameters), the two-sided flag, the opacity and a quantised normal
+    /// map.
     #[test]
     fn bsdf_is_small() {
         assert!(
-            core::mem::size_of::<Bsdf>() <= 72,
+            core::mem::size_of::<Bsdf>() <= 80,
             "{}",
             core::mem::size_of::<Bsdf>()
         );

@@ -100,3 +100,6 @@ pub use models::normalmap::NormalMap;
 pub use models::plastic::cache as table_cache;
 pub use models::plastic::tables as plastic;
 pub use models::plastic::{Plastic, RoughPlastic};
+pub use models::principled::{Principled, eta_of_specular};
+pub use models::principled_params::PrincipledParam;
+pub use models::principled_thin::PrincipledThin;

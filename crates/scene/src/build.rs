@@ -160,9 +160,14 @@ fn material(
         normal: None,
         alpha_u: None,
         alpha_v: None,
+        principled: Default::default(),
     };
     for b in bindings {
         let id = Some(cache.get(&b.texture, base_dir)?);
+        if let (Some(p), Some(id)) = (b.param.principled(), id) {
+            t.principled.set(p, id);
+            continue;
+        }
         match b.param {
             ColorParam::Reflectance | ColorParam::DiffuseReflectance => t.diffuse = id,
             ColorParam::SpecularReflectance => t.specular = id,
@@ -175,6 +180,7 @@ fn material(
             }
             ColorParam::AlphaU => t.alpha_u = id,
             ColorParam::AlphaV => t.alpha_v = id,
+            _ => unreachable!("the principled parameters are bound above"),
         }
     }
     Ok((bsdf, Some(t)))

@@ -32,6 +32,7 @@ mod light_share;
 mod load;
 mod material;
 mod meshio;
+pub mod principled;
 pub mod spectrum;
 mod spot;
 pub mod texture;
@@ -183,6 +184,10 @@ impl Scene {
         }
         match &self.bsdf_textures[bsdf as usize] {
             None => base,
+            Some(t) if t.principled.any() => {
+                let b = base.with_params(&t.eval(&self.textures, &self.shapes, at));
+                t.principled.apply(b, &self.textures, &self.shapes, at)
+            }
             Some(t) => base.with_params(&t.eval(&self.textures, &self.shapes, at)),
         }
     }
@@ -208,6 +213,8 @@ pub struct TexturedParams {
     pub alpha_u: Option<u32>,
     /// Texture of `alpha_v`.
     pub alpha_v: Option<u32>,
+    /// Textures of a principled material's parameters (its other slots are unused).
+    pub principled: principled::PrincipledTextures,
 }
 
 impl TexturedParams {

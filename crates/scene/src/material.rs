@@ -85,6 +85,26 @@ pub enum MaterialError {
         /// Its value.
         value: V3,
     },
+    /// A principled parameter outside its range.
+    PrincipledRange {
+        /// The parameter.
+        name: &'static str,
+        /// Its value.
+        value: f32,
+        /// Its range, as text.
+        range: &'static str,
+    },
+    /// `principled` with both `eta` and `specular`.
+    PrincipledEtaAndSpecular,
+    /// A checkerboard colour outside the range of the parameter it gives.
+    TextureRange {
+        /// The parameter.
+        name: &'static str,
+        /// The colour.
+        value: V3,
+        /// The parameter's range.
+        range: (f32, f32),
+    },
 }
 
 impl core::fmt::Display for MaterialError {
@@ -121,7 +141,7 @@ impl core::fmt::Display for MaterialError {
                 f.write_str("roughplastic: int_ior must differ from ext_ior")
             }
             MaterialError::TwoSidedTransmitting => f.write_str(
-                "twosided cannot wrap a transmitting material (dielectric, roughdielectric, null), as in Mitsuba",
+                "twosided cannot wrap a transmitting material (dielectric, roughdielectric, null, principledthin, principled with spec_trans), as in Mitsuba",
             ),
             MaterialError::NestedTextured => {
                 f.write_str("a textured material cannot wrap another textured material")
@@ -151,6 +171,23 @@ impl core::fmt::Display for MaterialError {
             ),
             MaterialError::BadNormal { value } => {
                 write!(f, "normalmap value {value:?} must be finite")
+            }
+            MaterialError::PrincipledRange { name, value, range } => {
+                write!(f, "{name} {value} must lie in {range}")
+            }
+            MaterialError::PrincipledEtaAndSpecular => f.write_str(
+                "give either eta or specular, not both (specular sets the IOR: eta = 2/(1 - sqrt(0.08 specular)) - 1)",
+            ),
+            MaterialError::TextureRange { name, value, range } => {
+                if range.1 == f32::MAX {
+                    write!(f, "texture for '{name}': colour {value:?} must be positive")
+                } else {
+                    write!(
+                        f,
+                        "texture for '{name}': colour {value:?} must lie in [{}, {}]",
+                        range.0, range.1
+                    )
+                }
             }
         }
     }
@@ -233,6 +270,16 @@ pub(crate) fn check(m: &MaterialDesc) -> Result<()> {
 /// The BSDF of a material with its constant parameters (textures are applied per shading point;
 /// see [`colors`]).
 pub(crate) fn bsdf(m: &MaterialDesc) -> Result<Bsdf> {
+    bsdf_in(m, false)
+}
+
+/// [`bsdf`] of a material inside a `Textured` that gives its `spec_trans` when
+/// `spec_trans_textured` (a principled material then transmits).
+fn bsdf_in(m: &MaterialDesc, spec_trans_textured: bool) -> Result<Bsdf> {
+    if let Some(b) = crate::principled::bsdf(m, spec_trans_textured) {
+        return b;
+    }
+    let bsdf = |m| bsdf_in(m, spec_trans_textured);
     Ok(match m {
         MaterialDesc::Diffuse { reflectance } => {
             Bsdf::diffuse(unit_color("diffuse reflectance", reflectance)?)
@@ -318,6 +365,9 @@ pub(crate) fn bsdf(m: &MaterialDesc) -> Result<Bsdf> {
             )
         }
         MaterialDesc::Null => Bsdf::null(),
+        MaterialDesc::Principled { .. } | MaterialDesc::PrincipledThin { .. } => {
+            unreachable!("converted by crate::principled::bsdf above")
+        }
         MaterialDesc::NormalMap {
             normal,
             flip_invalid_normals,
@@ -361,7 +411,8 @@ pub(crate) fn bsdf(m: &MaterialDesc) -> Result<Bsdf> {
             bsdf(material)?.masked(*opacity)
         }
         MaterialDesc::Textured { material, textures } => {
-            let b = bsdf(material)?;
+            let spec_trans = textures.iter().any(|t| t.param == ColorParam::SpecTrans);
+            let b = bsdf_in(material, spec_trans)?;
             let allowed = color_params(material);
             if contains_textured(material) {
                 return Err(MaterialError::NestedTextured);
@@ -378,6 +429,7 @@ pub(crate) fn bsdf(m: &MaterialDesc) -> Result<Bsdf> {
                 if textures[..i].iter().any(|u| u.param == t.param) {
                     return Err(MaterialError::TwoTextures { param: t.param });
                 }
+                crate::principled::check_binding(t)?;
             }
             b
         }
@@ -407,6 +459,8 @@ pub(crate) fn color_params(m: &MaterialDesc) -> &'static [ColorParam] {
         MaterialDesc::Mask { material, .. } | MaterialDesc::NormalMap { material, .. } => {
             color_params(material)
         }
+        MaterialDesc::Principled { .. } => crate::principled::PRINCIPLED_PARAMS,
+        MaterialDesc::PrincipledThin { .. } => crate::principled::PRINCIPLED_THIN_PARAMS,
         MaterialDesc::Null | MaterialDesc::Black => &[],
     }
 }

@@ -172,7 +172,10 @@ impl std::fmt::Display for TextureError {
                 "texture uv transform (scale {scale}, offset {offset}) is not finite"
             ),
             TextureError::CheckerColor { name, color } => {
-                write!(f, "checkerboard {name} {color:?} must lie in [0, 1]")
+                write!(
+                    f,
+                    "checkerboard {name} {color:?} must be finite and non-negative"
+                )
             }
             TextureError::Image(e) => write!(f, "{e}"),
             TextureError::AttributeName(n) => write!(
@@ -203,7 +206,8 @@ impl Texture {
         }
         if let TextureDesc::Checkerboard { color0, color1, .. } = desc {
             for (name, c) in [("color0", color0), ("color1", color1)] {
-                if !c.iter().all(|x| (0.0..=1.0).contains(x)) {
+                // The parameter it is bound to bounds it further (a reflectance to [0, 1]).
+                if !c.iter().all(|x| x.is_finite() && *x >= 0.0) {
                     return Err(TextureError::CheckerColor { name, color: *c });
                 }
             }

@@ -245,7 +245,7 @@ fn xml_texture_errors_name_file_and_line() {
         (
             r#"<bsdf type="diffuse" id="m">
 <texture type="checkerboard" name="reflectance"><rgb name="color0" value="2"/></texture></bsdf>"#,
-            "s.xml:4: texture 'checkerboard': reflectance 'color0'",
+            "s.xml:3: bsdf 'diffuse': texture for 'reflectance': colour [2.0, 2.0, 2.0] must lie in [0, 1]",
         ),
     ];
     for (body, want) in cases {

@@ -1,6 +1,8 @@
 //! The scattering models, one file per family, each with its parameters, its `eval`, `pdf` and
 //! `sample` and its unit tests: [`diffuse`], [`conductor`] (smooth and rough), [`dielectric`]
-//! (smooth and rough) and [`plastic`] (smooth and rough, with the rough plastic's coating tables).
+//! (smooth and rough), [`plastic`] (smooth and rough, with the rough plastic's coating tables) and
+//! [`principled`] and [`principled_thin`] (Burley's Disney BSDF, with their shared lobes in
+//! [`principled_lobes`]).
 //! [`crate::Bsdf`] dispatches to them with one `match` per method.
 //!
 //! Every model function works on directions that are already oriented (the two-sided mirroring
@@ -20,6 +22,10 @@ pub(crate) mod diffuse;
 pub(crate) mod mask;
 pub mod normalmap;
 pub(crate) mod plastic;
+pub(crate) mod principled;
+pub(crate) mod principled_lobes;
+pub(crate) mod principled_params;
+pub(crate) mod principled_thin;
 
 /// A sampled scattering direction.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -65,6 +65,13 @@ pub const CONDUCTOR_ETA: V3 = [0.0; 3];
 /// A conductor's imaginary IOR part when only `eta` is given.
 pub const CONDUCTOR_K: V3 = [1.0; 3];
 
+/// The principled models' `roughness`.
+pub const PRINCIPLED_ROUGHNESS: f32 = 0.5;
+/// `principled`'s `specular` (its IOR when neither `eta` nor `specular` is given).
+pub const PRINCIPLED_SPECULAR: f32 = 0.5;
+/// `principledthin`'s `eta`.
+pub const PRINCIPLED_THIN_ETA: f32 = 1.5;
+
 /// Radiance, intensity or irradiance of an emitter that does not give one.
 pub const EMISSION: V3 = [1.0; 3];
 /// An envmap's radiance multiplier.
@@ -129,6 +136,12 @@ pub(crate) fn bk7_ior() -> f32 {
 }
 pub(crate) fn polypropylene_ior() -> f32 {
     POLYPROPYLENE_IOR
+}
+pub(crate) fn principled_roughness() -> f32 {
+    PRINCIPLED_ROUGHNESS
+}
+pub(crate) fn principled_thin_eta() -> f32 {
+    PRINCIPLED_THIN_ETA
 }
 pub(crate) fn envmap_scale() -> f32 {
     ENVMAP_SCALE

@@ -174,6 +174,83 @@ pub enum MaterialDesc {
         #[serde(default)]
         roughness: RoughnessDesc,
     },
+    /// Burley's Disney BSDF (Mitsuba `principled`; every weight in `[0, 1]`). One-sided unless
+    /// it transmits (`spec_trans > 0`, or a texture gives `spec_trans`).
+    Principled {
+        /// Base colour in `[0, 1]` (default 0.5).
+        #[serde(default = "defaults::diffuse_reflectance")]
+        base_color: V3,
+        /// Roughness of the main specular lobes (default 0.5).
+        #[serde(default = "defaults::principled_roughness")]
+        roughness: f32,
+        /// Anisotropy (default 0).
+        #[serde(default)]
+        anisotropic: f32,
+        /// Metallic weight (default 0).
+        #[serde(default)]
+        metallic: f32,
+        /// Share of the dielectric part that transmits (default 0).
+        #[serde(default)]
+        spec_trans: f32,
+        /// Tint of the dielectric reflection towards the base colour (default 0).
+        #[serde(default)]
+        spec_tint: f32,
+        /// Sheen weight (default 0).
+        #[serde(default)]
+        sheen: f32,
+        /// Tint of the sheen towards the base colour (default 0).
+        #[serde(default)]
+        sheen_tint: f32,
+        /// Diffuse (0) to fake subsurface (1) (default 0).
+        #[serde(default)]
+        flatness: f32,
+        /// Clearcoat weight (default 0).
+        #[serde(default)]
+        clearcoat: f32,
+        /// Clearcoat glossiness (default 0).
+        #[serde(default)]
+        clearcoat_gloss: f32,
+        /// Relative IOR; not together with `specular` (default: from `specular`).
+        #[serde(default)]
+        eta: Option<f32>,
+        /// Fresnel reflectance control in `[0, 1]`, `η = 2/(1 − √(0.08 specular)) − 1`; not
+        /// together with `eta` (default 0.5 when neither is given).
+        #[serde(default)]
+        specular: Option<f32>,
+    },
+    /// Burley's thin-sheet BSDF (Mitsuba `principledthin`), the same from both sides.
+    PrincipledThin {
+        /// Base colour in `[0, 1]` (default 0.5).
+        #[serde(default = "defaults::diffuse_reflectance")]
+        base_color: V3,
+        /// Roughness (default 0.5).
+        #[serde(default = "defaults::principled_roughness")]
+        roughness: f32,
+        /// Anisotropy (default 0).
+        #[serde(default)]
+        anisotropic: f32,
+        /// Specular share, half reflected and half transmitted (default 0).
+        #[serde(default)]
+        spec_trans: f32,
+        /// Tint of the specular reflection towards the base colour (default 0).
+        #[serde(default)]
+        spec_tint: f32,
+        /// Sheen weight (default 0).
+        #[serde(default)]
+        sheen: f32,
+        /// Tint of the sheen towards the base colour (default 0).
+        #[serde(default)]
+        sheen_tint: f32,
+        /// Diffuse (0) to fake subsurface (1) (default 0).
+        #[serde(default)]
+        flatness: f32,
+        /// Diffuse transmission in `[0, 2]` (default 0).
+        #[serde(default)]
+        diff_trans: f32,
+        /// Relative IOR of the sheet, positive (default 1.5).
+        #[serde(default = "defaults::principled_thin_eta")]
+        eta: f32,
+    },
     /// A surface light passes through unchanged (Mitsuba `null`).
     Null,
     /// The wrapped material on both sides (an error around transmitting materials, as in
@@ -271,6 +348,32 @@ pub enum ColorParam {
     AlphaU,
     /// Their `alpha_v` (with `alpha_u`).
     AlphaV,
+    /// The principled models' `base_color`.
+    BaseColor,
+    /// The principled models' `roughness` (a scalar, as every principled parameter below).
+    Roughness,
+    /// `anisotropic`.
+    Anisotropic,
+    /// `principled`'s `metallic`.
+    Metallic,
+    /// `spec_trans`.
+    SpecTrans,
+    /// `spec_tint`.
+    SpecTint,
+    /// `sheen`.
+    Sheen,
+    /// `sheen_tint`.
+    SheenTint,
+    /// `flatness`.
+    Flatness,
+    /// `principled`'s `clearcoat`.
+    Clearcoat,
+    /// `principled`'s `clearcoat_gloss`.
+    ClearcoatGloss,
+    /// `principledthin`'s `diff_trans` (0 to 2).
+    DiffTrans,
+    /// `principledthin`'s `eta`.
+    Eta,
 }
 
 impl ColorParam {
@@ -286,6 +389,19 @@ impl ColorParam {
             ColorParam::Alpha => "alpha",
             ColorParam::AlphaU => "alpha_u",
             ColorParam::AlphaV => "alpha_v",
+            ColorParam::BaseColor => "base_color",
+            ColorParam::Roughness => "roughness",
+            ColorParam::Anisotropic => "anisotropic",
+            ColorParam::Metallic => "metallic",
+            ColorParam::SpecTrans => "spec_trans",
+            ColorParam::SpecTint => "spec_tint",
+            ColorParam::Sheen => "sheen",
+            ColorParam::SheenTint => "sheen_tint",
+            ColorParam::Flatness => "flatness",
+            ColorParam::Clearcoat => "clearcoat",
+            ColorParam::ClearcoatGloss => "clearcoat_gloss",
+            ColorParam::DiffTrans => "diff_trans",
+            ColorParam::Eta => "eta",
         }
     }
 
@@ -301,9 +417,45 @@ impl ColorParam {
             ColorParam::Alpha,
             ColorParam::AlphaU,
             ColorParam::AlphaV,
+            ColorParam::BaseColor,
+            ColorParam::Roughness,
+            ColorParam::Anisotropic,
+            ColorParam::Metallic,
+            ColorParam::SpecTrans,
+            ColorParam::SpecTint,
+            ColorParam::Sheen,
+            ColorParam::SheenTint,
+            ColorParam::Flatness,
+            ColorParam::Clearcoat,
+            ColorParam::ClearcoatGloss,
+            ColorParam::DiffTrans,
+            ColorParam::Eta,
         ]
         .into_iter()
         .find(|p| p.name() == name)
+    }
+}
+
+impl ColorParam {
+    /// The parameter of the principled models this is, if it is one.
+    pub fn principled(self) -> Option<restir_materials::PrincipledParam> {
+        use restir_materials::PrincipledParam as P;
+        Some(match self {
+            ColorParam::BaseColor => P::BaseColor,
+            ColorParam::Roughness => P::Roughness,
+            ColorParam::Anisotropic => P::Anisotropic,
+            ColorParam::Metallic => P::Metallic,
+            ColorParam::SpecTrans => P::SpecTrans,
+            ColorParam::SpecTint => P::SpecTint,
+            ColorParam::Sheen => P::Sheen,
+            ColorParam::SheenTint => P::SheenTint,
+            ColorParam::Flatness => P::Flatness,
+            ColorParam::Clearcoat => P::Clearcoat,
+            ColorParam::ClearcoatGloss => P::ClearcoatGloss,
+            ColorParam::DiffTrans => P::DiffTrans,
+            ColorParam::Eta => P::Eta,
+            _ => return None,
+        })
     }
 }
 

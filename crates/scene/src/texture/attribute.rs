@@ -166,6 +166,7 @@ pub(crate) fn bind(
         normal,
         alpha_u,
         alpha_v,
+        principled,
     } = *params;
     for (slot, param, scalar) in [
         (diffuse, "reflectance", false),
@@ -180,6 +181,12 @@ pub(crate) fn bind(
             && let Some(Texture::MeshAttribute(t)) = textures.get_mut(i as usize)
         {
             t.bind(shape, s, scalar, param)?;
+        }
+    }
+    for (param, name, i) in principled.bound() {
+        if let Some(Texture::MeshAttribute(t)) = textures.get_mut(i as usize) {
+            let scalar = param != restir_materials::PrincipledParam::BaseColor;
+            t.bind(shape, s, scalar, name)?;
         }
     }
     Ok(())

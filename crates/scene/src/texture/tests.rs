@@ -213,8 +213,9 @@ fn srgb_decoding_of_8_bit_values() {
 
 #[test]
 fn bad_texture_parameters_are_errors() {
+    // Negative (above 1 is for the parameter it is bound to to judge).
     let bad = TextureDesc::Checkerboard {
-        color0: [1.5, 0.0, 0.0],
+        color0: [-0.5, 0.0, 0.0],
         color1: [0.0; 3],
         uv: UvTransform::default(),
     };

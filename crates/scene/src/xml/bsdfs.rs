@@ -21,6 +21,8 @@ const BSDF_TYPES: &[&str] = &[
     "null",
     "mask",
     "normalmap",
+    "principled",
+    "principledthin",
 ];
 
 impl<'a> Importer<'a> {
@@ -47,6 +49,7 @@ impl<'a> Importer<'a> {
             "dielectric" | "roughdielectric" => self.dielectric(node, &ty, &props)?,
             "plastic" | "roughplastic" => self.plastic(node, &ty, &props)?,
             "null" => MaterialDesc::Null,
+            "principled" | "principledthin" => self.principled(node, &ty, &props)?,
             "mask" => return self.mask(node, props, textured),
             "thindielectric" => {
                 return Err(self.err(
@@ -92,11 +95,14 @@ impl<'a> Importer<'a> {
                 continue;
             };
             let name = snake_case(&name);
-            let param = ColorParam::from_name(&name).ok_or_else(|| {
+            // `eta` is a texture for principledthin only (elsewhere a value, never a texture).
+            let param = ColorParam::from_name(&name)
+                .filter(|p| *p != ColorParam::Eta || ty == "principledthin");
+            let param = param.ok_or_else(|| {
                 self.err(
                     c,
                     format!(
-                        "bsdf '{ty}': '{name}' cannot be a texture (only these can: reflectance, diffuse_reflectance, specular_reflectance, specular_transmittance, a mask's opacity, a normalmap's normalmap, and the rough conductor's and rough dielectric's alpha, alpha_u, alpha_v)"
+                        "bsdf '{ty}': '{name}' cannot be a texture (only these can: reflectance, diffuse_reflectance, specular_reflectance, specular_transmittance, a mask's opacity, a normalmap's normalmap, the rough conductor's and rough dielectric's alpha, alpha_u, alpha_v, and the principled models' parameters but principled's eta and specular)"
                     ),
                 )
             })?;

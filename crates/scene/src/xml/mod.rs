@@ -27,6 +27,7 @@ mod emitters;
 mod instances;
 mod integrator;
 mod normalmap;
+mod principled;
 mod props;
 mod resolve;
 mod sensor;

@@ -113,12 +113,14 @@ impl<'a> Importer<'a> {
                     filter,
                 }
             }
+            // Any non-negative colours: the parameter a checkerboard is bound to decides the
+            // range (a reflectance [0, 1], `principledthin`'s `diff_trans` [0, 2]).
             "checkerboard" => TextureDesc::Checkerboard {
                 color0: props
-                    .color("color0", ColorUse::Reflectance)?
+                    .color("color0", ColorUse::Unbounded)?
                     .unwrap_or(defaults::CHECKER_COLOR0),
                 color1: props
-                    .color("color1", ColorUse::Reflectance)?
+                    .color("color1", ColorUse::Unbounded)?
                     .unwrap_or(defaults::CHECKER_COLOR1),
                 uv,
             },

@@ -220,6 +220,15 @@ impl Writer<'_> {
                     self.roughness(r);
                 }
             }
+            MaterialDesc::Principled { .. } | MaterialDesc::PrincipledThin { .. } => {
+                let ty = if matches!(m, MaterialDesc::Principled { .. }) {
+                    "principled"
+                } else {
+                    "principledthin"
+                };
+                self.open(&format!(r#"<bsdf type="{ty}"{id_attr}>"#));
+                self.principled_params(m, textures.unwrap_or(&[]), item)?;
+            }
             MaterialDesc::Textured { .. }
             | MaterialDesc::TwoSided(_)
             | MaterialDesc::Mask { .. }

@@ -398,4 +398,5 @@ impl Writer<'_> {
 }
 
 mod materials;
+mod principled;
 mod shapes;
