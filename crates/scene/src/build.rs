@@ -391,13 +391,7 @@ impl Scene {
         }
         let cam_m =
             transform_matrix(&desc.camera.to_world).map_err(|e| whole(format!("camera: {e}")))?;
-        let fov_axis = match desc.camera.fov_axis {
-            FovAxis::X => GeoFovAxis::X,
-            FovAxis::Y => GeoFovAxis::Y,
-            FovAxis::Diagonal => GeoFovAxis::Diagonal,
-            FovAxis::Smaller => GeoFovAxis::Smaller,
-            FovAxis::Larger => GeoFovAxis::Larger,
-        };
+        let fov_axis: GeoFovAxis = desc.camera.fov_axis.into();
         let camera = if desc.camera.orthographic {
             Camera::orthographic(cam_m, (w, h))
         } else {
@@ -547,13 +541,15 @@ impl Scene {
                 LightDesc::Constant { radiance } => Light::Constant {
                     radiance: v3(radiance),
                 },
-                LightDesc::Spot { location, .. } => crate::spot::spot_light(
-                    l,
-                    base_dir,
-                    &mut |p| cache.budget.take_image(p),
-                    &mut spot_textures,
-                )
-                .map_err(|e| at(location, e))?,
+                LightDesc::Spot { location, .. } | LightDesc::Projector { location, .. } => {
+                    crate::spot::spot_light(
+                        l,
+                        base_dir,
+                        &mut |p| cache.budget.take_image(p),
+                        &mut spot_textures,
+                    )
+                    .map_err(|e| at(location, e))?
+                }
                 LightDesc::Envmap {
                     filename,
                     scale,
@@ -596,7 +592,10 @@ impl Scene {
             has_delta_lights: light_set.lights().iter().any(|l| {
                 matches!(
                     l,
-                    Light::Point { .. } | Light::Spot(_) | Light::Directional { .. }
+                    Light::Point { .. }
+                        | Light::Spot(_)
+                        | Light::Projector(_)
+                        | Light::Directional { .. }
                 )
             }),
             light_count: light_set.len(),
