@@ -250,6 +250,27 @@ impl Texture {
         }
     }
 
+    /// The gradient of [`Texture::eval_1`] in `(u, v)`, as Mitsuba's `eval_1_grad` (what a
+    /// `bumpmap` reads): for a bitmap the derivative of its bilinear lookup of the luminance
+    /// (zero with the nearest filter), through the `uv` transform; `None` for a checkerboard,
+    /// whose gradient Mitsuba does not define.
+    pub fn eval_1_grad(&self, uv: Vec2) -> Option<Vec2> {
+        match self {
+            Texture::Checkerboard { .. } => None,
+            Texture::Bitmap {
+                width,
+                height,
+                texels,
+                uv: t,
+                wrap,
+                filter,
+            } => Some(
+                lookup::lookup_grad(texels, (*width, *height), t.apply(uv), *wrap, *filter)
+                    * t.scale,
+            ),
+        }
+    }
+
     /// The mean texel value (the average reflectance of a bitmap, or the checkerboard's).
     pub fn mean(&self) -> Vec3 {
         match self {
