@@ -148,6 +148,11 @@ fn material(
 ) -> Result<(Bsdf, Option<TexturedParams>), String> {
     let bsdf = crate::material::bsdf(m).map_err(|e| e.to_string())?;
     let (base, bindings) = crate::material::colors(m);
+    if crate::material::bump_scale(m).is_some()
+        && !bindings.iter().any(|b| b.param == ColorParam::BumpMap)
+    {
+        return Err("bumpmap needs its height texture (a bitmap)".into());
+    }
     if bindings.is_empty() {
         return Ok((bsdf, None));
     }
@@ -160,6 +165,7 @@ fn material(
         normal: None,
         alpha_u: None,
         alpha_v: None,
+        bump: None,
     };
     for b in bindings {
         let id = Some(cache.get(&b.texture, base_dir)?);
@@ -169,6 +175,16 @@ fn material(
             ColorParam::SpecularTransmittance => t.transmittance = id,
             ColorParam::Opacity => t.opacity = id,
             ColorParam::NormalMap => t.normal = id,
+            ColorParam::BumpMap => {
+                if !matches!(b.texture, TextureDesc::Bitmap { .. }) {
+                    return Err(
+                        "bumpmap: the height must be a bitmap (Mitsuba defines no gradient for other textures)"
+                            .into(),
+                    );
+                }
+                let scale = crate::material::bump_scale(m).unwrap_or(defaults::BUMP_SCALE);
+                t.bump = id.map(|i| (i, scale));
+            }
             ColorParam::Alpha => {
                 t.alpha_u = id;
                 t.alpha_v = id;
@@ -519,6 +535,20 @@ impl Scene {
             }
             shapes.push(shape);
             shape_bsdf.push(bsdf);
+        }
+        // The G-buffer of the ReSTIR estimators keeps a hit's uv, not the surface derivatives a
+        // bump map needs: said once, at the first bump-mapped shape.
+        let bumped = desc.shapes.iter().zip(&shape_bsdf).find(|(_, b)| {
+            bsdf_textures[**b as usize].is_some_and(|t: TexturedParams| t.bump.is_some())
+        });
+        if let Some((sd, _)) = bumped {
+            warnings.push(SceneWarning {
+                location: at(&sd.location, String::new()).location,
+                message: "bumpmap: ReSTIR DI and ReSTIR PT look materials up at primary hits by \
+                          uv alone and render the bump flat there (the path tracer renders it \
+                          fully)"
+                    .into(),
+            });
         }
         let mut envmap = None;
         let mut spot_textures = Vec::new();

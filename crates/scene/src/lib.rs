@@ -166,15 +166,45 @@ impl Scene {
         self.accel.occluded(ray, t_max)
     }
 
-    /// The BSDF of a surface point (its material with textures looked up at `si.uv`).
+    /// The BSDF of a surface point (its material with textures looked up at `si.uv`, and a bump
+    /// map's normal from the height's gradient and the surface's derivatives there).
     #[inline]
     pub fn bsdf(&self, si: &SurfaceInteraction) -> Bsdf {
-        self.bsdf_at(self.shape_bsdf[si.shape as usize], si.uv)
+        let bsdf = self.shape_bsdf[si.shape as usize];
+        match &self.bsdf_textures[bsdf as usize] {
+            Some(t) if self.features.has_textures && t.bump.is_some() => {
+                let mut p = t.eval(&self.textures, si.uv);
+                if let Some((texture, scale)) = t.bump {
+                    p.normal = self.bump_texel(texture, scale, si);
+                }
+                self.bsdfs[bsdf as usize].with_params(&p)
+            }
+            _ => self.bsdf_at(bsdf, si.uv),
+        }
+    }
+
+    /// The normal-map texel of a bump map (height `texture` times `scale`) at `si`: Mitsuba's
+    /// perturbed normal in the shading frame ([`restir_materials::bump_normal`]).
+    fn bump_texel(&self, texture: u32, scale: f32, si: &SurfaceInteraction) -> Vec3 {
+        let grad = self.textures[texture as usize]
+            .eval_1_grad(si.uv)
+            .unwrap_or(Vec2::ZERO);
+        let (dp_du, dp_dv) = self.shapes[si.shape as usize].uv_derivatives(si.prim, si.param);
+        let f = &si.shading;
+        restir_materials::normal_texel(restir_materials::bump_normal(
+            scale * grad,
+            dp_du,
+            dp_dv,
+            [f.s, f.t, f.n],
+            si.ng,
+        ))
     }
 
     /// Material `bsdf` (an index into `bsdfs`) at texture coordinates `uv`: the one place where
     /// textures are resolved. A scene without textures (decided at build time,
-    /// [`SceneFeatures::has_textures`]) returns the stored BSDF without looking at `uv`.
+    /// [`SceneFeatures::has_textures`]) returns the stored BSDF without looking at `uv`. A bump
+    /// map's normal needs the surface's derivatives, which `uv` does not give: here it stays
+    /// flat, and [`Scene::bsdf`] (with the hit) applies it.
     #[inline]
     pub fn bsdf_at(&self, bsdf: u32, uv: Vec2) -> Bsdf {
         let base = self.bsdfs[bsdf as usize];
@@ -208,6 +238,9 @@ pub struct TexturedParams {
     pub alpha_u: Option<u32>,
     /// Texture of `alpha_v`.
     pub alpha_v: Option<u32>,
+    /// A `bumpmap`'s height texture and scale: its gradient perturbs the normal at each hit
+    /// ([`Scene::bsdf`]; [`TexturedParams::eval`] leaves the normal flat).
+    pub bump: Option<(u32, f32)>,
 }
 
 impl TexturedParams {

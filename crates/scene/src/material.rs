@@ -85,6 +85,13 @@ pub enum MaterialError {
         /// Its value.
         value: V3,
     },
+    /// A `bumpmap` inside another normal or bump map or a `twosided`, or around a `mask`.
+    BumpMapNesting,
+    /// A `bumpmap` scale that is not finite.
+    BadBumpScale {
+        /// Its value.
+        value: f32,
+    },
 }
 
 impl core::fmt::Display for MaterialError {
@@ -151,6 +158,12 @@ impl core::fmt::Display for MaterialError {
             ),
             MaterialError::BadNormal { value } => {
                 write!(f, "normalmap value {value:?} must be finite")
+            }
+            MaterialError::BumpMapNesting => f.write_str(
+                "a bumpmap may wrap any material but a mask, a normalmap or a bumpmap, and only a mask may wrap it (write mask(bumpmap(twosided(...))))",
+            ),
+            MaterialError::BadBumpScale { value } => {
+                write!(f, "bumpmap scale {value} must be finite")
             }
         }
     }
@@ -340,9 +353,37 @@ pub(crate) fn bsdf(m: &MaterialDesc) -> Result<Bsdf> {
                 *use_shadowing_function,
             ))
         }
+        MaterialDesc::BumpMap {
+            scale,
+            flip_invalid_normals,
+            use_shadowing_function,
+            material,
+        } => {
+            if matches!(
+                **material,
+                MaterialDesc::Mask { .. }
+                    | MaterialDesc::NormalMap { .. }
+                    | MaterialDesc::BumpMap { .. }
+            ) {
+                return Err(MaterialError::BumpMapNesting);
+            }
+            if !scale.is_finite() {
+                return Err(MaterialError::BadBumpScale { value: *scale });
+            }
+            // The normal map's frame with the flat normal; the bump's normal replaces it at
+            // each hit (`Scene::bsdf`).
+            bsdf(material)?.normal_mapped(restir_materials::NormalMap::new(
+                Vec3::from(defaults::FLAT_NORMAL),
+                *flip_invalid_normals,
+                *use_shadowing_function,
+            ))
+        }
         MaterialDesc::TwoSided(inner) => {
             if matches!(**inner, MaterialDesc::NormalMap { .. }) {
                 return Err(MaterialError::NormalMapNesting);
+            }
+            if matches!(**inner, MaterialDesc::BumpMap { .. }) {
+                return Err(MaterialError::BumpMapNesting);
             }
             let b = bsdf(inner)?;
             if b.kind.transmits() {
@@ -369,7 +410,8 @@ pub(crate) fn bsdf(m: &MaterialDesc) -> Result<Bsdf> {
             for (i, t) in textures.iter().enumerate() {
                 let mask_opacity = t.param == ColorParam::Opacity && is_mask(material);
                 let normal_map = t.param == ColorParam::NormalMap && has_normal_map(material);
-                if !(allowed.contains(&t.param) || mask_opacity || normal_map) {
+                let bump_map = t.param == ColorParam::BumpMap && bump_scale(material).is_some();
+                if !(allowed.contains(&t.param) || mask_opacity || normal_map || bump_map) {
                     return Err(MaterialError::NoSuchParameter {
                         param: t.param,
                         allowed,
@@ -404,9 +446,9 @@ pub(crate) fn color_params(m: &MaterialDesc) -> &'static [ColorParam] {
         }
         MaterialDesc::TwoSided(inner) => color_params(inner),
         MaterialDesc::Textured { material, .. } => color_params(material),
-        MaterialDesc::Mask { material, .. } | MaterialDesc::NormalMap { material, .. } => {
-            color_params(material)
-        }
+        MaterialDesc::Mask { material, .. }
+        | MaterialDesc::NormalMap { material, .. }
+        | MaterialDesc::BumpMap { material, .. } => color_params(material),
         MaterialDesc::Null | MaterialDesc::Black => &[],
     }
 }
@@ -420,6 +462,9 @@ fn contains_textured(m: &MaterialDesc) -> bool {
             material: inner, ..
         }
         | MaterialDesc::NormalMap {
+            material: inner, ..
+        }
+        | MaterialDesc::BumpMap {
             material: inner, ..
         } => contains_textured(inner),
         _ => false,
@@ -441,6 +486,17 @@ pub(crate) fn has_normal_map(m: &MaterialDesc) -> bool {
         MaterialDesc::NormalMap { .. } => true,
         MaterialDesc::Mask { material, .. } => has_normal_map(material),
         _ => false,
+    }
+}
+
+/// The scale of `m`'s `bumpmap` (perhaps inside a `mask`), whose height a texture gives.
+pub(crate) fn bump_scale(m: &MaterialDesc) -> Option<f32> {
+    match m {
+        MaterialDesc::BumpMap { scale, .. } => Some(*scale),
+        MaterialDesc::Mask { material, .. } | MaterialDesc::Textured { material, .. } => {
+            bump_scale(material)
+        }
+        _ => None,
     }
 }
 
@@ -471,6 +527,7 @@ pub(crate) fn colors(m: &MaterialDesc) -> (ReflectanceParams, &[TextureBinding])
                 p.normal = v3(normal);
                 m = material;
             }
+            MaterialDesc::BumpMap { material, .. } => m = material,
             MaterialDesc::Textured { material, textures } => {
                 bindings = textures;
                 m = material;

@@ -75,6 +75,8 @@ pub const ENVMAP_SCALE: f32 = 1.0;
 pub const SPOT_CUTOFF_ANGLE: f32 = 20.0;
 /// A spot light's `beam_width` as a fraction of its `cutoff_angle`.
 pub const SPOT_BEAM_FRACTION: f32 = 0.75;
+/// A bump map's gradient multiplier (`scale`).
+pub const BUMP_SCALE: f32 = 1.0;
 /// A projector's irradiance multiplier (`scale`).
 pub const PROJECTOR_SCALE: f32 = 1.0;
 
@@ -142,6 +144,9 @@ pub(crate) fn spot_cutoff_angle() -> f32 {
 }
 pub(crate) fn emission() -> V3 {
     EMISSION
+}
+pub(crate) fn bump_scale() -> f32 {
+    BUMP_SCALE
 }
 pub(crate) fn projector_scale() -> f32 {
     PROJECTOR_SCALE
