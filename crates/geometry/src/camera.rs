@@ -21,6 +21,31 @@ pub enum FovAxis {
     Larger,
 }
 
+impl FovAxis {
+    /// Half the extent of an image of aspect ratio `aspect` (width over height) on the plane
+    /// `z = 1` in front of a pinhole, `(tan(fov_x / 2), tan(fov_y / 2))`, when `fov_degrees` spans
+    /// this axis: Mitsuba 3's field-of-view rule, which its perspective sensor and its
+    /// `projector` emitter share (`smaller` and `larger` pick `x` or `y` by the aspect ratio).
+    pub fn tan_half(self, fov_degrees: f32, aspect: f32) -> Vec2 {
+        let t = (fov_degrees.to_radians() * 0.5).tan();
+        let axis = match self {
+            FovAxis::Smaller if aspect > 1.0 => FovAxis::Y,
+            FovAxis::Smaller => FovAxis::X,
+            FovAxis::Larger if aspect > 1.0 => FovAxis::X,
+            FovAxis::Larger => FovAxis::Y,
+            a => a,
+        };
+        match axis {
+            FovAxis::X => Vec2::new(t, t / aspect),
+            FovAxis::Y => Vec2::new(t * aspect, t),
+            _ => {
+                let diag = (aspect * aspect + 1.0).sqrt();
+                Vec2::new(t * aspect / diag, t / diag)
+            }
+        }
+    }
+}
+
 /// Why a camera cannot be built.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CameraError {
@@ -101,23 +126,7 @@ impl Camera {
         if !lens_ok {
             return Err(CameraError::Lens);
         }
-        let aspect = w as f32 / h as f32;
-        let t = (fov_degrees.to_radians() * 0.5).tan();
-        let axis = match fov_axis {
-            FovAxis::Smaller if aspect > 1.0 => FovAxis::Y,
-            FovAxis::Smaller => FovAxis::X,
-            FovAxis::Larger if aspect > 1.0 => FovAxis::X,
-            FovAxis::Larger => FovAxis::Y,
-            a => a,
-        };
-        let tan_half = match axis {
-            FovAxis::X => Vec2::new(t, t / aspect),
-            FovAxis::Y => Vec2::new(t * aspect, t),
-            _ => {
-                let diag = (aspect * aspect + 1.0).sqrt();
-                Vec2::new(t * aspect / diag, t / diag)
-            }
-        };
+        let tan_half = fov_axis.tan_half(fov_degrees, w as f32 / h as f32);
         Ok(Self {
             to_world,
             from_world: to_world.inverse(),

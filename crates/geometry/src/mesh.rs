@@ -351,6 +351,24 @@ impl TriangleMesh {
         Face { ng, dpdu }
     }
 
+    /// Triangle `i`'s partial derivatives `(dp/du, dp/dv)` in its texture coordinates, as
+    /// Mitsuba 3's mesh computes them: the edges `p1 − p0`, `p2 − p0` taken to the `uv` basis
+    /// (both zero when the `uv` triangle is degenerate), or the edges themselves without texture
+    /// coordinates (the parametrisation is then barycentric).
+    pub fn uv_derivatives(&self, i: usize) -> (Vec3, Vec3) {
+        let [p0, p1, p2] = self.triangle(i);
+        let (e1, e2) = (p1 - p0, p2 - p0);
+        let Some(uvs) = &self.uvs else {
+            return (e1, e2);
+        };
+        let [ia, ib, ic] = self.indices[i];
+        let t0 = uvs[ia as usize];
+        let (d1, d2) = (uvs[ib as usize] - t0, uvs[ic as usize] - t0);
+        let det = d1.x * d2.y - d1.y * d2.x;
+        let inv = if det != 0.0 { 1.0 / det } else { 0.0 };
+        ((e1 * d2.y - e2 * d1.y) * inv, (e2 * d1.x - e1 * d2.x) * inv)
+    }
+
     /// Point, geometric normal and shading normal at barycentrics `b = (b1, b2)` of triangle `i`
     /// (the cheaper part of [`TriangleMesh::surface_at`], for light sampling).
     #[inline(always)]

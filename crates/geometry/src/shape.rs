@@ -113,6 +113,32 @@ impl Shape {
         }
     }
 
+    /// The partial derivatives `(dp/du, dp/dv)` of the surface in its texture coordinates at
+    /// primitive `prim` and parameters `param`, as Mitsuba 3 computes them (a bump map's
+    /// frame): on a mesh triangle's with texture coordinates, the edges taken to the `uv` basis
+    /// (zero when its `uv` triangle is degenerate), without them the edges themselves; on a
+    /// sphere the derivatives of `(φ/2π, θ/π)`'s inverse, `2π·(−Δy, Δx, 0)` and
+    /// `π·(Δz cos φ, Δz sin φ, −ρ)` (`Δ` from the centre, `ρ` its distance from the axis).
+    pub fn uv_derivatives(&self, prim: u32, param: Vec2) -> (Vec3, Vec3) {
+        match self {
+            Shape::Mesh(m) => m.uv_derivatives(prim as usize),
+            Shape::Sphere(s) => {
+                let (p, _) = s.point_at(param);
+                let d = p - s.center;
+                let rho = (d.x * d.x + d.y * d.y).sqrt();
+                let (cos_phi, sin_phi) = if rho > 0.0 {
+                    (d.x / rho, d.y / rho)
+                } else {
+                    (1.0, 0.0)
+                };
+                (
+                    2.0 * PI * Vec3::new(-d.y, d.x, 0.0),
+                    PI * Vec3::new(d.z * cos_phi, d.z * sin_phi, -rho),
+                )
+            }
+        }
+    }
+
     /// The surface point at primitive `prim` and parameters `param` (barycentrics for meshes,
     /// [`Sphere::param_of`] for spheres).
     #[inline]

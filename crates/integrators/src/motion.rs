@@ -38,7 +38,7 @@ pub struct FrameMotion {
 /// Which light a light is across frames: an area light by its shape, any other light by its
 /// kind and its rank among the lights of that kind (they do not animate).
 fn light_keys(lights: &[Light]) -> Vec<(u8, u32)> {
-    let mut ranks = [0u32; 6];
+    let mut ranks = [0u32; 7];
     lights
         .iter()
         .map(|l| {
@@ -49,6 +49,7 @@ fn light_keys(lights: &[Light]) -> Vec<(u8, u32)> {
                 Light::Constant { .. } => 3,
                 Light::Envmap => 4,
                 Light::Spot(_) => 5,
+                Light::Projector(_) => 6,
             };
             ranks[kind as usize] += 1;
             (kind, ranks[kind as usize] - 1)

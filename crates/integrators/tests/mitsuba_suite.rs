@@ -51,9 +51,21 @@ const PASS_FRACTION: f64 = 0.9975;
 /// The smallest variance the criterion divides by.
 const MIN_VARIANCE: f64 = 1e-4;
 /// Scenes that must load (of the 29).
-const MIN_LOADING: usize = 23;
+const MIN_LOADING: usize = 26;
 /// `(scene, estimator, reason)`: failures that are known and explained in docs/VALIDATION.md.
 const KNOWN_FAILURES: &[(&str, &str, &str)] = &[
+    (
+        "bsdf_spheres/test_bumpmap_path.xml",
+        "restir-di",
+        "the G-buffer keeps a primary hit's uv, not the surface derivatives a bump map needs, so \
+         the bump is flat at primary hits (a warning says so when the scene loads)",
+    ),
+    (
+        "bsdf_spheres/test_bumpmap_path.xml",
+        "restir-pt",
+        "the G-buffer keeps a primary hit's uv, not the surface derivatives a bump map needs, so \
+         the bump is flat at primary hits (a warning says so when the scene loads)",
+    ),
     (
         "bsdf_spheres/test_constant_path.xml",
         "restir-di",

@@ -238,15 +238,15 @@ impl LightBvh {
                             power: w,
                         })
                     }
-                    Light::Point { position, .. } | Light::Spot(crate::Spot { position, .. }) => {
-                        Some(Item {
-                            entry,
-                            lo: position,
-                            hi: position,
-                            cone: Cone::ALL,
-                            power: w,
-                        })
-                    }
+                    Light::Point { position, .. }
+                    | Light::Spot(crate::Spot { position, .. })
+                    | Light::Projector(crate::Projector { position, .. }) => Some(Item {
+                        entry,
+                        lo: position,
+                        hi: position,
+                        cone: Cone::ALL,
+                        power: w,
+                    }),
                     _ => None,
                 },
             };

@@ -3,12 +3,13 @@
 //!
 //! | file | what it holds |
 //! |---|---|
-//! | `light.rs` | [`Light`] (diffuse area lights on shapes, one-sided as in Mitsuba; point, spot ([`Spot`]), directional, constant and image environment lights, [`EnvMap`] being Mitsuba's `envmap`), [`LightSample`] (a point on one light drawn for a receiver, [`LightSet::sample_light`]) and the densities of points reached another way ([`LightSet::pdf_sa`]) |
+//! | `light.rs` | [`Light`] (diffuse area lights on shapes, one-sided as in Mitsuba; point, spot ([`Spot`]), projector ([`Projector`]), directional, constant and image environment lights, [`EnvMap`] being Mitsuba's `envmap`), [`LightSample`] (a point on one light drawn for a receiver, [`LightSet::sample_light`]) and the densities of points reached another way ([`LightSet::pdf_sa`]) |
 //! | `set.rs` | [`LightSet`]: every light of a scene with the shapes area lights lie on (emitters know their shapes, as in Mitsuba 3's scene, so no caller hands the shape list around), each light's power, the environment's share of selections |
 //! | `select.rs` | which light: the power sampler ([`LightSet::sample`], [`LightSet::select`], [`LightSet::pmf`]) over one flat emitter table (`table.rs`: every emissive triangle, every other light), and the light hierarchy over the same entries (`bvh.rs`: [`LightSet::sample_hierarchy`], [`LightSet::hierarchy_pmf`]) |
 //! | `point.rs` | a light sample named without its receiver ([`LightPoint`], what a reservoir holds), resolved in world space ([`LightSet::resolve`], [`Resolved`]) and seen from a receiver ([`Contact`]) |
 //! | `learned.rs` | a selection learned across passes: per cell of a world-space grid, what each emitter (a triangle, another light, the environment) delivered after its shadow ray ([`LightRecords`]), sampled in a mixture with the power sampler with its exact probability ([`LearnedSampler`]) |
 //! | `spot.rs` | [`Spot`], Mitsuba's `spot` emitter (a point light with an angular falloff and an optional projected [`SpotTexture`]) |
+//! | `projector.rs` | [`Projector`], Mitsuba's `projector` emitter (a pinhole throwing an irradiance image, a [`SpotTexture`] or a constant, through a perspective frustum) |
 //! | `presample.rs` | samples drawn without a receiver ([`LightSet::presample`], [`Presampled`]), for pools of presampled candidates |
 //! | `sampler.rs` | one interface over all of these for a receiver's candidates ([`LightSampler`]: power, hierarchy, presampled pool, a table mixed with the power sampler, the learned cell), each candidate with the density that drew it and the power sampler's ([`LightCandidate`]) |
 //!
@@ -22,7 +23,7 @@
 //! # The set of lights is closed
 //!
 //! A program using this crate cannot add a kind of light of its own: [`Light`] is an enum of
-//! the kinds above (area, point, spot, directional, constant and image environment), and sampling,
+//! the kinds above (area, point, spot, projector, directional, constant and image environment), and sampling,
 //! densities, power and the emitter table dispatch with one `match` over it. This is
 //! deliberate: light sampling runs for every candidate of every pixel, and an enum keeps those
 //! calls monomorphised and inlinable, keeps a [`LightPoint`] a 16-byte value a reservoir can
@@ -32,7 +33,7 @@
 //!
 //! What a user does instead:
 //! - **Use the nearest light through its parameters**: any emissive shape (a mesh of any
-//!   shape with a radiance), a point, spot or directional light, a constant or image environment
+//!   shape with a radiance), a point, spot, projector or directional light, a constant or image environment
 //!   (an HDR image with a rotation and a scale).
 //! - **Fork** and add a variant to [`Light`]: the compiler then lists every `match` that must
 //!   learn it (sampling, density, power, bounds for the hierarchy).
@@ -48,6 +49,7 @@ mod learned;
 mod light;
 mod point;
 mod presample;
+mod projector;
 mod sampler;
 mod select;
 mod set;
@@ -59,6 +61,7 @@ pub use learned::{CellKey, LearnGrid, LearnedSampler, LightRecords};
 pub use light::{Light, LightSample};
 pub use point::{Contact, LightPoint, Resolved};
 pub use presample::Presampled;
+pub use projector::{Projector, ProjectorError};
 pub use sampler::{
     At, CandidateU, HierarchySampler, LearnedCellSampler, LightCandidate, LightSampler,
     PoolSampler, PowerSampler, TableSampler,

@@ -9,7 +9,7 @@ use restir_sampling::warp;
 
 use crate::point::point_contact;
 use crate::table::Emitter;
-use crate::{Contact, EnvMap, LightSet, Spot};
+use crate::{Contact, EnvMap, LightSet, Projector, Spot};
 
 /// An emitter.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,6 +31,9 @@ pub enum Light {
     /// Mitsuba's `spot`: a point light whose intensity falls off with the angle from its axis,
     /// optionally projecting a texture ([`Spot`]).
     Spot(Spot),
+    /// Mitsuba's `projector`: a point light throwing an irradiance image (or a constant) through
+    /// a perspective frustum ([`Projector`]).
+    Projector(Projector),
     /// A directional light.
     Directional {
         /// Unit direction in which the light travels.
@@ -168,8 +171,13 @@ impl LightSet {
             Light::Spot(spot) => point_light_sample(
                 light,
                 point_contact(spot.position, ref_p, |out| {
-                    let intensity = self.spot_intensity(&spot, out);
-                    (intensity != Vec3::ZERO).then_some(intensity) // outside the cone: none
+                    nonzero(self.spot_intensity(&spot, out)) // outside the cone: none
+                })?,
+            ),
+            Light::Projector(projector) => point_light_sample(
+                light,
+                point_contact(projector.position, ref_p, |out| {
+                    nonzero(self.projector_intensity(&projector, out)) // outside the frustum
                 })?,
             ),
             Light::Directional {
@@ -245,7 +253,10 @@ impl LightSet {
                 .envmap
                 .as_ref()
                 .map_or(0.0, |m| pmf * m.pdf(-n.normalize_or_zero())),
-            Light::Point { .. } | Light::Spot(_) | Light::Directional { .. } => 0.0,
+            Light::Point { .. }
+            | Light::Spot(_)
+            | Light::Projector(_)
+            | Light::Directional { .. } => 0.0,
         }
     }
 
@@ -259,6 +270,24 @@ impl LightSet {
                 .and_then(|t| self.spot_textures.get(t as usize)),
         )
     }
+
+    /// The intensity projector `projector` (one of this set's) sends in world direction `w`
+    /// (from the light, any length), its texture included.
+    #[inline]
+    pub fn projector_intensity(&self, projector: &Projector, w: Vec3) -> Vec3 {
+        projector.intensity_towards(
+            w,
+            projector
+                .texture
+                .and_then(|t| self.spot_textures.get(t as usize)),
+        )
+    }
+}
+
+/// `Some(v)` unless `v` is zero (a point emitter sending nothing that way has no contact).
+#[inline]
+pub(crate) fn nonzero(v: Vec3) -> Option<Vec3> {
+    (v != Vec3::ZERO).then_some(v)
 }
 
 /// The sample of area light `light` (radiance `radiance`) at point `ps` seen from `ref_p`, with

@@ -4,7 +4,7 @@
 //!
 //! # Sample space and measure
 //!
-//! A sample is a point on an area light (area measure), a point or spot light (counting measure), a
+//! A sample is a point on an area light (area measure), a point, spot or projector light (counting measure), a
 //! directional light (counting measure) or a direction towards the environment (solid-angle
 //! measure on the sphere at infinity). None of these depend on the receiver, so the shift
 //! between pixels is the identity with Jacobian 1 (GRIS, Lin et al. 2022, §6: a shift that keeps the sample has Jacobian 1); each pixel's target and
@@ -13,7 +13,8 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::{Light, LightSample, LightSet};
+use crate::light::nonzero;
+use crate::{Light, LightSample, LightSet, Projector, Spot};
 
 /// A ReSTIR DI sample: 16 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -103,8 +104,8 @@ pub enum Resolved {
         /// Radiant intensity.
         intensity: Vec3,
     },
-    /// A spot light (its intensity depends on the direction to the receiver: the set's light
-    /// `light` says how).
+    /// A point emitter whose intensity depends on the direction to the receiver, a spot light
+    /// or a projector (the set's light `light` says how).
     Spot {
         /// Position.
         p: Vec3,
@@ -152,10 +153,12 @@ impl LightSet {
                 p: position,
                 intensity,
             },
-            Light::Spot(spot) => Resolved::Spot {
-                p: spot.position,
-                light: sample.light,
-            },
+            Light::Spot(Spot { position, .. }) | Light::Projector(Projector { position, .. }) => {
+                Resolved::Spot {
+                    p: position,
+                    light: sample.light,
+                }
+            }
             Light::Directional {
                 direction,
                 irradiance,
@@ -188,7 +191,7 @@ impl LightSet {
 
 impl Resolved {
     /// The sample as seen from `x`, or `None` if it cannot contribute there (behind a one-sided
-    /// emitter, outside a spot light's cone, at zero distance). `lights` is the set that resolved
+    /// emitter, outside a spot light's cone or a projector's frustum, at zero distance). `lights` is the set that resolved
     /// it (a spot light's profile and texture are read there).
     #[inline]
     pub fn contact(&self, lights: &LightSet, x: Vec3) -> Option<Contact> {
@@ -223,15 +226,15 @@ impl Resolved {
                 })
             }
             Resolved::Point { p, intensity } => point_contact(p, x, |_| Some(intensity)),
-            Resolved::Spot { p, light } => {
-                let Some(Light::Spot(spot)) = lights.lights().get(light as usize) else {
-                    return None;
-                };
-                point_contact(p, x, |out| {
-                    let intensity = lights.spot_intensity(spot, out);
-                    (intensity != Vec3::ZERO).then_some(intensity)
-                })
-            }
+            Resolved::Spot { p, light } => match lights.lights().get(light as usize) {
+                Some(Light::Spot(spot)) => {
+                    point_contact(p, x, |out| nonzero(lights.spot_intensity(spot, out)))
+                }
+                Some(Light::Projector(projector)) => point_contact(p, x, |out| {
+                    nonzero(lights.projector_intensity(projector, out))
+                }),
+                _ => None,
+            },
             Resolved::Direction { wi, le, delta, pdf } => Some(Contact {
                 wi,
                 p: x + wi,

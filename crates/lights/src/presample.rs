@@ -74,7 +74,9 @@ impl LightSet {
         };
         let pmf = self.table.pmf(light);
         match self.lights[light as usize] {
-            Light::Area { .. } | Light::Spot(_) => Some(Presampled::Light { light, pmf }),
+            Light::Area { .. } | Light::Spot(_) | Light::Projector(_) => {
+                Some(Presampled::Light { light, pmf })
+            }
             Light::Point {
                 position,
                 intensity,

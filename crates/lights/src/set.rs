@@ -27,7 +27,8 @@ pub enum LightError {
     TooBright(usize, &'static str, f32),
     /// An `Envmap` light without an [`EnvMap`], or an [`EnvMap`] without an `Envmap` light.
     EnvmapMismatch,
-    /// A spot light names a texture the set was not given (light, texture index).
+    /// A spot light or a projector names a texture the set was not given (light, texture
+    /// index).
     MissingSpotTexture(usize, u32),
 }
 
@@ -53,7 +54,7 @@ impl core::fmt::Display for LightError {
             LightError::MissingSpotTexture(i, t) => {
                 write!(
                     f,
-                    "light {i}: spot texture {t} was not given to the light set"
+                    "light {i}: projected texture {t} was not given to the light set"
                 )
             }
         }
@@ -85,7 +86,8 @@ pub struct LightSet {
     pub(crate) environment: Option<u32>,
     /// The image of the `Envmap` light, if there is one.
     pub(crate) envmap: Option<Arc<EnvMap>>,
-    /// The textures spot lights project ([`crate::Spot::texture`] indexes them).
+    /// The textures spot lights and projectors project ([`crate::Spot::texture`] and
+    /// [`crate::Projector::texture`] index them).
     pub(crate) spot_textures: Vec<Arc<dyn SpotTexture>>,
     pub(crate) scene_radius: f32,
     /// The light hierarchy over the table's entries, built on first use.
@@ -119,8 +121,8 @@ impl LightSet {
     }
 
     /// Builds the set with the image of its [`Light::Envmap`] and the textures its spot lights
-    /// project ([`crate::Spot::texture`] indexes `spot_textures`; an error if one names a texture
-    /// beyond them).
+    /// and projectors project ([`crate::Spot::texture`] and [`crate::Projector::texture`] index
+    /// `spot_textures`; an error if one names a texture beyond them).
     pub fn with_textures(
         lights: Vec<Light>,
         envmap: Option<EnvMap>,
@@ -152,6 +154,7 @@ impl LightSet {
                 Light::Area { shape, .. } => shapes.get(shape as usize).map(bounding_sphere),
                 Light::Point { position, .. } => Some((position, 0.0)),
                 Light::Spot(s) => Some((s.position, 0.0)),
+                Light::Projector(p) => Some((p.position, 0.0)),
                 Light::Directional { .. } | Light::Constant { .. } | Light::Envmap => None,
             });
             let power = match *l {
@@ -190,6 +193,19 @@ impl LightSet {
                     // weight only).
                     s.solid_angle() * luminance(s.intensity)
                 }
+                Light::Projector(p) => {
+                    if !valid(p.intensity) || !p.position.is_finite() {
+                        return Err(LightError::BadParameter(i, "irradiance"));
+                    }
+                    let mean = match p.texture {
+                        Some(t) => spot_textures
+                            .get(t as usize)
+                            .ok_or(LightError::MissingSpotTexture(i, t))?
+                            .mean(),
+                        None => Vec3::ONE,
+                    };
+                    p.power(mean)
+                }
                 Light::Directional {
                     direction,
                     irradiance,
@@ -221,6 +237,7 @@ impl LightSet {
                 Light::Area { radiance: v, .. }
                 | Light::Point { intensity: v, .. }
                 | Light::Spot(crate::Spot { intensity: v, .. })
+                | Light::Projector(crate::Projector { intensity: v, .. })
                 | Light::Directional { irradiance: v, .. }
                 | Light::Constant { radiance: v } => v.max_element(),
                 Light::Envmap => 0.0,

@@ -20,11 +20,14 @@ use std::sync::Arc;
 
 use glam::{Mat3, Vec2, Vec3};
 
-/// A texture projected by a spot light: the renderer's textures (the scene crate's bitmaps)
-/// evaluated at `uv`, linear RGB.
+/// A texture projected by a spot light or a projector ([`crate::Projector`]): the renderer's
+/// textures (the scene crate's bitmaps) evaluated at `uv`, linear RGB.
 pub trait SpotTexture: Send + Sync + core::fmt::Debug {
     /// The texture's value at `uv`.
     fn eval(&self, uv: Vec2) -> Vec3;
+
+    /// The texture's mean over the unit square (a projector's power, for its selection weight).
+    fn mean(&self) -> Vec3;
 }
 
 /// Why a spot light's parameters are unusable.

@@ -234,6 +234,9 @@ impl SpotTexture for UvRamp {
     fn eval(&self, uv: Vec2) -> Vec3 {
         uv.extend(1.0)
     }
+    fn mean(&self) -> Vec3 {
+        Vec3::new(0.5, 0.5, 1.0)
+    }
 }
 
 /// The texture is read at `(½ + ½ tan θₓ / tan c, ½ + ½ tan θ_y / tan c)` in the light's frame

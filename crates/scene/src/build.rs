@@ -148,6 +148,11 @@ fn material(
 ) -> Result<(Bsdf, Option<TexturedParams>), String> {
     let bsdf = crate::material::bsdf(m).map_err(|e| e.to_string())?;
     let (base, bindings) = crate::material::colors(m);
+    if crate::material::bump_scale(m).is_some()
+        && !bindings.iter().any(|b| b.param == ColorParam::BumpMap)
+    {
+        return Err("bumpmap needs its height texture (a bitmap)".into());
+    }
     if bindings.is_empty() {
         return Ok((bsdf, None));
     }
@@ -161,6 +166,7 @@ fn material(
         alpha_u: None,
         alpha_v: None,
         principled: Default::default(),
+        bump: None,
     };
     for b in bindings {
         let id = Some(cache.get(&b.texture, base_dir)?);
@@ -174,6 +180,16 @@ fn material(
             ColorParam::SpecularTransmittance => t.transmittance = id,
             ColorParam::Opacity => t.opacity = id,
             ColorParam::NormalMap => t.normal = id,
+            ColorParam::BumpMap => {
+                if !matches!(b.texture, TextureDesc::Bitmap { .. }) {
+                    return Err(
+                        "bumpmap: the height must be a bitmap (Mitsuba defines no gradient for other textures)"
+                            .into(),
+                    );
+                }
+                let scale = crate::material::bump_scale(m).unwrap_or(defaults::BUMP_SCALE);
+                t.bump = id.map(|i| (i, scale));
+            }
             ColorParam::Alpha => {
                 t.alpha_u = id;
                 t.alpha_v = id;
@@ -417,13 +433,7 @@ impl Scene {
         }
         let cam_m =
             transform_matrix(&desc.camera.to_world).map_err(|e| whole(format!("camera: {e}")))?;
-        let fov_axis = match desc.camera.fov_axis {
-            FovAxis::X => GeoFovAxis::X,
-            FovAxis::Y => GeoFovAxis::Y,
-            FovAxis::Diagonal => GeoFovAxis::Diagonal,
-            FovAxis::Smaller => GeoFovAxis::Smaller,
-            FovAxis::Larger => GeoFovAxis::Larger,
-        };
+        let fov_axis: GeoFovAxis = desc.camera.fov_axis.into();
         let camera = if desc.camera.orthographic {
             Camera::orthographic(cam_m, (w, h))
         } else {
@@ -556,6 +566,20 @@ impl Scene {
             shapes.push(shape);
             shape_bsdf.push(bsdf);
         }
+        // The G-buffer of the ReSTIR estimators keeps a hit's uv, not the surface derivatives a
+        // bump map needs: said once, at the first bump-mapped shape.
+        let bumped = desc.shapes.iter().zip(&shape_bsdf).find(|(_, b)| {
+            bsdf_textures[**b as usize].is_some_and(|t: TexturedParams| t.bump.is_some())
+        });
+        if let Some((sd, _)) = bumped {
+            warnings.push(SceneWarning {
+                location: at(&sd.location, String::new()).location,
+                message: "bumpmap: ReSTIR DI and ReSTIR PT look materials up at primary hits by \
+                          uv alone and render the bump flat there (the path tracer renders it \
+                          fully)"
+                    .into(),
+            });
+        }
         let mut envmap = None;
         let mut spot_textures = Vec::new();
         for l in &desc.lights {
@@ -577,13 +601,15 @@ impl Scene {
                 LightDesc::Constant { radiance } => Light::Constant {
                     radiance: v3(radiance),
                 },
-                LightDesc::Spot { location, .. } => crate::spot::spot_light(
-                    l,
-                    base_dir,
-                    &mut |p| cache.budget.take_image(p),
-                    &mut spot_textures,
-                )
-                .map_err(|e| at(location, e))?,
+                LightDesc::Spot { location, .. } | LightDesc::Projector { location, .. } => {
+                    crate::spot::spot_light(
+                        l,
+                        base_dir,
+                        &mut |p| cache.budget.take_image(p),
+                        &mut spot_textures,
+                    )
+                    .map_err(|e| at(location, e))?
+                }
                 LightDesc::Envmap {
                     filename,
                     scale,
@@ -626,7 +652,10 @@ impl Scene {
             has_delta_lights: light_set.lights().iter().any(|l| {
                 matches!(
                     l,
-                    Light::Point { .. } | Light::Spot(_) | Light::Directional { .. }
+                    Light::Point { .. }
+                        | Light::Spot(_)
+                        | Light::Projector(_)
+                        | Light::Directional { .. }
                 )
             }),
             light_count: light_set.len(),

@@ -44,7 +44,7 @@ pub use error::{SceneError, SceneWarning};
 pub use light_share::EnvironmentShare;
 pub use load::{LoadOptions, LoadedScene, load_desc, load_scene, parse_ron, sidecar_path};
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use restir_geometry::{Accel, Camera, Hit, Ray, Shape, SurfaceInteraction};
 use restir_lights::LightSet;
 use restir_materials::{Bsdf, ReflectanceParams};
@@ -166,16 +166,52 @@ impl Scene {
         self.accel.occluded(ray, t_max)
     }
 
-    /// The BSDF of a surface point (its material with textures looked up there).
+    /// The BSDF of a surface point (its material with textures looked up there, and a bump
+    /// map's normal from the height's gradient and the surface's derivatives there).
     #[inline]
     pub fn bsdf(&self, si: &SurfaceInteraction) -> Bsdf {
-        self.bsdf_at(self.shape_bsdf[si.shape as usize], &TexturePoint::of(si))
+        let bsdf = self.shape_bsdf[si.shape as usize];
+        let at = TexturePoint::of(si);
+        match &self.bsdf_textures[bsdf as usize] {
+            Some(t) if self.features.has_textures && t.bump.is_some() => {
+                let mut p = t.eval(&self.textures, &self.shapes, &at);
+                if let Some((texture, scale)) = t.bump {
+                    p.normal = self.bump_texel(texture, scale, si);
+                }
+                let b = self.bsdfs[bsdf as usize].with_params(&p);
+                if t.principled.any() {
+                    t.principled.apply(b, &self.textures, &self.shapes, &at)
+                } else {
+                    b
+                }
+            }
+            _ => self.bsdf_at(bsdf, &at),
+        }
+    }
+
+    /// The normal-map texel of a bump map (height `texture` times `scale`) at `si`: Mitsuba's
+    /// perturbed normal in the shading frame ([`restir_materials::bump_normal`]).
+    fn bump_texel(&self, texture: u32, scale: f32, si: &SurfaceInteraction) -> Vec3 {
+        let grad = self.textures[texture as usize]
+            .eval_1_grad(si.uv)
+            .unwrap_or(Vec2::ZERO);
+        let (dp_du, dp_dv) = self.shapes[si.shape as usize].uv_derivatives(si.prim, si.param);
+        let f = &si.shading;
+        restir_materials::normal_texel(restir_materials::bump_normal(
+            scale * grad,
+            dp_du,
+            dp_dv,
+            [f.s, f.t, f.n],
+            si.ng,
+        ))
     }
 
     /// Material `bsdf` (an index into `bsdfs`) at lookup point `at` (texture coordinates, and
     /// the triangle and barycentrics a mesh attribute reads): the one place where textures are
     /// resolved. A scene without textures (decided at build time,
-    /// [`SceneFeatures::has_textures`]) returns the stored BSDF without looking at `at`.
+    /// [`SceneFeatures::has_textures`]) returns the stored BSDF without looking at `at`. A bump
+    /// map's normal needs the surface's derivatives and shading frame, which `at` does not
+    /// give: here it stays flat, and [`Scene::bsdf`] (with the hit) applies it.
     #[inline]
     pub fn bsdf_at(&self, bsdf: u32, at: &TexturePoint) -> Bsdf {
         let base = self.bsdfs[bsdf as usize];
@@ -215,6 +251,9 @@ pub struct TexturedParams {
     pub alpha_v: Option<u32>,
     /// Textures of a principled material's parameters (its other slots are unused).
     pub principled: principled::PrincipledTextures,
+    /// A `bumpmap`'s height texture and scale: its gradient perturbs the normal at each hit
+    /// ([`Scene::bsdf`]; [`TexturedParams::eval`] leaves the normal flat).
+    pub bump: Option<(u32, f32)>,
 }
 
 impl TexturedParams {

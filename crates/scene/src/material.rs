@@ -105,6 +105,13 @@ pub enum MaterialError {
         /// The parameter's range.
         range: (f32, f32),
     },
+    /// A `bumpmap` inside another normal or bump map or a `twosided`, or around a `mask`.
+    BumpMapNesting,
+    /// A `bumpmap` scale that is not finite.
+    BadBumpScale {
+        /// Its value.
+        value: f32,
+    },
 }
 
 impl core::fmt::Display for MaterialError {
@@ -188,6 +195,12 @@ impl core::fmt::Display for MaterialError {
                         range.0, range.1
                     )
                 }
+            }
+            MaterialError::BumpMapNesting => f.write_str(
+                "a bumpmap may wrap any material but a mask, a normalmap or a bumpmap, and only a mask may wrap it (write mask(bumpmap(twosided(...))))",
+            ),
+            MaterialError::BadBumpScale { value } => {
+                write!(f, "bumpmap scale {value} must be finite")
             }
         }
     }
@@ -390,9 +403,37 @@ fn bsdf_in(m: &MaterialDesc, spec_trans_textured: bool) -> Result<Bsdf> {
                 *use_shadowing_function,
             ))
         }
+        MaterialDesc::BumpMap {
+            scale,
+            flip_invalid_normals,
+            use_shadowing_function,
+            material,
+        } => {
+            if matches!(
+                **material,
+                MaterialDesc::Mask { .. }
+                    | MaterialDesc::NormalMap { .. }
+                    | MaterialDesc::BumpMap { .. }
+            ) {
+                return Err(MaterialError::BumpMapNesting);
+            }
+            if !scale.is_finite() {
+                return Err(MaterialError::BadBumpScale { value: *scale });
+            }
+            // The normal map's frame with the flat normal; the bump's normal replaces it at
+            // each hit (`Scene::bsdf`).
+            bsdf(material)?.normal_mapped(restir_materials::NormalMap::new(
+                Vec3::from(defaults::FLAT_NORMAL),
+                *flip_invalid_normals,
+                *use_shadowing_function,
+            ))
+        }
         MaterialDesc::TwoSided(inner) => {
             if matches!(**inner, MaterialDesc::NormalMap { .. }) {
                 return Err(MaterialError::NormalMapNesting);
+            }
+            if matches!(**inner, MaterialDesc::BumpMap { .. }) {
+                return Err(MaterialError::BumpMapNesting);
             }
             let b = bsdf(inner)?;
             if b.kind.transmits() {
@@ -420,7 +461,8 @@ fn bsdf_in(m: &MaterialDesc, spec_trans_textured: bool) -> Result<Bsdf> {
             for (i, t) in textures.iter().enumerate() {
                 let mask_opacity = t.param == ColorParam::Opacity && is_mask(material);
                 let normal_map = t.param == ColorParam::NormalMap && has_normal_map(material);
-                if !(allowed.contains(&t.param) || mask_opacity || normal_map) {
+                let bump_map = t.param == ColorParam::BumpMap && bump_scale(material).is_some();
+                if !(allowed.contains(&t.param) || mask_opacity || normal_map || bump_map) {
                     return Err(MaterialError::NoSuchParameter {
                         param: t.param,
                         allowed,
@@ -456,9 +498,9 @@ pub(crate) fn color_params(m: &MaterialDesc) -> &'static [ColorParam] {
         }
         MaterialDesc::TwoSided(inner) => color_params(inner),
         MaterialDesc::Textured { material, .. } => color_params(material),
-        MaterialDesc::Mask { material, .. } | MaterialDesc::NormalMap { material, .. } => {
-            color_params(material)
-        }
+        MaterialDesc::Mask { material, .. }
+        | MaterialDesc::NormalMap { material, .. }
+        | MaterialDesc::BumpMap { material, .. } => color_params(material),
         MaterialDesc::Principled { .. } => crate::principled::PRINCIPLED_PARAMS,
         MaterialDesc::PrincipledThin { .. } => crate::principled::PRINCIPLED_THIN_PARAMS,
         MaterialDesc::Null | MaterialDesc::Black => &[],
@@ -474,6 +516,9 @@ fn contains_textured(m: &MaterialDesc) -> bool {
             material: inner, ..
         }
         | MaterialDesc::NormalMap {
+            material: inner, ..
+        }
+        | MaterialDesc::BumpMap {
             material: inner, ..
         } => contains_textured(inner),
         _ => false,
@@ -495,6 +540,17 @@ pub(crate) fn has_normal_map(m: &MaterialDesc) -> bool {
         MaterialDesc::NormalMap { .. } => true,
         MaterialDesc::Mask { material, .. } => has_normal_map(material),
         _ => false,
+    }
+}
+
+/// The scale of `m`'s `bumpmap` (perhaps inside a `mask`), whose height a texture gives.
+pub(crate) fn bump_scale(m: &MaterialDesc) -> Option<f32> {
+    match m {
+        MaterialDesc::BumpMap { scale, .. } => Some(*scale),
+        MaterialDesc::Mask { material, .. } | MaterialDesc::Textured { material, .. } => {
+            bump_scale(material)
+        }
+        _ => None,
     }
 }
 
@@ -525,6 +581,7 @@ pub(crate) fn colors(m: &MaterialDesc) -> (ReflectanceParams, &[TextureBinding])
                 p.normal = v3(normal);
                 m = material;
             }
+            MaterialDesc::BumpMap { material, .. } => m = material,
             MaterialDesc::Textured { material, textures } => {
                 bindings = textures;
                 m = material;

@@ -1,12 +1,13 @@
-//! Mitsuba's `spot` emitter from its description ([`LightDesc::Spot`]): the light set's
-//! [`Spot`], and its projected texture as a [`SpotTexture`] (the scene's own bitmap and
-//! checkerboard lookups, so wrap modes, filters and `to_uv` are the materials' ones).
+//! Mitsuba's `spot` and `projector` emitters from their descriptions ([`LightDesc::Spot`],
+//! [`LightDesc::Projector`]): the light set's [`Spot`] and [`Projector`], and their projected
+//! textures as [`SpotTexture`]s (the scene's own bitmap and checkerboard lookups, so wrap modes,
+//! filters and `to_uv` are the materials' ones).
 
 use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
-use restir_lights::{Light, Spot, SpotTexture};
+use restir_lights::{Light, Projector, Spot, SpotTexture};
 
 use crate::desc::{LightDesc, TextureDesc, defaults, transform_matrix};
 use crate::texture::Texture;
@@ -15,48 +16,107 @@ impl SpotTexture for Texture {
     fn eval(&self, uv: Vec2) -> Vec3 {
         Texture::eval(self, uv)
     }
+
+    fn mean(&self) -> Vec3 {
+        Texture::mean(self)
+    }
 }
 
-/// The light of spot description `desc` (a [`LightDesc::Spot`]); its texture, if any, is loaded
-/// (after `take_image` counts a bitmap against the memory limit) and appended to `textures`,
-/// which the light names by index. Errors are the message without the location.
+/// The light of a spot or projector description (a [`LightDesc::Spot`] or
+/// [`LightDesc::Projector`]); its texture, if any, is loaded (after `take_image` counts a bitmap
+/// against the memory limit) and appended to `textures`, which the light names by index. Errors
+/// are the message without the location.
 pub(crate) fn spot_light(
     desc: &LightDesc,
     base_dir: &Path,
     take_image: &mut dyn FnMut(&Path) -> Result<(), String>,
     textures: &mut Vec<Arc<dyn SpotTexture>>,
 ) -> Result<Light, String> {
-    let LightDesc::Spot {
-        intensity,
-        cutoff_angle,
-        beam_width,
-        to_world,
-        texture,
-        ..
-    } = desc
-    else {
-        return Err("not a spot light".into());
-    };
-    let m = transform_matrix(to_world).map_err(|e| format!("spot emitter: to_world: {e}"))?;
-    let index = match texture {
-        Some(TextureDesc::MeshAttribute { name, .. }) => {
-            return Err(format!(
-                "spot emitter texture: a 'mesh_attribute' texture (\"{name}\") reads the mesh a \
-                 ray hits and cannot be projected by a light; use a bitmap or checkerboard"
-            ));
+    match desc {
+        LightDesc::Spot {
+            intensity,
+            cutoff_angle,
+            beam_width,
+            to_world,
+            texture,
+            ..
+        } => {
+            let m =
+                transform_matrix(to_world).map_err(|e| format!("spot emitter: to_world: {e}"))?;
+            let index = match texture {
+                Some(t) => Some(load(t, "spot", base_dir, take_image, textures)?.0),
+                None => None,
+            };
+            let beam = beam_width.unwrap_or(cutoff_angle * defaults::SPOT_BEAM_FRACTION);
+            let spot = Spot::new(m, Vec3::from(*intensity), *cutoff_angle, beam, index)
+                .map_err(|e| format!("spot emitter: {e}"))?;
+            Ok(Light::Spot(spot))
         }
-        Some(t) => {
-            if let TextureDesc::Bitmap { filename, .. } = t {
-                take_image(&base_dir.join(filename))?;
-            }
-            let t = Texture::load(t, base_dir).map_err(|e| format!("spot emitter texture: {e}"))?;
-            textures.push(Arc::new(t));
-            Some(textures.len() as u32 - 1)
+        LightDesc::Projector {
+            irradiance,
+            scale,
+            fov,
+            fov_axis,
+            to_world,
+            texture,
+            ..
+        } => {
+            let m = transform_matrix(to_world)
+                .map_err(|e| format!("projector emitter: to_world: {e}"))?;
+            // The image's aspect ratio is the texture's; a constant is 1×1, as in Mitsuba.
+            let (index, resolution) = match texture {
+                Some(t) => {
+                    let (i, r) = load(t, "projector", base_dir, take_image, textures)?;
+                    (Some(i), r)
+                }
+                None => (None, (1, 1)),
+            };
+            let (fov, axis) = match fov {
+                Some(f) => (*f, (*fov_axis).into()),
+                None => (
+                    defaults::fov_of_focal_length(defaults::FOCAL_LENGTH_MM),
+                    restir_geometry::FovAxis::Diagonal,
+                ),
+            };
+            let projector = Projector::new(
+                m,
+                Vec3::from(*irradiance),
+                *scale,
+                fov,
+                axis,
+                resolution,
+                index,
+            )
+            .map_err(|e| format!("projector emitter: {e}"))?;
+            Ok(Light::Projector(projector))
         }
-        None => None,
+        _ => Err("neither a spot light nor a projector".into()),
+    }
+}
+
+/// Loads texture `t` of a `plugin` emitter into `textures`: its index there and its resolution
+/// (`(1, 1)` for a checkerboard, as Mitsuba's textures other than bitmaps).
+fn load(
+    t: &TextureDesc,
+    plugin: &str,
+    base_dir: &Path,
+    take_image: &mut dyn FnMut(&Path) -> Result<(), String>,
+    textures: &mut Vec<Arc<dyn SpotTexture>>,
+) -> Result<(u32, (u32, u32)), String> {
+    if let TextureDesc::MeshAttribute { name, .. } = t {
+        return Err(format!(
+            "{plugin} emitter texture: a 'mesh_attribute' texture (\"{name}\") reads the mesh a \
+             ray hits and cannot be projected by a light; use a bitmap or checkerboard"
+        ));
+    }
+    if let TextureDesc::Bitmap { filename, .. } = t {
+        take_image(&base_dir.join(filename))?;
+    }
+    let t = Texture::load(t, base_dir).map_err(|e| format!("{plugin} emitter texture: {e}"))?;
+    let resolution = match &t {
+        Texture::Bitmap { width, height, .. } => (*width as u32, *height as u32),
+        Texture::Checkerboard { .. } | Texture::MeshAttribute(_) => (1, 1),
     };
-    let beam = beam_width.unwrap_or(cutoff_angle * defaults::SPOT_BEAM_FRACTION);
-    let spot = Spot::new(m, Vec3::from(*intensity), *cutoff_angle, beam, index)
-        .map_err(|e| format!("spot emitter: {e}"))?;
-    Ok(Light::Spot(spot))
+    textures.push(Arc::new(t));
+    Ok((textures.len() as u32 - 1, resolution))
 }

@@ -311,6 +311,29 @@ impl Texture {
         }
     }
 
+    /// The gradient of [`Texture::eval_1`] in `(u, v)`, as Mitsuba's `eval_1_grad` (what a
+    /// `bumpmap` reads): for a bitmap the derivative of its bilinear lookup of the luminance
+    /// (zero with the nearest filter), through the `uv` transform; `None` for a checkerboard,
+    /// whose gradient Mitsuba does not define.
+    pub fn eval_1_grad(&self, uv: Vec2) -> Option<Vec2> {
+        match self {
+            // A checkerboard's gradient Mitsuba does not define; a mesh attribute's is not one in
+            // texture space.
+            Texture::Checkerboard { .. } | Texture::MeshAttribute(_) => None,
+            Texture::Bitmap {
+                width,
+                height,
+                texels,
+                uv: t,
+                wrap,
+                filter,
+            } => Some(
+                lookup::lookup_grad(texels, (*width, *height), t.apply(uv), *wrap, *filter)
+                    * t.scale,
+            ),
+        }
+    }
+
     /// The mean texel value (the average reflectance of a bitmap, or the checkerboard's); zero
     /// for a mesh attribute, whose values are the meshes'.
     pub fn mean(&self) -> Vec3 {

@@ -264,6 +264,10 @@ const EVERYTHING: &str = r#"(
         Spot(intensity: (5, 4, 3), cutoff_angle: 35, beam_width: Some(10),
              to_world: [LookAt(origin: (0, 3, 0), target: (0, 0, 0), up: (0, 0, 1))],
              texture: Some(Bitmap(filename: "textured/tex.png", wrap: Clamp))),
+        Projector(irradiance: (2, 1, 0.5)),
+        Projector(scale: 3, fov: Some(40), fov_axis: y,
+             to_world: [LookAt(origin: (0, 3, 1), target: (0, 0, 0), up: (0, 0, 1))],
+             texture: Some(Bitmap(filename: "textured/tex.png"))),
         Directional(direction: (0.2, -1, 0.1), irradiance: (0.5, 0.5, 0.5)),
         Envmap(filename: "envmap/sky.exr", scale: 0.7, to_world: [Rotate(axis: (0, 1, 0), angle: 40)]),
     ],
@@ -297,6 +301,10 @@ fn every_model_filter_camera_and_light_round_trips() {
         r#"<float name="cutoff_angle" value="35"/>"#,
         r#"<float name="beam_width" value="10"/>"#,
         r#"<texture type="bitmap" name="texture">"#,
+        r#"<emitter type="projector">"#,
+        r#"<texture type="bitmap" name="irradiance">"#,
+        r#"<float name="scale" value="3"/>"#,
+        r#"<string name="fov_axis" value="y"/>"#,
         r#"<boolean name="hide_emitters" value="true"/>"#,
         "<!-- output file: out.exr -->",
     ] {
@@ -358,6 +366,17 @@ fn what_mitsuba_cannot_say_is_refused_by_name() {
     .unwrap();
     let e = write(&textured);
     assert!(e.contains("material 't'"), "{e}");
+
+    let tinted = restir_scene::parse_ron(
+        r#"(camera: (fov: 45), lights: [Projector(irradiance: (1, 0.5, 0.5), texture: Some(Checkerboard()))])"#,
+        "t.ron".as_ref(),
+    )
+    .unwrap();
+    let e = write(&tinted);
+    assert!(
+        e.contains("a projector: Mitsuba's irradiance is a colour or a texture"),
+        "{e}"
+    );
 }
 
 /// Mitsuba 3 substitutes `$name` in every attribute and has no escape for a literal `$`: a file

@@ -227,7 +227,7 @@ fn lamp_size(scene: &Scene, s: &PathSample, radius: f32) -> f32 {
             .shapes
             .get(*shape as usize)
             .map_or(f32::NAN, |sh| sh.area().sqrt() / radius),
-        Some(Light::Point { .. } | Light::Spot(_)) => 0.0,
+        Some(Light::Point { .. } | Light::Spot(_) | Light::Projector(_)) => 0.0,
         Some(_) => f32::INFINITY,
         None => f32::NAN,
     }

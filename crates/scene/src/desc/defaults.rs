@@ -13,6 +13,8 @@ pub const FOV: f32 = 45.0;
 /// The focal length of a Mitsuba 3 `perspective` or `thinlens` sensor that gives neither `fov`
 /// nor `focal_length`.
 pub const FOCAL_LENGTH: &str = "50mm";
+/// [`FOCAL_LENGTH`] in millimetres (a `projector` without `fov` has this lens too).
+pub const FOCAL_LENGTH_MM: f32 = 50.0;
 
 /// The diagonal field of view in degrees of a lens of focal length `mm` millimetres on a
 /// 36 × 24 mm film (Mitsuba 3's `focal_length`): `2·atan(√(36² + 24²) / (2·mm))`. For 50 mm
@@ -80,6 +82,10 @@ pub const ENVMAP_SCALE: f32 = 1.0;
 pub const SPOT_CUTOFF_ANGLE: f32 = 20.0;
 /// A spot light's `beam_width` as a fraction of its `cutoff_angle`.
 pub const SPOT_BEAM_FRACTION: f32 = 0.75;
+/// A bump map's gradient multiplier (`scale`).
+pub const BUMP_SCALE: f32 = 1.0;
+/// A projector's irradiance multiplier (`scale`).
+pub const PROJECTOR_SCALE: f32 = 1.0;
 
 /// A sphere's centre.
 pub const SPHERE_CENTER: V3 = [0.0; 3];
@@ -148,6 +154,15 @@ pub(crate) fn envmap_scale() -> f32 {
 }
 pub(crate) fn spot_cutoff_angle() -> f32 {
     SPOT_CUTOFF_ANGLE
+}
+pub(crate) fn emission() -> V3 {
+    EMISSION
+}
+pub(crate) fn bump_scale() -> f32 {
+    BUMP_SCALE
+}
+pub(crate) fn projector_scale() -> f32 {
+    PROJECTOR_SCALE
 }
 
 #[cfg(test)]

@@ -284,6 +284,22 @@ pub enum MaterialDesc {
         /// The perturbed material.
         material: Box<MaterialDesc>,
     },
+    /// Mitsuba's `bumpmap`: `material` in the shading frame perturbed by the gradient of a
+    /// height texture (`Textured` with the parameter `BumpMap` around this gives it; a bitmap,
+    /// its luminance), times `scale`.
+    BumpMap {
+        /// The gradient's multiplier (default 1).
+        #[serde(default = "defaults::bump_scale")]
+        scale: f32,
+        /// Mirror normals that face away from the viewer (default true).
+        #[serde(default = "defaults::yes")]
+        flip_invalid_normals: bool,
+        /// Apply the shadowing term against the bump terminator (default true).
+        #[serde(default = "defaults::yes")]
+        use_shadowing_function: bool,
+        /// The perturbed material.
+        material: Box<MaterialDesc>,
+    },
     /// `material` with some of its colour parameters given by textures, looked up at each
     /// shading point's texture coordinates; the constant values in `material` are unused for
     /// those parameters. In RON: `Textured(material: Diffuse(reflectance: (0.5, 0.5, 0.5)),
@@ -341,6 +357,8 @@ pub enum ColorParam {
     Opacity,
     /// A `normalmap`'s `normalmap` (raw values, not clamped).
     NormalMap,
+    /// A `bumpmap`'s height field (a bitmap; its luminance's gradient).
+    BumpMap,
     /// A rough conductor's or rough dielectric's isotropic `alpha` (a scalar: a colour texture
     /// gives its luminance).
     Alpha,
@@ -386,6 +404,7 @@ impl ColorParam {
             ColorParam::SpecularTransmittance => "specular_transmittance",
             ColorParam::Opacity => "opacity",
             ColorParam::NormalMap => "normalmap",
+            ColorParam::BumpMap => "bumpmap",
             ColorParam::Alpha => "alpha",
             ColorParam::AlphaU => "alpha_u",
             ColorParam::AlphaV => "alpha_v",
@@ -414,6 +433,7 @@ impl ColorParam {
             ColorParam::SpecularTransmittance,
             ColorParam::Opacity,
             ColorParam::NormalMap,
+            ColorParam::BumpMap,
             ColorParam::Alpha,
             ColorParam::AlphaU,
             ColorParam::AlphaV,

@@ -89,6 +89,18 @@ pub enum FovAxis {
     Larger,
 }
 
+impl From<FovAxis> for restir_geometry::FovAxis {
+    fn from(axis: FovAxis) -> Self {
+        match axis {
+            FovAxis::X => Self::X,
+            FovAxis::Y => Self::Y,
+            FovAxis::Diagonal => Self::Diagonal,
+            FovAxis::Smaller => Self::Smaller,
+            FovAxis::Larger => Self::Larger,
+        }
+    }
+}
+
 /// A perspective or thin-lens camera.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -330,6 +342,36 @@ pub enum LightDesc {
         to_world: Vec<TransformOp>,
         /// A texture projected along the axis (the cone's cutoff circle touches the edges of its
         /// unit square).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        texture: Option<TextureDesc>,
+        /// Where the emitter was declared (set by importers, not part of the RON format).
+        #[serde(skip)]
+        location: Location,
+    },
+    /// Mitsuba's `projector`: a pinhole at the origin of `to_world` throwing an irradiance image
+    /// through a perspective frustum along its `+z`, the reciprocal of a perspective camera
+    /// (docs/SCENES.md).
+    Projector {
+        /// Irradiance on the image plane at distance 1 in front of the pinhole, a constant
+        /// (default 1), multiplied by `texture` when there is one (Mitsuba's `irradiance` is the
+        /// one or the other). What arrives there is `π·scale·irradiance`, as in Mitsuba.
+        #[serde(default = "defaults::emission")]
+        irradiance: V3,
+        /// Multiplier of the irradiance (default 1).
+        #[serde(default = "defaults::projector_scale")]
+        scale: f32,
+        /// Field of view in degrees along `fov_axis`; without it, Mitsuba's 50 mm lens on a
+        /// 36 × 24 mm film, which fixes the diagonal field of view.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        fov: Option<f32>,
+        /// The image axis `fov` spans (default `x`); the image's aspect ratio is the
+        /// texture's (1 without one).
+        #[serde(default)]
+        fov_axis: FovAxis,
+        /// Position and orientation (the pinhole at the origin, looking along `+z`, `+y` up).
+        #[serde(default)]
+        to_world: Vec<TransformOp>,
+        /// The projected image (`uv = (0, 0)` its top-left corner, seen looking along `+z`).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         texture: Option<TextureDesc>,
         /// Where the emitter was declared (set by importers, not part of the RON format).

@@ -167,6 +167,7 @@ pub(crate) fn bind(
         alpha_u,
         alpha_v,
         principled,
+        bump,
     } = *params;
     for (slot, param, scalar) in [
         (diffuse, "reflectance", false),
@@ -182,6 +183,15 @@ pub(crate) fn bind(
         {
             t.bind(shape, s, scalar, param)?;
         }
+    }
+    if let Some((i, _)) = bump
+        && let Some(Texture::MeshAttribute(t)) = textures.get(i as usize)
+    {
+        return Err(format!(
+            "bumpmap: a 'mesh_attribute' texture (\"{}\") has no gradient in texture space to \
+             bump with; use a bitmap",
+            t.name()
+        ));
     }
     for (param, name, i) in principled.bound() {
         if let Some(Texture::MeshAttribute(t)) = textures.get_mut(i as usize) {

@@ -132,6 +132,34 @@ pub(super) fn lookup(
     }
 }
 
+/// The gradient in `(x, y)` (texture coordinates, already transformed) of the scalar (luminance)
+/// lookup of a `width × height` bitmap at `p`, as Mitsuba's `eval_1_grad`: the derivative of the
+/// bilinear interpolation of the four texels around `p`, zero for a nearest-neighbour lookup.
+#[inline]
+pub(super) fn lookup_grad(
+    texels: &Texels,
+    (width, height): (usize, usize),
+    p: Vec2,
+    wrap: WrapMode,
+    filter: FilterType,
+) -> Vec2 {
+    if filter == FilterType::Nearest {
+        return Vec2::ZERO;
+    }
+    let x = p.x * width as f32 - 0.5;
+    let y = p.y * height as f32 - 0.5;
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let (xa, xb) = wrap.pair(x0, width);
+    let (ya, yb) = wrap.pair(y0, height);
+    let (ra, rb) = (ya * width, yb * width);
+    let at = |i: usize| restir_sampling::luminance(texels.get(i));
+    let (f00, f10, f01, f11) = (at(ra + xa), at(ra + xb), at(rb + xa), at(rb + xb));
+    let dx = (1.0 - fy) * (f10 - f00) + fy * (f11 - f01);
+    let dy = (1.0 - fx) * (f01 - f00) + fx * (f11 - f10);
+    Vec2::new(dx * width as f32, dy * height as f32)
+}
+
 /// The texel indices of whole-number coordinates `i` and `i + 1` (as floats) on an axis of `n`
 /// texels, repeating (non-finite coordinates read texel 0). The integer remainder, a division,
 /// only when `i` lies outside the image.

@@ -23,6 +23,7 @@ const BSDF_TYPES: &[&str] = &[
     "normalmap",
     "principled",
     "principledthin",
+    "bumpmap",
 ];
 
 impl<'a> Importer<'a> {
@@ -32,6 +33,9 @@ impl<'a> Importer<'a> {
         let props = self.props(node, format!("bsdf '{ty}'"))?;
         if ty == "normalmap" {
             return self.normalmap(node, props);
+        }
+        if ty == "bumpmap" {
+            return self.bumpmap(node, props);
         }
         // An unknown plugin is named before its parameters are looked at.
         if !BSDF_TYPES.contains(&ty.as_str()) && ty != "thindielectric" {

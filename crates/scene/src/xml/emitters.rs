@@ -1,5 +1,5 @@
-//! Top-level `<emitter>`s: point, spot, directional, constant and envmap (area emitters belong
-//! to shapes).
+//! Top-level `<emitter>`s: point, spot, projector, directional, constant and envmap (area
+//! emitters belong to shapes).
 
 use roxmltree::Node;
 
@@ -30,6 +30,7 @@ impl<'a> Importer<'a> {
                 }
             }
             "spot" => self.spot(node, &props)?,
+            "projector" => self.projector(node, &props)?,
             "directional" => {
                 let irradiance = props
                     .color("irradiance", ColorUse::Emission)?
@@ -87,6 +88,7 @@ impl<'a> Importer<'a> {
                     &[
                         "point",
                         "spot",
+                        "projector",
                         "directional",
                         "constant",
                         "envmap",
@@ -118,23 +120,7 @@ impl<'a> Importer<'a> {
             ));
         }
         let mut texture = None;
-        for c in elements(node) {
-            let tag = c.tag_name().name();
-            let found = match tag {
-                "texture" => Some((self.req_attr(c, "name")?, self.texture(c)?)),
-                "ref" => {
-                    let id = self.req_attr(c, "id")?;
-                    let (t, _) = self.textures.get(&id).ok_or_else(|| {
-                        self.err(
-                            c,
-                            format!("spot emitter: reference to undefined texture '{id}'"),
-                        )
-                    })?;
-                    Some((self.attr(c, "name")?.unwrap_or_default(), t.clone()))
-                }
-                _ => None,
-            };
-            let Some((name, t)) = found else { continue };
+        for (c, name, t) in self.emitter_textures(node, "spot")? {
             match name.as_str() {
                 "texture" if texture.is_none() => texture = Some(t),
                 "texture" => return Err(self.err(c, "spot emitter: a second 'texture'")),
@@ -185,5 +171,137 @@ impl<'a> Importer<'a> {
             texture,
             location: self.loc(node),
         })
+    }
+
+    /// Mitsuba's `projector` (plugin page "Projection light source"): `irradiance` (a colour or
+    /// a nested or referenced texture, default 1), `scale` (1), the perspective sensor's field of
+    /// view (`fov` along `fov_axis`, or `focal_length`, default a 50 mm lens), `to_world`.
+    fn projector<'i>(&self, node: Node<'a, 'i>, props: &Props) -> Result<LightDesc> {
+        let color = props.color("irradiance", ColorUse::Emission)?;
+        let scale = props.float("scale")?.unwrap_or(defaults::PROJECTOR_SCALE);
+        if !(scale.is_finite() && scale >= 0.0) {
+            return Err(self.err(
+                props.node_or("scale", node),
+                format!("projector emitter: scale {scale} must be finite and non-negative"),
+            ));
+        }
+        let mut texture = None;
+        for (c, name, t) in self.emitter_textures(node, "projector")? {
+            match name.as_str() {
+                "irradiance" if texture.is_some() => {
+                    return Err(self.err(c, "projector emitter: a second 'irradiance'"));
+                }
+                "irradiance" if color.is_some() => {
+                    return Err(self.err(
+                        c,
+                        "projector emitter: 'irradiance' is given both as a colour and as a texture (give one)",
+                    ));
+                }
+                "irradiance" => texture = Some(t),
+                other => {
+                    return Err(self.err(
+                        c,
+                        format!(
+                            "projector emitter: '{other}' cannot be a texture (only 'irradiance' can)"
+                        ),
+                    ));
+                }
+            }
+        }
+        let (fov, fov_axis) = self.field_of_view(node, props, "emitter 'projector'")?;
+        Ok(LightDesc::Projector {
+            irradiance: color.unwrap_or(defaults::EMISSION),
+            scale,
+            fov: Some(fov),
+            fov_axis,
+            to_world: props.transform("to_world")?,
+            texture,
+            location: self.loc(node),
+        })
+    }
+
+    /// The nested (`<texture name=…>`) and referenced (`<ref name=… id=…>`) textures of emitter
+    /// `node` (a `plugin` emitter, for messages): each element with its name and texture.
+    fn emitter_textures<'i>(
+        &self,
+        node: Node<'a, 'i>,
+        plugin: &str,
+    ) -> Result<Vec<(Node<'a, 'i>, String, TextureDesc)>> {
+        let mut found = Vec::new();
+        for c in elements(node) {
+            match c.tag_name().name() {
+                "texture" => found.push((c, self.req_attr(c, "name")?, self.texture(c)?)),
+                "ref" => {
+                    let id = self.req_attr(c, "id")?;
+                    let (t, _) = self.textures.get(&id).ok_or_else(|| {
+                        self.err(
+                            c,
+                            format!("{plugin} emitter: reference to undefined texture '{id}'"),
+                        )
+                    })?;
+                    found.push((c, self.attr(c, "name")?.unwrap_or_default(), t.clone()));
+                }
+                _ => {}
+            }
+        }
+        Ok(found)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use crate::desc::{FovAxis, LightDesc, TextureDesc, defaults};
+
+    fn projector(body: &str) -> LightDesc {
+        let xml = format!(
+            r#"<scene version="3.0.0"><sensor type="perspective"/><emitter type="projector">{body}</emitter></scene>"#
+        );
+        let (desc, warnings) = crate::xml::parse_xml(&xml, Path::new("p.xml"), &[]).unwrap();
+        assert!(warnings.is_empty(), "{warnings:?}");
+        desc.lights.into_iter().next().unwrap()
+    }
+
+    /// Mitsuba's defaults: irradiance 1, scale 1, a 50 mm lens on the diagonal; `fov` along
+    /// `fov_axis`; the irradiance as a nested texture.
+    #[test]
+    fn projector_defaults_fov_and_texture() {
+        let LightDesc::Projector {
+            irradiance,
+            scale,
+            fov,
+            fov_axis,
+            texture,
+            ..
+        } = projector("")
+        else {
+            panic!("not a projector")
+        };
+        assert_eq!((irradiance, scale), (defaults::EMISSION, 1.0));
+        assert_eq!(
+            (fov, fov_axis),
+            (
+                Some(defaults::fov_of_focal_length(defaults::FOCAL_LENGTH_MM)),
+                FovAxis::Diagonal
+            )
+        );
+        assert!(texture.is_none());
+        let LightDesc::Projector {
+            scale,
+            fov,
+            fov_axis,
+            texture,
+            ..
+        } = projector(
+            r#"<float name="scale" value="15"/><float name="fov" value="30"/>
+               <string name="fov_axis" value="smaller"/>
+               <texture type="checkerboard" name="irradiance"/>"#,
+        )
+        else {
+            panic!("not a projector")
+        };
+        assert_eq!((scale, fov, fov_axis), (15.0, Some(30.0), FovAxis::Smaller));
+        assert!(matches!(texture, Some(TextureDesc::Checkerboard { .. })));
     }
 }

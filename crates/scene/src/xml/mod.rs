@@ -23,6 +23,7 @@
 //! file, which this importer reads back to the same scene.
 
 mod bsdfs;
+mod bumpmap;
 mod emitters;
 mod instances;
 mod integrator;

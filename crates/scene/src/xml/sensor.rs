@@ -22,7 +22,7 @@ impl<'a> Importer<'a> {
                 ..CameraDesc::default()
             }
         } else {
-            let (fov, fov_axis) = self.field_of_view(node, &props, &ty)?;
+            let (fov, fov_axis) = self.field_of_view(node, &props, &format!("sensor '{ty}'"))?;
             CameraDesc {
                 fov,
                 fov_axis,
@@ -113,14 +113,20 @@ impl<'a> Importer<'a> {
     /// (<https://mitsuba.readthedocs.io/en/latest/src/generated/plugins_sensors.html#perspective-pinhole-camera-perspective>):
     /// `fov` along `fov_axis` (default `x`), or else `focal_length` (default `50mm`) on a
     /// 36 × 24 mm film, which fixes the diagonal field of view (`fov_axis` is then not read).
-    /// Giving both is an error.
-    fn field_of_view(&self, node: Node, props: &Props, ty: &str) -> Result<(f32, FovAxis)> {
+    /// Giving both is an error. `what` names the plugin in messages (`sensor 'perspective'`);
+    /// Mitsuba's `projector` emitter reads its field of view the same way.
+    pub(super) fn field_of_view(
+        &self,
+        node: Node,
+        props: &Props,
+        what: &str,
+    ) -> Result<(f32, FovAxis)> {
         let fov_given = props.node_or("fov", node) != node;
         let focal_given = props.node_or("focal_length", node) != node;
         if fov_given && focal_given {
             return Err(self.err(
                 props.node_or("focal_length", node),
-                format!("sensor '{ty}': give either 'fov' or 'focal_length', not both"),
+                format!("{what}: give either 'fov' or 'focal_length', not both"),
             ));
         }
         // Checked even where it is unused (without `fov`, where a warning says so).
@@ -134,7 +140,7 @@ impl<'a> Importer<'a> {
                 return Err(self.err(
                     props.node_or("fov_axis", node),
                     format!(
-                        "sensor '{ty}': unknown fov_axis '{other}' (known: x, y, diagonal, smaller, larger)"
+                        "{what}: unknown fov_axis '{other}' (known: x, y, diagonal, smaller, larger)"
                     ),
                 ));
             }
@@ -143,7 +149,7 @@ impl<'a> Importer<'a> {
             if props.node_or("fov_axis", node) != node {
                 self.warn(
                     props.node_or("fov_axis", node),
-                    format!("sensor '{ty}': fov_axis has no effect without 'fov' (the focal length fixes the diagonal field of view)"),
+                    format!("{what}: fov_axis has no effect without 'fov' (the focal length fixes the diagonal field of view)"),
                 );
             }
             let written = props
@@ -159,7 +165,7 @@ impl<'a> Importer<'a> {
                     self.err(
                         props.node_or("focal_length", node),
                         format!(
-                            "sensor '{ty}': focal_length \"{written}\" must be a positive length in millimetres, such as \"50mm\""
+                            "{what}: focal_length \"{written}\" must be a positive length in millimetres, such as \"50mm\""
                         ),
                     )
                 })?;
@@ -170,7 +176,7 @@ impl<'a> Importer<'a> {
             let at = props.node_or("fov", node);
             return Err(self.err(
                 at,
-                format!("sensor '{ty}': fov {fov} must lie in (0, 180) degrees"),
+                format!("{what}: fov {fov} must lie in (0, 180) degrees"),
             ));
         }
         Ok((fov, axis))

@@ -85,6 +85,31 @@ impl Writer<'_> {
                 self.close("</bsdf>");
                 return Ok(());
             }
+            MaterialDesc::BumpMap {
+                scale,
+                flip_invalid_normals,
+                use_shadowing_function,
+                material,
+            } => {
+                self.open(&format!(r#"<bsdf type="bumpmap"{id_attr}>"#));
+                match bound(ColorParam::BumpMap) {
+                    Some(b) => self.texture(&b.texture, "bumpmap", item)?,
+                    None => return refuse(item, "a bumpmap without its height texture"),
+                }
+                finite(item, "scale", &[*scale])?;
+                self.float("scale", *scale);
+                self.boolean("flip_invalid_normals", *flip_invalid_normals);
+                self.boolean("use_shadowing_function", *use_shadowing_function);
+                let rest: Option<Vec<TextureBinding>> = textures.map(|t| {
+                    t.iter()
+                        .filter(|b| b.param != ColorParam::BumpMap)
+                        .cloned()
+                        .collect()
+                });
+                self.bsdf(material, None, rest.as_deref(), item)?;
+                self.close("</bsdf>");
+                return Ok(());
+            }
             _ => {}
         }
         // The colour parameters, constant or textured.
@@ -232,7 +257,8 @@ impl Writer<'_> {
             MaterialDesc::Textured { .. }
             | MaterialDesc::TwoSided(_)
             | MaterialDesc::Mask { .. }
-            | MaterialDesc::NormalMap { .. } => {
+            | MaterialDesc::NormalMap { .. }
+            | MaterialDesc::BumpMap { .. } => {
                 unreachable!()
             }
         }

@@ -202,6 +202,17 @@ fn literal(item: &str, what: &str, s: &str) -> Result<()> {
     }
 }
 
+/// Mitsuba's name of a field-of-view axis.
+fn fov_axis_name(axis: FovAxis) -> &'static str {
+    match axis {
+        FovAxis::X => "x",
+        FovAxis::Y => "y",
+        FovAxis::Diagonal => "diagonal",
+        FovAxis::Smaller => "smaller",
+        FovAxis::Larger => "larger",
+    }
+}
+
 fn finite(item: &str, what: &str, v: &[f32]) -> Result<()> {
     if v.iter().all(|x| x.is_finite()) {
         Ok(())
@@ -348,14 +359,7 @@ impl Writer<'_> {
             if thin { "thinlens" } else { "perspective" }
         ));
         self.float("fov", cam.fov);
-        let axis = match cam.fov_axis {
-            FovAxis::X => "x",
-            FovAxis::Y => "y",
-            FovAxis::Diagonal => "diagonal",
-            FovAxis::Smaller => "smaller",
-            FovAxis::Larger => "larger",
-        };
-        self.string("fov_axis", axis);
+        self.string("fov_axis", fov_axis_name(cam.fov_axis));
         if thin {
             self.float("aperture_radius", cam.aperture_radius);
             self.float("focus_distance", cam.focus_distance);

@@ -138,6 +138,40 @@ impl Writer<'_> {
                     self.texture(t, "texture", "a spot light")?;
                 }
             }
+            LightDesc::Projector {
+                irradiance,
+                scale,
+                fov,
+                fov_axis,
+                to_world,
+                texture,
+                ..
+            } => {
+                let item = "a projector";
+                finite(item, "irradiance", irradiance)?;
+                finite(item, "scale", &[*scale])?;
+                self.open(r#"<emitter type="projector">"#);
+                match texture {
+                    None => self.rgb("irradiance", irradiance),
+                    Some(_) if *irradiance != defaults::EMISSION => {
+                        return refuse(
+                            item,
+                            "Mitsuba's irradiance is a colour or a texture, not the product \
+                             of both",
+                        );
+                    }
+                    Some(t) => self.texture(t, "irradiance", item)?,
+                }
+                if *scale != defaults::PROJECTOR_SCALE {
+                    self.float("scale", *scale);
+                }
+                if let Some(f) = fov {
+                    finite(item, "fov", &[*f])?;
+                    self.float("fov", *f);
+                    self.string("fov_axis", fov_axis_name(*fov_axis));
+                }
+                self.transform("to_world", to_world, item)?;
+            }
             LightDesc::Directional {
                 direction,
                 irradiance,
