@@ -1,4 +1,5 @@
-//! Shapes: analytic spheres and triangle meshes behind one [`Shape`] enum, their area and
+//! Shapes: triangle meshes, analytic spheres and cylinders, and signed distance grids behind one
+//! [`Shape`] enum, their area and
 //! solid-angle sampling, the built-in rectangle, cube and disk meshes, the octahedral encoding of
 //! unit vectors and the area-to-solid-angle pdf conversion.
 
@@ -6,7 +7,7 @@ use core::f32::consts::PI;
 use glam::{Vec2, Vec3};
 use restir_sampling::warp;
 
-use crate::{Frame, MeshError, TriangleMesh};
+use crate::{Cylinder, Frame, MeshError, SdfGrid, TriangleMesh};
 
 /// An analytic sphere. Its normals point outwards unless `flip_normals`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -102,6 +103,11 @@ pub enum Shape {
     Mesh(TriangleMesh),
     /// An analytic sphere.
     Sphere(Sphere),
+    /// Mitsuba's open cylinder; its parameters are its uv `(φ/2π, z)`.
+    Cylinder(Cylinder),
+    /// A signed distance grid, one primitive per voxel holding surface; it has no area to emit
+    /// from (as in Mitsuba, its area is 0 and it cannot be sampled).
+    SdfGrid(SdfGrid),
 }
 
 impl Shape {
@@ -110,11 +116,49 @@ impl Shape {
         match self {
             Shape::Mesh(m) => m.area(),
             Shape::Sphere(s) => 4.0 * PI * s.radius * s.radius,
+            Shape::Cylinder(c) => c.area(),
+            Shape::SdfGrid(_) => 0.0,
+        }
+    }
+
+    /// The number of primitives the BVH holds for the shape (triangles, voxels; 1 otherwise).
+    pub fn primitive_count(&self) -> usize {
+        match self {
+            Shape::Mesh(m) => m.triangle_count(),
+            Shape::SdfGrid(g) => g.voxel_count(),
+            Shape::Sphere(_) | Shape::Cylinder(_) => 1,
+        }
+    }
+
+    /// World-space bounds `(min, max)` of primitive `prim`.
+    pub fn primitive_bounds(&self, prim: u32) -> (Vec3, Vec3) {
+        match self {
+            Shape::Mesh(m) => {
+                let [a, b, c] = m.triangle(prim as usize);
+                (a.min(b).min(c), a.max(b).max(c))
+            }
+            Shape::Sphere(s) => (s.center - s.radius, s.center + s.radius),
+            Shape::Cylinder(c) => c.bounds(),
+            Shape::SdfGrid(g) => g.voxel_bounds(prim),
+        }
+    }
+
+    /// World-space bounds `(min, max)` of the whole shape.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        match self {
+            Shape::SdfGrid(g) => g.bounds(),
+            Shape::Mesh(m) => m
+                .positions()
+                .iter()
+                .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), &p| {
+                    (a.min(p), b.max(p))
+                }),
+            _ => self.primitive_bounds(0),
         }
     }
 
     /// The surface point at primitive `prim` and parameters `param` (barycentrics for meshes,
-    /// [`Sphere::param_of`] for spheres).
+    /// [`Sphere::param_of`] for spheres, [`Cylinder::param_of`], [`SdfGrid::param_of`]).
     #[inline]
     pub fn position_at(&self, prim: u32, param: Vec2) -> PositionSample {
         match self {
@@ -139,10 +183,31 @@ impl Shape {
                     param,
                 }
             }
+            Shape::Cylinder(c) => {
+                let (p, n, _) = c.point_at(param);
+                PositionSample {
+                    p,
+                    n,
+                    ng: n,
+                    prim: 0,
+                    param,
+                }
+            }
+            Shape::SdfGrid(g) => {
+                let (p, ng, n) = g.point_at(prim, param);
+                PositionSample {
+                    p,
+                    n,
+                    ng,
+                    prim,
+                    param,
+                }
+            }
         }
     }
 
-    /// A uniformly distributed point on the surface; the area pdf is `1 / area()`.
+    /// A uniformly distributed point on the surface; the area pdf is `1 / area()`. `None` for a
+    /// signed distance grid (it has no area to sample, as in Mitsuba).
     #[inline]
     pub fn sample_uniform_area(&self, u: Vec2) -> Option<PositionSample> {
         match self {
@@ -168,11 +233,14 @@ impl Shape {
                     param: Sphere::param_of(dir),
                 })
             }
+            // Mitsuba's sample: φ = 2π·u.y, z = u.x.
+            Shape::Cylinder(_) => Some(self.position_at(0, Vec2::new(u.y, u.x))),
+            Shape::SdfGrid(_) => None,
         }
     }
 
     /// Samples a point on the shape as seen from `ref_p`, with a solid-angle pdf at `ref_p`.
-    /// Meshes sample uniformly by area; spheres seen from outside sample the cone of directions
+    /// Meshes and cylinders sample uniformly by area; spheres seen from outside sample the cone of directions
     /// they subtend, from inside uniformly by area. [`Shape::pdf_sa_from`] returns the same pdf.
     #[inline]
     pub fn sample_from(&self, ref_p: Vec3, u: Vec2) -> Option<(PositionSample, f32)> {
@@ -215,12 +283,13 @@ impl Shape {
                     pdf,
                 ))
             }
-            Shape::Mesh(_) => {
+            Shape::Mesh(_) | Shape::Cylinder(_) => {
                 let ps = self.sample_uniform_area(u)?;
                 // Uniform by area: the solid-angle density uses the geometric normal.
                 let pdf = area_to_solid_angle(1.0 / self.area(), ref_p, ps.p, ps.ng)?;
                 Some((ps, pdf))
             }
+            Shape::SdfGrid(_) => None,
         }
     }
 
@@ -238,7 +307,10 @@ impl Shape {
                 let cos_max = (1.0 - r2 / d2).max(0.0).sqrt();
                 warp::uniform_cone_pdf(cos_max)
             }
-            Shape::Mesh(_) => area_to_solid_angle(1.0 / self.area(), ref_p, p, n).unwrap_or(0.0),
+            Shape::Mesh(_) | Shape::Cylinder(_) => {
+                area_to_solid_angle(1.0 / self.area(), ref_p, p, n).unwrap_or(0.0)
+            }
+            Shape::SdfGrid(_) => 0.0,
         }
     }
 

@@ -35,6 +35,7 @@ mod meshio;
 pub mod spectrum;
 mod spot;
 pub mod texture;
+mod volfile;
 pub mod xml;
 
 pub use desc::*;

@@ -37,6 +37,31 @@ impl Writer<'_> {
                 ));
                 self.float("radius", r);
             }
+            GeometryDesc::Cylinder { p0, p1, radius } => {
+                self.open(&format!(r#"<shape type="cylinder"{id_attr}>"#));
+                for (name, p) in [("p0", p0), ("p1", p1)] {
+                    finite(&item, name, p)?;
+                    self.line(&format!(
+                        r#"<point name="{name}" x="{}" y="{}" z="{}"/>"#,
+                        num(p[0]),
+                        num(p[1]),
+                        num(p[2])
+                    ));
+                }
+                self.float("radius", *radius);
+            }
+            GeometryDesc::SdfGrid { filename, normals } => {
+                if s.emission.is_some() {
+                    return refuse(item, "an sdfgrid cannot be an area emitter");
+                }
+                if s.flip_normals {
+                    return refuse(item, "an sdfgrid takes no flip_normals");
+                }
+                self.open(&format!(r#"<shape type="sdfgrid"{id_attr}>"#));
+                let f = self.file(filename, &item)?;
+                self.string("filename", &f);
+                self.string("normals", normals.name());
+            }
             GeometryDesc::Obj { filename } | GeometryDesc::Ply { filename } => {
                 let ty = if matches!(s.geometry, GeometryDesc::Obj { .. }) {
                     "obj"
