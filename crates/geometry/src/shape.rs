@@ -18,16 +18,40 @@ pub struct Sphere {
     pub radius: f32,
     /// Whether normals point inwards.
     pub flip_normals: bool,
+    /// World directions to the sphere's object space (the inverse of its `to_world`'s rotation):
+    /// texture coordinates and tangents are those of the object-space direction, as in Mitsuba.
+    pub to_local: glam::Mat3,
 }
 
 impl Sphere {
-    /// A sphere.
+    /// A sphere, its object space aligned with the world's.
     pub fn new(center: Vec3, radius: f32, flip_normals: bool) -> Self {
         Self {
             center,
             radius,
             flip_normals,
+            to_local: glam::Mat3::IDENTITY,
         }
+    }
+
+    /// The sphere with object space turned by `rotation` (object to world, orthonormal).
+    pub fn with_rotation(mut self, rotation: glam::Mat3) -> Self {
+        self.to_local = rotation.inverse();
+        self
+    }
+
+    /// Mitsuba's texture coordinates of the point in world direction `n` (unit, outwards) from
+    /// the centre: [`Sphere::uv_of`] of the object-space direction.
+    #[inline]
+    pub fn local_uv(&self, n: Vec3) -> Vec2 {
+        Self::uv_of(self.to_local * n)
+    }
+
+    /// The tangent along increasing φ of object space at world direction `n` from the centre.
+    #[inline]
+    pub fn tangent(&self, n: Vec3) -> Vec3 {
+        let l = self.to_local * n;
+        self.to_local.transpose() * Vec3::new(-l.y, l.x, 0.0)
     }
 
     /// The surface point named by `param` (see [`Sphere::param_of`]) and its outward normal.
@@ -506,6 +530,31 @@ mod tests {
                 2e-3,
             );
         }
+    }
+
+    /// A turned sphere's texture follows it: uv and tangent are those of the object-space
+    /// direction (Mitsuba's sphere under a rotating `to_world`).
+    #[test]
+    fn turned_sphere_uv() {
+        let turn = glam::Mat3::from_rotation_z(core::f32::consts::FRAC_PI_2);
+        let s = Sphere::new(Vec3::ZERO, 2.0, false).with_rotation(turn);
+        let shapes = vec![Shape::Sphere(s)];
+        let accel = crate::Accel::build(&shapes);
+        // Object direction (cos 30°, sin 30°, 0) (φ = 30°, θ = 90°) is world (−sin 30°, cos 30°, 0).
+        let w = Vec3::new(-0.5, 0.75f32.sqrt(), 0.0);
+        let ray = crate::Ray::new(5.0 * w, -w);
+        let hit = accel.intersect(&ray, f32::INFINITY).unwrap();
+        let si = accel.surface_interaction(&shapes, &hit, &ray);
+        assert!(
+            (si.uv - Vec2::new(1.0 / 12.0, 0.5)).length() < 1e-5,
+            "{}",
+            si.uv
+        );
+        // The tangent of increasing φ: object (−sin 30°, cos 30°, 0), world (−cos 30°, −sin 30°, 0).
+        let t = Vec3::new(-(0.75f32.sqrt()), -0.5, 0.0);
+        assert!((si.shading.s - t).length() < 1e-5, "{}", si.shading.s);
+        let plain = Sphere::new(Vec3::ZERO, 2.0, false);
+        assert!((plain.local_uv(Vec3::Y) - Vec2::new(0.25, 0.5)).length() < 1e-6);
     }
 
     #[test]

@@ -249,7 +249,9 @@ fn build_shape(
             if (sy - scale).abs() > 1e-4 * scale || (sz - scale).abs() > 1e-4 * scale {
                 return Err("spheres take only uniform scales".into());
             }
-            Shape::Sphere(Sphere::new(c, radius * scale, desc.flip_normals))
+            // The rotation (and a mirroring) orients the texture, as in Mitsuba.
+            let rotation = glam::Mat3::from(a.matrix3) / scale;
+            Shape::Sphere(Sphere::new(c, radius * scale, desc.flip_normals).with_rotation(rotation))
         }
         GeometryDesc::Cylinder { p0, p1, radius } => Shape::Cylinder(Cylinder::new(
             Vec3::from(*p0),

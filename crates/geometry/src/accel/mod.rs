@@ -495,15 +495,15 @@ pub fn surface_at(shapes: &[Shape], shape: u32, prim: u32, param: Vec2) -> Surfa
             }
         }
         Shape::Sphere(s) => {
-            let (p, n) = s.point_at(param);
-            let n = if s.flip_normals { -n } else { n };
-            // Tangent along increasing φ.
-            let dpdu = Vec3::new(-(p.y - s.center.y), p.x - s.center.x, 0.0);
+            let (p, out) = s.point_at(param);
+            let n = if s.flip_normals { -out } else { out };
+            // Tangent along increasing φ (of object space).
+            let dpdu = s.tangent(out);
             SurfaceInteraction {
                 p,
                 ng: n,
                 shading: Frame::from_normal_tangent(n, dpdu),
-                uv: crate::Sphere::uv_of(if s.flip_normals { -n } else { n }),
+                uv: s.local_uv(out),
                 shape,
                 prim,
                 param,
