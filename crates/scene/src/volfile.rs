@@ -9,6 +9,9 @@ use std::path::Path;
 use glam::Affine3A;
 use restir_geometry::{SdfGrid, SdfNormals};
 
+/// Counts memory against the build's budget: `(kept bytes, transient bytes, what)`.
+pub(crate) type Take<'a> = dyn FnMut(u64, u64, &dyn Fn() -> String) -> Result<(), String> + 'a;
+
 /// The `sdfgrid` of the file at `path` placed by `to_world`. `take(kept, transient, what)`
 /// counts memory against the build's budget: the values before they are read, the voxels' BVH
 /// entries before the BVH is built.
@@ -16,7 +19,7 @@ pub(crate) fn load_sdfgrid(
     path: &Path,
     to_world: Affine3A,
     normals: SdfNormals,
-    take: &mut dyn FnMut(u64, u64, &dyn Fn() -> String) -> Result<(), String>,
+    take: &mut Take,
 ) -> Result<SdfGrid, String> {
     let name = || format!("sdfgrid '{}'", path.display());
     let h = read_vol_header(path)?;
