@@ -1,5 +1,6 @@
-//! Geometry for the `restir` renderer: rays, orthonormal frames, triangle meshes, analytic spheres,
-//! cameras, and the acceleration structure (an 8-wide compressed BVH from `obvhs`).
+//! Geometry for the `restir` renderer: rays, orthonormal frames, triangle meshes, analytic spheres
+//! and cylinders, signed distance grids, cameras, and the acceleration structure (an 8-wide
+//! compressed BVH from `obvhs`).
 //!
 //! Conventions: right-handed world space, `f32`. Normals are unit length. A shape's geometric
 //! normal follows its winding (counter-clockwise front faces, as in Mitsuba and OBJ) unless the
@@ -22,17 +23,21 @@
 mod accel;
 mod attribute;
 mod camera;
+mod cylinder;
 mod frame;
 mod mesh;
 mod ray;
+mod sdfgrid;
 mod shape;
 
 pub use accel::{Accel, Hit, SurfaceInteraction, surface_at};
 pub use attribute::{AttributeError, AttributeRate, MeshAttribute};
 pub use camera::{Camera, CameraError, FovAxis};
+pub use cylinder::Cylinder;
 pub use frame::Frame;
 pub use mesh::{MeshError, TriangleMesh};
 pub use ray::{Ray, offset_ray_origin, ray_epsilon, shadow_ray_between, shadow_ray_towards};
+pub use sdfgrid::{SdfGrid, SdfNormals};
 pub use shape::{PositionSample, Shape, Sphere, area_to_solid_angle};
 
 /// Mitsuba 3's relative ray epsilon, `1500 · 2⁻²⁴`.

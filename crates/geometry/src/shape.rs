@@ -1,4 +1,5 @@
-//! Shapes: analytic spheres and triangle meshes behind one [`Shape`] enum, their area and
+//! Shapes: triangle meshes, analytic spheres and cylinders, and signed distance grids behind one
+//! [`Shape`] enum, their area and
 //! solid-angle sampling, the built-in rectangle, cube and disk meshes, the octahedral encoding of
 //! unit vectors and the area-to-solid-angle pdf conversion.
 
@@ -6,7 +7,7 @@ use core::f32::consts::PI;
 use glam::{Vec2, Vec3};
 use restir_sampling::warp;
 
-use crate::{Frame, MeshError, TriangleMesh};
+use crate::{Cylinder, Frame, MeshError, SdfGrid, TriangleMesh};
 
 /// An analytic sphere. Its normals point outwards unless `flip_normals`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -17,16 +18,40 @@ pub struct Sphere {
     pub radius: f32,
     /// Whether normals point inwards.
     pub flip_normals: bool,
+    /// World directions to the sphere's object space (the inverse of its `to_world`'s rotation):
+    /// texture coordinates and tangents are those of the object-space direction, as in Mitsuba.
+    pub to_local: glam::Mat3,
 }
 
 impl Sphere {
-    /// A sphere.
+    /// A sphere, its object space aligned with the world's.
     pub fn new(center: Vec3, radius: f32, flip_normals: bool) -> Self {
         Self {
             center,
             radius,
             flip_normals,
+            to_local: glam::Mat3::IDENTITY,
         }
+    }
+
+    /// The sphere with object space turned by `rotation` (object to world, orthonormal).
+    pub fn with_rotation(mut self, rotation: glam::Mat3) -> Self {
+        self.to_local = rotation.inverse();
+        self
+    }
+
+    /// Mitsuba's texture coordinates of the point in world direction `n` (unit, outwards) from
+    /// the centre: [`Sphere::uv_of`] of the object-space direction.
+    #[inline]
+    pub fn local_uv(&self, n: Vec3) -> Vec2 {
+        Self::uv_of(self.to_local * n)
+    }
+
+    /// The tangent along increasing φ of object space at world direction `n` from the centre.
+    #[inline]
+    pub fn tangent(&self, n: Vec3) -> Vec3 {
+        let l = self.to_local * n;
+        self.to_local.transpose() * Vec3::new(-l.y, l.x, 0.0)
     }
 
     /// The surface point named by `param` (see [`Sphere::param_of`]) and its outward normal.
@@ -102,6 +127,11 @@ pub enum Shape {
     Mesh(TriangleMesh),
     /// An analytic sphere.
     Sphere(Sphere),
+    /// Mitsuba's open cylinder; its parameters are its uv `(φ/2π, z)`.
+    Cylinder(Cylinder),
+    /// A signed distance grid, one primitive per voxel holding surface; it has no area to emit
+    /// from (as in Mitsuba, its area is 0 and it cannot be sampled).
+    SdfGrid(SdfGrid),
 }
 
 impl Shape {
@@ -110,6 +140,44 @@ impl Shape {
         match self {
             Shape::Mesh(m) => m.area(),
             Shape::Sphere(s) => 4.0 * PI * s.radius * s.radius,
+            Shape::Cylinder(c) => c.area(),
+            Shape::SdfGrid(_) => 0.0,
+        }
+    }
+
+    /// The number of primitives the BVH holds for the shape (triangles, voxels; 1 otherwise).
+    pub fn primitive_count(&self) -> usize {
+        match self {
+            Shape::Mesh(m) => m.triangle_count(),
+            Shape::SdfGrid(g) => g.voxel_count(),
+            Shape::Sphere(_) | Shape::Cylinder(_) => 1,
+        }
+    }
+
+    /// World-space bounds `(min, max)` of primitive `prim`.
+    pub fn primitive_bounds(&self, prim: u32) -> (Vec3, Vec3) {
+        match self {
+            Shape::Mesh(m) => {
+                let [a, b, c] = m.triangle(prim as usize);
+                (a.min(b).min(c), a.max(b).max(c))
+            }
+            Shape::Sphere(s) => (s.center - s.radius, s.center + s.radius),
+            Shape::Cylinder(c) => c.bounds(),
+            Shape::SdfGrid(g) => g.voxel_bounds(prim),
+        }
+    }
+
+    /// World-space bounds `(min, max)` of the whole shape.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        match self {
+            Shape::SdfGrid(g) => g.bounds(),
+            Shape::Mesh(m) => m
+                .positions()
+                .iter()
+                .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), &p| {
+                    (a.min(p), b.max(p))
+                }),
+            _ => self.primitive_bounds(0),
         }
     }
 
@@ -118,29 +186,35 @@ impl Shape {
     /// frame): on a mesh triangle's with texture coordinates, the edges taken to the `uv` basis
     /// (zero when its `uv` triangle is degenerate), without them the edges themselves; on a
     /// sphere the derivatives of `(φ/2π, θ/π)`'s inverse, `2π·(−Δy, Δx, 0)` and
-    /// `π·(Δz cos φ, Δz sin φ, −ρ)` (`Δ` from the centre, `ρ` its distance from the axis).
+    /// `π·(Δz cos φ, Δz sin φ, −ρ)` (`Δ` from the centre in the sphere's object space, `ρ` its
+    /// distance from the axis, both turned back to the world); on a cylinder
+    /// [`Cylinder::uv_derivatives`]. An SDF grid has no texture coordinates: zero (a bump map on
+    /// one is refused when the scene is built).
     pub fn uv_derivatives(&self, prim: u32, param: Vec2) -> (Vec3, Vec3) {
         match self {
             Shape::Mesh(m) => m.uv_derivatives(prim as usize),
+            Shape::Cylinder(c) => c.uv_derivatives(param),
+            Shape::SdfGrid(_) => (Vec3::ZERO, Vec3::ZERO),
             Shape::Sphere(s) => {
                 let (p, _) = s.point_at(param);
-                let d = p - s.center;
+                let d = s.to_local * (p - s.center);
                 let rho = (d.x * d.x + d.y * d.y).sqrt();
                 let (cos_phi, sin_phi) = if rho > 0.0 {
                     (d.x / rho, d.y / rho)
                 } else {
                     (1.0, 0.0)
                 };
+                let to_world = s.to_local.transpose();
                 (
-                    2.0 * PI * Vec3::new(-d.y, d.x, 0.0),
-                    PI * Vec3::new(d.z * cos_phi, d.z * sin_phi, -rho),
+                    to_world * (2.0 * PI * Vec3::new(-d.y, d.x, 0.0)),
+                    to_world * (PI * Vec3::new(d.z * cos_phi, d.z * sin_phi, -rho)),
                 )
             }
         }
     }
 
     /// The surface point at primitive `prim` and parameters `param` (barycentrics for meshes,
-    /// [`Sphere::param_of`] for spheres).
+    /// [`Sphere::param_of`] for spheres, [`Cylinder::param_of`], [`SdfGrid::param_of`]).
     #[inline]
     pub fn position_at(&self, prim: u32, param: Vec2) -> PositionSample {
         match self {
@@ -165,10 +239,31 @@ impl Shape {
                     param,
                 }
             }
+            Shape::Cylinder(c) => {
+                let (p, n, _) = c.point_at(param);
+                PositionSample {
+                    p,
+                    n,
+                    ng: n,
+                    prim: 0,
+                    param,
+                }
+            }
+            Shape::SdfGrid(g) => {
+                let (p, ng, n) = g.point_at(prim, param);
+                PositionSample {
+                    p,
+                    n,
+                    ng,
+                    prim,
+                    param,
+                }
+            }
         }
     }
 
-    /// A uniformly distributed point on the surface; the area pdf is `1 / area()`.
+    /// A uniformly distributed point on the surface; the area pdf is `1 / area()`. `None` for a
+    /// signed distance grid (it has no area to sample, as in Mitsuba).
     #[inline]
     pub fn sample_uniform_area(&self, u: Vec2) -> Option<PositionSample> {
         match self {
@@ -194,11 +289,14 @@ impl Shape {
                     param: Sphere::param_of(dir),
                 })
             }
+            // Mitsuba's sample: φ = 2π·u.y, z = u.x.
+            Shape::Cylinder(_) => Some(self.position_at(0, Vec2::new(u.y, u.x))),
+            Shape::SdfGrid(_) => None,
         }
     }
 
     /// Samples a point on the shape as seen from `ref_p`, with a solid-angle pdf at `ref_p`.
-    /// Meshes sample uniformly by area; spheres seen from outside sample the cone of directions
+    /// Meshes and cylinders sample uniformly by area; spheres seen from outside sample the cone of directions
     /// they subtend, from inside uniformly by area. [`Shape::pdf_sa_from`] returns the same pdf.
     #[inline]
     pub fn sample_from(&self, ref_p: Vec3, u: Vec2) -> Option<(PositionSample, f32)> {
@@ -241,12 +339,13 @@ impl Shape {
                     pdf,
                 ))
             }
-            Shape::Mesh(_) => {
+            Shape::Mesh(_) | Shape::Cylinder(_) => {
                 let ps = self.sample_uniform_area(u)?;
                 // Uniform by area: the solid-angle density uses the geometric normal.
                 let pdf = area_to_solid_angle(1.0 / self.area(), ref_p, ps.p, ps.ng)?;
                 Some((ps, pdf))
             }
+            Shape::SdfGrid(_) => None,
         }
     }
 
@@ -264,7 +363,10 @@ impl Shape {
                 let cos_max = (1.0 - r2 / d2).max(0.0).sqrt();
                 warp::uniform_cone_pdf(cos_max)
             }
-            Shape::Mesh(_) => area_to_solid_angle(1.0 / self.area(), ref_p, p, n).unwrap_or(0.0),
+            Shape::Mesh(_) | Shape::Cylinder(_) => {
+                area_to_solid_angle(1.0 / self.area(), ref_p, p, n).unwrap_or(0.0)
+            }
+            Shape::SdfGrid(_) => 0.0,
         }
     }
 
@@ -460,6 +562,31 @@ mod tests {
                 2e-3,
             );
         }
+    }
+
+    /// A turned sphere's texture follows it: uv and tangent are those of the object-space
+    /// direction (Mitsuba's sphere under a rotating `to_world`).
+    #[test]
+    fn turned_sphere_uv() {
+        let turn = glam::Mat3::from_rotation_z(core::f32::consts::FRAC_PI_2);
+        let s = Sphere::new(Vec3::ZERO, 2.0, false).with_rotation(turn);
+        let shapes = vec![Shape::Sphere(s)];
+        let accel = crate::Accel::build(&shapes);
+        // Object direction (cos 30°, sin 30°, 0) (φ = 30°, θ = 90°) is world (−sin 30°, cos 30°, 0).
+        let w = Vec3::new(-0.5, 0.75f32.sqrt(), 0.0);
+        let ray = crate::Ray::new(5.0 * w, -w);
+        let hit = accel.intersect(&ray, f32::INFINITY).unwrap();
+        let si = accel.surface_interaction(&shapes, &hit, &ray);
+        assert!(
+            (si.uv - Vec2::new(1.0 / 12.0, 0.5)).length() < 1e-5,
+            "{}",
+            si.uv
+        );
+        // The tangent of increasing φ: object (−sin 30°, cos 30°, 0), world (−cos 30°, −sin 30°, 0).
+        let t = Vec3::new(-(0.75f32.sqrt()), -0.5, 0.0);
+        assert!((si.shading.s - t).length() < 1e-5, "{}", si.shading.s);
+        let plain = Sphere::new(Vec3::ZERO, 2.0, false);
+        assert!((plain.local_uv(Vec3::Y) - Vec2::new(0.25, 0.5)).length() < 1e-6);
     }
 
     #[test]

@@ -229,6 +229,7 @@ impl LightBvh {
                                 s.center + Vec3::splat(s.radius),
                             ),
                             Shape::Mesh(m) => mesh_bounds(m),
+                            s => s.bounds(),
                         };
                         Some(Item {
                             entry,

@@ -324,10 +324,14 @@ pub(crate) fn area_light_sample(
     })
 }
 
-/// A sphere around a shape (for meshes, around its bounding box).
+/// A sphere around a shape (for other shapes than spheres, around its bounding box).
 pub(crate) fn bounding_sphere(shape: &Shape) -> (Vec3, f32) {
     match shape {
         Shape::Sphere(s) => (s.center, s.radius),
+        Shape::Cylinder(_) | Shape::SdfGrid(_) => {
+            let (lo, hi) = shape.bounds();
+            (0.5 * (lo + hi), 0.5 * (hi - lo).length())
+        }
         Shape::Mesh(m) => {
             let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
             for i in 0..m.triangle_count() {

@@ -309,7 +309,7 @@ impl EmitterTable {
                 Emitter::Triangle { light, prim, .. } => match lights[light as usize] {
                     crate::Light::Area { shape, radiance } => match &shapes[shape as usize] {
                         Shape::Mesh(m) => triangle_weight(radiance, m, prim as usize),
-                        Shape::Sphere(_) => 0.0,
+                        _ => 0.0,
                     },
                     _ => 0.0,
                 },
@@ -381,7 +381,7 @@ impl EmitterTable {
         let n = match (self.constant_normal(ng, shading), shape) {
             (Some(n), _) => n,
             (None, Shape::Mesh(m)) => m.point_at(prim as usize, b).2,
-            (None, Shape::Sphere(_)) => ng,
+            (None, _) => ng,
         };
         PositionSample {
             p: point,

@@ -59,8 +59,8 @@ fn rectangle(sx: f32, sy: f32, center: Vec3, normal: Vec3) -> Shape {
 /// The reference point all lights are seen from.
 const REF_P: Vec3 = Vec3::new(0.05, -0.1, 0.1);
 
-/// Three rectangles facing (roughly) the reference point, a sphere and a rotated cube, all
-/// emitting with different radiances, a non-emitting rectangle, and a point light.
+/// Three rectangles facing (roughly) the reference point, a sphere, a rotated cube and a
+/// cylinder, all emitting with different radiances, a non-emitting rectangle, and a point light.
 fn scene() -> (Vec<Shape>, LightSet) {
     let mut cube = Shape::cube();
     cube.transform(&Affine3A::from_scale_rotation_translation(
@@ -86,6 +86,17 @@ fn scene() -> (Vec<Shape>, LightSet) {
         Shape::Mesh(cube),
         // Not a light.
         rectangle(3.0, 3.0, Vec3::new(0.0, 0.0, -3.0), Vec3::Z),
+        // A tilted open cylinder, seen partly from inside through its open end.
+        Shape::Cylinder(
+            restir_geometry::Cylinder::new(
+                Vec3::new(-1.2, 1.0, 0.6),
+                Vec3::new(-0.4, 1.6, 1.4),
+                0.3,
+                Affine3A::IDENTITY,
+                false,
+            )
+            .unwrap(),
+        ),
     ];
     let lights = vec![
         Light::Area {
@@ -111,6 +122,10 @@ fn scene() -> (Vec<Shape>, LightSet) {
         Light::Area {
             shape: 4,
             radiance: Vec3::new(2.0, 0.5, 0.5),
+        },
+        Light::Area {
+            shape: 6,
+            radiance: Vec3::new(1.0, 2.0, 3.0),
         },
     ];
     let set = LightSet::new(lights, &shapes[..], (Vec3::splat(-3.0), Vec3::splat(3.0))).unwrap();
@@ -143,6 +158,15 @@ fn first_hit(shape: &Shape, o: Vec3, w: Vec3) -> Option<(Vec3, Vec3, Vec3)> {
             let n = if s.flip_normals { -n } else { n };
             Some((p, n, n))
         }
+        Shape::Cylinder(c) => {
+            let t = c.intersect(o.into(), w.into(), f32::INFINITY);
+            if !t.is_finite() {
+                return None;
+            }
+            let ps = shape.position_at(0, c.param_of(o + t * w));
+            Some((ps.p, ps.n, ps.ng))
+        }
+        Shape::SdfGrid(_) => None,
         Shape::Mesh(mesh) => {
             let mut best: Option<(f32, usize, Vec2)> = None;
             for i in 0..mesh.triangle_count() {

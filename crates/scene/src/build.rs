@@ -5,7 +5,9 @@
 use std::path::Path;
 
 use glam::{Affine3A, Mat4, Vec2, Vec3};
-use restir_geometry::{Accel, Camera, FovAxis as GeoFovAxis, Shape, Sphere, TriangleMesh};
+use restir_geometry::{
+    Accel, Camera, Cylinder, FovAxis as GeoFovAxis, SdfNormals, Shape, Sphere, TriangleMesh,
+};
 use restir_lights::{EnvMap, Light, LightSet};
 use restir_materials::Bsdf;
 
@@ -238,6 +240,10 @@ fn extent_problem(shape: &Shape) -> Option<String> {
                 .fold(0.0, f32::max),
         ),
         Shape::Sphere(s) => ("the sphere", s.center.abs().max_element() + s.radius),
+        s => {
+            let (lo, hi) = s.bounds();
+            ("the shape", lo.abs().max(hi.abs()).max_element())
+        }
     };
     (v.is_nan() || v > limits::MAX_COORDINATE).then(|| {
         format!(
@@ -275,7 +281,37 @@ fn build_shape(
             if (sy - scale).abs() > 1e-4 * scale || (sz - scale).abs() > 1e-4 * scale {
                 return Err("spheres take only uniform scales".into());
             }
-            Shape::Sphere(Sphere::new(c, radius * scale, desc.flip_normals))
+            // The rotation (and a mirroring) orients the texture, as in Mitsuba.
+            let rotation = glam::Mat3::from(a.matrix3) / scale;
+            Shape::Sphere(Sphere::new(c, radius * scale, desc.flip_normals).with_rotation(rotation))
+        }
+        GeometryDesc::Cylinder { p0, p1, radius } => Shape::Cylinder(Cylinder::new(
+            Vec3::from(*p0),
+            Vec3::from(*p1),
+            *radius,
+            affine(m)?,
+            desc.flip_normals,
+        )?),
+        GeometryDesc::SdfGrid { filename, normals } => {
+            if desc.emission.is_some() {
+                return Err("an sdfgrid cannot be an area emitter (as in Mitsuba 3)".into());
+            }
+            if desc.flip_normals {
+                return Err("an sdfgrid takes no flip_normals (as in Mitsuba 3)".into());
+            }
+            let normals = match normals {
+                SdfNormalsDesc::Smooth => SdfNormals::Smooth,
+                SdfNormalsDesc::Analytic => SdfNormals::Analytic,
+            };
+            let mut take =
+                |kept, transient, what: &dyn Fn() -> String| budget.take(kept, transient, what);
+            let grid = crate::volfile::load_sdfgrid(
+                &base_dir.join(filename),
+                affine(m)?,
+                normals,
+                &mut take,
+            )?;
+            Shape::SdfGrid(grid)
         }
         GeometryDesc::Obj { filename } => {
             let path = base_dir.join(filename);

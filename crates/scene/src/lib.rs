@@ -36,6 +36,7 @@ pub mod principled;
 pub mod spectrum;
 mod spot;
 pub mod texture;
+mod volfile;
 pub mod xml;
 
 pub use desc::*;

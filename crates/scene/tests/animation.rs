@@ -46,7 +46,7 @@ fn write_scene(dir: &std::path::Path) -> std::path::PathBuf {
 fn sphere_center(s: &Shape) -> Vec3 {
     match s {
         Shape::Sphere(s) => s.center,
-        Shape::Mesh(_) => panic!("not a sphere"),
+        _ => panic!("not a sphere"),
     }
 }
 

@@ -310,8 +310,9 @@ fn every_model_filter_camera_and_light_round_trips() {
     ] {
         assert!(text.contains(expected), "{expected} not in\n{text}");
     }
-    // The sphere's transform is folded into its centre and radius.
-    assert!(!text.contains(r#"<rotate x="0" y="1" z="1""#), "{text}");
+    // The sphere's transform turns it (and its texture), so it is written as given; an unturned
+    // sphere's is folded into its centre and radius (the shipped scenes above).
+    assert!(text.contains(r#"<rotate x="0" y="1" z="1""#), "{text}");
     // A shape with a file only takes face_normals (Mitsuba rejects it elsewhere).
     assert_eq!(text.matches("face_normals").count(), 1, "{text}");
     std::fs::remove_dir_all(&dir).unwrap();
@@ -409,4 +410,56 @@ fn a_dollar_in_a_name_is_refused_not_substituted() {
     );
     // Without a '$' the same descriptions are written.
     write(r#"(camera: (fov: 45), shapes: [(geometry: Ply(filename: "m.ply"))])"#).unwrap();
+}
+
+/// Cylinders (with and without their defaults, as an emitter) and signed distance grids round
+/// trip.
+#[test]
+fn cylinders_and_sdfgrids_round_trip() {
+    let dir = temp_dir("shapes");
+    let n = 5u32;
+    let mut vol = b"VOL\x03".to_vec();
+    for v in [1i32, n as i32, n as i32, n as i32, 1] {
+        vol.extend(v.to_le_bytes());
+    }
+    for v in [0.0f32, 0.0, 0.0, 1.0, 1.0, 1.0] {
+        vol.extend(v.to_le_bytes());
+    }
+    for i in 0..n * n * n {
+        let p = [i % n, (i / n) % n, i / (n * n)].map(|c| c as f32 / (n - 1) as f32 - 0.5);
+        let d = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() - 0.3;
+        vol.extend(d.to_le_bytes());
+    }
+    std::fs::write(dir.join("ball.vol"), vol).unwrap();
+    let source = dir.join("shapes.ron");
+    let ron = r#"(
+        camera: (fov: 40, to_world: [LookAt(origin: (0, -5, 1), target: (0, 0, 0), up: (0, 0, 1))]),
+        shapes: [
+            (geometry: Cylinder()),
+            (geometry: Cylinder(p0: (1, 0, 0), p1: (1, 0, 2), radius: 0.25),
+             to_world: [Rotate(axis: (1, 0, 0), angle: 20)], emission: Some((2, 2, 2)), flip_normals: true),
+            (geometry: SdfGrid(filename: "ball.vol")),
+            (geometry: SdfGrid(filename: "ball.vol", normals: analytic), to_world: [Translate((2, 0, 0))]),
+        ],
+    )"#;
+    std::fs::write(&source, ron).unwrap();
+    let desc = restir_scene::parse_ron(ron, &source).unwrap();
+    let text = round_trip(&desc, &source, &dir.join("shapes.xml"), None);
+    for expected in [
+        r#"<shape type="cylinder">"#,
+        r#"<point name="p1" x="1" y="0" z="2"/>"#,
+        r#"<float name="radius" value="0.25"/>"#,
+        r#"<shape type="sdfgrid">"#,
+        r#"<string name="normals" value="analytic"/>"#,
+    ] {
+        assert!(text.contains(expected), "{expected} not in\n{text}");
+    }
+    // What Mitsuba's sdfgrid cannot be is refused by name.
+    let mut bad = desc.clone();
+    bad.shapes[2].emission = Some([1.0; 3]);
+    let e = to_mitsuba_xml(&bad, &XmlWriteOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("sdfgrid cannot be an area emitter"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }

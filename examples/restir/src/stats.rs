@@ -104,7 +104,7 @@ impl Report<'_> {
                 .iter()
                 .map(|s| match s {
                     Shape::Mesh(m) => m.triangle_count(),
-                    Shape::Sphere(_) => 0,
+                    _ => 0,
                 })
                 .sum(),
             spheres: scene

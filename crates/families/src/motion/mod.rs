@@ -349,6 +349,10 @@ mod tests {
         match s {
             Shape::Sphere(s) => s.center,
             Shape::Mesh(m) => m.positions().iter().sum::<Vec3>() / m.positions().len() as f32,
+            other => {
+                let (lo, hi) = other.bounds();
+                0.5 * (lo + hi)
+            }
         }
     }
 

@@ -1,5 +1,7 @@
-//! The acceleration structure: one `obvhs` CWBVH (8-wide, compressed nodes) over every triangle
-//! and sphere of the scene. Spheres are analytic primitives intersected in the traversal closure.
+//! The acceleration structure: one `obvhs` CWBVH (8-wide, compressed nodes) over every triangle,
+//! sphere, cylinder and signed-distance-grid voxel of the scene. All but triangles are tested one
+//! at a time in the traversal closure; cylinders and grid voxels through the structure's own copy
+//! of their shape.
 //!
 //! obvhs's PLOC builder pairs clusters only when both prefer each other; among many primitives
 //! with bit-identical bounds every choice ties, almost nothing pairs per sweep, and the build turns
@@ -19,6 +21,7 @@ mod avx2;
 mod prims;
 mod wide;
 
+pub(crate) use prims::REL_T_MIN;
 use prims::{Prim, group_entries};
 use wide::{Entries, Scalar, TRay, Wide};
 
@@ -72,6 +75,8 @@ pub struct Accel {
     scalar: ScalarPrims,
     /// (shape, primitive within shape) of each BVH-ordered primitive.
     ids: Vec<(u32, u32)>,
+    /// The cylinders and signed distance grids, which [`Prim::Analytic`] names by slot.
+    analytic: Vec<Shape>,
     /// With groups, BVH entry `e` holds primitives `groups[e]..groups[e + 1]`; without, entry
     /// `e` is primitive `e`.
     groups: Option<Vec<u32>>,
@@ -105,8 +110,9 @@ impl ScalarPrims {
     }
 }
 
-/// Primitive `ti` of shape `si` as the traversal stores it.
-fn prim_of(shapes: &[Shape], (si, ti): (u32, u32)) -> Prim {
+/// Primitive `ti` of shape `si` as the traversal stores it; `slots[si]` is the shape's slot
+/// among the analytic shapes (cylinders, grids).
+fn prim_of(shapes: &[Shape], slots: &[u32], (si, ti): (u32, u32)) -> Prim {
     match &shapes[si as usize] {
         Shape::Mesh(m) => {
             let [a, b, c] = m.triangle(ti as usize);
@@ -119,6 +125,10 @@ fn prim_of(shapes: &[Shape], (si, ti): (u32, u32)) -> Prim {
         Shape::Sphere(s) => Prim::Sphere {
             center: s.center.into(),
             radius: s.radius,
+        },
+        Shape::Cylinder(_) | Shape::SdfGrid(_) => Prim::Analytic {
+            slot: slots[si as usize],
+            prim: ti,
         },
     }
 }
@@ -156,13 +166,18 @@ impl Accel {
     /// blocks), and a triangle that is its own BVH entry is kept only inline, so the structure
     /// keeps the tree, the inline blocks and 8 bytes of ids per primitive.
     pub fn build(shapes: &[Shape]) -> Self {
-        let count: usize = shapes
+        let count: usize = shapes.iter().map(Shape::primitive_count).sum();
+        let mut analytic = Vec::new();
+        let slots: Vec<u32> = shapes
             .iter()
             .map(|s| match s {
-                Shape::Mesh(m) => m.triangle_count(),
-                Shape::Sphere(_) => 1,
+                Shape::Cylinder(_) | Shape::SdfGrid(_) => {
+                    analytic.push(s.clone());
+                    analytic.len() as u32 - 1
+                }
+                _ => u32::MAX,
             })
-            .sum();
+            .collect();
         let mut ids = Vec::with_capacity(count);
         let mut aabbs = Vec::with_capacity(count);
         for (si, shape) in shapes.iter().enumerate() {
@@ -182,6 +197,13 @@ impl Accel {
                         Vec3A::from(s.center) + r,
                     ));
                 }
+                _ => {
+                    for ti in 0..shape.primitive_count() as u32 {
+                        ids.push((si as u32, ti));
+                        let (lo, hi) = shape.primitive_bounds(ti);
+                        aabbs.push(Aabb::new(lo.into(), hi.into()));
+                    }
+                }
             }
         }
         let mut bounds = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
@@ -194,6 +216,7 @@ impl Accel {
             return Self {
                 wide: None,
                 scalar: ScalarPrims::default(),
+                analytic,
                 ids,
                 groups: None,
                 bounds: (Vec3::ZERO, Vec3::ZERO),
@@ -204,7 +227,7 @@ impl Accel {
                 reference: None,
             };
         }
-        let grouped = group_entries(&aabbs, |i| prim_of(shapes, ids[i]));
+        let grouped = group_entries(&aabbs, |i| prim_of(shapes, &slots, ids[i]));
         let (bvh, ids, groups) = match grouped {
             Some((entries, boxes)) => {
                 drop(aabbs);
@@ -248,7 +271,7 @@ impl Accel {
         let is_mesh = |id: usize| matches!(shapes[ids[id].0 as usize], Shape::Mesh(_));
         let wide = Wide::build(&bvh, |e| {
             let m = members(e);
-            match prim_of(shapes, ids[m.start]) {
+            match prim_of(shapes, &slots, ids[m.start]) {
                 Prim::Triangle { v0, e1, e2 } if m.len() == 1 => Some([v0, e1, e2]),
                 _ => None,
             }
@@ -263,7 +286,7 @@ impl Accel {
         let scalar = if scalar_ids.len() == ids.len() {
             ScalarPrims {
                 slot: None,
-                prims: ids.iter().map(|&id| prim_of(shapes, id)).collect(),
+                prims: ids.iter().map(|&id| prim_of(shapes, &slots, id)).collect(),
             }
         } else if scalar_ids.is_empty() {
             ScalarPrims::default()
@@ -276,15 +299,16 @@ impl Accel {
                 slot: Some(slot),
                 prims: scalar_ids
                     .iter()
-                    .map(|&id| prim_of(shapes, ids[id]))
+                    .map(|&id| prim_of(shapes, &slots, ids[id]))
                     .collect(),
             }
         };
         Self {
             wide: Some(wide),
             scalar,
+            analytic,
             #[cfg(test)]
-            prims: ids.iter().map(|&id| prim_of(shapes, id)).collect(),
+            prims: ids.iter().map(|&id| prim_of(shapes, &slots, id)).collect(),
             ids,
             groups,
             bounds,
@@ -299,7 +323,7 @@ impl Accel {
         self.bounds
     }
 
-    /// Number of primitives (triangles and spheres).
+    /// Number of primitives (triangles, spheres, cylinders and grid voxels).
     pub fn primitive_count(&self) -> usize {
         self.ids.len()
     }
@@ -326,14 +350,16 @@ impl Accel {
         {
             return self.intersect_prim(id, r, t_max);
         }
-        self.scalar.get(id).intersect(r.o, r.d, t_max)
+        self.scalar
+            .get(id)
+            .intersect(&self.analytic, r.o, r.d, t_max)
     }
 
     /// Any primitive `id`'s distance along `r` if below `t_max`, else infinity (brute force for
     /// the tests).
     #[cfg(test)]
     fn intersect_prim(&self, id: usize, r: &TRay, t_max: f32) -> f32 {
-        self.prims[id].intersect(r.o, r.d, t_max)
+        self.prims[id].intersect(&self.analytic, r.o, r.d, t_max)
     }
 
     /// BVH entry `e` tested member by member: the closest distance below `t_max` (infinity if
@@ -384,7 +410,7 @@ impl Accel {
                     prims::triangle_hit(v0, e1, e2, r.o, r.d, f32::INFINITY)
                         .map_or([0.0; 2], |(_, u, v)| [u, v])
                 }
-                Prim::Sphere { .. } => [0.0; 2],
+                Prim::Sphere { .. } | Prim::Analytic { .. } => [0.0; 2],
             },
         };
         let (shape, prim) = self.ids[id as usize];
@@ -435,6 +461,9 @@ impl Accel {
                 let n = (ray.at(hit.t) - s.center).normalize();
                 crate::Sphere::param_of(n)
             }
+            // Reprojected onto the tube, as Mitsuba does.
+            Shape::Cylinder(c) => c.param_of(ray.at(hit.t)),
+            Shape::SdfGrid(g) => g.param_of(hit.prim, ray.at(hit.t)),
         };
         let mut si = surface_at(shapes, hit.shape, hit.prim, param);
         si.t = hit.t;
@@ -466,15 +495,43 @@ pub fn surface_at(shapes: &[Shape], shape: u32, prim: u32, param: Vec2) -> Surfa
             }
         }
         Shape::Sphere(s) => {
-            let (p, n) = s.point_at(param);
-            let n = if s.flip_normals { -n } else { n };
-            // Tangent along increasing φ.
-            let dpdu = Vec3::new(-(p.y - s.center.y), p.x - s.center.x, 0.0);
+            let (p, out) = s.point_at(param);
+            let n = if s.flip_normals { -out } else { out };
+            // Tangent along increasing φ (of object space).
+            let dpdu = s.tangent(out);
             SurfaceInteraction {
                 p,
                 ng: n,
                 shading: Frame::from_normal_tangent(n, dpdu),
-                uv: crate::Sphere::uv_of(if s.flip_normals { -n } else { n }),
+                uv: s.local_uv(out),
+                shape,
+                prim,
+                param,
+                t: 0.0,
+            }
+        }
+        Shape::Cylinder(c) => {
+            let (p, n, dpdu) = c.point_at(param);
+            SurfaceInteraction {
+                p,
+                ng: n,
+                shading: Frame::from_normal_tangent(n, dpdu),
+                uv: param,
+                shape,
+                prim,
+                param,
+                t: 0.0,
+            }
+        }
+        Shape::SdfGrid(g) => {
+            let (p, ng, ns) = g.point_at(prim, param);
+            SurfaceInteraction {
+                p,
+                ng,
+                // No tangents (Mitsuba's frame around the normal alone).
+                shading: Frame::from_normal(ns),
+                // As in Mitsuba, the grid has no texture coordinates.
+                uv: Vec2::ZERO,
                 shape,
                 prim,
                 param,

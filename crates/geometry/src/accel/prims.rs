@@ -1,5 +1,6 @@
-//! The primitives the BVH holds (triangles with precomputed edges, analytic spheres), their ray
-//! tests, and the grouping of primitives with bit-identical bounds.
+//! The primitives the BVH holds (triangles with precomputed edges, analytic spheres, the
+//! primitives of cylinders and signed distance grids by reference), their ray tests, and the
+//! grouping of primitives with bit-identical bounds.
 
 use std::collections::{HashMap, HashSet};
 
@@ -7,12 +8,25 @@ use glam::Vec3A;
 use obvhs::aabb::Aabb;
 
 use super::MAX_SHARED_BOUNDS;
+use crate::Shape;
 
 /// One primitive as stored for traversal, in BVH order.
 #[derive(Clone, Copy, Debug)]
 pub(super) enum Prim {
-    Triangle { v0: Vec3A, e1: Vec3A, e2: Vec3A },
-    Sphere { center: Vec3A, radius: f32 },
+    Triangle {
+        v0: Vec3A,
+        e1: Vec3A,
+        e2: Vec3A,
+    },
+    Sphere {
+        center: Vec3A,
+        radius: f32,
+    },
+    /// Primitive `prim` of the analytic shape in slot `slot` of the structure's copies.
+    Analytic {
+        slot: u32,
+        prim: u32,
+    },
 }
 
 /// The bit pattern of a box, for finding boxes that are exactly equal.
@@ -32,6 +46,7 @@ fn prim_key(p: &Prim) -> [u32; 9] {
             let c = center.to_array();
             [c[0], c[1], c[2], radius, 0.0, 0.0, 0.0, 0.0, f32::NAN].map(f32::to_bits)
         }
+        Prim::Analytic { slot, prim } => [slot, prim, 0, 0, 0, 0, 0, 1, f32::NAN.to_bits()],
     }
 }
 
@@ -96,7 +111,7 @@ pub(super) fn intersect_triangle(
 /// `t ≤ δt` from its bound `δt` the same way (PBR 4th ed., §6.8.7). Relative, so the same scene
 /// in any unit is traced alike; a real surface this close to the origin of a ray is closer than
 /// the positions' own rounding can tell.
-pub(super) const REL_T_MIN: f32 = 32.0 / 16_777_216.0;
+pub(crate) const REL_T_MIN: f32 = 32.0 / 16_777_216.0;
 
 /// Möller–Trumbore: the distance and the barycentrics `(u, v)` of the hit (weights of `v0 + e1`
 /// and `v0 + e2`) when `REL_T_MIN · max|o − v0| < t < t_max`.
@@ -162,12 +177,18 @@ pub(super) fn intersect_sphere(center: Vec3A, radius: f32, o: Vec3A, d: Vec3A, t
 }
 
 impl Prim {
-    /// The distance along the ray `(o, d)` if below `t_max`, else infinity.
+    /// The distance along the ray `(o, d)` if below `t_max`, else infinity; `analytic` holds
+    /// the shapes [`Prim::Analytic`] names.
     #[inline(always)]
-    pub(super) fn intersect(&self, o: Vec3A, d: Vec3A, t_max: f32) -> f32 {
+    pub(super) fn intersect(&self, analytic: &[Shape], o: Vec3A, d: Vec3A, t_max: f32) -> f32 {
         match *self {
             Prim::Triangle { v0, e1, e2 } => intersect_triangle(v0, e1, e2, o, d, t_max),
             Prim::Sphere { center, radius } => intersect_sphere(center, radius, o, d, t_max),
+            Prim::Analytic { slot, prim } => match &analytic[slot as usize] {
+                Shape::Cylinder(c) => c.intersect(o, d, t_max),
+                Shape::SdfGrid(g) => g.intersect(prim, o, d, t_max),
+                _ => f32::INFINITY,
+            },
         }
     }
 }

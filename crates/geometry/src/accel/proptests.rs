@@ -50,6 +50,7 @@ fn well_posed(prim: &super::Prim, d: Vec3A, p: Vec3A) -> bool {
             (v0.min(a).min(b), v0.max(a).max(b))
         }
         super::Prim::Sphere { center, radius } => (center - radius, center + radius),
+        super::Prim::Analytic { .. } => return true,
     };
     // Away from the box's faces (rounding decides hits on them), except along flat axes.
     let pad = 1e-4 * (1.0 + p.abs().max_element());
@@ -119,6 +120,7 @@ fn rays(shapes: &[Shape]) -> Vec<(Ray, f32)> {
                 }
             }
             Shape::Sphere(sp) => targets.push(sp.center),
+            Shape::Cylinder(_) | Shape::SdfGrid(_) => unreachable!("not generated here"),
         }
     }
     let mut out = Vec::new();

@@ -157,6 +157,7 @@ fn scaled_scene(s: f32) -> Vec<Shape> {
         match shape {
             Shape::Mesh(m) => m.transform(&glam::Affine3A::from_scale(Vec3::splat(s))),
             Shape::Sphere(sp) => *sp = Sphere::new(sp.center * s, sp.radius * s, false),
+            Shape::Cylinder(_) | Shape::SdfGrid(_) => unreachable!("scene() has none"),
         }
     }
     shapes
@@ -285,4 +286,102 @@ fn no_self_intersection_at_any_scale_near_the_origin() {
         }
         assert!(checked > 10_000, "scale {s}: {checked}");
     }
+}
+
+/// A floor, a tilted cylinder and a signed distance grid of a sphere.
+fn analytic_scene() -> Vec<Shape> {
+    let mut floor = Shape::rectangle();
+    floor.transform(&glam::Affine3A::from_scale(Vec3::splat(10.0)));
+    let cylinder = crate::Cylinder::new(
+        Vec3::ZERO,
+        Vec3::Z,
+        0.7,
+        glam::Affine3A::from_rotation_translation(
+            glam::Quat::from_rotation_x(0.6),
+            Vec3::new(-1.5, 0.0, 0.5),
+        ) * glam::Affine3A::from_scale(Vec3::new(1.0, 1.0, 2.0)),
+        false,
+    )
+    .unwrap();
+    let n = 16u32;
+    let mut values = Vec::new();
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                let p = Vec3::new(x as f32, y as f32, z as f32) / (n - 1) as f32;
+                values.push((p - Vec3::splat(0.5)).length() - 0.35);
+            }
+        }
+    }
+    let grid = crate::SdfGrid::new(
+        n,
+        values,
+        glam::Affine3A::from_scale_rotation_translation(
+            Vec3::splat(2.0),
+            glam::Quat::from_rotation_z(0.4),
+            Vec3::new(1.0, -1.0, 0.2),
+        ),
+        crate::SdfNormals::Smooth,
+    )
+    .unwrap();
+    vec![
+        Shape::Mesh(floor),
+        Shape::Cylinder(cylinder),
+        Shape::SdfGrid(grid),
+    ]
+}
+
+/// With cylinders and grid voxels in the BVH, every hit is the brute-force closest hit, the
+/// occlusion answer agrees, and rays leaving a hit through the offset origin do not hit the
+/// same surface again right away.
+#[test]
+fn analytic_shapes_in_the_bvh() {
+    let shapes = analytic_scene();
+    let accel = Accel::build(&shapes);
+    assert_eq!(accel.primitive_count(), 2 + 1 + shapes[2].primitive_count());
+    let mut rng = Pcg32::new(31, 32);
+    let mut seen = [0usize; 3];
+    for _ in 0..4000 {
+        let o = Vec3::new(
+            rng.next_f32() * 8.0 - 4.0,
+            rng.next_f32() * 8.0 - 4.0,
+            rng.next_f32() * 4.0 + 0.1,
+        );
+        let d = restir_sampling::warp::sample_uniform_sphere(rng.next_2d());
+        let ray = Ray::new(o, d);
+        let r = TRay::new(o.into(), d.into());
+        let best = (0..accel.prims.len())
+            .map(|i| accel.intersect_prim(i, &r, f32::INFINITY))
+            .fold(f32::INFINITY, f32::min);
+        let got = accel.intersect(&ray, f32::INFINITY);
+        match got {
+            Some(h) => assert!((h.t - best).abs() <= 1e-4 * best.max(1.0)),
+            None => assert!(best.is_infinite()),
+        }
+        assert_eq!(accel.occluded(&ray, f32::INFINITY), best.is_finite());
+        let Some(hit) = got else { continue };
+        seen[hit.shape as usize] += 1;
+        let si = accel.surface_interaction(&shapes, &hit, &ray);
+        assert!(
+            (si.p - ray.at(hit.t)).length() < 1e-4,
+            "{} vs {}",
+            si.p,
+            ray.at(hit.t)
+        );
+        let towards = si.ng * -si.ng.dot(ray.d).signum();
+        let d = Frame::from_normal(towards).to_world(
+            restir_sampling::warp::sample_cosine_hemisphere(rng.next_2d()),
+        );
+        let o2 = offset_ray_origin(si.p, si.ng, d);
+        if let Some(h2) = accel.intersect(&Ray::new(o2, d), f32::INFINITY) {
+            assert!(
+                !(h2.shape == hit.shape && h2.t < 1e-3),
+                "shape {} hit again at t = {} from {}",
+                hit.shape,
+                h2.t,
+                si.p
+            );
+        }
+    }
+    assert!(seen.iter().all(|&n| n > 50), "{seen:?}");
 }

@@ -91,6 +91,12 @@ pub const PROJECTOR_SCALE: f32 = 1.0;
 pub const SPHERE_CENTER: V3 = [0.0; 3];
 /// A sphere's radius.
 pub const SPHERE_RADIUS: f32 = 1.0;
+/// A cylinder's `p0`, the start of its axis.
+pub const CYLINDER_P0: V3 = [0.0; 3];
+/// A cylinder's `p1`, the end of its axis.
+pub const CYLINDER_P1: V3 = [0.0, 0.0, 1.0];
+/// A cylinder's radius.
+pub const CYLINDER_RADIUS: f32 = 1.0;
 
 /// A checkerboard's `color0`.
 pub const CHECKER_COLOR0: V3 = [0.4; 3];
@@ -98,6 +104,18 @@ pub const CHECKER_COLOR0: V3 = [0.4; 3];
 pub const CHECKER_COLOR1: V3 = [0.2; 3];
 
 // Serde default functions for the RON format (serde takes a path to a function).
+
+pub(crate) fn cylinder_p0() -> V3 {
+    CYLINDER_P0
+}
+
+pub(crate) fn cylinder_p1() -> V3 {
+    CYLINDER_P1
+}
+
+pub(crate) fn cylinder_radius() -> f32 {
+    CYLINDER_RADIUS
+}
 
 pub(crate) fn spp() -> u32 {
     SPP

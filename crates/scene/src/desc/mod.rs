@@ -253,6 +253,37 @@ pub enum GeometryDesc {
         #[serde(deserialize_with = "limits::coordinate")]
         radius: f32,
     },
+    /// Mitsuba's `cylinder`: the open tube (no caps) of radius `radius` around the segment from
+    /// `p0` to `p1`; its transform may not shear, mirror or scale its cross-section unevenly.
+    Cylinder {
+        /// Start of the axis (default the origin).
+        #[serde(
+            default = "defaults::cylinder_p0",
+            deserialize_with = "limits::coordinates"
+        )]
+        p0: V3,
+        /// End of the axis (default `(0, 0, 1)`).
+        #[serde(
+            default = "defaults::cylinder_p1",
+            deserialize_with = "limits::coordinates"
+        )]
+        p1: V3,
+        /// Radius (default 1).
+        #[serde(
+            default = "defaults::cylinder_radius",
+            deserialize_with = "limits::coordinate"
+        )]
+        radius: f32,
+    },
+    /// Mitsuba's `sdfgrid`: a signed distance grid over the unit cube, read from a Mitsuba
+    /// grid-volume (`.vol`) file relative to the scene file. It cannot emit.
+    SdfGrid {
+        /// Path.
+        filename: String,
+        /// How shading normals are computed (default `smooth`).
+        #[serde(default)]
+        normals: SdfNormalsDesc,
+    },
     /// A Wavefront OBJ file, relative to the scene file.
     Obj {
         /// Path.
@@ -282,6 +313,27 @@ pub enum GeometryDesc {
         #[serde(default)]
         normals: Option<Vec<V3>>,
     },
+}
+
+/// How an `sdfgrid`'s shading normals are computed (Mitsuba's `normals`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SdfNormalsDesc {
+    /// Blended across neighbouring voxels, continuous (Mitsuba's default).
+    #[default]
+    Smooth,
+    /// The gradient of the voxel's interpolant.
+    Analytic,
+}
+
+impl SdfNormalsDesc {
+    /// Mitsuba's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            SdfNormalsDesc::Smooth => "smooth",
+            SdfNormalsDesc::Analytic => "analytic",
+        }
+    }
 }
 
 /// A shape with its transform, material and optional area emitter.

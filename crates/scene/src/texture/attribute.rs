@@ -184,6 +184,11 @@ pub(crate) fn bind(
             t.bind(shape, s, scalar, param)?;
         }
     }
+    if bump.is_some() && matches!(s, Shape::SdfGrid(_)) {
+        return Err(
+            "bumpmap on an sdfgrid: the grid has no texture coordinates to bump along".into(),
+        );
+    }
     if let Some((i, _)) = bump
         && let Some(Texture::MeshAttribute(t)) = textures.get(i as usize)
     {

@@ -1,5 +1,7 @@
 //! `<shape>`: built-in shapes and mesh files, with their bsdf (nested or by reference) and area
-//! emitter.
+//! emitter. Mitsuba 3's plugin pages: `rectangle`, `cube`, `disk`, `sphere`, `cylinder` (p0, p1,
+//! radius; an open tube), `sdfgrid` (a signed distance grid from a `.vol` file, `normals`
+//! smooth or analytic; no uv and no emitter), `obj`, `ply`, `serialized`.
 
 use roxmltree::Node;
 
@@ -22,6 +24,64 @@ impl<'a> Importer<'a> {
                     return Err(self.err(node, format!("sphere radius {radius} must be positive")));
                 }
                 GeometryDesc::Sphere { center, radius }
+            }
+            "cylinder" => {
+                let p0 = props.position("p0")?.unwrap_or(defaults::CYLINDER_P0);
+                let p1 = props.position("p1")?.unwrap_or(defaults::CYLINDER_P1);
+                let radius = props.length("radius")?.unwrap_or(defaults::CYLINDER_RADIUS);
+                if radius <= 0.0 {
+                    return Err(self.err(
+                        props.node_or("radius", node),
+                        format!("cylinder radius {radius} must be positive"),
+                    ));
+                }
+                if p0 == p1 {
+                    return Err(self.err(
+                        props.node_or("p1", node),
+                        format!(
+                            "cylinder p0 and p1 are the same point {p0:?}: the axis needs a length"
+                        ),
+                    ));
+                }
+                GeometryDesc::Cylinder { p0, p1, radius }
+            }
+            "sdfgrid" => {
+                let f = props.string("filename")?.ok_or_else(|| {
+                    self.err(
+                        node,
+                        "sdfgrid shape needs a 'filename' (a grid volume .vol file; Mitsuba's \
+                         'grid' tensor cannot be given in XML)",
+                    )
+                })?;
+                let f = self.file_name(props.node_or("filename", node), f)?;
+                let normals = match props.string("normals")?.as_deref() {
+                    None | Some("smooth") => SdfNormalsDesc::Smooth,
+                    Some("analytic") => SdfNormalsDesc::Analytic,
+                    Some(other) => {
+                        return Err(self.err(
+                            props.node_or("normals", node),
+                            format!("sdfgrid normals '{other}' is not one of: smooth, analytic"),
+                        ));
+                    }
+                };
+                if props.bool("flip_normals")?.is_some() {
+                    return Err(self.err(
+                        props.node_or("flip_normals", node),
+                        "sdfgrid takes no 'flip_normals' (its normals follow the distance \
+                         gradient, as in Mitsuba 3)",
+                    ));
+                }
+                if let Some(e) = elements(node).find(|e| e.tag_name().name() == "emitter") {
+                    return Err(self.err(
+                        e,
+                        "an sdfgrid cannot be an area emitter (as in Mitsuba 3: it has no \
+                         area to sample)",
+                    ));
+                }
+                GeometryDesc::SdfGrid {
+                    filename: f,
+                    normals,
+                }
             }
             "obj" => {
                 let f = props
@@ -64,6 +124,8 @@ impl<'a> Importer<'a> {
                         "cube",
                         "disk",
                         "sphere",
+                        "cylinder",
+                        "sdfgrid",
                         "obj",
                         "ply",
                         "serialized",

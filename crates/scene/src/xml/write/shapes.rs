@@ -21,13 +21,22 @@ impl Writer<'_> {
             s.id.as_ref()
                 .map_or(String::new(), |i| format!(r#" id="{}""#, esc(i)));
         let mut mesh_file = false;
+        // A sphere's transform is folded into its centre and radius unless it turns the sphere
+        // (which turns its texture): then centre, radius and transform are written as given.
+        let mut fold_sphere = true;
         match &s.geometry {
             GeometryDesc::Rectangle => self.open(&format!(r#"<shape type="rectangle"{id_attr}>"#)),
             GeometryDesc::Cube => self.open(&format!(r#"<shape type="cube"{id_attr}>"#)),
             GeometryDesc::Disk => self.open(&format!(r#"<shape type="disk"{id_attr}>"#)),
             GeometryDesc::Sphere { center, radius } => {
-                let (c, r) =
+                let (c, r, turned) =
                     world_sphere(*center, *radius, &s.to_world).or_else(|e| refuse(&item, e))?;
+                let (c, r) = if turned {
+                    fold_sphere = false;
+                    (*center, *radius)
+                } else {
+                    (c, r)
+                };
                 self.open(&format!(r#"<shape type="sphere"{id_attr}>"#));
                 self.line(&format!(
                     r#"<point name="center" x="{}" y="{}" z="{}"/>"#,
@@ -36,6 +45,31 @@ impl Writer<'_> {
                     num(c[2])
                 ));
                 self.float("radius", r);
+            }
+            GeometryDesc::Cylinder { p0, p1, radius } => {
+                self.open(&format!(r#"<shape type="cylinder"{id_attr}>"#));
+                for (name, p) in [("p0", p0), ("p1", p1)] {
+                    finite(&item, name, p)?;
+                    self.line(&format!(
+                        r#"<point name="{name}" x="{}" y="{}" z="{}"/>"#,
+                        num(p[0]),
+                        num(p[1]),
+                        num(p[2])
+                    ));
+                }
+                self.float("radius", *radius);
+            }
+            GeometryDesc::SdfGrid { filename, normals } => {
+                if s.emission.is_some() {
+                    return refuse(item, "an sdfgrid cannot be an area emitter");
+                }
+                if s.flip_normals {
+                    return refuse(item, "an sdfgrid takes no flip_normals");
+                }
+                self.open(&format!(r#"<shape type="sdfgrid"{id_attr}>"#));
+                let f = self.file(filename, &item)?;
+                self.string("filename", &f);
+                self.string("normals", normals.name());
             }
             GeometryDesc::Obj { filename } | GeometryDesc::Ply { filename } => {
                 let ty = if matches!(s.geometry, GeometryDesc::Obj { .. }) {
@@ -67,7 +101,7 @@ impl Writer<'_> {
                 );
             }
         }
-        if !matches!(s.geometry, GeometryDesc::Sphere { .. }) {
+        if !matches!(s.geometry, GeometryDesc::Sphere { .. }) || !fold_sphere {
             self.transform("to_world", &s.to_world, &item)?;
         }
         if s.flip_normals {
@@ -219,9 +253,9 @@ fn world_sphere(
     center: V3,
     radius: f32,
     to_world: &[TransformOp],
-) -> core::result::Result<(V3, f32), String> {
+) -> core::result::Result<(V3, f32, bool), String> {
     if to_world.is_empty() {
-        return Ok((center, radius));
+        return Ok((center, radius, false));
     }
     let m = transform_matrix(to_world).map_err(|e| format!("to_world: {e}"))?;
     let a = glam::Affine3A::from_mat4(m);
@@ -231,5 +265,9 @@ fn world_sphere(
     if (sy - scale).abs() > 1e-4 * scale || (sz - scale).abs() > 1e-4 * scale {
         return Err("spheres take only uniform scales".into());
     }
-    Ok((c.to_array(), radius * scale))
+    let turned = (glam::Mat3::from(a.matrix3) / scale - glam::Mat3::IDENTITY)
+        .to_cols_array()
+        .iter()
+        .any(|v| v.abs() > 1e-6);
+    Ok((c.to_array(), radius * scale, turned))
 }
