@@ -44,6 +44,7 @@
 #![deny(missing_docs)]
 
 mod bvh;
+mod contact;
 mod envmap;
 mod learned;
 mod light;
@@ -56,10 +57,11 @@ mod set;
 mod spot;
 mod table;
 
+pub use contact::Contact;
 pub use envmap::{EnvMap, EnvMapError};
 pub use learned::{CellKey, LearnGrid, LearnedSampler, LightRecords};
 pub use light::{Light, LightSample};
-pub use point::{Contact, LightPoint, Resolved};
+pub use point::{LightPoint, Resolved};
 pub use presample::Presampled;
 pub use projector::{Projector, ProjectorError};
 pub use sampler::{

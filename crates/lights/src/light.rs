@@ -7,9 +7,9 @@ use glam::{Vec2, Vec3};
 use restir_geometry::{PositionSample, Shape, area_to_solid_angle};
 use restir_sampling::warp;
 
-use crate::point::point_contact;
+use crate::contact::{Contact, nonzero, point_contact};
 use crate::table::Emitter;
-use crate::{Contact, EnvMap, LightSet, Projector, Spot};
+use crate::{EnvMap, LightSet, Projector, Spot};
 
 /// An emitter.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -282,12 +282,6 @@ impl LightSet {
                 .and_then(|t| self.spot_textures.get(t as usize)),
         )
     }
-}
-
-/// `Some(v)` unless `v` is zero (a point emitter sending nothing that way has no contact).
-#[inline]
-pub(crate) fn nonzero(v: Vec3) -> Option<Vec3> {
-    (v != Vec3::ZERO).then_some(v)
 }
 
 /// The sample of area light `light` (radiance `radiance`) at point `ps` seen from `ref_p`, with

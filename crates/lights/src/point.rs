@@ -13,7 +13,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::light::nonzero;
+use crate::contact::{Contact, nonzero, point_contact};
 use crate::{Light, LightSample, LightSet, Projector, Spot};
 
 /// A ReSTIR DI sample: 16 bytes.
@@ -54,29 +54,6 @@ impl LightPoint {
             param,
         }
     }
-}
-
-/// A light sample seen from a receiver.
-#[derive(Clone, Copy, Debug)]
-pub struct Contact {
-    /// Unit direction from the receiver towards the light (world space).
-    pub wi: Vec3,
-    /// The point on the light (shadow-ray end), for lights at a finite distance.
-    pub p: Vec3,
-    /// Distance to `p`; infinite for lights at infinity.
-    pub dist: f32,
-    /// Radiance arriving along `-wi` (for point lights intensity/distance²).
-    pub le: Vec3,
-    /// Converts a solid-angle density at the receiver into the sample's measure:
-    /// `|cos θ_y|/d²` on area lights, 1 otherwise.
-    pub measure: f32,
-    /// Whether the light is a delta light (BSDF sampling cannot reach it).
-    pub delta: bool,
-    /// The light's geometric normal at `p` (area lights), for the light pdf.
-    pub ng: Vec3,
-    /// The power sampler's density of the sample per unit solid angle at the receiver (selection
-    /// included), where it is known without a lookup (mesh lights, the environment).
-    pub pdf_sa: Option<f32>,
 }
 
 /// A sample resolved in world space, independent of any receiver: resolving once and
@@ -247,31 +224,4 @@ impl Resolved {
             }),
         }
     }
-}
-
-/// A point emitter at `p` seen from `x`, sending `intensity(direction from p to x, unnormalised)`
-/// toward it (`None` where it sends nothing, or where `x` is at `p`).
-#[inline]
-pub(crate) fn point_contact(
-    p: Vec3,
-    x: Vec3,
-    intensity: impl FnOnce(Vec3) -> Option<Vec3>,
-) -> Option<Contact> {
-    let to = p - x;
-    let d2 = to.length_squared();
-    if d2.is_nan() || d2 <= 0.0 {
-        return None;
-    }
-    let intensity = intensity(-to)?;
-    let dist = d2.sqrt();
-    Some(Contact {
-        wi: to / dist,
-        p,
-        dist,
-        le: intensity / d2,
-        measure: 1.0,
-        delta: true,
-        ng: Vec3::ZERO,
-        pdf_sa: None,
-    })
 }
