@@ -55,8 +55,8 @@ fn integrator_type_typo_is_an_error_listing_the_types() {
     fails_with(
         &["render", s(&sc), "-o", s(&out)],
         &format!(
-            "error: {}:2: unknown integrator type 'restir-dl' (known: path, moment, volpath, direct, \
-             restir-di, restir_di, restir, restirdi, restir-pt, restir_pt, restirpt)",
+            "error: {}:2: unknown integrator type 'restir-dl' (known: path, moment, ptracer, volpath, \
+             direct, restir-di, restir_di, restir, restirdi, restir-pt, restir_pt, restirpt)",
             s(&sc)
         ),
     );
@@ -75,7 +75,8 @@ fn unknown_plugin_types_list_the_valid_ones() {
         &["render", s(&sc), "-o", s(&dir.0.join("o.exr"))],
         &format!(
             "error: {}:2: unknown bsdf type 'velvet' (known: diffuse, twosided, conductor, \
-             roughconductor, dielectric, roughdielectric, plastic, roughplastic, null, mask, normalmap)",
+             roughconductor, dielectric, roughdielectric, plastic, roughplastic, null, mask, normalmap, \
+             principled, principledthin, bumpmap)",
             s(&sc)
         ),
     );
