@@ -51,7 +51,7 @@ mod light_connect;
 mod reconnect;
 
 /// A vertex a walk scatters from (`x1`, the primary hit, or a later surface hit;
-/// [`Vertex`](super::sample::Vertex) is the reconnection vertex `x_k` resolved from a sample):
+/// [`Vertex`] is the reconnection vertex `x_k` resolved from a sample):
 /// the shading point as a [`Receiver`] (frame, `wo`, material), its geometric normal, its BSDF
 /// with textures resolved, and whether it is connectible.
 #[derive(Clone, Copy, Debug)]
