@@ -173,21 +173,14 @@ impl Scene {
     pub fn bsdf(&self, si: &SurfaceInteraction) -> Bsdf {
         let bsdf = self.shape_bsdf[si.shape as usize];
         let at = TexturePoint::of(si);
-        match &self.bsdf_textures[bsdf as usize] {
-            Some(t) if self.features.has_textures && t.bump.is_some() => {
-                let mut p = t.eval(&self.textures, &self.shapes, &at);
-                if let Some((texture, scale)) = t.bump {
-                    p.normal = self.bump_texel(texture, scale, si);
-                }
-                let b = self.bsdfs[bsdf as usize].with_params(&p);
-                if t.principled.any() {
-                    t.principled.apply(b, &self.textures, &self.shapes, &at)
-                } else {
-                    b
-                }
-            }
-            _ => self.bsdf_at(bsdf, &at),
+        if self.features.has_textures
+            && let Some(t) = &self.bsdf_textures[bsdf as usize]
+            && let Some((texture, scale)) = t.bump
+        {
+            let normal = self.bump_texel(texture, scale, si);
+            return self.textured(bsdf, t, &at, Some(normal));
         }
+        self.bsdf_at(bsdf, &at)
     }
 
     /// The normal-map texel of a bump map (height `texture` times `scale`) at `si`: Mitsuba's
@@ -221,11 +214,29 @@ impl Scene {
         }
         match &self.bsdf_textures[bsdf as usize] {
             None => base,
-            Some(t) if t.principled.any() => {
-                let b = base.with_params(&t.eval(&self.textures, &self.shapes, at));
-                t.principled.apply(b, &self.textures, &self.shapes, at)
-            }
-            Some(t) => base.with_params(&t.eval(&self.textures, &self.shapes, at)),
+            Some(t) => self.textured(bsdf, t, at, None),
+        }
+    }
+
+    /// Material `bsdf` with its textures `t` looked up at `at`, and its normal map's texel
+    /// replaced by `normal` (a bump map's, from the hit).
+    #[inline]
+    fn textured(
+        &self,
+        bsdf: u32,
+        t: &TexturedParams,
+        at: &TexturePoint,
+        normal: Option<Vec3>,
+    ) -> Bsdf {
+        let mut p = t.eval(&self.textures, &self.shapes, at);
+        if let Some(n) = normal {
+            p.normal = n;
+        }
+        let b = self.bsdfs[bsdf as usize].with_params(&p);
+        if t.principled.any() {
+            t.principled.apply(b, &self.textures, &self.shapes, at)
+        } else {
+            b
         }
     }
 }
