@@ -125,6 +125,7 @@ fn render_entry(
         time_limit: (clock == Clock::Wall).then(|| Duration::from_secs_f64(budget)),
         seed,
         output: None,
+        moment: None,
     };
     let cpu_budget = (clock == Clock::Cpu).then_some(budget);
     let record = |m: &Measured, reference: &Image, frame, flicker| {

@@ -39,6 +39,12 @@ pub enum ImageError {
         /// The file.
         path: PathBuf,
     },
+    /// Channels beside RGB ([`crate::Channel`]) were to be written to a format without them
+    /// (PNG holds 8-bit RGB only).
+    ChannelsNeedExr {
+        /// The file.
+        path: PathBuf,
+    },
     /// Creating, writing, flushing, syncing or renaming an output file failed.
     Io {
         /// The target file.
@@ -98,6 +104,7 @@ impl ImageError {
             | ImageError::WriteExr { path, .. }
             | ImageError::WritePng { path, .. }
             | ImageError::UnknownFormat { path }
+            | ImageError::ChannelsNeedExr { path }
             | ImageError::Io { path, .. } => path,
         }
     }
@@ -123,6 +130,11 @@ impl core::fmt::Display for ImageError {
                 "{}: unknown image format: use a .exr or .png file name",
                 path.display()
             ),
+            ImageError::ChannelsNeedExr { path } => write!(
+                f,
+                "{}: channels beside RGB need an EXR file (a .exr file name)",
+                path.display()
+            ),
             ImageError::Io { path, what, source } => {
                 write!(f, "{}: {what}: {source}", path.display())
             }
@@ -139,7 +151,7 @@ impl std::error::Error for ImageError {
             ImageError::Read { reason, .. } => Some(reason),
             ImageError::WritePng { source, .. } => Some(source),
             ImageError::Io { source, .. } => Some(source),
-            ImageError::UnknownFormat { .. } => None,
+            ImageError::UnknownFormat { .. } | ImageError::ChannelsNeedExr { .. } => None,
         }
     }
 }

@@ -7,6 +7,16 @@ use glam::Vec3;
 
 use crate::{Image, ImageError, ReadFailure, input, srgb};
 
+/// A named channel written beside an image's R, G and B ([`Image::write_with`]): one value per
+/// pixel, row-major.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Channel {
+    /// The channel's name in the file (`m2_nested.X`, …).
+    pub name: String,
+    /// One value per pixel.
+    pub values: Vec<f32>,
+}
+
 /// How [`Image::read`] interprets the integer (8- or 16-bit) channels of PNG and JPEG files.
 /// Float formats (EXR, Radiance HDR) hold linear values and are never decoded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -90,7 +100,23 @@ impl Image {
     /// ([`write_atomically`](crate::write_atomically)): a failed write (a full disk included)
     /// is an error and leaves an existing file as it was.
     pub fn write(&self, path: &Path) -> Result<(), ImageError> {
-        match extension(path).as_deref() {
+        self.write_with(path, &[])
+    }
+
+    /// [`Image::write`] with more channels beside R, G and B (an EXR file; with channels, a PNG
+    /// file name is an error). Each channel holds one value per pixel, row-major; EXR stores the
+    /// channels sorted by name.
+    pub fn write_with(&self, path: &Path, extra: &[Channel]) -> Result<(), ImageError> {
+        let format = extension(path);
+        if !extra.is_empty() {
+            if format.as_deref() != Some("exr") {
+                return Err(ImageError::ChannelsNeedExr {
+                    path: path.to_path_buf(),
+                });
+            }
+            return self.write_exr_channels(path, extra);
+        }
+        match format.as_deref() {
             Some("exr") => {
                 use exr::prelude::{SpecificChannels, Vec2, WritableImage};
                 let w = self.width as usize;
@@ -141,6 +167,39 @@ impl Image {
                 path: path.to_path_buf(),
             }),
         }
+    }
+
+    /// An EXR of R, G, B and `extra`, all float32.
+    fn write_exr_channels(&self, path: &Path, extra: &[Channel]) -> Result<(), ImageError> {
+        use exr::prelude::{AnyChannel, AnyChannels, FlatSamples, SmallVec, WritableImage};
+        let n = self.pixels.len();
+        let rgb = |i: usize, name: &str| {
+            AnyChannel::new(
+                name,
+                FlatSamples::F32(self.pixels.iter().map(|p| p[i]).collect()),
+            )
+        };
+        let mut channels = vec![rgb(0, "R"), rgb(1, "G"), rgb(2, "B")];
+        for c in extra {
+            assert_eq!(c.values.len(), n, "channel {} has the image's size", c.name);
+            channels.push(AnyChannel::new(
+                c.name.as_str(),
+                FlatSamples::F32(c.values.clone()),
+            ));
+        }
+        let channels = AnyChannels::sort(SmallVec::from_vec(channels));
+        let image = exr::prelude::Image::from_channels(
+            (self.width as usize, self.height as usize),
+            channels,
+        );
+        crate::write_atomically(
+            path,
+            |out| image.write().to_buffered(out),
+            |source| ImageError::WriteExr {
+                path: path.to_path_buf(),
+                source,
+            },
+        )
     }
 
     /// Reads the first RGB(A) layer of an EXR file (alpha is ignored), as written by

@@ -36,7 +36,7 @@ mod part;
 pub mod srgb;
 
 pub use error::{ImageError, ReadFailure};
-pub use io::IntegerEncoding;
+pub use io::{Channel, IntegerEncoding};
 pub use metrics::{ErrorMetrics, compare};
 pub use output::{
     Destination, OutputWriter, check_writable, destination, same_destination, temp_path,

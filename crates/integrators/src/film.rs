@@ -6,8 +6,12 @@
 //! splatting film away from the image border, and every integrator sees the same footprint.
 //! Because the filter is in the sampling, the [`Film`] keeps one sum per pixel (in `f64`, so that
 //! thousands of passes lose nothing) and its image is the sum divided by the number of passes.
+//! Asked to ([`Film::with_second_moment`], Mitsuba's `moment` integrator), it also keeps the sum
+//! of each pass's estimate squared, in CIE XYZ as Mitsuba does: with `N` passes of mean `m` and
+//! second moment `m₂`, `(m₂ − m²)/(N − 1)` estimates the variance of the pixel's value.
 
 use glam::{DVec3, Vec2};
+use restir_image::srgb;
 use restir_sampling::{Distribution1D, warp};
 use restir_scene::FilterDesc;
 
@@ -83,6 +87,25 @@ pub struct Film {
     filter: Filter,
     sums: Vec<DVec3>,
     passes: u32,
+    /// With a second moment: per pixel the sum of the passes' estimates squared (XYZ), and the
+    /// buffer one pass writes its estimates into.
+    moment: Option<SecondMoment>,
+}
+
+#[derive(Clone, Debug)]
+struct SecondMoment {
+    squares: Vec<DVec3>,
+    pass: Vec<DVec3>,
+}
+
+/// A film's per-pixel mean and second moment over its passes, in CIE XYZ
+/// ([`Film::moments`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Moments {
+    /// The mean of the passes (the image in XYZ).
+    pub mean: Vec<DVec3>,
+    /// The mean of the passes' estimates squared, per XYZ channel.
+    pub second: Vec<DVec3>,
 }
 
 impl Film {
@@ -94,7 +117,19 @@ impl Film {
             filter: Filter::new(filter),
             sums: vec![DVec3::ZERO; width as usize * height as usize],
             passes: 0,
+            moment: None,
         }
+    }
+
+    /// The film also keeping each pixel's second moment ([`Film::moments`]): two more buffers of
+    /// the film's size, and a pass's estimates are added after it ends.
+    pub fn with_second_moment(mut self) -> Self {
+        let n = self.sums.len();
+        self.moment = Some(SecondMoment {
+            squares: vec![DVec3::ZERO; n],
+            pass: vec![DVec3::ZERO; n],
+        });
+        self
     }
 
     /// `(width, height)` in pixels.
@@ -115,9 +150,32 @@ impl Film {
     /// Adds one pass: `pass` gets the filter (for jittering camera rays) and the row-major
     /// per-pixel sums, to which it adds one estimate per pixel; its result is returned.
     pub fn add_pass<R>(&mut self, pass: impl FnOnce(&Filter, &mut [DVec3]) -> R) -> R {
-        let r = pass(&self.filter, &mut self.sums);
+        let r = match &mut self.moment {
+            None => pass(&self.filter, &mut self.sums),
+            Some(m) => {
+                m.pass.fill(DVec3::ZERO);
+                let r = pass(&self.filter, &mut m.pass);
+                for ((sum, square), v) in self.sums.iter_mut().zip(&mut m.squares).zip(&m.pass) {
+                    *sum += *v;
+                    let xyz = srgb::to_xyz(*v);
+                    *square += xyz * xyz;
+                }
+                r
+            }
+        };
         self.passes += 1;
         r
+    }
+
+    /// The per-pixel mean and second moment of the passes in XYZ, if the film keeps them
+    /// ([`Film::with_second_moment`]); zero before the first pass.
+    pub fn moments(&self) -> Option<Moments> {
+        let m = self.moment.as_ref()?;
+        let inv = 1.0 / self.passes.max(1) as f64;
+        Some(Moments {
+            mean: self.sums.iter().map(|s| srgb::to_xyz(*s * inv)).collect(),
+            second: m.squares.iter().map(|s| *s * inv).collect(),
+        })
     }
 
     /// The average of the passes (black before the first).
@@ -164,6 +222,26 @@ mod tests {
                 "{desc:?}: var {v} vs {var}"
             );
         }
+    }
+
+    /// The second moment is the mean of the passes' estimates squared in XYZ, the mean the
+    /// image's in XYZ; the image is the same as without it.
+    #[test]
+    fn film_keeps_the_second_moment() {
+        let passes = [DVec3::new(1.0, 0.0, 0.0), DVec3::new(3.0, 2.0, 1.0)];
+        let mut plain = Film::new(1, 1, FilterDesc::Box);
+        let mut film = Film::new(1, 1, FilterDesc::Box).with_second_moment();
+        assert!(plain.moments().is_none());
+        for v in passes {
+            plain.add_pass(|_, sums| sums[0] += v);
+            film.add_pass(|_, sums| sums[0] += v);
+        }
+        assert_eq!(film.image(), plain.image());
+        let m = film.moments().unwrap();
+        let xyz = passes.map(srgb::to_xyz);
+        let second = (xyz[0] * xyz[0] + xyz[1] * xyz[1]) / 2.0;
+        assert!((m.second[0] - second).abs().max_element() < 1e-12);
+        assert!((m.mean[0] - (xyz[0] + xyz[1]) / 2.0).abs().max_element() < 1e-12);
     }
 
     /// The image is the per-pixel mean of the passes.

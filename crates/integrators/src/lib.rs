@@ -71,7 +71,9 @@ pub use motion::FrameMotion;
 pub use params::{Param, ParamError, ParamSet, ParamSource, ParamValue};
 pub use pass::{CROP_ALIGN, Crop, Integrator, PassContext, PixelWindow};
 pub use path::PathIntegrator;
-pub use render::{EstimatorReport, RenderJob, RenderOutput, RenderPart, render, render_part};
+pub use render::{
+    EstimatorReport, MomentImages, RenderJob, RenderOutput, RenderPart, render, render_part,
+};
 pub use renderer::{RenderError, Renderer};
 pub use restir_di::{RestirDiIntegrator, RestirDiSettings};
 pub use restir_image::{ErrorMetrics, Image, ImageError, compare};

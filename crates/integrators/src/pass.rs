@@ -99,21 +99,23 @@ impl PixelWindow {
     /// The pixels of `inner` (a window inside this one, both in film coordinates) out of
     /// `image`, this window's pixels, row-major.
     pub fn extract(&self, image: &Image, inner: &PixelWindow) -> Image {
-        let (dx, dy) = ((inner.x0 - self.x0) as usize, (inner.y0 - self.y0) as usize);
-        let w = self.width as usize;
-        let pixels = (0..inner.height as usize)
-            .flat_map(|y| {
-                let row = (dy + y) * w + dx;
-                image.pixels[row..row + inner.width as usize]
-                    .iter()
-                    .copied()
-            })
-            .collect();
         Image {
             width: inner.width,
             height: inner.height,
-            pixels,
+            pixels: self.extract_values(&image.pixels, inner),
         }
+    }
+
+    /// [`PixelWindow::extract`] of any per-pixel values, row-major over this window.
+    pub fn extract_values<T: Copy>(&self, values: &[T], inner: &PixelWindow) -> Vec<T> {
+        let (dx, dy) = ((inner.x0 - self.x0) as usize, (inner.y0 - self.y0) as usize);
+        let w = self.width as usize;
+        (0..inner.height as usize)
+            .flat_map(|y| {
+                let row = (dy + y) * w + dx;
+                values[row..row + inner.width as usize].iter().copied()
+            })
+            .collect()
     }
 }
 

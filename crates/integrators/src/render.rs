@@ -29,6 +29,9 @@ pub struct RenderJob {
     pub seed: u64,
     /// Where the image is to be written; [`render`] does not write it.
     pub output: Option<PathBuf>,
+    /// Also keep each pixel's mean and second moment over the passes, under this name
+    /// (Mitsuba's `moment` integrator: [`RenderOutput::moment`]).
+    pub moment: Option<String>,
 }
 
 impl Default for RenderJob {
@@ -39,17 +42,19 @@ impl Default for RenderJob {
             time_limit: None,
             seed: 0,
             output: None,
+            moment: None,
         }
     }
 }
 
 impl RenderJob {
-    /// The job a scene description asks for: its sample count (at least one) and its film's
-    /// file name; seed 0 and no time limit.
+    /// The job a scene description asks for: its sample count (at least one), its film's
+    /// file name and its second moment (a `moment` integrator); seed 0 and no time limit.
     pub fn from_desc(desc: &SceneDesc) -> Self {
         Self {
             spp: desc.spp.max(1),
             output: desc.film.filename.as_ref().map(PathBuf::from),
+            moment: desc.integrator.moment.clone(),
             ..Self::default()
         }
     }
@@ -108,6 +113,39 @@ pub struct RenderOutput {
     pub rays: u64,
     /// Pixels with a NaN or infinite value.
     pub nonfinite_pixels: usize,
+    /// Each pixel's mean and second moment, when the job asked for them
+    /// ([`RenderJob::moment`]).
+    pub moment: Option<MomentImages>,
+}
+
+/// Each pixel's mean and second moment over the passes of a render, in CIE XYZ, as Mitsuba 3's
+/// `moment` integrator writes them beside the image (`name.X`, `name.Y`, `name.Z`,
+/// `m2_name.X`, …: [`MomentImages::channels`]). With `N` passes, `(m₂ − m²)/(N − 1)` estimates
+/// the variance of a pixel's value.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MomentImages {
+    /// The channels' name (the nested integrator's in Mitsuba).
+    pub name: String,
+    /// The mean per pixel (the image in XYZ), row-major.
+    pub mean: Vec<glam::DVec3>,
+    /// The mean of the passes' estimates squared per pixel and channel, row-major.
+    pub second: Vec<glam::DVec3>,
+}
+
+impl MomentImages {
+    /// The six channels as Mitsuba 3 names them, for [`Image::write_with`].
+    pub fn channels(&self) -> Vec<restir_image::Channel> {
+        let mut out = Vec::with_capacity(6);
+        for (prefix, values) in [("", &self.mean), ("m2_", &self.second)] {
+            for (i, axis) in ["X", "Y", "Z"].iter().enumerate() {
+                out.push(restir_image::Channel {
+                    name: format!("{prefix}{}.{axis}", self.name),
+                    values: values.iter().map(|v| v[i] as f32).collect(),
+                });
+            }
+        }
+        out
+    }
 }
 
 /// Renders `scene` with `integrator` in the current rayon pool. `cancel` stops the render after
@@ -168,6 +206,9 @@ pub fn render_part(
         film_width: film_size.0,
     });
     let mut film = Film::new(region.width, region.height, scene.filter);
+    if job.moment.is_some() {
+        film = film.with_second_moment();
+    }
     let start = Instant::now();
     let mut rays = 0u64;
     let spp = job.spp.max(1);
@@ -197,6 +238,18 @@ pub fn render_part(
         Some(window) => region.extract(&film.image(), window),
     };
     let nonfinite_pixels = image.nonfinite_count();
+    let moment = job.moment.as_ref().and_then(|name| {
+        let m = film.moments()?;
+        let window = |v: Vec<glam::DVec3>| match &part.window {
+            None => v,
+            Some(window) => region.extract_values(&v, window),
+        };
+        Some(MomentImages {
+            name: name.clone(),
+            mean: window(m.mean),
+            second: window(m.second),
+        })
+    });
     RenderOutput {
         estimator: EstimatorReport::of(integrator),
         image,
@@ -204,5 +257,6 @@ pub fn render_part(
         seconds,
         rays,
         nonfinite_pixels,
+        moment,
     }
 }

@@ -66,6 +66,14 @@ pub(crate) fn run(args: RenderArgs) -> Result<Rendered, String> {
     } = settle(&args, &mut job, scene, integrator.as_ref())?;
     let spp = job.spp;
     let output = prepare_outputs(&args, output, frame_plan.as_ref())?;
+    keep_moment_where_written(
+        &args,
+        &loaded,
+        &mut job,
+        &output,
+        plan.is_some(),
+        frame_plan.is_some(),
+    );
 
     let pool = strict::thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
@@ -295,6 +303,42 @@ fn settle(
     })
 }
 
+/// A scene's `moment` integrator asks for each pixel's mean and second moment beside the image:
+/// channels that only an EXR of a whole image holds. For a PNG, a part of a split render or a
+/// frame sequence they are not computed, and a warning says so before rendering.
+fn keep_moment_where_written(
+    args: &RenderArgs,
+    loaded: &LoadedScene,
+    job: &mut RenderJob,
+    output: &std::path::Path,
+    part: bool,
+    frames: bool,
+) {
+    if job.moment.is_none() {
+        return;
+    }
+    let exr = output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    let why = if !exr {
+        "a PNG holds RGB only"
+    } else if part {
+        "parts of a split render keep the image only"
+    } else if frames {
+        "frame sequences keep the image only"
+    } else {
+        return;
+    };
+    job.moment = None;
+    if !args.quiet {
+        say_err!(
+            "warning: {}: the moment integrator's second-moment channels are not written ({why}); {} gets the image",
+            loaded.desc.integrator.location,
+            output.display()
+        );
+    }
+}
+
 /// Fails before rendering, not after, when an output cannot be written: creates the output's
 /// (and a frame preview's) directory and checks the files. Returns the first file written (the
 /// first frame's with `--frames`).
@@ -352,6 +396,15 @@ fn write_image(
             integrator,
             args.seed,
         ),
-        None => out.image.write(output).map_err(|e| e.to_string()),
+        None => {
+            let channels = out
+                .moment
+                .as_ref()
+                .map(|m| m.channels())
+                .unwrap_or_default();
+            out.image
+                .write_with(output, &channels)
+                .map_err(|e| e.to_string())
+        }
     }
 }

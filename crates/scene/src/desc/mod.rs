@@ -216,6 +216,11 @@ pub struct IntegratorDesc {
     /// Estimator-specific parameters as `name = value` strings (e.g. ReSTIR settings).
     #[serde(default)]
     pub params: Vec<(String, String)>,
+    /// Mitsuba's `moment` integrator around this one: the name under which an EXR output
+    /// also holds each pixel's mean and second moment over the passes (CIE XYZ channels
+    /// `NAME.X`… and `m2_NAME.X`…, as Mitsuba 3 writes them). `None`: the image only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub moment: Option<String>,
     /// Where the integrator was declared (for errors in `params`); set by the loaders.
     #[serde(skip)]
     pub location: Location,
@@ -229,6 +234,7 @@ impl Default for IntegratorDesc {
             rr_depth: defaults::RR_DEPTH,
             hide_emitters: false,
             params: Vec::new(),
+            moment: None,
             location: Location::default(),
         }
     }

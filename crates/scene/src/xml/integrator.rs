@@ -98,8 +98,9 @@ impl<'a> Importer<'a> {
 
     /// Mitsuba 3's `moment` integrator: the nested integrator renders the image
     /// (<https://mitsuba.readthedocs.io/en/latest/src/generated/plugins_integrators.html#moment-integrator-moment>).
-    /// Mitsuba also writes each pixel's second moment as extra channels; that output is not made
-    /// here, and a warning says so. Exactly one nested integrator is read.
+    /// As Mitsuba, an EXR output also holds each pixel's mean and second moment under the
+    /// nested integrator's `name` (Mitsuba's `_arg_0` without one): [`IntegratorDesc::moment`].
+    /// Exactly one nested integrator is read.
     fn moment<'i>(&self, node: Node<'a, 'i>, desc: &mut SceneDesc) -> Result<()> {
         let props = self.props(node, "integrator 'moment'".into())?;
         let mut nested = Vec::new();
@@ -129,10 +130,10 @@ impl<'a> Importer<'a> {
         };
         props.finish();
         self.integrator(inner, desc)?;
-        self.warn(
-            node,
-            "integrator 'moment': the image is its nested integrator's; the second-moment channels Mitsuba adds are not written",
-        );
+        // Mitsuba names the channels after the nested plugin's `name` attribute, or after its
+        // position among the moment's children (the only one: `_arg_0`).
+        let name = inner.attribute("name").unwrap_or("_arg_0");
+        desc.integrator.moment = Some(name.to_string());
         Ok(())
     }
 }

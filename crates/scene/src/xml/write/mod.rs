@@ -324,7 +324,16 @@ impl Writer<'_> {
                 format!("the parameter '{name}' has no counterpart in Mitsuba 3's path tracer"),
             );
         }
-        self.open(&format!(r#"<integrator type="{mitsuba_type}">"#));
+        if let Some(name) = &integ.moment {
+            literal("the integrator", "the moment channels' name", name)?;
+            self.open(r#"<integrator type="moment">"#);
+            self.open(&format!(
+                r#"<integrator type="{mitsuba_type}" name="{}">"#,
+                esc(name)
+            ));
+        } else {
+            self.open(&format!(r#"<integrator type="{mitsuba_type}">"#));
+        }
         self.line(r#"<integer name="max_depth" value="$max_depth"/>"#);
         self.line(&format!(
             r#"<integer name="rr_depth" value="{}"/>"#,
@@ -334,6 +343,9 @@ impl Writer<'_> {
             self.boolean("hide_emitters", true);
         }
         self.close("</integrator>");
+        if integ.moment.is_some() {
+            self.close("</integrator>");
+        }
         Ok(())
     }
 

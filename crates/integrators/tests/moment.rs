@@ -1,0 +1,130 @@
+//! Each pixel's second moment (Mitsuba 3's `moment` integrator, [`RenderJob::moment`]): the mean
+//! over the passes of each pass's estimate squared, in CIE XYZ. Checked exactly against the
+//! passes rendered one at a time ([`render_part`] renders the same `(seed, pixel, pass)`
+//! streams), for the path tracer and for ReSTIR DI and PT (spatial reuse, no history between
+//! passes); asking for it leaves the image as it was. Negative control: the square of the mean
+//! (what a film that squared the average instead of each pass would give) differs.
+
+mod common;
+
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+
+use glam::DVec3;
+use restir_image::srgb;
+use restir_integrators::{
+    Integrator, IntegratorOptions, Param, ParamSource, RenderJob, RenderOutput, RenderPart,
+    make_integrator, render_part,
+};
+use restir_scene::{Scene, load_desc};
+
+fn cornell(w: u32, h: u32) -> common::Built {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml");
+    let (mut desc, _) = load_desc(&path, &[]).unwrap();
+    desc.film.width = w;
+    desc.film.height = h;
+    common::build(&desc, path.parent().unwrap(), &path)
+}
+
+fn integrator(scene: &common::Built, name: &str) -> Box<dyn Integrator> {
+    let params: &[(&str, &str)] = if name == "path" {
+        &[]
+    } else {
+        &[("radius", "4"), ("spatial_rounds", "2")]
+    };
+    let options = IntegratorOptions {
+        name: Some(name.into()),
+        max_depth: Some(3),
+        params: params
+            .iter()
+            .map(|(k, v)| Param::new(*k, *v, ParamSource::Caller))
+            .collect(),
+    };
+    make_integrator(scene, &scene.integrator, &options)
+        .unwrap()
+        .integrator
+}
+
+fn run(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    passes: std::ops::Range<u32>,
+    moment: bool,
+) -> RenderOutput {
+    let job = RenderJob {
+        spp: passes.len() as u32,
+        seed: 7,
+        moment: moment.then(|| "nested".to_string()),
+        ..RenderJob::default()
+    };
+    let part = RenderPart {
+        first_pass: passes.start,
+        window: None,
+    };
+    render_part(
+        scene,
+        integrator,
+        &job,
+        &part,
+        &AtomicBool::new(false),
+        &mut |_, _| {},
+    )
+}
+
+#[test]
+fn the_second_moment_is_the_mean_of_each_pass_squared() {
+    let scene = cornell(24, 18);
+    const N: u32 = 6;
+    for name in ["path", "restir-di", "restir-pt"] {
+        let est = integrator(&scene, name);
+        let with = run(&scene, est.as_ref(), 0..N, true);
+        let without = run(&scene, est.as_ref(), 0..N, false);
+        assert_eq!(with.image, without.image, "{name}: the image changed");
+        assert!(without.moment.is_none());
+        let m = with.moment.expect("moments were asked for");
+        assert_eq!(m.name, "nested");
+
+        // The passes one at a time: Σ xyz(pass)² / N and Σ xyz(pass) / N.
+        let n = with.image.pixels.len();
+        let (mut sum, mut squares) = (vec![DVec3::ZERO; n], vec![DVec3::ZERO; n]);
+        for k in 0..N {
+            let one = run(&scene, est.as_ref(), k..k + 1, false);
+            for (i, p) in one.image.pixels.iter().enumerate() {
+                let xyz = srgb::to_xyz(p.as_dvec3());
+                sum[i] += xyz;
+                squares[i] += xyz * xyz;
+            }
+        }
+        let mut worst = 0.0f64;
+        let mut control = 0.0f64;
+        for i in 0..n {
+            let (mean, second) = (sum[i] / N as f64, squares[i] / N as f64);
+            let scale = second.max_element().max(1e-6);
+            worst = worst.max((m.second[i] - second).abs().max_element() / scale);
+            worst = worst.max((m.mean[i] - mean).abs().max_element() / scale.sqrt());
+            control = control.max((m.second[i] - mean * mean).abs().max_element() / scale);
+        }
+        // Single passes are stored in f32, the film sums in f64.
+        assert!(worst < 1e-5, "{name}: relative difference {worst}");
+        assert!(
+            control > 1e-2,
+            "{name}: the control does not differ ({control})"
+        );
+
+        // Mitsuba's channel names and order of values.
+        let channels = m.channels();
+        let names: Vec<_> = channels.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "nested.X",
+                "nested.Y",
+                "nested.Z",
+                "m2_nested.X",
+                "m2_nested.Y",
+                "m2_nested.Z"
+            ]
+        );
+        assert_eq!(channels[4].values[5], m.second[5].y as f32);
+    }
+}
