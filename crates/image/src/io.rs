@@ -108,32 +108,13 @@ impl Image {
     /// channels sorted by name.
     pub fn write_with(&self, path: &Path, extra: &[Channel]) -> Result<(), ImageError> {
         let format = extension(path);
-        if !extra.is_empty() {
-            if format.as_deref() != Some("exr") {
-                return Err(ImageError::ChannelsNeedExr {
-                    path: path.to_path_buf(),
-                });
-            }
-            return self.write_exr_channels(path, extra);
+        if !extra.is_empty() && format.as_deref() != Some("exr") {
+            return Err(ImageError::ChannelsNeedExr {
+                path: path.to_path_buf(),
+            });
         }
         match format.as_deref() {
-            Some("exr") => {
-                use exr::prelude::{SpecificChannels, Vec2, WritableImage};
-                let w = self.width as usize;
-                let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
-                    let p = self.pixels[y * w + x];
-                    (p.x, p.y, p.z)
-                });
-                let image = exr::prelude::Image::from_channels((w, self.height as usize), channels);
-                crate::write_atomically(
-                    path,
-                    |out| image.write().to_buffered(out),
-                    |source| ImageError::WriteExr {
-                        path: path.to_path_buf(),
-                        source,
-                    },
-                )
-            }
+            Some("exr") => self.write_exr_channels(path, extra),
             Some("png") => {
                 let bytes: Vec<u8> = self
                     .pixels
@@ -331,6 +312,19 @@ mod tests {
         assert_eq!(Image::read(&path, IntegerEncoding::Srgb).unwrap(), img);
         img.write(&dir.join("t.png")).unwrap();
         assert!(img.write(&dir.join("t.bmp")).is_err());
+        // More channels: the RGB reads back the same; a PNG cannot hold them.
+        let extra = [Channel {
+            name: "m2_x.Y".into(),
+            values: vec![2.0; 6],
+        }];
+        img.write_with(&path, &extra).unwrap();
+        assert_eq!(Image::read_exr(&path).unwrap(), img);
+        let png = dir.join("m.png");
+        assert!(matches!(
+            img.write_with(&png, &extra),
+            Err(ImageError::ChannelsNeedExr { .. })
+        ));
+        assert!(!png.exists());
         std::fs::remove_dir_all(&dir).ok();
     }
 
