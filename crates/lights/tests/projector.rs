@@ -9,12 +9,14 @@
 //! the frame's `−x`, `v` along its `−y`). Written here again from that description, not taken
 //! from the crate.
 
+mod common;
+
 use core::f32::consts::PI;
 use std::sync::Arc;
 
 use glam::{Mat4, Vec2, Vec3};
 use restir_geometry::{FovAxis, Shape};
-use restir_lights::{Light, LightError, LightPoint, LightSet, Presampled, Projector, SpotTexture};
+use restir_lights::{Light, LightError, LightSet, Projector, SpotTexture};
 use restir_sampling::{Pcg32, luminance, warp};
 use restir_testkit::{Grid2D, Histogram, Quadrature, RunningStats, sidak_level, trials};
 
@@ -234,53 +236,10 @@ fn power_is_unbiased() {
 }
 
 /// The sample a reservoir holds, resolved once and seen from the receiver, is what `sample`
-/// returned; a presampled pool draws it per receiver; nothing outside the frustum.
+/// returned; a presampled pool draws it per receiver; nothing beyond the frustum.
 #[test]
 fn reservoir_path_agrees_with_sample() {
-    let set = set_with(Some(Arc::new(Ramp)));
-    let mut rng = Pcg32::new(9, 0);
-    let (mut inside, mut outside) = (0, 0);
-    for _ in 0..20_000 {
-        let x = POSITION + 3.0 * warp::sample_uniform_sphere(rng.next_2d());
-        match set.sample(x, rng.next_f32(), rng.next_2d()) {
-            Some(s) => {
-                inside += 1;
-                let c = set
-                    .contact(&LightPoint::from_light_sample(&s), x)
-                    .expect("a sampled projector is seen from its receiver");
-                assert!(c.delta && c.measure == 1.0 && c.pdf_sa.is_none());
-                assert!((c.le - s.le).abs().max_element() <= 1e-6 * s.le.max_element());
-                assert!((c.wi - s.wi).length() < 1e-6 && (c.dist - s.dist).abs() < 1e-5);
-                assert_eq!(set.pdf_sa(0, x, s.p, s.ng), 0.0);
-            }
-            None => {
-                outside += 1;
-                let lp = LightPoint {
-                    light: 0,
-                    prim: 0,
-                    param: Vec2::ZERO,
-                };
-                assert!(set.contact(&lp, x).is_none());
-            }
-        }
-    }
-    assert!(inside > 0 && outside > 0);
-    assert!(matches!(
-        set.presample(0.5, Vec2::splat(0.5)),
-        Some(Presampled::Light { light: 0, pmf }) if pmf == 1.0
-    ));
-}
-
-/// A texture that returns its coordinates: `(u, v, 1)`.
-#[derive(Debug)]
-struct UvRamp;
-impl SpotTexture for UvRamp {
-    fn eval(&self, uv: Vec2) -> Vec3 {
-        uv.extend(1.0)
-    }
-    fn mean(&self) -> Vec3 {
-        Vec3::new(0.5, 0.5, 1.0)
-    }
+    common::reservoir_path_agrees_with_sample(&set_with(Some(Arc::new(Ramp))), POSITION);
 }
 
 /// The image is upright and unmirrored seen along the projector: `u` grows to the right (the
@@ -288,7 +247,7 @@ impl SpotTexture for UvRamp {
 /// `π·scale·irradiance·E` wherever it is hit.
 #[test]
 fn image_is_projected_upright() {
-    let set = set_with(Some(Arc::new(UvRamp)));
+    let set = set_with(Some(Arc::new(common::UvRamp)));
     let m = to_world();
     let (x, y, z) = (
         m.x_axis.truncate(),

@@ -7,12 +7,14 @@
 //! `(cutoff − θ)/(cutoff − beam)`, 0 beyond `cutoff`; written here again from that description,
 //! not taken from the crate.
 
+mod common;
+
 use core::f32::consts::PI;
 use std::sync::Arc;
 
 use glam::{Mat4, Vec2, Vec3};
 use restir_geometry::Shape;
-use restir_lights::{Light, LightError, LightPoint, LightSet, Presampled, Spot, SpotTexture};
+use restir_lights::{Light, LightError, LightSet, Spot, SpotTexture};
 use restir_sampling::{Pcg32, luminance, warp};
 use restir_testkit::{Histogram, RunningStats, sidak_level, trials};
 
@@ -193,57 +195,14 @@ fn power_is_unbiased() {
 /// returned; a presampled pool draws it per receiver; nothing beyond the cutoff.
 #[test]
 fn reservoir_path_agrees_with_sample() {
-    let set = set_with(None);
-    let mut rng = Pcg32::new(9, 0);
-    let (mut inside, mut outside) = (0, 0);
-    for _ in 0..20_000 {
-        let x = POSITION + 3.0 * warp::sample_uniform_sphere(rng.next_2d());
-        match set.sample(x, rng.next_f32(), rng.next_2d()) {
-            Some(s) => {
-                inside += 1;
-                let c = set
-                    .contact(&LightPoint::from_light_sample(&s), x)
-                    .expect("a sampled spot is seen from its receiver");
-                assert!(c.delta && c.measure == 1.0 && c.pdf_sa.is_none());
-                assert!((c.le - s.le).abs().max_element() <= 1e-6 * s.le.max_element());
-                assert!((c.wi - s.wi).length() < 1e-6 && (c.dist - s.dist).abs() < 1e-5);
-                assert_eq!(set.pdf_sa(0, x, s.p, s.ng), 0.0);
-            }
-            None => {
-                outside += 1;
-                let lp = LightPoint {
-                    light: 0,
-                    prim: 0,
-                    param: Vec2::ZERO,
-                };
-                assert!(set.contact(&lp, x).is_none());
-            }
-        }
-    }
-    assert!(inside > 0 && outside > 0);
-    assert!(matches!(
-        set.presample(0.5, Vec2::splat(0.5)),
-        Some(Presampled::Light { light: 0, pmf }) if pmf == 1.0
-    ));
-}
-
-/// A texture that returns its coordinates: `(u, v, 1)`.
-#[derive(Debug)]
-struct UvRamp;
-impl SpotTexture for UvRamp {
-    fn eval(&self, uv: Vec2) -> Vec3 {
-        uv.extend(1.0)
-    }
-    fn mean(&self) -> Vec3 {
-        Vec3::new(0.5, 0.5, 1.0)
-    }
+    common::reservoir_path_agrees_with_sample(&set_with(None), POSITION);
 }
 
 /// The texture is read at `(½ + ½ tan θₓ / tan c, ½ + ½ tan θ_y / tan c)` in the light's frame
 /// (the frame's `+x` and `+y` as `to_world` gives them).
 #[test]
 fn texture_is_projected_along_the_frame() {
-    let set = set_with(Some(Arc::new(UvRamp)));
+    let set = set_with(Some(Arc::new(common::UvRamp)));
     let m = to_world();
     let (x, y, z) = (
         m.x_axis.truncate(),
