@@ -1,11 +1,12 @@
 //! `restir bench` end to end on the smoke suite (tiny images, 0.2 s budgets, 64-pass references
 //! rendered into a temporary directory), and its errors on bad input.
 
-use restir_testkit::TempDir;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+use common::{fails, restir, s};
 
-const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
+use restir_testkit::TempDir;
+use std::path::PathBuf;
+use std::process::Command;
 
 fn repo(rel: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -15,35 +16,6 @@ fn repo(rel: &str) -> PathBuf {
 
 fn temp_dir(tag: &str) -> TempDir {
     TempDir::new("bench", tag)
-}
-
-fn restir(args: &[&str]) -> Output {
-    Command::new(RESTIR).args(args).output().unwrap()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-/// Expects exit code 1 and one stderr line containing every needle.
-fn fails(args: &[&str], needles: &[&str]) -> String {
-    let out = restir(args);
-    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
-    assert!(
-        !stderr.contains("panicked"),
-        "{args:?}: panicked:\n{stderr}"
-    );
-    assert_eq!(out.status.code(), Some(1), "{args:?}: stderr:\n{stderr}");
-    let lines: Vec<&str> = stderr.lines().collect();
-    assert_eq!(
-        lines.len(),
-        1,
-        "{args:?}: expected one line, got:\n{stderr}"
-    );
-    for n in needles {
-        assert!(lines[0].contains(n), "{args:?}: {:?} lacks {n:?}", lines[0]);
-    }
-    lines[0].to_string()
 }
 
 /// Splits a CSV line without quoted commas (the smoke suite's labels and settings have none).

@@ -1,15 +1,11 @@
 //! The `restir` command on bad input (exit code 1, a one-line error naming the problem, never a
 //! panic) and on a tiny happy path (images, `--stats` JSON, `compare`).
 
+mod common;
+use common::{cornell, fails, restir, s};
+
 use restir_testkit::TempDir;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
-
-fn cornell() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml")
-}
 
 fn temp_dir(tag: &str) -> TempDir {
     TempDir::new("cli", tag)
@@ -19,36 +15,6 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
     path
-}
-
-fn restir(args: &[&str]) -> Output {
-    Command::new(RESTIR).args(args).output().unwrap()
-}
-
-/// Runs `restir` with `args`, expects failure with exit code 1 and a single stderr line that
-/// contains every string in `needles`; returns that line.
-fn fails(args: &[&str], needles: &[&str]) -> String {
-    let out = restir(args);
-    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
-    assert!(
-        !stderr.contains("panicked"),
-        "{args:?}: panicked:\n{stderr}"
-    );
-    assert_eq!(out.status.code(), Some(1), "{args:?}: stderr:\n{stderr}");
-    let lines: Vec<&str> = stderr.lines().collect();
-    assert_eq!(
-        lines.len(),
-        1,
-        "{args:?}: expected one line, got:\n{stderr}"
-    );
-    for n in needles {
-        assert!(lines[0].contains(n), "{args:?}: {:?} lacks {n:?}", lines[0]);
-    }
-    lines[0].to_string()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 #[test]

@@ -2,30 +2,15 @@
 //! animated PNG preview and the statistics, and every bad flag refused before rendering with
 //! exit code 1 and exactly the message checked here.
 
-use restir_testkit::TempDir;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+use common::{RESTIR, fails_with, restir, s};
 
-const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
+use restir_testkit::TempDir;
+use std::path::PathBuf;
+use std::process::Command;
 
 fn temp_dir(tag: &str) -> TempDir {
     TempDir::new("frames", tag)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn restir(args: &[&str]) -> Output {
-    Command::new(RESTIR).args(args).output().unwrap()
-}
-
-fn fails_with(args: &[&str], expected: &str) {
-    let out = restir(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
-    assert_eq!(stderr, format!("{expected}\n"), "{args:?}");
-    assert!(out.stdout.is_empty(), "{args:?} printed a summary");
 }
 
 const ANIMATED: &str = r#"(

@@ -3,13 +3,13 @@
 //! they cannot be written (a PNG) a warning says so before rendering and the image is written;
 //! `restir convert` writes the wrapper back.
 
+mod common;
+use common::restir;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use restir_testkit::TempDir;
-
-const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
 
 /// A diffuse sphere under a constant sky, 12×12 with a box filter; the sky fills the corners.
 const SCENE: &str = r#"<scene version="3.0.0">
@@ -31,10 +31,6 @@ const SCENE: &str = r#"<scene version="3.0.0">
     <shape type="sphere"><bsdf type="diffuse"/></shape>
 </scene>
 "#;
-
-fn restir(args: &[&str]) -> Output {
-    Command::new(RESTIR).args(args).output().unwrap()
-}
 
 fn scene(dir: &Path) -> PathBuf {
     let path = dir.join("moment.xml");

@@ -4,23 +4,16 @@
 //! or stderr is no panic; an interrupt writes what was rendered and exits 130, a second one
 //! aborts at once without writing.
 
+mod common;
+use common::{RESTIR, cornell, s};
+
 use restir_testkit::TempDir;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
-
-fn cornell() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml")
-}
-
 fn temp_dir(tag: &str) -> TempDir {
     TempDir::new("output", tag)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 /// The names of the files in `dir`.

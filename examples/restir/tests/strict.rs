@@ -2,36 +2,14 @@
 //! exit code 1 and exactly the message checked here, naming the file and line or the flag, and
 //! the valid choices.
 
+mod common;
+use common::{cornell, fails_with, restir, s};
+
 use restir_testkit::TempDir;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
-
-fn cornell() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml")
-}
+use std::path::PathBuf;
 
 fn temp_dir(tag: &str) -> TempDir {
     TempDir::new("strict", tag)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn restir(args: &[&str]) -> Output {
-    Command::new(RESTIR).args(args).output().unwrap()
-}
-
-/// Runs `restir args`: exit code 1, nothing on stdout (nothing rendered), stderr exactly
-/// `expected` plus a newline.
-fn fails_with(args: &[&str], expected: &str) {
-    let out = restir(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
-    assert_eq!(stderr, format!("{expected}\n"), "{args:?}");
-    assert!(out.stdout.is_empty(), "{args:?} printed a summary");
 }
 
 /// A minimal scene with `body` after its sensor.
