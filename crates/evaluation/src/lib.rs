@@ -71,6 +71,7 @@ pub mod suite;
 
 pub use analysis::{Summary, TimeToError, flicker, sequence_runs, summarize, time_to_error};
 pub use error::BenchError;
+pub use measure::process_cpu_seconds;
 pub use records::{
     BenchResults, Machine, Progress, ReferenceInfo, RunOptions, RunRecord, SceneImages, Strip,
 };

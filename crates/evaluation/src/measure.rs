@@ -13,11 +13,11 @@ pub(crate) fn reset_peak_rss() -> bool {
     std::fs::write("/proc/self/clear_refs", "5").is_ok()
 }
 
-/// CPU seconds this process has run so far: the sum over its threads of the time each has
+/// CPU seconds this process has run so far (the clock of a suite's `clock: Cpu` budgets): the sum over its threads of the time each has
 /// spent on a CPU (`/proc/self/task/*/schedstat`, nanoseconds; the render pool's threads live
 /// as long as the run), else user + system time from `/proc/self/stat` (fields 14 and 15, in
 /// the 1/100 s ticks Linux reports them in); NaN without either.
-pub(crate) fn process_cpu_seconds() -> f64 {
+pub fn process_cpu_seconds() -> f64 {
     let schedstat = || -> Option<f64> {
         let mut ns = 0u64;
         for task in std::fs::read_dir("/proc/self/task").ok()? {
