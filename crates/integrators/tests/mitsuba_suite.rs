@@ -83,16 +83,9 @@ const KNOWN_FAILURES: &[(&str, &str, &str)] = &[
     ),
 ];
 
-/// Rows of the linear sRGB → CIE XYZ matrix (D65), as Mitsuba's `srgb_to_xyz`.
-const SRGB_TO_XYZ: [[f64; 3]; 3] = [
-    [0.412453, 0.357580, 0.180423],
-    [0.212671, 0.715160, 0.072169],
-    [0.019334, 0.119193, 0.950227],
-];
-
+/// Linear sRGB → CIE XYZ, with the matrix Mitsuba converts with.
 fn to_xyz(c: glam::Vec3) -> [f64; 3] {
-    let c = [f64::from(c.x), f64::from(c.y), f64::from(c.z)];
-    SRGB_TO_XYZ.map(|row| row[0] * c[0] + row[1] * c[1] + row[2] * c[2])
+    restir_image::srgb::to_xyz(c.as_dvec3()).to_array()
 }
 
 /// The two-sided p-value of a standard normal statistic `z ≥ 0`: `2(1 − Φ(z)) = P(χ²₁ ≥ z²)`.
@@ -504,7 +497,7 @@ fn the_criterion_accepts_noise_and_rejects_bias() {
     // Per-sample variance 0.09 in every XYZ channel, written as Mitsuba writes it: through
     // XYZ → sRGB (so some of its RGB values are negative).
     let xyz_var = 0.09f64;
-    let inv = invert(SRGB_TO_XYZ);
+    let inv = invert(restir_image::srgb::TO_XYZ);
     let rgb_var: [f32; 3] = inv.map(|row| (xyz_var * (row[0] + row[1] + row[2])) as f32);
     let variance = Image {
         width: w,
