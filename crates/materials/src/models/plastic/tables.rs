@@ -324,7 +324,8 @@ fn view(k: usize) -> (f32, Vec3) {
 ///   η = 4 (both distributions, α from 0.001 to 1); beyond that it may refuse an honest table,
 ///   which costs a rebuild, never a wrong table.
 ///
-/// The cost is about 30 % of a build for η > 1 (the check of `T` at η < 1 is most of one).
+/// The cost is about 30 % of a build for η > 1 (the check of `T` at η < 1 is most of one),
+/// spread over the cores as a build is.
 /// `R_int ≤ 1 − T̄/η²` (energy conservation with reciprocity, `T̄ = 2∫T(μ)μ dμ`) is checked
 /// first, as the cheap refusal of an `R_int` near 1, which would scale the diffuse base by
 /// `1/(1 − R_int)` as much as it likes.
@@ -350,26 +351,47 @@ pub(super) fn plausible(
     let mf = Microfacet::new(distribution, alpha);
     let avx2 = has_avx2();
     let nodes_t = Nodes::for_eta(distribution, eta);
-    let rows_ok = (0..TABLE_RES).all(|k| {
+    let rows_ok = in_parallel(|k| {
         let v = integrate_vndf(Lobe::Transmit, &mf, view(k).1, eta, nodes_t, avx2) as f32;
         (v - t.transmittance[k]).abs() <= 1e-5
     });
-    if !rows_ok {
+    if !rows_ok.into_iter().all(|ok| ok) {
         return false;
     }
     let built = Nodes::for_eta(distribution, 1.0 / eta);
     let exact = built.gl.len() <= 32;
     let coarse = (!exact).then(|| Nodes::new(distribution, 64));
     let nodes_r = coarse.as_ref().unwrap_or(built);
-    let r_sum: f64 = (0..TABLE_RES)
-        .map(|k| {
-            let (mu, v) = view(k);
-            integrate_vndf(Lobe::Reflect, &mf, v, 1.0 / eta, nodes_r, avx2) * mu as f64
-        })
-        .sum();
+    let r_sum: f64 = in_parallel(|k| {
+        let (mu, v) = view(k);
+        integrate_vndf(Lobe::Reflect, &mf, v, 1.0 / eta, nodes_r, avx2) * mu as f64
+    })
+    .into_iter()
+    .sum();
     let r_int = 2.0 * r_sum / TABLE_RES as f64;
     let tolerance = if exact { 1e-5 } else { 0.02 * (1.0 - r_int) };
     (t.internal_reflectance as f64 - r_int).abs() <= tolerance
+}
+
+/// `row(k)` for every row `k` of a table, in order. The rows are independent: they are spread
+/// over the cores (loading a scene waits for this).
+fn in_parallel<R: Copy + Default + Send>(row: impl Fn(usize) -> R + Sync) -> Vec<R> {
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(TABLE_RES);
+    let mut rows = vec![R::default(); TABLE_RES];
+    std::thread::scope(|s| {
+        let chunk = TABLE_RES.div_ceil(threads);
+        for (c, out) in rows.chunks_mut(chunk).enumerate() {
+            let row = &row;
+            s.spawn(move || {
+                for (i, slot) in out.iter_mut().enumerate() {
+                    *slot = row(c * chunk + i);
+                }
+            });
+        }
+    });
+    rows
 }
 
 fn build(distribution: Distribution, alpha: f32, eta: f32) -> RoughPlasticTable {
@@ -389,22 +411,7 @@ fn build_with(distribution: Distribution, alpha: f32, eta: f32, avx2: bool) -> R
         let r = integrate_vndf(Lobe::Reflect, &mf, v, 1.0 / eta, nodes_r, avx2);
         (t, r * mu as f64)
     };
-    // The rows are independent: spread them over the cores (loading a scene waits for this).
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(TABLE_RES);
-    let mut rows = vec![(0.0f32, 0.0f64); TABLE_RES];
-    std::thread::scope(|s| {
-        let chunk = TABLE_RES.div_ceil(threads);
-        for (c, out) in rows.chunks_mut(chunk).enumerate() {
-            let row = &row;
-            s.spawn(move || {
-                for (i, slot) in out.iter_mut().enumerate() {
-                    *slot = row(c * chunk + i);
-                }
-            });
-        }
-    });
+    let rows = in_parallel(row);
     let mut transmittance = [0.0f32; TABLE_RES];
     for (t, r) in transmittance.iter_mut().zip(&rows) {
         *t = r.0;
