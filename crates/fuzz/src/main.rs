@@ -2,15 +2,18 @@
 //! (`xml`, `ron`, `obj`, `ply`, `serialized`, `exr`, `hdr`, `png`), the reader of the parts
 //! of a split render that `restir merge` reads (`part`: `restir_image::Image::read_exr_part`),
 //! `restir bench` suite files (`suite`: `restir_evaluation::Suite::load_located`), animation
-//! files (`anim`: an XML scene's `NAME.anim.ron` sidecar, loaded with the scene and built at a
-//! few times) and the rough-plastic table cache (`cache`: a file at a table's name in the cache
-//! directory, read when a scene with that material loads).
+//! files (`anim`: an XML scene's `NAME.anim.ron` sidecar, or a RON scene with its animation
+//! inline, loaded and built at a few times and frames) and the rough-plastic table cache
+//! (`cache`: a file at a table's name in the cache directory, read when a scene with that
+//! material loads; half of its inputs are tables with changed values and a valid checksum, and a
+//! table the reader uses must be the integral it stands for).
 //!
 //! Coverage-guided fuzzers need nightly Rust (cargo-fuzz) or an AFL++ toolchain; this workspace
 //! builds on one stable toolchain, so the harness mutates the checked-in seeds in
 //! `crates/fuzz/corpus/<target>/` with a fixed-seed generator (byte flips and overwrites,
 //! interesting integers, numbers replaced by `1e38`, `NaN`, `-0`, huge counts, chunk
-//! duplication, splices, truncation) and loads each input (`restir_scene::load_scene`, the
+//! duplication, splices, truncation; for the cache, value changes under a valid checksum:
+//! `mutate.rs`) and loads each input (`restir_scene::load_scene`, the
 //! whole build) in a child process run under `ulimit -v` (a memory cap) and a time limit. Errors
 //! are the expected outcome; a panic, an abort, a signal, a hang or a breach of the memory cap
 //! fails the run, and the input is kept in the work directory for a regression case.
@@ -24,6 +27,9 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
 use std::time::{Duration, Instant};
+
+mod mutate;
+use mutate::{Rng, mutate, mutate_table};
 
 /// The formats, with how an input of each is placed into a scene.
 const TARGETS: [&str; 12] = [
@@ -46,138 +52,6 @@ const TIME_LIMIT: Duration = Duration::from_secs(10);
 
 /// The child's address-space limit in KiB (`ulimit -v`): 3 GiB.
 const MEMORY_LIMIT_KIB: u64 = 3 << 20;
-
-/// SplitMix64: the mutator's random numbers (fixed seed, so a run is reproducible).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
-
-/// Numbers that stress a loader where a number is expected.
-const NUMBERS: [&str; 14] = [
-    "1e38",
-    "3e38",
-    "1e39",
-    "NaN",
-    "nan",
-    "inf",
-    "-inf",
-    "-0",
-    "1e20",
-    "1e-45",
-    "4294967295",
-    "-1",
-    "99999999999999999999",
-    "65536",
-];
-
-/// Integers that stress a binary header.
-const INTEGERS: [u64; 10] = [
-    0,
-    1,
-    0xFF,
-    0xFFFF,
-    0x7FFF_FFFF,
-    0xFFFF_FFFF,
-    0x8000_0000,
-    1 << 32,
-    u64::MAX,
-    0x7FC0_0000, // f32 NaN
-];
-
-/// One mutation of `input` (`others` are the target's seeds, for splicing).
-fn mutate(rng: &mut Rng, input: &[u8], others: &[Vec<u8>]) -> Vec<u8> {
-    let mut v = input.to_vec();
-    let rounds = 1 + rng.below(4);
-    for _ in 0..rounds {
-        let len = v.len().max(1);
-        match rng.below(9) {
-            0 if !v.is_empty() => {
-                let i = rng.below(v.len());
-                v[i] ^= 1 << rng.below(8);
-            }
-            1 if !v.is_empty() => {
-                let i = rng.below(v.len());
-                v[i] = rng.next() as u8;
-            }
-            2 => {
-                // An interesting integer, little- or big-endian, 1 to 8 bytes wide.
-                let x = INTEGERS[rng.below(INTEGERS.len())];
-                let w = [1, 2, 4, 8][rng.below(4)];
-                let bytes = if rng.below(2) == 0 {
-                    x.to_le_bytes()
-                } else {
-                    x.to_be_bytes()
-                };
-                let at = rng.below(len);
-                for k in 0..w {
-                    if let Some(b) = v.get_mut(at + k) {
-                        *b = bytes[if rng.below(2) == 0 { k } else { 8 - w + k }];
-                    }
-                }
-            }
-            3 => {
-                // Replace a number in text by a stressful one.
-                let starts: Vec<usize> = (0..v.len())
-                    .filter(|&i| {
-                        v[i].is_ascii_digit() && (i == 0 || !v[i - 1].is_ascii_alphanumeric())
-                    })
-                    .collect();
-                if !starts.is_empty() {
-                    let s = starts[rng.below(starts.len())];
-                    let e = (s..v.len())
-                        .find(|&i| !(v[i].is_ascii_digit() || b".eE-+".contains(&v[i])))
-                        .unwrap_or(v.len());
-                    let n = NUMBERS[rng.below(NUMBERS.len())].as_bytes();
-                    v.splice(s..e, n.iter().copied());
-                }
-            }
-            4 => {
-                // Duplicate a chunk many times (amplification, huge element lists).
-                let s = rng.below(len);
-                let e = (s + 1 + rng.below(64)).min(v.len());
-                if s < e {
-                    let chunk = v[s..e].to_vec();
-                    let times = 1 + rng.below(200);
-                    for _ in 0..times {
-                        v.splice(e..e, chunk.iter().copied());
-                    }
-                }
-            }
-            5 => {
-                let s = rng.below(len);
-                let e = (s + rng.below(32)).min(v.len());
-                if s < e {
-                    v.drain(s..e);
-                }
-            }
-            6 => v.truncate(rng.below(len)),
-            7 if !others.is_empty() => {
-                let o = &others[rng.below(others.len())];
-                let at = rng.below(len).min(v.len());
-                let from = rng.below(o.len().max(1)).min(o.len());
-                v.truncate(at);
-                v.extend_from_slice(&o[from..]);
-            }
-            _ => {
-                let at = rng.below(len).min(v.len());
-                let b = [b'$', b'<', b'>', b'"', b'\0', b'\n', b'(', b')', b',', b'-'];
-                v.insert(at, b[rng.below(b.len())]);
-            }
-        }
-    }
-    v
-}
 
 /// The scene (file name, text) that refers to an asset input of `target` named `asset`.
 fn wrapper_scene(target: &str, asset: &str) -> String {
@@ -223,16 +97,25 @@ fn answer(result: Result<(), String>) -> ExitCode {
     ExitCode::SUCCESS
 }
 
-/// An animation input: the sidecar of [`ANIM_SCENE`], the scene loaded with it and built at a
-/// few times (inside, before, after and far beyond its keys).
+/// An animation input: the sidecar of [`ANIM_SCENE`] (or, for a seed named `*.scene.ron`, a RON
+/// scene with its animation inline), the scene loaded with it and built at a few times: inside,
+/// before, after and far beyond its keys, and the times of the first, a later and the last
+/// frame `--frames` can name at the animation's own rate.
 fn load_animated(input: &Path) -> Result<(), String> {
-    let dir = input.parent().unwrap_or(Path::new("."));
-    let scene = dir.join("anim-scene.xml");
-    std::fs::write(&scene, ANIM_SCENE).map_err(|e| e.to_string())?;
-    std::fs::copy(input, restir_scene::sidecar_path(&scene)).map_err(|e| e.to_string())?;
+    let scene = if input.to_string_lossy().ends_with(".scene.ron") {
+        input.to_path_buf()
+    } else {
+        let dir = input.parent().unwrap_or(Path::new("."));
+        let scene = dir.join("anim-scene.xml");
+        std::fs::write(&scene, ANIM_SCENE).map_err(|e| e.to_string())?;
+        std::fs::copy(input, restir_scene::sidecar_path(&scene)).map_err(|e| e.to_string())?;
+        scene
+    };
     let loaded = restir_scene::load_scene(&scene, &restir_scene::LoadOptions::default())
         .map_err(|e| e.to_string())?;
-    for t in [0.0, 1.3, -1.0, 1e6] {
+    let fps = loaded.desc.animation.as_ref().map_or(24.0, |a| a.fps);
+    let frames = [0, 47, u32::MAX].map(|f| restir_scene::animation::frame_time(f, fps));
+    for t in [0.0, 1.3, -1.0, 1e6].into_iter().chain(frames) {
         restir_scene::animation::build_at(&loaded.desc, &scene, t).map_err(|e| e.to_string())?;
     }
     Ok(())
@@ -241,7 +124,10 @@ fn load_animated(input: &Path) -> Result<(), String> {
 /// A table cache input: `input` lies in a directory of its own under the name of the table the
 /// seed holds; that directory is the cache while [`CACHE_SCENE`] loads. A seed must be read as
 /// it is (the loader rebuilding and replacing it would mean its name or contents went stale, and
-/// the target no longer reached the reader).
+/// the target no longer reached the reader). A mutated input that is read (not replaced by a
+/// rebuilt table) must be the seed's table within what the reader's checks let through: a
+/// transmittance row within 10⁻⁵, the internal reflectance within 2.5 % of `1 − R_int`;
+/// anything else is a crafted table trusted, and the child exits with status 5.
 fn load_cached(input: &Path) -> Result<(), String> {
     use std::os::unix::fs::MetadataExt as _;
     let cache = input.parent().ok_or("the input has no directory")?;
@@ -259,7 +145,53 @@ fn load_cached(input: &Path) -> Result<(), String> {
             input.display()
         ));
     }
+    if !replaced && let Some(why) = trusted_but_not_honest(input) {
+        eprintln!(
+            "{}: a table that is not the integral was used ({why})",
+            input.display()
+        );
+        std::process::exit(5);
+    }
     Ok(())
+}
+
+/// The values of a table cache file (between the 8-byte magic and the 8-byte checksum).
+fn table_values(bytes: &[u8]) -> Vec<f32> {
+    bytes
+        .get(8..bytes.len().saturating_sub(8))
+        .unwrap_or_default()
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect()
+}
+
+/// How the table cache file `input` differs from the seed of its name (the honest table) by
+/// more than the reader's checks allow, if it does.
+fn trusted_but_not_honest(input: &Path) -> Option<String> {
+    let name = input.file_name()?;
+    let seed = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("corpus/cache")
+        .join(name);
+    let honest = table_values(&std::fs::read(seed).ok()?);
+    let read = table_values(&std::fs::read(input).unwrap_or_default());
+    let (&r_honest, t_honest) = honest.split_last()?;
+    let Some((&r_read, t_read)) = read.split_last() else {
+        return Some("it has no values".into());
+    };
+    if t_read.len() != t_honest.len() {
+        return Some(format!("{} values", read.len()));
+    }
+    // Written so that NaN counts as a difference.
+    let close = |a: f32, b: f32, tolerance: f32| (a - b).abs() <= tolerance;
+    for (k, (&a, &b)) in t_read.iter().zip(t_honest).enumerate() {
+        if !close(a, b, 1e-5) {
+            return Some(format!("transmittance row {k}: {a} for {b}"));
+        }
+    }
+    if !close(r_read, r_honest, 0.025 * (1.0 - r_honest)) {
+        return Some(format!("internal reflectance {r_read} for {r_honest}"));
+    }
+    None
 }
 
 /// The child: loads one input of `target` (`input` is the mutated file) and exits 0 whatever the
@@ -441,15 +373,17 @@ fn run(o: &Options) -> ExitCode {
         while start.elapsed().as_secs_f64() < o.seconds {
             let (name, seed) = &seeds[n % seeds.len()];
             // The seeds first, as they are (they must load), then mutations.
+            // Half of the cache's inputs are crafted tables with a valid checksum.
             let bytes = if n < seeds.len() {
                 seed.clone()
+            } else if target == "cache" && n % 2 == 1 {
+                mutate_table(&mut rng, seed, &others)
             } else {
                 mutate(&mut rng, seed, &others)
             };
-            let ext = Path::new(name)
-                .extension()
-                .and_then(|e| e.to_str())
-                .unwrap_or(target);
+            // Everything after the name's first dot (`scene.ron` tells a RON scene with its
+            // animation inline from a sidecar).
+            let ext = name.split_once('.').map_or(target.as_str(), |(_, e)| e);
             // A cache input keeps its seed's name (the table's), in a directory of its own.
             let input = if target == "cache" {
                 dir.join("cache").join(name)
@@ -553,6 +487,27 @@ mod tests {
                 "{name} does not start with {prefix}"
             );
         }
+    }
+
+    /// A crafted table keeps the cache file's shape and carries a valid checksum, so that it
+    /// reaches the reader's value checks; it differs from its seed.
+    #[test]
+    fn crafted_tables_pass_the_checksum() {
+        let (_, seed) = &seeds(
+            &Path::new(env!("CARGO_MANIFEST_DIR")).join("corpus"),
+            "cache",
+        )[0];
+        let mut rng = Rng(3);
+        let mut changed = 0;
+        for _ in 0..100 {
+            let t = mutate_table(&mut rng, seed, &[]);
+            assert_eq!(t.len(), seed.len());
+            let body = t.len() - 8;
+            let sum = u64::from_le_bytes(t[body..].try_into().unwrap());
+            assert_eq!(sum, restir_sampling::hash::fnv1a(&t[..body]));
+            changed += usize::from(t != *seed);
+        }
+        assert!(changed > 80, "{changed}");
     }
 
     /// The mutator is deterministic and does change its input.
