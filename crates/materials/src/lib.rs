@@ -96,6 +96,7 @@ pub use bsdf::{Bsdf, BsdfKind, ReflectanceParams};
 pub use lobe::LobeFlags;
 pub use microfacet::{Distribution, Microfacet};
 pub use models::BsdfSample;
+pub use models::blend::Blend;
 pub use models::bumpmap::{bump_normal, normal_texel};
 pub use models::normalmap::NormalMap;
 pub use models::plastic::cache as table_cache;
