@@ -711,7 +711,10 @@ mod tests {
             core::mem::size_of::<Principled>()
         );
         assert!(core::mem::size_of::<Blend>() <= core::mem::size_of::<Principled>());
-        assert_eq!(core::mem::align_of::<Blend>(), core::mem::align_of::<BsdfKind>());
+        assert_eq!(
+            core::mem::align_of::<Blend>(),
+            core::mem::align_of::<BsdfKind>()
+        );
     }
 
     #[test]

@@ -26,7 +26,11 @@ fn models() -> Vec<Bsdf> {
         Bsdf::black(),
         Bsdf::diffuse(c).masked(0.4),
         Bsdf::diffuse(c).normal_mapped(NormalMap::new(Vec3::new(0.7, 0.4, 0.85), true, true)),
-        Bsdf::blend(0.3, Bsdf::diffuse(c), Bsdf::rough_conductor(au_eta, au_k, Vec3::ONE, mf)),
+        Bsdf::blend(
+            0.3,
+            Bsdf::diffuse(c),
+            Bsdf::rough_conductor(au_eta, au_k, Vec3::ONE, mf),
+        ),
     ]
 }
 
