@@ -64,7 +64,7 @@ pub enum ReadFailure {
     Io(std::io::Error),
     /// The EXR decoder failed.
     Exr(exr::error::Error),
-    /// The PNG/JPEG/HDR decoder failed.
+    /// The PNG/JPEG/BMP/HDR decoder failed.
     Decode(image::ImageError),
     /// The image has no pixels, or fewer than its size says.
     Empty,

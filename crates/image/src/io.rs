@@ -1,5 +1,5 @@
 //! Reading and writing image files: EXR (linear float32), PNG (8-bit sRGB) output; EXR, Radiance
-//! HDR, PNG and JPEG input. The one EXR decoder of the workspace is [`read_exr_pixels`].
+//! HDR, PNG, JPEG and BMP input. The one EXR decoder of the workspace is [`read_exr_pixels`].
 
 use std::path::Path;
 
@@ -17,7 +17,7 @@ pub struct Channel {
     pub values: Vec<f32>,
 }
 
-/// How [`Image::read`] interprets the integer (8- or 16-bit) channels of PNG and JPEG files.
+/// How [`Image::read`] interprets the integer (8- or 16-bit) channels of PNG, JPEG and BMP files.
 /// Float formats (EXR, Radiance HDR) hold linear values and are never decoded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum IntegerEncoding {
@@ -234,7 +234,7 @@ impl Image {
     }
 
     /// Reads an image a scene refers to as linear RGB, the first row at the top: EXR (by
-    /// extension) and Radiance HDR hold linear values; PNG/JPEG (8- or 16-bit, format guessed from
+    /// extension) and Radiance HDR hold linear values; PNG/JPEG/BMP (8- or 16-bit, format guessed from
     /// the contents) are decoded as `encoding` says. Empty images and non-finite values are errors.
     /// Used for bitmap textures and environment maps.
     pub fn read(path: &Path, encoding: IntegerEncoding) -> Result<Self, ImageError> {
@@ -348,6 +348,30 @@ mod tests {
         );
         assert!(
             (back.pixels[1] - Vec3::new(1.0, 0.0, 0.25))
+                .abs()
+                .max_element()
+                < 0.01
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// BMP textures (Mitsuba reads them; its test scenes use one) are 8-bit sRGB like PNG, and
+    /// their size is read from the header.
+    #[test]
+    fn bmp_is_read_as_srgb() {
+        let dir = temp_dir("bmp");
+        let path = dir.join("t.bmp");
+        image::RgbImage::from_raw(2, 1, vec![0, 188, 255, 255, 0, 64])
+            .unwrap()
+            .save(&path)
+            .unwrap();
+        assert_eq!(Image::read_dimensions(&path).unwrap(), (2, 1));
+        let raw = Image::read(&path, IntegerEncoding::Raw).unwrap();
+        assert_eq!(raw.pixels[0], Vec3::new(0.0, 188.0 / 255.0, 1.0));
+        assert_eq!(raw.pixels[1], Vec3::new(1.0, 0.0, 64.0 / 255.0));
+        let back = Image::read(&path, IntegerEncoding::Srgb).unwrap();
+        assert!(
+            (back.pixels[0] - Vec3::new(0.0, 0.5, 1.0))
                 .abs()
                 .max_element()
                 < 0.01

@@ -7,7 +7,7 @@
 //!   [`Image::read_exr`] reads a rendered EXR back; [`Image::write_exr_part`] /
 //!   [`Image::read_exr_part`] an EXR of one part of a render ([`ExrPart`]: its place in the film
 //!   and text attributes); [`Image::read`] reads what a scene refers to
-//!   (PNG/JPEG, sRGB-decoded unless told otherwise, EXR and Radiance HDR as linear values) for
+//!   (PNG/JPEG/BMP, sRGB-decoded unless told otherwise, EXR and Radiance HDR as linear values) for
 //!   textures and environment maps. Failures are an [`ImageError`] naming the file.
 //! - [`srgb`]: the sRGB transfer function both ways.
 //! - [`compare`]: the error metrics of a test image against a reference ([`ErrorMetrics`]:

@@ -535,6 +535,34 @@ fn unbiased_with_glass() {
     assert!(z < Z_MAX, "glass: max |z| = {z:.2}");
 }
 
+/// Blends (Mitsuba's `blendbsdf`): one of a diffuse and a rough conductor (connectible, so paths
+/// reconnect at it and the shift evaluates the mix), one of a diffuse and a smooth mirror (a
+/// delta component: not connectible), and a two-sided blend in a blend as the partition.
+#[test]
+fn unbiased_with_blends() {
+    let scene = build(
+        &scene_text(
+            r#"(geometry: Sphere(center: (-0.6, 0.45, 0.6), radius: 0.4),
+             material: Some(Inline(Blend(weight: 0.4, bsdfs: (Diffuse(reflectance: (0.2, 0.6, 0.3)),
+             RoughConductor(ior: (material: Some("Cu")), roughness: (alpha: 0.3))))))),
+            (geometry: Sphere(center: (0.9, 1.2, -0.3), radius: 0.3),
+             material: Some(Inline(Blend(weight: 0.5, bsdfs: (Diffuse(reflectance: (0.6, 0.6, 0.6)),
+             Conductor()))))),"#,
+        )
+        .replace(
+            "Inline(TwoSided(Diffuse(reflectance: (0.6, 0.6, 0.5))))",
+            "Inline(TwoSided(Blend(weight: 0.7, bsdfs: (Diffuse(reflectance: (0.6, 0.6, 0.5)), \
+             Blend(weight: 0.5, bsdfs: (Diffuse(reflectance: (0.9, 0.2, 0.2)), \
+             RoughPlastic(roughness: (alpha: 0.2))))))))",
+        ),
+    );
+    let reference = statistics(&scene, "path", &[("max_depth", "5")], 128, 64);
+    let pt = statistics(&scene, "restir-pt", &[("max_depth", "5")], 1, 400);
+    let z = max_z(&pt, &reference);
+    eprintln!("blends, max_depth 5: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "blends: max |z| = {z:.2}");
+}
+
 /// A floor of eight strips, near-specular (a rough conductor with alpha 0.01, not connectible)
 /// alternating with diffuse ones, under most of the view: paths from neighbouring pixels often
 /// bounce off different kinds of strip, which is what the hybrid shift's invertibility checks

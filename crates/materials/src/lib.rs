@@ -30,7 +30,8 @@
 //! # Models
 //!
 //! [`BsdfKind`] holds Mitsuba 3's `diffuse`, `conductor`, `roughconductor`, `dielectric`,
-//! `roughdielectric`, `plastic`, `roughplastic` and `null` with Mitsuba's parameters, defaults and
+//! `roughdielectric`, `plastic`, `roughplastic` and `null`, and `blendbsdf` (two of them mixed by
+//! a weight: [`Blend`], `src/models/blend.rs`), with Mitsuba's parameters, defaults and
 //! formulas (the specification is Mitsuba 3's plugin reference, "BSDFs", and its
 //! `src/bsdfs/*.cpp`; each model's documentation names the paper it follows). Each family's
 //! maths sits in one file of `src/models/` (`diffuse`, `conductor`, `dielectric`, `plastic`: its
@@ -96,6 +97,7 @@ pub use bsdf::{Bsdf, BsdfKind, ReflectanceParams};
 pub use lobe::LobeFlags;
 pub use microfacet::{Distribution, Microfacet};
 pub use models::BsdfSample;
+pub use models::blend::Blend;
 pub use models::bumpmap::{bump_normal, normal_texel};
 pub use models::normalmap::NormalMap;
 pub use models::plastic::cache as table_cache;

@@ -208,6 +208,74 @@ fn cases() -> Vec<Case> {
         albedo: None,
         eta: 1.0,
     });
+    // Blends: a component picked by weight; smooth samples carry the whole mix's eval and pdf.
+    let coloured = Vec3::new(0.8, 0.5, 0.2);
+    v.push(Case {
+        name: "blend 0.3 of coloured and white diffuse",
+        bsdf: Bsdf::blend(0.3, Bsdf::diffuse(coloured), Bsdf::diffuse(Vec3::ONE)),
+        mass: Mass::One,
+        albedo: Some(coloured * 0.7 + Vec3::splat(0.3)),
+        eta: 1.0,
+    });
+    v.push(Case {
+        name: "blend 0.5 of diffuse and a mirror (delta)",
+        bsdf: Bsdf::blend(
+            0.5,
+            Bsdf::diffuse(coloured),
+            Bsdf::conductor(mirror.0, mirror.1, Vec3::ONE),
+        ),
+        mass: Mass::AtMostOne,
+        albedo: Some(coloured * 0.5 + Vec3::splat(0.5)),
+        eta: 1.0,
+    });
+    v.push(Case {
+        name: "blend 0.6 of rough plastic and rough gold",
+        bsdf: Bsdf::blend(
+            0.6,
+            Bsdf::rough_plastic(pp, coloured, Vec3::ONE, false, Distribution::Beckmann, 0.2),
+            Bsdf::rough_conductor(
+                gold.0,
+                gold.1,
+                Vec3::ONE,
+                Microfacet::new(Distribution::Ggx, 0.3),
+            ),
+        ),
+        mass: Mass::AtMostOne,
+        albedo: None,
+        eta: 1.0,
+    });
+    v.push(Case {
+        name: "blend 0.4 of two-sided diffuse and smooth glass",
+        bsdf: Bsdf::blend(
+            0.4,
+            Bsdf::diffuse(coloured).two_sided(),
+            Bsdf::dielectric(glass, Vec3::ONE, Vec3::ONE),
+        ),
+        mass: Mass::AtMostOne,
+        albedo: None,
+        eta: glass,
+    });
+    v.push(Case {
+        name: "two-sided blend 0.5 of a blend (diffuse, rough conductor) and a normal-mapped mask",
+        bsdf: Bsdf::blend(
+            0.5,
+            Bsdf::blend(
+                0.25,
+                Bsdf::diffuse(coloured),
+                Bsdf::rough_conductor(
+                    mirror.0,
+                    mirror.1,
+                    Vec3::ONE,
+                    Microfacet::new(Distribution::Beckmann, 0.2),
+                ),
+            ),
+            Bsdf::diffuse(Vec3::ONE).normal_mapped(tilted).masked(0.7),
+        )
+        .two_sided(),
+        mass: Mass::AtMostOne,
+        albedo: None,
+        eta: 1.0,
+    });
     for (dist, dname) in [
         (Distribution::Beckmann, "beckmann"),
         (Distribution::Ggx, "ggx"),
@@ -592,6 +660,27 @@ fn control_normal_map_vs_unperturbed_pdf() {
     rejected(
         "normal-mapped samples vs the unperturbed pdf",
         hist.chi2(&pdf_cells(&grid, &inner, wo)),
+    );
+}
+
+/// A blend's samples against the pdf of its first component alone, as if `pdf_sa` had
+/// forgotten the mix.
+#[test]
+fn control_blend_vs_one_component_pdf() {
+    let grid = SphereGrid::default();
+    let first = Bsdf::diffuse(Vec3::ONE);
+    let second = Bsdf::rough_conductor(
+        Vec3::ZERO,
+        Vec3::ONE,
+        Vec3::ONE,
+        Microfacet::new(Distribution::Ggx, 0.2),
+    );
+    let blend = Bsdf::blend(0.3, first, second);
+    let wo = Vec3::new(0.3, 0.2, 0.93).normalize();
+    let hist = sample_histogram(&grid, &blend, wo, 96, SAMPLES);
+    rejected(
+        "blend samples vs its first component's pdf",
+        hist.chi2(&pdf_cells(&grid, &first, wo)),
     );
 }
 

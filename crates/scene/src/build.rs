@@ -100,6 +100,7 @@ fn material(
         alpha_v: None,
         principled: Default::default(),
         bump: None,
+        weight: None,
     };
     for b in bindings {
         let id = Some(cache.get(&b.texture, base_dir)?);
@@ -129,6 +130,7 @@ fn material(
             }
             ColorParam::AlphaU => t.alpha_u = id,
             ColorParam::AlphaV => t.alpha_v = id,
+            ColorParam::Weight => t.weight = id,
             _ => unreachable!("the principled parameters are bound above"),
         }
     }

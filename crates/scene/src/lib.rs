@@ -232,7 +232,10 @@ impl Scene {
         if let Some(n) = normal {
             p.normal = n;
         }
-        let b = self.bsdfs[bsdf as usize].with_params(&p);
+        let mut b = self.bsdfs[bsdf as usize].with_params(&p);
+        if let Some(w) = t.weight {
+            b = b.with_blend_weight(self.textures[w as usize].eval_1_at(&self.shapes, at));
+        }
         if t.principled.any() {
             t.principled.apply(b, &self.textures, &self.shapes, at)
         } else {
@@ -266,6 +269,9 @@ pub struct TexturedParams {
     /// A `bumpmap`'s height texture and scale: its gradient perturbs the normal at each hit
     /// ([`Scene::bsdf`]; [`TexturedParams::eval`] leaves the normal flat).
     pub bump: Option<(u32, f32)>,
+    /// Texture of a `blendbsdf`'s `weight` (its luminance, as Mitsuba's scalar lookup; clamped
+    /// to `[0, 1]`).
+    pub weight: Option<u32>,
 }
 
 impl TexturedParams {

@@ -112,7 +112,20 @@ pub enum MaterialError {
         /// Its value.
         value: f32,
     },
+    /// A `blendbsdf` weight outside `[0, 1]` (or not finite).
+    BadBlendWeight {
+        /// Its value.
+        value: f32,
+    },
+    /// A `blendbsdf` component with textured parameters (or a bump map, whose height is one).
+    BlendTexturedComponent,
+    /// `blendbsdf`s nested deeper than [`MAX_BLEND_DEPTH`].
+    BlendTooDeep,
 }
+
+/// How many `blendbsdf`s may nest inside one another (each level is one more recursive call
+/// in every evaluation).
+pub const MAX_BLEND_DEPTH: usize = 8;
 
 impl core::fmt::Display for MaterialError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
@@ -202,6 +215,16 @@ impl core::fmt::Display for MaterialError {
             MaterialError::BadBumpScale { value } => {
                 write!(f, "bumpmap scale {value} must be finite")
             }
+            MaterialError::BadBlendWeight { value } => {
+                write!(f, "blendbsdf weight {value} must lie in [0, 1]")
+            }
+            MaterialError::BlendTexturedComponent => f.write_str(
+                "a blendbsdf's two bsdfs must have constant parameters: only the weight may be a texture (a textured bsdf or a bumpmap inside a blendbsdf is not supported)",
+            ),
+            MaterialError::BlendTooDeep => write!(
+                f,
+                "blendbsdfs nest at most {MAX_BLEND_DEPTH} deep"
+            ),
         }
     }
 }
@@ -442,6 +465,21 @@ fn bsdf_in(m: &MaterialDesc, spec_trans_textured: bool) -> Result<Bsdf> {
             b.two_sided()
         }
         MaterialDesc::Black => Bsdf::black(),
+        MaterialDesc::Blend { weight, bsdfs } => {
+            if !(0.0..=1.0).contains(weight) {
+                return Err(MaterialError::BadBlendWeight { value: *weight });
+            }
+            if blend_depth(m) > MAX_BLEND_DEPTH {
+                return Err(MaterialError::BlendTooDeep);
+            }
+            let (first, second) = &**bsdfs;
+            for c in [first, second] {
+                if contains_textured(c) || bump_scale(c).is_some() {
+                    return Err(MaterialError::BlendTexturedComponent);
+                }
+            }
+            Bsdf::blend(*weight, bsdf(first)?, bsdf(second)?)
+        }
         MaterialDesc::Mask { opacity, material } => {
             if matches!(**material, MaterialDesc::Mask { .. }) {
                 return Err(MaterialError::NestedMask);
@@ -462,7 +500,9 @@ fn bsdf_in(m: &MaterialDesc, spec_trans_textured: bool) -> Result<Bsdf> {
                 let mask_opacity = t.param == ColorParam::Opacity && is_mask(material);
                 let normal_map = t.param == ColorParam::NormalMap && has_normal_map(material);
                 let bump_map = t.param == ColorParam::BumpMap && bump_scale(material).is_some();
-                if !(allowed.contains(&t.param) || mask_opacity || normal_map || bump_map) {
+                let weight = t.param == ColorParam::Weight && is_blend(material);
+                if !(allowed.contains(&t.param) || mask_opacity || normal_map || bump_map || weight)
+                {
                     return Err(MaterialError::NoSuchParameter {
                         param: t.param,
                         allowed,
@@ -503,12 +543,55 @@ pub(crate) fn color_params(m: &MaterialDesc) -> &'static [ColorParam] {
         | MaterialDesc::BumpMap { material, .. } => color_params(material),
         MaterialDesc::Principled { .. } => crate::principled::PRINCIPLED_PARAMS,
         MaterialDesc::PrincipledThin { .. } => crate::principled::PRINCIPLED_THIN_PARAMS,
-        MaterialDesc::Null | MaterialDesc::Black => &[],
+        MaterialDesc::Null | MaterialDesc::Black | MaterialDesc::Blend { .. } => &[],
+    }
+}
+
+/// Whether `m` is a `blendbsdf` (perhaps inside a `twosided`, a `mask`, a normal or bump
+/// map), whose weight a texture may give.
+pub(crate) fn is_blend(m: &MaterialDesc) -> bool {
+    match m {
+        MaterialDesc::Blend { .. } => true,
+        MaterialDesc::TwoSided(inner)
+        | MaterialDesc::Mask {
+            material: inner, ..
+        }
+        | MaterialDesc::NormalMap {
+            material: inner, ..
+        }
+        | MaterialDesc::BumpMap {
+            material: inner, ..
+        }
+        | MaterialDesc::Textured {
+            material: inner, ..
+        } => is_blend(inner),
+        _ => false,
+    }
+}
+
+/// How many `blendbsdf`s nest in `m` at most (0 without one).
+fn blend_depth(m: &MaterialDesc) -> usize {
+    match m {
+        MaterialDesc::Blend { bsdfs, .. } => 1 + blend_depth(&bsdfs.0).max(blend_depth(&bsdfs.1)),
+        MaterialDesc::TwoSided(inner)
+        | MaterialDesc::Mask {
+            material: inner, ..
+        }
+        | MaterialDesc::NormalMap {
+            material: inner, ..
+        }
+        | MaterialDesc::BumpMap {
+            material: inner, ..
+        }
+        | MaterialDesc::Textured {
+            material: inner, ..
+        } => blend_depth(inner),
+        _ => 0,
     }
 }
 
 /// Whether `m` is textured, or wraps (in `twosided` or `mask`) a textured material.
-fn contains_textured(m: &MaterialDesc) -> bool {
+pub(crate) fn contains_textured(m: &MaterialDesc) -> bool {
     match m {
         MaterialDesc::Textured { .. } => true,
         MaterialDesc::TwoSided(inner)

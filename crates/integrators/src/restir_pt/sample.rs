@@ -251,7 +251,8 @@ impl Vertex {
 }
 
 /// Whether a BSDF is rough enough to reconnect at: no delta lobe (a `mask`'s pass-through is
-/// one), and a diffuse lobe or a microfacet roughness of at least [`ROUGH_ALPHA`].
+/// one), and a diffuse lobe or a microfacet roughness of at least [`ROUGH_ALPHA`]; a blend
+/// when both its components are.
 pub fn connectible(bsdf: &Bsdf) -> bool {
     if bsdf.is_masked() {
         return false;
@@ -261,6 +262,7 @@ pub fn connectible(bsdf: &Bsdf) -> bool {
         BsdfKind::RoughConductor { microfacet, .. }
         | BsdfKind::RoughDielectric { microfacet, .. } => microfacet.alpha() >= ROUGH_ALPHA,
         BsdfKind::RoughPlastic(p) => p.microfacet.alpha() >= ROUGH_ALPHA,
+        BsdfKind::Blend(b) => b.parts().iter().all(connectible),
         _ => false,
     }
 }

@@ -16,6 +16,7 @@ use glam::Vec3;
 use crate::LobeFlags;
 use crate::microfacet::Microfacet;
 
+pub mod blend;
 pub mod bumpmap;
 pub(crate) mod conductor;
 pub(crate) mod dielectric;

@@ -300,6 +300,16 @@ pub enum MaterialDesc {
         /// The perturbed material.
         material: Box<MaterialDesc>,
     },
+    /// Mitsuba's `blendbsdf`: `(1 − weight)·bsdfs.0 + weight·bsdfs.1`. A texture may give the
+    /// weight (`Textured` with the parameter `Weight` around this); the two materials'
+    /// parameters are constant (a textured component is an error). In RON: `Blend(weight: 0.3,
+    /// bsdfs: (Diffuse(reflectance: (0.5, 0.5, 0.5)), Conductor()))`.
+    Blend {
+        /// The second material's share, in `[0, 1]` (required, as in Mitsuba).
+        weight: f32,
+        /// The two materials: weight 0 is the first, weight 1 the second.
+        bsdfs: Box<(MaterialDesc, MaterialDesc)>,
+    },
     /// `material` with some of its colour parameters given by textures, looked up at each
     /// shading point's texture coordinates; the constant values in `material` are unused for
     /// those parameters. In RON: `Textured(material: Diffuse(reflectance: (0.5, 0.5, 0.5)),
@@ -366,6 +376,8 @@ pub enum ColorParam {
     AlphaU,
     /// Their `alpha_v` (with `alpha_u`).
     AlphaV,
+    /// A `blendbsdf`'s `weight` (a scalar: a colour texture gives its luminance).
+    Weight,
     /// The principled models' `base_color`.
     BaseColor,
     /// The principled models' `roughness` (a scalar, as every principled parameter below).
@@ -421,6 +433,7 @@ impl ColorParam {
             ColorParam::ClearcoatGloss => "clearcoat_gloss",
             ColorParam::DiffTrans => "diff_trans",
             ColorParam::Eta => "eta",
+            ColorParam::Weight => "weight",
         }
     }
 
@@ -450,6 +463,7 @@ impl ColorParam {
             ColorParam::ClearcoatGloss,
             ColorParam::DiffTrans,
             ColorParam::Eta,
+            ColorParam::Weight,
         ]
         .into_iter()
         .find(|p| p.name() == name)

@@ -168,6 +168,7 @@ pub(crate) fn bind(
         alpha_v,
         principled,
         bump,
+        weight,
     } = *params;
     for (slot, param, scalar) in [
         (diffuse, "reflectance", false),
@@ -177,6 +178,7 @@ pub(crate) fn bind(
         (normal, "normal map", false),
         (alpha_u, "alpha_u", true),
         (alpha_v, "alpha_v", true),
+        (weight, "weight", true),
     ] {
         if let Some(i) = slot
             && let Some(Texture::MeshAttribute(t)) = textures.get_mut(i as usize)

@@ -1,5 +1,5 @@
 //! `<bsdf>`: the material models (diffuse, conductors, dielectrics, plastics, twosided, mask,
-//! null),
+//! null; `blendbsdf` in `blend.rs`),
 //! their roughness and IOR properties, and textures bound to their colour parameters.
 
 use roxmltree::Node;
@@ -24,6 +24,7 @@ const BSDF_TYPES: &[&str] = &[
     "principled",
     "principledthin",
     "bumpmap",
+    "blendbsdf",
 ];
 
 impl<'a> Importer<'a> {
@@ -36,6 +37,9 @@ impl<'a> Importer<'a> {
         }
         if ty == "bumpmap" {
             return self.bumpmap(node, props);
+        }
+        if ty == "blendbsdf" {
+            return self.blendbsdf(node, props);
         }
         // An unknown plugin is named before its parameters are looked at.
         if !BSDF_TYPES.contains(&ty.as_str()) && ty != "thindielectric" {

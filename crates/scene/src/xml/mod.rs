@@ -22,6 +22,7 @@
 //! The other direction is [`to_mitsuba_xml`] (`write/`): a description as a Mitsuba 3 scene
 //! file, which this importer reads back to the same scene.
 
+mod blend;
 mod bsdfs;
 mod bumpmap;
 mod emitters;
@@ -73,8 +74,9 @@ pub fn snake_case(name: &str) -> String {
 /// The document walk's state: the source it reads through and the ids declared so far.
 struct Importer<'a> {
     src: &'a Source<'a>,
-    /// Top-level bsdf ids, with the line that declares them.
-    bsdf_ids: HashMap<String, u32>,
+    /// Top-level bsdf ids, with the line that declares them and the material (which a
+    /// `blendbsdf` may reference).
+    bsdf_ids: HashMap<String, (u32, MaterialDesc)>,
     bsdf_anon: usize,
     /// Top-level textures by id, with the line that declares them.
     textures: HashMap<String, (TextureDesc, u32)>,
@@ -244,7 +246,7 @@ impl<'a> Importer<'a> {
                     let material = self.bsdf(c)?;
                     let name = match self.attr(c, "id")? {
                         Some(id) => {
-                            if let Some(line) = self.bsdf_ids.get(&id) {
+                            if let Some((line, _)) = self.bsdf_ids.get(&id) {
                                 return Err(self.err(
                                     c,
                                     format!("bsdf id '{id}' is already declared at line {line}"),
@@ -258,7 +260,7 @@ impl<'a> Importer<'a> {
                         }
                     };
                     let line = self.loc(c).line;
-                    self.bsdf_ids.insert(name.clone(), line);
+                    self.bsdf_ids.insert(name.clone(), (line, material.clone()));
                     desc.materials.push(NamedMaterial { name, material });
                 }
                 "texture" => {

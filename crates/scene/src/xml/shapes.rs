@@ -6,7 +6,7 @@
 use roxmltree::Node;
 
 use super::props::{ColorUse, PROPERTY_TAGS};
-use super::{Importer, Result, elements};
+use super::{Importer, Result, elements, snake_case};
 use crate::desc::*;
 
 impl<'a> Importer<'a> {
@@ -167,6 +167,17 @@ impl<'a> Importer<'a> {
                     }
                     if emission.is_some() {
                         return Err(self.err(c, "a shape takes one emitter"));
+                    }
+                    // A textured radiance varies over the surface, which the light tables and
+                    // samplers (one radiance per area light) cannot represent.
+                    if let Some(t) = elements(c).find(|t| {
+                        ["texture", "ref"].contains(&t.tag_name().name())
+                            && t.attribute("name").map(snake_case).as_deref() == Some("radiance")
+                    }) {
+                        return Err(self.err(
+                            t,
+                            "emitter 'area': a texture for 'radiance' is not supported (give the radiance as a colour: rgb, spectrum or float)",
+                        ));
                     }
                     let ep = self.props(c, "emitter 'area'".into())?;
                     let r = ep

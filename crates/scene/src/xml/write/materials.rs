@@ -110,6 +110,25 @@ impl Writer<'_> {
                 self.close("</bsdf>");
                 return Ok(());
             }
+            MaterialDesc::Blend { weight, bsdfs } => {
+                if let Some(b) =
+                    textures.and_then(|t| t.iter().find(|b| b.param != ColorParam::Weight))
+                {
+                    return refuse(
+                        item,
+                        format!("the blendbsdf has no parameter '{}'", b.param.name()),
+                    );
+                }
+                self.open(&format!(r#"<bsdf type="blendbsdf"{id_attr}>"#));
+                match bound(ColorParam::Weight) {
+                    Some(b) => self.texture(&b.texture, "weight", item)?,
+                    None => self.float("weight", *weight),
+                }
+                self.bsdf(&bsdfs.0, None, None, item)?;
+                self.bsdf(&bsdfs.1, None, None, item)?;
+                self.close("</bsdf>");
+                return Ok(());
+            }
             _ => {}
         }
         // The colour parameters, constant or textured.
@@ -258,7 +277,8 @@ impl Writer<'_> {
             | MaterialDesc::TwoSided(_)
             | MaterialDesc::Mask { .. }
             | MaterialDesc::NormalMap { .. }
-            | MaterialDesc::BumpMap { .. } => {
+            | MaterialDesc::BumpMap { .. }
+            | MaterialDesc::Blend { .. } => {
                 unreachable!()
             }
         }
