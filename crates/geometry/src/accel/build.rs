@@ -4,7 +4,7 @@
 //! binary tree is built, the PLOC builder's scratch is sized for the sort precision used, and
 //! the binary tree's parent links (needed only by the reinsertion pass) are dropped before it
 //! is converted. With the crate's 32-byte binary nodes (the `small_bvh2_node` feature) the build
-//! peaks at the conversion, about 260 bytes per primitive (obvhs's conversion keeps 7 cost
+//! peaks at the conversion, 264 bytes per primitive (obvhs's conversion keeps 7 cost
 //! decisions of 8 bytes per binary node, 112 bytes per primitive, and reserves a wide node of 80
 //! bytes per primitive).
 
