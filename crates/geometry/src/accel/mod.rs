@@ -170,10 +170,12 @@ impl Entries for Accel {
 impl Accel {
     /// Builds the BVH over all shapes.
     ///
-    /// Memory: the input-order boxes and ids live only until obvhs has built its tree, the
-    /// triangles are read from the shapes where they are needed (the groups' keys, the inline
-    /// blocks), and a triangle that is its own BVH entry is kept only inline, so the structure
-    /// keeps the tree, the inline blocks and 8 bytes of ids per primitive.
+    /// Memory: the input-order boxes live only until obvhs has built its binary tree and the
+    /// ids are not held while it builds (without groups they are made again after; see
+    /// `build.rs` for the build's own peak), the triangles are read from the shapes where they
+    /// are needed (the groups' keys, the inline blocks), and a triangle that is its own BVH
+    /// entry is kept only inline, so the structure keeps the tree, the inline blocks and 8 bytes
+    /// of ids per primitive.
     pub fn build(shapes: &[Shape]) -> Self {
         let count: usize = shapes.iter().map(Shape::primitive_count).sum();
         let mut analytic = Vec::new();
