@@ -50,7 +50,8 @@ fn affine(m: Mat4) -> Result<Affine3A, String> {
     Ok(a)
 }
 
-/// Decoded textures, each distinct description loaded once, and the memory budget.
+/// Decoded textures, each distinct description loaded once, and the memory budget (which counted
+/// every image before the first was decoded).
 #[derive(Default)]
 struct TextureCache {
     descs: Vec<TextureDesc>,
@@ -62,9 +63,6 @@ impl TextureCache {
     fn get(&mut self, d: &TextureDesc, base_dir: &Path) -> Result<u32, String> {
         if let Some(i) = self.descs.iter().position(|e| e == d) {
             return Ok(i as u32);
-        }
-        if let TextureDesc::Bitmap { filename, .. } = d {
-            self.budget.take_image(&base_dir.join(filename))?;
         }
         let t = Texture::load(d, base_dir).map_err(|e| e.to_string())?;
         self.descs.push(d.clone());
@@ -137,19 +135,28 @@ fn material(
     Ok((bsdf, Some(t)))
 }
 
-/// Reads an environment map's image and sets up its lookup and sampling.
+/// Reads an environment map's image (counted against the budget already) and sets up its lookup
+/// and sampling.
 fn build_envmap(
     filename: &str,
     scale: f32,
     to_world: &[TransformOp],
     base_dir: &Path,
-    budget: &mut Budget,
 ) -> Result<EnvMap, String> {
     let m = transform_matrix(to_world).map_err(|e| e.to_string())?;
-    budget.take_image(&base_dir.join(filename))?;
     let (w, h, texels) =
         crate::texture::read_image(&base_dir.join(filename), false).map_err(|e| e.to_string())?;
     EnvMap::new(w, h, texels, scale, glam::Mat3::from_mat4(m)).map_err(|e| e.to_string())
+}
+
+/// Where the scene declares light `l`, if the description records it.
+fn light_location(l: &LightDesc) -> Option<&Location> {
+    match l {
+        LightDesc::Spot { location, .. }
+        | LightDesc::Projector { location, .. }
+        | LightDesc::Envmap { location, .. } => Some(location),
+        _ => None,
+    }
 }
 
 /// ` (mesh 'file')` for a shape read from a file, else nothing.
@@ -368,11 +375,13 @@ impl Scene {
         Self::build_within(desc, base_dir, source, None)
     }
 
-    /// [`Scene::build_noting`] within `max_bytes` of memory for meshes and images (`None`:
-    /// unbounded): each mesh ([`limits::MESH_BYTES_PER_TRIANGLE`]) and image (its texels, read
-    /// from the header, [`limits::TEXTURE_BYTES_PER_TEXEL`] kept and
-    /// [`limits::DECODE_BYTES_PER_TEXEL`] while decoding) is counted before it is built or
-    /// decoded, and the one that would cross the limit is an error at its line.
+    /// [`Scene::build_noting`] within `max_bytes` of memory for images, meshes and light tables
+    /// (`None`: unbounded): every image is counted from its header before the first is decoded
+    /// ([`limits::TEXTURE_BYTES_PER_TEXEL`] kept, [`limits::DECODE_BYTES_PER_TEXEL`] while
+    /// decoding, and an environment map's sampling tables), each mesh
+    /// ([`limits::MESH_BYTES_PER_TRIANGLE`] and its vertex data) before it is built, and each
+    /// emitter ([`limits::EMITTER_BYTES_PER_ENTRY`] per emissive triangle or light) before its
+    /// tables are made; the one that would cross the limit is an error at its line.
     pub fn build_within(
         desc: &SceneDesc,
         base_dir: &Path,
@@ -453,6 +462,11 @@ impl Scene {
             },
             ..TextureCache::default()
         };
+        // Every image, counted from its header before the first is decoded.
+        cache
+            .budget
+            .take_images(&budget::images(desc, base_dir))
+            .map_err(|(location, e)| at(&location, e))?;
         let mut names = std::collections::HashMap::new();
         for nm in &desc.materials {
             let (b, t) = material(&nm.material, &mut cache, base_dir)
@@ -526,6 +540,14 @@ impl Scene {
                     ));
                 }
                 if radiance.max_element() > 0.0 && shape.area() > 0.0 {
+                    let entries = match &shape {
+                        Shape::Mesh(m) => m.triangle_count(),
+                        _ => 1,
+                    };
+                    cache
+                        .budget
+                        .take_emitters(entries, || format!("shape {i}: the area emitter"))
+                        .map_err(|e| at(&sd.location, e))?;
                     lights.push(Light::Area {
                         shape: shapes.len() as u32,
                         radiance,
@@ -571,13 +593,8 @@ impl Scene {
                     radiance: v3(radiance),
                 },
                 LightDesc::Spot { location, .. } | LightDesc::Projector { location, .. } => {
-                    crate::spot::spot_light(
-                        l,
-                        base_dir,
-                        &mut |p| cache.budget.take_image(p),
-                        &mut spot_textures,
-                    )
-                    .map_err(|e| at(location, e))?
+                    crate::spot::spot_light(l, base_dir, &mut spot_textures)
+                        .map_err(|e| at(location, e))?
                 }
                 LightDesc::Envmap {
                     filename,
@@ -592,12 +609,19 @@ impl Scene {
                                 .into(),
                         ));
                     }
-                    let map = build_envmap(filename, *scale, to_world, base_dir, &mut cache.budget)
+                    let map = build_envmap(filename, *scale, to_world, base_dir)
                         .map_err(|e| at(location, format!("envmap: {e}")))?;
                     envmap = Some(map);
                     Light::Envmap
                 }
             };
+            cache
+                .budget
+                .take_emitters(1, || "an emitter".into())
+                .map_err(|e| match light_location(l) {
+                    Some(location) => at(location, e),
+                    None => whole(e),
+                })?;
             lights.push(light);
         }
 

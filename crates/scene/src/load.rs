@@ -20,8 +20,9 @@ pub struct LoadOptions {
     pub height: Option<u32>,
     /// Whether a scene without light sources adds a warning (default: yes).
     pub warn_no_lights: bool,
-    /// The most memory, in bytes, the scene's meshes and images may need (`--max-memory`),
-    /// checked before each is built or decoded; `None` (the default): unbounded.
+    /// The most memory, in bytes, the scene's images, meshes and light tables may need
+    /// (`--max-memory`), checked before each is decoded, built or made; `None` (the default):
+    /// unbounded.
     pub max_memory: Option<u64>,
 }
 

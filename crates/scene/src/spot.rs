@@ -23,13 +23,12 @@ impl SpotTexture for Texture {
 }
 
 /// The light of a spot or projector description (a [`LightDesc::Spot`] or
-/// [`LightDesc::Projector`]); its texture, if any, is loaded (after `take_image` counts a bitmap
-/// against the memory limit) and appended to `textures`, which the light names by index. Errors
+/// [`LightDesc::Projector`]); its texture, if any, is loaded (a bitmap was counted against the
+/// memory limit with the scene's other images) and appended to `textures`, which the light names by index. Errors
 /// are the message without the location.
 pub(crate) fn spot_light(
     desc: &LightDesc,
     base_dir: &Path,
-    take_image: &mut dyn FnMut(&Path) -> Result<(), String>,
     textures: &mut Vec<Arc<dyn SpotTexture>>,
 ) -> Result<Light, String> {
     match desc {
@@ -44,7 +43,7 @@ pub(crate) fn spot_light(
             let m =
                 transform_matrix(to_world).map_err(|e| format!("spot emitter: to_world: {e}"))?;
             let index = match texture {
-                Some(t) => Some(load(t, "spot", base_dir, take_image, textures)?.0),
+                Some(t) => Some(load(t, "spot", base_dir, textures)?.0),
                 None => None,
             };
             let beam = beam_width.unwrap_or(cutoff_angle * defaults::SPOT_BEAM_FRACTION);
@@ -66,7 +65,7 @@ pub(crate) fn spot_light(
             // The image's aspect ratio is the texture's; a constant is 1×1, as in Mitsuba.
             let (index, resolution) = match texture {
                 Some(t) => {
-                    let (i, r) = load(t, "projector", base_dir, take_image, textures)?;
+                    let (i, r) = load(t, "projector", base_dir, textures)?;
                     (Some(i), r)
                 }
                 None => (None, (1, 1)),
@@ -100,7 +99,6 @@ fn load(
     t: &TextureDesc,
     plugin: &str,
     base_dir: &Path,
-    take_image: &mut dyn FnMut(&Path) -> Result<(), String>,
     textures: &mut Vec<Arc<dyn SpotTexture>>,
 ) -> Result<(u32, (u32, u32)), String> {
     if let TextureDesc::MeshAttribute { name, .. } = t {
@@ -108,9 +106,6 @@ fn load(
             "{plugin} emitter texture: a 'mesh_attribute' texture (\"{name}\") reads the mesh a \
              ray hits and cannot be projected by a light; use a bitmap or checkerboard"
         ));
-    }
-    if let TextureDesc::Bitmap { filename, .. } = t {
-        take_image(&base_dir.join(filename))?;
     }
     let t = Texture::load(t, base_dir).map_err(|e| format!("{plugin} emitter texture: {e}"))?;
     let resolution = match &t {

@@ -1,8 +1,11 @@
-//! `--max-memory` (`LoadOptions::max_memory`) covers a scene's meshes and images together: each is
-//! counted before it is built or decoded, and the one that crosses the limit is named.
+//! `--max-memory` (`LoadOptions::max_memory`) covers a scene's images, meshes and light tables
+//! together: every image is counted from its header before the first is decoded, each mesh
+//! before it is built, each emitter's tables before they are made, and the one that crosses the
+//! limit is named where the scene declares it.
 
 use std::path::{Path, PathBuf};
 
+use restir_scene::desc::limits;
 use restir_scene::{LoadOptions, load_scene};
 
 fn temp_dir(tag: &str) -> PathBuf {
@@ -69,10 +72,8 @@ fn textures_are_bounded_together() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// A mesh beyond the limit is an error naming the shape and the file before its BVH is built.
-#[test]
-fn meshes_are_bounded_before_the_build() {
-    let dir = temp_dir("mesh");
+/// A 40 × 40 quad grid (3200 triangles, 1681 vertices) as an OBJ file in `dir`.
+fn write_grid(dir: &Path) {
     let mut obj = String::new();
     let n = 40;
     for y in 0..=n {
@@ -93,6 +94,13 @@ fn meshes_are_bounded_before_the_build() {
         }
     }
     std::fs::write(dir.join("grid.obj"), obj).unwrap();
+}
+
+/// A mesh beyond the limit is an error naming the shape and the file before its BVH is built.
+#[test]
+fn meshes_are_bounded_before_the_build() {
+    let dir = temp_dir("mesh");
+    write_grid(&dir);
     let scene = dir.join("scene.ron");
     std::fs::write(
         &scene,
@@ -102,10 +110,131 @@ fn meshes_are_bounded_before_the_build() {
         ),
     )
     .unwrap();
-    // 3200 triangles at 390 bytes and 1681 vertices at 12: 1.27 MB.
-    let err = load(&scene, Some(1 << 20)).unwrap_err();
+    // 3200 triangles at the estimate per triangle and 1681 vertices at 12 bytes.
+    let mesh = 3200 * limits::MESH_BYTES_PER_TRIANGLE + 12 * 1681;
+    let err = load(&scene, Some(mesh - 50_000)).unwrap_err();
     assert!(err.contains("shape 1: mesh '"), "{err}");
     assert!(err.contains("grid.obj' (3200 triangles)"), "{err}");
-    load(&scene, Some(2 << 20)).unwrap();
+    load(&scene, Some(mesh + 50_000)).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// An emissive mesh's light tables (one entry per triangle, and the light hierarchy over them)
+/// are counted too: the mesh that fits as a plain shape does not fit as an area emitter, and the
+/// error names the emitter.
+#[test]
+fn emitters_are_counted() {
+    let dir = temp_dir("emitter");
+    write_grid(&dir);
+    let scene = |emissive: bool| {
+        let path = dir.join(format!("scene-{emissive}.ron"));
+        let emission = if emissive {
+            ", emission: Some((1, 1, 1))"
+        } else {
+            ""
+        };
+        std::fs::write(
+            &path,
+            format!(
+                "{HEAD}materials: [], shapes: [(geometry: Obj(filename: \"grid.obj\"){emission})], \
+                 lights: [Point(position: (0, 0, 3), intensity: (1, 1, 1))])"
+            ),
+        )
+        .unwrap();
+        path
+    };
+    // The mesh and 200 kB: less than the tables of 3200 emissive triangles.
+    let limit = 3200 * limits::MESH_BYTES_PER_TRIANGLE + 12 * 1681 + 200_000;
+    load(&scene(false), Some(limit)).unwrap();
+    let err = load(&scene(true), Some(limit)).unwrap_err();
+    assert!(
+        err.contains("shape 0: the area emitter (3200 light table entries)"),
+        "{err}"
+    );
+    assert!(err.contains("raise --max-memory"), "{err}");
+    load(&scene(true), Some(limit + 3200 * 300)).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A PNG whose header says 64 × 64 but whose pixel data is cut off: its size is known, its
+/// decoding fails.
+fn write_truncated_png(path: &Path) {
+    let img = image::RgbImage::from_fn(64, 64, |x, y| image::Rgb([x as u8, y as u8, 7]));
+    img.save(path).unwrap();
+    let bytes = std::fs::read(path).unwrap();
+    std::fs::write(path, &bytes[..60]).unwrap();
+}
+
+/// Every image is counted from its header before the first is decoded: with a first texture
+/// that cannot be decoded and a second beyond the limit, the error is the limit's, naming the
+/// second, the scene's image count and their total; without a limit the first texture's decoding
+/// fails (the negative control: it is decoded first).
+#[test]
+fn images_are_counted_before_any_is_decoded() {
+    let dir = temp_dir("before");
+    write_truncated_png(&dir.join("broken.png"));
+    image::RgbImage::from_pixel(1024, 1024, image::Rgb([100, 150, 200]))
+        .save(dir.join("big.png"))
+        .unwrap();
+    let scene = dir.join("scene.ron");
+    let material = |k: usize, file: &str| {
+        format!(
+            "(name: \"m{k}\", material: Textured(material: Diffuse(reflectance: (0.5, 0.5, 0.5)), \
+             textures: [(param: Reflectance, texture: Bitmap(filename: \"{file}\"))])), "
+        )
+    };
+    std::fs::write(
+        &scene,
+        format!(
+            "{HEAD}materials: [{}{}], shapes: [(geometry: Rectangle, material: Some(Ref(\"m0\"))), \
+             (geometry: Rectangle, material: Some(Ref(\"m1\")))], \
+             lights: [Point(position: (0, 0, 3), intensity: (1, 1, 1))])",
+            material(0, "broken.png"),
+            material(1, "big.png"),
+        ),
+    )
+    .unwrap();
+    // 1024² texels: 12 MiB kept and 28 MiB more while decoding.
+    let err = load(&scene, Some(20 << 20)).unwrap_err();
+    assert!(err.contains("shape 1: material 'm1': image '"), "{err}");
+    assert!(err.contains("big.png' (1024×1024 texels)"), "{err}");
+    assert!(err.contains("the scene's 2 images need about"), "{err}");
+    assert!(err.contains("before any is decoded"), "{err}");
+    let err = load(&scene, None).unwrap_err();
+    assert!(err.contains("broken.png"), "{err}");
+    assert!(!err.contains("--max-memory"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// In an XML scene the error is at the line of the shape that uses the named material whose
+/// texture crosses the limit (the material itself is declared at the top level).
+#[test]
+fn an_image_beyond_the_limit_is_located() {
+    let dir = temp_dir("xml");
+    image::RgbImage::from_pixel(1024, 1024, image::Rgb([100, 150, 200]))
+        .save(dir.join("big.png"))
+        .unwrap();
+    let scene = dir.join("scene.xml");
+    std::fs::write(
+        &scene,
+        r#"<scene version="3.0.0">
+  <sensor type="perspective"><float name="fov" value="40"/><film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>
+  <bsdf type="diffuse" id="wall">
+    <texture type="bitmap" name="reflectance"><string name="filename" value="big.png"/></texture>
+  </bsdf>
+  <shape type="rectangle"/>
+  <shape type="rectangle">
+    <ref id="wall"/>
+  </shape>
+  <emitter type="point"><point name="position" x="0" y="0" z="3"/></emitter>
+</scene>
+"#,
+    )
+    .unwrap();
+    let err = load(&scene, Some(20 << 20)).unwrap_err();
+    assert!(err.contains("scene.xml:7"), "{err}");
+    assert!(err.contains("material 'wall'"), "{err}");
+    assert!(err.contains("big.png' (1024×1024 texels)"), "{err}");
+    load(&scene, Some(60 << 20)).unwrap();
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -9,15 +9,14 @@
 //! share their bounds, those primitives become one BVH entry (a *group*, tested in a loop, exact
 //! duplicates once); scenes without such pile-ups get the plain one-primitive-per-entry BVH.
 
-use std::time::Duration;
-
 use glam::{Vec2, Vec3, Vec3A};
-use obvhs::{BvhBuildParams, aabb::Aabb, cwbvh::builder::build_cwbvh};
+use obvhs::aabb::Aabb;
 
 use crate::{Frame, Ray, Shape};
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+mod build;
 mod prims;
 mod wide;
 
@@ -133,6 +132,16 @@ fn prim_of(shapes: &[Shape], slots: &[u32], (si, ti): (u32, u32)) -> Prim {
     }
 }
 
+/// (shape, primitive within shape) of every primitive of `shapes`, in input order (`count` of
+/// them).
+fn prim_ids(shapes: &[Shape], count: usize) -> Vec<(u32, u32)> {
+    let mut ids = Vec::with_capacity(count);
+    for (si, shape) in shapes.iter().enumerate() {
+        ids.extend((0..shape.primitive_count() as u32).map(|ti| (si as u32, ti)));
+    }
+    ids
+}
+
 /// Whether this CPU runs the AVX2 kernel.
 fn detect_avx2() -> bool {
     #[cfg(target_arch = "x86_64")]
@@ -161,10 +170,12 @@ impl Entries for Accel {
 impl Accel {
     /// Builds the BVH over all shapes.
     ///
-    /// Memory: the input-order boxes and ids live only until obvhs has built its tree, the
-    /// triangles are read from the shapes where they are needed (the groups' keys, the inline
-    /// blocks), and a triangle that is its own BVH entry is kept only inline, so the structure
-    /// keeps the tree, the inline blocks and 8 bytes of ids per primitive.
+    /// Memory: the input-order boxes live only until obvhs has built its binary tree and the
+    /// ids are not held while it builds (without groups they are made again after; see
+    /// `build.rs` for the build's own peak), the triangles are read from the shapes where they
+    /// are needed (the groups' keys, the inline blocks), and a triangle that is its own BVH
+    /// entry is kept only inline, so the structure keeps the tree, the inline blocks and 8 bytes
+    /// of ids per primitive.
     pub fn build(shapes: &[Shape]) -> Self {
         let count: usize = shapes.iter().map(Shape::primitive_count).sum();
         let mut analytic = Vec::new();
@@ -178,19 +189,17 @@ impl Accel {
                 _ => u32::MAX,
             })
             .collect();
-        let mut ids = Vec::with_capacity(count);
+        let ids = prim_ids(shapes, count);
         let mut aabbs = Vec::with_capacity(count);
-        for (si, shape) in shapes.iter().enumerate() {
+        for shape in shapes {
             match shape {
                 Shape::Mesh(m) => {
                     for ti in 0..m.triangle_count() {
                         let [a, b, c] = m.triangle(ti);
-                        ids.push((si as u32, ti as u32));
                         aabbs.push(Aabb::from_points(&[a.into(), b.into(), c.into()]));
                     }
                 }
                 Shape::Sphere(s) => {
-                    ids.push((si as u32, 0));
                     let r = Vec3A::splat(s.radius);
                     aabbs.push(Aabb::new(
                         Vec3A::from(s.center) - r,
@@ -199,7 +208,6 @@ impl Accel {
                 }
                 _ => {
                     for ti in 0..shape.primitive_count() as u32 {
-                        ids.push((si as u32, ti));
                         let (lo, hi) = shape.primitive_bounds(ti);
                         aabbs.push(Aabb::new(lo.into(), hi.into()));
                     }
@@ -231,12 +239,7 @@ impl Accel {
         let (bvh, ids, groups) = match grouped {
             Some((entries, boxes)) => {
                 drop(aabbs);
-                let bvh = build_cwbvh(
-                    &boxes,
-                    BvhBuildParams::medium_build(),
-                    &mut Duration::default(),
-                );
-                drop(boxes);
+                let bvh = build::cwbvh(boxes);
                 let mut starts = Vec::with_capacity(entries.len() + 1);
                 starts.push(0);
                 let mut out_ids = Vec::with_capacity(ids.len());
@@ -249,12 +252,11 @@ impl Accel {
                 (bvh, out_ids, Some(starts))
             }
             None => {
-                let bvh = build_cwbvh(
-                    &aabbs,
-                    BvhBuildParams::medium_build(),
-                    &mut Duration::default(),
-                );
-                drop(aabbs);
+                // The ids are made again once the tree is built, so that they do not take
+                // memory while obvhs builds it.
+                drop(ids);
+                let bvh = build::cwbvh(aabbs);
+                let ids = prim_ids(shapes, count);
                 // Lay primitives out in BVH order so the traversal indexes them directly.
                 let d = bvh
                     .primitive_indices

@@ -31,12 +31,30 @@ pub const MAX_MESH_ELEMENTS: u64 = 1 << 25;
 pub const MAX_INSTANCED_SHAPES: u64 = 1 << 18;
 
 /// What one triangle of a mesh costs while the scene is built, in bytes, beside its vertices:
-/// its indices, per-triangle faces and area table, the BVH while obvhs builds it (its temporary
-/// memory included) and the light tables of an emissive mesh. A 1M-triangle emissive PLY (half
-/// a vertex per triangle, positions only) peaks at 394 bytes per triangle, 388 beside its
-/// positions (`crates/scene/tests/mesh_memory.rs`); meshes are checked against `--max-memory`
-/// with this and their vertex data before the BVH is built.
-pub const MESH_BYTES_PER_TRIANGLE: u64 = 390;
+/// its indices, per-triangle faces and area table, and the BVH while obvhs builds it (its
+/// temporary memory included; the build peaks when obvhs converts its binary tree to the wide
+/// one, at 264 bytes per triangle). A 1M-triangle PLY (half a vertex per triangle, positions
+/// only) peaks at 314 bytes per triangle, 308 beside its positions
+/// (`crates/scene/tests/mesh_memory.rs`); meshes are checked against `--max-memory` with this
+/// and their vertex data before the BVH is built. An emissive mesh's light tables are counted
+/// apart ([`EMITTER_BYTES_PER_ENTRY`]).
+pub const MESH_BYTES_PER_TRIANGLE: u64 = 320;
+
+/// What one entry of the light tables costs, in bytes: an emissive triangle's (or any other
+/// light's) emitter-table entry and alias-table bin (76), and its share of the light hierarchy
+/// a light sampler may build (two tree nodes, its path, and the build's item: about 176 at the
+/// build's peak, 120 kept). Counted against `--max-memory` for each emitter before the tables
+/// are made; a 1M-triangle emissive PLY with its hierarchy built peaks at 401 bytes per
+/// triangle, within this and [`MESH_BYTES_PER_TRIANGLE`] (`crates/scene/tests/mesh_memory.rs`).
+pub const EMITTER_BYTES_PER_ENTRY: u64 = 260;
+
+/// What an environment map keeps per texel beside its texels, in bytes: the bin of its
+/// conditional alias table.
+pub const ENVMAP_TABLE_BYTES_PER_TEXEL: u64 = 12;
+
+/// What building an environment map's sampling needs per texel at its peak beside the decode,
+/// in bytes: its grid of patch weights.
+pub const ENVMAP_BUILD_BYTES_PER_TEXEL: u64 = 8;
 
 /// What a texel of a bitmap texture keeps, in bytes, at most (a float texel; 8-bit images keep
 /// 4).
