@@ -55,18 +55,6 @@ const MIN_LOADING: usize = 28;
 /// `(scene, estimator, reason)`: failures that are known and explained in docs/VALIDATION.md.
 const KNOWN_FAILURES: &[(&str, &str, &str)] = &[
     (
-        "bsdf_spheres/test_bumpmap_path.xml",
-        "restir-di",
-        "the G-buffer keeps a primary hit's uv, not the surface derivatives a bump map needs, so \
-         the bump is flat at primary hits (a warning says so when the scene loads)",
-    ),
-    (
-        "bsdf_spheres/test_bumpmap_path.xml",
-        "restir-pt",
-        "the G-buffer keeps a primary hit's uv, not the surface derivatives a bump map needs, so \
-         the bump is flat at primary hits (a warning says so when the scene loads)",
-    ),
-    (
         "bsdf_spheres/test_constant_path.xml",
         "restir-di",
         "unbiased but, on the Beckmann alpha 0.05 conductor under a constant environment, about 25 \

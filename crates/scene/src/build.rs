@@ -557,20 +557,6 @@ impl Scene {
             shapes.push(shape);
             shape_bsdf.push(bsdf);
         }
-        // The G-buffer of the ReSTIR estimators keeps a hit's uv, not the surface derivatives a
-        // bump map needs: said once, at the first bump-mapped shape.
-        let bumped = desc.shapes.iter().zip(&shape_bsdf).find(|(_, b)| {
-            bsdf_textures[**b as usize].is_some_and(|t: TexturedParams| t.bump.is_some())
-        });
-        if let Some((sd, _)) = bumped {
-            warnings.push(SceneWarning {
-                location: at(&sd.location, String::new()).location,
-                message: "bumpmap: ReSTIR DI and ReSTIR PT look materials up at primary hits by \
-                          uv alone and render the bump flat there (the path tracer renders it \
-                          fully)"
-                    .into(),
-            });
-        }
         let mut envmap = None;
         let mut spot_textures = Vec::new();
         for l in &desc.lights {

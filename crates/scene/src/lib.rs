@@ -172,15 +172,22 @@ impl Scene {
     #[inline]
     pub fn bsdf(&self, si: &SurfaceInteraction) -> Bsdf {
         let bsdf = self.shape_bsdf[si.shape as usize];
-        let at = TexturePoint::of(si);
-        if self.features.has_textures
-            && let Some(t) = &self.bsdf_textures[bsdf as usize]
-            && let Some((texture, scale)) = t.bump
-        {
-            let normal = self.bump_texel(texture, scale, si);
-            return self.textured(bsdf, t, &at, Some(normal));
+        self.bsdf_bumped(bsdf, &TexturePoint::of(si), self.bump_at(si))
+    }
+
+    /// The normal-map texel a bump map gives at `si` (from the height's gradient, the
+    /// surface's derivatives and its shading frame there: [`restir_materials::bump_normal`]),
+    /// or `None` when the material of `si`'s shape has no bump map. With the hit's
+    /// [`TexturePoint`] it is all [`Scene::bsdf_bumped`] needs to give [`Scene::bsdf`]'s BSDF
+    /// later, without the hit.
+    #[inline]
+    pub fn bump_at(&self, si: &SurfaceInteraction) -> Option<Vec3> {
+        if !self.features.has_textures {
+            return None;
         }
-        self.bsdf_at(bsdf, &at)
+        let bsdf = self.shape_bsdf[si.shape as usize];
+        let (texture, scale) = self.bsdf_textures[bsdf as usize].as_ref()?.bump?;
+        Some(self.bump_texel(texture, scale, si))
     }
 
     /// The normal-map texel of a bump map (height `texture` times `scale`) at `si`: Mitsuba's
@@ -205,16 +212,25 @@ impl Scene {
     /// resolved. A scene without textures (decided at build time,
     /// [`SceneFeatures::has_textures`]) returns the stored BSDF without looking at `at`. A bump
     /// map's normal needs the surface's derivatives and shading frame, which `at` does not
-    /// give: here it stays flat, and [`Scene::bsdf`] (with the hit) applies it.
+    /// give: here it stays flat; [`Scene::bsdf`] (with the hit) and [`Scene::bsdf_bumped`]
+    /// (with the texel [`Scene::bump_at`] gave at the hit) apply it.
     #[inline]
     pub fn bsdf_at(&self, bsdf: u32, at: &TexturePoint) -> Bsdf {
+        self.bsdf_bumped(bsdf, at, None)
+    }
+
+    /// [`Scene::bsdf_at`] with a bump map's normal-map texel `bump` ([`Scene::bump_at`] of the
+    /// hit `at` was taken from): the same BSDF as [`Scene::bsdf`] of that hit. `None` leaves a
+    /// bump map flat; a material without a bump map ignores `bump`.
+    #[inline]
+    pub fn bsdf_bumped(&self, bsdf: u32, at: &TexturePoint, bump: Option<Vec3>) -> Bsdf {
         let base = self.bsdfs[bsdf as usize];
         if !self.features.has_textures {
             return base;
         }
         match &self.bsdf_textures[bsdf as usize] {
             None => base,
-            Some(t) => self.textured(bsdf, t, at, None),
+            Some(t) => self.textured(bsdf, t, at, bump.filter(|_| t.bump.is_some())),
         }
     }
 

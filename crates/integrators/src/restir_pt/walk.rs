@@ -38,7 +38,7 @@ use glam::{Vec2, Vec3};
 use restir_geometry::{Frame, Ray, SurfaceInteraction, offset_ray_origin};
 use restir_materials::{Bsdf, LobeFlags};
 use restir_sampling::Pcg32;
-use restir_scene::{Scene, TexturePoint};
+use restir_scene::Scene;
 
 use super::sample::{Kind, PathSample, Reconnection, ShiftKind, Vertex, connectible, smooth};
 use crate::path::{EmissionMis, PrevVertex};
@@ -89,11 +89,10 @@ impl ScatterVertex {
     /// A surface hit, reached along `-to_prev`, `reach` from the camera along the path.
     #[inline]
     fn at(scene: &Scene, si: &SurfaceInteraction, to_prev: Vec3, reach: f32) -> Self {
-        let bsdf = scene.shape_bsdf()[si.shape as usize];
-        let at = TexturePoint::of(si);
-        let resolved = scene.bsdf_at(bsdf, &at);
+        let r = Receiver::at_hit(scene, si, to_prev, 0.0);
+        let resolved = r.resolve_bsdf(scene);
         Self {
-            r: Receiver::new(si.p, &si.shading, at, to_prev, bsdf, 0.0),
+            r,
             bsdf: resolved,
             ng: si.ng,
             conn: connectible(&resolved),

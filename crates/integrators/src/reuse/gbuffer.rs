@@ -4,7 +4,7 @@
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
-use restir_geometry::Frame;
+use restir_geometry::{Frame, SurfaceInteraction};
 use restir_materials::Bsdf;
 use restir_scene::{Scene, TexturePoint};
 
@@ -17,8 +17,8 @@ use restir_reuse::{Similarity, SimilarityKey, Surfaces};
 /// its material and where its textures are looked up, the direction to the camera and what the
 /// neighbour-similarity tests compare. Cache-line aligned (spatial reuse reads it at random
 /// neighbours): two lines since it holds the texture lookup point of mesh attributes (the
-/// triangle and barycentrics) beside the texture coordinates; the second tangent of the shading
-/// frame is recomputed as `n × s`.
+/// triangle and barycentrics) beside the texture coordinates, and a bump map's normal at the
+/// hit; the second tangent of the shading frame is recomputed as `n × s`.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub struct Receiver {
@@ -37,6 +37,10 @@ pub struct Receiver {
     /// Where [`Scene::bsdf_at`] looks up the material's textures (texture coordinates; the
     /// shape, triangle and barycentrics for mesh attributes).
     pub at: TexturePoint,
+    /// A bump map's perturbed normal as a normal-map texel ([`Scene::bump_at`]), computed at
+    /// the hit from the surface's derivatives, which `at` does not keep; `None` when the
+    /// material has no bump map.
+    pub bump: Option<Vec3>,
 }
 
 impl Receiver {
@@ -56,35 +60,34 @@ impl Receiver {
             prim: 0,
             bary: Vec2::ZERO,
         },
+        bump: None,
     };
 
-    /// A receiver at a surface point with shading frame `(s, ·, n)` and texture lookup point
-    /// `at`, seen from direction `to_camera` (world space, unit) at distance `depth`.
-    pub fn new(
-        p: Vec3,
-        frame: &Frame,
-        at: TexturePoint,
-        to_camera: Vec3,
-        bsdf: u32,
-        depth: f32,
-    ) -> Self {
+    /// The receiver at surface hit `si` of `scene`, seen from direction `to_camera` (world
+    /// space, unit) at distance `depth`: its shading frame, material, texture lookup point and
+    /// bump-map normal, so that [`Receiver::resolve_bsdf`] gives `scene.bsdf(si)`.
+    #[inline]
+    pub fn at_hit(scene: &Scene, si: &SurfaceInteraction, to_camera: Vec3, depth: f32) -> Self {
+        let frame = &si.shading;
         let mut r = Self {
-            p,
+            p: si.p,
             n: frame.n,
             s: frame.s,
             wo: Vec3::Z,
-            bsdf,
+            bsdf: scene.shape_bsdf()[si.shape as usize],
             depth,
-            at,
+            at: TexturePoint::of(si),
+            bump: scene.bump_at(si),
         };
         r.wo = r.frame().to_local(to_camera);
         r
     }
 
-    /// The BSDF at this point, textures resolved ([`Scene::bsdf_at`]).
+    /// The BSDF at this point, textures resolved and a bump map applied: the BSDF
+    /// [`Scene::bsdf`] gives at the hit ([`Scene::bsdf_bumped`]).
     #[inline]
     pub fn resolve_bsdf(&self, scene: &Scene) -> Bsdf {
-        scene.bsdf_at(self.bsdf, &self.at)
+        scene.bsdf_bumped(self.bsdf, &self.at, self.bump)
     }
 
     /// The shading frame.
@@ -189,14 +192,7 @@ impl GBuffer {
                     *l += lights.area_radiance(light, si.shading.n, -ray.d);
                 }
                 if keep_hits {
-                    recv[i] = Receiver::new(
-                        si.p,
-                        &si.shading,
-                        TexturePoint::of(&si),
-                        -ray.d,
-                        scene.shape_bsdf()[si.shape as usize],
-                        si.t,
-                    );
+                    recv[i] = Receiver::at_hit(scene, &si, -ray.d, si.t);
                     ngs[i] = si.ng;
                     shapes[i] = si.shape;
                 }
@@ -295,5 +291,65 @@ impl Surfaces for GBuffer {
                 (a.hit() && b.hit() && a.is_similar(b, rule)).then_some(index)
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// A bump-mapped sphere and plane (the same height texture), seen by a 16 × 16 camera.
+    fn bumped_scene() -> Scene {
+        let bumped = |geometry: &str| {
+            format!(
+                r#"(geometry: {geometry}, material: Some(Inline(Textured(
+                    material: BumpMap(scale: 3.0, material: Diffuse(reflectance: (0.5, 0.5, 0.5))),
+                    textures: [(param: BumpMap, texture: Bitmap(filename: "tex.png"))]))))"#
+            )
+        };
+        let ron = format!(
+            r#"(
+            camera: (fov: 40, to_world: [LookAt(origin: (0, 0, 5), target: (0, 0, 0), up: (0, 1, 0))]),
+            film: (width: 16, height: 16, filter: Box),
+            shapes: [{}, {}],
+            lights: [Constant(radiance: (1, 1, 1))],
+        )"#,
+            bumped("Sphere(center: (0.6, 0, 0.5), radius: 0.6)"),
+            bumped("Rectangle"),
+        );
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/textured");
+        let desc = restir_scene::parse_ron(&ron, "bumped.ron".as_ref()).unwrap();
+        Scene::build(&desc, &dir, "bumped.ron".as_ref()).unwrap()
+    }
+
+    /// A receiver resolves the BSDF the path tracer gets at the same hit, bump map applied;
+    /// the lookup by texture point alone (the negative control) leaves the bump flat and differs.
+    #[test]
+    fn receiver_resolves_the_bumped_bsdf_of_its_hit() {
+        let scene = bumped_scene();
+        let (mut hits, mut flat_differs) = (0, 0);
+        for y in 0..16 {
+            for x in 0..16 {
+                let film = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                let ray = scene.camera.generate_ray(film, Vec2::splat(0.5));
+                let Some(si) = scene.intersect(&ray) else {
+                    continue;
+                };
+                hits += 1;
+                let r = Receiver::at_hit(&scene, &si, -ray.d, si.t);
+                assert!(r.bump.is_some());
+                assert_eq!(r.resolve_bsdf(&scene), scene.bsdf(&si), "pixel ({x}, {y})");
+                flat_differs += usize::from(scene.bsdf_at(r.bsdf, &r.at) != scene.bsdf(&si));
+            }
+        }
+        assert!(hits > 50, "{hits}");
+        assert!(flat_differs > hits / 2, "{flat_differs} of {hits}");
+    }
+
+    /// The receiver stays within two cache lines with the bump map's normal.
+    #[test]
+    fn receiver_size() {
+        assert_eq!(std::mem::size_of::<Receiver>(), 128);
     }
 }
