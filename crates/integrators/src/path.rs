@@ -68,10 +68,10 @@ pub enum EmissionMis {
     /// One light sample and one BSDF sample, power heuristic (the path tracer).
     Power,
     /// `light_samples` light-strategy samples and `bsdf_samples` BSDF samples combined by the
-    /// balance heuristic; this continuation is one of the BSDF samples (or, with
-    /// `bsdf_samples = 0`, an indirect-only continuation whose direct emission counts zero).
-    /// ReSTIR DI uses it: its reservoirs cover the light strategy's share.
-    Balance {
+    /// power heuristic with sample counts ([`power_share`]); this continuation is one of the
+    /// BSDF samples (or, with `bsdf_samples = 0`, an indirect-only continuation whose direct
+    /// emission counts zero). ReSTIR DI uses it: its reservoirs cover the light strategy's share.
+    Counted {
         /// Light-strategy sample count `N_L`.
         light_samples: f32,
         /// BSDF sample count `N_B`.
@@ -89,23 +89,42 @@ impl PrevVertex {
         }
         match self.mis {
             EmissionMis::Power => power_heuristic(self.pdf_sa, light_pdf_sa),
-            EmissionMis::Balance {
+            EmissionMis::Counted {
                 light_samples,
                 bsdf_samples,
-            } => balance_share(self.pdf_sa, bsdf_samples, light_pdf_sa, light_samples),
+            } => bsdf_sample_share(self.pdf_sa, bsdf_samples, light_pdf_sa, light_samples),
         }
     }
 }
 
-/// The share `p_b / (N_l·p_l + N_b·p_b)` of one of `N_b` BSDF samples of density `p_b` against
-/// `N_l` light samples of density `p_l` (0 when there are no BSDF samples).
+/// The power heuristic with sample counts: the share `a² / (a² + b²)` of a strategy whose
+/// samples have the count-weighted density `a = N_a·p_a` against one with `b = N_b·p_b`
+/// (Veach's β = 2). 0 when `a` is 0, 1 when `b` is, never NaN; computed from `b / a`, so huge
+/// densities do not overflow.
 #[inline]
-pub fn balance_share(bsdf_pdf: f32, bsdf_samples: f32, light_pdf: f32, light_samples: f32) -> f32 {
+pub fn power_share(a: f32, b: f32) -> f32 {
+    if !(a > 0.0) {
+        return 0.0;
+    }
+    let r = b / a;
+    let w = 1.0 / (1.0 + r * r);
+    if w.is_finite() { w } else { 0.0 }
+}
+
+/// The weight `m_B / N_b` of one of `N_b` BSDF samples of density `p_b` against `N_l` light
+/// samples of density `p_l`, `m_B` their power-heuristic share ([`power_share`]): the sample
+/// contributes `f·L_e·m_B / (N_b·p_b)` (0 when there are no BSDF samples).
+#[inline]
+pub fn bsdf_sample_share(
+    bsdf_pdf: f32,
+    bsdf_samples: f32,
+    light_pdf: f32,
+    light_samples: f32,
+) -> f32 {
     if !(bsdf_samples > 0.0 && bsdf_pdf > 0.0) {
         return 0.0;
     }
-    let w = bsdf_pdf / (light_samples * light_pdf + bsdf_samples * bsdf_pdf);
-    if w.is_finite() { w } else { 0.0 }
+    power_share(bsdf_samples * bsdf_pdf, light_samples * light_pdf) / bsdf_samples
 }
 
 /// Radiance arriving along `ray` (a camera ray, or a continuation from `prev`), estimated with one

@@ -53,23 +53,14 @@ const MIN_VARIANCE: f64 = 1e-4;
 /// Scenes that must load (of the 29).
 const MIN_LOADING: usize = 28;
 /// `(scene, estimator, reason)`: failures that are known and explained in docs/VALIDATION.md.
-const KNOWN_FAILURES: &[(&str, &str, &str)] = &[
-    (
-        "bsdf_spheres/test_constant_path.xml",
-        "restir-di",
-        "unbiased but, on the Beckmann alpha 0.05 conductor under a constant environment, about 25 \
-         times the path tracer's per-sample variance (light sampling misses the narrow lobe), more \
-         than Mitsuba's variance image allows in a few pixels",
-    ),
-    (
-        "bsdf_spheres/test_constant_path.xml",
-        "restir-pt",
-        "at Mitsuba's full budget only: unbiased, but behind fully transparent mask texels, where \
+const KNOWN_FAILURES: &[(&str, &str, &str)] = &[(
+    "bsdf_spheres/test_constant_path.xml",
+    "restir-pt",
+    "at Mitsuba's full budget only: unbiased, but behind fully transparent mask texels, where \
          the path tracer is exact (variance 0, so the criterion uses its floor 1e-4), reuse with \
          the neighbours' paths through the partly opaque leaf gives a per-sample variance of \
          3-5e-3",
-    ),
-];
+)];
 
 /// Linear sRGB → CIE XYZ, with the matrix Mitsuba converts with.
 fn to_xyz(c: glam::Vec3) -> [f64; 3] {

@@ -20,7 +20,7 @@
 //!    depend on scheduling. Confidence is capped at `mcap` after every step. Steps 3 and 4
 //!    are the shared [`crate::reuse::passes`]; this module plugs in the identity shift.
 //! 5. **Shading**: the selected sample with a shadow ray, times its `W`; plus `N_B` BSDF samples
-//!    weighted by the balance heuristic against the light strategy (the exact split is explained
+//!    weighted by the power heuristic against the light strategy (the exact split is explained
 //!    in [`mod@target`]); the first BSDF sample continues as a path-traced path when
 //!    `max_depth > 2` (indirect light) or when it followed a delta lobe.
 
@@ -186,7 +186,7 @@ impl RestirDiIntegrator {
                 p: r.p,
                 pdf_sa: bs.pdf_sa,
                 delta,
-                mis: EmissionMis::Balance {
+                mis: EmissionMis::Counted {
                     light_samples: self.counts.light,
                     bsdf_samples: self.counts.bsdf,
                 },

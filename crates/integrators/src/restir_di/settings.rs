@@ -178,7 +178,7 @@ pub struct RestirDiSettings {
     /// (a cell of `n` records takes `learn_share · n / (n + learn_prior)`; default 64).
     pub learn_prior: f32,
     /// BSDF samples per pixel, `N_B` (default 1), combined with the reservoirs' light strategy
-    /// by the balance heuristic.
+    /// by the power heuristic with sample counts.
     pub bsdf_candidates: u32,
     /// Where visibility is tested (default in every target: chosen on the training family with
     /// the reuse defaults, `docs/studies/2026-12-02-restir-di-light-pool-and-defaults.md`).

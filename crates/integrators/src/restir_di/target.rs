@@ -1,12 +1,19 @@
 //! ReSTIR DI's target: the light strategy's share of the direct light at a receiver.
 //!
 //! The direct light at receiver `x` is split exactly between the two strategies that cover it,
-//! light sampling (the reservoirs) and BSDF sampling (traced at shading), by balance-heuristic
-//! weights that depend only on `x` and `y`:
+//! light sampling (the reservoirs) and BSDF sampling (traced at shading), by power-heuristic
+//! weights with sample counts that depend only on `x` and `y`:
 //!
 //! ```text
-//! m_L(y) = N_L·p_L(y) / (N_L·p_L(y) + N_B·p_B(y)),   m_B = 1 − m_L      (solid angle at x)
+//! m_L(y) = (N_L·p_L(y))² / ((N_L·p_L(y))² + (N_B·p_B(y))²),   m_B = 1 − m_L   (solid angle at x)
 //! ```
+//!
+//! The power heuristic, not the balance heuristic, because light sampling cannot find a narrow
+//! glossy lobe that BSDF sampling covers almost exactly: the balance heuristic still gives the
+//! light strategy about `N_L·p_L/p_B` of such a lobe, which a candidate hits rarely and then
+//! with a large weight (on a Beckmann α = 0.05 conductor under a constant environment, 8
+//! candidates, a per-sample variance about 25 times the path tracer's); the power heuristic
+//! leaves it the square of that share.
 //!
 //! The reservoirs estimate `∫ F(y)·m_L(y)·V(x, y) dy` with `F = f_s·|cos θ_x|·L_e·G` (the
 //! unshadowed contribution) and target `p̂(y) = lum(F(y)·m_L(y))`; visibility is tested once, at
@@ -19,6 +26,7 @@ use restir_materials::Bsdf;
 use restir_sampling::luminance;
 use restir_scene::Scene;
 
+use crate::path::power_share;
 use crate::reuse::gbuffer::Receiver;
 use restir_lights::{Contact, LightPoint};
 
@@ -72,9 +80,10 @@ pub fn evaluate(
         let light_pdf_sa = known_light_pdf_sa
             .or(c.pdf_sa)
             .unwrap_or_else(|| scene.lights.pdf_sa(sample.light, r.p, c.p, c.ng));
-        let nl = counts.light * light_pdf_sa;
-        let nb = counts.bsdf * bsdf.pdf_sa(r.wo, wi);
-        if nl > 0.0 { nl / (nl + nb) } else { 0.0 }
+        power_share(
+            counts.light * light_pdf_sa,
+            counts.bsdf * bsdf.pdf_sa(r.wo, wi),
+        )
     };
     let contribution = f * c.le * (c.measure * m_light);
     let target = luminance(contribution);
@@ -84,5 +93,42 @@ pub fn evaluate(
     Evaluated {
         contribution,
         target,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::path::{bsdf_sample_share, power_share};
+
+    /// The light strategy's weight and the `N_B` BSDF samples' weights add up to one wherever a
+    /// BSDF sample can land (the split is exact), at any density, never NaN.
+    #[test]
+    fn light_and_bsdf_weights_add_up_to_one() {
+        let pdfs = [0.0, 1e-30, 0.08, 0.3, 1.0, 32.0, 1e12, 1e30, f32::INFINITY];
+        for (nl, nb) in [(8.0, 1.0), (1.0, 1.0), (32.0, 4.0)] {
+            for pl in pdfs {
+                for pb in pdfs.into_iter().filter(|p| *p > 0.0 && p.is_finite()) {
+                    let m_l = power_share(nl * pl, nb * pb);
+                    let m_b = nb * bsdf_sample_share(pb, nb, pl, nl);
+                    assert!(m_l.is_finite() && m_b.is_finite(), "{pl} {pb}");
+                    assert!((m_l + m_b - 1.0).abs() < 1e-6, "{pl} {pb}: {m_l} + {m_b}");
+                }
+            }
+        }
+        // No BSDF samples: the light strategy takes everything.
+        assert_eq!(bsdf_sample_share(1.0, 0.0, 0.5, 8.0), 0.0);
+    }
+
+    /// In a narrow lobe that BSDF sampling covers (`p_B = 32`, a Beckmann α = 0.05 peak) and 8
+    /// light candidates of a uniform sphere reach with `N_L·p_L ≈ 0.64`, the light strategy keeps
+    /// the square of the balance heuristic's share; with a light it finds well it keeps almost
+    /// everything.
+    #[test]
+    fn a_narrow_lobe_is_left_to_bsdf_sampling() {
+        let (a, b) = (8.0 * 0.0796, 32.0);
+        let balance = a / (a + b);
+        let power = power_share(a, b);
+        assert!(balance > 0.019 && power < 0.0005, "{balance} {power}");
+        assert!(power_share(1e4, 32.0) > 0.99999);
     }
 }
