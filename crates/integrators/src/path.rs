@@ -103,7 +103,7 @@ impl PrevVertex {
 /// densities do not overflow.
 #[inline]
 pub fn power_share(a: f32, b: f32) -> f32 {
-    if !(a > 0.0) {
+    if a.is_nan() || a <= 0.0 {
         return 0.0;
     }
     let r = b / a;

@@ -129,6 +129,6 @@ mod tests {
         let balance = a / (a + b);
         let power = power_share(a, b);
         assert!(balance > 0.019 && power < 0.0005, "{balance} {power}");
-        assert!(power_share(1e4, 32.0) > 0.99999);
+        assert!(power_share(1e4, 32.0) > 0.9999);
     }
 }
