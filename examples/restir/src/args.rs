@@ -34,8 +34,9 @@ pub(crate) struct RenderArgs {
     /// Worker threads, 1 to 256 (0 or absent: one per core).
     #[arg(long)]
     pub(crate) threads: Option<usize>,
-    /// Refuse films whose estimated memory (film, images and the estimator's per-pixel
-    /// buffers) exceeds this many GiB, before allocating anything [default: 8].
+    /// Refuse scenes and films whose estimated memory (images, meshes, light tables, the film
+    /// and the estimator's per-pixel buffers) exceeds this many GiB, before allocating it
+    /// [default: 8].
     #[arg(long, value_name = "GIB")]
     pub(crate) max_memory: Option<f64>,
     /// Image width; overrides the scene.
