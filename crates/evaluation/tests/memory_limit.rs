@@ -7,9 +7,9 @@ use std::path::Path;
 use restir_evaluation::{RunOptions, Suite, run_suite};
 use restir_testkit::TempDir;
 
-/// A 40×40 grid of quads: 3200 triangles and 1681 vertices, 1.27 MB by the mesh estimate.
+/// A 50×50 grid of quads: 5000 triangles and 2601 vertices, about 1.6 MB by the mesh estimate.
 fn write_grid(path: &Path) {
-    let n = 40;
+    let n = 50;
     let mut obj = String::new();
     for y in 0..=n {
         for x in 0..=n {
@@ -53,11 +53,11 @@ fn a_scene_over_the_limit_fails_at_its_line_before_rendering() {
     write_grid(&dir.path().join("grid.obj"));
     std::fs::write(
         dir.path().join("scene.ron"),
-        "(camera: (fov: 40, to_world: [LookAt(origin: (20, 20, 60), target: (20, 20, 0), \
+        "(camera: (fov: 40, to_world: [LookAt(origin: (25, 25, 75), target: (25, 25, 0), \
          up: (0, 1, 0))]), film: (width: 8, height: 8, filter: Box), spp: 1, \
          integrator: (kind: \"path\", max_depth: 2), materials: [], \
          shapes: [(geometry: Obj(filename: \"grid.obj\"))], \
-         lights: [Point(position: (20, 20, 30), intensity: (1, 1, 1))])",
+         lights: [Point(position: (25, 25, 30), intensity: (1, 1, 1))])",
     )
     .unwrap();
     let suite = dir.path().join("suite.ron");
@@ -68,11 +68,11 @@ fn a_scene_over_the_limit_fails_at_its_line_before_rendering() {
          seeds: 1,\n    reference_spp: 2,\n)\n",
     )
     .unwrap();
-    // 1 MiB: the mesh needs 1.27 MB. The images of 8×8 pixels need far less.
+    // 1 MiB: the mesh needs about 1.6 MB. The images of 8×8 pixels need far less.
     let (result, steps) = run(&suite, 1.0 / 1024.0);
     let err = result.unwrap_err();
     assert!(err.contains("suite.ron:3: "), "{err}");
-    assert!(err.contains("grid.obj' (3200 triangles)"), "{err}");
+    assert!(err.contains("grid.obj' (5000 triangles)"), "{err}");
     assert!(err.contains("raise --max-memory"), "{err}");
     assert_eq!(steps, 0, "progress was reported before the error: {err}");
     assert!(!dir.path().join("out/references").exists());

@@ -54,7 +54,7 @@ fn unknown_plugin_types_list_the_valid_ones() {
         &format!(
             "error: {}:2: unknown bsdf type 'velvet' (known: diffuse, twosided, conductor, \
              roughconductor, dielectric, roughdielectric, plastic, roughplastic, null, mask, normalmap, \
-             principled, principledthin, bumpmap)",
+             principled, principledthin, bumpmap, blendbsdf)",
             s(&sc)
         ),
     );
