@@ -547,11 +547,10 @@ pub(crate) fn color_params(m: &MaterialDesc) -> &'static [ColorParam] {
     }
 }
 
-/// Whether `m` is a `blendbsdf` (perhaps inside a `twosided`, a `mask`, a normal or bump
-/// map), whose weight a texture may give.
-pub(crate) fn is_blend(m: &MaterialDesc) -> bool {
+/// The material a wrapper holds: `twosided`, `mask`, `normalmap`, `bumpmap` or a textured
+/// model's constant part; `None` for a model.
+fn wrapped(m: &MaterialDesc) -> Option<&MaterialDesc> {
     match m {
-        MaterialDesc::Blend { .. } => true,
         MaterialDesc::TwoSided(inner)
         | MaterialDesc::Mask {
             material: inner, ..
@@ -564,48 +563,29 @@ pub(crate) fn is_blend(m: &MaterialDesc) -> bool {
         }
         | MaterialDesc::Textured {
             material: inner, ..
-        } => is_blend(inner),
-        _ => false,
+        } => Some(inner),
+        _ => None,
     }
+}
+
+/// Whether `m` is a `blendbsdf` (perhaps inside a `twosided`, a `mask`, a normal or bump
+/// map), whose weight a texture may give.
+pub(crate) fn is_blend(m: &MaterialDesc) -> bool {
+    matches!(m, MaterialDesc::Blend { .. }) || wrapped(m).is_some_and(is_blend)
 }
 
 /// How many `blendbsdf`s nest in `m` at most (0 without one).
 fn blend_depth(m: &MaterialDesc) -> usize {
     match m {
         MaterialDesc::Blend { bsdfs, .. } => 1 + blend_depth(&bsdfs.0).max(blend_depth(&bsdfs.1)),
-        MaterialDesc::TwoSided(inner)
-        | MaterialDesc::Mask {
-            material: inner, ..
-        }
-        | MaterialDesc::NormalMap {
-            material: inner, ..
-        }
-        | MaterialDesc::BumpMap {
-            material: inner, ..
-        }
-        | MaterialDesc::Textured {
-            material: inner, ..
-        } => blend_depth(inner),
-        _ => 0,
+        _ => wrapped(m).map_or(0, blend_depth),
     }
 }
 
-/// Whether `m` is textured, or wraps (in `twosided` or `mask`) a textured material.
+/// Whether `m` is textured, or wraps (in `twosided`, `mask`, a normal or bump map) a textured
+/// material.
 pub(crate) fn contains_textured(m: &MaterialDesc) -> bool {
-    match m {
-        MaterialDesc::Textured { .. } => true,
-        MaterialDesc::TwoSided(inner)
-        | MaterialDesc::Mask {
-            material: inner, ..
-        }
-        | MaterialDesc::NormalMap {
-            material: inner, ..
-        }
-        | MaterialDesc::BumpMap {
-            material: inner, ..
-        } => contains_textured(inner),
-        _ => false,
-    }
+    matches!(m, MaterialDesc::Textured { .. }) || wrapped(m).is_some_and(contains_textured)
 }
 
 /// Whether `m` is a `mask` (perhaps inside `twosided`), whose opacity a texture may give.
