@@ -23,6 +23,20 @@ pub(crate) fn run(test: &Path, reference: &Path, html: Option<&Path>) -> Result<
         }
         restir_image::check_writable(out).map_err(|e| e.to_string())?;
     }
+    // Sizes from the headers first: images that cannot be compared are refused before either
+    // is decoded (a small file may claim a large image).
+    let size = |p: &Path| Image::read_dimensions(p).map_err(|e| e.to_string());
+    let (ts, rs) = (size(test)?, size(reference)?);
+    if ts != rs {
+        return Err(format!(
+            "{}: size {}×{} differs from the reference's {}×{}",
+            test.display(),
+            ts.0,
+            ts.1,
+            rs.0,
+            rs.1
+        ));
+    }
     let t = Image::read_exr(test).map_err(|e| e.to_string())?;
     let r = Image::read_exr(reference).map_err(|e| e.to_string())?;
     let m = restir_evaluation::metrics::evaluate(&t, &r).ok_or_else(|| {

@@ -313,6 +313,23 @@ fn compare_bad_inputs() {
 
 /// NaN is never a perfect match: an all-NaN image is an error, NaN in the reference is counted
 /// and warned about.
+/// Images of different sizes are refused from their headers, before either is decoded: a
+/// truncated file that claims a 1024² image is not read beyond its header.
+#[test]
+fn compare_refuses_different_sizes_before_decoding() {
+    let dir = temp_dir("compare-size");
+    let small = dir.join("small.exr");
+    restir_image::Image::new(8, 8).write(&small).unwrap();
+    let big = dir.join("big.exr");
+    restir_image::Image::new(1024, 1024).write(&big).unwrap();
+    let f = std::fs::OpenOptions::new().write(true).open(&big).unwrap();
+    f.set_len(2000).unwrap();
+    fails(
+        &["compare", s(&small), s(&big)],
+        &[s(&small), "size 8×8 differs from the reference's 1024×1024"],
+    );
+}
+
 #[test]
 fn compare_counts_nan_on_both_sides() {
     let dir = temp_dir("compare-nan");
