@@ -7,7 +7,8 @@
 
 use glam::{DVec3, Vec2, Vec3};
 use restir_geometry::{Ray, offset_ray_origin};
-use restir_sampling::{Pcg32, warp::power_heuristic};
+use restir_sampling::Pcg32;
+use restir_sampling::warp::{power_heuristic, power_share};
 use restir_scene::{IntegratorDesc, Scene};
 
 use crate::bands::Bands;
@@ -95,20 +96,6 @@ impl PrevVertex {
             } => bsdf_sample_share(self.pdf_sa, bsdf_samples, light_pdf_sa, light_samples),
         }
     }
-}
-
-/// The power heuristic with sample counts: the share `a² / (a² + b²)` of a strategy whose
-/// samples have the count-weighted density `a = N_a·p_a` against one with `b = N_b·p_b`
-/// (Veach's β = 2). 0 when `a` is 0, 1 when `b` is, never NaN; computed from `b / a`, so huge
-/// densities do not overflow.
-#[inline]
-pub fn power_share(a: f32, b: f32) -> f32 {
-    if a.is_nan() || a <= 0.0 {
-        return 0.0;
-    }
-    let r = b / a;
-    let w = 1.0 / (1.0 + r * r);
-    if w.is_finite() { w } else { 0.0 }
 }
 
 /// The weight `m_B / N_b` of one of `N_b` BSDF samples of density `p_b` against `N_l` light

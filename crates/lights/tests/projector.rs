@@ -32,16 +32,7 @@ const R: f32 = 2.0;
 /// The light's frame: Mitsuba's look-at from `POSITION` towards a tilted axis (`x = up × z`, the
 /// image's left).
 fn to_world() -> Mat4 {
-    let axis = Vec3::new(0.3, -0.5, 0.8).normalize();
-    let up = Vec3::Y;
-    let x = up.cross(axis).normalize();
-    let y = axis.cross(x);
-    Mat4::from_cols(
-        x.extend(0.0),
-        y.extend(0.0),
-        axis.extend(0.0),
-        POSITION.extend(1.0),
-    )
+    common::tilted_frame(POSITION)
 }
 
 /// Half the image's extent on the plane `z = 1`: `tan 30°` across, ¾ of it up and down.

@@ -27,17 +27,7 @@ const R: f32 = 2.0;
 
 /// The light's frame: a look-at from `POSITION` towards a tilted axis.
 fn to_world() -> Mat4 {
-    let axis = Vec3::new(0.3, -0.5, 0.8).normalize();
-    // Mitsuba's look-at: z towards the target, x = up × z, y = z × x.
-    let up = Vec3::Y;
-    let x = up.cross(axis).normalize();
-    let y = axis.cross(x);
-    Mat4::from_cols(
-        x.extend(0.0),
-        y.extend(0.0),
-        axis.extend(0.0),
-        POSITION.extend(1.0),
-    )
+    common::tilted_frame(POSITION)
 }
 
 fn set_with(texture: Option<Arc<dyn SpotTexture>>) -> LightSet {

@@ -190,6 +190,20 @@ pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
     if w.is_finite() { w } else { 0.0 }
 }
 
+/// The power heuristic with sample counts: the share `a² / (a² + b²)` of a strategy whose
+/// samples have the count-weighted density `a = N_a·p_a` against one with `b = N_b·p_b`
+/// (Veach's β = 2), for densities already multiplied by their sample counts. 0 when `a` is 0, 1 when `b` is, never NaN; computed from `b / a`, so huge
+/// densities do not overflow.
+#[inline]
+pub fn power_share(a: f32, b: f32) -> f32 {
+    if a.is_nan() || a <= 0.0 {
+        return 0.0;
+    }
+    let r = b / a;
+    let w = 1.0 / (1.0 + r * r);
+    if w.is_finite() { w } else { 0.0 }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -26,9 +26,9 @@ use restir_materials::Bsdf;
 use restir_sampling::luminance;
 use restir_scene::Scene;
 
-use crate::path::power_share;
 use crate::reuse::gbuffer::Receiver;
 use restir_lights::{Contact, LightPoint};
+use restir_sampling::warp::power_share;
 
 /// The two strategy counts of the direct-light split.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,7 +98,8 @@ pub fn evaluate(
 
 #[cfg(test)]
 mod tests {
-    use crate::path::{bsdf_sample_share, power_share};
+    use crate::path::bsdf_sample_share;
+    use restir_sampling::warp::power_share;
 
     /// The light strategy's weight and the `N_B` BSDF samples' weights add up to one wherever a
     /// BSDF sample can land (the split is exact), at any density, never NaN.

@@ -3,9 +3,23 @@
 //! with `sample`.
 #![allow(dead_code)] // each test file uses a different subset
 
-use glam::{Vec2, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 use restir_lights::{LightPoint, LightSet, Presampled, SpotTexture};
 use restir_sampling::{Pcg32, warp};
+
+/// Mitsuba's look-at frame from `position` towards a tilted axis (`z` along the axis,
+/// `x = up × z`, `y = z × x`, up `+y`): the spot's and the projector's `to_world`.
+pub fn tilted_frame(position: Vec3) -> Mat4 {
+    let axis = Vec3::new(0.3, -0.5, 0.8).normalize();
+    let x = Vec3::Y.cross(axis).normalize();
+    let y = axis.cross(x);
+    Mat4::from_cols(
+        x.extend(0.0),
+        y.extend(0.0),
+        axis.extend(0.0),
+        position.extend(1.0),
+    )
+}
 
 /// A texture that returns its coordinates: `(u, v, 1)`.
 #[derive(Debug)]
