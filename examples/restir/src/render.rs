@@ -290,10 +290,17 @@ fn settle(
         }
     }
     let (width, height) = scene.camera.resolution();
+    // A second moment is kept for an EXR of a whole image (`keep_moment_where_written`).
+    let moment = job.moment.is_some()
+        && plan.is_none()
+        && output
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
     strict::check_memory(
         width,
         height,
         integrator,
+        moment,
         strict::max_memory(args.max_memory)?,
     )?;
     Ok(Settled {

@@ -71,6 +71,10 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, String> 
 /// (3 × f64), one pass's image and the output image (3 × f32 each).
 pub const FILM_BYTES_PER_PIXEL: u64 = 24 + 12 + 12;
 
+/// Bytes per pixel the film adds for a `moment` integrator's second moment: the sums of the
+/// squares and one pass's estimates (3 × f64 each).
+pub const MOMENT_BYTES_PER_PIXEL: u64 = 24 + 24;
+
 /// The default of `--max-memory`, in GiB.
 pub const DEFAULT_MAX_MEMORY_GIB: f64 = 8.0;
 
@@ -80,10 +84,13 @@ pub fn check_memory(
     width: u32,
     height: u32,
     integrator: &dyn Integrator,
+    moment: bool,
     max_gib: f64,
 ) -> Result<(), String> {
     let pixels = width as u64 * height as u64;
-    let per_pixel = FILM_BYTES_PER_PIXEL + integrator.buffer_bytes_per_pixel() as u64;
+    let per_pixel = FILM_BYTES_PER_PIXEL
+        + integrator.buffer_bytes_per_pixel() as u64
+        + if moment { MOMENT_BYTES_PER_PIXEL } else { 0 };
     let need = pixels.saturating_mul(per_pixel);
     let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
     if gib(need) > max_gib {

@@ -151,3 +151,44 @@ fn convert_writes_the_moment_back() {
     render(&again, &out);
     assert!(channels(&out).contains_key("m2_nested.Y"));
 }
+
+/// The second moment's buffers count against `--max-memory`: a film that fits without them
+/// (a PNG keeps none) is refused before rendering when an EXR would keep them.
+#[test]
+fn the_second_moment_counts_against_the_memory_limit() {
+    let dir = TempDir::new("moment", "memory");
+    let sc = scene(&dir.0);
+    let run = |name: &str| {
+        let out = dir.0.join(name);
+        let o = restir(&[
+            "render",
+            sc.to_str().unwrap(),
+            "--width",
+            "100",
+            "--height",
+            "100",
+            "--spp",
+            "1",
+            "--max-memory",
+            "0.0007",
+            "--quiet",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+            out,
+        )
+    };
+    let (code, err, out) = run("m.png");
+    assert_eq!(code, Some(0), "{err}");
+    assert!(out.is_file());
+    let (code, err, out) = run("m.exr");
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("96 bytes per pixel") && err.contains("raise --max-memory"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
