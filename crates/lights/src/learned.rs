@@ -23,9 +23,15 @@
 use std::collections::{BTreeMap, HashMap};
 
 use glam::Vec3;
-use restir_sampling::{AliasTable, ONE_MINUS_EPSILON};
+use restir_sampling::{AliasTable, ONE_MINUS_EPSILON, Pcg32};
 
-use crate::LightSet;
+use crate::{LightSet, Presampled};
+
+/// A draw of the learned mixture made without a receiver ([`LearnedSampler::presample`]): the
+/// power sampler's presampled draw of the picked emitter ([`LightSet::presample_emitter`]) and
+/// the ratio of the mixture's probability of that emitter to the power sampler's, by which its
+/// density is multiplied.
+pub type LearnedDraw = (Presampled, f32);
 
 /// A cell of the grid: integer coordinates and the receiver normal's dominant axis and sign.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -225,6 +231,44 @@ impl LearnedSampler {
         match cell.map(|c| &self.tables[c as usize]) {
             None => power,
             Some(t) => t.share * t.pmf(emitter as u32) + (1.0 - t.share) * power,
+        }
+    }
+
+    /// Fills `out` with independent draws of `cell`'s mixture ([`LearnedSampler::sample`], the
+    /// selections stratified over `out`), each with the ratio of its probability to the power
+    /// sampler's, or with the ratio of the table's probability alone
+    /// ([`LearnedSampler::pmf_without_defensive_share`], the tests' negative control) when
+    /// `defensive` is false. A pool of such draws serves a cell's receivers as the power
+    /// sampler's presampled tiles serve theirs: one read per candidate from a small array
+    /// instead of an alias pick, a table lookup and a point on a triangle at random places in
+    /// memory (Wyman and Panteleev 2021, presampled cell tables).
+    pub fn presample(
+        &self,
+        lights: &LightSet,
+        cell: u32,
+        defensive: bool,
+        rng: &mut Pcg32,
+        out: &mut [Option<LearnedDraw>],
+    ) {
+        let n = out.len() as f32;
+        let u0 = rng.next_f32();
+        for (j, slot) in out.iter_mut().enumerate() {
+            let u_select = ((j as f32 + u0) / n).min(ONE_MINUS_EPSILON);
+            let u = rng.next_2d();
+            *slot = self
+                .sample(lights, Some(cell), u_select)
+                .and_then(|(e, pmf)| {
+                    let power = lights.emitter_pmf(e);
+                    let claimed = if defensive {
+                        pmf
+                    } else {
+                        self.pmf_without_defensive_share(lights, Some(cell), e)
+                    };
+                    (power > 0.0)
+                        .then(|| lights.presample_emitter(e, u))
+                        .flatten()
+                        .map(|d| (d, claimed / power))
+                });
         }
     }
 

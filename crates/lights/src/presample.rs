@@ -39,7 +39,23 @@ impl LightSet {
     /// the receiver ([`Presampled`]): the point of a triangle, a point light, the direction of a
     /// light at infinity; a sphere light only picked. `None` where nothing can be sampled.
     pub fn presample(&self, u_select: f32, u: Vec2) -> Option<Presampled> {
-        let light = match self.table.pick(u_select)? {
+        let picked = match self.table.pick_index(u_select)? {
+            Ok(e) => e,
+            Err(_) => self.table.len(),
+        };
+        self.presample_emitter(picked, u)
+    }
+
+    /// [`LightSet::presample`] of a given emitter `e` (an entry of the emitter table, or the
+    /// table's length for the environment; [`LightSet::emitter_of`]'s numbering), its density
+    /// still the power sampler's. `None` for an emitter that does not exist or cannot be sampled.
+    pub fn presample_emitter(&self, e: usize, u: Vec2) -> Option<Presampled> {
+        let picked = match self.table.entries().get(e) {
+            Some(entry) => Ok(entry),
+            None if e == self.table.len() => Err(self.environment?),
+            None => return None,
+        };
+        let light = match picked {
             Ok(&Emitter::Triangle {
                 light,
                 prim,

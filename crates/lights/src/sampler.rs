@@ -11,7 +11,7 @@
 //! | [`HierarchySampler`] | the light hierarchy, receiver-aware ([`LightSet::sample_hierarchy`]) | the same |
 //! | [`PoolSampler`] | the power sampler's draws made once for a block of pixels ([`LightSet::presample`]) | fixed with the draw (a sphere's point per receiver) |
 //! | [`TableSampler`] | a table over the lights mixed with the power sampler (screen tiles) | [`LightSet::sample_light`] |
-//! | [`LearnedCellSampler`] | the learned table of the receiver's cell over emitters (triangles, other lights, the environment) mixed with the power sampler ([`LearnedSampler`]) | [`LightSet::sample_entry`], or the pool's draw for the power share |
+//! | [`LearnedCellSampler`] | the learned table of the receiver's cell over emitters (triangles, other lights, the environment) mixed with the power sampler ([`LearnedSampler`](crate::LearnedSampler)) | a pool of the mixture's draws per cell, made once per pass ([`LearnedSampler::presample`](crate::LearnedSampler::presample)) |
 //!
 //! Each is a small value made per receiver from tables built per pass, so the candidate loop is
 //! monomorphised for each.
@@ -19,7 +19,7 @@
 use glam::{Vec2, Vec3};
 use restir_sampling::{AliasTable, ONE_MINUS_EPSILON, Pcg32};
 
-use crate::{Contact, LearnedSampler, LightPoint, LightSample, LightSet, Presampled, Resolved};
+use crate::{Contact, LearnedDraw, LightPoint, LightSample, LightSet, Presampled, Resolved};
 
 /// A receiver as light selection sees it: its position and shading normal (zero if unknown).
 #[derive(Clone, Copy, Debug)]
@@ -336,48 +336,26 @@ impl LightSampler for TableSampler<'_> {
     }
 }
 
-/// The learned selection at a receiver's cell ([`LearnedSampler`]); its power share drawn from a
-/// pool of presampled draws when there is one.
+/// The learned selection at a receiver's cell ([`LearnedSampler`]), from the cell's pool of
+/// presampled draws of the mixture ([`LearnedSampler::presample`]), taken as [`PoolSampler`]
+/// takes a tile's: from a uniform start, one entry from each of `n` strata of the pool. Each
+/// entry is an independent draw of the mixture whose density is the power sampler's times the
+/// entry's probability ratio, so whichever entries a receiver takes, each candidate is
+/// distributed as the mixture with exactly the density it carries.
 #[derive(Clone, Copy, Debug)]
 pub struct LearnedCellSampler<'a> {
-    learned: &'a LearnedSampler,
-    cell: u32,
-    pool: Option<PoolSampler<'a>>,
-    defensive: bool,
+    pool: &'a [Option<LearnedDraw>],
+    start: usize,
+    stride: usize,
 }
 
 impl<'a> LearnedCellSampler<'a> {
-    /// The sampler of `learned` in `cell` ([`LearnedSampler::cell`]), the power share from
-    /// `pool` if given.
-    pub fn new(
-        learned: &'a LearnedSampler,
-        cell: u32,
-        pool: Option<&'a [Option<Presampled>]>,
-    ) -> Self {
+    /// The sampler over a cell's `pool` (not empty).
+    pub fn new(pool: &'a [Option<LearnedDraw>]) -> Self {
         Self {
-            learned,
-            cell,
-            pool: pool.map(PoolSampler::new),
-            defensive: true,
-        }
-    }
-
-    /// The sampler that claims the cell's table alone as its probability, forgetting the
-    /// power sampler's share (a negative control of the tests: biased).
-    #[doc(hidden)]
-    pub fn without_defensive_share(mut self) -> Self {
-        self.defensive = false;
-        self
-    }
-
-    /// The mixture's probability of `emitter` (or the control's).
-    #[inline]
-    fn pmf(&self, lights: &LightSet, emitter: usize) -> f32 {
-        if self.defensive {
-            self.learned.pmf(lights, Some(self.cell), emitter)
-        } else {
-            self.learned
-                .pmf_without_defensive_share(lights, Some(self.cell), emitter)
+            pool,
+            start: 0,
+            stride: 1,
         }
     }
 }
@@ -385,9 +363,8 @@ impl<'a> LearnedCellSampler<'a> {
 impl LightSampler for LearnedCellSampler<'_> {
     #[inline]
     fn begin(&mut self, rng: &mut Pcg32, n: u32) {
-        if let Some(pool) = &mut self.pool {
-            pool.begin(rng, n);
-        }
+        self.start = rng.next_u32() as usize % self.pool.len();
+        self.stride = (self.pool.len() / n as usize).max(1);
     }
 
     #[inline]
@@ -398,22 +375,9 @@ impl LightSampler for LearnedCellSampler<'_> {
         u: &CandidateU,
         _rng: &mut Pcg32,
     ) -> Option<LightCandidate> {
-        if let Some(pool) = &self.pool
-            && u.select >= self.learned.cell_share(Some(self.cell))
-        {
-            // The power sampler's share, from the pool: its density times the mixture's
-            // probability of the emitter over the power sampler's.
-            let mut c = LightCandidate::presampled(lights, &pool.entry(u.i)?, at.p, u.point)?;
-            let e = lights.emitter_of(c.point.light, c.point.prim)?;
-            let power_pmf = lights.emitter_pmf(e);
-            if power_pmf <= 0.0 {
-                return None;
-            }
-            c.source_pdf *= self.pmf(lights, e) / power_pmf;
-            return Some(c);
-        }
-        let (e, _) = self.learned.sample(lights, Some(self.cell), u.select)?;
-        let (ls, power_pdf_sa) = lights.sample_entry(e, self.pmf(lights, e), at.p, u.point)?;
-        LightCandidate::from_sample(&ls, ls.pdf_sa, power_pdf_sa)
+        let (e, ratio) = self.pool[(self.start + u.i as usize * self.stride) % self.pool.len()]?;
+        let mut c = LightCandidate::presampled(lights, &e, at.p, u.point)?;
+        c.source_pdf *= ratio;
+        Some(c)
     }
 }

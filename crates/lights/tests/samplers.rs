@@ -14,9 +14,9 @@
 use glam::{Affine3A, Quat, Vec2, Vec3};
 use restir_geometry::{Shape, Sphere};
 use restir_lights::{
-    At, CandidateU, HierarchySampler, LearnGrid, LearnedCellSampler, LearnedSampler, Light,
-    LightCandidate, LightRecords, LightSampler, LightSet, PoolSampler, PowerSampler, Presampled,
-    TableSampler,
+    At, CandidateU, HierarchySampler, LearnGrid, LearnedCellSampler, LearnedDraw, LearnedSampler,
+    Light, LightCandidate, LightRecords, LightSampler, LightSet, PoolSampler, PowerSampler,
+    Presampled, TableSampler,
 };
 use restir_sampling::{AliasTable, ONE_MINUS_EPSILON, Pcg32, luminance};
 
@@ -139,6 +139,25 @@ fn learned(lights: &LightSet) -> (LearnedSampler, u32) {
     (sampler, cell)
 }
 
+/// One pool of `len` presampled draws of `cell`'s mixture per receiver, as a pass makes them
+/// (`defensive` false: the negative control's probabilities).
+fn cell_pools(
+    lights: &LightSet,
+    learned: &LearnedSampler,
+    cell: u32,
+    defensive: bool,
+    len: usize,
+) -> Vec<Vec<Option<LearnedDraw>>> {
+    let mut rng = Pcg32::new(21, 7);
+    (0..RECEIVERS)
+        .map(|_| {
+            let mut pool = vec![None; len];
+            learned.presample(lights, cell, defensive, &mut rng, &mut pool);
+            pool
+        })
+        .collect()
+}
+
 /// A skewed table over the lights (every third light, growing weights).
 fn table(lights: &LightSet) -> AliasTable {
     let w: Vec<f32> = (0..lights.len())
@@ -180,25 +199,24 @@ fn every_sampler_estimates_the_same_integral() {
                 share: 0.5,
             }),
         ),
-        (
-            "learned",
-            estimate(&lights, 5, |_| {
-                LearnedCellSampler::new(&learned, cell, None)
-            }),
-        ),
     ];
+    let pools = cell_pools(&lights, &learned, cell, true, 64);
     let mut k = 0;
-    let mut next_tile = || {
+    let learned_pool = estimate(&lights, 5, |_| {
         k += 1;
-        &tiles[k - 1][..]
-    };
-    let learned_pool = estimate(&lights, 6, |_| {
-        LearnedCellSampler::new(&learned, cell, Some(next_tile()))
+        LearnedCellSampler::new(&pools[k - 1])
     });
-    for (name, e) in cases
-        .into_iter()
-        .chain(std::iter::once(("learned with a pool", learned_pool)))
-    {
+    // A pool smaller than the candidates: entries are taken more than once.
+    let small = cell_pools(&lights, &learned, cell, true, 3);
+    let mut k = 0;
+    let learned_small = estimate(&lights, 6, |_| {
+        k += 1;
+        LearnedCellSampler::new(&small[k - 1])
+    });
+    for (name, e) in cases.into_iter().chain([
+        ("learned cell pool", learned_pool),
+        ("learned cell pool of 3", learned_small),
+    ]) {
         let z = z(e, power);
         eprintln!("{name}: {:.6} ± {:.6}, z {z:.2}", e.0, e.1);
         assert!(z.abs() < 4.0, "{name}: z {z}");
@@ -212,7 +230,8 @@ fn negative_controls_are_rejected() {
     let (learned, cell) = learned(&lights);
     let mut rng = Pcg32::new(4, 4);
     let tiles: Vec<_> = (0..RECEIVERS).map(|_| tile(&lights, &mut rng)).collect();
-    let mut k = 0;
+    let forgetful = cell_pools(&lights, &learned, cell, false, 64);
+    let (mut k, mut j) = (0, 0);
     let controls = [
         (
             "hierarchy claiming the power density",
@@ -230,7 +249,8 @@ fn negative_controls_are_rejected() {
         (
             "learned without its defensive share",
             estimate(&lights, 5, |_| {
-                LearnedCellSampler::new(&learned, cell, None).without_defensive_share()
+                j += 1;
+                LearnedCellSampler::new(&forgetful[j - 1])
             }),
         ),
     ];

@@ -12,8 +12,12 @@
 use std::sync::{Arc, Mutex};
 
 use glam::Vec3;
-use restir_lights::{CellKey, LearnGrid, LearnedSampler, LightRecords};
+use rayon::prelude::*;
+use restir_lights::{CellKey, LearnGrid, LearnedDraw, LearnedSampler, LightRecords};
 use restir_scene::Scene;
+
+use crate::pass::PassContext;
+use crate::reuse::gbuffer::GBuffer;
 
 /// One record of a pass: a receiver's cell, the emitter of its shaded sample
 /// ([`restir_lights::LightSet::emitter_of`]) and what it delivered (shadow ray included).
@@ -102,4 +106,75 @@ pub(super) fn record(
 ) -> Record {
     let lit = restir_sampling::luminance(contribution) > 0.0;
     (grid.key(p, n), emitter, if lit { 1.0 } else { 0.0 })
+}
+
+/// Candidates of a pass that one entry of a cell's pool serves, on average: a cell of `m`
+/// receivers gets `⌈m · N_L / USES_PER_ENTRY⌉` entries, at least `N_L` (a lone receiver still
+/// gets `N_L` different draws) and at most [`MAX_POOL`].
+pub const USES_PER_ENTRY: usize = 16;
+
+/// At most this many entries in one cell's pool (the power sampler's tile size).
+pub const MAX_POOL: usize = super::pool::TILE_SIZE;
+
+/// One pass's draws of the learned mixture: each receiver's cell and each cell's pool
+/// ([`LearnedSampler::presample`]), made from the pass's streams before any candidate is drawn.
+pub(super) struct CellPools {
+    /// Per pixel, its cell's index in `pools`, if the cell has a table.
+    pub cell_of: Vec<Option<u32>>,
+    /// Per cell of the sampler, its pool (empty for a cell no receiver of this pass is in).
+    pub pools: Vec<Vec<Option<LearnedDraw>>>,
+}
+
+impl CellPools {
+    /// Bytes per pixel of the cell index and the pools, on average (`candidates` per pixel).
+    pub fn bytes_per_pixel(candidates: u32) -> usize {
+        std::mem::size_of::<Option<u32>>()
+            + (candidates as usize).div_ceil(USES_PER_ENTRY)
+                * std::mem::size_of::<Option<LearnedDraw>>()
+    }
+
+    /// The pools of `learned` for the receivers of `gbuf`, with `candidates` candidates per
+    /// receiver, from the streams of stage `stage` of pass `ctx` (one per cell, so the pools do
+    /// not depend on the thread count). `defensive` false makes the tests' negative control.
+    pub fn build(
+        learned: &LearnedSampler,
+        scene: &Scene,
+        ctx: &PassContext,
+        gbuf: &GBuffer,
+        candidates: u32,
+        defensive: bool,
+        stage: u64,
+    ) -> Self {
+        let cell_of: Vec<Option<u32>> = (0..gbuf.receivers.len())
+            .into_par_iter()
+            .map(|i| gbuf.receiver(i).and_then(|r| learned.cell(r.p, r.n)))
+            .collect();
+        let mut receivers = vec![0usize; learned.cells()];
+        for c in cell_of.iter().flatten() {
+            receivers[*c as usize] += 1;
+        }
+        let n = candidates.max(1) as usize;
+        let pools = receivers
+            .into_par_iter()
+            .enumerate()
+            .map(|(c, m)| {
+                if m == 0 {
+                    return Vec::new();
+                }
+                let len = (m * n).div_ceil(USES_PER_ENTRY).clamp(n, MAX_POOL.max(n));
+                let mut pool = vec![None; len];
+                let mut rng = ctx.pass_stream(stage, c as u64);
+                learned.presample(&scene.lights, c as u32, defensive, &mut rng, &mut pool);
+                pool
+            })
+            .collect();
+        Self { cell_of, pools }
+    }
+
+    /// The pool of pixel `index`'s cell, if it has one.
+    #[inline]
+    pub fn pool(&self, index: usize) -> Option<&[Option<LearnedDraw>]> {
+        let c = self.cell_of[index]?;
+        Some(&self.pools[c as usize]).filter(|p| !p.is_empty()).map(|p| &p[..])
+    }
 }

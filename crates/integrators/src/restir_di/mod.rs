@@ -62,6 +62,7 @@ use target::{StrategyCounts, evaluate};
 const STAGE_INITIAL: u64 = 1;
 const STAGE_SHADE: u64 = 3;
 const STAGE_POOL: u64 = 4;
+const STAGE_LEARN_POOL: u64 = 5;
 const STAGES: Stages = Stages {
     temporal: 2,
     spatial: 16,
@@ -274,6 +275,11 @@ impl Integrator for RestirDiIntegrator {
             + reciprocal::table_bytes_per_pixel::<LightPoint>(&self.settings.reuse)
             + std::mem::size_of::<Option<(LightPoint, Resolved)>>()
             + std::mem::size_of::<Option<Bsdf>>()
+            + if self.settings.learn.is_on() {
+                learn::CellPools::bytes_per_pixel(self.settings.candidates)
+            } else {
+                0
+            }
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
@@ -310,6 +316,17 @@ impl Integrator for RestirDiIntegrator {
             } else {
                 None
             };
+            let cell_pools = learned.as_ref().map(|l| {
+                learn::CellPools::build(
+                    l,
+                    scene,
+                    ctx,
+                    &gbuf,
+                    s.candidates,
+                    s.learn != Learn::WithoutDefensiveShare,
+                    STAGE_LEARN_POOL,
+                )
+            });
             let mut current = vec![DiReservoir::empty(); n];
             // Each pixel's initial sample resolved in world space and its BSDF (textures looked
             // up), which the shifts into its neighbours and its shading would otherwise look up
@@ -337,7 +354,6 @@ impl Integrator for RestirDiIntegrator {
                         if let Some(r) = gbuf.receiver(index) {
                             let bsdf = r.resolve_bsdf(scene);
                             let mut rng = ctx.stage_rng(index, STAGE_INITIAL);
-                            let cell = learned.as_ref().and_then(|l| l.cell(r.p, r.n));
                             let ng = gbuf.ng[index];
                             let pool_tile = || {
                                 pool.as_ref().map(|p| {
@@ -345,15 +361,10 @@ impl Integrator for RestirDiIntegrator {
                                     p.tile_of(ctx, x, y)
                                 })
                             };
-                            let (init, nr, y) = if let (Some(learned), Some(cell)) =
-                                (&learned, cell)
+                            let (init, nr, y) = if let Some(cell_pool) =
+                                cell_pools.as_ref().and_then(|p| p.pool(index))
                             {
-                                let sampler = LearnedCellSampler::new(learned, cell, pool_tile());
-                                let sampler = if s.learn == Learn::WithoutDefensiveShare {
-                                    sampler.without_defensive_share()
-                                } else {
-                                    sampler
-                                };
+                                let sampler = LearnedCellSampler::new(cell_pool);
                                 self.initial(scene, r, &bsdf, ng, sampler, &mut rng)
                             } else if let Some(tile) = pool_tile() {
                                 let sampler =
