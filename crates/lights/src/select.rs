@@ -211,7 +211,7 @@ impl LightSet {
             return Some(self.table.len());
         }
         let entries = self.table.entries();
-        let first = entries.partition_point(|e| e.light() < light);
+        let first = self.table.first_entry(light)?;
         match entries.get(first)? {
             Emitter::Whole { light: l } => (*l == light).then_some(first),
             Emitter::Triangle { light: l, .. } if *l != light => None,

@@ -131,6 +131,10 @@ pub(crate) struct EmitterTable {
     /// Per light, the entry of its triangle 0 when every triangle of its mesh has an entry, in
     /// order (so triangle `t` is entry `first + t`); [`EmitterTable::NO_ENTRIES`] otherwise.
     first_triangle_entry: Vec<u32>,
+    /// Per light, its first entry ([`EmitterTable::NO_ENTRIES`] for a light without entries):
+    /// a light's entries are consecutive, so naming a sample's emitter needs no search over the
+    /// table ([`crate::LightSet::emitter_of`]).
+    first_entry: Vec<u32>,
 }
 
 impl EmitterTable {
@@ -159,6 +163,7 @@ impl EmitterTable {
         let mut weights = Vec::with_capacity(capacity);
         let mut normals = Vec::new();
         let mut first_triangle_entry = vec![Self::NO_ENTRIES; lights.len()];
+        let mut first_entry = vec![Self::NO_ENTRIES; lights.len()];
         for (i, (l, &power)) in lights.iter().zip(powers).enumerate() {
             let light = i as u32;
             if power <= 0.0 || Some(light) == environment {
@@ -200,8 +205,12 @@ impl EmitterTable {
                     if entries.len() - first == m.triangle_count() {
                         first_triangle_entry[i] = first as u32;
                     }
+                    if entries.len() > first {
+                        first_entry[i] = first as u32;
+                    }
                 }
                 None => {
+                    first_entry[i] = entries.len() as u32;
                     entries.push(Emitter::Whole { light });
                     weights.push(power);
                 }
@@ -242,6 +251,7 @@ impl EmitterTable {
             env_share: 0.0,
             env_power_share,
             first_triangle_entry,
+            first_entry,
         };
         table.set_env_share(env_power_share);
         table
@@ -259,6 +269,13 @@ impl EmitterTable {
             return None;
         }
         self.entries.get(first as usize + prim as usize)
+    }
+
+    /// The first entry of `light`, if it has entries (its entries follow it).
+    #[inline]
+    pub fn first_entry(&self, light: u32) -> Option<usize> {
+        let first = *self.first_entry.get(light as usize)?;
+        (first != Self::NO_ENTRIES).then_some(first as usize)
     }
 
     /// Sets the environment's share of selections (clamped to what the table holds: 0 without

@@ -111,7 +111,7 @@ pub(super) fn record(
 /// Candidates of a pass that one entry of a cell's pool serves, on average: a cell of `m`
 /// receivers gets `⌈m · N_L / USES_PER_ENTRY⌉` entries, at least `N_L` (a lone receiver still
 /// gets `N_L` different draws) and at most [`MAX_POOL`].
-pub const USES_PER_ENTRY: usize = 16;
+pub const USES_PER_ENTRY: usize = 64;
 
 /// At most this many entries in one cell's pool (the power sampler's tile size).
 pub const MAX_POOL: usize = super::pool::TILE_SIZE;
