@@ -111,7 +111,7 @@ pub(super) fn record(
 /// Candidates of a pass that one entry of a cell's pool serves, on average: a cell of `m`
 /// receivers gets `⌈m · N_L / USES_PER_ENTRY⌉` entries, at least `N_L` (a lone receiver still
 /// gets `N_L` different draws) and at most [`MAX_POOL`].
-pub const USES_PER_ENTRY: usize = 64;
+pub const USES_PER_ENTRY: usize = 16;
 
 /// At most this many entries in one cell's pool (the power sampler's tile size).
 pub const MAX_POOL: usize = super::pool::TILE_SIZE;
@@ -129,8 +129,8 @@ impl CellPools {
     /// Bytes per pixel of the cell index and the pools, on average (`candidates` per pixel).
     pub fn bytes_per_pixel(candidates: u32) -> usize {
         std::mem::size_of::<Option<u32>>()
-            + (candidates as usize).div_ceil(USES_PER_ENTRY)
-                * std::mem::size_of::<Option<LearnedDraw>>()
+            + (candidates as usize * std::mem::size_of::<Option<LearnedDraw>>())
+                .div_ceil(USES_PER_ENTRY)
     }
 
     /// The pools of `learned` for the receivers of `gbuf`, with `candidates` candidates per
