@@ -1,0 +1,185 @@
+#!/usr/bin/env python3
+"""Equal-CPU-time efficiency of unbiased configurations from pairs of renders, without a reference.
+
+Development tool (needs numpy and the OpenEXR Python bindings). For an unbiased estimator the
+mean squared error of a render is its variance, and two renders with independent seeds `a`, `b`
+estimate it per pixel without a reference: `E[(a − b)²] / 2`. A reference of finite passes adds
+its own variance to every configuration's relMSE and pulls their ratios towards 1 (at 640×360 a
+1024-pass path-traced reference of the DI training hall, member 10, adds about a third to a
+16-pass ReSTIR DI render's error), so this measures more sharply for the same CPU time.
+
+Per scene, every configuration renders `--passes` passes (its own count) with each of two seeds,
+interleaved seed-major; its relative variance is the mean over pixels and channels of
+`(a − b)² / 2 / (m² + 0.01)`, `m` the mean of all renders of the scene (the same denominator for
+every configuration, as `restir compare`'s relMSE uses the reference); its time is the child's
+user + system CPU time minus its load time (`--stats`' `load_seconds`); its efficiency is
+1 / (relative variance × CPU seconds), which does not depend on the pass count when a pass's
+cost does not. Prints, per scene and as the median over scenes, each configuration's efficiency
+relative to the first. A configuration is `label=passes=flags`. Renders are kept in `--out` and
+reused when their stats file exists, so an interrupted run resumes.
+
+    python3 scripts/pair_variance.py --bin target/release/restir --size 640x360 --threads 1 \\
+        --out /tmp/pv --config 'path=16=--integrator path' \\
+        --config 'di=4=--integrator restir-di' FAMILY/di-test-*.ron
+
+With `--mitsuba INTEGRATOR --mitsuba-spp N` (needs `pip install mitsuba`), Mitsuba 3 renders
+each scene too, as `restir convert` writes it, with its integrator replaced by INTEGRATOR (e.g.
+`direct`), in `--mitsuba-variant` (default `llvm_ad_rgb`; with Debian's `libllvm19`, point
+`DRJIT_LIBLLVM_PATH` at `libLLVM-19.so`) on `--threads` threads, after one
+discarded render at the same sample count (the JIT compiles for it); its time is this process's
+CPU time around `mi.render` (scene loading and compiling excluded), and its row is named
+`mitsuba`. The conversion and loading are `scripts/mitsuba_equal_time.py`'s.
+
+Only for unbiased configurations: a bias is invisible to it (use `restir compare` against a
+converged reference, or the statistical tests, for that).
+"""
+
+import argparse
+import json
+import os
+import shlex
+import statistics
+import subprocess
+import sys
+
+import numpy as np
+import OpenEXR
+import Imath
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+
+def read_rgb(path):
+    f = OpenEXR.InputFile(path)
+    dw = f.header()["dataWindow"]
+    w, h = dw.max.x - dw.min.x + 1, dw.max.y - dw.min.y + 1
+    pt = Imath.PixelType(Imath.PixelType.FLOAT)
+    chans = [np.frombuffer(f.channel(c, pt), dtype=np.float32).reshape(h, w) for c in "RGB"]
+    return np.stack(chans, -1).astype(np.float64)
+
+
+def render(a, scene, flags, passes, seed, out):
+    """Renders once unless `out`'s stats exist; returns (image, CPU seconds without loading)."""
+    stats = out + ".json"
+    if not os.path.exists(stats):
+        w, h = a.size.split("x")
+        cmd = [a.bin, "render", scene, *shlex.split(flags), "--spp", str(passes), "--seed",
+               str(seed), "--width", w, "--height", h, "--threads", str(a.threads), "--quiet",
+               "-o", out, "--stats", stats + ".tmp"]
+        p = subprocess.Popen(cmd, stderr=subprocess.PIPE)
+        _, status, usage = os.wait4(p.pid, 0)
+        err = p.stderr.read().decode()
+        if os.waitstatus_to_exitcode(status) != 0:
+            sys.exit(f"failed: {shlex.join(cmd)}\n{err}")
+        with open(stats + ".tmp") as f:
+            s = json.load(f)
+        s["cpu_seconds"] = usage.ru_utime + usage.ru_stime - s["load_seconds"]
+        with open(stats + ".tmp", "w") as f:
+            json.dump(s, f)
+        os.replace(stats + ".tmp", stats)
+    with open(stats) as f:
+        s = json.load(f)
+    return read_rgb(out), s["cpu_seconds"]
+
+
+def mitsuba_renders(a, scene, name, seeds):
+    """Two renders of `scene` by Mitsuba 3 (module documentation): images and CPU seconds."""
+    import tempfile
+    import drjit as dr
+    import mitsuba as mi
+    import mitsuba_equal_time as met
+
+    mi.set_variant(a.mitsuba_variant)
+    images, cpu = [], []
+    outs = [os.path.join(a.out, f"{name}.mitsuba.{seed}.exr") for seed in seeds]
+    stats = os.path.join(a.out, f"{name}.mitsuba.json")
+    if os.path.exists(stats):
+        with open(stats) as f:
+            cpu = json.load(f)
+        return [read_rgb(o) for o in outs], cpu
+    w, h = a.size.split("x")
+    a.work = tempfile.mkdtemp(prefix="pair-variance-")
+    a.convert, a.max_depth, a.mi_integrator = True, None, a.mitsuba
+    ms = met.load_mitsuba(a, mi, scene, w, h)
+    dr.set_thread_count(a.threads)
+    mi.render(ms, spp=a.mitsuba_spp, seed=10_000).numpy()
+    for seed, out in zip(seeds, outs):
+        t = met.self_cpu()
+        arr = np.array(mi.render(ms, spp=a.mitsuba_spp, seed=seed))
+        cpu.append(met.self_cpu() - t)
+        met.write_exr(out, arr[..., :3])
+        images.append(read_rgb(out))
+    with open(stats, "w") as f:
+        json.dump(cpu, f)
+    return images, cpu
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--bin", default="target/release/restir")
+    ap.add_argument("--size", default="640x360")
+    ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--seeds", default="11,12", help="two seeds, comma-separated")
+    ap.add_argument("--out", required=True, help="directory for the renders")
+    ap.add_argument("--config", action="append", required=True, help="label=passes=flags")
+    ap.add_argument("--mitsuba", help="also render with this Mitsuba 3 integrator (e.g. direct)")
+    ap.add_argument("--mitsuba-spp", type=int, default=16)
+    ap.add_argument("--mitsuba-variant", default="llvm_ad_rgb")
+    ap.add_argument("scenes", nargs="+")
+    a = ap.parse_args()
+    seeds = [int(s) for s in a.seeds.split(",")]
+    if len(seeds) != 2:
+        sys.exit("--seeds takes two seeds")
+    configs = []
+    for c in a.config:
+        parts = c.split("=", 2)
+        if len(parts) != 3 or not parts[1].isdigit():
+            sys.exit(f"--config {c!r}: expected label=passes=flags")
+        configs.append((parts[0], int(parts[1]), parts[2]))
+    os.makedirs(a.out, exist_ok=True)
+    base = configs[0][0]
+    ratios = {label: [] for label, _, _ in configs}
+    print(f"# {a.size}, {a.threads} thread(s), seeds {seeds}; efficiency relative to {base}")
+    for scene in a.scenes:
+        name = os.path.splitext(os.path.basename(scene))[0]
+        images, cpu = {}, {}
+        for seed in seeds:
+            for label, passes, flags in configs:
+                out = os.path.join(a.out, f"{name}.{label}.{seed}.exr")
+                img, t = render(a, scene, flags, passes, seed, out)
+                images.setdefault(label, []).append(img)
+                cpu.setdefault(label, []).append(t)
+        rows = list(configs)
+        if a.mitsuba:
+            images["mitsuba"], cpu["mitsuba"] = mitsuba_renders(a, scene, name, seeds)
+            rows.append(("mitsuba", a.mitsuba_spp, a.mitsuba))
+        # Mitsuba's images are not in the mean: the denominator stays ours, whatever its film.
+        m = np.mean([img for label, imgs in images.items() if label != "mitsuba" for img in imgs],
+                    axis=0)
+        denom = m * m + 1e-2
+        eff = {}
+        cells = []
+        for label, passes, _ in rows:
+            x, y = images[label]
+            rel_var = float(np.mean((x - y) ** 2 / 2 / denom))
+            t = statistics.mean(cpu[label])
+            eff[label] = 1.0 / (rel_var * t) if rel_var > 0 and t > 0 else float("inf")
+            cells.append(f"{label}: relvar {rel_var:.3g} cpu {t:.2f}s ({t / passes:.3f}/pass)")
+        for label in eff:
+            ratios.setdefault(label, []).append(eff[label] / eff[base])
+        print(name)
+        for (label, _, _), cell in zip(rows, cells):
+            print(f"    {cell}  eff {eff[label] / eff[base]:.2f}x", flush=True)
+    print(f"median over {len(a.scenes)} scenes (range), efficiency relative to {base}:")
+    for label, r in ratios.items():
+        print(f"    {label}: {statistics.median(r):.2f}x ({min(r):.2f}-{max(r):.2f})")
+    if a.mitsuba:
+        print(f"median (range), efficiency relative to Mitsuba 3 {a.mitsuba} "
+              f"({a.mitsuba_variant}, {a.threads} thread(s)):")
+        for label, r in ratios.items():
+            rel = [x / y for x, y in zip(r, ratios["mitsuba"])]
+            print(f"    {label}: {statistics.median(rel):.2f}x ({min(rel):.2f}-{max(rel):.2f})")
+
+
+if __name__ == "__main__":
+    main()
