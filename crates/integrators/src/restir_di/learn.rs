@@ -7,7 +7,9 @@
 //! so given the earlier passes each pass is the usual unbiased estimator with a fixed candidate
 //! distribution whose support is the power sampler's (the defensive share), and so is the
 //! average of the passes. Records are gathered per band of image rows and added band after band,
-//! so the sums, hence the sampler and the image, do not depend on the thread count.
+//! so the sums, hence the sampler and the image, do not depend on the thread count. A pass draws
+//! its candidates from [`CellPools`]: per cell, independent draws of the mixture made once, from
+//! streams of the pass and the cell.
 
 use std::sync::{Arc, Mutex};
 
@@ -175,6 +177,7 @@ impl CellPools {
     #[inline]
     pub fn pool(&self, index: usize) -> Option<&[Option<LearnedDraw>]> {
         let c = self.cell_of[index]?;
-        Some(&self.pools[c as usize]).filter(|p| !p.is_empty()).map(|p| &p[..])
+        let pool = &self.pools[c as usize];
+        (!pool.is_empty()).then_some(&pool[..])
     }
 }
