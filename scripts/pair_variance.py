@@ -100,6 +100,9 @@ def mitsuba_renders(a, scene, name, seeds):
     w, h = a.size.split("x")
     a.work = tempfile.mkdtemp(prefix="pair-variance-")
     a.convert, a.max_depth, a.mi_integrator = True, None, a.mitsuba
+    # Loaded on a pool of every core: loading a scene with an environment map on a one-thread
+    # pool hangs (Mitsuba 3.9.1); rendering on one thread does not.
+    dr.set_thread_count(os.cpu_count())
     ms = met.load_mitsuba(a, mi, scene, w, h)
     dr.set_thread_count(a.threads)
     mi.render(ms, spp=a.mitsuba_spp, seed=10_000).numpy()
