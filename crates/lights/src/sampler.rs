@@ -336,8 +336,9 @@ impl LightSampler for TableSampler<'_> {
     }
 }
 
-/// The learned selection at a receiver's cell ([`LearnedSampler`]), from the cell's pool of
-/// presampled draws of the mixture ([`LearnedSampler::presample`]), taken as [`PoolSampler`]
+/// The learned selection at a receiver's cell ([`LearnedSampler`](crate::LearnedSampler)),
+/// from the cell's pool of presampled draws of the mixture
+/// ([`LearnedSampler::presample`](crate::LearnedSampler::presample)), taken as [`PoolSampler`]
 /// takes a tile's: from a uniform start, one entry from each of `n` strata of the pool. Each
 /// entry is an independent draw of the mixture whose density is the power sampler's times the
 /// entry's probability ratio, so whichever entries a receiver takes, each candidate is

@@ -8,7 +8,7 @@
 //! distribution whose support is the power sampler's (the defensive share), and so is the
 //! average of the passes. Records are gathered per band of image rows and added band after band,
 //! so the sums, hence the sampler and the image, do not depend on the thread count. A pass draws
-//! its candidates from [`CellPools`]: per cell, independent draws of the mixture made once, from
+//! its candidates from `CellPools`: per cell, independent draws of the mixture made once, from
 //! streams of the pass and the cell.
 
 use std::sync::{Arc, Mutex};
