@@ -5,21 +5,14 @@
 use std::path::Path;
 
 use glam::Vec3;
-use restir_geometry::Ray;
 use restir_materials::{Bsdf, BsdfKind};
 use restir_scene::{
     ColorParam, LoadOptions, MaterialDesc, load_scene, parse_ron,
     xml::{XmlWriteOptions, parse_xml, to_mitsuba_xml},
 };
 
-fn scene_text(body: &str) -> String {
-    format!(
-        r#"<scene version="3.0.0">
-    <sensor type="perspective"><film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor>
-{body}
-</scene>"#
-    )
-}
+mod common;
+use common::scene_text;
 
 fn parse(body: &str) -> Result<Vec<MaterialDesc>, String> {
     parse_xml(&scene_text(body), Path::new("b.xml"), &[])
@@ -82,12 +75,7 @@ fn textured_weight_reaches_the_bsdf() {
         m => panic!("{m:?}"),
     }
     let scene = &loaded.scene;
-    let at = |x: f32| -> Bsdf {
-        let si = scene
-            .intersect(&Ray::new(Vec3::new(x, 0.5, 5.0), -Vec3::Z))
-            .expect("hit");
-        scene.bsdf(&si)
-    };
+    let at = |x: f32| -> Bsdf { common::bsdf_from_above(scene, x, 0.5) };
     let weight = |b: Bsdf| match b.kind {
         BsdfKind::Blend(b) => b.weight,
         k => panic!("{k:?}"),

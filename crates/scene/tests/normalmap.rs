@@ -5,20 +5,13 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use restir_geometry::Ray;
 use restir_scene::{
     ColorParam, LoadOptions, MaterialDesc, load_scene, parse_ron,
     xml::{XmlWriteOptions, parse_xml, to_mitsuba_xml},
 };
 
-fn scene_text(body: &str) -> String {
-    format!(
-        r#"<scene version="3.0.0">
-    <sensor type="perspective"><film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor>
-{body}
-</scene>"#
-    )
-}
+mod common;
+use common::scene_text;
 
 /// A fresh directory with a 2×1 raw PNG normal map: left texel tilted towards +x, right flat.
 fn dir_with_map(tag: &str) -> PathBuf {
@@ -109,12 +102,7 @@ fn bitmap_map_reaches_the_bsdf() {
         m => panic!("{m:?}"),
     }
     let scene = &loaded.scene;
-    let at = |x: f32| {
-        let si = scene
-            .intersect(&Ray::new(Vec3::new(x, 0.0, 5.0), -Vec3::Z))
-            .expect("hit");
-        scene.bsdf(&si)
-    };
+    let at = |x: f32| common::bsdf_from_above(scene, x, 0.0);
     let (left, right) = (at(-0.5), at(0.5));
     assert_eq!(left.opacity, 0.8);
     assert!(left.two_sided);

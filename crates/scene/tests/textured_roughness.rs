@@ -11,14 +11,8 @@ use restir_scene::{
     xml::{XmlWriteOptions, parse_xml, to_mitsuba_xml},
 };
 
-fn scene_text(body: &str) -> String {
-    format!(
-        r#"<scene version="3.0.0">
-    <sensor type="perspective"><film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor>
-{body}
-</scene>"#
-    )
-}
+mod common;
+use common::scene_text;
 
 const CHECKER_U: &str = r#"<texture name="alpha_u" type="checkerboard">
                 <float name="color0" value="0.05"/><float name="color1" value="0.3"/></texture>"#;
