@@ -340,18 +340,8 @@ mod tests {
         assert_eq!(raw.pixels[0], Vec3::new(0.0, 188.0 / 255.0, 1.0));
         assert_eq!(raw.pixels[1].y, 0.0);
         let back = Image::read(&path, IntegerEncoding::Srgb).unwrap();
-        assert!(
-            (back.pixels[0] - Vec3::new(0.0, 0.5, 1.0))
-                .abs()
-                .max_element()
-                < 0.01
-        );
-        assert!(
-            (back.pixels[1] - Vec3::new(1.0, 0.0, 0.25))
-                .abs()
-                .max_element()
-                < 0.01
-        );
+        assert!(back.pixels[0].abs_diff_eq(Vec3::new(0.0, 0.5, 1.0), 0.01));
+        assert!(back.pixels[1].abs_diff_eq(Vec3::new(1.0, 0.0, 0.25), 0.01));
         std::fs::remove_dir_all(&dir).ok();
     }
 
@@ -370,12 +360,7 @@ mod tests {
         assert_eq!(raw.pixels[0], Vec3::new(0.0, 188.0 / 255.0, 1.0));
         assert_eq!(raw.pixels[1], Vec3::new(1.0, 0.0, 64.0 / 255.0));
         let back = Image::read(&path, IntegerEncoding::Srgb).unwrap();
-        assert!(
-            (back.pixels[0] - Vec3::new(0.0, 0.5, 1.0))
-                .abs()
-                .max_element()
-                < 0.01
-        );
+        assert!(back.pixels[0].abs_diff_eq(Vec3::new(0.0, 0.5, 1.0), 0.01));
         std::fs::remove_dir_all(&dir).ok();
     }
 

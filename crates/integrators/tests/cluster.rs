@@ -8,38 +8,19 @@
 
 mod common;
 
-use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
 use glam::{DVec3, Vec3};
 use restir_integrators::{
-    Image, Integrator, IntegratorOptions, Param, ParamSource, PassContext, PixelWindow, RenderJob,
-    RenderPart, make_integrator, render, render_part,
+    Image, Integrator, PassContext, PixelWindow, RenderJob, RenderPart, render, render_part,
 };
-use restir_scene::{Scene, load_desc};
+use restir_scene::Scene;
 use restir_testkit::{block_means, block_statistics, max_z};
 
-/// The Cornell box at `w × h`.
-fn cornell(w: u32, h: u32) -> common::Built {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml");
-    let (mut desc, _) = load_desc(&path, &[]).unwrap();
-    desc.film.width = w;
-    desc.film.height = h;
-    common::build(&desc, path.parent().unwrap(), &path)
-}
+use common::cornell;
 
 fn integrator(scene: &common::Built, name: &str, params: &[(&str, &str)]) -> Box<dyn Integrator> {
-    let options = IntegratorOptions {
-        name: Some(name.into()),
-        max_depth: Some(3),
-        params: params
-            .iter()
-            .map(|(k, v)| Param::new(*k, *v, ParamSource::Caller))
-            .collect(),
-    };
-    let made = make_integrator(scene, &scene.integrator, &options).unwrap();
-    assert!(made.unused_params.is_empty());
-    made.integrator
+    common::make(scene, name, &[&[("max_depth", "3")], params].concat())
 }
 
 /// Small spatial reuse: two rounds within 4 pixels, a halo of 8.

@@ -7,42 +7,22 @@
 
 mod common;
 
-use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
 use glam::DVec3;
 use restir_image::srgb;
-use restir_integrators::{
-    Integrator, IntegratorOptions, Param, ParamSource, RenderJob, RenderOutput, RenderPart,
-    make_integrator, render_part,
-};
-use restir_scene::{Scene, load_desc};
+use restir_integrators::{Integrator, RenderJob, RenderOutput, RenderPart, render_part};
+use restir_scene::Scene;
 
-fn cornell(w: u32, h: u32) -> common::Built {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml");
-    let (mut desc, _) = load_desc(&path, &[]).unwrap();
-    desc.film.width = w;
-    desc.film.height = h;
-    common::build(&desc, path.parent().unwrap(), &path)
-}
+use common::cornell;
 
 fn integrator(scene: &common::Built, name: &str) -> Box<dyn Integrator> {
-    let params: &[(&str, &str)] = if name == "path" {
+    let reuse: &[(&str, &str)] = if name == "path" {
         &[]
     } else {
         &[("radius", "4"), ("spatial_rounds", "2")]
     };
-    let options = IntegratorOptions {
-        name: Some(name.into()),
-        max_depth: Some(3),
-        params: params
-            .iter()
-            .map(|(k, v)| Param::new(*k, *v, ParamSource::Caller))
-            .collect(),
-    };
-    make_integrator(scene, &scene.integrator, &options)
-        .unwrap()
-        .integrator
+    common::make(scene, name, &[&[("max_depth", "3")], reuse].concat())
 }
 
 fn run(

@@ -58,6 +58,16 @@ pub fn build(desc: &SceneDesc, base: &std::path::Path, file: &std::path::Path) -
     try_build(desc, base, file).unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// The repository's Cornell box at `w × h`.
+pub fn cornell(w: u32, h: u32) -> Built {
+    let path =
+        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml");
+    let (mut desc, _) = restir_scene::load_desc(&path, &[]).unwrap();
+    desc.film.width = w;
+    desc.film.height = h;
+    build(&desc, path.parent().unwrap(), &path)
+}
+
 /// Renders `scene` with estimator `name`. `params` are the estimator's parameters, except
 /// `max_depth`, which is taken as the command line's `--max-depth`. Every parameter must be used
 /// and every pixel finite.
@@ -68,6 +78,12 @@ pub fn render_image(
     spp: u32,
     seed: u64,
 ) -> Image {
+    render_with(scene, make(scene, name, params).as_ref(), spp, seed)
+}
+
+/// Estimator `name` for `scene` with `params` (`max_depth` as the command line's
+/// `--max-depth`); every parameter must be used.
+pub fn make(scene: &Built, name: &str, params: &[(&str, &str)]) -> Box<dyn Integrator> {
     let max_depth = params
         .iter()
         .find(|(k, _)| *k == "max_depth")
@@ -83,7 +99,7 @@ pub fn render_image(
     };
     let made = make_integrator(scene, &scene.integrator, &options).unwrap();
     assert!(made.unused_params.is_empty());
-    render_with(scene, made.integrator.as_ref(), spp, seed)
+    made.integrator
 }
 
 /// Renders `spp` passes of `scene` with `integrator` (which keeps whatever history it has
