@@ -176,12 +176,6 @@ impl LearnedSampler {
         self.share
     }
 
-    /// The share of selections that go to `cell`'s table (0 for no cell).
-    #[inline]
-    pub fn cell_share(&self, cell: Option<u32>) -> f32 {
-        cell.map_or(0.0, |c| self.tables[c as usize].share)
-    }
-
     /// Cells with a table.
     pub fn cells(&self) -> usize {
         self.tables.len()
