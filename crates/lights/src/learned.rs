@@ -20,10 +20,11 @@
 //! [`LearnedSampler::pmf`] is the mixture's probability, exactly, for any receiver and emitter. A receiver whose cell has no records selects by power
 //! alone.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use glam::Vec3;
-use restir_sampling::{AliasTable, ONE_MINUS_EPSILON, Pcg32};
+use restir_sampling::{AliasTable, ONE_MINUS_EPSILON, Pcg32, mix64};
 
 use crate::{LightSet, Presampled};
 
@@ -42,6 +43,59 @@ pub struct CellKey {
     face: u8,
 }
 
+/// The hash of the learning's maps: a multiply-xor over the key's integers and one final mix
+/// ([`mix64`]). The keys are small integers made by this module, not input an adversary chooses,
+/// so the standard library's keyed SipHash (several times the cost, once per receiver and per
+/// record) buys nothing here. Nothing iterates these maps in their hash order: the determinism
+/// of the tables comes from sorting ([`LearnedSampler::new`]).
+#[derive(Clone, Copy, Debug, Default)]
+struct KeyHasher(u64);
+
+impl Hasher for KeyHasher {
+    #[inline]
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+
+    #[inline]
+    fn write_u8(&mut self, v: u8) {
+        self.write_u64(u64::from(v));
+    }
+
+    #[inline]
+    fn write_u32(&mut self, v: u32) {
+        self.write_u64(u64::from(v));
+    }
+
+    #[inline]
+    fn write_i32(&mut self, v: i32) {
+        self.write_u64(u64::from(v as u32));
+    }
+
+    #[inline]
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7cc1_b727_220a_95);
+    }
+
+    #[inline]
+    fn finish(&self) -> u64 {
+        mix64(self.0)
+    }
+}
+
+type KeyMap<K, V> = HashMap<K, V, BuildHasherDefault<KeyHasher>>;
+
+/// `⌊v⌋` as an integer, clamped to ±10⁹ (the cast itself, without a call to `floorf` on targets
+/// without SSE4.1's rounding instruction).
+#[inline]
+fn floor_i32(v: f32) -> i32 {
+    let v = v.clamp(-1.0e9, 1.0e9);
+    let t = v as i32;
+    if (t as f32) > v { t - 1 } else { t }
+}
+
 /// The grid: cubes of side `cell` in world space, split by the receiver normal's dominant axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LearnGrid {
@@ -53,8 +107,7 @@ impl LearnGrid {
     /// The cell of a receiver at `p` with normal `n` (zero if unknown).
     #[inline]
     pub fn key(&self, p: Vec3, n: Vec3) -> CellKey {
-        let q = (p / self.cell).floor();
-        let clamp = |v: f32| v.clamp(-1.0e9, 1.0e9) as i32;
+        let q = p / self.cell;
         let a = n.abs();
         let (axis, sign) = if a.x >= a.y && a.x >= a.z {
             (0, n.x < 0.0)
@@ -64,9 +117,9 @@ impl LearnGrid {
             (2, n.z < 0.0)
         };
         CellKey {
-            x: clamp(q.x),
-            y: clamp(q.y),
-            z: clamp(q.z),
+            x: floor_i32(q.x),
+            y: floor_i32(q.y),
+            z: floor_i32(q.z),
             face: 2 * axis + u8::from(sign),
         }
     }
@@ -75,10 +128,22 @@ impl LearnGrid {
 /// What emitters delivered, per cell: the sum of the contributions recorded for each emitter.
 #[derive(Clone, Debug, Default)]
 pub struct LightRecords {
-    cells: BTreeMap<CellKey, BTreeMap<u32, f64>>,
-    /// Records per cell.
-    counts: BTreeMap<CellKey, u64>,
+    /// Per cell its slot in `cells`.
+    slots: KeyMap<CellKey, u32>,
+    cells: Vec<CellRecords>,
     records: u64,
+}
+
+/// One cell's records: per emitter (in the order they were first recorded) its sum.
+#[derive(Clone, Debug)]
+struct CellRecords {
+    key: CellKey,
+    /// Per emitter its slot in `emitters` and `sums`.
+    slots: KeyMap<u32, u32>,
+    emitters: Vec<u32>,
+    sums: Vec<f64>,
+    /// Records added.
+    count: u64,
 }
 
 impl LightRecords {
@@ -87,16 +152,30 @@ impl LightRecords {
     /// records in the same order give the same bits.
     #[inline]
     pub fn add(&mut self, key: CellKey, emitter: u32, value: f32) {
-        if value > 0.0 && value.is_finite() {
-            *self
-                .cells
-                .entry(key)
-                .or_default()
-                .entry(emitter)
-                .or_insert(0.0) += value as f64;
-            *self.counts.entry(key).or_insert(0) += 1;
-            self.records += 1;
+        if !(value > 0.0 && value.is_finite()) {
+            return;
         }
+        let next = self.cells.len() as u32;
+        let slot = *self.slots.entry(key).or_insert(next) as usize;
+        if slot == self.cells.len() {
+            self.cells.push(CellRecords {
+                key,
+                slots: KeyMap::default(),
+                emitters: Vec::new(),
+                sums: Vec::new(),
+                count: 0,
+            });
+        }
+        let cell = &mut self.cells[slot];
+        let next = cell.emitters.len() as u32;
+        let e = *cell.slots.entry(emitter).or_insert(next) as usize;
+        if e == cell.emitters.len() {
+            cell.emitters.push(emitter);
+            cell.sums.push(0.0);
+        }
+        cell.sums[e] += value as f64;
+        cell.count += 1;
+        self.records += 1;
     }
 
     /// Cells with records.
@@ -137,7 +216,7 @@ impl CellTable {
 pub struct LearnedSampler {
     grid: LearnGrid,
     share: f32,
-    index: HashMap<CellKey, u32>,
+    index: KeyMap<CellKey, u32>,
     tables: Vec<CellTable>,
 }
 
@@ -148,15 +227,23 @@ impl LearnedSampler {
     pub fn new(grid: LearnGrid, share: f32, prior: f32, records: &LightRecords) -> Self {
         let share = share.clamp(0.0, ONE_MINUS_EPSILON);
         let prior = prior.max(0.0);
-        let mut index = HashMap::with_capacity(records.cells.len());
-        let mut tables = Vec::with_capacity(records.cells.len());
-        for (key, sums) in &records.cells {
-            let weights: Vec<f32> = sums.values().map(|&v| v as f32).collect();
-            let n = records.counts.get(key).copied().unwrap_or(0) as f32;
+        // Cells in key order and each cell's emitters ascending, so that the tables (and the
+        // cell numbers the pools' streams are named by) depend on the records, not on the order
+        // in which cells and emitters first appeared.
+        let mut cells: Vec<&CellRecords> = records.cells.iter().collect();
+        cells.sort_unstable_by_key(|c| c.key);
+        let mut index = KeyMap::default();
+        index.reserve(cells.len());
+        let mut tables = Vec::with_capacity(cells.len());
+        for cell in cells {
+            let mut order: Vec<usize> = (0..cell.emitters.len()).collect();
+            order.sort_unstable_by_key(|&i| cell.emitters[i]);
+            let weights: Vec<f32> = order.iter().map(|&i| cell.sums[i] as f32).collect();
+            let n = cell.count as f32;
             if let Some(alias) = AliasTable::new(&weights) {
-                index.insert(*key, tables.len() as u32);
+                index.insert(cell.key, tables.len() as u32);
                 tables.push(CellTable {
-                    emitters: sums.keys().copied().collect(),
+                    emitters: order.iter().map(|&i| cell.emitters[i]).collect(),
                     alias,
                     share: share * n / (n + prior),
                 });
