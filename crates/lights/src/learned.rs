@@ -22,6 +22,7 @@
 
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
+use std::sync::Arc;
 
 use glam::Vec3;
 use restir_sampling::{AliasTable, ONE_MINUS_EPSILON, Pcg32, mix64};
@@ -33,6 +34,77 @@ use crate::{LightSet, Presampled};
 /// the ratio of the mixture's probability of that emitter to the power sampler's, by which its
 /// density is multiplied.
 pub type LearnedDraw = (Presampled, f32);
+
+/// Emitters learned as one: runs of consecutive triangles of one mesh light (in the mesh's own
+/// order, in which neighbours are mostly neighbours in space) that fit in a box of a given
+/// diagonal ([`LightSet::emitter_groups`]); every other light, and the environment, alone. A
+/// cell's table picks a group and the group an emitter by power, so a compact lamp of many
+/// triangles is learned from one count per lamp rather than from a few counts per triangle,
+/// while a long garland mesh is still learned piece by piece.
+#[derive(Clone, Debug, Default)]
+pub struct EmitterGroups {
+    /// Per emitter its group's first emitter.
+    pub(crate) start: Vec<u32>,
+    /// Per emitter its group's end (one past its last emitter).
+    pub(crate) end: Vec<u32>,
+    /// Per emitter `e` the power sampler's probability of the emitters before it (`n + 1`
+    /// values): a group's power is a difference, and an emitter is found in it by bisection.
+    pub(crate) cumulative: Vec<f64>,
+}
+
+impl EmitterGroups {
+    /// The emitters `[start, end)` of `e`'s group (`e` alone past the table).
+    #[inline]
+    pub fn group(&self, e: usize) -> (usize, usize) {
+        match (self.start.get(e), self.end.get(e)) {
+            (Some(&s), Some(&t)) => (s as usize, t as usize),
+            _ => (e, e + 1),
+        }
+    }
+
+    /// Groups.
+    pub fn len(&self) -> usize {
+        self.start
+            .iter()
+            .enumerate()
+            .filter(|&(e, &s)| s as usize == e)
+            .count()
+    }
+
+    /// Whether there are no emitters.
+    pub fn is_empty(&self) -> bool {
+        self.start.is_empty()
+    }
+
+    /// The group's share of the power sampler's probability.
+    #[inline]
+    fn power(&self, start: usize, end: usize) -> f64 {
+        self.cumulative[end] - self.cumulative[start]
+    }
+
+    /// An emitter of the group `[start, end)` picked in proportion to its power with uniform
+    /// `u` (`None` if none has power).
+    #[inline]
+    fn pick(&self, start: usize, end: usize, u: f32) -> Option<usize> {
+        if end - start == 1 {
+            return Some(start);
+        }
+        let c = &self.cumulative;
+        let (lo, hi) = (c[start], c[end]);
+        if hi <= lo {
+            return None;
+        }
+        let target = lo + f64::from(u) * (hi - lo);
+        // The first emitter whose interval ends past the target; emitters without power have
+        // empty intervals and are never found.
+        let i = c[start + 1..=end].partition_point(|&x| x <= target);
+        let mut e = (start + i).min(end - 1);
+        while e > start && c[e + 1] <= c[e] {
+            e -= 1;
+        }
+        (c[e + 1] > c[e]).then_some(e)
+    }
+}
 
 /// A cell of the grid: integer coordinates and the receiver normal's dominant axis and sign.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -189,25 +261,57 @@ impl LightRecords {
     }
 }
 
-/// One cell's distribution over the emitters it recorded.
+/// One level of a cell's table: a distribution over units (single emitters, or groups of
+/// emitters), each named by its first emitter, ascending.
+#[derive(Clone, Debug)]
+struct Level {
+    starts: Vec<u32>,
+    alias: AliasTable,
+}
+
+impl Level {
+    /// The level of `sums` (per emitter, ascending, its records) with each emitter counted in
+    /// the unit `unit` names (by its first emitter).
+    fn new(sums: &[(u32, f64)], unit: impl Fn(u32) -> u32) -> Option<Self> {
+        let mut by_unit: Vec<(u32, f64)> = sums.iter().map(|&(e, v)| (unit(e), v)).collect();
+        // Stable, so each unit's sum is taken in emitter order.
+        by_unit.sort_by_key(|&(g, _)| g);
+        let mut starts = Vec::with_capacity(by_unit.len());
+        let mut weights = Vec::with_capacity(by_unit.len());
+        let mut acc = 0.0f64;
+        for (i, &(g, v)) in by_unit.iter().enumerate() {
+            acc += v;
+            if by_unit.get(i + 1).is_none_or(|&(next, _)| next != g) {
+                starts.push(g);
+                weights.push(acc as f32);
+                acc = 0.0;
+            }
+        }
+        Some(Self {
+            alias: AliasTable::new(&weights)?,
+            starts,
+        })
+    }
+
+    /// The probability the level picks the unit starting at emitter `start`.
+    #[inline]
+    fn pmf(&self, start: u32) -> f32 {
+        self.starts
+            .binary_search(&start)
+            .map_or(0.0, |i| self.alias.pmf(i))
+    }
+}
+
+/// One cell's distribution over what it recorded: over single emitters and, where the scene has
+/// groups of several emitters ([`EmitterGroups`]), half over the groups (a group picked from
+/// the table, an emitter within it by power).
 #[derive(Clone, Debug)]
 struct CellTable {
-    /// The emitters, ascending.
-    emitters: Vec<u32>,
-    alias: AliasTable,
+    emitters: Level,
+    groups: Option<Level>,
     /// The share of selections the table takes in this cell: the sampler's share times
     /// `n / (n + prior)` for `n` records, so a cell of few records leans on the power sampler.
     share: f32,
-}
-
-impl CellTable {
-    /// The probability the table picks `emitter`.
-    #[inline]
-    fn pmf(&self, emitter: u32) -> f32 {
-        self.emitters
-            .binary_search(&emitter)
-            .map_or(0.0, |i| self.alias.pmf(i))
-    }
 }
 
 /// The learned selection: per cell an alias table over the lights recorded there, mixed with the
@@ -216,6 +320,8 @@ impl CellTable {
 pub struct LearnedSampler {
     grid: LearnGrid,
     share: f32,
+    /// Emitters learned together.
+    groups: Arc<EmitterGroups>,
     index: KeyMap<CellKey, u32>,
     tables: Vec<CellTable>,
 }
@@ -223,8 +329,16 @@ pub struct LearnedSampler {
 impl LearnedSampler {
     /// The sampler of `records` on `grid`, taking a cell's table with probability
     /// `share · n / (n + prior)` for a cell of `n` records (`share` in `[0, 1)`: the rest goes
-    /// to the power sampler).
-    pub fn new(grid: LearnGrid, share: f32, prior: f32, records: &LightRecords) -> Self {
+    /// to the power sampler). The tables are over `groups` ([`EmitterGroups`]): what a cell
+    /// recorded of a group's emitters is pooled, and an emitter is drawn within its group by
+    /// power.
+    pub fn new(
+        grid: LearnGrid,
+        share: f32,
+        prior: f32,
+        records: &LightRecords,
+        groups: Arc<EmitterGroups>,
+    ) -> Self {
         let share = share.clamp(0.0, ONE_MINUS_EPSILON);
         let prior = prior.max(0.0);
         // Cells in key order and each cell's emitters ascending, so that the tables (and the
@@ -235,16 +349,24 @@ impl LearnedSampler {
         let mut index = KeyMap::default();
         index.reserve(cells.len());
         let mut tables = Vec::with_capacity(cells.len());
+        let grouped = groups.len() < groups.start.len();
         for cell in cells {
-            let mut order: Vec<usize> = (0..cell.emitters.len()).collect();
-            order.sort_unstable_by_key(|&i| cell.emitters[i]);
-            let weights: Vec<f32> = order.iter().map(|&i| cell.sums[i] as f32).collect();
+            let mut sums: Vec<(u32, f64)> = cell
+                .emitters
+                .iter()
+                .copied()
+                .zip(cell.sums.iter().copied())
+                .collect();
+            sums.sort_by_key(|&(e, _)| e);
             let n = cell.count as f32;
-            if let Some(alias) = AliasTable::new(&weights) {
+            if let Some(emitters) = Level::new(&sums, |e| e) {
+                let group_level = grouped
+                    .then(|| Level::new(&sums, |e| groups.group(e as usize).0 as u32))
+                    .flatten();
                 index.insert(cell.key, tables.len() as u32);
                 tables.push(CellTable {
-                    emitters: order.iter().map(|&i| cell.emitters[i]).collect(),
-                    alias,
+                    emitters,
+                    groups: group_level,
                     share: share * n / (n + prior),
                 });
             }
@@ -252,6 +374,7 @@ impl LearnedSampler {
         Self {
             grid,
             share,
+            groups,
             index,
             tables,
         }
@@ -270,8 +393,12 @@ impl LearnedSampler {
 
     /// Approximate heap bytes of the tables and the cell index.
     pub fn bytes(&self) -> usize {
-        let entries: usize = self.tables.iter().map(|t| t.emitters.len()).sum();
-        // Per entry an emitter index and an alias bin (probability, alias, pmf); per cell its
+        let entries: usize = self
+            .tables
+            .iter()
+            .map(|t| t.emitters.starts.len() + t.groups.as_ref().map_or(0, |g| g.starts.len()))
+            .sum();
+        // Per entry a unit's first emitter and an alias bin (probability, alias, pmf); per cell its
         // key, index slot and table header.
         entries * (4 + 12) + self.tables.len() * (16 + 4 + 64)
     }
@@ -295,7 +422,20 @@ impl LearnedSampler {
         let share = table.share;
         let emitter = if u < share {
             let v = (u / share).min(ONE_MINUS_EPSILON);
-            table.emitters[table.alias.sample(v).0] as usize
+            match &table.groups {
+                Some(g) if v >= 0.5 => {
+                    let v = (2.0 * v - 1.0).min(ONE_MINUS_EPSILON);
+                    let (i, _, rest) = g.alias.sample(v);
+                    let start = g.starts[i] as usize;
+                    let (_, end) = self.groups.group(start);
+                    self.groups.pick(start, end, rest)?
+                }
+                Some(_) => {
+                    let v = (2.0 * v).min(ONE_MINUS_EPSILON);
+                    table.emitters.starts[table.emitters.alias.sample(v).0] as usize
+                }
+                None => table.emitters.starts[table.emitters.alias.sample(v).0] as usize,
+            }
         } else {
             let v = ((u - share) / (1.0 - share)).min(ONE_MINUS_EPSILON);
             lights.pick_emitter(v)?.0
@@ -304,15 +444,39 @@ impl LearnedSampler {
     }
 
     /// The probability that [`LearnedSampler::sample`] picks `emitter` for a receiver in
-    /// `cell`: `share · table(emitter) + (1 − share) · power(emitter)`, or the power sampler's
-    /// alone ([`LightSet::emitter_pmf`]) in a cell without a table.
+    /// `cell`: `share · table(emitter) + (1 − share) · power(emitter)`, with `table(emitter)`
+    /// the table's probability of its group times its share of the group's power, or the power
+    /// sampler's alone ([`LightSet::emitter_pmf`]) in a cell without a table.
     #[inline]
     pub fn pmf(&self, lights: &LightSet, cell: Option<u32>, emitter: usize) -> f32 {
         let power = lights.emitter_pmf(emitter);
         match cell.map(|c| &self.tables[c as usize]) {
             None => power,
-            Some(t) => t.share * t.pmf(emitter as u32) + (1.0 - t.share) * power,
+            Some(t) => t.share * self.table_pmf(lights, t, emitter) + (1.0 - t.share) * power,
         }
+    }
+
+    /// The probability that `table` picks `emitter`: its own, or with groups the mean of its
+    /// own and its group's times its share of the group's power.
+    #[inline]
+    fn table_pmf(&self, lights: &LightSet, table: &CellTable, emitter: usize) -> f32 {
+        let own = table.emitters.pmf(emitter as u32);
+        let Some(level) = &table.groups else {
+            return own;
+        };
+        let (start, end) = self.groups.group(emitter);
+        let p = level.pmf(start as u32);
+        let total = self.groups.power(start, end);
+        let in_group = if p == 0.0 {
+            0.0
+        } else if end - start == 1 {
+            p
+        } else if total > 0.0 {
+            (f64::from(p) * f64::from(lights.emitter_pmf(emitter)) / total) as f32
+        } else {
+            0.0
+        };
+        0.5 * (own + in_group)
     }
 
     /// Fills `out` with independent draws of `cell`'s mixture ([`LearnedSampler::sample`], the
@@ -363,7 +527,7 @@ impl LearnedSampler {
         cell: Option<u32>,
         emitter: usize,
     ) -> f32 {
-        match cell.map(|c| self.tables[c as usize].pmf(emitter as u32)) {
+        match cell.map(|c| self.table_pmf(lights, &self.tables[c as usize], emitter)) {
             Some(p) if p > 0.0 => p,
             _ => lights.emitter_pmf(emitter),
         }

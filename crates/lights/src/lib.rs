@@ -59,7 +59,7 @@ mod table;
 
 pub use contact::Contact;
 pub use envmap::{EnvMap, EnvMapError};
-pub use learned::{CellKey, LearnGrid, LearnedDraw, LearnedSampler, LightRecords};
+pub use learned::{CellKey, EmitterGroups, LearnGrid, LearnedDraw, LearnedSampler, LightRecords};
 pub use light::{Light, LightSample};
 pub use point::{LightPoint, Resolved};
 pub use presample::Presampled;

@@ -10,7 +10,7 @@ use restir_geometry::area_to_solid_angle;
 use crate::bvh::LightBvh;
 use crate::light::area_light_sample;
 use crate::table::Emitter;
-use crate::{Light, LightSample, LightSet};
+use crate::{EmitterGroups, Light, LightSample, LightSet};
 
 impl LightSet {
     /// Picks a light: `(index, probability)`, the probability being [`LightSet::pmf`].
@@ -200,6 +200,59 @@ impl LightSet {
             s
         } else {
             0.0
+        }
+    }
+
+    /// Groups of emitters that fit in a box of diagonal `size` ([`EmitterGroups`]).
+    pub fn emitter_groups(&self, size: f32) -> EmitterGroups {
+        let entries = self.table.entries();
+        let n = self.emitters_with_environment();
+        let mut start = Vec::with_capacity(n);
+        let mut cumulative = Vec::with_capacity(n + 1);
+        let mut acc = 0.0f64;
+        cumulative.push(0.0);
+        let (mut first, mut lo, mut hi) = (0usize, Vec3::ZERO, Vec3::ZERO);
+        for e in 0..n {
+            acc += f64::from(self.emitter_pmf(e));
+            cumulative.push(acc);
+            let grown = match (entries.get(e), e.checked_sub(1).and_then(|d| entries.get(d))) {
+                (Some(Emitter::Triangle { light, p, .. }), Some(prev))
+                    if prev.light() == *light && matches!(prev, Emitter::Triangle { .. }) =>
+                {
+                    let (l, h) = (
+                        lo.min(p[0].min(p[1]).min(p[2])),
+                        hi.max(p[0].max(p[1]).max(p[2])),
+                    );
+                    ((h - l).length() < size).then_some((l, h))
+                }
+                _ => None,
+            };
+            match grown {
+                Some((l, h)) => (lo, hi) = (l, h),
+                None => {
+                    first = e;
+                    (lo, hi) = match entries.get(e) {
+                        Some(Emitter::Triangle { p, .. }) => {
+                            (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]))
+                        }
+                        _ => (Vec3::ZERO, Vec3::ZERO),
+                    };
+                }
+            }
+            start.push(first as u32);
+        }
+        let mut end = vec![0u32; n];
+        let mut next = n as u32;
+        for e in (0..n).rev() {
+            end[e] = next;
+            if start[e] as usize == e {
+                next = e as u32;
+            }
+        }
+        EmitterGroups {
+            start,
+            end,
+            cumulative,
         }
     }
 

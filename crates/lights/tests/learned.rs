@@ -13,6 +13,8 @@
 //! The scene: 40 emissive spheres of powers over two decades, a point light, a directional
 //! light and a constant environment, so every kind of light takes part.
 
+use std::sync::Arc;
+
 use glam::Vec3;
 use restir_geometry::{Shape, Sphere};
 use restir_lights::{LearnGrid, LearnedSampler, Light, LightRecords, LightSet};
@@ -102,9 +104,9 @@ fn histogram(learned: &LearnedSampler, set: &LightSet, cell: Option<u32>, seed: 
 #[test]
 fn picks_follow_the_pmf_and_keep_every_light() {
     let set = scene();
-    let learned = LearnedSampler::new(GRID, 0.5, 16.0, &records(1));
+    let learned = LearnedSampler::new(GRID, 0.5, 16.0, &records(1), Arc::new(set.emitter_groups(0.0)));
     assert_eq!(learned.cells(), 2);
-    let empty = LearnedSampler::new(GRID, 0.5, 16.0, &LightRecords::default());
+    let empty = LearnedSampler::new(GRID, 0.5, 16.0, &LightRecords::default(), Arc::new(set.emitter_groups(0.0)));
     let level = sidak_level(0.01, RECEIVERS.len() + 1);
     let mut cases: Vec<(&LearnedSampler, Vec3, Vec3)> =
         RECEIVERS.iter().map(|&(p, n)| (&learned, p, n)).collect();
@@ -135,8 +137,8 @@ fn picks_follow_the_pmf_and_keep_every_light() {
 fn same_records_same_sampler() {
     let set = scene();
     let (a, b) = (
-        LearnedSampler::new(GRID, 0.5, 16.0, &records(4)),
-        LearnedSampler::new(GRID, 0.5, 16.0, &records(4)),
+        LearnedSampler::new(GRID, 0.5, 16.0, &records(4), Arc::new(set.emitter_groups(0.0))),
+        LearnedSampler::new(GRID, 0.5, 16.0, &records(4), Arc::new(set.emitter_groups(0.0))),
     );
     let (p, n) = RECEIVERS[0];
     let (ca, cb) = (a.cell(p, n), b.cell(p, n));
@@ -150,7 +152,7 @@ fn same_records_same_sampler() {
 #[test]
 fn negative_control_pmf_without_defensive_share_is_rejected() {
     let set = scene();
-    let learned = LearnedSampler::new(GRID, 0.5, 16.0, &records(1));
+    let learned = LearnedSampler::new(GRID, 0.5, 16.0, &records(1), Arc::new(set.emitter_groups(0.0)));
     let (p, n) = RECEIVERS[0];
     let cell = learned.cell(p, n);
     let wrong: Vec<f64> = (0..set.emitters_with_environment())

@@ -6,10 +6,12 @@
 //!
 //! Negative controls, each rejected (|z| > 8): the hierarchy claiming the power sampler's
 //! density, a pool forgetting a whole light's selection probability, the learned cell forgetting
-//! its defensive share.
+//! its defensive share, the learned cell in groups claiming the probabilities of single emitters.
 //!
 //! The scene: 30 emissive spheres over two decades of radiance, two emissive rectangles (mesh
 //! triangles), a point light, a directional light and a constant environment.
+
+use std::sync::Arc;
 
 use glam::{Affine3A, Quat, Vec2, Vec3};
 use restir_geometry::{Shape, Sphere};
@@ -123,7 +125,10 @@ fn tile(lights: &LightSet, rng: &mut Pcg32) -> Vec<Option<Presampled>> {
         .collect()
 }
 
-fn learned(lights: &LightSet) -> (LearnedSampler, u32) {
+/// The learned sampler of a cell's records, over emitters grouped within boxes of diagonal
+/// `group` ([`LightSet::emitter_groups`]: 0 keeps every emitter alone, 10 makes each
+/// rectangle's two triangles one group).
+fn learned_sampler(lights: &LightSet, group: f32) -> (LearnedSampler, u32) {
     let grid = LearnGrid { cell: 0.5 };
     let key = grid.key(AT.p, AT.n);
     let mut records = LightRecords::default();
@@ -133,7 +138,7 @@ fn learned(lights: &LightSet) -> (LearnedSampler, u32) {
         let e = (rng.next_u32() % 13) * 3;
         records.add(key, e, rng.next_f32() * (e as f32 + 1.0));
     }
-    let sampler = LearnedSampler::new(grid, 0.5, 16.0, &records);
+    let sampler = LearnedSampler::new(grid, 0.5, 16.0, &records, Arc::new(lights.emitter_groups(group)));
     let cell = sampler.cell(AT.p, AT.n).unwrap();
     assert_eq!(lights.emitters_with_environment(), 37);
     (sampler, cell)
@@ -171,7 +176,8 @@ fn every_sampler_estimates_the_same_integral() {
     let lights = scene();
     let power = estimate(&lights, 1, |_| PowerSampler);
     eprintln!("power: {:.6} ± {:.6}", power.0, power.1);
-    let (learned, cell) = learned(&lights);
+    let (grouped, grouped_cell) = learned_sampler(&lights, 10.0);
+    let (learned, cell) = learned_sampler(&lights, 0.0);
     let table = table(&lights);
     let mut tiles: Vec<Vec<Option<Presampled>>> = Vec::new();
     let mut rng = Pcg32::new(4, 4);
@@ -213,9 +219,16 @@ fn every_sampler_estimates_the_same_integral() {
         k += 1;
         LearnedCellSampler::new(&small[k - 1])
     });
+    let grouped_pools = cell_pools(&lights, &grouped, grouped_cell, true, 64);
+    let mut k = 0;
+    let learned_grouped = estimate(&lights, 7, |_| {
+        k += 1;
+        LearnedCellSampler::new(&grouped_pools[k - 1])
+    });
     for (name, e) in cases.into_iter().chain([
         ("learned cell pool", learned_pool),
         ("learned cell pool of 3", learned_small),
+        ("learned cell pool, each rectangle one group", learned_grouped),
     ]) {
         let z = z(e, power);
         eprintln!("{name}: {:.6} ± {:.6}, z {z:.2}", e.0, e.1);
@@ -227,11 +240,25 @@ fn every_sampler_estimates_the_same_integral() {
 fn negative_controls_are_rejected() {
     let lights = scene();
     let power = estimate(&lights, 1, |_| PowerSampler);
-    let (learned, cell) = learned(&lights);
+    let (learned, cell) = learned_sampler(&lights, 0.0);
     let mut rng = Pcg32::new(4, 4);
     let tiles: Vec<_> = (0..RECEIVERS).map(|_| tile(&lights, &mut rng)).collect();
     let forgetful = cell_pools(&lights, &learned, cell, false, 64);
-    let (mut k, mut j) = (0, 0);
+    // Draws of the grouped tables claiming the probabilities of the ungrouped ones (a pmf that
+    // forgets the groups).
+    let (grouped, grouped_cell) = learned_sampler(&lights, 10.0);
+    assert_eq!(grouped_cell, cell);
+    let mut ungrouped_claims = cell_pools(&lights, &grouped, cell, true, 64);
+    for pool in &mut ungrouped_claims {
+        for (draw, ratio) in pool.iter_mut().flatten() {
+            if let Presampled::Fixed { point, .. } = draw
+                && let Some(e) = lights.emitter_of(point.light, point.prim)
+            {
+                *ratio = learned.pmf(&lights, Some(cell), e) / lights.emitter_pmf(e);
+            }
+        }
+    }
+    let (mut k, mut j, mut i) = (0, 0, 0);
     let controls = [
         (
             "hierarchy claiming the power density",
@@ -251,6 +278,13 @@ fn negative_controls_are_rejected() {
             estimate(&lights, 5, |_| {
                 j += 1;
                 LearnedCellSampler::new(&forgetful[j - 1])
+            }),
+        ),
+        (
+            "learned in groups, claiming the ungrouped probabilities",
+            estimate(&lights, 7, |_| {
+                i += 1;
+                LearnedCellSampler::new(&ungrouped_claims[i - 1])
             }),
         ),
     ];

@@ -93,6 +93,11 @@ pub(crate) struct RestirArgs {
     /// from its table (n records: learn_share·n/(n + learn_prior)) [default: 64].
     #[arg(long)]
     learn_prior: Option<f32>,
+    /// restir-di with --learn on: consecutive triangles of one mesh light that fit in a box whose
+    /// diagonal is this fraction of a learning cell's side, 0 to 1, are also learned as one
+    /// (0: each triangle alone) [default: 1].
+    #[arg(long)]
+    learn_group: Option<f32>,
     /// Removed: a named integrator runs as named, and --integrator auto makes the never-worse
     /// choice. Kept hidden so that old command lines get an error saying so.
     #[arg(long, hide = true)]
@@ -182,6 +187,7 @@ impl RestirArgs {
         put("learn_share", self.learn_share.map(ParamValue::Number));
         put("learn_cells", self.learn_cells.map(ParamValue::Number));
         put("learn_prior", self.learn_prior.map(ParamValue::Number));
+        put("learn_group", self.learn_group.map(ParamValue::Number));
         put("fallback", self.fallback.clone().map(ParamValue::Text));
         put(
             "bsdf_candidates",

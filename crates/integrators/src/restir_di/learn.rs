@@ -15,7 +15,9 @@ use std::sync::{Arc, Mutex};
 
 use glam::Vec3;
 use rayon::prelude::*;
-use restir_lights::{CellKey, LearnGrid, LearnedDraw, LearnedSampler, LightRecords};
+use restir_lights::{
+    CellKey, EmitterGroups, LearnGrid, LearnedDraw, LearnedSampler, LightRecords,
+};
 use restir_scene::Scene;
 
 use crate::pass::PassContext;
@@ -36,6 +38,9 @@ struct State {
     records: LightRecords,
     /// The sampler of the records as they were after the last pass, built on demand.
     sampler: Option<Arc<LearnedSampler>>,
+    /// The emitters learned together, made with the first sampler (they depend on the scene
+    /// and the grid only).
+    groups: Option<Arc<EmitterGroups>>,
     /// Passes recorded.
     passes: u32,
 }
@@ -61,13 +66,19 @@ impl Learning {
         share: f32,
         prior: f32,
         cells: f32,
+        group: f32,
     ) -> Option<Arc<LearnedSampler>> {
         let mut s = self.state.lock().ok()?;
         if s.records.records() == 0 {
             return None;
         }
         if s.sampler.is_none() {
-            let sampler = LearnedSampler::new(Self::grid(scene, cells), share, prior, &s.records);
+            let grid = Self::grid(scene, cells);
+            let groups = s
+                .groups
+                .get_or_insert_with(|| Arc::new(scene.lights.emitter_groups(group * grid.cell)))
+                .clone();
+            let sampler = LearnedSampler::new(grid, share, prior, &s.records, groups);
             s.sampler = Some(Arc::new(sampler));
         }
         s.sampler.clone()

@@ -227,11 +227,12 @@ impl Integrator for RestirDiIntegrator {
             s.light_sampler.name().to_string()
                 + &if s.learn.is_on() {
                     format!(
-                        " learn={} learn_share={} learn_prior={} learn_cells={}",
+                        " learn={} learn_share={} learn_prior={} learn_cells={} learn_group={}",
                         s.learn.name(),
                         s.learn_share,
                         s.learn_prior,
-                        s.learn_cells
+                        s.learn_cells,
+                        s.learn_group
                     )
                 } else {
                     " learn=off".to_string()
@@ -312,7 +313,7 @@ impl Integrator for RestirDiIntegrator {
             // The distribution learned in the passes before this one.
             let learned = if s.learn.is_on() {
                 self.learning
-                    .sampler(scene, s.learn_share, s.learn_prior, s.learn_cells)
+                    .sampler(scene, s.learn_share, s.learn_prior, s.learn_cells, s.learn_group)
             } else {
                 None
             };

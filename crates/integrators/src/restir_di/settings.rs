@@ -177,6 +177,10 @@ pub struct RestirDiSettings {
     /// With `learn` on, the records a cell needs for its table to take half of `learn_share`
     /// (a cell of `n` records takes `learn_share · n / (n + learn_prior)`; default 64).
     pub learn_prior: f32,
+    /// With `learn` on, consecutive triangles of one mesh light that fit in a box whose diagonal
+    /// is this fraction of a cell's side are learned as one too ([`restir_lights::EmitterGroups`];
+    /// 0: each emitter alone; default 1, chosen on the training family).
+    pub learn_group: f32,
     /// BSDF samples per pixel, `N_B` (default 1), combined with the reservoirs' light strategy
     /// by the power heuristic with sample counts.
     pub bsdf_candidates: u32,
@@ -199,6 +203,7 @@ impl RestirDiSettings {
             learn_share: 0.5,
             learn_cells: 16.0,
             learn_prior: 64.0,
+            learn_group: 1.0,
             bsdf_candidates: 1,
             visibility: Visibility::Target,
         }
@@ -261,6 +266,10 @@ impl RestirDiSettings {
                 }
                 "learn_cells" => {
                     self.learn_cells = p.positive()?;
+                    true
+                }
+                "learn_group" => {
+                    self.learn_group = p.fraction()?;
                     true
                 }
                 "bsdf_candidates" | "brdf_candidates" => {
