@@ -206,6 +206,10 @@ impl Integrator for AutoIntegrator {
         self.chosen.stage_seconds()
     }
 
+    fn learned(&self) -> Option<String> {
+        self.chosen.learned()
+    }
+
     fn next_frame(&self, motion: Arc<FrameMotion>) {
         self.chosen.next_frame(motion);
     }

@@ -247,6 +247,11 @@ pub trait Integrator: Sync + Send + std::fmt::Debug {
     fn next_frame(&self, motion: Arc<FrameMotion>) {
         let _ = motion;
     }
+    /// What the estimator learned across the passes so far and decided from it, one line
+    /// (`None`, the default, for an estimator that learns nothing).
+    fn learned(&self) -> Option<String> {
+        None
+    }
     /// Why this estimator renders when the `auto` estimator chose it (what its rules measured
     /// of the scene, one line); `None` (the default) when it was asked for by name.
     fn auto_choice(&self) -> Option<&str> {

@@ -17,10 +17,12 @@ use restir_scene::Scene;
 use common::cornell;
 
 fn integrator(scene: &common::Built, name: &str) -> Box<dyn Integrator> {
-    let reuse: &[(&str, &str)] = if name == "path" {
-        &[]
-    } else {
-        &[("radius", "4"), ("spatial_rounds", "2")]
+    // ReSTIR DI without learning across passes: with it a pass depends on the passes before,
+    // and the passes rendered one at a time below would each start with nothing learned.
+    let reuse: &[(&str, &str)] = match name {
+        "path" => &[],
+        "restir-di" => &[("radius", "4"), ("spatial_rounds", "2"), ("learn", "off")],
+        _ => &[("radius", "4"), ("spatial_rounds", "2")],
     };
     common::make(scene, name, &[&[("max_depth", "3")], reuse].concat())
 }

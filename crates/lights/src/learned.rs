@@ -71,6 +71,11 @@ impl EmitterGroups {
             .count()
     }
 
+    /// Emitters (the environment included).
+    pub fn emitters(&self) -> usize {
+        self.start.len()
+    }
+
     /// Whether there are no emitters.
     pub fn is_empty(&self) -> bool {
         self.start.is_empty()
@@ -148,7 +153,7 @@ impl Hasher for KeyHasher {
 
     #[inline]
     fn write_u64(&mut self, v: u64) {
-        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7cc1_b727_220a_95);
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x517c_c1b7_2722_0a95);
     }
 
     #[inline]

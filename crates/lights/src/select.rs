@@ -215,7 +215,10 @@ impl LightSet {
         for e in 0..n {
             acc += f64::from(self.emitter_pmf(e));
             cumulative.push(acc);
-            let grown = match (entries.get(e), e.checked_sub(1).and_then(|d| entries.get(d))) {
+            let grown = match (
+                entries.get(e),
+                e.checked_sub(1).and_then(|d| entries.get(d)),
+            ) {
                 (Some(Emitter::Triangle { light, p, .. }), Some(prev))
                     if prev.light() == *light && matches!(prev, Emitter::Triangle { .. }) =>
                 {

@@ -104,9 +104,21 @@ fn histogram(learned: &LearnedSampler, set: &LightSet, cell: Option<u32>, seed: 
 #[test]
 fn picks_follow_the_pmf_and_keep_every_light() {
     let set = scene();
-    let learned = LearnedSampler::new(GRID, 0.5, 16.0, &records(1), Arc::new(set.emitter_groups(0.0)));
+    let learned = LearnedSampler::new(
+        GRID,
+        0.5,
+        16.0,
+        &records(1),
+        Arc::new(set.emitter_groups(0.0)),
+    );
     assert_eq!(learned.cells(), 2);
-    let empty = LearnedSampler::new(GRID, 0.5, 16.0, &LightRecords::default(), Arc::new(set.emitter_groups(0.0)));
+    let empty = LearnedSampler::new(
+        GRID,
+        0.5,
+        16.0,
+        &LightRecords::default(),
+        Arc::new(set.emitter_groups(0.0)),
+    );
     let level = sidak_level(0.01, RECEIVERS.len() + 1);
     let mut cases: Vec<(&LearnedSampler, Vec3, Vec3)> =
         RECEIVERS.iter().map(|&(p, n)| (&learned, p, n)).collect();
@@ -137,8 +149,20 @@ fn picks_follow_the_pmf_and_keep_every_light() {
 fn same_records_same_sampler() {
     let set = scene();
     let (a, b) = (
-        LearnedSampler::new(GRID, 0.5, 16.0, &records(4), Arc::new(set.emitter_groups(0.0))),
-        LearnedSampler::new(GRID, 0.5, 16.0, &records(4), Arc::new(set.emitter_groups(0.0))),
+        LearnedSampler::new(
+            GRID,
+            0.5,
+            16.0,
+            &records(4),
+            Arc::new(set.emitter_groups(0.0)),
+        ),
+        LearnedSampler::new(
+            GRID,
+            0.5,
+            16.0,
+            &records(4),
+            Arc::new(set.emitter_groups(0.0)),
+        ),
     );
     let (p, n) = RECEIVERS[0];
     let (ca, cb) = (a.cell(p, n), b.cell(p, n));
@@ -152,7 +176,13 @@ fn same_records_same_sampler() {
 #[test]
 fn negative_control_pmf_without_defensive_share_is_rejected() {
     let set = scene();
-    let learned = LearnedSampler::new(GRID, 0.5, 16.0, &records(1), Arc::new(set.emitter_groups(0.0)));
+    let learned = LearnedSampler::new(
+        GRID,
+        0.5,
+        16.0,
+        &records(1),
+        Arc::new(set.emitter_groups(0.0)),
+    );
     let (p, n) = RECEIVERS[0];
     let cell = learned.cell(p, n);
     let wrong: Vec<f64> = (0..set.emitters_with_environment())

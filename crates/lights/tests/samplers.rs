@@ -138,7 +138,13 @@ fn learned_sampler(lights: &LightSet, group: f32) -> (LearnedSampler, u32) {
         let e = (rng.next_u32() % 13) * 3;
         records.add(key, e, rng.next_f32() * (e as f32 + 1.0));
     }
-    let sampler = LearnedSampler::new(grid, 0.5, 16.0, &records, Arc::new(lights.emitter_groups(group)));
+    let sampler = LearnedSampler::new(
+        grid,
+        0.5,
+        16.0,
+        &records,
+        Arc::new(lights.emitter_groups(group)),
+    );
     let cell = sampler.cell(AT.p, AT.n).unwrap();
     assert_eq!(lights.emitters_with_environment(), 37);
     (sampler, cell)
@@ -228,7 +234,10 @@ fn every_sampler_estimates_the_same_integral() {
     for (name, e) in cases.into_iter().chain([
         ("learned cell pool", learned_pool),
         ("learned cell pool of 3", learned_small),
-        ("learned cell pool, each rectangle one group", learned_grouped),
+        (
+            "learned cell pool, each rectangle one group",
+            learned_grouped,
+        ),
     ]) {
         let z = z(e, power);
         eprintln!("{name}: {:.6} ± {:.6}, z {z:.2}", e.0, e.1);

@@ -184,6 +184,9 @@ pub struct PartStats {
     /// Whether the estimator reuses temporally: its history then starts afresh at the part's
     /// first pass (each chain, each tile keeps its own), unlike one process rendering all passes.
     pub temporal_restarts: bool,
+    /// Whether the estimator learns across passes (ReSTIR DI's `learn`): it then learns only
+    /// from the part's own passes, starting with nothing learned at the part's first pass.
+    pub learning_restarts: bool,
 }
 
 fn corners(w: &PixelWindow) -> [u32; 4] {
@@ -215,6 +218,7 @@ impl Plan {
             region: corners(&self.part().region(integrator, self.film)),
             halo: integrator.halo(),
             temporal_restarts: integrator.describe().contains("temporal=true"),
+            learning_restarts: integrator.learned().is_some(),
         }
     }
 

@@ -39,6 +39,9 @@ struct Stats<'a> {
     /// the path tracer).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     stage_seconds: Vec<StageSeconds>,
+    /// What the estimator learned across passes (ReSTIR DI with `--learn on`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    learned: Option<String>,
     /// The part of a split render this process rendered (--chain, --crop).
     #[serde(skip_serializing_if = "Option::is_none")]
     part: Option<cluster::PartStats>,
@@ -129,6 +132,7 @@ impl Report<'_> {
                 .into_iter()
                 .map(|(stage, seconds)| StageSeconds { stage, seconds })
                 .collect(),
+            learned: integrator.learned(),
             part: self.plan.map(|p| p.stats(integrator)),
         };
         let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;

@@ -66,7 +66,18 @@ fn chains_and_tiles_merge_into_the_single_render() {
     let dir = temp_dir("merge");
     let d = &dir.0;
     let scene = cornell();
-    let di = ["--integrator", "restir-di", "--radius", "3", "--spp", "3"];
+    // Without learning: a part learns only from its own passes, so with it (the default) a split
+    // render is another estimator of the image, not the single render's bits.
+    let di = [
+        "--integrator",
+        "restir-di",
+        "--radius",
+        "3",
+        "--spp",
+        "3",
+        "--learn",
+        "off",
+    ];
     render(&scene, &di, &p(d, "full.exr"));
     // Tiles of rows, plus chains inside the last tile.
     render(
@@ -104,6 +115,7 @@ fn chains_and_tiles_merge_into_the_single_render() {
     assert_eq!(part["region"], serde_json::json!([0, 16, 48, 32]));
     assert_eq!(part["halo"], 3);
     assert_eq!(part["temporal_restarts"], false);
+    assert_eq!(part["learning_restarts"], false);
     assert_eq!(json["spp"], 1);
     let merged = p(d, "merged.exr");
     let parts = ["t0.exr", "c0.exr", "c1.exr", "c2.exr"].map(|n| p(d, n));
@@ -134,6 +146,23 @@ fn chains_and_tiles_merge_into_the_single_render() {
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&temporal).unwrap()).unwrap();
     assert_eq!(json["part"]["temporal_restarts"], true);
+    // With learning (the default) each part learns from its own passes, and the stats say so.
+    let learning = p(d, "learning.json");
+    let args = [
+        &di[..di.len() - 2],
+        &["--chain", "2", "--chains", "3", "--stats", &learning],
+    ]
+    .concat();
+    render(&scene, &args, &p(d, "learning.exr"));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&learning).unwrap()).unwrap();
+    assert_eq!(json["part"]["learning_restarts"], true);
+    assert!(
+        json["learned"]
+            .as_str()
+            .is_some_and(|l| l.contains(" records from 1 pass in ")),
+        "{json}"
+    );
     // A plain render has no stats part.
     let plain = p(d, "plain.json");
     render(

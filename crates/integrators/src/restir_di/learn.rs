@@ -15,9 +15,7 @@ use std::sync::{Arc, Mutex};
 
 use glam::Vec3;
 use rayon::prelude::*;
-use restir_lights::{
-    CellKey, EmitterGroups, LearnGrid, LearnedDraw, LearnedSampler, LightRecords,
-};
+use restir_lights::{CellKey, EmitterGroups, LearnGrid, LearnedDraw, LearnedSampler, LightRecords};
 use restir_scene::Scene;
 
 use crate::pass::PassContext;
@@ -41,6 +39,10 @@ struct State {
     /// The emitters learned together, made with the first sampler (they depend on the scene
     /// and the grid only).
     groups: Option<Arc<EmitterGroups>>,
+    /// Cells with a table and the tables' bytes, of the last sampler built.
+    last_tables: (usize, usize),
+    /// The seed and pass that continue the passes recorded so far.
+    next: Option<(u64, u32)>,
     /// Passes recorded.
     passes: u32,
 }
@@ -79,6 +81,7 @@ impl Learning {
                 .get_or_insert_with(|| Arc::new(scene.lights.emitter_groups(group * grid.cell)))
                 .clone();
             let sampler = LearnedSampler::new(grid, share, prior, &s.records, groups);
+            s.last_tables = (sampler.cells(), sampler.bytes());
             s.sampler = Some(Arc::new(sampler));
         }
         s.sampler.clone()
@@ -92,6 +95,48 @@ impl Learning {
             }
             s.sampler = None;
             s.passes += 1;
+        }
+    }
+
+    /// What was learned, one line: records, passes recorded, cells with tables, the groups of
+    /// emitters, the sampler's memory.
+    pub fn summary(&self) -> String {
+        let Ok(s) = self.state.lock() else {
+            return String::new();
+        };
+        let groups = s.groups.as_ref().map_or_else(
+            || "no groups yet".to_string(),
+            |g| {
+                format!(
+                    "{} emitters in {} learned groups (runs of a mesh's triangles within a cell)",
+                    g.emitters(),
+                    g.len()
+                )
+            },
+        );
+        let (cells, bytes) = s.last_tables;
+        format!(
+            "{} records from {} pass{} in {} cells; the last pass drew from tables of {} cells, {:.1} MB; {}",
+            s.records.records(),
+            s.passes,
+            if s.passes == 1 { "" } else { "es" },
+            s.records.cells(),
+            cells,
+            bytes as f64 / 1e6,
+            groups
+        )
+    }
+
+    /// Starts pass `pass` of a render with seed `seed`: what was learned carries over only when
+    /// this pass continues the passes learned from (the next pass of the same seed), so a new
+    /// render, or a part of a split render, starts with nothing learned whatever the estimator
+    /// rendered before.
+    pub fn begin(&self, seed: u64, pass: u32) {
+        if let Ok(mut s) = self.state.lock() {
+            if s.next != Some((seed, pass)) {
+                *s = State::default();
+            }
+            s.next = Some((seed, pass.wrapping_add(1)));
         }
     }
 

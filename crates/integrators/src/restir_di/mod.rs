@@ -254,6 +254,10 @@ impl Integrator for RestirDiIntegrator {
         self.clock.seconds()
     }
 
+    fn learned(&self) -> Option<String> {
+        self.settings.learn.is_on().then(|| self.learning.summary())
+    }
+
     /// The previous frame's reservoirs are reused with the motion: light samples move with
     /// their lights, receivers are found by motion vectors, targets of previous domains are
     /// evaluated in the previous frame's scene.
@@ -312,8 +316,14 @@ impl Integrator for RestirDiIntegrator {
             });
             // The distribution learned in the passes before this one.
             let learned = if s.learn.is_on() {
-                self.learning
-                    .sampler(scene, s.learn_share, s.learn_prior, s.learn_cells, s.learn_group)
+                self.learning.begin(ctx.seed, ctx.pass);
+                self.learning.sampler(
+                    scene,
+                    s.learn_share,
+                    s.learn_prior,
+                    s.learn_cells,
+                    s.learn_group,
+                )
             } else {
                 None
             };

@@ -166,8 +166,9 @@ pub struct RestirDiSettings {
     pub candidates: u32,
     /// Where candidates' lights come from (default the power sampler).
     pub light_sampler: LightSampler,
-    /// Whether candidates come from a light distribution learned across passes (default off:
-    /// see `docs/RESTIR_DI.md`, "Learning across passes").
+    /// Whether candidates come from a light distribution learned across passes (default on:
+    /// chosen on the training family at 640×360; `docs/RESTIR_DI.md`, "Learning across
+    /// passes").
     pub learn: Learn,
     /// With `learn` on, the share of candidate selections that go to the learned tables, in
     /// `[0, 1)` (the rest, the defensive share, to the power sampler; default 0.5).
@@ -199,7 +200,7 @@ impl RestirDiSettings {
             reuse: ReuseSettings::default(),
             candidates: 8,
             light_sampler: LightSampler::Auto,
-            learn: Learn::Off,
+            learn: Learn::On,
             learn_share: 0.5,
             learn_cells: 16.0,
             learn_prior: 64.0,
