@@ -101,24 +101,17 @@ fn histogram(learned: &LearnedSampler, set: &LightSet, cell: Option<u32>, seed: 
     hist
 }
 
+/// The sampler of `records` on the test grid, every emitter alone (the scene has no meshes).
+fn sampler(set: &LightSet, records: &LightRecords) -> LearnedSampler {
+    LearnedSampler::new(GRID, 0.5, 16.0, records, Arc::new(set.emitter_groups(0.0)))
+}
+
 #[test]
 fn picks_follow_the_pmf_and_keep_every_light() {
     let set = scene();
-    let learned = LearnedSampler::new(
-        GRID,
-        0.5,
-        16.0,
-        &records(1),
-        Arc::new(set.emitter_groups(0.0)),
-    );
+    let learned = sampler(&set, &records(1));
     assert_eq!(learned.cells(), 2);
-    let empty = LearnedSampler::new(
-        GRID,
-        0.5,
-        16.0,
-        &LightRecords::default(),
-        Arc::new(set.emitter_groups(0.0)),
-    );
+    let empty = sampler(&set, &LightRecords::default());
     let level = sidak_level(0.01, RECEIVERS.len() + 1);
     let mut cases: Vec<(&LearnedSampler, Vec3, Vec3)> =
         RECEIVERS.iter().map(|&(p, n)| (&learned, p, n)).collect();
@@ -148,22 +141,7 @@ fn picks_follow_the_pmf_and_keep_every_light() {
 #[test]
 fn same_records_same_sampler() {
     let set = scene();
-    let (a, b) = (
-        LearnedSampler::new(
-            GRID,
-            0.5,
-            16.0,
-            &records(4),
-            Arc::new(set.emitter_groups(0.0)),
-        ),
-        LearnedSampler::new(
-            GRID,
-            0.5,
-            16.0,
-            &records(4),
-            Arc::new(set.emitter_groups(0.0)),
-        ),
-    );
+    let (a, b) = (sampler(&set, &records(4)), sampler(&set, &records(4)));
     let (p, n) = RECEIVERS[0];
     let (ca, cb) = (a.cell(p, n), b.cell(p, n));
     for l in 0..set.emitters_with_environment() {
@@ -176,13 +154,7 @@ fn same_records_same_sampler() {
 #[test]
 fn negative_control_pmf_without_defensive_share_is_rejected() {
     let set = scene();
-    let learned = LearnedSampler::new(
-        GRID,
-        0.5,
-        16.0,
-        &records(1),
-        Arc::new(set.emitter_groups(0.0)),
-    );
+    let learned = sampler(&set, &records(1));
     let (p, n) = RECEIVERS[0];
     let cell = learned.cell(p, n);
     let wrong: Vec<f64> = (0..set.emitters_with_environment())
