@@ -323,18 +323,24 @@ fn same_image_for_one_and_two_threads() {
     assert!(c.pixels != run(1, &[]).pixels);
 }
 
-/// An estimator that learns across passes (the default) renders the same image each time it
-/// renders: a render that does not continue the passes learned from starts with nothing
-/// learned. Control: learning does change the image (against `learn off`).
+/// An estimator that keeps something between passes (what it learned, the default; the
+/// temporal history) renders the same image each time it renders: a render that does not
+/// continue the passes before starts afresh. Controls: learning and temporal reuse do change
+/// the image (against the estimator without them).
 #[test]
 fn a_second_render_with_the_same_estimator_is_the_same_image() {
     let scene = scene();
-    let est = common::make(&scene, "restir-di", &[]);
-    let a = common::render_with(&scene, est.as_ref(), 4, 5);
-    let b = common::render_with(&scene, est.as_ref(), 4, 5);
-    assert!(a.pixels == b.pixels, "the second render differs");
-    let off = render_image(&scene, "restir-di", &[("learn", "off")], 4, 5);
-    assert!(off.pixels != a.pixels, "learning changed nothing");
+    for params in [&[][..], &[("learn", "off"), ("temporal", "true")][..]] {
+        let est = common::make(&scene, "restir-di", params);
+        let a = common::render_with(&scene, est.as_ref(), 4, 5);
+        let b = common::render_with(&scene, est.as_ref(), 4, 5);
+        assert!(
+            a.pixels == b.pixels,
+            "{params:?}: the second render differs"
+        );
+        let plain = render_image(&scene, "restir-di", &[("learn", "off")], 4, 5);
+        assert!(plain.pixels != a.pixels, "{params:?}: changed nothing");
+    }
 }
 
 /// First seed of the independent renders (fixed; `DI_SEED_BASE` re-runs the test on other

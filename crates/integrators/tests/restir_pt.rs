@@ -872,3 +872,18 @@ fn duplication_aware_confidence_is_biased_and_labelled() {
         }
     }
 }
+
+/// With temporal reuse, rendering twice with one estimator gives the same image twice: a render
+/// that does not continue the passes before starts without their history. Control: temporal
+/// reuse changes the image.
+#[test]
+fn a_second_temporal_render_with_the_same_estimator_is_the_same_image() {
+    let scene = scene();
+    let params = [("max_depth", "3"), ("temporal", "true")];
+    let est = common::make(&scene, "restir-pt", &params);
+    let a = common::render_with(&scene, est.as_ref(), 3, 9);
+    let b = common::render_with(&scene, est.as_ref(), 3, 9);
+    assert!(a.pixels == b.pixels, "the second render differs");
+    let plain = common::make(&scene, "restir-pt", &params[..1]);
+    assert!(common::render_with(&scene, plain.as_ref(), 3, 9).pixels != a.pixels);
+}

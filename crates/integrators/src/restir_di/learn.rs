@@ -41,8 +41,6 @@ struct State {
     groups: Option<Arc<EmitterGroups>>,
     /// Cells with a table and the tables' bytes, of the last sampler built.
     last_tables: (usize, usize),
-    /// The seed and pass that continue the passes recorded so far.
-    next: Option<(u64, u32)>,
     /// Passes recorded.
     passes: u32,
 }
@@ -127,20 +125,8 @@ impl Learning {
         )
     }
 
-    /// Starts pass `pass` of a render with seed `seed`: what was learned carries over only when
-    /// this pass continues the passes learned from (the next pass of the same seed), so a new
-    /// render, or a part of a split render, starts with nothing learned whatever the estimator
-    /// rendered before.
-    pub fn begin(&self, seed: u64, pass: u32) {
-        if let Ok(mut s) = self.state.lock() {
-            if s.next != Some((seed, pass)) {
-                *s = State::default();
-            }
-            s.next = Some((seed, pass.wrapping_add(1)));
-        }
-    }
-
-    /// Forgets everything (a new frame: the lights and receivers have moved).
+    /// Forgets everything (a new frame: the lights and receivers have moved; or a pass that
+    /// does not continue the passes learned from, [`crate::reuse::chain::PassChain`]).
     pub fn reset(&self) {
         if let Ok(mut s) = self.state.lock() {
             *s = State::default();

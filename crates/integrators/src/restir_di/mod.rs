@@ -50,6 +50,7 @@ use crate::bands::Bands;
 use crate::motion::FrameMotion;
 use crate::pass::{Integrator, PassContext};
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
+use crate::reuse::chain::PassChain;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::reciprocal;
 use crate::reuse::settings::mis_name;
@@ -81,6 +82,8 @@ pub struct RestirDiIntegrator {
     clock: StageClock,
     /// What earlier passes recorded, with `learn` on.
     learning: learn::Learning,
+    /// Whether a pass continues the passes the history and the learning come from.
+    chain: PassChain,
     /// The per-pixel lookups of the last pass, kept so the next pass reuses their memory.
     lookups: std::sync::Mutex<Lookups>,
 }
@@ -104,6 +107,7 @@ impl RestirDiIntegrator {
             reuse: ScreenReuse::default(),
             clock: StageClock::default(),
             learning: learn::Learning::default(),
+            chain: PassChain::default(),
             lookups: Default::default(),
         }
     }
@@ -262,6 +266,7 @@ impl Integrator for RestirDiIntegrator {
     /// their lights, receivers are found by motion vectors, targets of previous domains are
     /// evaluated in the previous frame's scene.
     fn next_frame(&self, motion: std::sync::Arc<FrameMotion>) {
+        self.chain.next_frame();
         self.reuse.next_frame(Some(motion));
         self.learning.reset();
     }
@@ -289,6 +294,11 @@ impl Integrator for RestirDiIntegrator {
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
         let s = &self.settings;
+        if !self.chain.advance(ctx.seed, ctx.pass) {
+            // Another render: nothing of the passes before carries over.
+            self.reuse.next_frame(None);
+            self.learning.reset();
+        }
         let reuse = &s.reuse;
         let n = accum.len();
         let mut radiance = vec![Vec3::ZERO; n];
@@ -316,7 +326,6 @@ impl Integrator for RestirDiIntegrator {
             });
             // The distribution learned in the passes before this one.
             let learned = if s.learn.is_on() {
-                self.learning.begin(ctx.seed, ctx.pass);
                 self.learning.sampler(
                     scene,
                     s.learn_share,

@@ -43,6 +43,7 @@ pub use shift::{Frames, PtShift};
 
 use crate::bands::Bands;
 use crate::motion::FrameMotion;
+use crate::reuse::chain::PassChain;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::reciprocal;
 use restir_reuse::{ScreenReuse, Stages};
@@ -73,6 +74,8 @@ pub struct RestirPtIntegrator {
     di: Option<RestirDiIntegrator>,
     /// The neighbour pattern and the history of temporal reuse.
     reuse: ScreenReuse<PathSample, GBuffer>,
+    /// Whether a pass continues the passes the history comes from.
+    chain: PassChain,
     clock: StageClock,
     /// Where the brightest pixels come from (`RESTIR_PT_DIAG`, [`diag`]); `None` unless asked.
     diag: Option<diag::Diag>,
@@ -98,6 +101,7 @@ impl RestirPtIntegrator {
             settings,
             di,
             reuse: ScreenReuse::default(),
+            chain: PassChain::default(),
             clock: StageClock::default(),
             diag: diag::Diag::from_env(),
             seen: (settings.edge_rays > 1)
@@ -389,6 +393,7 @@ impl Integrator for RestirPtIntegrator {
         if let Some(di) = &self.di {
             di.next_frame(motion.clone()); // its light samples move with their lights
         }
+        self.chain.next_frame();
         self.reuse.next_frame(Some(motion));
         if let Some(seen) = &self.seen {
             seen.clear();
@@ -413,6 +418,10 @@ impl Integrator for RestirPtIntegrator {
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
         let s = &self.settings.reuse;
+        if !self.chain.advance(ctx.seed, ctx.pass) {
+            // Another render: the history of the passes before does not carry over.
+            self.reuse.next_frame(None);
+        }
         let n = accum.len();
         // Emitters seen by the camera and the direct light at the primary hit (paths of one and
         // two segments) from ReSTIR DI; the reservoirs below carry the longer paths.

@@ -4,6 +4,7 @@
 //! [`PassContext`](crate::PassContext) the crate's [`Streams`](restir_reuse::Streams), and
 //! [`params`] reads the reuse settings from scene files and the command line.
 
+pub mod chain;
 pub mod gbuffer;
 pub mod params;
 
