@@ -78,7 +78,8 @@ pub(crate) struct RestirArgs {
     light_sampler: Option<String>,
     /// restir-di: on draws candidates' lights, from the second pass on, from a mixture of the
     /// power sampler and what each light delivered (after its shadow ray) to a cell of a
-    /// world-space grid in earlier passes; off uses the light sampler alone [default: on].
+    /// world-space grid in earlier passes; off uses the light sampler alone; auto is on up to
+    /// 50000 emitters (emissive triangles and other lights) and off above [default: auto].
     #[arg(long)]
     learn: Option<String>,
     /// restir-di with --learn on: the share of candidate selections drawn from the learned

@@ -44,7 +44,9 @@ use restir_materials::Bsdf;
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
-pub use settings::{HIERARCHY_MIN_EMITTERS, Learn, LightSampler, RestirDiSettings, Visibility};
+pub use settings::{
+    HIERARCHY_MIN_EMITTERS, LEARN_MAX_EMITTERS, Learn, LightSampler, RestirDiSettings, Visibility,
+};
 
 use crate::bands::Bands;
 use crate::motion::FrameMotion;

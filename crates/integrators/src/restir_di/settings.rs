@@ -1,8 +1,9 @@
 //! ReSTIR DI settings and their parsing from named parameters (XML scenes and the command line
 //! use the same names; the names Lajolla ReSTIR ports use are accepted too). The reuse settings
-//! are [`ReuseSettings`]. One default is a rule of the scene summary, decided once when the
+//! are [`ReuseSettings`]. Two defaults are rules of the scene summary, decided once when the
 //! integrator is made ([`RestirDiSettings::resolve`]): the candidate source (the light hierarchy
-//! above [`HIERARCHY_MIN_EMITTERS`] emitters).
+//! above [`HIERARCHY_MIN_EMITTERS`] emitters) and learning across passes (up to
+//! [`LEARN_MAX_EMITTERS`] emitters).
 
 use crate::reuse::params::ReuseParams;
 use restir_scene::SceneFeatures;
@@ -18,6 +19,14 @@ use crate::reuse::settings::ReuseSettings;
 /// qualifies (`None`): `auto` is the power table everywhere until the descent gets cheaper,
 /// and this bound is where the rule lives.
 pub const HIERARCHY_MIN_EMITTERS: Option<usize> = None;
+
+/// Emitter-table entries (emissive triangles and other lights, the environment not counted) up to
+/// which `learn = auto` learns across passes. On the DI training family at 640×360 (16 passes,
+/// equal CPU time; `docs/RESTIR_DI.md`, "Learning across passes") learning pays on every member
+/// of 10³ to 2.4·10⁴ emitters (1.00–1.69×) and loses on the three of 10⁵ and more (0.62–0.88×,
+/// variance 1.10–1.27×: a cell's records then spread over more emitters than a table tells
+/// apart); the bound sits between the two, where the rule lives.
+pub const LEARN_MAX_EMITTERS: usize = 50_000;
 
 /// Where initial candidates' lights come from (`--light-sampler`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -84,6 +93,9 @@ impl LightSampler {
 /// [`super::learn`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Learn {
+    /// Decided from the scene summary ([`RestirDiSettings::resolve`]): on up to
+    /// [`LEARN_MAX_EMITTERS`] emitters, off above (off where nothing resolves it).
+    Auto,
     /// The light sampler alone.
     Off,
     /// From the second pass on, per cell of a world-space grid, a mixture of what lights
@@ -98,11 +110,16 @@ pub enum Learn {
 
 impl Learn {
     /// The names `--learn` takes.
-    pub const NAMES: &[(&str, Learn)] = &[("off", Learn::Off), ("on", Learn::On)];
+    pub const NAMES: &[(&str, Learn)] = &[
+        ("auto", Learn::Auto),
+        ("off", Learn::Off),
+        ("on", Learn::On),
+    ];
 
     /// The name `--learn` takes.
     pub fn name(self) -> &'static str {
         match self {
+            Learn::Auto => "auto",
             Learn::Off => "off",
             Learn::On => "on",
             Learn::WithoutDefensiveShare => "without-defensive-share",
@@ -111,7 +128,7 @@ impl Learn {
 
     /// Whether passes learn and later passes draw from what was learned.
     pub fn is_on(self) -> bool {
-        self != Learn::Off
+        matches!(self, Learn::On | Learn::WithoutDefensiveShare)
     }
 }
 
@@ -166,9 +183,9 @@ pub struct RestirDiSettings {
     pub candidates: u32,
     /// Where candidates' lights come from (default the power sampler).
     pub light_sampler: LightSampler,
-    /// Whether candidates come from a light distribution learned across passes (default on:
-    /// chosen on the training family at 640×360; `docs/RESTIR_DI.md`, "Learning across
-    /// passes").
+    /// Whether candidates come from a light distribution learned across passes (default `auto`:
+    /// on up to [`LEARN_MAX_EMITTERS`] emitters, chosen on the training family at 640×360;
+    /// `docs/RESTIR_DI.md`, "Learning across passes").
     pub learn: Learn,
     /// With `learn` on, the share of candidate selections that go to the learned tables, in
     /// `[0, 1)` (the rest, the defensive share, to the power sampler; default 0.5).
@@ -200,7 +217,7 @@ impl RestirDiSettings {
             reuse: ReuseSettings::default(),
             candidates: 8,
             light_sampler: LightSampler::Auto,
-            learn: Learn::On,
+            learn: Learn::Auto,
             learn_share: 0.5,
             learn_cells: 16.0,
             learn_prior: 64.0,
@@ -210,10 +227,17 @@ impl RestirDiSettings {
         }
     }
 
-    /// Decides the scene-dependent default from the scene summary: an `auto` light sampler
+    /// Decides the scene-dependent defaults from the scene summary: an `auto` light sampler
     /// becomes the hierarchy from [`HIERARCHY_MIN_EMITTERS`] emitters on (else the power
-    /// table).
+    /// table), and `auto` learning is on up to [`LEARN_MAX_EMITTERS`] emitters (else off).
     pub fn resolve(&mut self, features: &SceneFeatures) {
+        if self.learn == Learn::Auto {
+            self.learn = if features.emitter_count <= LEARN_MAX_EMITTERS {
+                Learn::On
+            } else {
+                Learn::Off
+            };
+        }
         if self.light_sampler == LightSampler::Auto {
             self.light_sampler =
                 if HIERARCHY_MIN_EMITTERS.is_some_and(|m| features.emitter_count >= m) {
@@ -249,7 +273,7 @@ impl RestirDiSettings {
                     true
                 }
                 "learn" => {
-                    self.learn = p.choice(Learn::NAMES, "off or on")?;
+                    self.learn = p.choice(Learn::NAMES, "auto, off or on")?;
                     true
                 }
                 "learn_share" => {
