@@ -12,13 +12,15 @@
 //! blocked from a cell stop being drawn there.
 //!
 //! [`LightRecords`] gathers `(cell, emitter, contribution)` records in the order they are given;
-//! [`LearnedSampler::new`] freezes them into one alias table per cell. A selection at a receiver
+//! [`LearnedSampler::new`] freezes them into one table per cell: an alias table over the
+//! emitters it recorded and, where a scene's meshes have triangles learned together
+//! ([`EmitterGroups`]), another over those groups, each taking half. A selection at a receiver
 //! picks the cell's table with probability `share · n / (n + prior)` (`n` the cell's records,
 //! so a cell that has seen little leans on the power sampler) and the power sampler
 //! ([`LightSet::pick_emitter`]) otherwise, so every emitter with power keeps a positive
 //! probability whatever was learned (the defensive share, Hesterberg 1995), and
-//! [`LearnedSampler::pmf`] is the mixture's probability, exactly, for any receiver and emitter. A receiver whose cell has no records selects by power
-//! alone.
+//! [`LearnedSampler::pmf`] is the mixture's probability, exactly, for any receiver and emitter.
+//! A receiver whose cell has no records selects by power alone.
 
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
@@ -50,6 +52,8 @@ pub struct EmitterGroups {
     /// Per emitter `e` the power sampler's probability of the emitters before it (`n + 1`
     /// values): a group's power is a difference, and an emitter is found in it by bisection.
     pub(crate) cumulative: Vec<f64>,
+    /// Groups.
+    pub(crate) count: usize,
 }
 
 impl EmitterGroups {
@@ -64,11 +68,12 @@ impl EmitterGroups {
 
     /// Groups.
     pub fn len(&self) -> usize {
-        self.start
-            .iter()
-            .enumerate()
-            .filter(|&(e, &s)| s as usize == e)
-            .count()
+        self.count
+    }
+
+    /// Whether some group holds more than one emitter.
+    pub fn any_grouped(&self) -> bool {
+        self.count < self.start.len()
     }
 
     /// Emitters (the environment included).
@@ -319,8 +324,8 @@ struct CellTable {
     share: f32,
 }
 
-/// The learned selection: per cell an alias table over the lights recorded there, mixed with the
-/// power sampler (module documentation).
+/// The learned selection: per cell a table over the emitters (and groups) recorded there, mixed
+/// with the power sampler (module documentation).
 #[derive(Clone, Debug)]
 pub struct LearnedSampler {
     grid: LearnGrid,
@@ -354,7 +359,7 @@ impl LearnedSampler {
         let mut index = KeyMap::default();
         index.reserve(cells.len());
         let mut tables = Vec::with_capacity(cells.len());
-        let grouped = groups.len() < groups.start.len();
+        let grouped = groups.any_grouped();
         for cell in cells {
             let mut sums: Vec<(u32, f64)> = cell
                 .emitters

@@ -253,6 +253,11 @@ impl LightSet {
             }
         }
         EmitterGroups {
+            count: start
+                .iter()
+                .enumerate()
+                .filter(|&(e, &s)| s as usize == e)
+                .count(),
             start,
             end,
             cumulative,

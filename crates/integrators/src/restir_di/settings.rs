@@ -372,4 +372,25 @@ mod tests {
             "light_sampler = 'near': expected auto, power, tiles or bvh"
         );
     }
+
+    /// `learn = auto` learns up to `LEARN_MAX_EMITTERS` emitters and not above; a named choice
+    /// stays as named whatever the scene.
+    #[test]
+    fn auto_learning_is_decided_by_the_emitter_count() {
+        let at = |emitters: usize, learn: Learn| {
+            let mut s = settings();
+            s.learn = learn;
+            s.resolve(&SceneFeatures {
+                emitter_count: emitters,
+                ..SceneFeatures::default()
+            });
+            s.learn
+        };
+        assert_eq!(settings().learn, Learn::Auto);
+        assert_eq!(at(LEARN_MAX_EMITTERS, Learn::Auto), Learn::On);
+        assert_eq!(at(LEARN_MAX_EMITTERS + 1, Learn::Auto), Learn::Off);
+        assert_eq!(at(LEARN_MAX_EMITTERS + 1, Learn::On), Learn::On);
+        assert_eq!(at(10, Learn::Off), Learn::Off);
+        assert!(!Learn::Auto.is_on());
+    }
 }
