@@ -107,7 +107,9 @@ ready=$(date +%s)
 
 scene=$repo/scenes/cornell-box.xml
 chains_args=(--width 64 --height 48 --integrator path --seed 3)
-tiles_args=(--width 64 --height 64 --integrator restir-di --radius 4 --spatial-rounds 2 --seed 5)
+# Tiles merge bit for bit only without learning: with it each tile learns from its own region
+# (docs/CLUSTER.md, "Learning restarts per part").
+tiles_args=(--width 64 --height 64 --integrator restir-di --learn off --radius 4 --spatial-rounds 2 --seed 5)
 echo "== submitting 4 chains and 4 tiles"
 read -r _ chains_merge < <(RESTIR=$restir "$here/submit.sh" chains 4 "$scene" 16 "$work/chains" "${chains_args[@]}")
 read -r _ tiles_merge < <(RESTIR=$restir "$here/submit.sh" tiles 4 "$scene" 2 "$work/tiles" "${tiles_args[@]}")
