@@ -430,6 +430,7 @@ mod lights {
     fn gbuffer(scene: &Scene) -> GBuffer {
         let filter = Filter::new(scene.filter);
         let ctx = PassContext {
+            shared_offset: None,
             seed: 0,
             pass: 0,
             filter: &filter,

@@ -50,6 +50,7 @@ fn measure(scene: &Scene, integrator: &dyn Integrator, budget: f64) -> Measureme
     let mut pass = 0u32;
     let mut run = |accum: &mut [DVec3]| {
         let ctx = PassContext {
+            shared_offset: None,
             seed: 0,
             pass,
             filter: &filter,

@@ -144,6 +144,7 @@ fn cornell_flag(budget: f64) {
     let [off, on] = interleaved(budget, |c| {
         scene.features.has_textures = c == 1;
         let ctx = PassContext {
+            shared_offset: None,
             seed: 0,
             pass: pass / 2,
             filter: &filter,
@@ -198,6 +199,7 @@ fn sponza(budget: f64) {
     let [tex, con] = interleaved(budget, |c| {
         let scene = if c == 0 { &textured_scene } else { &constant };
         let ctx = PassContext {
+            shared_offset: None,
             seed: 0,
             pass: pass / 2,
             filter: &filter,

@@ -72,7 +72,8 @@ pub use params::{Param, ParamError, ParamSet, ParamSource, ParamValue};
 pub use pass::{CROP_ALIGN, Crop, Integrator, PassContext, PixelWindow};
 pub use path::PathIntegrator;
 pub use render::{
-    EstimatorReport, MomentImages, RenderJob, RenderOutput, RenderPart, render, render_part,
+    EstimatorReport, MomentImages, RenderJob, RenderOutput, RenderPart, part_halo, render,
+    render_part,
 };
 pub use renderer::{RenderError, Renderer};
 pub use restir_di::{RestirDiIntegrator, RestirDiSettings};

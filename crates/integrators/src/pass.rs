@@ -14,6 +14,9 @@ use crate::Image;
 use crate::film::Filter;
 use crate::motion::FrameMotion;
 
+/// The pass stream of the film's shared offset ([`PassContext::shared_offset_of`]).
+const STAGE_FILM: u64 = 0xF11E;
+
 /// What an integrator needs to know about the current pass.
 #[derive(Debug)]
 pub struct PassContext<'a> {
@@ -23,6 +26,9 @@ pub struct PassContext<'a> {
     pub pass: u32,
     /// The pixel filter, for jittering camera rays.
     pub filter: &'a Filter,
+    /// Where within its pixel every camera ray of the pass goes, when the film splats
+    /// (`restir_integrators::film::Reconstruction`); `None`: each ray samples `filter`.
+    pub shared_offset: Option<Vec2>,
     /// The part of the film this pass renders, if not all of it: pixel indices and coordinates
     /// the integrator sees are then the region's, and the random streams and camera rays are
     /// those of the same pixels in the whole film.
@@ -202,15 +208,27 @@ impl PassContext<'_> {
         }
     }
 
-    /// The film position (pixel units) of a filter-jittered camera ray through pixel `(x, y)`
-    /// of this pass.
+    /// The film position (pixel units) of the camera ray through pixel `(x, y)` of this pass:
+    /// jittered by the filter, or at the pass's shared offset. Draws two numbers from `rng`
+    /// either way.
     #[inline]
     pub fn film_position(&self, x: u32, y: u32, rng: &mut Pcg32) -> Vec2 {
         let (x, y) = match &self.crop {
             None => (x, y),
             Some(c) => (x + c.region.x0, y + c.region.y0),
         };
-        Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + self.filter.sample(rng.next_2d())
+        let u = rng.next_2d();
+        match self.shared_offset {
+            None => Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + self.filter.sample(u),
+            Some(offset) => Vec2::new(x as f32, y as f32) + offset,
+        }
+    }
+
+    /// The position within their pixels that every camera ray of pass `pass` of a render with
+    /// seed `seed` goes through when the film splats: uniform in `[0, 1)²`, the same in every
+    /// part of a split render.
+    pub fn shared_offset_of(seed: u64, pass: u32) -> Vec2 {
+        SeededStreams { seed, pass }.pass(STAGE_FILM).next_2d()
     }
 }
 

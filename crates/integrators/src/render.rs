@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use restir_scene::{Scene, SceneDesc};
 
 use crate::Image;
-use crate::film::Film;
+use crate::film::{Film, Reconstruction};
 use crate::pass::{Crop, Integrator, PassContext, PixelWindow};
 
 /// One render of a scene: what belongs to this render rather than to the scene. A scene
@@ -180,12 +180,20 @@ pub struct RenderPart {
 impl RenderPart {
     /// The region rendered for the window: the window with the integrator's halo, aligned
     /// ([`PixelWindow::with_halo`]); the whole film without a window.
-    pub fn region(&self, integrator: &dyn Integrator, film: (u32, u32)) -> PixelWindow {
+    pub fn region(&self, integrator: &dyn Integrator, scene: &Scene) -> PixelWindow {
+        let film = scene.camera.resolution();
         match &self.window {
             None => PixelWindow::full(film),
-            Some(w) => w.with_halo(integrator.halo(), film),
+            Some(w) => w.with_halo(part_halo(integrator, scene), film),
         }
     }
+}
+
+/// How far, in pixels, a pixel of the image reaches for the estimates of others in one pass:
+/// the integrator's spatial reuse ([`Integrator::halo`]) beyond the film's splatting reach
+/// ([`Reconstruction::reach`]). A cropped render renders its window with this halo.
+pub fn part_halo(integrator: &dyn Integrator, scene: &Scene) -> u32 {
+    integrator.halo() + Reconstruction::decide(scene.filter).reach()
 }
 
 /// [`render`] for one part of a render: passes from `part.first_pass` on, and with a window only
@@ -200,12 +208,13 @@ pub fn render_part(
     progress: &mut dyn FnMut(u32, Duration),
 ) -> RenderOutput {
     let film_size = scene.camera.resolution();
-    let region = part.region(integrator, film_size);
+    let region = part.region(integrator, scene);
     let crop = part.window.map(|_| Crop {
         region,
         film_width: film_size.0,
     });
-    let mut film = Film::new(region.width, region.height, scene.filter);
+    let mut film = Film::region(region, film_size, scene.filter);
+    let splats = matches!(film.reconstruction(), Reconstruction::Splatted { .. });
     if job.moment.is_some() {
         film = film.with_second_moment();
     }
@@ -214,11 +223,13 @@ pub fn render_part(
     let spp = job.spp.max(1);
     while film.passes() < spp {
         let pass = part.first_pass + film.passes();
-        rays += film.add_pass(|filter, sums| {
+        let offset = PassContext::shared_offset_of(job.seed, pass);
+        rays += film.add_pass(offset, |filter, sums| {
             let ctx = PassContext {
                 seed: job.seed,
                 pass,
                 filter,
+                shared_offset: splats.then_some(offset),
                 crop,
             };
             integrator.render_pass(scene, &ctx, sums)

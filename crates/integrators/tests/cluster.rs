@@ -178,7 +178,7 @@ fn tiles_equal_the_untiled_window() {
             first_pass: 0,
             window: Some(WINDOW),
         }
-        .region(&bare, (96, 96));
+        .region(&bare, &scene);
         assert_eq!(region, WINDOW, "the control's region is the bare window");
         let tile = part(&scene, &bare, 3, 0..2, Some(WINDOW));
         let (mut edge_rows, mut inner) = (0, 0);
@@ -198,6 +198,30 @@ fn tiles_equal_the_untiled_window() {
         assert!(
             edge_rows >= (WINDOW.width * halo / 4) as usize,
             "{name}: only {edge_rows} pixels near the tile's edges differ without a halo"
+        );
+    }
+}
+
+/// With a splatting film (Mitsuba's Gaussian filter) a pixel's value gathers the estimates of
+/// pixels within the filter's reach: the region grows by that reach, and the tile is still the
+/// film's window exactly.
+#[test]
+fn splatted_tiles_equal_the_untiled_window() {
+    let mut scene = cornell(96, 96);
+    scene.filter = restir_scene::FilterDesc::Gaussian { stddev: 0.5 };
+    for integrator in estimators(&scene) {
+        let name = integrator.name();
+        let halo = restir_integrators::part_halo(integrator.as_ref(), &scene);
+        assert_eq!(
+            halo,
+            integrator.halo() + 2,
+            "{name}: the Gaussian reaches 2 pixels"
+        );
+        let full = window_of(&whole(&scene, integrator.as_ref(), 3, 2));
+        let tile = part(&scene, integrator.as_ref(), 3, 0..2, Some(WINDOW));
+        assert!(
+            tile == full,
+            "{name}: the splatted tile differs from the untiled window"
         );
     }
 }

@@ -325,6 +325,7 @@ fn temporal_reuse_across_moving_frames_is_unbiased() {
 fn gbuffer(scene: &Scene, pass: u32) -> GBuffer {
     let filter = Filter::new(scene.filter);
     let ctx = PassContext {
+        shared_offset: None,
         seed: 7,
         pass,
         filter: &filter,
@@ -407,6 +408,7 @@ fn restir_pt_shift_across_frames_is_invertible() {
     assert!(!motion.scene_is_still());
     let filter = Filter::new(s1.filter);
     let ctx = |pass| PassContext {
+        shared_offset: None,
         seed: 3,
         pass,
         filter: &filter,

@@ -230,6 +230,7 @@ fn check_shifts(scene: &common::Built, pt: &RestirPtIntegrator) -> ShiftStats {
     let (mut identity, mut pairs, mut fwd_ok, mut visible, mut exact) = (0, 0, 0, 0, 0);
     for pass in 0..4 {
         let ctx = PassContext {
+            shared_offset: None,
             seed: 7,
             pass,
             filter: &filter,

@@ -11,7 +11,7 @@ use std::time::Duration;
 
 use restir_image::{ExrPart, Image};
 use restir_integrators::{
-    Integrator, PixelWindow, RenderJob, RenderOutput, RenderPart, render_part,
+    Integrator, PixelWindow, RenderJob, RenderOutput, RenderPart, part_halo, render_part,
 };
 use restir_scene::{Scene, SceneDesc};
 
@@ -179,7 +179,8 @@ pub struct PartStats {
     pub window: [u32; 4],
     /// The region rendered (window plus halo, aligned), `[x0, y0, x1, y1]`.
     pub region: [u32; 4],
-    /// The estimator's spatial-reuse halo in pixels.
+    /// The halo in pixels: the estimator's spatial reuse beyond the film's splatting reach
+    /// (`restir_integrators::part_halo`).
     pub halo: u32,
     /// Whether the estimator reuses temporally: its history then starts afresh at the part's
     /// first pass (each chain, each tile keeps its own), unlike one process rendering all passes.
@@ -209,14 +210,14 @@ impl Plan {
     }
 
     /// The statistics of this part rendered with `integrator`.
-    pub fn stats(&self, integrator: &dyn Integrator) -> PartStats {
+    pub fn stats(&self, integrator: &dyn Integrator, scene: &Scene) -> PartStats {
         PartStats {
             passes: [self.passes.start, self.passes.end],
             spp_total: self.spp,
             chain: self.chain.map(|(i, n)| [i, n]),
             window: corners(&self.window()),
-            region: corners(&self.part().region(integrator, self.film)),
-            halo: integrator.halo(),
+            region: corners(&self.part().region(integrator, scene)),
+            halo: part_halo(integrator, scene),
             temporal_restarts: integrator.describe().contains("temporal=true"),
             learning_restarts: integrator.learned().is_some(),
         }

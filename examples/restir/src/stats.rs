@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use restir_geometry::Shape;
+use restir_integrators::film::Reconstruction;
 use restir_integrators::{EstimatorReport, Integrator, RenderOutput};
 use restir_scene::Scene;
 
@@ -35,6 +36,8 @@ struct Stats<'a> {
     threads: usize,
     /// How light samples are drawn, as the scene build decided it.
     light_selection: String,
+    /// The pixel filter and how the film uses it (sampled or splatted), and why.
+    film: String,
     /// Wall seconds per stage of the estimator's passes, summed over the passes (empty for
     /// the path tracer).
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -127,13 +130,14 @@ impl Report<'_> {
             seed: self.seed,
             threads: self.threads,
             light_selection: scene.light_selection(),
+            film: Reconstruction::decide(scene.filter).describe(scene.filter),
             stage_seconds: integrator
                 .stage_seconds()
                 .into_iter()
                 .map(|(stage, seconds)| StageSeconds { stage, seconds })
                 .collect(),
             learned: integrator.learned(),
-            part: self.plan.map(|p| p.stats(integrator)),
+            part: self.plan.map(|p| p.stats(integrator, scene)),
         };
         let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
         restir_image::write_file_atomically(path, (json + "\n").as_bytes())
