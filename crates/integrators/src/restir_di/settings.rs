@@ -199,6 +199,9 @@ pub struct RestirDiSettings {
     /// is this fraction of a cell's side are learned as one too ([`restir_lights::EmitterGroups`];
     /// 0: each emitter alone; default 1, chosen on the training family).
     pub learn_group: f32,
+    /// When `learn` was `auto` and [`RestirDiSettings::resolve`] decided it: the emitter count
+    /// it decided from (`--stats` says why learning is on or off).
+    pub learn_decided_from: Option<usize>,
     /// BSDF samples per pixel, `N_B` (default 1), combined with the reservoirs' light strategy
     /// by the power heuristic with sample counts.
     pub bsdf_candidates: u32,
@@ -222,6 +225,7 @@ impl RestirDiSettings {
             learn_cells: 16.0,
             learn_prior: 64.0,
             learn_group: 1.0,
+            learn_decided_from: None,
             bsdf_candidates: 1,
             visibility: Visibility::Target,
         }
@@ -232,6 +236,7 @@ impl RestirDiSettings {
     /// table), and `auto` learning is on up to [`LEARN_MAX_EMITTERS`] emitters (else off).
     pub fn resolve(&mut self, features: &SceneFeatures) {
         if self.learn == Learn::Auto {
+            self.learn_decided_from = Some(features.emitter_count);
             self.learn = if features.emitter_count <= LEARN_MAX_EMITTERS {
                 Learn::On
             } else {
@@ -246,6 +251,15 @@ impl RestirDiSettings {
                     LightSampler::Power
                 };
         }
+    }
+
+    /// Why learning is on or off when `auto` decided it (`auto: N emitters ≤ 50000`), for the
+    /// settings line; `None` when it was asked for.
+    pub fn learn_reason(&self) -> Option<String> {
+        self.learn_decided_from.map(|n| {
+            let cmp = if n <= LEARN_MAX_EMITTERS { "≤" } else { ">" };
+            format!("auto: {n} emitters {cmp} {LEARN_MAX_EMITTERS}")
+        })
     }
 
     /// Whether the estimator is unbiased with these settings.
@@ -392,5 +406,16 @@ mod tests {
         assert_eq!(at(LEARN_MAX_EMITTERS + 1, Learn::On), Learn::On);
         assert_eq!(at(10, Learn::Off), Learn::Off);
         assert!(!Learn::Auto.is_on());
+        // The settings line says what auto decided from.
+        let mut s = settings();
+        s.resolve(&SceneFeatures {
+            emitter_count: 103_680,
+            ..SceneFeatures::default()
+        });
+        assert_eq!(s.learn_decided_from, Some(103_680));
+        assert_eq!(
+            s.learn_reason().as_deref(),
+            Some("auto: 103680 emitters > 50000")
+        );
     }
 }
