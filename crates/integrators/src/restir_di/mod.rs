@@ -243,7 +243,8 @@ impl Integrator for RestirDiIntegrator {
                 } else {
                     " learn=off".to_string()
                 }
-                + &s.learn_reason().map_or(String::new(), |r| format!(" ({r})")),
+                + &s.learn_reason()
+                    .map_or(String::new(), |r| format!(" ({r})")),
             s.bsdf_candidates,
             s.reuse.neighbors,
             s.reuse.radius,
