@@ -253,11 +253,11 @@ impl RestirDiSettings {
         }
     }
 
-    /// Why learning is on or off when `auto` decided it (`auto: N emitters ≤ 50000`), for the
-    /// settings line; `None` when it was asked for.
+    /// Why learning is on or off when `auto` decided it (`auto: N emitters <= 50000`), for the
+    /// settings line (ASCII: it is written into image attributes); `None` when it was asked for.
     pub fn learn_reason(&self) -> Option<String> {
         self.learn_decided_from.map(|n| {
-            let cmp = if n <= LEARN_MAX_EMITTERS { "≤" } else { ">" };
+            let cmp = if n <= LEARN_MAX_EMITTERS { "<=" } else { ">" };
             format!("auto: {n} emitters {cmp} {LEARN_MAX_EMITTERS}")
         })
     }
