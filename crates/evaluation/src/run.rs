@@ -6,6 +6,7 @@ use std::time::{Duration, Instant};
 
 use restir_image::Image;
 use restir_integrators::FrameSequence;
+use restir_integrators::film::Reconstruction;
 use restir_integrators::{Integrator, RenderJob, RenderOutput, render};
 use restir_scene::Scene;
 
@@ -209,7 +210,8 @@ fn render_entry(
 pub const BYTES_PER_PIXEL: u64 = 24 + 12 + 12 + 6 * 12;
 
 /// Refuses a scene whose renders would need more than `max_gib` GiB: [`BYTES_PER_PIXEL`], the
-/// largest buffers of the configurations that render it, and the images kept for the page.
+/// largest buffers of the configurations that render it with the splatting film's, and the
+/// images kept for the page.
 fn check_memory(
     name: &str,
     (w, h): (u32, u32),
@@ -270,10 +272,11 @@ pub fn run_suite(
             configs += 1;
         }
         let (w, h) = loaded.scene.camera.resolution();
+        let film = Reconstruction::decide(loaded.scene.filter).buffer_bytes_per_pixel() as u64;
         check_memory(
             &loaded.name,
             (w, h),
-            largest_buffers,
+            largest_buffers + film,
             configs * suite.budgets.len() as u64,
             opts.max_memory_gib,
         )

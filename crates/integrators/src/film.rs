@@ -163,6 +163,15 @@ impl Reconstruction {
         }
     }
 
+    /// Bytes per pixel the film keeps for this reconstruction beside its sums: when splatting,
+    /// a pass's estimates and their rows gathered (3 × f64 each).
+    pub fn buffer_bytes_per_pixel(&self) -> usize {
+        match self {
+            Self::Sampled => 0,
+            Self::Splatted { .. } => 2 * std::mem::size_of::<DVec3>(),
+        }
+    }
+
     /// One line for `--stats`: what was decided and why.
     pub fn describe(&self, filter: FilterDesc) -> String {
         let name = match filter {

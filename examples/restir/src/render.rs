@@ -7,6 +7,7 @@ use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 use restir_image::Image;
+use restir_integrators::film::Reconstruction;
 use restir_integrators::{Integrator, IntegratorOptions, RenderJob, RenderOutput, make_integrator};
 use restir_scene::{LoadOptions, LoadedScene, Scene, load_scene};
 
@@ -300,6 +301,7 @@ fn settle(
         width,
         height,
         integrator,
+        &Reconstruction::decide(scene.filter),
         moment,
         strict::max_memory(args.max_memory)?,
     )?;

@@ -1,6 +1,7 @@
 //! Checks of the command line made before anything is rendered: flags the chosen estimator
 //! does not use, the thread count, and the memory a film needs.
 
+use restir_integrators::film::Reconstruction;
 use restir_integrators::{
     Integrator, IntegratorOptions, MadeIntegrator, ParamSet, ParamSource, make_integrator,
 };
@@ -79,16 +80,19 @@ pub const MOMENT_BYTES_PER_PIXEL: u64 = 24 + 24;
 pub const DEFAULT_MAX_MEMORY_GIB: f64 = 8.0;
 
 /// Refuses, before anything is allocated, a film whose estimated memory (film, pass and output
-/// images, the estimator's per-pixel buffers) exceeds `max_gib` GiB.
+/// images, the splatting film's buffers, the estimator's per-pixel buffers) exceeds `max_gib`
+/// GiB.
 pub fn check_memory(
     width: u32,
     height: u32,
     integrator: &dyn Integrator,
+    reconstruction: &Reconstruction,
     moment: bool,
     max_gib: f64,
 ) -> Result<(), String> {
     let pixels = width as u64 * height as u64;
     let per_pixel = FILM_BYTES_PER_PIXEL
+        + reconstruction.buffer_bytes_per_pixel() as u64
         + integrator.buffer_bytes_per_pixel() as u64
         + if moment { MOMENT_BYTES_PER_PIXEL } else { 0 };
     let need = pixels.saturating_mul(per_pixel);
