@@ -34,7 +34,6 @@ use restir_sampling::{Distribution1D, warp};
 use restir_scene::FilterDesc;
 
 use crate::Image;
-use crate::pass::PixelWindow;
 
 /// Table resolution for filters without an analytic inverse.
 const TABLE_SIZE: usize = 1024;
@@ -65,13 +64,12 @@ impl Filter {
             FilterDesc::Box => Filter::Box,
             FilterDesc::Tent { radius } => Filter::Tent { radius },
             FilterDesc::Gaussian { stddev } => {
-                // Mitsuba: exp(−x²/2σ²) − exp(−8) clamped at zero, radius 4σ.
+                // Mitsuba's profile ([`profile`]) over its radius 4σ.
                 let radius = 4.0 * stddev;
-                let floor = (-8.0f32).exp();
                 let vals: Vec<f32> = (0..TABLE_SIZE)
                     .map(|i| {
                         let x = ((i as f32 + 0.5) / TABLE_SIZE as f32 * 2.0 - 1.0) * radius;
-                        ((-x * x / (2.0 * stddev * stddev)).exp() - floor).max(0.0)
+                        profile(desc, f64::from(x)) as f32
                     })
                     .collect();
                 let table = Distribution1D::new(&vals).expect("gaussian profile is positive");
@@ -226,8 +224,8 @@ fn pixel_integrals(filter: FilterDesc, k: i32) -> (f64, f64) {
     })
 }
 
-/// What a splatting film keeps: the filter, and per column and row of its region the inverse
-/// of the filter's expected weight over the film.
+/// What a splatting film keeps: the filter, and per column and row the inverse of the filter's
+/// expected weight over the film.
 #[derive(Clone, Debug)]
 struct Splat {
     filter: FilterDesc,
@@ -240,12 +238,12 @@ struct Splat {
 }
 
 impl Splat {
-    fn new(filter: FilterDesc, reach: u32, region: PixelWindow, film: (u32, u32)) -> Self {
+    fn new(filter: FilterDesc, reach: u32, (width, height): (u32, u32)) -> Self {
         let r = reach as i32;
         let expected: Vec<f64> = (-r..=r).map(|k| pixel_integrals(filter, k).0).collect();
         // Pixel `p` of the film sums the pixels `p + k` that are in the film.
-        let inv_norm = |first: u32, count: u32, size: u32| -> Vec<f64> {
-            (first..first + count)
+        let inv_norm = |size: u32| -> Vec<f64> {
+            (0..size)
                 .map(|p| {
                     let sum: f64 = (-r..=r)
                         .filter(|k| (0..size as i64).contains(&(i64::from(p) + i64::from(*k))))
@@ -255,20 +253,20 @@ impl Splat {
                 })
                 .collect()
         };
-        let n = region.pixels();
+        let n = width as usize * height as usize;
         Self {
             filter,
             reach: reach as usize,
-            inv_norm_x: inv_norm(region.x0, region.width, film.0),
-            inv_norm_y: inv_norm(region.y0, region.height, film.1),
+            inv_norm_x: inv_norm(width),
+            inv_norm_y: inv_norm(height),
             pass: vec![DVec3::ZERO; n],
             rows: vec![DVec3::ZERO; n],
         }
     }
 
     /// Adds the pass's pixel values, made from its estimates (in `self.pass`) whose rays went
-    /// through `offset` within their pixels, to `out`. Pixels nearer the region's edge than `reach` (and not
-    /// at the film's) miss estimates; a cropped render's halo keeps them out of its window.
+    /// through `offset` within their pixels, to `out`. Pixels nearer the film's edge than
+    /// `reach` sum the estimates it has and are normalised by their expected weight.
     fn gather(&mut self, offset: Vec2, out: &mut [DVec3]) {
         let Splat {
             filter,
@@ -359,30 +357,28 @@ pub struct Moments {
 }
 
 impl Film {
-    /// An empty film of `width × height` pixels with the filter `filter`.
+    /// An empty film of `width × height` pixels with the filter `filter`. A cropped render's
+    /// film is its region's: when splatting, its pixels within the filter's reach
+    /// ([`Reconstruction::reach`]) of a region edge inside the whole film miss estimates, and
+    /// the halo keeps them out of the window.
     pub fn new(width: u32, height: u32, filter: FilterDesc) -> Self {
-        Self::region(PixelWindow::full((width, height)), (width, height), filter)
-    }
-
-    /// An empty film for the pixels of `region` of a `film`-sized image: pixel values are
-    /// those of the whole film's render, except, when splatting, within the filter's reach
-    /// ([`Reconstruction::reach`]) of the region's edges inside the film.
-    pub fn region(region: PixelWindow, film: (u32, u32), filter: FilterDesc) -> Self {
         let reconstruction = Reconstruction::decide(filter);
         let splat = match reconstruction {
             Reconstruction::Sampled => None,
-            Reconstruction::Splatted { reach, .. } => Some(Splat::new(filter, reach, region, film)),
+            Reconstruction::Splatted { reach, .. } => {
+                Some(Splat::new(filter, reach, (width, height)))
+            }
         };
         Self {
-            width: region.width,
-            height: region.height,
+            width,
+            height,
             filter: match splat {
                 None => Filter::new(filter),
                 Some(_) => Filter::Box,
             },
             reconstruction,
             splat,
-            sums: vec![DVec3::ZERO; region.pixels()],
+            sums: vec![DVec3::ZERO; width as usize * height as usize],
             passes: 0,
             moment: None,
         }
@@ -480,6 +476,7 @@ impl Film {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::pass::PixelWindow;
 
     /// Sample offsets have mean zero and the variance of the filter profile.
     #[test]
@@ -695,7 +692,7 @@ mod tests {
         };
         let value = |x: u32, y: u32| DVec3::new(f64::from(x * 31 + y * 7 % 13), 1.0, f64::from(y));
         let mut whole = Film::new(film.0, film.1, filter);
-        let mut part = Film::region(region, film, filter);
+        let mut part = Film::new(region.width, region.height, filter);
         for u in [Vec2::new(0.1, 0.7), Vec2::new(0.9, 0.3)] {
             whole.add_pass(u, |_, sums| {
                 for (i, v) in sums.iter_mut().enumerate() {

@@ -213,7 +213,7 @@ pub fn render_part(
         region,
         film_width: film_size.0,
     });
-    let mut film = Film::region(region, film_size, scene.filter);
+    let mut film = Film::new(region.width, region.height, scene.filter);
     let splats = matches!(film.reconstruction(), Reconstruction::Splatted { .. });
     if job.moment.is_some() {
         film = film.with_second_moment();
