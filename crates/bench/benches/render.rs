@@ -111,6 +111,7 @@ fn main() {
                 name: Some(kind.into()),
                 max_depth: None,
                 params: params.into(),
+                sampler: None,
             };
             let integrator = make_integrator(&scene, &scene_integrator, &options)
                 .unwrap()

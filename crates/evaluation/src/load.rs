@@ -115,6 +115,7 @@ pub(crate) fn options_for(config: &IntegratorConfig, entry: &SuiteScene) -> Inte
         name: Some(config.integrator.clone()),
         max_depth: entry.max_depth,
         params: config.params.as_slice().into(),
+        sampler: None,
     }
 }
 

@@ -82,7 +82,7 @@ pub use restir_pt::{RestirPtIntegrator, RestirPtSettings};
 pub use sequence::FrameSequence;
 
 use params::ParamProblem;
-use restir_scene::{IntegratorDesc, Scene};
+use restir_scene::{IntegratorDesc, SamplerKind, Scene};
 
 /// The integrators this crate provides, by command-line name: three estimators, and `auto`,
 /// which chooses one of them from the scene ([`auto`]).
@@ -101,6 +101,10 @@ pub struct IntegratorOptions {
     pub max_depth: Option<i32>,
     /// Estimator parameters, applied after the scene's.
     pub params: ParamSet,
+    /// The path tracer's numbers; `None` takes the scene's. Only the path tracer (and `auto`
+    /// when it chooses the path tracer) draws from a sequence: asking ReSTIR DI or PT for one is
+    /// an error.
+    pub sampler: Option<SamplerKind>,
 }
 
 /// A built integrator and the scene parameters it did not recognise.
@@ -132,6 +136,13 @@ pub enum IntegratorError {
     },
     /// A parameter with a bad value.
     Param(ParamError),
+    /// A sampler asked of an estimator that draws independent numbers only.
+    Sampler {
+        /// The sampler asked for.
+        sampler: SamplerKind,
+        /// The estimator.
+        integrator: String,
+    },
 }
 
 impl std::fmt::Display for IntegratorError {
@@ -153,6 +164,16 @@ impl std::fmt::Display for IntegratorError {
                 INTEGRATORS.join(", ")
             ),
             IntegratorError::Param(e) => e.fmt(f),
+            IntegratorError::Sampler {
+                sampler,
+                integrator,
+            } => write!(
+                f,
+                "--sampler {}: {integrator} draws independent random numbers only; the {} \
+                 sampler is the path tracer's (--integrator path or auto)",
+                sampler.name(),
+                sampler.name()
+            ),
         }
     }
 }
@@ -181,6 +202,15 @@ pub fn make_integrator(
     }
     let scene_kind = canonical_name(&desc.kind);
     let name = options.name.as_deref().map_or(scene_kind, canonical_name);
+    if let Some(sampler) = options.sampler {
+        if sampler != SamplerKind::Independent && !matches!(name, "path" | "auto") {
+            return Err(IntegratorError::Sampler {
+                sampler,
+                integrator: name.to_string(),
+            });
+        }
+        settings.sampler = sampler;
+    }
     // The scene's parameters belong to the scene's estimator; their errors name the scene file.
     let mut params = if name == scene_kind {
         ParamSet::from_scene(&desc.params, &desc.location)
@@ -196,6 +226,13 @@ pub fn make_integrator(
             .into());
     }
     let mut notes = Vec::new();
+    if settings.sampler != SamplerKind::Independent && !matches!(name, "path" | "auto") {
+        notes.push(format!(
+            "{name} draws independent random numbers: the scene's {} sampler is the path \
+             tracer's",
+            settings.sampler.name()
+        ));
+    }
     let (integrator, unused_params): (Box<dyn Integrator>, _) = match name {
         "path" => (
             Box::new(PathIntegrator { settings }),

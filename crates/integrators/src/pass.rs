@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use glam::{DVec3, Vec2};
 use restir_reuse::{SeededStreams, Streams};
-use restir_sampling::Pcg32;
+use restir_sampling::{OwenSobol, Pcg32, Sampler, mix64};
 use restir_scene::Scene;
 
 use crate::Image;
@@ -16,6 +16,9 @@ use crate::motion::FrameMotion;
 
 /// The pass stream of the film's shared offset ([`PassContext::shared_offset_of`]).
 const STAGE_FILM: u64 = 0xF11E;
+
+/// Separates the pixel sequences' scrambles from the random streams of the same seed.
+const SEQUENCE_SALT: u64 = 0x50B0_1000_5EED;
 
 /// What an integrator needs to know about the current pass.
 #[derive(Debug)]
@@ -175,6 +178,15 @@ impl PassContext<'_> {
         self.stage_rng(index, 0)
     }
 
+    /// Pixel `index`'s sample of this pass from its own Owen-scrambled Sobol sequence (the
+    /// pass is the sample's index): the alternative to [`PassContext::pixel_rng`] when a scene
+    /// asks for stratified samples. The scrambles depend on the seed and the film pixel only.
+    #[inline]
+    pub fn pixel_sequence(&self, index: usize) -> OwenSobol {
+        let seed = mix64(mix64(self.seed ^ SEQUENCE_SALT) ^ self.film_index(index));
+        OwenSobol::new(seed, self.pass)
+    }
+
     /// A second, independent stream of pixel `index` in this pass, for estimator stage `stage`
     /// (stage 0 is [`PassContext::pixel_rng`]'s stream).
     #[inline]
@@ -212,7 +224,7 @@ impl PassContext<'_> {
     /// jittered by the filter, or at the pass's shared offset. Draws two numbers from `rng`
     /// either way.
     #[inline]
-    pub fn film_position(&self, x: u32, y: u32, rng: &mut Pcg32) -> Vec2 {
+    pub fn film_position<S: Sampler>(&self, x: u32, y: u32, rng: &mut S) -> Vec2 {
         let (x, y) = match &self.crop {
             None => (x, y),
             Some(c) => (x + c.region.x0, y + c.region.y0),

@@ -7,9 +7,9 @@
 
 use glam::{DVec3, Vec2, Vec3};
 use restir_geometry::{Ray, offset_ray_origin};
-use restir_sampling::Pcg32;
+use restir_sampling::Sampler;
 use restir_sampling::warp::{power_heuristic, power_share};
-use restir_scene::{IntegratorDesc, Scene};
+use restir_scene::{IntegratorDesc, SamplerKind, Scene};
 
 use crate::bands::Bands;
 use crate::pass::{Integrator, PassContext};
@@ -24,6 +24,8 @@ pub struct PathSettings {
     pub rr_depth: u32,
     /// Hide directly visible emitters.
     pub hide_emitters: bool,
+    /// Where the path tracer's numbers come from (ReSTIR DI and PT draw independent ones).
+    pub sampler: SamplerKind,
 }
 
 impl PathSettings {
@@ -33,6 +35,7 @@ impl PathSettings {
             max_depth: desc.max_depth,
             rr_depth: desc.rr_depth.max(1),
             hide_emitters: desc.hide_emitters,
+            sampler: desc.sampler,
         }
     }
 
@@ -117,14 +120,14 @@ pub fn bsdf_sample_share(
 /// Radiance arriving along `ray` (a camera ray, or a continuation from `prev`), estimated with one
 /// path. `depth` is the number of segments already traced before `ray`. Returns the estimate and
 /// the number of rays traced.
-pub fn trace_path(
+pub fn trace_path<S: Sampler>(
     scene: &Scene,
     settings: &PathSettings,
     mut ray: Ray,
     mut depth: u32,
     mut beta: Vec3,
     mut prev: Option<PrevVertex>,
-    rng: &mut Pcg32,
+    rng: &mut S,
 ) -> (Vec3, u64) {
     let mut radiance = Vec3::ZERO;
     let mut rays = 0u64;
@@ -179,11 +182,11 @@ pub fn trace_path(
         }
 
         // The fixed per-bounce budget of random numbers.
-        let u_select = rng.next_f32();
+        let u_select = rng.next_1d();
         let u_light = rng.next_2d();
-        let u_lobe = rng.next_f32();
+        let u_lobe = rng.next_1d();
         let u_bsdf = rng.next_2d();
-        let u_rr = rng.next_f32();
+        let u_rr = rng.next_1d();
 
         let bsdf = scene.bsdf(&si);
         let wo = si.shading.to_local(-ray.d);
@@ -240,11 +243,11 @@ pub fn trace_path(
 
 /// One path-traced estimate for the camera ray through `film` (pixel coordinates).
 #[inline]
-pub fn trace_camera_path(
+pub fn trace_camera_path<S: Sampler>(
     scene: &Scene,
     settings: &PathSettings,
     film: Vec2,
-    rng: &mut Pcg32,
+    rng: &mut S,
 ) -> (Vec3, u64) {
     let u_lens = rng.next_2d();
     let ray = scene.camera.generate_ray(film, u_lens);
@@ -265,8 +268,10 @@ impl Integrator for PathIntegrator {
 
     fn describe(&self) -> String {
         format!(
-            "path max_depth={} rr_depth={}",
-            self.settings.max_depth, self.settings.rr_depth
+            "path max_depth={} rr_depth={} sampler={}",
+            self.settings.max_depth,
+            self.settings.rr_depth,
+            self.settings.sampler.name()
         )
     }
 
@@ -279,9 +284,18 @@ impl Integrator for PathIntegrator {
             for (i, px) in chunk.iter_mut().enumerate() {
                 let index = first + i;
                 let (x, y) = ((index % w) as u32, (index / w) as u32);
-                let mut rng = ctx.pixel_rng(index);
-                let film = ctx.film_position(x, y, &mut rng);
-                let (l, r) = trace_camera_path(scene, &self.settings, film, &mut rng);
+                let (l, r) = match self.settings.sampler {
+                    SamplerKind::Independent => {
+                        let mut rng = ctx.pixel_rng(index);
+                        let film = ctx.film_position(x, y, &mut rng);
+                        trace_camera_path(scene, &self.settings, film, &mut rng)
+                    }
+                    SamplerKind::Sobol => {
+                        let mut rng = ctx.pixel_sequence(index);
+                        let film = ctx.film_position(x, y, &mut rng);
+                        trace_camera_path(scene, &self.settings, film, &mut rng)
+                    }
+                };
                 *px += l.as_dvec3();
                 rays += r;
             }

@@ -30,12 +30,31 @@ const REUSE: &[(&str, &str)] = &[("radius", "4"), ("spatial_rounds", "2")];
 /// (docs/CLUSTER.md), so with learning a split render is another estimator, not the same bits.
 const DI: &[(&str, &str)] = &[("radius", "4"), ("spatial_rounds", "2"), ("learn", "off")];
 
+/// The path tracer (with independent numbers and with Sobol sequences), ReSTIR DI and PT.
 fn estimators(scene: &common::Built) -> Vec<Box<dyn Integrator>> {
+    let sobol = make_with_sampler(scene, restir_scene::SamplerKind::Sobol);
     vec![
         integrator(scene, "path", &[]),
+        sobol,
         integrator(scene, "restir-di", DI),
         integrator(scene, "restir-pt", REUSE),
     ]
+}
+
+/// The path tracer of `scene` drawing from `sampler`.
+fn make_with_sampler(
+    scene: &common::Built,
+    sampler: restir_scene::SamplerKind,
+) -> Box<dyn Integrator> {
+    let options = restir_integrators::IntegratorOptions {
+        name: Some("path".into()),
+        max_depth: Some(3),
+        sampler: Some(sampler),
+        ..Default::default()
+    };
+    restir_integrators::make_integrator(scene, &scene.integrator, &options)
+        .unwrap()
+        .integrator
 }
 
 fn part(

@@ -287,6 +287,7 @@ fn mitsuba_render_suite() {
                     name: Some(est.into()),
                     max_depth: None,
                     params: Default::default(),
+                    sampler: None,
                 };
                 match make_integrator(scene, &loaded.desc.integrator, &opts) {
                     Err(e) => Outcome::Refused(e.to_string()),

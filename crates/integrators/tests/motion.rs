@@ -145,6 +145,7 @@ fn options(name: &str, max_depth: Option<i32>, params: &[(&str, &str)]) -> Integ
             .iter()
             .map(|(k, v)| Param::new(*k, *v, ParamSource::Caller))
             .collect(),
+        sampler: None,
     }
 }
 
@@ -403,6 +404,7 @@ fn restir_pt_shift_across_frames_is_invertible() {
         max_depth: 4,
         rr_depth: 5,
         hide_emitters: false,
+        sampler: restir_scene::SamplerKind::Independent,
     }));
     let motion = FrameMotion::new(s0.clone(), &s1, desc.animation.as_ref().unwrap(), T0, T1);
     assert!(!motion.scene_is_still());

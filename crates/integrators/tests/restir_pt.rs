@@ -160,6 +160,7 @@ fn integrator(max_depth: i32) -> RestirPtIntegrator {
         max_depth,
         rr_depth: 3,
         hide_emitters: false,
+        sampler: restir_scene::SamplerKind::Independent,
     }))
 }
 

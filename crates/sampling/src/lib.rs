@@ -28,12 +28,46 @@
 
 mod distribution;
 pub mod hash;
+pub mod owen;
 mod rng;
 pub mod sequences;
 pub mod warp;
 
 pub use distribution::{AliasTable, Distribution1D, Distribution2D};
+pub use owen::OwenSobol;
 pub use rng::{Pcg32, mix64};
+
+/// A pixel sample's source of uniform numbers in `[0, 1)`: a random generator ([`Pcg32`]) or a
+/// randomised low-discrepancy sequence ([`OwenSobol`]). Estimators draw from it in a fixed order
+/// (the same count per path vertex), so that a sequence's dimensions line up across samples.
+pub trait Sampler {
+    /// One number.
+    fn next_1d(&mut self) -> f32;
+    /// Two numbers (one point of a 2-D dimension, for a sequence).
+    fn next_2d(&mut self) -> glam::Vec2;
+}
+
+impl Sampler for Pcg32 {
+    #[inline]
+    fn next_1d(&mut self) -> f32 {
+        self.next_f32()
+    }
+    #[inline]
+    fn next_2d(&mut self) -> glam::Vec2 {
+        Pcg32::next_2d(self)
+    }
+}
+
+impl Sampler for OwenSobol {
+    #[inline]
+    fn next_1d(&mut self) -> f32 {
+        self.next_f32()
+    }
+    #[inline]
+    fn next_2d(&mut self) -> glam::Vec2 {
+        OwenSobol::next_2d(self)
+    }
+}
 
 /// The largest `f32` strictly below one: random numbers are clamped to it so that `u < 1` holds.
 pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;

@@ -129,3 +129,47 @@ fn names_beside_the_scene_stay_relative_and_newer_paths_win() {
     assert_eq!(names[1], "meshes/own.obj");
     let _ = std::fs::remove_dir_all(&root);
 }
+
+/// A sensor's `<sampler>` decides where the path tracer's numbers come from: `independent` (and
+/// no sampler, Mitsuba's default) is independent, the stratified and low-discrepancy samplers are
+/// Owen-scrambled Sobol, whether the `<integrator>` comes before or after the sensor; the XML
+/// writer says it back.
+#[test]
+fn samplers_choose_the_path_tracers_numbers() {
+    use restir_scene::SamplerKind;
+    use restir_scene::xml::{XmlWriteOptions, to_mitsuba_xml};
+    let root = tree("samplers");
+    let cases = [
+        (Some("independent"), SamplerKind::Independent),
+        (None, SamplerKind::Independent),
+        (Some("ldsampler"), SamplerKind::Sobol),
+        (Some("stratified"), SamplerKind::Sobol),
+        (Some("multijitter"), SamplerKind::Sobol),
+        (Some("orthogonal"), SamplerKind::Sobol),
+    ];
+    for (sampler, kind) in cases {
+        for integrator_first in [false, true] {
+            let sampler_xml = sampler.map_or(String::new(), |s| {
+                format!(r#"<sampler type="{s}"><integer name="sample_count" value="4"/></sampler>"#)
+            });
+            let integrator =
+                r#"<integrator type="path"><integer name="max_depth" value="3"/></integrator>"#;
+            let sensor = format!(r#"<sensor type="perspective">{sampler_xml}</sensor>"#);
+            let body = if integrator_first {
+                format!("{integrator}{sensor}")
+            } else {
+                format!("{sensor}{integrator}")
+            };
+            let scene = root.join("s.xml");
+            write(&scene, &format!(r#"<scene version="3.0.0">{body}</scene>"#));
+            let (desc, warnings) = load_desc(&scene, &[]).unwrap();
+            assert!(warnings.is_empty(), "{sampler:?}: {warnings:?}");
+            assert_eq!(desc.integrator.sampler, kind, "{sampler:?}");
+            assert_eq!(desc.integrator.max_depth, 3);
+            let written = to_mitsuba_xml(&desc, &XmlWriteOptions::default()).unwrap();
+            write(&scene, &written);
+            let (back, _) = load_desc(&scene, &[]).unwrap();
+            assert_eq!(back.integrator.sampler, kind, "written back: {sampler:?}");
+        }
+    }
+}

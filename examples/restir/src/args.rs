@@ -28,6 +28,11 @@ pub(crate) struct RenderArgs {
     /// Longest path in segments from the camera (1 = emitters only, 2 = direct light, -1 = no limit).
     #[arg(long, allow_negative_numbers = true)]
     pub(crate) max_depth: Option<i32>,
+    /// Where the path tracer's numbers come from: `independent` (PCG32) or `sobol`
+    /// (Owen-scrambled Sobol points, stratified over each pixel's passes); overrides the
+    /// scene's sampler. ReSTIR DI and PT draw independent numbers.
+    #[arg(long, value_parser = ["independent", "sobol"])]
+    pub(crate) sampler: Option<String>,
     /// Random seed.
     #[arg(long, default_value_t = 0)]
     pub(crate) seed: u64,

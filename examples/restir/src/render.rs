@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use restir_image::Image;
 use restir_integrators::film::Reconstruction;
 use restir_integrators::{Integrator, IntegratorOptions, RenderJob, RenderOutput, make_integrator};
-use restir_scene::{LoadOptions, LoadedScene, Scene, load_scene};
+use restir_scene::{LoadOptions, LoadedScene, SamplerKind, Scene, load_scene};
 
 use crate::args::{RenderArgs, parse_defines};
 use crate::frames::{self, FramePlan};
@@ -206,6 +206,10 @@ fn make(
         name: args.integrator.clone(),
         max_depth: args.max_depth,
         params: args.restir.params(),
+        sampler: args.sampler.as_deref().map(|s| match s {
+            "sobol" => SamplerKind::Sobol,
+            _ => SamplerKind::Independent,
+        }),
     };
     let (scene, integrator) = (&loaded.scene, &loaded.desc.integrator);
     let made = make_integrator(scene, integrator, &options).map_err(|e| e.to_string())?;

@@ -35,6 +35,7 @@ pub fn check_flags_used(
                 name: Some(name.to_string()),
                 max_depth: None,
                 params,
+                sampler: None,
             };
             match make_integrator(scene, integrator, &options) {
                 Ok(m) => m.unused_params.is_empty(),

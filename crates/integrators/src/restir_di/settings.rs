@@ -344,6 +344,7 @@ mod tests {
             max_depth: 2,
             rr_depth: 5,
             hide_emitters: false,
+            sampler: restir_scene::SamplerKind::Independent,
         })
     }
 

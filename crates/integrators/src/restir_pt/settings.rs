@@ -205,6 +205,7 @@ mod tests {
             max_depth: 4,
             rr_depth: 5,
             hide_emitters: false,
+            sampler: restir_scene::SamplerKind::Independent,
         });
         let p = |a: &str, b: &str| ParamSet::from(&[(a, b)][..]);
         let unknown = s

@@ -96,6 +96,7 @@ pub fn make(scene: &Built, name: &str, params: &[(&str, &str)]) -> Box<dyn Integ
             .iter()
             .map(|(k, v)| Param::new(*k, *v, ParamSource::Caller))
             .collect(),
+        sampler: None,
     };
     let made = make_integrator(scene, &scene.integrator, &options).unwrap();
     assert!(made.unused_params.is_empty());

@@ -216,6 +216,9 @@ pub struct IntegratorDesc {
     /// Estimator-specific parameters as `name = value` strings (e.g. ReSTIR settings).
     #[serde(default)]
     pub params: Vec<(String, String)>,
+    /// Where the path tracer's uniform numbers come from (a Mitsuba scene's `<sampler>`).
+    #[serde(default, skip_serializing_if = "SamplerKind::is_independent")]
+    pub sampler: SamplerKind,
     /// Mitsuba's `moment` integrator around this one: the name under which an EXR output
     /// also holds each pixel's mean and second moment over the passes (CIE XYZ channels
     /// `NAME.X`… and `m2_NAME.X`…, as Mitsuba 3 writes them). `None`: the image only.
@@ -234,9 +237,37 @@ impl Default for IntegratorDesc {
             rr_depth: defaults::RR_DEPTH,
             hide_emitters: false,
             params: Vec::new(),
+            sampler: SamplerKind::Independent,
             moment: None,
             location: Location::default(),
         }
+    }
+}
+
+/// Where an estimator's uniform numbers come from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum SamplerKind {
+    /// Independent pseudo-random numbers (PCG32), Mitsuba's `independent`: the default.
+    #[default]
+    Independent,
+    /// Owen-scrambled Sobol points, padded per dimension (Burley 2020): stratified across the
+    /// passes of each pixel, unbiased like independent numbers. Mitsuba's `ldsampler`,
+    /// `stratified`, `multijitter` and `orthogonal` are rendered with it.
+    Sobol,
+}
+
+impl SamplerKind {
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            SamplerKind::Independent => "independent",
+            SamplerKind::Sobol => "sobol",
+        }
+    }
+
+    /// Whether this is the default, [`SamplerKind::Independent`].
+    pub fn is_independent(&self) -> bool {
+        *self == SamplerKind::Independent
     }
 }
 

@@ -92,6 +92,8 @@ impl<'a> Importer<'a> {
         }
         props.finish();
         integ.location = self.loc(node);
+        // The sensor's sampler, if it came first, stays.
+        integ.sampler = desc.integrator.sampler;
         desc.integrator = integ;
         Ok(())
     }

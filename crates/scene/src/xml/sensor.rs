@@ -43,7 +43,8 @@ impl<'a> Importer<'a> {
                 "film" => self.film(c, &mut desc.film)?,
                 "sampler" => {
                     let sty = self.plugin_type(c)?;
-                    // Mitsuba's samplers (0.6 and 3): all stand for this renderer's own.
+                    // Mitsuba's samplers (0.6 and 3): `independent` is honoured, the
+                    // stratified and low-discrepancy ones are rendered with Owen-scrambled Sobol.
                     const SAMPLERS: &[&str] = &[
                         "independent",
                         "stratified",
@@ -64,12 +65,11 @@ impl<'a> Importer<'a> {
                         }
                         desc.spp = n as u32;
                     }
-                    if sty != "independent" {
-                        self.warn(
-                            c,
-                            format!("sampler '{sty}' is replaced by this renderer's own sampler"),
-                        );
-                    }
+                    desc.integrator.sampler = if sty == "independent" {
+                        crate::SamplerKind::Independent
+                    } else {
+                        crate::SamplerKind::Sobol
+                    };
                     sp.finish();
                 }
                 t if PROPERTY_TAGS.contains(&t) => {}

@@ -381,7 +381,10 @@ impl Writer<'_> {
 
     /// A `<sensor>`'s sampler and film.
     fn sensor_rest(&mut self, desc: &SceneDesc) -> Result<()> {
-        self.open(r#"<sampler type="independent">"#);
+        self.open(match desc.integrator.sampler {
+            SamplerKind::Independent => r#"<sampler type="independent">"#,
+            SamplerKind::Sobol => r#"<sampler type="ldsampler">"#,
+        });
         self.line(r#"<integer name="sample_count" value="$spp"/>"#);
         self.close("</sampler>");
         self.open(r#"<film type="hdrfilm">"#);
