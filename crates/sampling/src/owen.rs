@@ -52,9 +52,15 @@ const fn pascal_directions() -> [u32; 32] {
     v
 }
 
-/// The matrix-vector product over GF(2), one byte of the index at a time: `BYTES[b][x]` is the
-/// xor of the columns that byte `b` of the index selects when it is `x`.
-const BYTES: [[u32; 256]; 4] = {
+/// The matrix-vector product over GF(2), one byte at a time: `BYTES[b][x]` is the xor of the
+/// columns that byte `b` of the index selects when it is `x`.
+const BYTES: [[u32; 256]; 4] = byte_tables(false);
+
+/// The same product in bit-reversed form, `reverse(sobol(reverse(r)))` for an argument `r`:
+/// the scrambles work on reversed bits, so the sampler never reverses in between.
+const REVERSED_BYTES: [[u32; 256]; 4] = byte_tables(true);
+
+const fn byte_tables(reversed: bool) -> [[u32; 256]; 4] {
     let v = pascal_directions();
     let mut t = [[0u32; 256]; 4];
     let mut b = 0;
@@ -65,7 +71,12 @@ const BYTES: [[u32; 256]; 4] = {
             let mut bit = 0;
             while bit < 8 {
                 if x & (1 << bit) != 0 {
-                    r ^= v[8 * b + bit];
+                    let j = 8 * b + bit;
+                    r ^= if reversed {
+                        v[31 - j].reverse_bits()
+                    } else {
+                        v[j]
+                    };
                 }
                 bit += 1;
             }
@@ -75,13 +86,21 @@ const BYTES: [[u32; 256]; 4] = {
         b += 1;
     }
     t
-};
+}
+
+#[inline]
+fn product(tables: &[[u32; 256]; 4], x: u32) -> u32 {
+    let [b0, b1, b2, b3] = x.to_le_bytes();
+    tables[0][b0 as usize]
+        ^ tables[1][b1 as usize]
+        ^ tables[2][b2 as usize]
+        ^ tables[3][b3 as usize]
+}
 
 /// The second Sobol dimension of point `index` as 32-bit fixed point.
 #[inline]
 pub fn sobol_dimension_1(index: u32) -> u32 {
-    let [b0, b1, b2, b3] = index.to_le_bytes();
-    BYTES[0][b0 as usize] ^ BYTES[1][b1 as usize] ^ BYTES[2][b2 as usize] ^ BYTES[3][b3 as usize]
+    product(&BYTES, index)
 }
 
 /// A fixed-point number as an `f32` in `[0, 1)` (its top 24 bits).
@@ -96,7 +115,8 @@ fn to_unit(x: u32) -> f32 {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct OwenSobol {
     seed: u64,
-    index: u32,
+    /// The sample index, bit-reversed (every dimension starts from it).
+    reversed_index: u32,
     dimension: u32,
 }
 
@@ -106,7 +126,7 @@ impl OwenSobol {
     pub fn new(seed: u64, index: u32) -> Self {
         Self {
             seed,
-            index,
+            reversed_index: index.reverse_bits(),
             dimension: 0,
         }
     }
@@ -126,22 +146,28 @@ impl OwenSobol {
     }
 
     /// One uniform number in `[0, 1)`: a scrambled van der Corput point.
+    ///
+    /// The point of shuffled index `i` is `reverse(i)`, and its Owen scramble is
+    /// `reverse(LK(reverse(reverse(i))))`: with the shuffle `i = reverse(LK(reverse(index)))`,
+    /// the value is `reverse(LK(reverse(LK(reverse(index)))))`, three bit reversals.
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
         let h = self.next_seeds();
-        let i = nested_uniform_scramble(self.index, h as u32);
-        to_unit(nested_uniform_scramble(i.reverse_bits(), (h >> 32) as u32))
+        let i = laine_karras(self.reversed_index, h as u32).reverse_bits();
+        to_unit(laine_karras(i, (h >> 32) as u32).reverse_bits())
     }
 
-    /// Two uniform numbers in `[0, 1)²`: a scrambled `(0, 2)`-sequence point.
+    /// Two uniform numbers in `[0, 1)²`: a scrambled `(0, 2)`-sequence point (the same
+    /// shuffle; the second coordinate's scramble takes the reversed Sobol value straight from
+    /// [`REVERSED_BYTES`]).
     #[inline]
     pub fn next_2d(&mut self) -> glam::Vec2 {
         let h = self.next_seeds();
-        let i = nested_uniform_scramble(self.index, h as u32);
+        let r = laine_karras(self.reversed_index, h as u32);
         let h2 = (h.wrapping_mul(0xd1b5_4a32_d192_ed03) >> 32) as u32;
         glam::Vec2::new(
-            to_unit(nested_uniform_scramble(i.reverse_bits(), (h >> 32) as u32)),
-            to_unit(nested_uniform_scramble(sobol_dimension_1(i), h2)),
+            to_unit(laine_karras(r.reverse_bits(), (h >> 32) as u32).reverse_bits()),
+            to_unit(laine_karras(product(&REVERSED_BYTES, r), h2).reverse_bits()),
         )
     }
 }
@@ -159,6 +185,10 @@ mod tests {
                 .filter(|j| index >> j & 1 == 1)
                 .fold(0, |r, j| r ^ v[j]);
             assert_eq!(sobol_dimension_1(index), direct, "{index:#x}");
+        }
+        for r in [0u32, 1, 0x8000_0000, 0x1234_5678, u32::MAX] {
+            let direct = sobol_dimension_1(r.reverse_bits()).reverse_bits();
+            assert_eq!(product(&REVERSED_BYTES, r), direct, "{r:#x}");
         }
         // The first points: 1/2, 3/4 and 1/4 at indices 1, 2, 3.
         assert_eq!(sobol_dimension_1(1), 1 << 31);
