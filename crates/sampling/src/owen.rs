@@ -159,7 +159,7 @@ impl OwenSobol {
 
     /// Two uniform numbers in `[0, 1)²`: a scrambled `(0, 2)`-sequence point (the same
     /// shuffle; the second coordinate's scramble takes the reversed Sobol value straight from
-    /// [`REVERSED_BYTES`]).
+    /// a table of the reversed product).
     #[inline]
     pub fn next_2d(&mut self) -> glam::Vec2 {
         let h = self.next_seeds();
