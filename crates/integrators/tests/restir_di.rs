@@ -10,7 +10,7 @@
 
 use std::sync::atomic::AtomicBool;
 
-use restir_integrators::restir_di::{Learn, LightSampler};
+use restir_integrators::restir_di::{BsdfDiffuse, Learn, LightSampler};
 use restir_integrators::reuse::MIS_NAMES;
 use restir_integrators::{
     IntegratorOptions, RenderJob, RestirDiIntegrator, RestirDiSettings, make_integrator, render,
@@ -24,6 +24,14 @@ const SIZE: u32 = 32;
 const BLOCK: u32 = 8;
 
 fn scene() -> common::Built {
+    scene_with(
+        "Diffuse(reflectance: (0.9, 0.9, 0.9))",
+        "Diffuse(reflectance: (0.3, 0.6, 0.3))",
+    )
+}
+
+/// The test scene with the wall's and the cube's materials given (RON).
+fn scene_with(wall: &str, cube: &str) -> common::Built {
     let ron = format!(
         r#"(
         camera: (fov: 50, to_world: [LookAt(origin: (0, 5, 0.01), target: (0, 0, 0), up: (0, 0, -1))]),
@@ -35,9 +43,9 @@ fn scene() -> common::Built {
             (geometry: Rectangle, to_world: [Scale((0.25, 3, 1)), Rotate(axis: (1, 0, 0), angle: -90),
              Translate((-0.9, 0.002, 0))], material: Some(Inline(Black))),
             (geometry: Rectangle, to_world: [Scale((3, 1.5, 1)), Rotate(axis: (0, 1, 0), angle: -90),
-             Translate((1.8, 1.5, 0))], material: Some(Inline(Diffuse(reflectance: (0.9, 0.9, 0.9))))),
+             Translate((1.8, 1.5, 0))], material: Some(Inline({wall}))),
             (geometry: Cube, to_world: [Scale((0.35, 0.35, 0.35)), Translate((0.4, 0.7, 0.2))],
-             material: Some(Inline(Diffuse(reflectance: (0.3, 0.6, 0.3))))),
+             material: Some(Inline({cube}))),
             (geometry: Rectangle, to_world: [Scale((0.8, 0.8, 1)), Rotate(axis: (1, 0, 0), angle: 90),
              Translate((-1.2, 2.5, 0))], emission: Some((1.5, 1.5, 1.5))),
             (geometry: Sphere(center: (1.3, 1.4, -0.6), radius: 0.08), emission: Some((300, 220, 150))),
@@ -207,6 +215,38 @@ fn unbiased_for_every_unbiased_mis_scheme() {
     );
     eprintln!("temporal: max |z| = {z:.2}");
     assert!(z < Z_MAX, "temporal: max |z| = {z:.2}");
+}
+
+/// Receivers without a glossy lobe may leave their whole direct light to light sampling while
+/// glossy ones keep their BSDF samples (`bsdf_diffuse = off`, the default without an
+/// environment): every receiver's target and shading agree on its own strategy counts, also
+/// where reuse mixes diffuse and glossy neighbours. The negative control skips the diffuse
+/// receivers' BSDF samples but keeps their light strategy's share, losing the rest.
+#[test]
+fn bsdf_samples_only_at_glossy_receivers_stay_unbiased() {
+    let scene = scene_with(
+        "RoughPlastic(diffuse_reflectance: (0.5, 0.5, 0.5), roughness: (distribution: ggx, alpha: 0.15))",
+        "RoughConductor(roughness: (distribution: ggx, alpha: 0.2))",
+    );
+    let reference = direct_reference(&scene);
+    for value in ["off", "on"] {
+        let z = max_z(
+            &statistics(&scene, "restir-di", &[("bsdf_diffuse", value)], 1, 200),
+            &reference,
+        );
+        eprintln!("bsdf_diffuse {value}: max |z| = {z:.2}");
+        assert!(z < Z_MAX, "bsdf_diffuse {value}: max |z| = {z:.2}");
+    }
+    let mut wrong = RestirDiSettings::new(restir_integrators::path::PathSettings::from_desc(
+        &scene.integrator,
+    ));
+    wrong.bsdf_diffuse = BsdfDiffuse::OffKeepingShare;
+    let z = max_z(&settings_statistics(&scene, wrong, 200), &reference);
+    eprintln!("diffuse receivers without their BSDF samples' share: max |z| = {z:.2}");
+    assert!(
+        z > 2.0 * Z_MAX,
+        "a lost BSDF share should be caught: max |z| = {z:.2}"
+    );
 }
 
 /// The candidates come from the power sampler's pool of presampled lights (the default): the

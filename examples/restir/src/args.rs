@@ -111,6 +111,11 @@ pub(crate) struct RestirArgs {
     /// BSDF samples per pixel, MIS-combined with the reservoirs [default: 1].
     #[arg(long)]
     bsdf_candidates: Option<u32>,
+    /// restir-di: whether receivers without a glossy lobe take the BSDF samples too (off: light
+    /// sampling takes their whole direct light); auto is on when the scene has an environment
+    /// [default: auto].
+    #[arg(long)]
+    bsdf_diffuse: Option<String>,
     /// Spatial neighbours per round [default: 4].
     #[arg(long, alias = "neighbours")]
     neighbors: Option<u32>,
@@ -198,6 +203,10 @@ impl RestirArgs {
         put(
             "bsdf_candidates",
             self.bsdf_candidates.map(ParamValue::Count),
+        );
+        put(
+            "bsdf_diffuse",
+            self.bsdf_diffuse.clone().map(ParamValue::Text),
         );
         put("neighbors", self.neighbors.map(ParamValue::Count));
         put("radius", self.radius.map(ParamValue::Number));

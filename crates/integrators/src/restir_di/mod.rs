@@ -45,7 +45,8 @@ use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
 pub use settings::{
-    HIERARCHY_MIN_EMITTERS, LEARN_MAX_EMITTERS, Learn, LightSampler, RestirDiSettings, Visibility,
+    BsdfDiffuse, HIERARCHY_MIN_EMITTERS, LEARN_MAX_EMITTERS, Learn, LightSampler, RestirDiSettings,
+    Visibility,
 };
 
 use crate::bands::Bands;
@@ -104,6 +105,11 @@ impl RestirDiIntegrator {
             counts: StrategyCounts {
                 light: settings.candidates as f32,
                 bsdf: settings.bsdf_candidates as f32,
+                bsdf_on_diffuse: matches!(
+                    settings.bsdf_diffuse,
+                    BsdfDiffuse::Auto | BsdfDiffuse::On
+                ),
+                keep_share: settings.bsdf_diffuse == BsdfDiffuse::OffKeepingShare,
             },
             settings,
             reuse: ScreenReuse::default(),
@@ -165,7 +171,9 @@ impl RestirDiIntegrator {
         let settings = &self.settings.path;
         let max_depth = settings.max_segments();
         let continues = max_depth > 2 || scene.features.has_delta_lobes;
-        let samples = self.settings.bsdf_candidates.max(u32::from(continues));
+        let n_b = self.counts.samples_at(bsdf).bsdf as u32;
+        let counts = self.counts.at(bsdf);
+        let samples = n_b.max(u32::from(continues));
         // BSDF samples after the first only look for emitters at their first hit.
         let direct_only = PathSettings {
             max_depth: 2,
@@ -180,10 +188,10 @@ impl RestirDiIntegrator {
             };
             let delta = bs.lobe.is_delta();
             let cont = b == 0 && continues;
-            if !cont && self.settings.bsdf_candidates == 0 {
+            if !cont && n_b == 0 {
                 continue;
             }
-            if cont && !delta && max_depth <= 2 && self.settings.bsdf_candidates == 0 {
+            if cont && !delta && max_depth <= 2 && n_b == 0 {
                 continue; // nothing this ray could add
             }
             let mut beta = bs.f / bs.pdf_sa;
@@ -194,8 +202,8 @@ impl RestirDiIntegrator {
                 pdf_sa: bs.pdf_sa,
                 delta,
                 mis: EmissionMis::Counted {
-                    light_samples: self.counts.light,
-                    bsdf_samples: self.counts.bsdf,
+                    light_samples: counts.light,
+                    bsdf_samples: counts.bsdf,
                 },
             };
             let path = if cont { settings } else { &direct_only };
@@ -225,7 +233,7 @@ impl Integrator for RestirDiIntegrator {
     fn describe(&self) -> String {
         let s = &self.settings;
         format!(
-            "restir-di max_depth={} candidates={} light_sampler={} bsdf_candidates={} neighbors={} \
+            "restir-di max_depth={} candidates={} light_sampler={} bsdf_candidates={} {} neighbors={} \
              radius={} spatial_rounds={} reciprocal={} mis={} mcap={} {} \
              visibility={}{}",
             s.path.max_depth,
@@ -246,6 +254,7 @@ impl Integrator for RestirDiIntegrator {
                 + &s.learn_reason()
                     .map_or(String::new(), |r| format!(" ({r})")),
             s.bsdf_candidates,
+            s.bsdf_diffuse_label(),
             s.reuse.neighbors,
             s.reuse.radius,
             s.reuse.spatial_rounds,

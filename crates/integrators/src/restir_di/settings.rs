@@ -132,6 +132,43 @@ impl Learn {
     }
 }
 
+/// Whether receivers without a glossy lobe take the BSDF samples (`--bsdf-diffuse`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BsdfDiffuse {
+    /// Decided from the scene summary ([`RestirDiSettings::resolve`]): on when the scene has an
+    /// environment (on where nothing resolves it).
+    Auto,
+    /// Only receivers with a glossy lobe take BSDF samples; at the others light sampling takes
+    /// the whole direct light.
+    Off,
+    /// Every receiver takes `bsdf_candidates` BSDF samples.
+    On,
+    /// A negative control for the tests, never a choice: receivers without a glossy lobe skip
+    /// their BSDF samples, but their light strategy keeps only its power-heuristic share, as if
+    /// they took them (biased: the BSDF samples' share of their direct light is lost).
+    #[doc(hidden)]
+    OffKeepingShare,
+}
+
+impl BsdfDiffuse {
+    /// The names `--bsdf-diffuse` takes.
+    pub const NAMES: &[(&str, BsdfDiffuse)] = &[
+        ("auto", BsdfDiffuse::Auto),
+        ("off", BsdfDiffuse::Off),
+        ("on", BsdfDiffuse::On),
+    ];
+
+    /// The name `--bsdf-diffuse` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            BsdfDiffuse::Auto => "auto",
+            BsdfDiffuse::Off => "off",
+            BsdfDiffuse::On => "on",
+            BsdfDiffuse::OffKeepingShare => "off-keeping-share",
+        }
+    }
+}
+
 /// Where ReSTIR DI tests the visibility of its light samples (`--visibility`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Visibility {
@@ -205,6 +242,12 @@ pub struct RestirDiSettings {
     /// BSDF samples per pixel, `N_B` (default 1), combined with the reservoirs' light strategy
     /// by the power heuristic with sample counts.
     pub bsdf_candidates: u32,
+    /// Whether receivers without a glossy lobe take the BSDF samples too (default auto: when
+    /// the scene has an environment; chosen on the training family, `docs/RESTIR_DI.md`).
+    pub bsdf_diffuse: BsdfDiffuse,
+    /// Whether `bsdf_diffuse` was auto and [`RestirDiSettings::resolve`] decided it (`--stats`
+    /// says why).
+    pub bsdf_diffuse_decided: bool,
     /// Where visibility is tested (default in every target: chosen on the training family with
     /// the reuse defaults, `docs/studies/2026-12-02-restir-di-light-pool-and-defaults.md`).
     pub visibility: Visibility,
@@ -227,13 +270,16 @@ impl RestirDiSettings {
             learn_group: 1.0,
             learn_decided_from: None,
             bsdf_candidates: 1,
+            bsdf_diffuse: BsdfDiffuse::Auto,
+            bsdf_diffuse_decided: false,
             visibility: Visibility::Target,
         }
     }
 
     /// Decides the scene-dependent defaults from the scene summary: an `auto` light sampler
     /// becomes the hierarchy from [`HIERARCHY_MIN_EMITTERS`] emitters on (else the power
-    /// table), and `auto` learning is on up to [`LEARN_MAX_EMITTERS`] emitters (else off).
+    /// table), `auto` learning is on up to [`LEARN_MAX_EMITTERS`] emitters (else off), and
+    /// receivers without a glossy lobe take BSDF samples when the scene has an environment.
     pub fn resolve(&mut self, features: &SceneFeatures) {
         if self.learn == Learn::Auto {
             self.learn_decided_from = Some(features.emitter_count);
@@ -241,6 +287,14 @@ impl RestirDiSettings {
                 Learn::On
             } else {
                 Learn::Off
+            };
+        }
+        if self.bsdf_diffuse == BsdfDiffuse::Auto {
+            self.bsdf_diffuse_decided = true;
+            self.bsdf_diffuse = if features.has_environment {
+                BsdfDiffuse::On
+            } else {
+                BsdfDiffuse::Off
             };
         }
         if self.light_sampler == LightSampler::Auto {
@@ -262,6 +316,17 @@ impl RestirDiSettings {
         })
     }
 
+    /// `bsdf_diffuse=on|off`, with why when `auto` decided it (`(auto: environment)`), for the
+    /// settings line.
+    pub fn bsdf_diffuse_label(&self) -> String {
+        let why = match (self.bsdf_diffuse_decided, self.bsdf_diffuse) {
+            (false, _) => "",
+            (true, BsdfDiffuse::On) => " (auto: environment)",
+            (true, _) => " (auto: no environment)",
+        };
+        format!("bsdf_diffuse={}{why}", self.bsdf_diffuse.name())
+    }
+
     /// Whether the estimator is unbiased with these settings.
     pub fn is_unbiased(&self) -> bool {
         self.reuse.is_unbiased()
@@ -269,6 +334,7 @@ impl RestirDiSettings {
             && self.light_sampler != LightSampler::BvhWithPowerPmf
             && self.light_sampler != LightSampler::PoolWithoutSelection
             && self.learn != Learn::WithoutDefensiveShare
+            && self.bsdf_diffuse != BsdfDiffuse::OffKeepingShare
     }
 
     /// Applies `params` in order (later ones win). Names are case-insensitive, `-` and `_` are
@@ -313,6 +379,10 @@ impl RestirDiSettings {
                 }
                 "bsdf_candidates" | "brdf_candidates" => {
                     self.bsdf_candidates = p.count(0)?;
+                    true
+                }
+                "bsdf_diffuse" => {
+                    self.bsdf_diffuse = p.choice(BsdfDiffuse::NAMES, "auto, off or on")?;
                     true
                 }
                 "visibility" => {

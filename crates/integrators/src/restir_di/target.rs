@@ -22,7 +22,7 @@
 //! reservoirs without that (their density on a light is zero wherever the light is occluded).
 
 use glam::Vec3;
-use restir_materials::Bsdf;
+use restir_materials::{Bsdf, LobeFlags};
 use restir_sampling::luminance;
 use restir_scene::Scene;
 
@@ -37,6 +37,33 @@ pub struct StrategyCounts {
     pub light: f32,
     /// BSDF samples per pixel, `N_B`.
     pub bsdf: f32,
+    /// Whether receivers without a glossy lobe take the BSDF samples too; when not, `N_B` is 0
+    /// at them and light sampling takes their whole direct light.
+    pub bsdf_on_diffuse: bool,
+    /// The negative control [`BsdfDiffuse::OffKeepingShare`](super::BsdfDiffuse): receivers
+    /// without a glossy lobe take no BSDF samples but their light strategy keeps its share.
+    pub keep_share: bool,
+}
+
+impl StrategyCounts {
+    /// The counts at a receiver whose BSDF is `bsdf`, as its target sees them.
+    #[inline]
+    pub fn at(self, bsdf: &Bsdf) -> Self {
+        if self.keep_share {
+            return self;
+        }
+        self.samples_at(bsdf)
+    }
+
+    /// The counts at a receiver whose BSDF is `bsdf`, as its shading draws them.
+    #[inline]
+    pub fn samples_at(self, bsdf: &Bsdf) -> Self {
+        if self.bsdf_on_diffuse || bsdf.flags().intersects(LobeFlags::GLOSSY) {
+            self
+        } else {
+            Self { bsdf: 0.0, ..self }
+        }
+    }
 }
 
 /// A sample's value at a receiver: the reservoirs' integrand without visibility, and its target.
@@ -74,6 +101,7 @@ pub fn evaluate(
     if f == Vec3::ZERO {
         return Evaluated::ZERO;
     }
+    let counts = counts.at(bsdf);
     let m_light = if c.delta || counts.bsdf == 0.0 {
         1.0
     } else {
