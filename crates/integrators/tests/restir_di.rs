@@ -249,6 +249,35 @@ fn bsdf_samples_only_at_glossy_receivers_stay_unbiased() {
     );
 }
 
+/// The emission seen on emitter silhouettes from more camera rays (`edge_rays`, shared with
+/// ReSTIR PT): the small bright sphere lamp and the quad light in view. Unbiased with the mask
+/// made from pixel-centre rays; choosing the pixels by what the pass's own camera ray saw (the
+/// negative control) darkens the edges (a pixel whose ray missed the lamp never gets the extra
+/// rays).
+#[test]
+fn edge_rays_unbiased() {
+    let scene = scene();
+    let reference = direct_reference(&scene);
+    for rays in ["1", "8"] {
+        let z = max_z(
+            &statistics(&scene, "restir-di", &[("edge_rays", rays)], 1, 200),
+            &reference,
+        );
+        eprintln!("edge_rays = {rays}: max |z| = {z:.2}");
+        assert!(z < Z_MAX, "edge_rays = {rays}: max |z| = {z:.2}");
+    }
+    let control = [("edge_rays", "8"), ("edge_mask_from_pass", "true")];
+    let z = max_z(
+        &statistics(&scene, "restir-di", &control, 1, 200),
+        &reference,
+    );
+    eprintln!("edge rays where the pass's own ray saw a lamp: max |z| = {z:.2}");
+    assert!(
+        z > Z_MAX,
+        "a mask from the pass's own rays should be biased: {z:.2}"
+    );
+}
+
 /// The candidates come from the power sampler's pool of presampled lights (the default): the
 /// MIS loop above covers it; here the pool's negative control — whole lights' candidates
 /// (the sphere, the point light, the environment) weighted without their selection probability

@@ -111,6 +111,11 @@ pub(crate) struct RestirArgs {
     /// BSDF samples per pixel, MIS-combined with the reservoirs [default: 1].
     #[arg(long)]
     bsdf_candidates: Option<u32>,
+    /// restir-di and restir-pt: camera rays for the emission seen on pixels that an emitter's
+    /// silhouette crosses, the first camera ray included (1: no more rays) [default: 4 for
+    /// restir-di, 1 for restir-pt].
+    #[arg(long)]
+    edge_rays: Option<u32>,
     /// restir-di: whether receivers without a glossy lobe take the BSDF samples too (off: light
     /// sampling takes their whole direct light); auto is on when the scene has an environment
     /// [default: auto].
@@ -208,6 +213,7 @@ impl RestirArgs {
             "bsdf_diffuse",
             self.bsdf_diffuse.clone().map(ParamValue::Text),
         );
+        put("edge_rays", self.edge_rays.map(ParamValue::Count));
         put("neighbors", self.neighbors.map(ParamValue::Count));
         put("radius", self.radius.map(ParamValue::Number));
         put("spatial_rounds", self.spatial_rounds.map(ParamValue::Count));

@@ -56,6 +56,7 @@ use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
 use crate::reuse::chain::PassChain;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::reciprocal;
+use crate::reuse::seen::SeenEmission;
 use crate::reuse::settings::mis_name;
 use crate::stages::StageClock;
 use restir_reuse::{ScreenReuse, Stages};
@@ -89,6 +90,8 @@ pub struct RestirDiIntegrator {
     chain: PassChain,
     /// The per-pixel lookups of the last pass, kept so the next pass reuses their memory.
     lookups: std::sync::Mutex<Lookups>,
+    /// More camera rays for the seen emission on emitter silhouettes (`edge_rays > 1`).
+    seen: Option<SeenEmission>,
 }
 
 /// What a pass looks up once per pixel: the initial sample resolved in world space and the BSDF.
@@ -117,6 +120,8 @@ impl RestirDiIntegrator {
             learning: learn::Learning::default(),
             chain: PassChain::default(),
             lookups: Default::default(),
+            seen: (settings.edge_rays > 1)
+                .then(|| SeenEmission::new(settings.edge_rays, settings.edge_mask_from_pass)),
         }
     }
 
@@ -235,7 +240,7 @@ impl Integrator for RestirDiIntegrator {
         format!(
             "restir-di max_depth={} candidates={} light_sampler={} bsdf_candidates={} {} neighbors={} \
              radius={} spatial_rounds={} reciprocal={} mis={} mcap={} {} \
-             visibility={}{}",
+             visibility={}{}{}",
             s.path.max_depth,
             s.candidates,
             s.light_sampler.name().to_string()
@@ -263,6 +268,11 @@ impl Integrator for RestirDiIntegrator {
             s.reuse.mcap,
             s.reuse.describe_temporal(),
             s.visibility.name(),
+            if s.edge_rays > 1 {
+                format!(" edge_rays={}", s.edge_rays)
+            } else {
+                String::new()
+            },
             if s.is_unbiased() { "" } else { " (biased)" }
         )
     }
@@ -282,6 +292,9 @@ impl Integrator for RestirDiIntegrator {
         self.chain.next_frame();
         self.reuse.next_frame(Some(motion));
         self.learning.reset();
+        if let Some(seen) = &self.seen {
+            seen.clear();
+        }
     }
 
     fn halo(&self) -> u32 {
@@ -303,6 +316,10 @@ impl Integrator for RestirDiIntegrator {
             } else {
                 0
             }
+            + self
+                .seen
+                .as_ref()
+                .map_or(0, |_| std::mem::size_of::<bool>())
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
@@ -311,6 +328,9 @@ impl Integrator for RestirDiIntegrator {
             // Another render: nothing of the passes before carries over.
             self.reuse.next_frame(None);
             self.learning.reset();
+            if let Some(seen) = &self.seen {
+                seen.clear();
+            }
         }
         let reuse = &s.reuse;
         let n = accum.len();
@@ -319,6 +339,15 @@ impl Integrator for RestirDiIntegrator {
         let (gbuf, mut rays) = self.clock.time("primary", || {
             GBuffer::trace(scene, ctx, s.path.hide_emitters, true, keep, &mut radiance)
         });
+        // The seen emission on emitter silhouettes from more camera rays (`radiance` holds the
+        // G-buffer's seen emission only, nothing else yet).
+        if let Some(seen) = &self.seen
+            && !s.path.hide_emitters
+        {
+            rays += self.clock.time("silhouettes", || {
+                seen.supersample(scene, ctx, &mut radiance)
+            });
+        }
         let w = gbuf.width;
         let bands = Bands::new(w);
         if keep {

@@ -248,6 +248,14 @@ pub struct RestirDiSettings {
     /// Whether `bsdf_diffuse` was auto and [`RestirDiSettings::resolve`] decided it (`--stats`
     /// says why).
     pub bsdf_diffuse_decided: bool,
+    /// Camera rays for the emission seen on emitter silhouettes, the G-buffer's included
+    /// (`crate::reuse::seen`; 1: the G-buffer's only; default 4, chosen on the training family:
+    /// a hall's squared error 3.6× lower at the same cost).
+    pub edge_rays: u32,
+    /// Negative control only: choose the pixels that get `edge_rays` by what the pass's own
+    /// camera ray saw (an emitter) instead of a mask made without the pass's samples (biased).
+    #[doc(hidden)]
+    pub edge_mask_from_pass: bool,
     /// Where visibility is tested (default in every target: chosen on the training family with
     /// the reuse defaults, `docs/studies/2026-12-02-restir-di-light-pool-and-defaults.md`).
     pub visibility: Visibility,
@@ -272,6 +280,8 @@ impl RestirDiSettings {
             bsdf_candidates: 1,
             bsdf_diffuse: BsdfDiffuse::Auto,
             bsdf_diffuse_decided: false,
+            edge_rays: 4,
+            edge_mask_from_pass: false,
             visibility: Visibility::Target,
         }
     }
@@ -335,6 +345,7 @@ impl RestirDiSettings {
             && self.light_sampler != LightSampler::PoolWithoutSelection
             && self.learn != Learn::WithoutDefensiveShare
             && self.bsdf_diffuse != BsdfDiffuse::OffKeepingShare
+            && (!self.edge_mask_from_pass || self.edge_rays <= 1)
     }
 
     /// Applies `params` in order (later ones win). Names are case-insensitive, `-` and `_` are
@@ -379,6 +390,14 @@ impl RestirDiSettings {
                 }
                 "bsdf_candidates" | "brdf_candidates" => {
                     self.bsdf_candidates = p.count(0)?;
+                    true
+                }
+                "edge_rays" | "silhouette_rays" => {
+                    self.edge_rays = p.count(1)?;
+                    true
+                }
+                "edge_mask_from_pass" => {
+                    self.edge_mask_from_pass = p.boolean()?;
                     true
                 }
                 "bsdf_diffuse" => {

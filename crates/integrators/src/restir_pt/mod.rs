@@ -23,7 +23,6 @@ mod candidate;
 mod diag;
 pub mod pilot;
 pub mod sample;
-mod seen;
 mod settings;
 pub mod shift;
 pub mod walk;
@@ -46,6 +45,7 @@ use crate::motion::FrameMotion;
 use crate::reuse::chain::PassChain;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::reciprocal;
+use crate::reuse::seen::SeenEmission;
 use restir_reuse::{ScreenReuse, Stages};
 
 use crate::pass::{Integrator, PassContext};
@@ -80,7 +80,7 @@ pub struct RestirPtIntegrator {
     /// Where the brightest pixels come from (`RESTIR_PT_DIAG`, [`diag`]); `None` unless asked.
     diag: Option<diag::Diag>,
     /// More camera rays for the seen emission on emitter silhouettes (`edge_rays > 1`).
-    seen: Option<seen::SeenEmission>,
+    seen: Option<SeenEmission>,
 }
 
 impl RestirPtIntegrator {
@@ -105,7 +105,7 @@ impl RestirPtIntegrator {
             clock: StageClock::default(),
             diag: diag::Diag::from_env(),
             seen: (settings.edge_rays > 1)
-                .then(|| seen::SeenEmission::new(settings.edge_rays, settings.edge_mask_from_pass)),
+                .then(|| SeenEmission::new(settings.edge_rays, settings.edge_mask_from_pass)),
         }
     }
 
@@ -419,8 +419,12 @@ impl Integrator for RestirPtIntegrator {
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
         let s = &self.settings.reuse;
         if !self.chain.advance(ctx.seed, ctx.pass) {
-            // Another render: the history of the passes before does not carry over.
+            // Another render: the history of the passes before does not carry over, nor the
+            // silhouette mask (the scene may have changed).
             self.reuse.next_frame(None);
+            if let Some(seen) = &self.seen {
+                seen.clear();
+            }
         }
         let n = accum.len();
         // Emitters seen by the camera and the direct light at the primary hit (paths of one and

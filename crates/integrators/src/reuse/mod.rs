@@ -7,6 +7,7 @@
 pub mod chain;
 pub mod gbuffer;
 pub mod params;
+pub mod seen;
 
 pub use restir_reuse::{
     MIS_NAMES, ReuseSettings, duplication, mis_name, neighbors, passes, reciprocal, settings, shift,

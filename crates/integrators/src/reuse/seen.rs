@@ -1,11 +1,12 @@
 //! The emission the camera sees, estimated with more camera rays on emitter silhouettes
-//! (`edge_rays`, `docs/RESTIR_PT.md`).
+//! (`edge_rays` of ReSTIR DI and PT, `docs/RESTIR_DI.md`, `docs/RESTIR_PT.md`).
 //!
 //! A pixel that an emitter's silhouette crosses averages the emitter's radiance, often hundreds
 //! of times its surroundings', over the part of the pixel filter the emitter covers; one camera
 //! ray per pass estimates that fraction with a variance no reuse can lower. Such pixels hold
 //! most of ReSTIR PT's squared error in scenes with many small visible lamps
-//! (`docs/studies/2026-12-03-restir-pt-error-concentration.md`).
+//! (`docs/studies/2026-12-03-restir-pt-error-concentration.md`), and a large share of ReSTIR
+//! DI's where garlands of small emitters are in view.
 //!
 //! The pixel integral is the seen emission plus the light the primary hit reflects; both parts
 //! can be estimated with their own samples. On the pixels of the silhouette mask the seen
@@ -31,7 +32,7 @@ const STAGE_SEEN: u64 = 117;
 
 /// The extra camera rays on silhouettes, with the mask of the current film window.
 #[derive(Debug)]
-pub(super) struct SeenEmission {
+pub struct SeenEmission {
     /// Camera rays for the seen emission on a silhouette pixel (the G-buffer's included).
     rays: u32,
     /// Negative control: the pixels whose own camera ray saw emission instead of the mask.
@@ -63,7 +64,7 @@ fn filter_reach(filter: &Filter) -> i32 {
 
 impl SeenEmission {
     /// `rays` camera rays per silhouette pixel (more than 1).
-    pub(super) fn new(rays: u32, from_pass: bool) -> Self {
+    pub fn new(rays: u32, from_pass: bool) -> Self {
         Self {
             rays,
             from_pass,
@@ -72,7 +73,7 @@ impl SeenEmission {
     }
 
     /// Forgets the mask (the camera or the scene moved).
-    pub(super) fn clear(&self) {
+    pub fn clear(&self) {
         if let Ok(mut m) = self.mask.lock() {
             *m = None;
         }
@@ -80,7 +81,7 @@ impl SeenEmission {
 
     /// The silhouette mask of pass `ctx`'s window: pixels within the filter's reach of a pixel
     /// whose centre sees another emitter (or the environment, or a surface that does not emit)
-    /// than their own, where an emitter is in the neighbourhood. Made once per window; returns
+    /// than their own, where an area emitter is in the neighbourhood. Made once per window; returns
     /// it and the rays traced.
     fn mask(&self, scene: &Scene, ctx: &PassContext) -> (Vec<bool>, u64) {
         let (w, h) = ctx.resolution(scene);
@@ -109,7 +110,11 @@ impl SeenEmission {
             .collect();
         let rays = ids.iter().map(|&(_, r)| r).sum();
         let id = |x: i32, y: i32| ids[((y + reach) * bw + x + reach) as usize].0;
-        let emits = |v: u32| v != 0 && (v != u32::MAX || scene.lights.environment().is_some());
+        // Only area emitters: an environment behind a silhouette is about as bright as the
+        // surface it lights, and there the seen emission and the reflected light of one camera
+        // ray are anticorrelated (whichever the ray sees, the pixel gets about the same), so
+        // estimating them with separate samples would add variance, not remove it.
+        let emits = |v: u32| v != 0 && v != u32::MAX;
         let mask: Vec<bool> = (0..(wi * hi) as usize)
             .into_par_iter()
             .map(|i| {
@@ -135,13 +140,13 @@ impl SeenEmission {
 
     /// Replaces the seen emission in `radiance` (what the G-buffer's camera rays added, and
     /// nothing else yet) by the mean over this many camera rays on the silhouette pixels.
-    /// Returns the rays traced.
-    pub(super) fn supersample(
-        &self,
-        scene: &Scene,
-        ctx: &PassContext,
-        radiance: &mut [Vec3],
-    ) -> u64 {
+    /// Returns the rays traced. Does nothing when the film splats: every camera ray of the pass
+    /// goes through the pass's shared offset in its pixel, so more rays would repeat the
+    /// G-buffer's, and the splatting already averages each pixel over its neighbours' rays.
+    pub fn supersample(&self, scene: &Scene, ctx: &PassContext, radiance: &mut [Vec3]) -> u64 {
+        if ctx.shared_offset.is_some() {
+            return 0;
+        }
         let (mask, mut rays) = if self.from_pass {
             (radiance.iter().map(|l| l.max_element() > 0.0).collect(), 0)
         } else {
