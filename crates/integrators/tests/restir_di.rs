@@ -229,6 +229,9 @@ fn bsdf_samples_only_at_glossy_receivers_stay_unbiased() {
         "RoughConductor(roughness: (distribution: ggx, alpha: 0.2))",
     );
     let reference = direct_reference(&scene);
+    // The split is exercised: without BSDF samples at the diffuse receivers the image changes.
+    let one = |value| render_image(&scene, "restir-di", &[("bsdf_diffuse", value)], 1, 5);
+    assert_ne!(one("off"), one("on"));
     for value in ["off", "on"] {
         let z = max_z(
             &statistics(&scene, "restir-di", &[("bsdf_diffuse", value)], 1, 200),
@@ -258,6 +261,9 @@ fn bsdf_samples_only_at_glossy_receivers_stay_unbiased() {
 fn edge_rays_unbiased() {
     let scene = scene();
     let reference = direct_reference(&scene);
+    // The mask is not empty: the extra rays change the image.
+    let one = |rays| render_image(&scene, "restir-di", &[("edge_rays", rays)], 1, 5);
+    assert_ne!(one("1"), one("8"));
     for rays in ["1", "8"] {
         let z = max_z(
             &statistics(&scene, "restir-di", &[("edge_rays", rays)], 1, 200),
