@@ -138,6 +138,12 @@ pub enum ParamProblem {
     },
     /// A parameter given to the `auto` estimator, which takes none.
     NotForAuto,
+    /// A value that needs another parameter's value, which was not given (`needs` says which,
+    /// e.g. `visibility = target`).
+    Needs {
+        /// What the value needs.
+        needs: String,
+    },
 }
 
 /// A parameter that could not be read: its name, its value as given and where it came from.
@@ -192,6 +198,7 @@ impl fmt::Display for ParamError {
                 "{name} = '{v}': the integrator auto takes no estimator parameters (it runs \
                  path, restir-di or restir-pt at its defaults); name the integrator to configure it"
             ),
+            ParamProblem::Needs { needs } => write!(f, "{name} = '{v}' needs {needs}"),
         }
     }
 }

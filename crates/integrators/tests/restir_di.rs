@@ -10,7 +10,7 @@
 
 use std::sync::atomic::AtomicBool;
 
-use restir_integrators::restir_di::{BsdfDiffuse, Learn, LightSampler};
+use restir_integrators::restir_di::{BsdfDiffuse, BsdfSamples, Learn, LightSampler};
 use restir_integrators::reuse::MIS_NAMES;
 use restir_integrators::{
     IntegratorOptions, RenderJob, RestirDiIntegrator, RestirDiSettings, make_integrator, render,
@@ -249,6 +249,52 @@ fn bsdf_samples_only_at_glossy_receivers_stay_unbiased() {
     assert!(
         z > 2.0 * Z_MAX,
         "a lost BSDF share should be caught: max |z| = {z:.2}"
+    );
+}
+
+/// BSDF samples resampled with the light candidates (`bsdf_samples = resampled`): the reservoirs
+/// hold the whole direct light, the two strategies' candidates weighted by their shares of the
+/// split, and reuse spreads what BSDF rays found (visible, as the targets' visibility makes
+/// every reused sample); with BSDF samples at every receiver and only at glossy ones, with
+/// direct light only and with indirect light (the continuation's first hit is the reservoirs').
+/// The negative control weights BSDF candidates without their share, so light both
+/// strategies reach counts twice.
+#[test]
+fn resampled_bsdf_samples_are_unbiased_and_a_double_count_is_caught() {
+    let scene = scene_with(
+        "RoughPlastic(diffuse_reflectance: (0.5, 0.5, 0.5), roughness: (distribution: ggx, alpha: 0.15))",
+        "RoughConductor(roughness: (distribution: ggx, alpha: 0.2))",
+    );
+    let reference = direct_reference(&scene);
+    let one = |value| render_image(&scene, "restir-di", &[("bsdf_samples", value)], 1, 5);
+    assert_ne!(one("separate"), one("resampled"));
+    for diffuse in ["off", "on"] {
+        let params = [("bsdf_samples", "resampled"), ("bsdf_diffuse", diffuse)];
+        let z = max_z(
+            &statistics(&scene, "restir-di", &params, 1, 200),
+            &reference,
+        );
+        eprintln!("resampled, bsdf_diffuse {diffuse}: max |z| = {z:.2}");
+        assert!(
+            z < Z_MAX,
+            "resampled, bsdf_diffuse {diffuse}: max |z| = {z:.2}"
+        );
+    }
+    let indirect = statistics(&scene, "path", &[("max_depth", "-1")], 128, 48);
+    let params = [("bsdf_samples", "resampled"), ("max_depth", "-1")];
+    let z = max_z(&statistics(&scene, "restir-di", &params, 1, 200), &indirect);
+    eprintln!("resampled, max_depth -1: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "resampled, max_depth -1: max |z| = {z:.2}");
+    let mut wrong = RestirDiSettings::new(restir_integrators::path::PathSettings::from_desc(
+        &scene.integrator,
+    ));
+    wrong.bsdf_samples = BsdfSamples::ResampledWithoutShare;
+    wrong.bsdf_diffuse = BsdfDiffuse::On;
+    let z = max_z(&settings_statistics(&scene, wrong, 200), &reference);
+    eprintln!("BSDF candidates without their share: max |z| = {z:.2}");
+    assert!(
+        z > 2.0 * Z_MAX,
+        "a double-counted BSDF share should be caught: max |z| = {z:.2}"
     );
 }
 

@@ -12,6 +12,7 @@
 //!
 
 use glam::{Vec2, Vec3};
+use restir_geometry::SurfaceInteraction;
 
 use crate::contact::{Contact, nonzero, point_contact};
 use crate::{Light, LightSample, LightSet, Projector, Spot};
@@ -156,6 +157,43 @@ impl LightSet {
                     pdf,
                 }
             }
+        }
+    }
+
+    /// The light point a ray from `p` in unit direction `d` reaches: the emitter of `hit`, or
+    /// the environment when it is `None` (a miss). Returns the point, its radiance towards `p`
+    /// and [`LightSet::sample`]'s density of it from `p` (solid angle, the selection included);
+    /// `None` when nothing emits towards `p` there (a surface that is no light, the back of a
+    /// one-sided emitter, a scene without an environment).
+    #[inline]
+    pub fn reached(
+        &self,
+        p: Vec3,
+        d: Vec3,
+        hit: Option<&SurfaceInteraction>,
+    ) -> Option<(LightPoint, Vec3, f32)> {
+        match hit {
+            None => self.environment().map(|env| {
+                let le = self.environment_radiance(d);
+                let pdf = self.pdf_sa(env, p, p + d, -d);
+                (
+                    LightPoint::environment(env, self.environment_param(d)),
+                    le,
+                    pdf,
+                )
+            }),
+            Some(si) => self.light_on_shape(si.shape).and_then(|light| {
+                let le = self.area_radiance(light, si.shading.n, -d);
+                (le != Vec3::ZERO).then(|| {
+                    let pdf = self.pdf_sa(light, p, si.p, si.ng);
+                    let y = LightPoint {
+                        light,
+                        prim: si.prim,
+                        param: si.param,
+                    };
+                    (y, le, pdf)
+                })
+            }),
         }
     }
 

@@ -36,6 +36,10 @@ pub struct EnvironmentShare {
     pub share: f32,
     /// Camera rays of the pilot that hit a surface.
     pub receivers: u32,
+    /// The fraction of the pilot's environment samples above a receiver's surface that reach
+    /// the environment unoccluded: near 1 under an open sky, small in a room lit through
+    /// windows.
+    pub visible: f32,
 }
 
 impl Scene {
@@ -51,8 +55,12 @@ impl Scene {
         match (lights.environment(), self.features.environment_share) {
             (None, _) => table,
             (Some(_), Some(d)) => format!(
-                "{table}; environment share {:.4} from a pilot at {} camera hits (power share {:.4})",
-                d.share, d.receivers, d.power_share
+                "{table}; environment share {:.4} from a pilot at {} camera hits (power share \
+                 {:.4}; {:.0} % of its samples there unoccluded)",
+                d.share,
+                d.receivers,
+                d.power_share,
+                100.0 * d.visible
             ),
             (Some(env), None) => format!(
                 "{table}; environment share {:.4} (power share)",
@@ -80,6 +88,7 @@ impl Scene {
         let mut rng = Pcg32::new(0x5eed_0e4e, 0);
         let (mut second_env, mut second_local) = (0.0f64, 0.0f64);
         let mut receivers = 0u32;
+        let (mut env_above, mut env_visible) = (0u32, 0u32);
         for j in 0..GRID {
             for i in 0..GRID {
                 let film = Vec2::new(
@@ -110,10 +119,12 @@ impl Scene {
                     if cos <= 0.0 || s.pdf_sa <= 0.0 {
                         continue;
                     }
+                    env_above += u32::from(k < SAMPLES);
                     let (r, t_max) = shadow_ray_towards(si.p, n, s.wi, s.dist);
                     if self.occluded(&r, t_max) {
                         continue;
                     }
+                    env_visible += u32::from(k < SAMPLES);
                     let f = (luminance(s.le) * cos / s.pdf_sa) as f64;
                     if k < SAMPLES {
                         second_env += f * f;
@@ -139,6 +150,7 @@ impl Scene {
             power_share,
             share,
             receivers,
+            visible: env_visible as f32 / env_above.max(1) as f32,
         })
     }
 }

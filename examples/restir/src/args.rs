@@ -121,6 +121,11 @@ pub(crate) struct RestirArgs {
     /// [default: auto].
     #[arg(long)]
     bsdf_diffuse: Option<String>,
+    /// restir-di: where BSDF samples go: candidates of initial resampling beside the light
+    /// candidates, spread by reuse (resampled), or traced at shading beside the reservoirs
+    /// (separate); auto is resampled when visibility is in every target [default: auto].
+    #[arg(long)]
+    bsdf_samples: Option<String>,
     /// Spatial neighbours per round [default: 4].
     #[arg(long, alias = "neighbours")]
     neighbors: Option<u32>,
@@ -212,6 +217,10 @@ impl RestirArgs {
         put(
             "bsdf_diffuse",
             self.bsdf_diffuse.clone().map(ParamValue::Text),
+        );
+        put(
+            "bsdf_samples",
+            self.bsdf_samples.clone().map(ParamValue::Text),
         );
         put("edge_rays", self.edge_rays.map(ParamValue::Count));
         put("neighbors", self.neighbors.map(ParamValue::Count));

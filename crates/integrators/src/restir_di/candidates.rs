@@ -4,6 +4,7 @@
 //! pass and per pixel in `mod.rs`), streamed into a reservoir.
 
 use glam::Vec3;
+use restir_geometry::{Ray, offset_ray_origin};
 use restir_gris::{Reservoir, StreamingReservoir};
 use restir_lights::{At, CandidateU, LightPoint, LightSampler, Resolved};
 use restir_materials::Bsdf;
@@ -11,7 +12,7 @@ use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
 use super::shift::visible;
-use super::target::evaluate;
+use super::target::{evaluate, light_share};
 use super::{DiReservoir, RestirDiIntegrator};
 use crate::reuse::gbuffer::Receiver;
 
@@ -40,6 +41,9 @@ impl RestirDiIntegrator {
         }
         let n = self.settings.candidates;
         let nf = n as f32;
+        // With resampled BSDF samples the candidates of both strategies are weighted by their
+        // shares of a split that depends only on the receiver and the sample (`target`).
+        let split = self.counts.resampled_at(bsdf);
         let mut stream = StreamingReservoir::new();
         let u0 = rng.next_f32();
         sampler.begin(rng, n);
@@ -60,14 +64,81 @@ impl RestirDiIntegrator {
                 Some(cand.power_pdf_sa),
                 self.counts,
             );
-            let w = e.target / (nf * cand.source_pdf);
+            let m = if let Some(split) = split
+                && e.target > 0.0
+            {
+                let wi = r.frame().to_local(cand.contact.wi);
+                light_share(
+                    scene,
+                    r,
+                    bsdf,
+                    wi,
+                    &cand.point,
+                    &cand.contact,
+                    Some(cand.power_pdf_sa),
+                    split,
+                )
+            } else {
+                1.0
+            };
+            let w = m * e.target / (nf * cand.source_pdf);
             stream.add_candidate(cand.point, e.target, w, 0.0, u_pick);
+        }
+        let mut rays = 0;
+        // The BSDF candidates: a found light point is visible from the receiver.
+        let mut found = None;
+        if let Some(split) = split {
+            let share_ignored =
+                self.settings.bsdf_samples == super::BsdfSamples::ResampledWithoutShare;
+            for _ in 0..split.bsdf as u32 {
+                let u_lobe = rng.next_f32();
+                let u_dir = rng.next_2d();
+                let u_pick = rng.next_f32();
+                let Some(bs) = bsdf.sample(r.wo, u_lobe, u_dir) else {
+                    continue;
+                };
+                if bs.lobe.is_delta() || !bs.pdf_sa.is_finite() || bs.pdf_sa <= 0.0 {
+                    continue; // delta lobes are shading's continuation
+                }
+                let d = r.frame().to_world(bs.wi);
+                rays += 1;
+                let hit = scene.intersect(&Ray::new(offset_ray_origin(r.p, ng, d), d));
+                let Some((y, _, power_pdf_sa)) = scene.lights.reached(r.p, d, hit.as_ref()) else {
+                    continue;
+                };
+                let resolved = scene.lights.resolve(&y);
+                let Some(c) = resolved.contact(&scene.lights, r.p) else {
+                    continue;
+                };
+                let e = evaluate(scene, r, bsdf, &y, &c, None, self.counts);
+                if e.target <= 0.0 {
+                    continue;
+                }
+                // m_B / N_B, with m_B = 1 − m_L as the light candidates see it.
+                let m = if share_ignored {
+                    1.0 / split.bsdf
+                } else {
+                    let wi = r.frame().to_local(c.wi);
+                    let m_light =
+                        light_share(scene, r, bsdf, wi, &y, &c, Some(power_pdf_sa), split);
+                    (1.0 - m_light) / split.bsdf
+                };
+                let w = m * e.target / (bs.pdf_sa * c.measure);
+                if stream.add_candidate(y, e.target, w, 0.0, u_pick) {
+                    found = Some((y, resolved));
+                }
+            }
         }
         let mut res = stream.finalize_recorded();
         res.confidence = 1.0;
-        let mut rays = 0;
-        let resolved = res.sample.map(|y| (y, scene.lights.resolve(&y)));
+        let by_bsdf = found.is_some_and(|(y, _)| res.sample == Some(y));
+        let resolved = if by_bsdf {
+            found
+        } else {
+            res.sample.map(|y| (y, scene.lights.resolve(&y)))
+        };
         if self.settings.visibility.tests_initial()
+            && !by_bsdf
             && let Some((_, y)) = &resolved
         {
             let visible = y.contact(&scene.lights, r.p).is_some_and(|c| {

@@ -45,8 +45,8 @@ use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
 pub use settings::{
-    BsdfDiffuse, HIERARCHY_MIN_EMITTERS, LEARN_MAX_EMITTERS, Learn, LightSampler, RestirDiSettings,
-    Visibility,
+    BsdfDiffuse, BsdfSamples, HIERARCHY_MIN_EMITTERS, LEARN_MAX_EMITTERS, Learn, LightSampler,
+    RESAMPLE_BELOW_VISIBLE, RestirDiSettings, Visibility,
 };
 
 use crate::bands::Bands;
@@ -80,6 +80,7 @@ pub type DiReservoir = Reservoir<LightPoint>;
 #[derive(Debug)]
 pub struct RestirDiIntegrator {
     settings: RestirDiSettings,
+    /// The strategy counts of the direct-light split and where BSDF samples go.
     counts: StrategyCounts,
     /// The neighbour pattern and the history of temporal reuse.
     reuse: ScreenReuse<LightPoint, GBuffer>,
@@ -113,6 +114,7 @@ impl RestirDiIntegrator {
                     BsdfDiffuse::Auto | BsdfDiffuse::On
                 ),
                 keep_share: settings.bsdf_diffuse == BsdfDiffuse::OffKeepingShare,
+                resampled: settings.bsdf_resampled(),
             },
             settings,
             reuse: ScreenReuse::default(),
@@ -238,7 +240,7 @@ impl Integrator for RestirDiIntegrator {
     fn describe(&self) -> String {
         let s = &self.settings;
         format!(
-            "restir-di max_depth={} candidates={} light_sampler={} bsdf_candidates={} {} neighbors={} \
+            "restir-di max_depth={} candidates={} light_sampler={} bsdf_candidates={} {} {} neighbors={} \
              radius={} spatial_rounds={} reciprocal={} mis={} mcap={} {} \
              visibility={}{}{}",
             s.path.max_depth,
@@ -260,6 +262,7 @@ impl Integrator for RestirDiIntegrator {
                     .map_or(String::new(), |r| format!(" ({r})")),
             s.bsdf_candidates,
             s.bsdf_diffuse_label(),
+            s.bsdf_samples_label(),
             s.reuse.neighbors,
             s.reuse.radius,
             s.reuse.spatial_rounds,

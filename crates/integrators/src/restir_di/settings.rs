@@ -8,7 +8,7 @@
 use crate::reuse::params::ReuseParams;
 use restir_scene::SceneFeatures;
 
-use crate::params::{Param, ParamError, ParamSet};
+use crate::params::{Param, ParamError, ParamProblem, ParamSet};
 use crate::path::PathSettings;
 use crate::reuse::settings::ReuseSettings;
 
@@ -169,6 +169,60 @@ impl BsdfDiffuse {
     }
 }
 
+/// `auto` resamples BSDF samples with the light candidates when less than this fraction of the
+/// environment pilot's samples at the camera's receivers are unoccluded (chosen on the training
+/// family: rooms lit through windows see 3–6 %, scenes under an open sky 65–80 %).
+pub const RESAMPLE_BELOW_VISIBLE: f32 = 0.25;
+
+/// Where ReSTIR DI's BSDF samples go (`--bsdf-samples`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BsdfSamples {
+    /// Decided from the scene summary ([`RestirDiSettings::resolve`]): `resampled` when
+    /// visibility is in every target and the scene's receivers see little of its environment
+    /// (less than [`RESAMPLE_BELOW_VISIBLE`] of the pilot's samples of it unoccluded), else
+    /// `separate` (also where nothing resolves it).
+    Auto,
+    /// Traced at shading and added to the reservoir's light strategy with their MIS weights; the
+    /// reservoirs hold the light strategy's share of the direct light.
+    Separate,
+    /// Candidates of initial resampling beside the light candidates, MIS-weighted against them;
+    /// the reservoirs hold the whole direct light and reuse spreads what BSDF samples found
+    /// (needs visibility in every target).
+    Resampled,
+    /// A negative control for the tests, never a choice: resampled, but a BSDF candidate's weight
+    /// ignores its MIS share, as if the light candidates could not find its point (biased: the
+    /// light found by both strategies counts twice where both reach it).
+    #[doc(hidden)]
+    ResampledWithoutShare,
+}
+
+impl BsdfSamples {
+    /// The names `--bsdf-samples` takes.
+    pub const NAMES: &[(&str, BsdfSamples)] = &[
+        ("auto", BsdfSamples::Auto),
+        ("separate", BsdfSamples::Separate),
+        ("resampled", BsdfSamples::Resampled),
+    ];
+
+    /// The name `--bsdf-samples` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            BsdfSamples::Auto => "auto",
+            BsdfSamples::Separate => "separate",
+            BsdfSamples::Resampled => "resampled",
+            BsdfSamples::ResampledWithoutShare => "resampled-without-share",
+        }
+    }
+
+    /// Whether BSDF samples are candidates of initial resampling.
+    pub fn is_resampled(self) -> bool {
+        matches!(
+            self,
+            BsdfSamples::Resampled | BsdfSamples::ResampledWithoutShare
+        )
+    }
+}
+
 /// Where ReSTIR DI tests the visibility of its light samples (`--visibility`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Visibility {
@@ -248,6 +302,13 @@ pub struct RestirDiSettings {
     /// Whether `bsdf_diffuse` was auto and [`RestirDiSettings::resolve`] decided it (`--stats`
     /// says why).
     pub bsdf_diffuse_decided: bool,
+    /// Where the BSDF samples go (default auto: resampled with the light candidates where the
+    /// receivers see little of an environment; `docs/RESTIR_DI.md`).
+    pub bsdf_samples: BsdfSamples,
+    /// When `bsdf_samples` was auto and [`RestirDiSettings::resolve`] decided it: the fraction
+    /// of the environment pilot's samples that were unoccluded (`None`: no pilot, no
+    /// environment).
+    pub bsdf_samples_decided_from: Option<Option<f32>>,
     /// Camera rays for the emission seen on emitter silhouettes, the G-buffer's included
     /// (`crate::reuse::seen`; 1: the G-buffer's only; default 4, chosen on the training family:
     /// a hall's squared error 3.6× lower at the same cost).
@@ -280,6 +341,8 @@ impl RestirDiSettings {
             bsdf_candidates: 1,
             bsdf_diffuse: BsdfDiffuse::Auto,
             bsdf_diffuse_decided: false,
+            bsdf_samples: BsdfSamples::Auto,
+            bsdf_samples_decided_from: None,
             edge_rays: 4,
             edge_mask_from_pass: false,
             visibility: Visibility::Target,
@@ -305,6 +368,17 @@ impl RestirDiSettings {
                 BsdfDiffuse::On
             } else {
                 BsdfDiffuse::Off
+            };
+        }
+        if self.bsdf_samples == BsdfSamples::Auto {
+            let visible = features.environment_share.map(|e| e.visible);
+            self.bsdf_samples_decided_from = Some(visible);
+            self.bsdf_samples = if self.visibility == Visibility::Target
+                && visible.is_some_and(|v| v < RESAMPLE_BELOW_VISIBLE)
+            {
+                BsdfSamples::Resampled
+            } else {
+                BsdfSamples::Separate
             };
         }
         if self.light_sampler == LightSampler::Auto {
@@ -337,6 +411,34 @@ impl RestirDiSettings {
         format!("bsdf_diffuse={}{why}", self.bsdf_diffuse.name())
     }
 
+    /// Whether BSDF samples are candidates of initial resampling (an unresolved `auto` is
+    /// `separate`).
+    pub fn bsdf_resampled(&self) -> bool {
+        self.bsdf_samples.is_resampled()
+    }
+
+    /// `bsdf_samples=separate|resampled`, with why when `auto` decided it, for the settings
+    /// line.
+    pub fn bsdf_samples_label(&self) -> String {
+        let why = match self.bsdf_samples_decided_from {
+            None => String::new(),
+            Some(None) => " (auto: no environment beside local lights)".to_string(),
+            Some(Some(v)) => {
+                let cmp = if v < RESAMPLE_BELOW_VISIBLE {
+                    "<"
+                } else {
+                    ">="
+                };
+                format!(
+                    " (auto: {:.0} % of environment samples unoccluded {cmp} {:.0} %)",
+                    100.0 * v,
+                    100.0 * RESAMPLE_BELOW_VISIBLE
+                )
+            }
+        };
+        format!("bsdf_samples={}{why}", self.bsdf_samples.name())
+    }
+
     /// Whether the estimator is unbiased with these settings.
     pub fn is_unbiased(&self) -> bool {
         self.reuse.is_unbiased()
@@ -345,13 +447,15 @@ impl RestirDiSettings {
             && self.light_sampler != LightSampler::PoolWithoutSelection
             && self.learn != Learn::WithoutDefensiveShare
             && self.bsdf_diffuse != BsdfDiffuse::OffKeepingShare
+            && self.bsdf_samples != BsdfSamples::ResampledWithoutShare
             && (!self.edge_mask_from_pass || self.edge_rays <= 1)
     }
 
     /// Applies `params` in order (later ones win). Names are case-insensitive, `-` and `_` are
     /// the same. Returns the parameters it did not know, for the caller to warn about.
     pub fn apply(&mut self, params: &ParamSet) -> Result<Vec<Param>, ParamError> {
-        params.apply(|key, p| {
+        let mut resampled_by = None;
+        let unused = params.apply(|key, p| {
             Ok(match key {
                 "candidates" | "light_candidates" | "initial_candidates" | "num_candidates"
                 | "reservoir_size" | "reservior_size" => {
@@ -404,6 +508,12 @@ impl RestirDiSettings {
                     self.bsdf_diffuse = p.choice(BsdfDiffuse::NAMES, "auto, off or on")?;
                     true
                 }
+                "bsdf_samples" => {
+                    self.bsdf_samples =
+                        p.choice(BsdfSamples::NAMES, "auto, separate or resampled")?;
+                    resampled_by = self.bsdf_samples.is_resampled().then(|| p.clone());
+                    true
+                }
                 "visibility" => {
                     self.visibility = p.choice(Visibility::NAMES, "shading, target or reuse")?;
                     true
@@ -418,7 +528,17 @@ impl RestirDiSettings {
                 }
                 _ => self.reuse.apply(key, p)?,
             })
-        })
+        })?;
+        // Resampled BSDF samples are unbiased only with visibility in every target: a neighbour's
+        // BSDF candidates never land where its view of the light is blocked.
+        if let Some(p) = resampled_by
+            && self.visibility != Visibility::Target
+        {
+            return Err(p.error(ParamProblem::Needs {
+                needs: "visibility = target".to_string(),
+            }));
+        }
+        Ok(unused)
     }
 }
 

@@ -30,7 +30,7 @@ use crate::reuse::gbuffer::Receiver;
 use restir_lights::{Contact, LightPoint};
 use restir_sampling::warp::power_share;
 
-/// The two strategy counts of the direct-light split.
+/// The two strategy counts of the direct-light split, and where BSDF samples go.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StrategyCounts {
     /// Light candidates per pixel, `N_L`.
@@ -43,21 +43,45 @@ pub struct StrategyCounts {
     /// The negative control [`BsdfDiffuse::OffKeepingShare`](super::BsdfDiffuse): receivers
     /// without a glossy lobe take no BSDF samples but their light strategy keeps its share.
     pub keep_share: bool,
+    /// Whether the BSDF samples are candidates of initial resampling (the reservoirs hold the
+    /// whole direct light).
+    pub resampled: bool,
 }
 
 impl StrategyCounts {
-    /// The counts at a receiver whose BSDF is `bsdf`, as its target sees them.
+    /// The counts at a receiver whose BSDF is `bsdf`, as its target sees them: no BSDF samples
+    /// where they are resampled (the target is the whole direct light).
     #[inline]
     pub fn at(self, bsdf: &Bsdf) -> Self {
+        if self.resampled_at(bsdf).is_some() {
+            return Self { bsdf: 0.0, ..self };
+        }
         if self.keep_share {
             return self;
         }
-        self.samples_at(bsdf)
+        self.split_at(bsdf)
     }
 
-    /// The counts at a receiver whose BSDF is `bsdf`, as its shading draws them.
+    /// The counts at a receiver whose BSDF is `bsdf`, as its shading draws them: none where they
+    /// are resampled.
     #[inline]
     pub fn samples_at(self, bsdf: &Bsdf) -> Self {
+        if self.resampled_at(bsdf).is_some() {
+            return Self { bsdf: 0.0, ..self };
+        }
+        self.split_at(bsdf)
+    }
+
+    /// The split between light and BSDF candidates of initial resampling at a receiver whose
+    /// BSDF is `bsdf`, when it resamples its BSDF samples.
+    #[inline]
+    pub fn resampled_at(self, bsdf: &Bsdf) -> Option<Self> {
+        self.resampled.then(|| self.split_at(bsdf))
+    }
+
+    /// The strategy counts drawn at a receiver whose BSDF is `bsdf`, wherever they go.
+    #[inline]
+    fn split_at(self, bsdf: &Bsdf) -> Self {
         if self.bsdf_on_diffuse || bsdf.flags().intersects(LobeFlags::GLOSSY) {
             self
         } else {
@@ -101,18 +125,16 @@ pub fn evaluate(
     if f == Vec3::ZERO {
         return Evaluated::ZERO;
     }
-    let counts = counts.at(bsdf);
-    let m_light = if c.delta || counts.bsdf == 0.0 {
-        1.0
-    } else {
-        let light_pdf_sa = known_light_pdf_sa
-            .or(c.pdf_sa)
-            .unwrap_or_else(|| scene.lights.pdf_sa(sample.light, r.p, c.p, c.ng));
-        power_share(
-            counts.light * light_pdf_sa,
-            counts.bsdf * bsdf.pdf_sa(r.wo, wi),
-        )
-    };
+    let m_light = light_share(
+        scene,
+        r,
+        bsdf,
+        wi,
+        sample,
+        c,
+        known_light_pdf_sa,
+        counts.at(bsdf),
+    );
     let contribution = f * c.le * (c.measure * m_light);
     let target = luminance(contribution);
     if !(target > 0.0 && target.is_finite()) {
@@ -122,6 +144,33 @@ pub fn evaluate(
         contribution,
         target,
     }
+}
+
+/// The light strategy's share `m_L(y)` of `sample` (seen as `c`, in local direction `wi`) at
+/// receiver `r` against `counts.bsdf` BSDF samples: 1 for delta lights and without BSDF samples.
+/// `known_light_pdf_sa` as for [`evaluate`].
+#[allow(clippy::too_many_arguments)] // the receiver, the sample and what is known of both
+#[inline]
+pub fn light_share(
+    scene: &Scene,
+    r: &Receiver,
+    bsdf: &Bsdf,
+    wi: Vec3,
+    sample: &LightPoint,
+    c: &Contact,
+    known_light_pdf_sa: Option<f32>,
+    counts: StrategyCounts,
+) -> f32 {
+    if c.delta || counts.bsdf == 0.0 {
+        return 1.0;
+    }
+    let light_pdf_sa = known_light_pdf_sa
+        .or(c.pdf_sa)
+        .unwrap_or_else(|| scene.lights.pdf_sa(sample.light, r.p, c.p, c.ng));
+    power_share(
+        counts.light * light_pdf_sa,
+        counts.bsdf * bsdf.pdf_sa(r.wo, wi),
+    )
 }
 
 #[cfg(test)]

@@ -79,7 +79,7 @@ impl Walker<'_> {
         sink: &mut dyn FnMut(PathSample, Vec3),
     ) -> Option<Replayed> {
         let scene = self.scene;
-        let (y, le, light_pdf_sa) = self.emission(w.cur.r.p, step.d, hit)?;
+        let (y, le, light_pdf_sa) = self.scene.lights.reached(w.cur.r.p, step.d, hit)?;
         let mis = step.prev.emission_weight(light_pdf_sa);
         let direct = PathSample::direct(y, Kind::DirectHit);
         let eligible =
@@ -99,40 +99,5 @@ impl Walker<'_> {
         let sample = self.candidate(w, &connection, direct, eligible);
         sink(sample, connection.contribution(w.beta, w.inv_q));
         None
-    }
-
-    /// The emitter (or the environment) a ray from `p` along `d` reached (`hit`, `None` for a
-    /// miss): the light point, its radiance towards `p` and the light-sampling density of that
-    /// point from `p` (solid angle); `None` when it emits nothing towards `p`.
-    pub(super) fn emission(
-        &self,
-        p: Vec3,
-        d: Vec3,
-        hit: Option<&SurfaceInteraction>,
-    ) -> Option<(LightPoint, Vec3, f32)> {
-        let lights = &self.scene.lights;
-        match hit {
-            None => lights.environment().map(|env| {
-                let le = lights.environment_radiance(d);
-                let lp = lights.pdf_sa(env, p, p + d, -d);
-                (
-                    LightPoint::environment(env, lights.environment_param(d)),
-                    le,
-                    lp,
-                )
-            }),
-            Some(si) => lights.light_on_shape(si.shape).and_then(|light| {
-                let le = lights.area_radiance(light, si.shading.n, -d);
-                (le != Vec3::ZERO).then(|| {
-                    let lp = lights.pdf_sa(light, p, si.p, si.ng);
-                    let y = LightPoint {
-                        light,
-                        prim: si.prim,
-                        param: si.param,
-                    };
-                    (y, le, lp)
-                })
-            }),
-        }
     }
 }
