@@ -9,7 +9,8 @@
 //!    [`settings::HIERARCHY_MIN_EMITTERS`] emitters on by default; stratified selection either
 //!    way; with `learn` on, from the second pass on, a mixture of the power sampler and what
 //!    lights delivered to the receiver's cell in earlier passes, [`learn`]), streamed into a
-//!    reservoir with weights `p̂/(N_L·p_L)`; the result
+//!    reservoir with weights `p̂/(N_L·p_L)` (with `--bsdf-samples resampled`, `N_B` BSDF
+//!    candidates beside them, both weighted by their shares of the light/BSDF split); the result
 //!    counts as confidence 1. Optional visibility reuse drops an occluded selection (biased).
 //! 3. **Temporal reuse** (optional): the same pixel's reservoir from the previous pass.
 //! 4. **Spatial reuse**: `R` rounds of `k` neighbours from a low-discrepancy disk pattern with a
@@ -19,9 +20,10 @@
 //!    Each round reads the previous round's buffer and writes a new one, so the result does not
 //!    depend on scheduling. Confidence is capped at `mcap` after every step. Steps 3 and 4
 //!    are the shared [`crate::reuse::passes`]; this module plugs in the identity shift.
-//! 5. **Shading**: the selected sample with a shadow ray, times its `W`; plus `N_B` BSDF samples
-//!    weighted by the power heuristic against the light strategy (the exact split is explained
-//!    in [`mod@target`]); the first BSDF sample continues as a path-traced path when
+//! 5. **Shading**: the selected sample with a shadow ray, times its `W`; plus, unless they were
+//!    resampled, `N_B` BSDF samples weighted by the power heuristic against the light strategy
+//!    (the exact split is explained in [`mod@target`]); the first BSDF sample continues as a
+//!    path-traced path when
 //!    `max_depth > 2` (indirect light) or when it followed a delta lobe.
 
 mod candidates;

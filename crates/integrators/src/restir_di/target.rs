@@ -1,7 +1,7 @@
 //! ReSTIR DI's target: the light strategy's share of the direct light at a receiver.
 //!
 //! The direct light at receiver `x` is split exactly between the two strategies that cover it,
-//! light sampling (the reservoirs) and BSDF sampling (traced at shading), by power-heuristic
+//! light sampling and BSDF sampling, by power-heuristic
 //! weights with sample counts that depend only on `x` and `y`:
 //!
 //! ```text
@@ -15,11 +15,14 @@
 //! candidates, a per-sample variance about 25 times the path tracer's); the power heuristic
 //! leaves it the square of that share.
 //!
-//! The reservoirs estimate `∫ F(y)·m_L(y)·V(x, y) dy` with `F = f_s·|cos θ_x|·L_e·G` (the
-//! unshadowed contribution) and target `p̂(y) = lum(F(y)·m_L(y))`; visibility is tested once, at
-//! shading. Because `m_L` needs no visibility, every pixel's target is a fixed function and
-//! reservoirs stay valid at their neighbours; BSDF samples could not be resampled into the
-//! reservoirs without that (their density on a light is zero wherever the light is occluded).
+//! With BSDF samples traced at shading (`separate`) the reservoirs estimate
+//! `∫ F(y)·m_L(y)·V(x, y) dy` with `F = f_s·|cos θ_x|·L_e·G` (the unshadowed contribution) and
+//! target `p̂(y) = lum(F(y)·m_L(y))`. Because `m_L` needs no visibility, every pixel's target is
+//! a fixed function and reservoirs stay valid at their neighbours. With BSDF samples resampled
+//! among the candidates (`resampled`, [`StrategyCounts::resampled_at`]) the target is `lum(F)`
+//! and the split only weights the two kinds of candidates; that needs visibility in every
+//! target, since a BSDF candidate's density on a light is zero wherever the light is occluded
+//! (`docs/RESTIR_DI.md`, "How light and BSDF samples are combined").
 
 use glam::Vec3;
 use restir_materials::{Bsdf, LobeFlags};
