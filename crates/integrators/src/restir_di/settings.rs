@@ -177,10 +177,11 @@ pub const RESAMPLE_BELOW_VISIBLE: f32 = 0.25;
 /// Where ReSTIR DI's BSDF samples go (`--bsdf-samples`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BsdfSamples {
-    /// Decided from the scene summary ([`RestirDiSettings::resolve`]): `resampled` when
-    /// visibility is in every target and the scene's receivers see little of its environment
-    /// (less than [`RESAMPLE_BELOW_VISIBLE`] of the pilot's samples of it unoccluded), else
-    /// `separate` (also where nothing resolves it).
+    /// Decided from the scene summary ([`RestirDiSettings::resolve`]): `resampled` for direct
+    /// light (`max_depth` 2) with visibility in every target when the scene's receivers see
+    /// little of its environment (less than [`RESAMPLE_BELOW_VISIBLE`] of the pilot's samples of
+    /// it unoccluded), else `separate` (also where nothing resolves it): with indirect light the
+    /// continuation traces a BSDF ray of its own, which resampling does not save.
     Auto,
     /// Traced at shading and added to the reservoir's light strategy with their MIS weights; the
     /// reservoirs hold the light strategy's share of the direct light.
@@ -374,6 +375,7 @@ impl RestirDiSettings {
             let visible = features.environment_share.map(|e| e.visible);
             self.bsdf_samples_decided_from = Some(visible);
             self.bsdf_samples = if self.visibility == Visibility::Target
+                && self.path.max_segments() <= 2
                 && visible.is_some_and(|v| v < RESAMPLE_BELOW_VISIBLE)
             {
                 BsdfSamples::Resampled
@@ -423,6 +425,7 @@ impl RestirDiSettings {
         let why = match self.bsdf_samples_decided_from {
             None => String::new(),
             Some(None) => " (auto: no environment beside local lights)".to_string(),
+            Some(_) if self.path.max_segments() > 2 => " (auto: indirect light)".to_string(),
             Some(Some(v)) => {
                 let cmp = if v < RESAMPLE_BELOW_VISIBLE {
                     "<"
@@ -595,6 +598,54 @@ mod tests {
                 .to_string(),
             "light_sampler = 'near': expected auto, power, tiles or bvh"
         );
+    }
+
+    /// `bsdf_samples = auto` resamples for direct light with visibility in every target where
+    /// less than `RESAMPLE_BELOW_VISIBLE` of the environment pilot's samples were unoccluded;
+    /// `resampled` with another visibility is an error naming what it needs.
+    #[test]
+    fn auto_bsdf_samples_are_decided_by_the_environment_seen() {
+        let at = |visible: Option<f32>, max_depth: i32, visibility: Visibility| {
+            let mut s = settings();
+            s.path.max_depth = max_depth;
+            s.visibility = visibility;
+            s.resolve(&SceneFeatures {
+                environment_share: visible.map(|visible| restir_scene::EnvironmentShare {
+                    power_share: 0.5,
+                    share: 0.5,
+                    receivers: 1000,
+                    visible,
+                }),
+                ..SceneFeatures::default()
+            });
+            (s.bsdf_samples, s.bsdf_samples_label())
+        };
+        let room = at(Some(0.05), 2, Visibility::Target);
+        assert_eq!(room.0, BsdfSamples::Resampled);
+        assert!(
+            room.1
+                .contains("5 % of environment samples unoccluded < 25 %"),
+            "{}",
+            room.1
+        );
+        let open = at(Some(0.7), 2, Visibility::Target);
+        assert_eq!(open.0, BsdfSamples::Separate);
+        assert_eq!(at(None, 2, Visibility::Target).0, BsdfSamples::Separate);
+        let indirect = at(Some(0.05), -1, Visibility::Target);
+        assert_eq!(indirect.0, BsdfSamples::Separate);
+        assert!(indirect.1.contains("indirect light"), "{}", indirect.1);
+        assert_eq!(
+            at(Some(0.05), 2, Visibility::Shading).0,
+            BsdfSamples::Separate
+        );
+        let mut s = settings();
+        let err = s
+            .apply(&ParamSet::from(
+                &[("bsdf_samples", "resampled"), ("visibility", "shading")][..],
+            ))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(err, "bsdf_samples = 'resampled' needs visibility = target");
     }
 
     /// `learn = auto` learns up to `LEARN_MAX_EMITTERS` emitters and not above; a named choice
