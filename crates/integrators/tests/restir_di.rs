@@ -256,7 +256,8 @@ fn bsdf_samples_only_at_glossy_receivers_stay_unbiased() {
 /// hold the whole direct light, the two strategies' candidates weighted by their shares of the
 /// split, and reuse spreads what BSDF rays found (visible, as the targets' visibility makes
 /// every reused sample); with BSDF samples at every receiver and only at glossy ones, with
-/// direct light only and with indirect light (the continuation's first hit is the reservoirs').
+/// temporal reuse, with direct light only and with indirect light (the continuation's first
+/// hit is the reservoirs').
 /// The negative control weights BSDF candidates without their share, so light both
 /// strategies reach counts twice.
 #[test]
@@ -280,6 +281,13 @@ fn resampled_bsdf_samples_are_unbiased_and_a_double_count_is_caught() {
             "resampled, bsdf_diffuse {diffuse}: max |z| = {z:.2}"
         );
     }
+    let params = [("bsdf_samples", "resampled"), ("temporal", "true")];
+    let z = max_z(
+        &statistics(&scene, "restir-di", &params, 4, 100),
+        &reference,
+    );
+    eprintln!("resampled, temporal: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "resampled, temporal: max |z| = {z:.2}");
     let indirect = statistics(&scene, "path", &[("max_depth", "-1")], 128, 48);
     let params = [("bsdf_samples", "resampled"), ("max_depth", "-1")];
     let z = max_z(&statistics(&scene, "restir-di", &params, 1, 200), &indirect);
