@@ -171,7 +171,8 @@ impl BsdfDiffuse {
 
 /// `auto` resamples BSDF samples with the light candidates when less than this fraction of the
 /// environment pilot's samples at the camera's receivers are unoccluded (chosen on the training
-/// family: rooms lit through windows see 3–6 %, scenes under an open sky 65–80 %).
+/// family: its halls, lit by garlands and through windows, see 3–6 %, scenes under an open sky
+/// 65–80 %).
 pub const RESAMPLE_BELOW_VISIBLE: f32 = 0.25;
 
 /// Where ReSTIR DI's BSDF samples go (`--bsdf-samples`).
