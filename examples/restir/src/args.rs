@@ -122,8 +122,9 @@ pub(crate) struct RestirArgs {
     #[arg(long)]
     bsdf_diffuse: Option<String>,
     /// restir-di: where BSDF samples go: candidates of initial resampling beside the light
-    /// candidates, spread by reuse (resampled), or traced at shading beside the reservoirs
-    /// (separate); auto is resampled when visibility is in every target [default: auto].
+    /// candidates, spread by reuse (resampled; needs --visibility target), or traced at shading
+    /// beside the reservoirs (separate); auto resamples for direct light where the receivers see
+    /// little of the environment (under 25 % of its pilot samples unoccluded) [default: auto].
     #[arg(long)]
     bsdf_samples: Option<String>,
     /// Spatial neighbours per round [default: 4].
