@@ -439,6 +439,7 @@ fn same_image_for_one_and_two_threads() {
         &[][..],
         &[("temporal", "true"), ("spatial_rounds", "2")][..],
         &[("learn", "on")][..],
+        &[("bsdf_samples", "resampled"), ("bsdf_diffuse", "on")][..],
     ] {
         let a = run(1, params);
         let b = run(2, params);
