@@ -209,6 +209,21 @@ fn restir_di_and_pt_with_envmap_match_path_tracer() {
     let z = max_z(&di, &brighter);
     eprintln!("restir-di vs map × 1.05: max |z| = {z:.2}");
     assert!(z > Z_MAX, "a 5 % error went unnoticed: max |z| = {z:.2}");
+    // BSDF candidates that reach the map, resampled with the light candidates.
+    let params = [
+        ("candidates", "8"),
+        ("bsdf_samples", "resampled"),
+        ("bsdf_diffuse", "on"),
+    ];
+    let z = max_z(
+        &statistics(&scene, "restir-di", &params, 1, 120),
+        &reference,
+    );
+    eprintln!("restir-di, resampled BSDF samples: max |z| = {z:.2}");
+    assert!(
+        z < Z_MAX,
+        "restir-di, resampled BSDF samples: max |z| = {z:.2}"
+    );
 
     // Global illumination (max_depth 4): ReSTIR PT.
     let scene = sky_scene(&map, 1.0, 4);
