@@ -163,8 +163,9 @@ impl LightSet {
     /// The light point a ray from `p` in unit direction `d` reaches: the emitter of `hit`, or
     /// the environment when it is `None` (a miss). Returns the point, its radiance towards `p`
     /// and [`LightSet::sample`]'s density of it from `p` (solid angle, the selection included);
-    /// `None` when nothing emits towards `p` there (a surface that is no light, the back of a
-    /// one-sided emitter, a scene without an environment).
+    /// `None` when no light is there (a surface that is no light, the back of a one-sided
+    /// emitter, a miss in a scene without an environment). An environment's radiance may be
+    /// zero in direction `d`.
     #[inline]
     pub fn reached(
         &self,

@@ -14,6 +14,7 @@ use restir_scene::Scene;
 use super::shift::visible;
 use super::target::{evaluate, light_share};
 use super::{DiReservoir, RestirDiIntegrator};
+use crate::path::bsdf_sample_share;
 use crate::reuse::gbuffer::Receiver;
 
 impl RestirDiIntegrator {
@@ -114,14 +115,12 @@ impl RestirDiIntegrator {
                 if e.target <= 0.0 {
                     continue;
                 }
-                // m_B / N_B, with m_B = 1 − m_L as the light candidates see it.
+                // m_B / N_B, the same split as the light candidates' `m_L`.
                 let m = if share_ignored {
                     1.0 / split.bsdf
                 } else {
-                    let wi = r.frame().to_local(c.wi);
-                    let m_light =
-                        light_share(scene, r, bsdf, wi, &y, &c, Some(power_pdf_sa), split);
-                    (1.0 - m_light) / split.bsdf
+                    let pdf_b = bsdf.pdf_sa(r.wo, r.frame().to_local(c.wi));
+                    bsdf_sample_share(pdf_b, split.bsdf, power_pdf_sa, split.light)
                 };
                 let w = m * e.target / (bs.pdf_sa * c.measure);
                 if stream.add_candidate(y, e.target, w, 0.0, u_pick) {

@@ -116,7 +116,8 @@ impl RestirDiIntegrator {
                     BsdfDiffuse::Auto | BsdfDiffuse::On
                 ),
                 keep_share: settings.bsdf_diffuse == BsdfDiffuse::OffKeepingShare,
-                resampled: settings.bsdf_resampled(),
+                // An unresolved `auto` is `separate`.
+                resampled: settings.bsdf_samples.is_resampled(),
             },
             settings,
             reuse: ScreenReuse::default(),

@@ -414,18 +414,15 @@ impl RestirDiSettings {
         format!("bsdf_diffuse={}{why}", self.bsdf_diffuse.name())
     }
 
-    /// Whether BSDF samples are candidates of initial resampling (an unresolved `auto` is
-    /// `separate`).
-    pub fn bsdf_resampled(&self) -> bool {
-        self.bsdf_samples.is_resampled()
-    }
-
     /// `bsdf_samples=separate|resampled`, with why when `auto` decided it, for the settings
     /// line.
     pub fn bsdf_samples_label(&self) -> String {
         let why = match self.bsdf_samples_decided_from {
             None => String::new(),
             Some(None) => " (auto: no environment beside local lights)".to_string(),
+            Some(_) if self.visibility != Visibility::Target => {
+                " (auto: visibility not in every target)".to_string()
+            }
             Some(_) if self.path.max_segments() > 2 => " (auto: indirect light)".to_string(),
             Some(Some(v)) => {
                 let cmp = if v < RESAMPLE_BELOW_VISIBLE {
@@ -635,9 +632,12 @@ mod tests {
         let indirect = at(Some(0.05), -1, Visibility::Target);
         assert_eq!(indirect.0, BsdfSamples::Separate);
         assert!(indirect.1.contains("indirect light"), "{}", indirect.1);
-        assert_eq!(
-            at(Some(0.05), 2, Visibility::Shading).0,
-            BsdfSamples::Separate
+        let shading = at(Some(0.05), 2, Visibility::Shading);
+        assert_eq!(shading.0, BsdfSamples::Separate);
+        assert!(
+            shading.1.contains("visibility not in every target"),
+            "{}",
+            shading.1
         );
         let mut s = settings();
         let err = s
