@@ -15,7 +15,10 @@ every configuration, as `restir compare`'s relMSE uses the reference); its time 
 user + system CPU time minus its load time (`--stats`' `load_seconds`); its efficiency is
 1 / (relative variance × CPU seconds), which does not depend on the pass count when a pass's
 cost does not. Prints, per scene and as the median over scenes, each configuration's efficiency
-relative to the first. A configuration is `label=passes=flags`. Renders are kept in `--out` and
+relative to the first, also in plain squared error (MSE: `(a − b)² / 2` without the denominator,
+which weighs bright pixels as a viewer does), and the share of its squared error in the 1 % of
+pixels where it is largest (how concentrated the noise is; from two renders, so it reads a little
+high for every configuration alike). A configuration is `label=passes=flags`. Renders are kept in `--out` and
 reused when their stats file exists, so an interrupted run resumes.
 
     python3 scripts/pair_variance.py --bin target/release/restir --size 640x360 --threads 1 \\
@@ -142,6 +145,7 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     base = configs[0][0]
     ratios = {label: [] for label, _, _ in configs}
+    ratios_mse = {label: [] for label, _, _ in configs}
     print(f"# {a.size}, {a.threads} thread(s), seeds {seeds}; efficiency relative to {base}")
     for scene in a.scenes:
         name = os.path.splitext(os.path.basename(scene))[0]
@@ -160,22 +164,33 @@ def main():
         m = np.mean([img for label, imgs in images.items() if label != "mitsuba" for img in imgs],
                     axis=0)
         denom = m * m + 1e-2
-        eff = {}
+        eff, eff_mse = {}, {}
         cells = []
         for label, passes, _ in rows:
             x, y = images[label]
-            rel_var = float(np.mean((x - y) ** 2 / 2 / denom))
+            sq = (x - y) ** 2 / 2
+            rel_var = float(np.mean(sq / denom))
+            mse = float(np.mean(sq))
+            per_pixel = np.sort(sq.sum(-1).ravel())[::-1]
+            top = float(per_pixel[: max(1, per_pixel.size // 100)].sum() / max(per_pixel.sum(), 1e-30))
             t = statistics.mean(cpu[label])
             eff[label] = 1.0 / (rel_var * t) if rel_var > 0 and t > 0 else float("inf")
-            cells.append(f"{label}: relvar {rel_var:.3g} cpu {t:.2f}s ({t / passes:.3f}/pass)")
+            eff_mse[label] = 1.0 / (mse * t) if mse > 0 and t > 0 else float("inf")
+            cells.append(f"{label}: relvar {rel_var:.3g} mse {mse:.3g} top-1% {100 * top:.0f}% "
+                         f"cpu {t:.2f}s ({t / passes:.3f}/pass)")
         for label in eff:
             ratios.setdefault(label, []).append(eff[label] / eff[base])
+            ratios_mse.setdefault(label, []).append(eff_mse[label] / eff_mse[base])
         print(name)
         for (label, _, _), cell in zip(rows, cells):
-            print(f"    {cell}  eff {eff[label] / eff[base]:.2f}x", flush=True)
-    print(f"median over {len(a.scenes)} scenes (range), efficiency relative to {base}:")
+            print(f"    {cell}  eff {eff[label] / eff[base]:.2f}x "
+                  f"(MSE {eff_mse[label] / eff_mse[base]:.2f}x)", flush=True)
+    print(f"median over {len(a.scenes)} scenes (range), efficiency relative to {base}, "
+          "in relative variance and in MSE:")
     for label, r in ratios.items():
-        print(f"    {label}: {statistics.median(r):.2f}x ({min(r):.2f}-{max(r):.2f})")
+        q = ratios_mse[label]
+        print(f"    {label}: {statistics.median(r):.2f}x ({min(r):.2f}-{max(r):.2f}); "
+              f"MSE {statistics.median(q):.2f}x ({min(q):.2f}-{max(q):.2f})")
     if a.mitsuba:
         print(f"median (range), efficiency relative to Mitsuba 3 {a.mitsuba} "
               f"({a.mitsuba_variant}, {a.threads} thread(s)):")

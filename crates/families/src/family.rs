@@ -11,7 +11,8 @@
 //!   splits (training 4000 and 12000 triangles, test 8000 and 20000), so that a default chosen on
 //!   training halls is checked on halls of other sizes as well as other layouts.
 //! - [`Family::Pt`] (ReSTIR PT): glossy rooms without glass, with smooth and with rough glass,
-//!   each with and without a window to a sky.
+//!   each with and without a window to a sky, and two rooms lit by a hundred or so small lamps
+//!   (tessellated bulbs) instead of one hidden light, the kind of the seed report's scene.
 //! - [`Family::DiMotion`] (ReSTIR DI under motion): rectangles, spheres and emissive
 //!   meshes at 10³ lights, two of each, with diffuse, glossy, mixed and textured receivers,
 //!   occluders everywhere and a sky in three, each animated by [`super::animate`] (camera,
@@ -165,9 +166,24 @@ fn di_params(split: Split) -> Vec<Params> {
     ]
 }
 
-/// The PT family's parameters: each glass choice with and without a window, two more plain ones.
+/// The PT family's parameters: each glass choice with and without a window, two more plain ones,
+/// and two rooms lit by small lamps (the seed report's kind), one plain and closed, one with
+/// smooth glass and a window.
 fn pt_params() -> Vec<Params> {
-    let room = |glass, window| Params::Room(RoomOptions { glass, window });
+    let room = |glass, window| {
+        Params::Room(RoomOptions {
+            glass,
+            window,
+            lamps: 0,
+        })
+    };
+    let lit = |glass, window, lamps| {
+        Params::Room(RoomOptions {
+            glass,
+            window,
+            lamps,
+        })
+    };
     vec![
         room(Glass::None, false),
         room(Glass::None, true),
@@ -177,6 +193,8 @@ fn pt_params() -> Vec<Params> {
         room(Glass::Rough, true),
         room(Glass::None, false),
         room(Glass::Rough, true),
+        lit(Glass::None, false, 120),
+        lit(Glass::Smooth, true, 60),
     ]
 }
 
@@ -210,7 +228,15 @@ fn di_motion_params() -> Vec<Params> {
 fn pt_motion_params() -> Vec<Params> {
     Glass::ALL
         .into_iter()
-        .flat_map(|glass| [false, true].map(|window| Params::Room(RoomOptions { glass, window })))
+        .flat_map(|glass| {
+            [false, true].map(|window| {
+                Params::Room(RoomOptions {
+                    glass,
+                    window,
+                    lamps: 0,
+                })
+            })
+        })
         .collect()
 }
 

@@ -26,6 +26,7 @@ pub mod envmap;
 mod family;
 mod garlands;
 mod hall;
+mod lamps;
 mod many_lights;
 mod meshes;
 mod motion;

@@ -73,7 +73,19 @@ fn di(kind: Kind, lights: u32, receivers: Receivers, envmap: bool) -> Params {
 }
 
 fn room(glass: Glass, window: bool) -> Params {
-    Params::Room(RoomOptions { glass, window })
+    Params::Room(RoomOptions {
+        glass,
+        window,
+        lamps: 0,
+    })
+}
+
+fn lamp_room(glass: Glass, window: bool, lamps: u32) -> Params {
+    Params::Room(RoomOptions {
+        glass,
+        window,
+        lamps,
+    })
 }
 
 #[test]
@@ -102,6 +114,7 @@ fn every_kind_builds_and_renders_finite_and_lit() {
         ("room", room(Glass::None, false), "restir-pt"),
         ("room-smooth-window", room(Glass::Smooth, true), "restir-pt"),
         ("room-rough", room(Glass::Rough, false), "restir-pt"),
+        ("room-lamps", lamp_room(Glass::None, false, 40), "restir-pt"),
     ];
     for (name, params, restir) in cases {
         for seed in [1, 2] {
@@ -125,6 +138,17 @@ fn every_kind_builds_and_renders_finite_and_lit() {
                 assert_eq!(scene.integrator.max_depth, 2, "{name}: direct light only");
             } else {
                 assert_eq!(scene.integrator.max_depth, 8, "{name}");
+                if let Params::Room(o) = &params {
+                    // The lamps replace the hidden light: one emitter per lamp, each a bulb.
+                    let emitters = generated
+                        .desc
+                        .shapes
+                        .iter()
+                        .filter(|s| s.emission.is_some())
+                        .count();
+                    let expected = if o.lamps > 0 { o.lamps as usize } else { 1 };
+                    assert_eq!(emitters, expected, "{name} seed {seed}");
+                }
             }
             for estimator in ["path", restir] {
                 let image = common::render_image(&scene, estimator, &[], 4, 7);
@@ -147,6 +171,7 @@ fn same_seed_same_scene_other_seed_other_scene() {
         di(Kind::Meshes, 500, Receivers::Glossy, false),
         di(Kind::Hall, 500, Receivers::Mixed, true),
         room(Glass::Rough, true),
+        lamp_room(Glass::Smooth, true, 30),
     ] {
         let a = generate(&params, 5).unwrap();
         assert_eq!(a, generate(&params, 5).unwrap(), "{params:?}");
@@ -240,6 +265,11 @@ fn families_are_disjoint_and_cover_every_kind_and_light_count() {
             );
         }
     }
+    // The seed report's kind: rooms lit by many small lamps.
+    assert!(
+        pt.iter()
+            .any(|m| matches!(&m.params, Params::Room(o) if o.lamps >= 100))
+    );
 }
 
 #[test]

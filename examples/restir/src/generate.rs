@@ -21,7 +21,7 @@ pub enum Generate {
     Spheres(DiArgs),
     /// A few emissive OBJ meshes of thousands of small triangles over receivers (direct light only).
     Meshes(DiArgs),
-    /// A glossy room lit mostly indirectly by one hidden area light.
+    /// A glossy room lit mostly indirectly by one hidden area light, or by many small lamps.
     Room(RoomArgs),
     /// Every scene of a training or test family with an index: di (ReSTIR DI), pt (ReSTIR PT),
     /// and the moving di-motion and pt-motion (animated, 12 fps; render them with
@@ -255,6 +255,10 @@ pub struct RoomArgs {
     /// A window in the right wall with a sky (EXR written beside the scene) outside.
     #[arg(long)]
     window: bool,
+    /// Light the room with this many small lamps (tessellated bulbs, an OBJ file written beside
+    /// the scene) instead of its hidden area light: the seed report's kind of scene.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=2000))]
+    lamps: u32,
     /// Output RON file; assets go beside it. Default: room-<options>-s<seed>.ron.
     #[arg(short = 'o', long = "output")]
     output: Option<PathBuf>,
@@ -334,12 +338,17 @@ fn describe(params: &Params) -> String {
             }
         ),
         Params::Room(o) => format!(
-            "room: glass {}, {}",
+            "room: glass {}, {}, {}",
             o.glass.name(),
             if o.window {
                 "window with a sky"
             } else {
                 "closed"
+            },
+            if o.lamps > 0 {
+                format!("{} small lamps", o.lamps)
+            } else {
+                "one hidden area light".to_string()
             }
         ),
     }
@@ -517,6 +526,7 @@ fn write_room(args: RoomArgs) -> Result<(), String> {
     let params = Params::Room(RoomOptions {
         glass,
         window: args.window,
+        lamps: args.lamps,
     });
     write_one(&params, args.seed, args.output)
 }
