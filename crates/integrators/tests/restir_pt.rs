@@ -456,7 +456,7 @@ fn edge_rays_unbiased() {
         r#"(geometry: Sphere(center: (0.6, 1.45, 0.4), radius: 0.25), emission: Some((20, 20, 20))),"#,
     );
     let reference = statistics(&scene, "path", &[], 128, 64);
-    for rays in ["1", "8"] {
+    for rays in ["1", "32"] {
         let z = max_z(
             &statistics(&scene, "restir-pt", &[("edge_rays", rays)], 1, 300),
             &reference,

@@ -113,7 +113,7 @@ pub(crate) struct RestirArgs {
     bsdf_candidates: Option<u32>,
     /// restir-di and restir-pt: camera rays for the emission seen on pixels that an emitter's
     /// silhouette crosses, the first camera ray included (1: no more rays) [default: 4 for
-    /// restir-di, 1 for restir-pt].
+    /// restir-di, 32 for restir-pt].
     #[arg(long)]
     edge_rays: Option<u32>,
     /// restir-di: whether receivers without a glossy lobe take the BSDF samples too (off: light

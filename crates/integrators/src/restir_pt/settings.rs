@@ -84,8 +84,7 @@ pub struct RestirPtSettings {
     /// Where the direct light at the primary hit comes from (default the reservoirs).
     pub direct: DirectLight,
     /// Camera rays for the emission seen on emitter silhouettes, the G-buffer's included
-    /// (default 1, the G-buffer's only: with 8, Mitsuba's `test_envmap_path` fails its
-    /// criterion, 0.9933, so the extra rays stay opt-in until that is understood).
+    /// (default 32: docs/RESTIR_PT.md, "Silhouettes"; 1 traces no more).
     pub edge_rays: u32,
     /// Negative control only: choose the pixels that get `edge_rays` by what the pass's own
     /// camera ray saw (an emitter) instead of a mask made without the pass's samples (biased).
@@ -127,7 +126,7 @@ impl RestirPtSettings {
             footprint: 30.0,
             max_jacobian: 0.0,
             direct: DirectLight::Reservoir,
-            edge_rays: 1,
+            edge_rays: 32,
             edge_mask_from_pass: false,
             unit_jacobian: false,
             one_sided_jacobian: false,
