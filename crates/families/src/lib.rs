@@ -9,6 +9,7 @@
 //! | [`Kind::Meshes`] | `meshes.rs` | a few emissive OBJ meshes of thousands of small triangles over receivers |
 //! | [`Kind::Room`] | `room.rs` | a glossy room lit mostly indirectly by one hidden area light |
 //! | [`Kind::Hall`] | `hall.rs`, `garlands.rs` | a hall of tens of emissive garlands (thousands of triangles) among pillars, partitions and shelves, a dim sky through its windows |
+//! | [`added_lamps`] | `added_lamps.rs` | small lamps added to a scene somebody else wrote, by a rule that needs only its geometry and camera |
 //!
 //! The rectangles, spheres and meshes share their stage (`stage.rs`: a floor, receivers,
 //! occluders between lights and receivers, an optional environment map); the hall builds its
@@ -22,6 +23,7 @@
 //! function of exactly the parameters that determine their contents, so scenes of one family can
 //! share a directory.
 
+mod added_lamps;
 pub mod envmap;
 mod family;
 mod garlands;
@@ -42,6 +44,9 @@ use restir_image::{Image, ImageError};
 
 use restir_scene::SceneDesc;
 
+pub use added_lamps::{
+    AddedLamp, POWER_RATIO as ADDED_LAMPS_POWER_RATIO, added_lamps, added_lamps_xml,
+};
 pub use family::{Family, FamilyMember, Split, members};
 pub use many_lights::{many_lights, many_lights_ron};
 pub use motion::{DURATION, FPS, animate};

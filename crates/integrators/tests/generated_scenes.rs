@@ -301,3 +301,66 @@ fn hundred_thousand_light_members_build() {
         let _ = std::fs::remove_dir_all(dir);
     }
 }
+
+/// Lamps added to a scene somebody else wrote (`restir generate lamps`): placed in free space,
+/// emitting the rule's total power, and the written XML loads as the scene plus the lamps and
+/// renders.
+#[test]
+fn added_lamps_sit_in_free_space_and_the_written_scene_loads() {
+    let host =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml");
+    let host = std::fs::canonicalize(host).unwrap();
+    let loaded = load_scene(&host, &LoadOptions::default()).unwrap();
+    let lamps = restir_families::added_lamps(&loaded.scene, 60, 3);
+    assert!(lamps.len() >= 50, "{} of 60 lamps placed", lamps.len());
+    assert_eq!(lamps, restir_families::added_lamps(&loaded.scene, 60, 3));
+    let (lo, hi) = loaded.scene.accel.bounds();
+    let e = hi - lo;
+    let area = 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
+    let mut flux = 0.0;
+    for l in &lamps {
+        assert!(l.radius > 0.0 && l.radiance.is_finite() && l.radiance.min_element() > 0.0);
+        // Clear of every surface: rays from the centre in the six axis directions travel
+        // farther than the radius (or leave through the box's open side).
+        for d in [
+            glam::Vec3::X,
+            -glam::Vec3::X,
+            glam::Vec3::Y,
+            -glam::Vec3::Y,
+            glam::Vec3::Z,
+            -glam::Vec3::Z,
+        ] {
+            if let Some(hit) = loaded
+                .scene
+                .intersect(&restir_geometry::Ray::new(l.centre, d))
+            {
+                assert!(hit.p.distance(l.centre) > l.radius, "{l:?} touches a wall");
+            }
+        }
+        flux += std::f32::consts::PI * l.radiance.element_sum() / 3.0
+            * 4.0
+            * std::f32::consts::PI
+            * l.radius
+            * l.radius;
+    }
+    assert!((flux / (0.2 * area) - 1.0).abs() < 1e-3, "{flux} W");
+
+    let dir = temp_dir("added-lamps");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("lamps.xml");
+    let text = restir_families::added_lamps_xml(host.to_str().unwrap(), &lamps, "a test");
+    std::fs::write(&path, text).unwrap();
+    let options = LoadOptions {
+        width: Some(32),
+        height: Some(24),
+        ..LoadOptions::default()
+    };
+    let with = common::Built::from(load_scene(&path, &options).unwrap());
+    assert_eq!(
+        with.scene.lights.len(),
+        loaded.scene.lights.len() + lamps.len()
+    );
+    let image = common::render_image(&with, "restir-di", &[], 2, 7);
+    assert!(image.mean().max_element() > 1e-3);
+    let _ = std::fs::remove_dir_all(dir);
+}

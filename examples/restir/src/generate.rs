@@ -23,6 +23,10 @@ pub enum Generate {
     Meshes(DiArgs),
     /// A glossy room lit mostly indirectly by one hidden area light, or by many small lamps.
     Room(RoomArgs),
+    /// Small lamps added to a scene somebody else wrote (a Mitsuba 3 XML file, included by the
+    /// file written, not copied): N emissive spheres placed by a rule that needs only the scene's
+    /// geometry and camera (docs/SCENES.md).
+    Lamps(LampsArgs),
     /// Every scene of a training or test family with an index: di (ReSTIR DI), pt (ReSTIR PT),
     /// and the moving di-motion and pt-motion (animated, 12 fps; render them with
     /// `restir render DIR/NAME.ron --frames 0..23`).
@@ -97,6 +101,7 @@ pub fn run(what: Generate) -> Result<(), String> {
         Generate::Spheres(args) => write_di(Kind::Spheres, args),
         Generate::Meshes(args) => write_di(Kind::Meshes, args),
         Generate::Room(args) => write_room(args),
+        Generate::Lamps(args) => write_lamps(args),
         Generate::Family(args) => write_family(&args),
         Generate::Envmap(args) => {
             if !(4..=8192).contains(&args.width) || args.width % 2 != 0 {
@@ -262,6 +267,23 @@ pub struct RoomArgs {
     /// Output RON file; assets go beside it. Default: room-<options>-s<seed>.ron.
     #[arg(short = 'o', long = "output")]
     output: Option<PathBuf>,
+}
+
+/// Options of `restir generate lamps`.
+#[derive(clap::Args, Debug)]
+pub struct LampsArgs {
+    /// The scene to add lamps to (Mitsuba 3 XML; RON scenes cannot be included).
+    #[arg(long)]
+    scene: PathBuf,
+    /// How many lamps.
+    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    lamps: u32,
+    /// Seed of the placement, powers and colours.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output XML file (it includes the scene by its absolute path).
+    #[arg(short = 'o', long = "output")]
+    output: PathBuf,
 }
 
 /// Options of `restir generate family`.
@@ -529,4 +551,49 @@ fn write_room(args: RoomArgs) -> Result<(), String> {
         lamps: args.lamps,
     });
     write_one(&params, args.seed, args.output)
+}
+
+/// Writes a scene with small lamps added (`restir generate lamps`).
+fn write_lamps(args: LampsArgs) -> Result<(), String> {
+    let ext = args.scene.extension().and_then(|e| e.to_str());
+    if ext != Some("xml") {
+        return Err(format!(
+            "--scene {}: expected a Mitsuba 3 XML file (.xml): only XML scenes can be included",
+            args.scene.display()
+        ));
+    }
+    let loaded = restir_scene::load_scene(&args.scene, &restir_scene::LoadOptions::default())
+        .map_err(|e| e.to_string())?;
+    let lamps = restir_families::added_lamps(&loaded.scene, args.lamps, args.seed);
+    if lamps.is_empty() {
+        return Err(format!(
+            "{}: no lamp could be placed (the rays from the camera's position hit nothing)",
+            args.scene.display()
+        ));
+    }
+    let included =
+        std::fs::canonicalize(&args.scene).map_err(|e| format!("{}: {e}", args.scene.display()))?;
+    let included = included
+        .to_str()
+        .ok_or_else(|| format!("{}: not a UTF-8 path", included.display()))?;
+    let header = format!(
+        "Written by `restir generate lamps --scene {} --lamps {} --seed {}`: the scene, included\n\
+         (not copied), with {} small emissive spheres added by the rule of docs/SCENES.md\n\
+         (powers over {}x). Regenerate rather than edit.",
+        args.scene.display(),
+        args.lamps,
+        args.seed,
+        lamps.len(),
+        restir_families::ADDED_LAMPS_POWER_RATIO,
+    );
+    let text = restir_families::added_lamps_xml(included, &lamps, &header);
+    restir_image::write_file_atomically(&args.output, text.as_bytes())
+        .map_err(|e| e.to_string())?;
+    tell!(
+        "{} lamps added to {} -> {}",
+        lamps.len(),
+        args.scene.display(),
+        args.output.display()
+    )?;
+    Ok(())
 }
