@@ -11,8 +11,8 @@
 //! 2. the lamp hangs above the anchor along the surface normal turned towards the camera's side,
 //!    at a height uniform in `[0.5 %, 2 %]·D` but at most half the hit distance, with a radius
 //!    uniform in `[0.05 %, 0.15 %]·D` and at most a third of the height;
-//! 3. a ray from the anchor along that normal must travel the height plus the radius without a
-//!    hit (the lamp is in free space), or the lamp draws again (at most 100 times);
+//! 3. a ray from the anchor along that normal must travel the height plus twice the radius
+//!    without a hit (the lamp is in free space), or the lamp draws again (at most 100 tries);
 //! 4. powers log-uniform over [`POWER_RATIO`], three in four warm white and the rest coloured,
 //!    scaled so that all the lamps together emit `0.2·A` watts, `A` the area of the scene's
 //!    bounding box (in the scene's units).
@@ -25,7 +25,7 @@ use restir_geometry::{Ray, offset_ray_origin};
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
-use super::util::{hue_colour, uniform};
+use super::util::{lamp_tint, uniform};
 
 /// The brightest lamp's power over the dimmest's, at most.
 pub const POWER_RATIO: f32 = 100.0;
@@ -79,11 +79,7 @@ pub fn added_lamps(scene: &Scene, count: u32, seed: u64) -> Vec<AddedLamp> {
             continue;
         };
         let level = POWER_RATIO.powf(rng.next_f32());
-        let tint = if rng.next_bounded(4) == 0 {
-            hue_colour(rng.next_f32(), uniform(&mut rng, 0.4, 0.8))
-        } else {
-            hue_colour(uniform(&mut rng, 0.02, 0.12), uniform(&mut rng, 0.05, 0.3))
-        };
+        let tint = lamp_tint(&mut rng);
         drawn.push((centre, radius, level, Vec3::from(tint)));
     }
     // Flux of a Lambertian sphere: π · L · 4πr².

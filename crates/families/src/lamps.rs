@@ -7,7 +7,7 @@
 use glam::Vec3;
 use restir_sampling::Pcg32;
 
-use super::util::{emitter, grid, hue_colour, obj, round, round3, uniform};
+use super::util::{emitter, grid, lamp_tint, obj, round, round3, uniform};
 use super::{Asset, AssetContents};
 use restir_scene::{GeometryDesc, ShapeDesc, TransformOp};
 
@@ -108,11 +108,7 @@ pub(super) fn lamps(
         let Some(c) = spot else { continue };
         placed.push((c, r));
         let level = POWER_RATIO.powf(rng.next_f32());
-        let tint = if rng.next_bounded(4) == 0 {
-            hue_colour(rng.next_f32(), uniform(rng, 0.4, 0.8))
-        } else {
-            hue_colour(uniform(rng, 0.02, 0.12), uniform(rng, 0.05, 0.3))
-        };
+        let tint = lamp_tint(rng);
         drawn.push((c, r, level, tint));
     }
     // Radiance from power: flux = π · L · area for a Lambertian emitter.

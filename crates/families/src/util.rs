@@ -41,6 +41,15 @@ pub(super) fn hue_colour(h: f32, s: f32) -> [f32; 3] {
     rgb.map(|c| 1.0 - s + s * c)
 }
 
+/// A lamp's colour (maximum component 1): three in four warm white, the rest saturated.
+pub(super) fn lamp_tint(rng: &mut Pcg32) -> [f32; 3] {
+    if rng.next_bounded(4) == 0 {
+        hue_colour(rng.next_f32(), uniform(rng, 0.4, 0.8))
+    } else {
+        hue_colour(uniform(rng, 0.02, 0.12), uniform(rng, 0.05, 0.3))
+    }
+}
+
 /// A shape with a material and a transform, not emitting.
 pub(super) fn shape(
     geometry: GeometryDesc,
