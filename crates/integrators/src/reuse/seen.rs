@@ -12,7 +12,7 @@
 //! can be estimated with their own samples. On the pixels of the silhouette mask the seen
 //! emission is the mean of `n` camera rays, the G-buffer's and `n − 1` more drawn from their own
 //! stream; elsewhere it is the G-buffer ray's, as before. The mask depends on the camera, the
-//! film window and the scene only (pixel-centre rays, no random numbers), never on the pass's
+//! film window and the scene only (camera rays every half pixel, no random numbers), never on the pass's
 //! samples, so every pixel's estimate stays unbiased and a split render gets the same mask.
 
 use std::sync::Mutex;
@@ -79,9 +79,9 @@ impl SeenEmission {
         }
     }
 
-    /// The silhouette mask of pass `ctx`'s window: pixels within the filter's reach of a pixel
-    /// whose centre sees another emitter (or the environment, or a surface that does not emit)
-    /// than their own, where an area emitter is in the neighbourhood. Made once per window; returns
+    /// The silhouette mask of pass `ctx`'s window: pixels within whose filter's reach probes
+    /// every half pixel see more than one thing (emitters, the environment, surfaces that do not
+    /// emit), an area emitter among them. Made once per window; returns
     /// it and the rays traced.
     fn mask(&self, scene: &Scene, ctx: &PassContext) -> (Vec<bool>, u64) {
         let (w, h) = ctx.resolution(scene);
@@ -98,18 +98,24 @@ impl SeenEmission {
         }
         let reach = filter_reach(ctx.filter);
         let (wi, hi) = (w as i32, h as i32);
-        // Centre rays over the window and a border of `reach` pixels (the filter sees past it).
-        let (bw, bh) = (wi + 2 * reach, hi + 2 * reach);
+        // Probes every half pixel (film coordinates `p / 2`: pixel centres, edge midpoints and
+        // corners) over the window and a border of `reach` pixels (the filter sees past it), so
+        // an emitter showing as a sliver thinner than a pixel between two pixel centres is seen.
+        let side = |n: i32| 2 * n - 1 + 4 * reach;
+        let (bw, bh) = (side(wi), side(hi));
+        let lo = 1 - 2 * reach;
         let ids: Vec<(u32, u64)> = (0..(bw * bh) as usize)
             .into_par_iter()
             .map(|i| {
-                let (x, y) = ((i as i32 % bw) - reach, (i as i32 / bw) - reach);
-                let film = Vec2::new((x + x0 as i32) as f32 + 0.5, (y + y0 as i32) as f32 + 0.5);
+                let (px, py) = ((i as i32 % bw) + lo, (i as i32 / bw) + lo);
+                let film = Vec2::new(
+                    x0 as f32 + px as f32 * 0.5,
+                    y0 as f32 + py as f32 * 0.5,
+                );
                 seen_id(scene, film)
             })
             .collect();
         let rays = ids.iter().map(|&(_, r)| r).sum();
-        let id = |x: i32, y: i32| ids[((y + reach) * bw + x + reach) as usize].0;
         // Only area emitters: an environment behind a silhouette is about as bright as the
         // surface it lights, and there the seen emission and the reflected light of one camera
         // ray are anticorrelated (whichever the ray sees, the pixel gets about the same), so
@@ -118,13 +124,15 @@ impl SeenEmission {
         let mask: Vec<bool> = (0..(wi * hi) as usize)
             .into_par_iter()
             .map(|i| {
+                // The probes within the filter's reach of the pixel's centre.
                 let (x, y) = (i as i32 % wi, i as i32 / wi);
-                let c = id(x, y);
-                let mut any_emitter = emits(c);
+                let (qx, qy) = (2 * x, 2 * y);
+                let c = ids[((qy + 2 * reach) * bw + qx + 2 * reach) as usize].0;
+                let mut any_emitter = false;
                 let mut differs = false;
-                for dy in -reach..=reach {
-                    for dx in -reach..=reach {
-                        let v = id(x + dx, y + dy);
+                for py in qy..=qy + 4 * reach {
+                    let row = &ids[(py * bw + qx) as usize..=(py * bw + qx + 4 * reach) as usize];
+                    for &(v, _) in row {
                         differs |= v != c;
                         any_emitter |= emits(v);
                     }
