@@ -12,8 +12,9 @@
 //! can be estimated with their own samples. On the pixels of the silhouette mask the seen
 //! emission is the mean of `n` camera rays, the G-buffer's and `n − 1` more drawn from their own
 //! stream; elsewhere it is the G-buffer ray's, as before. The mask depends on the camera, the
-//! film window and the scene only (camera rays every half pixel, no random numbers), never on the pass's
-//! samples, so every pixel's estimate stays unbiased and a split render gets the same mask.
+//! film window and the scene only (camera rays every half pixel, no random numbers), never on
+//! the pass's samples, so every pixel's estimate stays unbiased and a split render gets the
+//! same mask.
 
 use std::sync::Mutex;
 
@@ -108,10 +109,7 @@ impl SeenEmission {
             .into_par_iter()
             .map(|i| {
                 let (px, py) = ((i as i32 % bw) + lo, (i as i32 / bw) + lo);
-                let film = Vec2::new(
-                    x0 as f32 + px as f32 * 0.5,
-                    y0 as f32 + py as f32 * 0.5,
-                );
+                let film = Vec2::new(x0 as f32 + px as f32 * 0.5, y0 as f32 + py as f32 * 0.5);
                 seen_id(scene, film)
             })
             .collect();
