@@ -322,10 +322,7 @@ impl Integrator for RestirDiIntegrator {
             } else {
                 0
             }
-            + self
-                .seen
-                .as_ref()
-                .map_or(0, |_| std::mem::size_of::<bool>())
+            + self.seen.as_ref().map_or(0, |_| std::mem::size_of::<u16>())
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {

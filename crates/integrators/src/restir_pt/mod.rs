@@ -412,8 +412,8 @@ impl Integrator for RestirPtIntegrator {
             + std::mem::size_of::<Vec3>()
             + reciprocal::table_bytes_per_pixel::<PathSample>(&self.settings.reuse)
             + self.di.as_ref().map_or(0, |d| d.buffer_bytes_per_pixel())
-            // The silhouette mask, one byte per pixel.
-            + self.seen.as_ref().map_or(0, |_| std::mem::size_of::<bool>())
+            // The silhouette mask, a ray count per pixel.
+            + self.seen.as_ref().map_or(0, |_| std::mem::size_of::<u16>())
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {

@@ -11,10 +11,16 @@
 //! The pixel integral is the seen emission plus the light the primary hit reflects; both parts
 //! can be estimated with their own samples. On the pixels of the silhouette mask the seen
 //! emission is the mean of `n` camera rays, the G-buffer's and `n − 1` more drawn from their own
-//! stream; elsewhere it is the G-buffer ray's, as before. The mask depends on the camera, the
-//! film window and the scene only (camera rays every half pixel, no random numbers), never on
-//! the pass's samples, so every pixel's estimate stays unbiased and a split render gets the
-//! same mask.
+//! stream; elsewhere it is the G-buffer ray's, as before. `n` follows what the silhouette is
+//! worth: one ray's variance there is at most a quarter of the squared contrast the pixel
+//! straddles (the largest minus the smallest luminance its probes see), so for a given number
+//! of rays the summed variance is least with `n` in proportion to that contrast (Neyman's
+//! allocation). `n` is `edge_rays` times the pixel's contrast over the mean contrast of the
+//! film's silhouette pixels, at least 1 and at most [`MAX_RAYS_FACTOR`] times `edge_rays`: the
+//! rays `edge_rays` pays for on average, moved from dim lights' silhouettes to bright ones'.
+//! The counts depend on the camera, the film and the scene only (camera rays every half pixel,
+//! no random numbers), never on a pass's samples, so every pixel's estimate stays unbiased and
+//! a split render (chains, tiles) gets the same counts.
 
 use std::sync::Mutex;
 
@@ -25,8 +31,15 @@ use restir_scene::Scene;
 use crate::film::Filter;
 use crate::pass::PassContext;
 
-/// A film window (width, height, x0, y0) and its silhouette mask.
-type WindowMask = ((u32, u32, u32, u32), Vec<bool>);
+/// A film window (width, height, x0, y0) and its mask: each pixel's camera rays for the seen
+/// emission (0 off the mask).
+type WindowMask = (Window, Vec<u16>);
+
+/// A film window: width, height and the film position of its first pixel.
+type Window = (u32, u32, u32, u32);
+
+/// The most camera rays a silhouette pixel gets, in multiples of `edge_rays`.
+pub const MAX_RAYS_FACTOR: u32 = 8;
 
 /// Random-stream stage of the extra camera rays.
 const STAGE_SEEN: u64 = 117;
@@ -34,7 +47,8 @@ const STAGE_SEEN: u64 = 117;
 /// The extra camera rays on silhouettes, with the mask of the current film window.
 #[derive(Debug)]
 pub struct SeenEmission {
-    /// Camera rays for the seen emission on a silhouette pixel (the G-buffer's included).
+    /// Camera rays for the seen emission on a silhouette pixel whose contrast is the scene's
+    /// typical emitted radiance (the G-buffer's included).
     rays: u32,
     /// Negative control: the pixels whose own camera ray saw emission instead of the mask.
     from_pass: bool,
@@ -43,15 +57,26 @@ pub struct SeenEmission {
 }
 
 /// What a camera ray sees, for the mask: 0 a surface that does not emit, `1 + light` an
-/// emitter's shape, `u32::MAX` the environment (or nothing).
-fn seen_id(scene: &Scene, film: Vec2) -> (u32, u64) {
+/// emitter's shape, `u32::MAX` the environment (or nothing); the luminance of the emission it
+/// sees (0 on a surface that does not emit); the rays traced.
+fn seen_id(scene: &Scene, film: Vec2) -> (u32, f32, u64) {
     let ray = scene.camera.generate_ray(film, Vec2::splat(0.5));
     let (hit, rays) = scene.camera_intersect(&ray, false);
-    let id = match hit {
-        None => u32::MAX,
-        Some(si) => scene.lights.light_on_shape(si.shape).map_or(0, |l| l + 1),
+    let lights = &scene.lights;
+    let (id, seen) = match hit {
+        None => (u32::MAX, lights.environment_radiance(ray.d)),
+        Some(si) => lights
+            .light_on_shape(si.shape)
+            .map_or((0, Vec3::ZERO), |l| {
+                (l + 1, lights.area_radiance(l, si.shading.n, -ray.d))
+            }),
     };
-    (id, rays)
+    (id, luminance(seen), rays)
+}
+
+/// Rec. 709 luminance.
+fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
 /// How far, in whole pixels, a pixel's filter reaches beyond its own square.
@@ -80,11 +105,79 @@ impl SeenEmission {
         }
     }
 
-    /// The silhouette mask of pass `ctx`'s window: pixels within whose filter's reach probes
-    /// every half pixel see more than one thing (emitters, the environment, surfaces that do not
-    /// emit), an area emitter among them. Made once per window; returns
-    /// it and the rays traced.
-    fn mask(&self, scene: &Scene, ctx: &PassContext) -> (Vec<bool>, u64) {
+    /// The contrast that each pixel of the film window `(w, h, x0, y0)` straddles: the largest
+    /// minus the smallest luminance seen by the probes within its filter's reach, on the
+    /// pixels where those probes see more than one thing (emitters, the environment, surfaces
+    /// that do not emit), an area emitter among them; 0 elsewhere. Probes are camera rays every
+    /// half pixel (film coordinates `p / 2`: pixel centres, edge midpoints and corners) over the
+    /// window and a border of `reach` pixels (the filter sees past it), so an emitter showing as
+    /// a sliver thinner than a pixel between two pixel centres is seen; a pixel's value depends
+    /// on its own neighbourhood only, never on the window. Returns it and the rays traced.
+    fn contrast(scene: &Scene, reach: i32, (w, h, x0, y0): Window) -> (Vec<f32>, u64) {
+        let (wi, hi) = (w as i32, h as i32);
+        let side = |n: i32| 2 * n - 1 + 4 * reach;
+        let (bw, bh) = (side(wi), side(hi));
+        let lo = 1 - 2 * reach;
+        let ids: Vec<(u32, f32, u64)> = (0..(bw * bh) as usize)
+            .into_par_iter()
+            .map(|i| {
+                let (px, py) = ((i as i32 % bw) + lo, (i as i32 / bw) + lo);
+                let film = Vec2::new(x0 as f32 + px as f32 * 0.5, y0 as f32 + py as f32 * 0.5);
+                seen_id(scene, film)
+            })
+            .collect();
+        let rays = ids.iter().map(|&(_, _, r)| r).sum();
+        // Only area emitters: an environment behind a silhouette is about as bright as the
+        // surface it lights, and there the seen emission and the reflected light of one camera
+        // ray are anticorrelated (whichever the ray sees, the pixel gets about the same), so
+        // estimating them with separate samples would add variance, not remove it.
+        let emits = |v: u32| v != 0 && v != u32::MAX;
+        let contrast = (0..(wi * hi) as usize)
+            .into_par_iter()
+            .map(|i| {
+                // The probes within the filter's reach of the pixel's centre.
+                let (x, y) = (i as i32 % wi, i as i32 / wi);
+                let (qx, qy) = (2 * x, 2 * y);
+                let c = ids[((qy + 2 * reach) * bw + qx + 2 * reach) as usize].0;
+                let mut any_emitter = false;
+                let mut differs = false;
+                let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
+                for py in qy..=qy + 4 * reach {
+                    let row = &ids[(py * bw + qx) as usize..=(py * bw + qx + 4 * reach) as usize];
+                    for &(v, l, _) in row {
+                        differs |= v != c;
+                        any_emitter |= emits(v);
+                        lo = lo.min(l);
+                        hi = hi.max(l);
+                    }
+                }
+                if differs && any_emitter {
+                    (hi - lo).max(0.0)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        (contrast, rays)
+    }
+
+    /// The mean contrast over the pixels of the mask (0 without any), summed in order so that
+    /// it does not depend on the thread count.
+    fn mean_contrast(contrast: &[f32]) -> f64 {
+        let (sum, n) = contrast
+            .iter()
+            .filter(|&&c| c > 0.0)
+            .fold((0.0f64, 0u64), |(s, n), &c| (s + f64::from(c), n + 1));
+        if n > 0 { sum / n as f64 } else { 0.0 }
+    }
+
+    /// The camera rays for the seen emission of each pixel of pass `ctx`'s window (0 or 1: the
+    /// G-buffer's only): `edge_rays` times the contrast the pixel straddles over the mean
+    /// contrast of the whole film's silhouette pixels, at least 1 and at most
+    /// [`MAX_RAYS_FACTOR`] times `edge_rays`. A window smaller than the film probes the whole
+    /// film too, for that mean, so a tile gets the untiled render's counts. Made once per
+    /// window; returns it and the rays traced.
+    fn mask(&self, scene: &Scene, ctx: &PassContext) -> (Vec<u16>, u64) {
         let (w, h) = ctx.resolution(scene);
         let (x0, y0) = ctx
             .crop
@@ -98,44 +191,24 @@ impl SeenEmission {
             return (mask.clone(), 0);
         }
         let reach = filter_reach(ctx.filter);
-        let (wi, hi) = (w as i32, h as i32);
-        // Probes every half pixel (film coordinates `p / 2`: pixel centres, edge midpoints and
-        // corners) over the window and a border of `reach` pixels (the filter sees past it), so
-        // an emitter showing as a sliver thinner than a pixel between two pixel centres is seen.
-        let side = |n: i32| 2 * n - 1 + 4 * reach;
-        let (bw, bh) = (side(wi), side(hi));
-        let lo = 1 - 2 * reach;
-        let ids: Vec<(u32, u64)> = (0..(bw * bh) as usize)
-            .into_par_iter()
-            .map(|i| {
-                let (px, py) = ((i as i32 % bw) + lo, (i as i32 / bw) + lo);
-                let film = Vec2::new(x0 as f32 + px as f32 * 0.5, y0 as f32 + py as f32 * 0.5);
-                seen_id(scene, film)
-            })
-            .collect();
-        let rays = ids.iter().map(|&(_, r)| r).sum();
-        // Only area emitters: an environment behind a silhouette is about as bright as the
-        // surface it lights, and there the seen emission and the reflected light of one camera
-        // ray are anticorrelated (whichever the ray sees, the pixel gets about the same), so
-        // estimating them with separate samples would add variance, not remove it.
-        let emits = |v: u32| v != 0 && v != u32::MAX;
-        let mask: Vec<bool> = (0..(wi * hi) as usize)
-            .into_par_iter()
-            .map(|i| {
-                // The probes within the filter's reach of the pixel's centre.
-                let (x, y) = (i as i32 % wi, i as i32 / wi);
-                let (qx, qy) = (2 * x, 2 * y);
-                let c = ids[((qy + 2 * reach) * bw + qx + 2 * reach) as usize].0;
-                let mut any_emitter = false;
-                let mut differs = false;
-                for py in qy..=qy + 4 * reach {
-                    let row = &ids[(py * bw + qx) as usize..=(py * bw + qx + 4 * reach) as usize];
-                    for &(v, _) in row {
-                        differs |= v != c;
-                        any_emitter |= emits(v);
-                    }
+        let (contrast, mut rays) = Self::contrast(scene, reach, key);
+        let (fw, fh) = scene.camera.resolution();
+        let mean = if key == (fw, fh, 0, 0) {
+            Self::mean_contrast(&contrast)
+        } else {
+            let (film, r) = Self::contrast(scene, reach, (fw, fh, 0, 0));
+            rays += r;
+            Self::mean_contrast(&film)
+        };
+        let most = f64::from((self.rays * MAX_RAYS_FACTOR).min(u32::from(u16::MAX)));
+        let mask: Vec<u16> = contrast
+            .iter()
+            .map(|&c| {
+                if c <= 0.0 || mean <= 0.0 {
+                    return 0;
                 }
-                differs && any_emitter
+                let n = (f64::from(self.rays) * f64::from(c) / mean).round();
+                n.clamp(1.0, most) as u16
             })
             .collect();
         if let Ok(mut m) = self.mask.lock() {
@@ -154,23 +227,27 @@ impl SeenEmission {
             return 0;
         }
         let (mask, mut rays) = if self.from_pass {
-            (radiance.iter().map(|l| l.max_element() > 0.0).collect(), 0)
+            let n = self.rays.min(u32::from(u16::MAX)) as u16;
+            let mask = radiance
+                .iter()
+                .map(|l| if l.max_element() > 0.0 { n } else { 0 });
+            (mask.collect(), 0)
         } else {
             self.mask(scene, ctx)
         };
         let (w, _) = ctx.resolution(scene);
         let lights = &scene.lights;
-        let extra = self.rays - 1;
         rays += radiance
             .par_iter_mut()
             .enumerate()
-            .filter(|(i, _)| mask[*i])
+            .filter(|(i, _)| mask[*i] > 1)
             .map(|(i, l)| {
+                let n = u32::from(mask[i]);
                 let (x, y) = ((i % w as usize) as u32, (i / w as usize) as u32);
                 let mut rng = ctx.stage_rng(i, STAGE_SEEN);
                 let mut sum = *l;
                 let mut rays = 0;
-                for _ in 0..extra {
+                for _ in 1..n {
                     let film = ctx.film_position(x, y, &mut rng);
                     let ray = scene.camera.generate_ray(film, rng.next_2d());
                     let (hit, n) = scene.camera_intersect(&ray, false);
@@ -182,7 +259,7 @@ impl SeenEmission {
                         }),
                     };
                 }
-                *l = sum / self.rays as f32;
+                *l = sum / n as f32;
                 rays
             })
             .sum::<u64>();
