@@ -210,6 +210,10 @@ impl Integrator for AutoIntegrator {
         self.chosen.learned()
     }
 
+    fn silhouettes(&self) -> Option<String> {
+        self.chosen.silhouettes()
+    }
+
     fn next_frame(&self, motion: Arc<FrameMotion>) {
         self.chosen.next_frame(motion);
     }

@@ -282,6 +282,12 @@ pub trait Integrator: Sync + Send + std::fmt::Debug {
     fn learned(&self) -> Option<String> {
         None
     }
+    /// What the estimator decided about the emitter silhouettes in view (pixels that get more
+    /// camera rays for the emission they see, and how many), one line; `None` (the default)
+    /// when it decides nothing of the kind.
+    fn silhouettes(&self) -> Option<String> {
+        None
+    }
     /// Why this estimator renders when the `auto` estimator chose it (what its rules measured
     /// of the scene, one line); `None` (the default) when it was asked for by name.
     fn auto_choice(&self) -> Option<&str> {

@@ -45,6 +45,9 @@ struct Stats<'a> {
     /// What the estimator learned across passes (ReSTIR DI with `--learn on`).
     #[serde(skip_serializing_if = "Option::is_none")]
     learned: Option<String>,
+    /// The camera rays given to emitter silhouettes (ReSTIR DI and PT with `--edge-rays` above 1).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    silhouettes: Option<String>,
     /// The part of a split render this process rendered (--chain, --crop).
     #[serde(skip_serializing_if = "Option::is_none")]
     part: Option<cluster::PartStats>,
@@ -137,6 +140,7 @@ impl Report<'_> {
                 .map(|(stage, seconds)| StageSeconds { stage, seconds })
                 .collect(),
             learned: integrator.learned(),
+            silhouettes: integrator.silhouettes(),
             part: self.plan.map(|p| p.stats(integrator, scene)),
         };
         let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;

@@ -291,6 +291,10 @@ impl Integrator for RestirDiIntegrator {
         self.settings.learn.is_on().then(|| self.learning.summary())
     }
 
+    fn silhouettes(&self) -> Option<String> {
+        self.seen.as_ref().and_then(SeenEmission::summary)
+    }
+
     /// The previous frame's reservoirs are reused with the motion: light samples move with
     /// their lights, receivers are found by motion vectors, targets of previous domains are
     /// evaluated in the previous frame's scene.

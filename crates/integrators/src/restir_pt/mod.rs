@@ -378,6 +378,10 @@ impl Integrator for RestirPtIntegrator {
         self.settings.reuse.halo()
     }
 
+    fn silhouettes(&self) -> Option<String> {
+        self.seen.as_ref().and_then(SeenEmission::summary)
+    }
+
     fn stage_seconds(&self) -> Vec<(&'static str, f64)> {
         self.clock.seconds()
     }

@@ -98,6 +98,27 @@ impl SeenEmission {
         }
     }
 
+    /// What the current mask decided, one line: its pixels, the mean and largest camera-ray
+    /// counts on them, the film's mean contrast (`None` before the first pass or in the
+    /// negative control).
+    pub fn summary(&self) -> Option<String> {
+        let m = self.mask.lock().ok()?;
+        let ((w, h, _, _), mask) = m.as_ref()?;
+        let on: Vec<u32> = mask.iter().filter(|&&n| n > 0).map(|&n| u32::from(n)).collect();
+        let most = on.iter().copied().max().unwrap_or(0);
+        let mean = on.iter().map(|&n| f64::from(n)).sum::<f64>() / on.len().max(1) as f64;
+        Some(format!(
+            "{} of {} pixels on emitter silhouettes ({:.2} %), {mean:.1} camera rays each on average \
+             (edge_rays {}: in proportion to the luminance contrast each straddles, at most {most} \
+             here, at most {} allowed)",
+            on.len(),
+            w * h,
+            100.0 * on.len() as f64 / f64::from((w * h).max(1)),
+            self.rays,
+            self.rays * MAX_RAYS_FACTOR
+        ))
+    }
+
     /// Forgets the mask (the camera or the scene moved).
     pub fn clear(&self) {
         if let Ok(mut m) = self.mask.lock() {
