@@ -104,7 +104,11 @@ impl SeenEmission {
     pub fn summary(&self) -> Option<String> {
         let m = self.mask.lock().ok()?;
         let ((w, h, _, _), mask) = m.as_ref()?;
-        let on: Vec<u32> = mask.iter().filter(|&&n| n > 0).map(|&n| u32::from(n)).collect();
+        let on: Vec<u32> = mask
+            .iter()
+            .filter(|&&n| n > 0)
+            .map(|&n| u32::from(n))
+            .collect();
         let most = on.iter().copied().max().unwrap_or(0);
         let mean = on.iter().map(|&n| f64::from(n)).sum::<f64>() / on.len().max(1) as f64;
         Some(format!(
