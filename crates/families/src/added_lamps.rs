@@ -23,6 +23,7 @@
 use glam::{Vec2, Vec3};
 use restir_geometry::{Ray, offset_ray_origin};
 use restir_sampling::Pcg32;
+use restir_sampling::warp::sample_uniform_sphere;
 use restir_scene::Scene;
 
 use super::util::{lamp_tint, uniform};
@@ -55,10 +56,7 @@ pub fn added_lamps(scene: &Scene, count: u32, seed: u64) -> Vec<AddedLamp> {
     let mut drawn = Vec::new();
     for _ in 0..count {
         let spot = (0..100).find_map(|_| {
-            let z = 1.0 - 2.0 * rng.next_f32();
-            let phi = core::f32::consts::TAU * rng.next_f32();
-            let s = (1.0 - z * z).max(0.0).sqrt();
-            let d = Vec3::new(s * phi.cos(), s * phi.sin(), z);
+            let d = sample_uniform_sphere(rng.next_2d());
             let height = uniform(&mut rng, 0.005, 0.02) * diag;
             let radius = uniform(&mut rng, 0.0005, 0.0015) * diag;
             let hit = scene.intersect(&Ray::new(eye, d))?;

@@ -22,10 +22,11 @@
 //! no random numbers), never on a pass's samples, so every pixel's estimate stays unbiased and
 //! a split render (chains, tiles) gets the same counts.
 
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
+use restir_sampling::luminance;
 use restir_scene::Scene;
 
 use crate::film::Filter;
@@ -33,7 +34,7 @@ use crate::pass::PassContext;
 
 /// A film window (width, height, x0, y0) and its mask: each pixel's camera rays for the seen
 /// emission (0 off the mask).
-type WindowMask = (Window, Vec<u16>);
+type WindowMask = (Window, Arc<Vec<u16>>);
 
 /// A film window: width, height and the film position of its first pixel.
 type Window = (u32, u32, u32, u32);
@@ -47,8 +48,8 @@ const STAGE_SEEN: u64 = 117;
 /// The extra camera rays on silhouettes, with the mask of the current film window.
 #[derive(Debug)]
 pub struct SeenEmission {
-    /// Camera rays for the seen emission on a silhouette pixel whose contrast is the scene's
-    /// typical emitted radiance (the G-buffer's included).
+    /// Camera rays for the seen emission on a silhouette pixel, the G-buffer's included: the
+    /// mean over the film's silhouette pixels (each gets a count in proportion to its contrast).
     rays: u32,
     /// Negative control: the pixels whose own camera ray saw emission instead of the mask.
     from_pass: bool,
@@ -74,11 +75,6 @@ fn seen_id(scene: &Scene, film: Vec2) -> (u32, f32, u64) {
     (id, luminance(seen), rays)
 }
 
-/// Rec. 709 luminance.
-fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
-}
-
 /// How far, in whole pixels, a pixel's filter reaches beyond its own square.
 fn filter_reach(filter: &Filter) -> i32 {
     let radius = match filter {
@@ -98,9 +94,8 @@ impl SeenEmission {
         }
     }
 
-    /// What the current mask decided, one line: its pixels, the mean and largest camera-ray
-    /// counts on them, the film's mean contrast (`None` before the first pass or in the
-    /// negative control).
+    /// What the current mask decided, one line: its pixels and the mean and largest camera-ray
+    /// counts on them (`None` before the first pass or in the negative control).
     pub fn summary(&self) -> Option<String> {
         let m = self.mask.lock().ok()?;
         let ((w, h, _, _), mask) = m.as_ref()?;
@@ -130,15 +125,15 @@ impl SeenEmission {
         }
     }
 
-    /// The contrast that each pixel of the film window `(w, h, x0, y0)` straddles: the largest
+    /// The contrast that each pixel of a `w × h` film straddles: the largest
     /// minus the smallest luminance seen by the probes within its filter's reach, on the
     /// pixels where those probes see more than one thing (emitters, the environment, surfaces
     /// that do not emit), an area emitter among them; 0 elsewhere. Probes are camera rays every
     /// half pixel (film coordinates `p / 2`: pixel centres, edge midpoints and corners) over the
-    /// window and a border of `reach` pixels (the filter sees past it), so an emitter showing as
+    /// film and a border of `reach` pixels (the filter sees past it), so an emitter showing as
     /// a sliver thinner than a pixel between two pixel centres is seen; a pixel's value depends
-    /// on its own neighbourhood only, never on the window. Returns it and the rays traced.
-    fn contrast(scene: &Scene, reach: i32, (w, h, x0, y0): Window) -> (Vec<f32>, u64) {
+    /// on its own neighbourhood only. Returns it and the rays traced.
+    fn contrast(scene: &Scene, reach: i32, (w, h): (u32, u32)) -> (Vec<f32>, u64) {
         let (wi, hi) = (w as i32, h as i32);
         let side = |n: i32| 2 * n - 1 + 4 * reach;
         let (bw, bh) = (side(wi), side(hi));
@@ -147,7 +142,7 @@ impl SeenEmission {
             .into_par_iter()
             .map(|i| {
                 let (px, py) = ((i as i32 % bw) + lo, (i as i32 / bw) + lo);
-                let film = Vec2::new(x0 as f32 + px as f32 * 0.5, y0 as f32 + py as f32 * 0.5);
+                let film = Vec2::new(px as f32 * 0.5, py as f32 * 0.5);
                 seen_id(scene, film)
             })
             .collect();
@@ -200,9 +195,9 @@ impl SeenEmission {
     /// G-buffer's only): `edge_rays` times the contrast the pixel straddles over the mean
     /// contrast of the whole film's silhouette pixels, at least 1 and at most
     /// [`MAX_RAYS_FACTOR`] times `edge_rays`. A window smaller than the film probes the whole
-    /// film too, for that mean, so a tile gets the untiled render's counts. Made once per
-    /// window; returns it and the rays traced.
-    fn mask(&self, scene: &Scene, ctx: &PassContext) -> (Vec<u16>, u64) {
+    /// film, for that mean, and takes its pixels' contrasts from it, so a tile gets the untiled
+    /// render's counts. Made once per window; returns it and the rays traced.
+    fn mask(&self, scene: &Scene, ctx: &PassContext) -> (Arc<Vec<u16>>, u64) {
         let (w, h) = ctx.resolution(scene);
         let (x0, y0) = ctx
             .crop
@@ -213,31 +208,37 @@ impl SeenEmission {
             && let Some((k, mask)) = m.as_ref()
             && *k == key
         {
-            return (mask.clone(), 0);
+            return (Arc::clone(mask), 0);
         }
         let reach = filter_reach(ctx.filter);
-        let (contrast, mut rays) = Self::contrast(scene, reach, key);
         let (fw, fh) = scene.camera.resolution();
-        let mean = if key == (fw, fh, 0, 0) {
-            Self::mean_contrast(&contrast)
-        } else {
-            let (film, r) = Self::contrast(scene, reach, (fw, fh, 0, 0));
-            rays += r;
-            Self::mean_contrast(&film)
+        let (film, rays) = Self::contrast(scene, reach, (fw, fh));
+        let mean = Self::mean_contrast(&film);
+        // A pixel's contrast depends on its own neighbourhood only: a window takes the film's
+        // values (none beyond the film).
+        let film_contrast = |x: u32, y: u32| {
+            let (x, y) = (x0 + x, y0 + y);
+            if x < fw && y < fh {
+                film[(y * fw + x) as usize]
+            } else {
+                0.0
+            }
         };
         let most = f64::from((self.rays * MAX_RAYS_FACTOR).min(u32::from(u16::MAX)));
-        let mask: Vec<u16> = contrast
-            .iter()
-            .map(|&c| {
-                if c <= 0.0 || mean <= 0.0 {
-                    return 0;
-                }
-                let n = (f64::from(self.rays) * f64::from(c) / mean).round();
-                n.clamp(1.0, most) as u16
-            })
-            .collect();
+        let mask: Arc<Vec<u16>> = Arc::new(
+            (0..w * h)
+                .map(|i| {
+                    let c = film_contrast(i % w, i / w);
+                    if c <= 0.0 || mean <= 0.0 {
+                        return 0;
+                    }
+                    let n = (f64::from(self.rays) * f64::from(c) / mean).round();
+                    n.clamp(1.0, most) as u16
+                })
+                .collect(),
+        );
         if let Ok(mut m) = self.mask.lock() {
-            *m = Some((key, mask.clone()));
+            *m = Some((key, Arc::clone(&mask)));
         }
         (mask, rays)
     }
@@ -256,7 +257,7 @@ impl SeenEmission {
             let mask = radiance
                 .iter()
                 .map(|l| if l.max_element() > 0.0 { n } else { 0 });
-            (mask.collect(), 0)
+            (Arc::new(mask.collect()), 0)
         } else {
             self.mask(scene, ctx)
         };
