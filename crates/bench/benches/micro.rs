@@ -427,22 +427,27 @@ mod lights {
             });
     }
 
-    fn gbuffer(scene: &Scene) -> GBuffer {
-        let filter = Filter::new(scene.filter);
-        let ctx = PassContext {
+    fn context(filter: &Filter) -> PassContext<'_> {
+        PassContext {
             shared_offset: None,
             seed: 0,
             pass: 0,
-            filter: &filter,
+            filter,
             crop: None,
-        };
+        }
+    }
+
+    fn gbuffer(scene: &Scene) -> GBuffer {
+        let filter = Filter::new(scene.filter);
+        let ctx = context(&filter);
         let (w, h) = scene.camera.resolution();
         let mut radiance = vec![Vec3::ZERO; (w * h) as usize];
         GBuffer::trace(scene, &ctx, false, false, true, &mut radiance).0
     }
 
-    /// Building the per-tile light tables of one 128×128 pass (64 tiles; one thread).
-    #[divan::bench(args = [1, 400, 4096])]
+    /// Building the tiles' light cuts and their pools for one 128×128 pass (64 tiles, 8
+    /// candidates per pixel; one thread).
+    #[divan::bench(args = COUNTS)]
     fn tiles_build(bencher: Bencher, n: usize) {
         let scene = scene(n);
         let pool = rayon::ThreadPoolBuilder::new()
@@ -450,28 +455,38 @@ mod lights {
             .build()
             .unwrap();
         let gbuf = pool.install(|| gbuffer(&scene));
-        bencher.bench_local(|| pool.install(|| black_box(tiles::LightTiles::build(&scene, &gbuf))));
+        let filter = Filter::new(scene.filter);
+        let ctx = context(&filter);
+        scene.lights.build_hierarchy();
+        bencher.bench_local(|| {
+            pool.install(|| {
+                black_box(tiles::LightTiles::build(
+                    &scene,
+                    &ctx,
+                    &gbuf,
+                    8,
+                    false,
+                    6,
+                    |_| true,
+                ))
+            })
+        });
     }
 
-    /// Drawing a light from the tile/power mixture (selection only; the point on the light is
-    /// `sample_light`'s, as in `sample`).
-    #[divan::bench(args = [1, 400, 4096])]
-    fn tiles_select(bencher: Bencher, n: usize) {
+    /// Picking an emitter from a cut of 256 nodes of the light hierarchy (the node by its
+    /// alias table, the emitter within it by power).
+    #[divan::bench(args = COUNTS)]
+    fn cut_pick(bencher: Bencher, n: usize) {
         let scene = scene(n);
-        let gbuf = gbuffer(&scene);
-        let t = tiles::LightTiles::build(&scene, &gbuf).expect("tables");
+        let cut = scene
+            .lights
+            .light_cut(Vec3::new(0.0, 0.5, 0.0), Vec3::ZERO, 0.5, tiles::CUT_NODES)
+            .expect("a cut");
         let input = receivers();
         bencher.counter(ItemsCount::new(BATCH)).bench_local(|| {
             let mut acc = 0.0f32;
-            for (i, &(_, us, _)) in input.iter().enumerate() {
-                let Some(table) = t.table((i * 13) % 128, (i * 7) % 128) else {
-                    continue;
-                };
-                let mixture = restir_lights::TableSampler {
-                    table,
-                    share: tiles::TILE_SHARE,
-                };
-                if let Some((_, pmf, _)) = mixture.select(&scene.lights, us) {
+            for &(_, us, u) in &input {
+                if let Some((_, pmf)) = scene.lights.pick_from_cut(&cut, us, u.x as f64) {
                     acc += pmf;
                 }
             }

@@ -214,6 +214,10 @@ impl Integrator for AutoIntegrator {
         self.chosen.silhouettes()
     }
 
+    fn light_cuts(&self) -> Option<String> {
+        self.chosen.light_cuts()
+    }
+
     fn next_frame(&self, motion: Arc<FrameMotion>) {
         self.chosen.next_frame(motion);
     }

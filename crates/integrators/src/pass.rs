@@ -288,6 +288,11 @@ pub trait Integrator: Sync + Send + std::fmt::Debug {
     fn silhouettes(&self) -> Option<String> {
         None
     }
+    /// How the estimator cut the light hierarchy for screen tiles in its last pass (ReSTIR DI
+    /// with `light_sampler = tiles`), one line; `None` (the default) when it does not.
+    fn light_cuts(&self) -> Option<String> {
+        None
+    }
     /// Why this estimator renders when the `auto` estimator chose it (what its rules measured
     /// of the scene, one line); `None` (the default) when it was asked for by name.
     fn auto_choice(&self) -> Option<&str> {

@@ -30,13 +30,24 @@ const REUSE: &[(&str, &str)] = &[("radius", "4"), ("spatial_rounds", "2")];
 /// (docs/CLUSTER.md), so with learning a split render is another estimator, not the same bits.
 const DI: &[(&str, &str)] = &[("radius", "4"), ("spatial_rounds", "2"), ("learn", "off")];
 
-/// The path tracer (with independent numbers and with Sobol sequences), ReSTIR DI and PT.
+/// The same with candidates from the 16×16 tiles' cuts of the light hierarchy, whose pools
+/// come from streams named by the tiles' places on the film.
+const DI_TILES: &[(&str, &str)] = &[
+    ("radius", "4"),
+    ("spatial_rounds", "2"),
+    ("learn", "off"),
+    ("light_sampler", "tiles"),
+];
+
+/// The path tracer (with independent numbers and with Sobol sequences), ReSTIR DI (with the
+/// power sampler's pool and with the tiles' light cuts) and PT.
 fn estimators(scene: &common::Built) -> Vec<Box<dyn Integrator>> {
     let sobol = make_with_sampler(scene, restir_scene::SamplerKind::Sobol);
     vec![
         integrator(scene, "path", &[]),
         sobol,
         integrator(scene, "restir-di", DI),
+        integrator(scene, "restir-di", DI_TILES),
         integrator(scene, "restir-pt", REUSE),
     ]
 }

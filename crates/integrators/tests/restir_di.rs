@@ -4,8 +4,8 @@
 //! tracer for every unbiased MIS scheme, block by block, within the standard error measured
 //! *across seeds* (spatial reuse correlates the pixels of one render). The biased options
 //! (constant 1/M weights, visibility reuse) must fail the same test. The light hierarchy as
-//! the candidate source (`light_sampler = bvh`) passes it, and its negative control (the
-//! hierarchy's candidates weighted by the power table's pmf) fails it, and so does ReSTIR DI at
+//! the candidate source (`light_sampler = bvh`, and its per-tile cuts, `tiles`) passes it, and
+//! its negative controls (the candidates weighted by the power table's pmf) fail it, and so does ReSTIR DI at
 //! its defaults on this scene of one dominant light, where `auto` takes the path tracer.
 
 use std::sync::atomic::AtomicBool;
@@ -172,7 +172,7 @@ fn unbiased_for_every_unbiased_mis_scheme() {
     );
     eprintln!("2 rounds: max |z| = {z:.2}");
     assert!(z < Z_MAX, "2 rounds: max |z| = {z:.2}");
-    // Tile light selection (mixed with the power sampler) and a tiny radius stay unbiased.
+    // The tiles' cuts of the light hierarchy with two rounds stay unbiased.
     let params = [
         ("light_sampler", "tiles"),
         ("candidates", "4"),
@@ -535,32 +535,40 @@ fn xml_restir_integrator_and_parameters() {
     );
 }
 
-/// The light hierarchy as the candidate source is unbiased (alone and with two rounds of reuse);
-/// weighting its candidates by the power table's pmf instead of the hierarchy's (the wrong
-/// density) is caught by the same test.
+/// The light hierarchy as the candidate source, by a descent per receiver (`bvh`) or from the
+/// tiles' cuts (`tiles`), is unbiased (alone and with two rounds of reuse); weighting its
+/// candidates by the power table's pmf instead of theirs (the wrong density) is caught by the
+/// same test, for each.
 #[test]
-fn light_hierarchy_is_unbiased_and_a_wrong_pmf_is_caught() {
+fn light_hierarchy_and_its_cuts_are_unbiased_and_a_wrong_pmf_is_caught() {
     let scene = scene();
     let reference = direct_reference(&scene);
     for params in [
         &[("light_sampler", "bvh"), ("candidates", "4")][..],
         &[("light_sampler", "bvh"), ("spatial_rounds", "2")][..],
+        &[("light_sampler", "tiles"), ("candidates", "4")][..],
     ] {
         let z = max_z(&statistics(&scene, "restir-di", params, 1, 200), &reference);
         eprintln!("{params:?}: max |z| = {z:.2}");
         assert!(z < Z_MAX, "{params:?}: max |z| = {z:.2}");
     }
-    let mut wrong = RestirDiSettings::new(restir_integrators::path::PathSettings::from_desc(
-        &scene.integrator,
-    ));
-    wrong.light_sampler = LightSampler::BvhWithPowerPmf;
-    wrong.candidates = 4;
-    let z = max_z(&settings_statistics(&scene, wrong, 200), &reference);
-    eprintln!("hierarchy with the power pmf: max |z| = {z:.2}");
-    assert!(
-        z > 2.0 * Z_MAX,
-        "the wrong pmf should be visibly biased, max |z| = {z:.2}"
-    );
+    for sampler in [
+        LightSampler::BvhWithPowerPmf,
+        LightSampler::TilesWithPowerPmf,
+    ] {
+        let mut wrong = RestirDiSettings::new(restir_integrators::path::PathSettings::from_desc(
+            &scene.integrator,
+        ));
+        wrong.light_sampler = sampler;
+        wrong.candidates = 4;
+        let z = max_z(&settings_statistics(&scene, wrong, 200), &reference);
+        eprintln!("{} with the power pmf: max |z| = {z:.2}", sampler.name());
+        assert!(
+            z > 2.0 * Z_MAX,
+            "{}: the wrong pmf should be visibly biased, max |z| = {z:.2}",
+            sampler.name()
+        );
+    }
 }
 
 /// On this scene (the small bright sphere takes more than half of the light selections among a

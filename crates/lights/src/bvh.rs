@@ -179,11 +179,24 @@ pub(crate) struct LightBvh {
     /// Per entry of the table, its leaf's path from the root (bit `d` set: second child at
     /// depth `d`); `u64::MAX` for an entry outside the tree.
     trails: Vec<u64>,
+    /// Per node, the leaves under it: `(first, count)` in depth-first leaf order.
+    spans: Vec<(u32, u32)>,
+    /// Per entry of the table, its leaf's position in depth-first order; `u32::MAX` outside.
+    ordinals: Vec<u32>,
+    /// The entries in depth-first leaf order.
+    by_ordinal: Vec<u32>,
+    /// Prefix sums of the leaves' power in depth-first order (one more than the leaves), so a
+    /// node's entries are drawn by power in its span ([`LightBvh::sample_span`]).
+    prefix: Vec<f64>,
+    /// A guide into `prefix`: entry `k` is the leaf whose interval holds `k / len` of the total
+    /// power, so a search by power starts next to its answer (the guide table of Chen and
+    /// Asau, 1974).
+    guide: Vec<u32>,
     /// Entries without bounds (directional lights), picked by power beside the tree.
-    unbounded: Vec<(u32, f32)>,
+    pub(crate) unbounded: Vec<(u32, f32)>,
     /// Share of local selections that go to `unbounded` (their power share).
-    unbounded_share: f32,
-    unbounded_power: f32,
+    pub(crate) unbounded_share: f32,
+    pub(crate) unbounded_power: f32,
     /// The least squared distance importance divides by: `(10⁻⁶ · extent)²` of the tree's box
     /// (10⁻¹² for a scene of unit extent), so that a receiver on a point-like node does not
     /// divide by zero, and the same scene in any unit weighs its nodes alike (an absolute floor
@@ -265,6 +278,11 @@ impl LightBvh {
         let mut bvh = LightBvh {
             nodes: Vec::with_capacity(2 * items.len()),
             trails: vec![u64::MAX; entries.len()],
+            spans: Vec::with_capacity(2 * items.len()),
+            ordinals: vec![u32::MAX; entries.len()],
+            by_ordinal: Vec::with_capacity(items.len()),
+            prefix: vec![0.0],
+            guide: Vec::new(),
             unbounded,
             unbounded_share: (unbounded_power / (unbounded_power + bounded_power).max(1e-300))
                 as f32,
@@ -276,6 +294,7 @@ impl LightBvh {
         } else {
             bvh.build(&mut items, 0, 0);
             bvh.d2_floor = Self::d2_floor(bvh.nodes[0].lo, bvh.nodes[0].hi);
+            bvh.guide = guide(&bvh.prefix);
         }
         bvh
     }
@@ -327,6 +346,12 @@ impl LightBvh {
                 leaf: true,
             });
             self.trails[entry as usize] = trail;
+            let ordinal = self.by_ordinal.len() as u32;
+            self.spans.push((ordinal, 1));
+            self.ordinals[entry as usize] = ordinal;
+            self.by_ordinal.push(entry);
+            let last = *self.prefix.last().unwrap_or(&0.0);
+            self.prefix.push(last + power as f64);
             return index;
         }
         self.nodes.push(Node {
@@ -337,6 +362,8 @@ impl LightBvh {
             index: 0,
             leaf: false,
         });
+        let first = self.by_ordinal.len() as u32;
+        self.spans.push((first, items.len() as u32));
         // Median split of the centroids along their widest axis.
         let extent = chi - clo;
         let axis = if extent.x >= extent.y && extent.x >= extent.z {
@@ -368,16 +395,8 @@ impl LightBvh {
         let s = self.unbounded_share as f64;
         if !self.unbounded.is_empty() {
             if u < s {
-                let v = u / s * self.unbounded_power as f64;
-                let mut acc = 0.0f64;
-                for &(entry, w) in &self.unbounded {
-                    acc += w as f64;
-                    if v < acc {
-                        return Some((entry, self.unbounded_share * w / self.unbounded_power));
-                    }
-                }
-                let &(entry, w) = self.unbounded.last()?;
-                return Some((entry, self.unbounded_share * w / self.unbounded_power));
+                let (entry, pmf) = self.sample_unbounded(u / s)?;
+                return Some((entry, self.unbounded_share * pmf));
             }
             u = ((u - s) / (1.0 - s)).min(1.0 - f64::EPSILON);
             pmf = 1.0 - self.unbounded_share;
@@ -415,7 +434,7 @@ impl LightBvh {
     #[inline]
     pub fn pmf(&self, p: Vec3, n: Vec3, entry: u32) -> f32 {
         if let Some(&(_, w)) = self.unbounded.iter().find(|(e, _)| *e == entry) {
-            return self.unbounded_share * w / self.unbounded_power;
+            return self.unbounded_share * (w / self.unbounded_power);
         }
         let Some(&trail) = self.trails.get(entry as usize) else {
             return 0.0;
@@ -461,6 +480,132 @@ impl LightBvh {
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }
+
+    /// The importance of node `i` for every receiver within `spread` of `p` whose normal is `n`
+    /// (zero: any normal): the node's box grown by `spread`, so that each such receiver sees
+    /// the node's emitters within the directions `p` sees the grown box in, and the bound stays
+    /// conservative (zero only where no emitter of the node can light any of them).
+    #[inline]
+    pub(crate) fn region_importance(&self, i: usize, p: Vec3, n: Vec3, spread: f32) -> f32 {
+        let mut node = self.nodes[i];
+        let grow = Vec3::splat(spread);
+        node.lo -= grow;
+        node.hi += grow;
+        node.importance(p, n, self.d2_floor)
+    }
+
+    /// The children of node `i`, or `None` for a leaf.
+    #[inline]
+    pub(crate) fn children(&self, i: usize) -> Option<(usize, usize)> {
+        let node = &self.nodes[i];
+        (!node.leaf).then_some((i + 1, node.index as usize))
+    }
+
+    /// How far node `i`'s emitters spread as seen from `p`: the radius of its bounding sphere
+    /// over the distance to its centre, at most 1.
+    #[inline]
+    pub(crate) fn angular_size(&self, i: usize, p: Vec3) -> f32 {
+        let node = &self.nodes[i];
+        let r = 0.5 * (node.hi - node.lo).length();
+        let d = (0.5 * (node.lo + node.hi) - p).length();
+        if d <= r { 1.0 } else { r / d }
+    }
+
+    /// Node `i`'s leaves, `(first, count)` in depth-first order.
+    #[inline]
+    pub(crate) fn span(&self, i: usize) -> (u32, u32) {
+        self.spans[i]
+    }
+
+    /// Whether the tree holds any entry.
+    pub(crate) fn has_nodes(&self) -> bool {
+        !self.nodes.is_empty()
+    }
+
+    /// Picks an entry of the span `(first, count)` by power with `u ∈ [0, 1)`: `(entry,
+    /// probability within the span)`.
+    #[inline]
+    pub(crate) fn sample_span(&self, (first, count): (u32, u32), u: f64) -> (u32, f32) {
+        let (a, b) = (first as usize, (first + count) as usize);
+        let (lo, hi) = (self.prefix[a], self.prefix[b]);
+        let target = lo + u * (hi - lo);
+        // The leaf whose interval [prefix[o], prefix[o + 1]) holds the target: from the guide's
+        // leaf a few steps forward, else by bisection over the rest of the span.
+        let total = self.prefix[self.prefix.len() - 1];
+        let n = self.guide.len();
+        let k = ((target / total * n as f64) as usize).min(n - 1);
+        let mut o = (self.guide[k] as usize).clamp(a, b - 1);
+        // Rounding of the bucket can put the guide one leaf past the target.
+        while o > a && self.prefix[o] > target {
+            o -= 1;
+        }
+        let mut steps = 0;
+        while o + 1 < b && self.prefix[o + 1] <= target {
+            o += 1;
+            steps += 1;
+            if steps == 8 {
+                o += self.prefix[o + 1..b].partition_point(|&c| c <= target);
+                break;
+            }
+        }
+        let o = o.min(b - 1);
+        let pmf = ((self.prefix[o + 1] - self.prefix[o]) / (hi - lo)) as f32;
+        (self.by_ordinal[o], pmf)
+    }
+
+    /// The probability that [`LightBvh::sample_span`] picks `entry` from the span `(first,
+    /// count)`; `None` if the entry is not in it.
+    #[inline]
+    pub(crate) fn span_pmf(&self, (first, count): (u32, u32), entry: u32) -> Option<f32> {
+        let o = *self.ordinals.get(entry as usize)? as usize;
+        let (a, b) = (first as usize, (first + count) as usize);
+        if o < a || o >= b {
+            return None;
+        }
+        Some(((self.prefix[o + 1] - self.prefix[o]) / (self.prefix[b] - self.prefix[a])) as f32)
+    }
+
+    /// The depth-first position of `entry`'s leaf, if the tree holds it.
+    #[inline]
+    pub(crate) fn ordinal(&self, entry: u32) -> Option<u32> {
+        self.ordinals
+            .get(entry as usize)
+            .copied()
+            .filter(|&o| o != u32::MAX)
+    }
+
+    /// Picks one of the entries without bounds by power with `u ∈ [0, 1)`: `(entry, probability
+    /// among them)`.
+    pub(crate) fn sample_unbounded(&self, u: f64) -> Option<(u32, f32)> {
+        let v = u * self.unbounded_power as f64;
+        let mut acc = 0.0f64;
+        for &(entry, w) in &self.unbounded {
+            acc += w as f64;
+            if v < acc {
+                return Some((entry, w / self.unbounded_power));
+            }
+        }
+        let &(entry, w) = self.unbounded.last()?;
+        Some((entry, w / self.unbounded_power))
+    }
+}
+
+/// The guide table of the prefix sums `prefix` (one more than the leaves, non-decreasing,
+/// starting at 0): per bucket `k` of as many as leaves, the last leaf `o` with
+/// `prefix[o] ≤ k / n · total`, so the leaf holding any target in the bucket is at or after it.
+fn guide(prefix: &[f64]) -> Vec<u32> {
+    let n = prefix.len() - 1;
+    let total = prefix[n];
+    let mut out = Vec::with_capacity(n);
+    let mut o = 0usize;
+    for k in 0..n {
+        let t = k as f64 / n as f64 * total;
+        while o + 1 < n && prefix[o + 1] <= t {
+            o += 1;
+        }
+        out.push(o as u32);
+    }
+    out
 }
 
 /// The bounding box of a mesh.

@@ -6,12 +6,13 @@
 //! | `light.rs` | [`Light`] (diffuse area lights on shapes, one-sided as in Mitsuba; point, spot ([`Spot`]), projector ([`Projector`]), directional, constant and image environment lights, [`EnvMap`] being Mitsuba's `envmap`), [`LightSample`] (a point on one light drawn for a receiver, [`LightSet::sample_light`]) and the densities of points reached another way ([`LightSet::pdf_sa`]) |
 //! | `set.rs` | [`LightSet`]: every light of a scene with the shapes area lights lie on (emitters know their shapes, as in Mitsuba 3's scene, so no caller hands the shape list around), each light's power, the environment's share of selections |
 //! | `select.rs` | which light: the power sampler ([`LightSet::sample`], [`LightSet::select`], [`LightSet::pmf`]) over one flat emitter table (`table.rs`: every emissive triangle, every other light), and the light hierarchy over the same entries (`bvh.rs`: [`LightSet::sample_hierarchy`], [`LightSet::hierarchy_pmf`]) |
+//! | `cut.rs` | the hierarchy cut once for a region of receivers ([`LightCut`], [`LightSet::light_cut`]): a node by an alias table over the cut, an emitter of it by power, with the exact probability of any entry ([`LightSet::cut_pmf`]) |
 //! | `point.rs` | a light sample named without its receiver ([`LightPoint`], what a reservoir holds), resolved in world space ([`LightSet::resolve`], [`Resolved`]) and seen from a receiver ([`Contact`]) |
 //! | `learned.rs` | a selection learned across passes: per cell of a world-space grid, what each emitter (a triangle, another light, the environment) delivered after its shadow ray ([`LightRecords`]), sampled in a mixture with the power sampler with its exact probability ([`LearnedSampler`]) |
 //! | `spot.rs` | [`Spot`], Mitsuba's `spot` emitter (a point light with an angular falloff and an optional projected [`SpotTexture`]) |
 //! | `projector.rs` | [`Projector`], Mitsuba's `projector` emitter (a pinhole throwing an irradiance image, a [`SpotTexture`] or a constant, through a perspective frustum) |
 //! | `presample.rs` | samples drawn without a receiver ([`LightSet::presample`], [`Presampled`]), for pools of presampled candidates |
-//! | `sampler.rs` | one interface over all of these for a receiver's candidates ([`LightSampler`]: power, hierarchy, presampled pool, a table mixed with the power sampler, the learned cell), each candidate with the density that drew it and the power sampler's ([`LightCandidate`]) |
+//! | `sampler.rs` | one interface over all of these for a receiver's candidates ([`LightSampler`]: power, hierarchy, presampled pool, a cut of the hierarchy for a screen tile, the learned cell), each candidate with the density that drew it and the power sampler's ([`LightCandidate`]) |
 //!
 //! [`LightSet::sample`] returns a [`LightSample`] whose `pdf_sa` already includes the selection
 //! probability; [`LightSet::pdf_sa`] returns exactly that density for a point reached another
@@ -45,6 +46,7 @@
 
 mod bvh;
 mod contact;
+mod cut;
 mod envmap;
 mod learned;
 mod light;
@@ -58,6 +60,7 @@ mod spot;
 mod table;
 
 pub use contact::Contact;
+pub use cut::LightCut;
 pub use envmap::{EnvMap, EnvMapError};
 pub use learned::{CellKey, EmitterGroups, LearnGrid, LearnedDraw, LearnedSampler, LightRecords};
 pub use light::{Light, LightSample};
@@ -66,7 +69,7 @@ pub use presample::Presampled;
 pub use projector::{Projector, ProjectorError};
 pub use sampler::{
     At, CandidateU, HierarchySampler, LearnedCellSampler, LightCandidate, LightSampler,
-    PoolSampler, PowerSampler, TableSampler,
+    PoolSampler, PowerSampler,
 };
 pub use set::{LightError, LightSet};
 pub use spot::{Spot, SpotError, SpotTexture};

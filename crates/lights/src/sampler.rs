@@ -10,14 +10,14 @@
 //! | [`PowerSampler`] | the emitter table by power ([`LightSet::sample`]) | a uniform point of the picked triangle, or the light's own sampling |
 //! | [`HierarchySampler`] | the light hierarchy, receiver-aware ([`LightSet::sample_hierarchy`]) | the same |
 //! | [`PoolSampler`] | the power sampler's draws made once for a block of pixels ([`LightSet::presample`]) | fixed with the draw (a sphere's point per receiver) |
-//! | [`TableSampler`] | a table over the lights mixed with the power sampler (screen tiles) | [`LightSet::sample_light`] |
+//! | [`LearnedCellSampler`] over a tile's pool | a cut of the light hierarchy made for a screen tile's receivers ([`LightSet::light_cut`], [`LightSet::presample_cut`]) | a pool of the cut's draws per tile, made once per pass |
 //! | [`LearnedCellSampler`] | the learned table of the receiver's cell over emitters (triangles, other lights, the environment) mixed with the power sampler ([`LearnedSampler`](crate::LearnedSampler)) | a pool of the mixture's draws per cell, made once per pass ([`LearnedSampler::presample`](crate::LearnedSampler::presample)) |
 //!
 //! Each is a small value made per receiver from tables built per pass, so the candidate loop is
 //! monomorphised for each.
 
 use glam::{Vec2, Vec3};
-use restir_sampling::{AliasTable, ONE_MINUS_EPSILON, Pcg32};
+use restir_sampling::{ONE_MINUS_EPSILON, Pcg32};
 
 use crate::{Contact, LearnedDraw, LightPoint, LightSample, LightSet, Presampled, Resolved};
 
@@ -292,57 +292,15 @@ fn without_selection(lights: &LightSet, e: Presampled) -> Presampled {
     }
 }
 
-/// A table over the lights mixed with the power sampler: the light is the table's with
-/// probability `share`, else the power sampler's, and its probability is the mixture's,
-/// `share · table + (1 − share) · power`, so every light with power keeps its support whatever
-/// the table got wrong.
-#[derive(Clone, Copy, Debug)]
-pub struct TableSampler<'a> {
-    /// The table, indexed by light.
-    pub table: &'a AliasTable,
-    /// The table's share of selections, in `[0, 1)`.
-    pub share: f32,
-}
-
-impl TableSampler<'_> {
-    /// Picks a light with uniform `u`: `(light, mixture probability, power probability)`.
-    #[inline]
-    pub fn select(&self, lights: &LightSet, u: f32) -> Option<(u32, f32, f32)> {
-        let share = self.share;
-        let light = if u < share {
-            self.table.sample(u / share).0 as u32
-        } else {
-            let v = ((u - share) / (1.0 - share)).min(ONE_MINUS_EPSILON);
-            lights.select(v)?.0
-        };
-        let power_pmf = lights.pmf(light);
-        let pmf = share * self.table.pmf(light as usize) + (1.0 - share) * power_pmf;
-        Some((light, pmf, power_pmf))
-    }
-}
-
-impl LightSampler for TableSampler<'_> {
-    #[inline]
-    fn candidate(
-        &self,
-        lights: &LightSet,
-        at: At,
-        u: &CandidateU,
-        _rng: &mut Pcg32,
-    ) -> Option<LightCandidate> {
-        let (light, pmf, power_pmf) = self.select(lights, u.select)?;
-        let ls = lights.sample_light(light, at.p, u.point)?;
-        LightCandidate::from_sample(&ls, pmf * ls.pdf_sa, power_pmf * ls.pdf_sa)
-    }
-}
-
 /// The learned selection at a receiver's cell ([`LearnedSampler`](crate::LearnedSampler)),
 /// from the cell's pool of presampled draws of the mixture
 /// ([`LearnedSampler::presample`](crate::LearnedSampler::presample)), taken as [`PoolSampler`]
 /// takes a tile's: from a uniform start, one entry from each of `n` strata of the pool. Each
 /// entry is an independent draw of the mixture whose density is the power sampler's times the
 /// entry's probability ratio, so whichever entries a receiver takes, each candidate is
-/// distributed as the mixture with exactly the density it carries.
+/// distributed as the mixture with exactly the density it carries. A screen tile's pool of
+/// draws from its cut of the light hierarchy ([`LightSet::presample_cut`]) is taken the same
+/// way.
 #[derive(Clone, Copy, Debug)]
 pub struct LearnedCellSampler<'a> {
     pool: &'a [Option<LearnedDraw>],

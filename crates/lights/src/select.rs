@@ -60,7 +60,7 @@ impl LightSet {
     }
 
     /// The light hierarchy over the table's entries (built on the first call).
-    fn hierarchy(&self) -> &LightBvh {
+    pub(crate) fn hierarchy(&self) -> &LightBvh {
         self.hierarchy.get_or_init(|| {
             let weights = self.table.weights(&self.lights, &self.shapes, &self.powers);
             LightBvh::new(&self.lights, &self.shapes, &self.table, &weights)

@@ -9,6 +9,15 @@
 //!   local share), and the power density it reports is what `LightSet::pdf_sa` says;
 //! - the negative control: the same descent tested against the power table's pmf is rejected.
 //!
+//! Cuts of the hierarchy for a region of receivers (`LightSet::light_cut`, `pick_from_cut`,
+//! `cut_pmf`, `presample_cut`, `sample_cut`), at cuts of 1 to 2000 nodes:
+//!
+//! - picks follow `cut_pmf` (chi-square), which sums to 1, and a pick's probability equals it;
+//! - every entry that can light some receiver of the region (the hierarchy gives it a positive
+//!   probability there) keeps a positive probability in the cut;
+//! - presampled draws and samples carry the cut's density;
+//! - the negative control: the cut's picks tested against the power table's pmf are rejected.
+//!
 //! The scene: 300 one-sided emissive rectangles (600 triangle entries) of powers spread over
 //! three decades, facing up, down and sideways, two emissive spheres, a point light and a
 //! directional light (kept beside the tree).
@@ -282,4 +291,141 @@ fn probabilities_do_not_depend_on_the_unit() {
         unit.hierarchy_pmf(receivers[1], Vec3::ZERO, 0),
     );
     assert!((a - b).abs() / a > 1e-2, "{a} {b}");
+}
+
+/// Cut sizes: the root alone, a few clusters, most of the tree, every leaf.
+const CUT_SIZES: [usize; 4] = [1, 16, 256, 2000];
+/// The region's radius around each receiver.
+const SPREAD: f32 = 0.4;
+
+fn cut_pmfs(set: &LightSet, cut: &restir_lights::LightCut) -> Vec<f64> {
+    (0..set.emitter_count())
+        .map(|e| set.cut_pmf(cut, e) as f64)
+        .collect()
+}
+
+fn cut_histogram(set: &LightSet, cut: &restir_lights::LightCut, seed: u64) -> Histogram {
+    let mut rng = Pcg32::new(seed, 2);
+    let mut hist = Histogram::new(set.emitter_count());
+    for _ in 0..SAMPLES {
+        let (e, pmf) = set
+            .pick_from_cut(cut, rng.next_f32(), rng.next_f64())
+            .expect("a cut with importance always picks");
+        assert_eq!(pmf, set.cut_pmf(cut, e), "entry {e}");
+        assert!(pmf > 0.0);
+        hist.record(Some(e));
+    }
+    hist
+}
+
+#[test]
+fn cut_follows_its_pmf() {
+    let (_, set) = scene();
+    let level = sidak_level(0.01, RECEIVERS.len() * CUT_SIZES.len());
+    for (i, &(p, n)) in RECEIVERS.iter().enumerate() {
+        for (j, &nodes) in CUT_SIZES.iter().enumerate() {
+            let cut = set.light_cut(p, n, SPREAD, nodes).unwrap();
+            assert!(cut.len() <= nodes.max(1));
+            let pmf = cut_pmfs(&set, &cut);
+            let total: f64 = pmf.iter().sum();
+            assert!(
+                (total - 1.0).abs() < 1e-4,
+                "receiver {i}, {nodes} nodes: Σ pmf = {total}"
+            );
+            let seed = 300 + 10 * i as u64 + j as u64 + seed_offset();
+            let outcome = cut_histogram(&set, &cut, seed).chi2(&pmf).unwrap();
+            eprintln!("receiver {i}, cut of {} nodes: {outcome}", cut.len());
+            assert!(
+                outcome.accepts(level),
+                "receiver {i}, {nodes} nodes: {outcome}"
+            );
+        }
+    }
+}
+
+/// The cut's importance holds for the whole region: an entry the hierarchy can pick at any
+/// receiver within the spread (with the region's normal) has a positive probability in the
+/// cut, at every cut size.
+#[test]
+fn cut_keeps_every_light_that_can_reach_the_region() {
+    let (_, set) = scene();
+    let mut rng = Pcg32::new(21, 4);
+    let mut zero_somewhere = 0;
+    for &(p, n) in &RECEIVERS {
+        for &nodes in &CUT_SIZES {
+            let cut = set.light_cut(p, n, SPREAD, nodes).unwrap();
+            for _ in 0..32 {
+                let d = restir_sampling::warp::sample_uniform_sphere(rng.next_2d());
+                let q = p + d * SPREAD * rng.next_f32().cbrt();
+                for e in 0..set.emitter_count() {
+                    if set.hierarchy_pmf(q, n, e) > 0.0 {
+                        assert!(
+                            set.cut_pmf(&cut, e) > 0.0,
+                            "entry {e} at {q}, {nodes} nodes"
+                        );
+                    } else {
+                        zero_somewhere += 1;
+                    }
+                }
+            }
+        }
+    }
+    // Some entries cannot light some receivers (the test is not vacuous).
+    assert!(zero_somewhere > 0);
+}
+
+/// A point sampled from a cut carries the cut's entry probability over the power sampler's
+/// times the power density; a presampled draw carries the same ratio.
+#[test]
+fn cut_samples_carry_the_cut_density() {
+    let (_, set) = scene();
+    let mut rng = Pcg32::new(13, 1);
+    for &(p, n) in &RECEIVERS {
+        let cut = set.light_cut(p, n, SPREAD, 64).unwrap();
+        let mut checked = 0;
+        for _ in 0..4000 {
+            let Some((s, power_pdf)) =
+                set.sample_cut(&cut, p, rng.next_f32(), rng.next_f64(), rng.next_2d())
+            else {
+                continue;
+            };
+            if s.delta {
+                continue;
+            }
+            let e = set.emitter_of(s.light, s.prim).unwrap();
+            let want = set.cut_pmf(&cut, e) / set.emitter_pmf(e);
+            let ratio = s.pdf_sa / power_pdf;
+            assert!((ratio - want).abs() <= 1e-3 * want, "{ratio} vs {want}");
+            checked += 1;
+        }
+        assert!(checked > 1000, "{checked}");
+        let mut pool = vec![None; 512];
+        set.presample_cut(&cut, &mut rng, false, &mut pool);
+        for (d, ratio) in pool.iter().flatten() {
+            let e = match *d {
+                restir_lights::Presampled::Fixed { point, .. } => {
+                    set.emitter_of(point.light, point.prim)
+                }
+                restir_lights::Presampled::Light { light, .. } => set.emitter_of(light, 0),
+            }
+            .unwrap();
+            let want = set.cut_pmf(&cut, e) / set.emitter_pmf(e);
+            assert!((ratio - want).abs() <= 1e-4 * want, "{ratio} vs {want}");
+        }
+    }
+}
+
+/// Negative control: a fine cut's picks are far from the power table's probabilities, and the
+/// test says so.
+#[test]
+fn negative_control_cut_against_power_pmf_is_rejected() {
+    let (_, set) = scene();
+    let (p, n) = RECEIVERS[0];
+    let cut = set.light_cut(p, n, SPREAD, 256).unwrap();
+    let power: Vec<f64> = (0..set.emitter_count())
+        .map(|e| set.emitter_pmf(e) as f64)
+        .collect();
+    let outcome = cut_histogram(&set, &cut, 78).chi2(&power).unwrap();
+    eprintln!("power pmf: {outcome}");
+    assert!(outcome.p_value < 1e-6, "{outcome}");
 }

@@ -4,8 +4,8 @@
 //! power sampler and each other sampler (|z| < 4, fixed seeds), and the power sampler's
 //! solid-angle density it reports with every candidate is the power sampler's own.
 //!
-//! Negative controls, each rejected (|z| > 8): the hierarchy claiming the power sampler's
-//! density, a pool forgetting a whole light's selection probability, the learned cell forgetting
+//! Negative controls, each rejected (|z| > 8): the hierarchy and a pool of a cut of it
+//! claiming the power sampler's density, a pool forgetting a whole light's selection probability, the learned cell forgetting
 //! its defensive share, the learned cell in groups claiming the probabilities of single emitters.
 //!
 //! The scene: 30 emissive spheres over two decades of radiance, two emissive rectangles (mesh
@@ -18,9 +18,9 @@ use restir_geometry::{Shape, Sphere};
 use restir_lights::{
     At, CandidateU, HierarchySampler, LearnGrid, LearnedCellSampler, LearnedDraw, LearnedSampler,
     Light, LightCandidate, LightRecords, LightSampler, LightSet, PoolSampler, PowerSampler,
-    Presampled, TableSampler,
+    Presampled,
 };
-use restir_sampling::{AliasTable, ONE_MINUS_EPSILON, Pcg32, luminance};
+use restir_sampling::{ONE_MINUS_EPSILON, Pcg32, luminance};
 
 fn scene() -> LightSet {
     let mut rng = Pcg32::new(11, 5);
@@ -170,11 +170,21 @@ fn cell_pools(
 }
 
 /// A skewed table over the lights (every third light, growing weights).
-fn table(lights: &LightSet) -> AliasTable {
-    let w: Vec<f32> = (0..lights.len())
-        .map(|l| if l % 3 == 0 { 1.0 + l as f32 } else { 0.0 })
-        .collect();
-    AliasTable::new(&w).unwrap()
+/// Per receiver, a pool of draws from a cut of the light hierarchy made for a region around
+/// the receiver (as a screen tile's), of `len` entries; `claim_power` weighs them as the power
+/// sampler's (the negative control).
+fn cut_pools(lights: &LightSet, nodes: usize, claim_power: bool) -> Vec<Vec<Option<LearnedDraw>>> {
+    let cut = lights
+        .light_cut(AT.p + Vec3::new(0.2, 0.1, 0.0), AT.n, 0.5, nodes)
+        .unwrap();
+    let mut rng = Pcg32::new(23, 7);
+    (0..RECEIVERS)
+        .map(|_| {
+            let mut pool = vec![None; 32];
+            lights.presample_cut(&cut, &mut rng, claim_power, &mut pool);
+            pool
+        })
+        .collect()
 }
 
 #[test]
@@ -184,7 +194,7 @@ fn every_sampler_estimates_the_same_integral() {
     eprintln!("power: {:.6} ± {:.6}", power.0, power.1);
     let (grouped, grouped_cell) = learned_sampler(&lights, 10.0);
     let (learned, cell) = learned_sampler(&lights, 0.0);
-    let table = table(&lights);
+    let cut_pool = cut_pools(&lights, 16, false);
     let mut tiles: Vec<Vec<Option<Presampled>>> = Vec::new();
     let mut rng = Pcg32::new(4, 4);
     for _ in 0..RECEIVERS {
@@ -204,14 +214,12 @@ fn every_sampler_estimates_the_same_integral() {
             "pool",
             estimate(&lights, 3, |_| PoolSampler::new(next_tile())),
         ),
-        (
-            "table",
-            estimate(&lights, 14, |_| TableSampler {
-                table: &table,
-                share: 0.5,
-            }),
-        ),
     ];
+    let mut k = 0;
+    let cut = estimate(&lights, 14, |_| {
+        k += 1;
+        LearnedCellSampler::new(&cut_pool[k - 1])
+    });
     let pools = cell_pools(&lights, &learned, cell, true, 64);
     let mut k = 0;
     let learned_pool = estimate(&lights, 5, |_| {
@@ -232,6 +240,7 @@ fn every_sampler_estimates_the_same_integral() {
         LearnedCellSampler::new(&grouped_pools[k - 1])
     });
     for (name, e) in cases.into_iter().chain([
+        ("pool of a cut of the hierarchy", cut),
         ("learned cell pool", learned_pool),
         ("learned cell pool of 3", learned_small),
         (
@@ -267,8 +276,16 @@ fn negative_controls_are_rejected() {
             }
         }
     }
-    let (mut k, mut j, mut i) = (0, 0, 0);
+    let power_claims = cut_pools(&lights, 16, true);
+    let (mut k, mut j, mut i, mut c) = (0, 0, 0, 0);
     let controls = [
+        (
+            "cut pool claiming the power density",
+            estimate(&lights, 15, |_| {
+                c += 1;
+                LearnedCellSampler::new(&power_claims[c - 1])
+            }),
+        ),
         (
             "hierarchy claiming the power density",
             estimate(&lights, 2, |_| HierarchySampler {

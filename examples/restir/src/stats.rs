@@ -48,6 +48,9 @@ struct Stats<'a> {
     /// The camera rays given to emitter silhouettes (ReSTIR DI and PT with `--edge-rays` above 1).
     #[serde(skip_serializing_if = "Option::is_none")]
     silhouettes: Option<String>,
+    /// How screen tiles cut the light hierarchy (ReSTIR DI with `--light-sampler tiles`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    light_cuts: Option<String>,
     /// The part of a split render this process rendered (--chain, --crop).
     #[serde(skip_serializing_if = "Option::is_none")]
     part: Option<cluster::PartStats>,
@@ -141,6 +144,7 @@ impl Report<'_> {
                 .collect(),
             learned: integrator.learned(),
             silhouettes: integrator.silhouettes(),
+            light_cuts: integrator.light_cuts(),
             part: self.plan.map(|p| p.stats(integrator, scene)),
         };
         let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;

@@ -4,10 +4,10 @@
 //! One pass, for every pixel at once (`docs/RESTIR_DI.md`):
 //!
 //! 1. **Primary hits** ([`GBuffer`]), adding what the camera sees directly.
-//! 2. **Initial resampling**: `N_L` light candidates from the power-based light sampler or the
-//!    light hierarchy (a receiver-aware descent with its exact probability; from
-//!    [`settings::HIERARCHY_MIN_EMITTERS`] emitters on by default; stratified selection either
-//!    way; with `learn` on, from the second pass on, a mixture of the power sampler and what
+//! 2. **Initial resampling**: `N_L` light candidates from the screen tile's cut of the light
+//!    hierarchy ([`tiles`], the default where the scene has a local emitter), the power-based
+//!    light sampler or the hierarchy's descent per receiver (stratified selection each way;
+//!    with `learn` on, from the second pass on, a mixture of the power sampler and what
 //!    lights delivered to the receiver's cell in earlier passes, [`learn`]), streamed into a
 //!    reservoir with weights `p̂/(N_L·p_L)` (with `--bsdf-samples resampled`, `N_B` BSDF
 //!    candidates beside them, both weighted by their shares of the light/BSDF split); the result
@@ -40,14 +40,13 @@ use restir_geometry::{Ray, offset_ray_origin};
 use restir_gris::Reservoir;
 use restir_lights::{
     HierarchySampler, LearnedCellSampler, LightPoint, PoolSampler, PowerSampler, Resolved,
-    TableSampler,
 };
 use restir_materials::Bsdf;
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
 pub use settings::{
-    BsdfDiffuse, BsdfSamples, HIERARCHY_MIN_EMITTERS, LEARN_MAX_EMITTERS, Learn, LightSampler,
+    AUTO_LIGHT_SAMPLER, BsdfDiffuse, BsdfSamples, LEARN_MAX_EMITTERS, Learn, LightSampler,
     RESAMPLE_BELOW_VISIBLE, RestirDiSettings, Visibility,
 };
 
@@ -70,6 +69,7 @@ const STAGE_INITIAL: u64 = 1;
 const STAGE_SHADE: u64 = 3;
 const STAGE_POOL: u64 = 4;
 const STAGE_LEARN_POOL: u64 = 5;
+const STAGE_TILE_POOL: u64 = 6;
 const STAGES: Stages = Stages {
     temporal: 2,
     spatial: 16,
@@ -95,6 +95,8 @@ pub struct RestirDiIntegrator {
     lookups: std::sync::Mutex<Lookups>,
     /// More camera rays for the seen emission on emitter silhouettes (`edge_rays > 1`).
     seen: Option<SeenEmission>,
+    /// What the last pass's tiles' light cuts held (`light_sampler = tiles`).
+    cuts: std::sync::Mutex<Option<tiles::CutSummary>>,
 }
 
 /// What a pass looks up once per pixel: the initial sample resolved in world space and the BSDF.
@@ -125,6 +127,7 @@ impl RestirDiIntegrator {
             learning: learn::Learning::default(),
             chain: PassChain::default(),
             lookups: Default::default(),
+            cuts: Default::default(),
             seen: (settings.edge_rays > 1)
                 .then(|| SeenEmission::new(settings.edge_rays, settings.edge_mask_from_pass)),
         }
@@ -295,6 +298,11 @@ impl Integrator for RestirDiIntegrator {
         self.seen.as_ref().and_then(SeenEmission::summary)
     }
 
+    fn light_cuts(&self) -> Option<String> {
+        let summary = *self.cuts.lock().ok()?;
+        summary.map(|c| c.describe())
+    }
+
     /// The previous frame's reservoirs are reused with the motion: light samples move with
     /// their lights, receivers are found by motion vectors, targets of previous domains are
     /// evaluated in the previous frame's scene.
@@ -323,6 +331,11 @@ impl Integrator for RestirDiIntegrator {
             + std::mem::size_of::<Option<Bsdf>>()
             + if self.settings.learn.is_on() {
                 learn::CellPools::bytes_per_pixel(self.settings.candidates)
+            } else {
+                0
+            }
+            + if self.settings.light_sampler.is_tiles() {
+                tiles::LightTiles::bytes_per_pixel(self.settings.candidates)
             } else {
                 0
             }
@@ -360,10 +373,6 @@ impl Integrator for RestirDiIntegrator {
         if keep {
             // Initial resampling.
             let start = std::time::Instant::now();
-            let light_tiles = match s.light_sampler {
-                LightSampler::Tiles => tiles::LightTiles::build(scene, &gbuf),
-                _ => None,
-            };
             if s.light_sampler.is_hierarchy() {
                 scene.lights.build_hierarchy();
             }
@@ -396,6 +405,27 @@ impl Integrator for RestirDiIntegrator {
                     STAGE_LEARN_POOL,
                 )
             });
+            // The tiles' light cuts and their pools, for the tiles with a receiver that draws
+            // without a learned cell's pool.
+            let cuts_start = std::time::Instant::now();
+            let light_tiles = s.light_sampler.is_tiles().then(|| {
+                let unlearned = |i: usize| cell_pools.as_ref().is_none_or(|p| p.pool(i).is_none());
+                tiles::LightTiles::build(
+                    scene,
+                    ctx,
+                    &gbuf,
+                    s.candidates,
+                    s.light_sampler == LightSampler::TilesWithPowerPmf,
+                    STAGE_TILE_POOL,
+                    unlearned,
+                )
+            });
+            let light_tiles = light_tiles.flatten();
+            if let (Some(t), Ok(mut last)) = (&light_tiles, self.cuts.lock()) {
+                *last = Some(t.summary());
+            }
+            let cuts_time = cuts_start.elapsed();
+            self.clock.add("cuts", cuts_time);
             let mut current = vec![DiReservoir::empty(); n];
             // Each pixel's initial sample resolved in world space and its BSDF (textures looked
             // up), which the shifts into its neighbours and its shading would otherwise look up
@@ -443,14 +473,11 @@ impl Integrator for RestirDiIntegrator {
                                         PoolSampler::new(tile)
                                     };
                                 self.initial(scene, r, &bsdf, ng, sampler, &mut rng)
-                            } else if let Some(table) = light_tiles
+                            } else if let Some(tile_pool) = light_tiles
                                 .as_ref()
-                                .and_then(|t| t.table(index % w, index / w))
+                                .and_then(|t| t.pool(index % w, index / w))
                             {
-                                let sampler = TableSampler {
-                                    table,
-                                    share: tiles::TILE_SHARE,
-                                };
+                                let sampler = LearnedCellSampler::new(tile_pool);
                                 self.initial(scene, r, &bsdf, ng, sampler, &mut rng)
                             } else if s.light_sampler.is_hierarchy() {
                                 let sampler = HierarchySampler {
@@ -470,7 +497,8 @@ impl Integrator for RestirDiIntegrator {
                     rays
                 },
             );
-            self.clock.add("initial", start.elapsed());
+            self.clock
+                .add("initial", start.elapsed().saturating_sub(cuts_time));
 
             // Temporal and spatial reuse.
             let history = self.reuse.take_history(reuse, n);

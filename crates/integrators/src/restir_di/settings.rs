@@ -1,9 +1,9 @@
 //! ReSTIR DI settings and their parsing from named parameters (XML scenes and the command line
 //! use the same names; the names Lajolla ReSTIR ports use are accepted too). The reuse settings
 //! are [`ReuseSettings`]. Two defaults are rules of the scene summary, decided once when the
-//! integrator is made ([`RestirDiSettings::resolve`]): the candidate source (the light hierarchy
-//! above [`HIERARCHY_MIN_EMITTERS`] emitters) and learning across passes (up to
-//! [`LEARN_MAX_EMITTERS`] emitters).
+//! integrator is made ([`RestirDiSettings::resolve`]): the candidate source
+//! ([`AUTO_LIGHT_SAMPLER`] where the scene has a local emitter) and learning across passes (up
+//! to [`LEARN_MAX_EMITTERS`] emitters).
 
 use crate::reuse::params::ReuseParams;
 use restir_scene::SceneFeatures;
@@ -12,13 +12,14 @@ use crate::params::{Param, ParamError, ParamProblem, ParamSet};
 use crate::path::PathSettings;
 use crate::reuse::settings::ReuseSettings;
 
-/// Emitter-table entries (emissive triangles and other lights) from which the light hierarchy
-/// is the default candidate source. On the training family (10², 10³ and 10⁴ lights, equal CPU
-/// time, `docs/studies/2026-12-02-light-hierarchy.md`) a hierarchy pass costs 1.6–3.0× a power-table
-/// pass and its candidates make a pass only 1.3–1.7× better, so no measured light count
-/// qualifies (`None`): `auto` is the power table everywhere until the descent gets cheaper,
-/// and this bound is where the rule lives.
-pub const HIERARCHY_MIN_EMITTERS: Option<usize> = None;
+/// The candidate source `light_sampler = auto` takes for a scene with local emitters (emissive
+/// triangles and other lights besides the environment): the screen tiles' cuts of the light
+/// hierarchy ([`super::tiles`]). On the DI training family at 640×360 (8 passes, equal CPU
+/// time, with learning as `auto` decides) they are 1.03× the power sampler's pool at the median
+/// (0.85–1.44×) and 0.77–4.70× in squared error, 4.70× on the training Sponza with lamps, whose
+/// receivers right under a lamp the power sampler rarely reaches; a scene lit by an environment
+/// alone has nothing to cut and keeps the power sampler.
+pub const AUTO_LIGHT_SAMPLER: LightSampler = LightSampler::Tiles;
 
 /// Emitter-table entries (emissive triangles and other lights, the environment not counted) up to
 /// which `learn = auto` learns across passes. On the DI training family at 640×360 (16 passes,
@@ -31,14 +32,14 @@ pub const LEARN_MAX_EMITTERS: usize = 50_000;
 /// Where initial candidates' lights come from (`--light-sampler`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LightSampler {
-    /// Decided from the scene: [`LightSampler::Bvh`] from [`HIERARCHY_MIN_EMITTERS`] emitters
-    /// on, else [`LightSampler::Power`] (the default; [`RestirDiSettings::resolve`]).
+    /// Decided from the scene: [`AUTO_LIGHT_SAMPLER`] where it has a local emitter, else
+    /// [`LightSampler::Power`] (the default; [`RestirDiSettings::resolve`]).
     Auto,
     /// The power-based light sampler (the paper's choice), its draws presampled once per pass
     /// into a pool that blocks of pixels share (see [`super::pool`]).
     Power,
-    /// Per 16×16-pixel tile, a mixture of a distance-aware table and the power sampler
-    /// (see [`super::tiles`]).
+    /// Per 16×16-pixel tile, a cut of the light hierarchy for the tile's primary hits, drawn
+    /// from by an alias table (see [`super::tiles`]).
     Tiles,
     /// The light hierarchy: per receiver, a descent of a light BVH by power, distance and
     /// orientation, with its exact probability (`restir_lights::LightSet::sample_hierarchy`).
@@ -47,6 +48,10 @@ pub enum LightSampler {
     /// as if the power table had drawn them (biased).
     #[doc(hidden)]
     BvhWithPowerPmf,
+    /// A negative control for the tests, never a choice: candidates from the tiles' cuts
+    /// weighted as if the power table had drawn them (biased).
+    #[doc(hidden)]
+    TilesWithPowerPmf,
     /// A negative control for the tests, never a choice: the power sampler's pool with the
     /// selection probability of whole lights (spheres, point lights, the environment) left out
     /// of their candidates' density (biased).
@@ -63,6 +68,11 @@ impl LightSampler {
         ("bvh", LightSampler::Bvh),
     ];
 
+    /// Whether candidates come from the tiles' light cuts ([`super::tiles`]).
+    pub fn is_tiles(self) -> bool {
+        matches!(self, LightSampler::Tiles | LightSampler::TilesWithPowerPmf)
+    }
+
     /// Whether candidates come from the light hierarchy.
     pub fn is_hierarchy(self) -> bool {
         matches!(self, LightSampler::Bvh | LightSampler::BvhWithPowerPmf)
@@ -76,6 +86,7 @@ impl LightSampler {
             LightSampler::Tiles => "tiles",
             LightSampler::Bvh => "bvh",
             LightSampler::BvhWithPowerPmf => "bvh-with-power-pmf",
+            LightSampler::TilesWithPowerPmf => "tiles-with-power-pmf",
             LightSampler::PoolWithoutSelection => "pool-without-selection",
         }
     }
@@ -352,7 +363,7 @@ impl RestirDiSettings {
     }
 
     /// Decides the scene-dependent defaults from the scene summary: an `auto` light sampler
-    /// becomes the hierarchy from [`HIERARCHY_MIN_EMITTERS`] emitters on (else the power
+    /// becomes [`AUTO_LIGHT_SAMPLER`] where the scene has a local emitter (else the power
     /// table), `auto` learning is on up to [`LEARN_MAX_EMITTERS`] emitters (else off), and
     /// receivers without a glossy lobe take BSDF samples when the scene has an environment.
     pub fn resolve(&mut self, features: &SceneFeatures) {
@@ -385,12 +396,11 @@ impl RestirDiSettings {
             };
         }
         if self.light_sampler == LightSampler::Auto {
-            self.light_sampler =
-                if HIERARCHY_MIN_EMITTERS.is_some_and(|m| features.emitter_count >= m) {
-                    LightSampler::Bvh
-                } else {
-                    LightSampler::Power
-                };
+            self.light_sampler = if features.emitter_count > 0 {
+                AUTO_LIGHT_SAMPLER
+            } else {
+                LightSampler::Power
+            };
         }
     }
 
