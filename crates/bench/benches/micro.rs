@@ -465,9 +465,9 @@ mod lights {
                     &ctx,
                     &gbuf,
                     8,
-                    false,
+                    None,
+                    restir_lights::Claim::Exact,
                     6,
-                    |_| true,
                 ))
             })
         });

@@ -119,6 +119,15 @@ impl Node {
     #[inline(always)]
     /// `d2_floor` bounds the squared distance below (see [`LightBvh::d2_floor`]).
     fn importance(&self, p: Vec3, n: Vec3, d2_floor: f32) -> f32 {
+        self.importance_at(p, n, d2_floor, None)
+    }
+
+    /// [`Node::importance`], or with `nearest = Some(floor)` the squared distance taken from
+    /// `p` to the nearest point of the box (at least `floor`) instead of to its centre: a lower
+    /// bound of every emitter's distance, so no emitter's importance is underestimated by the
+    /// distance (what a region of receivers needs, [`LightBvh::region_importance`]).
+    #[inline(always)]
+    fn importance_at(&self, p: Vec3, n: Vec3, d2_floor: f32, nearest: Option<f32>) -> f32 {
         if self.power <= 0.0 {
             return 0.0;
         }
@@ -126,7 +135,11 @@ impl Node {
         let r2 = 0.25 * (self.hi - self.lo).length_squared();
         let to = p - c;
         let dist2 = to.length_squared();
-        let d2 = dist2.max(r2).max(d2_floor);
+        let d2 = match nearest {
+            None => dist2.max(r2),
+            Some(floor) => (p.clamp(self.lo, self.hi) - p).length_squared().max(floor),
+        }
+        .max(d2_floor);
         let wi = if dist2 > 0.0 {
             to / dist2.sqrt()
         } else {
@@ -483,15 +496,21 @@ impl LightBvh {
 
     /// The importance of node `i` for every receiver within `spread` of `p` whose normal is `n`
     /// (zero: any normal): the node's box grown by `spread`, so that each such receiver sees
-    /// the node's emitters within the directions `p` sees the grown box in, and the bound stays
-    /// conservative (zero only where no emitter of the node can light any of them).
+    /// the node's emitters within the directions `p` sees the grown box in, and the distance
+    /// from `p` to the grown box's nearest point, a lower bound of every receiver's distance to
+    /// every emitter of the node (floored at the region's radius and the node's own half
+    /// diagonal: what is nearer is one of the region's or the node's own). So the bound stays
+    /// conservative: zero only where no emitter of the node can light any receiver, and no
+    /// emitter near one receiver of the region has its probability set by the region's mean
+    /// (the distance to a box's centre would make it arbitrarily small there).
     #[inline]
     pub(crate) fn region_importance(&self, i: usize, p: Vec3, n: Vec3, spread: f32) -> f32 {
         let mut node = self.nodes[i];
+        let r2 = 0.25 * (node.hi - node.lo).length_squared();
         let grow = Vec3::splat(spread);
         node.lo -= grow;
         node.hi += grow;
-        node.importance(p, n, self.d2_floor)
+        node.importance_at(p, n, self.d2_floor, Some(r2.max(spread * spread)))
     }
 
     /// The children of node `i`, or `None` for a leaf.

@@ -25,7 +25,7 @@ use glam::{Vec2, Vec3};
 use restir_sampling::AliasTable;
 
 use crate::bvh::LightBvh;
-use crate::{LearnedDraw, LightSample, LightSet};
+use crate::{LearnedDraw, LearnedSampler, LightSample, LightSet};
 
 /// The hierarchy cut for one region of receivers ([`LightSet::light_cut`]).
 #[derive(Clone, Debug)]
@@ -227,40 +227,81 @@ impl LightSet {
         Some((entry as usize, pmf * (1.0 - share)))
     }
 
-    /// Fills `out` with independent draws from `cut` made without a receiver, stratified over
-    /// the selection: each a [`Presampled`](crate::Presampled) point (its density the power
-    /// sampler's) with the ratio of the cut's probability to the power sampler's, as
-    /// [`LearnedSampler::presample`](crate::LearnedSampler::presample) fills a cell's pool.
-    /// `claim_power` weighs the draws as the power sampler's (the tests' negative control).
+    /// Fills `out` with independent draws made without a receiver from `cut`, or, with
+    /// `learned = Some((sampler, cell))`, from the mixture of the cell's learned table (its
+    /// share, [`LearnedSampler::table_share`]) and the cut (the rest) — the cut as the learned
+    /// table's defensive part in place of the power sampler. The selections are stratified
+    /// over `out`; each draw is a [`Presampled`](crate::Presampled) point (its density the
+    /// power sampler's) with the ratio of the mixture's probability to the power sampler's, as
+    /// [`LearnedSampler::presample`] fills a cell's pool. The tests' negative controls:
+    /// `claim` [`Claim::Power`] weighs the draws as the power sampler's, [`Claim::TableAlone`]
+    /// as the learned table's alone where it has the emitter.
     pub fn presample_cut(
         &self,
         cut: &LightCut,
+        learned: Option<(&LearnedSampler, u32)>,
         rng: &mut restir_sampling::Pcg32,
-        claim_power: bool,
+        claim: Claim,
         out: &mut [Option<LearnedDraw>],
     ) {
         let n = out.len() as f32;
         let u0 = rng.next_f32();
+        let share = learned.map_or(0.0, |(l, c)| l.table_share(Some(c)));
         for (j, slot) in out.iter_mut().enumerate() {
             let u_select = ((j as f32 + u0) / n).min(restir_sampling::ONE_MINUS_EPSILON);
             let u_leaf = rng.next_f64();
             let u = rng.next_2d();
-            *slot = self
-                .pick_from_cut(cut, u_select, u_leaf)
-                .and_then(|(e, pmf)| {
-                    let power = self.emitter_pmf(e);
-                    let claimed = if claim_power { power } else { pmf };
-                    (power > 0.0)
-                        .then(|| self.presample_emitter(e, u))
-                        .flatten()
-                        .map(|d| (d, claimed / power))
-                });
+            let picked = match learned {
+                Some((l, c)) if u_select < share => l.sample_table(
+                    c,
+                    (u_select / share).min(restir_sampling::ONE_MINUS_EPSILON),
+                ),
+                _ => {
+                    let v = ((u_select - share) / (1.0 - share))
+                        .clamp(0.0, restir_sampling::ONE_MINUS_EPSILON);
+                    self.pick_from_cut(cut, v, u_leaf).map(|(e, _)| e)
+                }
+            };
+            *slot = picked.and_then(|e| {
+                let power = self.emitter_pmf(e);
+                let table = learned.map_or(0.0, |(l, c)| l.table_probability(self, c, e));
+                let mixture = share * table + (1.0 - share) * self.cut_pmf(cut, e);
+                let claimed = match claim {
+                    Claim::Exact => mixture,
+                    Claim::Power => power,
+                    Claim::TableAlone if table > 0.0 => table,
+                    Claim::TableAlone => mixture,
+                };
+                (power > 0.0)
+                    .then(|| self.presample_emitter(e, u))
+                    .flatten()
+                    .map(|d| (d, claimed / power))
+            });
         }
     }
 
-    /// The probability that [`LightSet::sample_cut`] picks local entry `entry` (numbered as
-    /// [`LightSet::pick_emitter`] numbers them) from `cut`.
-    pub fn cut_pmf(&self, cut: &LightCut, entry: usize) -> f32 {
-        (1.0 - self.table.env_share()) * self.hierarchy().cut_pmf(cut, entry as u32)
+    /// The probability that [`LightSet::sample_cut`] picks emitter `e` (numbered as
+    /// [`LightSet::pick_emitter`] numbers them: the environment after the local entries) from
+    /// `cut`.
+    pub fn cut_pmf(&self, cut: &LightCut, e: usize) -> f32 {
+        let share = self.table.env_share();
+        if e == self.table.len() && self.environment.is_some() {
+            return share;
+        }
+        (1.0 - share) * self.hierarchy().cut_pmf(cut, e as u32)
     }
+}
+
+/// What a pool's draws claim as their probability ([`LightSet::presample_cut`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Claim {
+    /// The mixture's, exactly.
+    Exact,
+    /// The power sampler's (a negative control of the tests: biased).
+    #[doc(hidden)]
+    Power,
+    /// The learned table's alone where it has the emitter, forgetting the defensive part (a
+    /// negative control of the tests: biased).
+    #[doc(hidden)]
+    TableAlone,
 }

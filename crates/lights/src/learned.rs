@@ -426,31 +426,52 @@ impl LearnedSampler {
     /// `(emitter, probability)`, the probability being [`LearnedSampler::pmf`]'s.
     #[inline]
     pub fn sample(&self, lights: &LightSet, cell: Option<u32>, u: f32) -> Option<(usize, f32)> {
-        let Some(table) = cell.map(|c| &self.tables[c as usize]) else {
+        let Some(c) = cell else {
             return lights.pick_emitter(u);
         };
-        let share = table.share;
+        let share = self.tables[c as usize].share;
         let emitter = if u < share {
-            let v = (u / share).min(ONE_MINUS_EPSILON);
-            match &table.groups {
-                Some(g) if v >= 0.5 => {
-                    let v = (2.0 * v - 1.0).min(ONE_MINUS_EPSILON);
-                    let (i, _, rest) = g.alias.sample(v);
-                    let start = g.starts[i] as usize;
-                    let (_, end) = self.groups.group(start);
-                    self.groups.pick(start, end, rest)?
-                }
-                Some(_) => {
-                    let v = (2.0 * v).min(ONE_MINUS_EPSILON);
-                    table.emitters.starts[table.emitters.alias.sample(v).0] as usize
-                }
-                None => table.emitters.starts[table.emitters.alias.sample(v).0] as usize,
-            }
+            self.sample_table(c, (u / share).min(ONE_MINUS_EPSILON))?
         } else {
             let v = ((u - share) / (1.0 - share)).min(ONE_MINUS_EPSILON);
             lights.pick_emitter(v)?.0
         };
         Some((emitter, self.pmf(lights, cell, emitter)))
+    }
+
+    /// The share of selections `cell`'s table takes (`share · n / (n + prior)`), the rest
+    /// going to the defensive sampler; 0 for no cell.
+    #[inline]
+    pub fn table_share(&self, cell: Option<u32>) -> f32 {
+        cell.map_or(0.0, |c| self.tables[c as usize].share)
+    }
+
+    /// Picks an emitter from `cell`'s table alone with uniform `u` (no defensive part; its
+    /// probability is [`LearnedSampler::table_probability`]'s).
+    #[inline]
+    pub fn sample_table(&self, cell: u32, u: f32) -> Option<usize> {
+        let table = &self.tables[cell as usize];
+        Some(match &table.groups {
+            Some(g) if u >= 0.5 => {
+                let v = (2.0 * u - 1.0).min(ONE_MINUS_EPSILON);
+                let (i, _, rest) = g.alias.sample(v);
+                let start = g.starts[i] as usize;
+                let (_, end) = self.groups.group(start);
+                self.groups.pick(start, end, rest)?
+            }
+            Some(_) => {
+                let v = (2.0 * u).min(ONE_MINUS_EPSILON);
+                table.emitters.starts[table.emitters.alias.sample(v).0] as usize
+            }
+            None => table.emitters.starts[table.emitters.alias.sample(u).0] as usize,
+        })
+    }
+
+    /// The probability that [`LearnedSampler::sample_table`] picks `emitter` from `cell`'s
+    /// table.
+    #[inline]
+    pub fn table_probability(&self, lights: &LightSet, cell: u32, emitter: usize) -> f32 {
+        self.table_pmf(lights, &self.tables[cell as usize], emitter)
     }
 
     /// The probability that [`LearnedSampler::sample`] picks `emitter` for a receiver in

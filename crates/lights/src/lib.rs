@@ -60,7 +60,7 @@ mod spot;
 mod table;
 
 pub use contact::Contact;
-pub use cut::LightCut;
+pub use cut::{Claim, LightCut};
 pub use envmap::{EnvMap, EnvMapError};
 pub use learned::{CellKey, EmitterGroups, LearnGrid, LearnedDraw, LearnedSampler, LightRecords};
 pub use light::{Light, LightSample};

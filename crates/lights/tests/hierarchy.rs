@@ -400,7 +400,7 @@ fn cut_samples_carry_the_cut_density() {
         }
         assert!(checked > 1000, "{checked}");
         let mut pool = vec![None; 512];
-        set.presample_cut(&cut, &mut rng, false, &mut pool);
+        set.presample_cut(&cut, None, &mut rng, restir_lights::Claim::Exact, &mut pool);
         for (d, ratio) in pool.iter().flatten() {
             let e = match *d {
                 restir_lights::Presampled::Fixed { point, .. } => {

@@ -16,9 +16,9 @@ use std::sync::Arc;
 use glam::{Affine3A, Quat, Vec2, Vec3};
 use restir_geometry::{Shape, Sphere};
 use restir_lights::{
-    At, CandidateU, HierarchySampler, LearnGrid, LearnedCellSampler, LearnedDraw, LearnedSampler,
-    Light, LightCandidate, LightRecords, LightSampler, LightSet, PoolSampler, PowerSampler,
-    Presampled,
+    At, CandidateU, Claim, HierarchySampler, LearnGrid, LearnedCellSampler, LearnedDraw,
+    LearnedSampler, Light, LightCandidate, LightRecords, LightSampler, LightSet, PoolSampler,
+    PowerSampler, Presampled,
 };
 use restir_sampling::{ONE_MINUS_EPSILON, Pcg32, luminance};
 
@@ -174,6 +174,21 @@ fn cell_pools(
 /// the receiver (as a screen tile's), of `len` entries; `claim_power` weighs them as the power
 /// sampler's (the negative control).
 fn cut_pools(lights: &LightSet, nodes: usize, claim_power: bool) -> Vec<Vec<Option<LearnedDraw>>> {
+    let claim = if claim_power {
+        Claim::Power
+    } else {
+        Claim::Exact
+    };
+    mixed_pools(lights, nodes, None, claim)
+}
+
+/// As [`cut_pools`], the cut mixed with a learned cell's table when `learned` is given.
+fn mixed_pools(
+    lights: &LightSet,
+    nodes: usize,
+    learned: Option<(&LearnedSampler, u32)>,
+    claim: Claim,
+) -> Vec<Vec<Option<LearnedDraw>>> {
     let cut = lights
         .light_cut(AT.p + Vec3::new(0.2, 0.1, 0.0), AT.n, 0.5, nodes)
         .unwrap();
@@ -181,7 +196,7 @@ fn cut_pools(lights: &LightSet, nodes: usize, claim_power: bool) -> Vec<Vec<Opti
     (0..RECEIVERS)
         .map(|_| {
             let mut pool = vec![None; 32];
-            lights.presample_cut(&cut, &mut rng, claim_power, &mut pool);
+            lights.presample_cut(&cut, learned, &mut rng, claim, &mut pool);
             pool
         })
         .collect()
@@ -195,6 +210,7 @@ fn every_sampler_estimates_the_same_integral() {
     let (grouped, grouped_cell) = learned_sampler(&lights, 10.0);
     let (learned, cell) = learned_sampler(&lights, 0.0);
     let cut_pool = cut_pools(&lights, 16, false);
+    let mixed_pool = mixed_pools(&lights, 16, Some((&learned, cell)), Claim::Exact);
     let mut tiles: Vec<Vec<Option<Presampled>>> = Vec::new();
     let mut rng = Pcg32::new(4, 4);
     for _ in 0..RECEIVERS {
@@ -220,6 +236,11 @@ fn every_sampler_estimates_the_same_integral() {
         k += 1;
         LearnedCellSampler::new(&cut_pool[k - 1])
     });
+    let mut k = 0;
+    let mixed = estimate(&lights, 16, |_| {
+        k += 1;
+        LearnedCellSampler::new(&mixed_pool[k - 1])
+    });
     let pools = cell_pools(&lights, &learned, cell, true, 64);
     let mut k = 0;
     let learned_pool = estimate(&lights, 5, |_| {
@@ -241,6 +262,10 @@ fn every_sampler_estimates_the_same_integral() {
     });
     for (name, e) in cases.into_iter().chain([
         ("pool of a cut of the hierarchy", cut),
+        (
+            "pool of a learned table with a cut as its defensive part",
+            mixed,
+        ),
         ("learned cell pool", learned_pool),
         ("learned cell pool of 3", learned_small),
         (
@@ -277,8 +302,16 @@ fn negative_controls_are_rejected() {
         }
     }
     let power_claims = cut_pools(&lights, 16, true);
-    let (mut k, mut j, mut i, mut c) = (0, 0, 0, 0);
+    let table_claims = mixed_pools(&lights, 16, Some((&learned, cell)), Claim::TableAlone);
+    let (mut k, mut j, mut i, mut c, mut t) = (0, 0, 0, 0, 0);
     let controls = [
+        (
+            "learned table over a cut claiming the table alone",
+            estimate(&lights, 17, |_| {
+                t += 1;
+                LearnedCellSampler::new(&table_claims[t - 1])
+            }),
+        ),
         (
             "cut pool claiming the power density",
             estimate(&lights, 15, |_| {

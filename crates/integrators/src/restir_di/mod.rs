@@ -39,7 +39,7 @@ use rayon::prelude::*;
 use restir_geometry::{Ray, offset_ray_origin};
 use restir_gris::Reservoir;
 use restir_lights::{
-    HierarchySampler, LearnedCellSampler, LightPoint, PoolSampler, PowerSampler, Resolved,
+    Claim, HierarchySampler, LearnedCellSampler, LightPoint, PoolSampler, PowerSampler, Resolved,
 };
 use restir_materials::Bsdf;
 use restir_sampling::Pcg32;
@@ -329,7 +329,7 @@ impl Integrator for RestirDiIntegrator {
             + reciprocal::table_bytes_per_pixel::<LightPoint>(&self.settings.reuse)
             + std::mem::size_of::<Option<(LightPoint, Resolved)>>()
             + std::mem::size_of::<Option<Bsdf>>()
-            + if self.settings.learn.is_on() {
+            + if self.settings.learn.is_on() && !self.settings.light_sampler.is_tiles() {
                 learn::CellPools::bytes_per_pixel(self.settings.candidates)
             } else {
                 0
@@ -394,7 +394,34 @@ impl Integrator for RestirDiIntegrator {
             } else {
                 None
             };
-            let cell_pools = learned.as_ref().map(|l| {
+            // Candidates from the tiles' cuts of the light hierarchy (mixed with the learned
+            // cells' tables), else from the learned cells' pools (mixed with the power sampler).
+            let cuts_start = std::time::Instant::now();
+            let light_tiles = s.light_sampler.is_tiles().then(|| {
+                let claim = if s.light_sampler == LightSampler::TilesWithPowerPmf {
+                    Claim::Power
+                } else if s.learn == Learn::WithoutDefensiveShare {
+                    Claim::TableAlone
+                } else {
+                    Claim::Exact
+                };
+                tiles::LightTiles::build(
+                    scene,
+                    ctx,
+                    &gbuf,
+                    s.candidates,
+                    learned.as_deref(),
+                    claim,
+                    STAGE_TILE_POOL,
+                )
+            });
+            let light_tiles = light_tiles.flatten();
+            if let (Some(t), Ok(mut last)) = (&light_tiles, self.cuts.lock()) {
+                *last = Some(t.summary());
+            }
+            let cuts_time = cuts_start.elapsed();
+            self.clock.add("cuts", cuts_time);
+            let cell_pools = learned.as_ref().filter(|_| light_tiles.is_none()).map(|l| {
                 learn::CellPools::build(
                     l,
                     scene,
@@ -405,27 +432,6 @@ impl Integrator for RestirDiIntegrator {
                     STAGE_LEARN_POOL,
                 )
             });
-            // The tiles' light cuts and their pools, for the tiles with a receiver that draws
-            // without a learned cell's pool.
-            let cuts_start = std::time::Instant::now();
-            let light_tiles = s.light_sampler.is_tiles().then(|| {
-                let unlearned = |i: usize| cell_pools.as_ref().is_none_or(|p| p.pool(i).is_none());
-                tiles::LightTiles::build(
-                    scene,
-                    ctx,
-                    &gbuf,
-                    s.candidates,
-                    s.light_sampler == LightSampler::TilesWithPowerPmf,
-                    STAGE_TILE_POOL,
-                    unlearned,
-                )
-            });
-            let light_tiles = light_tiles.flatten();
-            if let (Some(t), Ok(mut last)) = (&light_tiles, self.cuts.lock()) {
-                *last = Some(t.summary());
-            }
-            let cuts_time = cuts_start.elapsed();
-            self.clock.add("cuts", cuts_time);
             let mut current = vec![DiReservoir::empty(); n];
             // Each pixel's initial sample resolved in world space and its BSDF (textures looked
             // up), which the shifts into its neighbours and its shading would otherwise look up
@@ -460,7 +466,13 @@ impl Integrator for RestirDiIntegrator {
                                     p.tile_of(ctx, x, y)
                                 })
                             };
-                            let (init, nr, y) = if let Some(cell_pool) =
+                            let (init, nr, y) = if let Some(tile_pool) = light_tiles
+                                .as_ref()
+                                .and_then(|t| t.pool(index, index % w, index / w))
+                            {
+                                let sampler = LearnedCellSampler::new(tile_pool);
+                                self.initial(scene, r, &bsdf, ng, sampler, &mut rng)
+                            } else if let Some(cell_pool) =
                                 cell_pools.as_ref().and_then(|p| p.pool(index))
                             {
                                 let sampler = LearnedCellSampler::new(cell_pool);
@@ -472,12 +484,6 @@ impl Integrator for RestirDiIntegrator {
                                     } else {
                                         PoolSampler::new(tile)
                                     };
-                                self.initial(scene, r, &bsdf, ng, sampler, &mut rng)
-                            } else if let Some(tile_pool) = light_tiles
-                                .as_ref()
-                                .and_then(|t| t.pool(index % w, index / w))
-                            {
-                                let sampler = LearnedCellSampler::new(tile_pool);
                                 self.initial(scene, r, &bsdf, ng, sampler, &mut rng)
                             } else if s.light_sampler.is_hierarchy() {
                                 let sampler = HierarchySampler {
