@@ -42,11 +42,12 @@ pub const MESH_BYTES_PER_TRIANGLE: u64 = 320;
 
 /// What one entry of the light tables costs, in bytes: an emissive triangle's (or any other
 /// light's) emitter-table entry and alias-table bin (76), and its share of the light hierarchy
-/// a light sampler may build (two tree nodes, its path, and the build's item: about 176 at the
-/// build's peak, 120 kept). Counted against `--max-memory` for each emitter before the tables
-/// are made; a 1M-triangle emissive PLY with its hierarchy built peaks at 401 bytes per
-/// triangle, within this and [`MESH_BYTES_PER_TRIANGLE`] (`crates/scene/tests/mesh_memory.rs`).
-pub const EMITTER_BYTES_PER_ENTRY: u64 = 260;
+/// the light samplers build (two tree nodes and their leaf spans, its path, its leaf's place,
+/// power prefix and guide for cuts, and the build's item: about 212 at the build's peak, 156
+/// kept). Counted against `--max-memory` for each emitter before the tables are made; a
+/// 1M-triangle emissive PLY with its hierarchy built peaks at 437 bytes per triangle, within
+/// this and [`MESH_BYTES_PER_TRIANGLE`] (`crates/scene/tests/mesh_memory.rs`).
+pub const EMITTER_BYTES_PER_ENTRY: u64 = 290;
 
 /// What an environment map keeps per texel beside its texels, in bytes: the bin of its
 /// conditional alias table.
