@@ -32,10 +32,15 @@ fn scene() -> common::Built {
 
 /// The test scene with the wall's and the cube's materials given (RON).
 fn scene_with(wall: &str, cube: &str) -> common::Built {
+    scene_sized(wall, cube, SIZE)
+}
+
+/// The test scene at `size`×`size` pixels.
+fn scene_sized(wall: &str, cube: &str, size: u32) -> common::Built {
     let ron = format!(
         r#"(
         camera: (fov: 50, to_world: [LookAt(origin: (0, 5, 0.01), target: (0, 0, 0), up: (0, 0, -1))]),
-        film: (width: {SIZE}, height: {SIZE}, filter: Box),
+        film: (width: {size}, height: {size}, filter: Box),
         integrator: (max_depth: 2),
         shapes: [
             (geometry: Rectangle, to_world: [Scale((3, 3, 1)), Rotate(axis: (1, 0, 0), angle: -90)],
@@ -538,35 +543,44 @@ fn xml_restir_integrator_and_parameters() {
 /// The light hierarchy as the candidate source, by a descent per receiver (`bvh`) or from the
 /// tiles' cuts (`tiles`), is unbiased (alone and with two rounds of reuse); weighting its
 /// candidates by the power table's pmf instead of theirs (the wrong density) is caught by the
-/// same test, for each.
+/// same test, for each. The tiles are tested at 64×64 pixels: at 32×32 a 16×16 tile spans half
+/// the view, every light is within its reach, and its cut weighs the lights by power alone (so
+/// claiming the power pmf would not be wrong there).
 #[test]
 fn light_hierarchy_and_its_cuts_are_unbiased_and_a_wrong_pmf_is_caught() {
-    let scene = scene();
-    let reference = direct_reference(&scene);
-    for params in [
-        &[("light_sampler", "bvh"), ("candidates", "4")][..],
-        &[("light_sampler", "bvh"), ("spatial_rounds", "2")][..],
-        &[("light_sampler", "tiles"), ("candidates", "4")][..],
+    let small = scene();
+    let large = scene_sized(
+        "Diffuse(reflectance: (0.9, 0.9, 0.9))",
+        "Diffuse(reflectance: (0.3, 0.6, 0.3))",
+        64,
+    );
+    for (scene, sampler, wrong_sampler) in [
+        (&small, "bvh", LightSampler::BvhWithPowerPmf),
+        (&large, "tiles", LightSampler::TilesWithPowerPmf),
     ] {
-        let z = max_z(&statistics(&scene, "restir-di", params, 1, 200), &reference);
-        eprintln!("{params:?}: max |z| = {z:.2}");
-        assert!(z < Z_MAX, "{params:?}: max |z| = {z:.2}");
-    }
-    for sampler in [
-        LightSampler::BvhWithPowerPmf,
-        LightSampler::TilesWithPowerPmf,
-    ] {
+        let reference = direct_reference(scene);
+        for params in [
+            &[("light_sampler", sampler), ("candidates", "4")][..],
+            &[("light_sampler", sampler), ("spatial_rounds", "2")][..],
+        ] {
+            let z = max_z(&statistics(scene, "restir-di", params, 1, 200), &reference);
+            eprintln!("{params:?}: max |z| = {z:.2}");
+            assert!(z < Z_MAX, "{params:?}: max |z| = {z:.2}");
+        }
         let mut wrong = RestirDiSettings::new(restir_integrators::path::PathSettings::from_desc(
             &scene.integrator,
         ));
-        wrong.light_sampler = sampler;
+        wrong.light_sampler = wrong_sampler;
         wrong.candidates = 4;
-        let z = max_z(&settings_statistics(&scene, wrong, 200), &reference);
-        eprintln!("{} with the power pmf: max |z| = {z:.2}", sampler.name());
+        let z = max_z(&settings_statistics(scene, wrong, 200), &reference);
+        eprintln!(
+            "{} with the power pmf: max |z| = {z:.2}",
+            wrong_sampler.name()
+        );
         assert!(
             z > 2.0 * Z_MAX,
             "{}: the wrong pmf should be visibly biased, max |z| = {z:.2}",
-            sampler.name()
+            wrong_sampler.name()
         );
     }
 }
