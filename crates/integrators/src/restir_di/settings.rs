@@ -15,8 +15,8 @@ use crate::reuse::settings::ReuseSettings;
 /// The candidate source `light_sampler = auto` takes for a scene with local emitters (emissive
 /// triangles and other lights besides the environment): the screen tiles' cuts of the light
 /// hierarchy ([`super::tiles`]). On the DI training family at 640×360 (8 passes, equal CPU
-/// time, with learning as `auto` decides) they are 1.03× the power sampler's pool at the median
-/// (0.85–1.44×) and 0.77–4.70× in squared error, 4.70× on the training Sponza with lamps, whose
+/// time, with learning as `auto` decides) they are 1.08× the power sampler's pool at the median
+/// (0.88–1.94×) and 0.69–4.78× in squared error, 4.78× on the training Sponza with lamps, whose
 /// receivers right under a lamp the power sampler rarely reaches; a scene lit by an environment
 /// alone has nothing to cut and keeps the power sampler.
 pub const AUTO_LIGHT_SAMPLER: LightSampler = LightSampler::Tiles;
