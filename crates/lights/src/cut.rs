@@ -30,28 +30,22 @@ use crate::{LearnedDraw, LearnedSampler, LightSample, LightSet};
 /// The hierarchy cut for one region of receivers ([`LightSet::light_cut`]).
 #[derive(Clone, Debug)]
 pub struct LightCut {
-    /// The cut's nodes, ordered by their first leaf.
-    nodes: Vec<u32>,
-    /// Per node of `nodes`, its leaves `(first, count)` in the hierarchy's depth-first order.
+    /// Per node of the cut, ordered by its first leaf, its leaves `(first, count)` in the
+    /// hierarchy's depth-first order.
     spans: Vec<(u32, u32)>,
-    /// Over `nodes`, by their importance for the region.
+    /// Over the nodes, by their importance for the region.
     table: AliasTable,
 }
 
 impl LightCut {
     /// Number of nodes in the cut.
     pub fn len(&self) -> usize {
-        self.nodes.len()
+        self.spans.len()
     }
 
     /// Always false: a cut without a node with importance is not built.
     pub fn is_empty(&self) -> bool {
-        self.nodes.is_empty()
-    }
-
-    /// Bytes held.
-    pub fn bytes(&self) -> usize {
-        self.nodes.len() * (4 + 8 + 12)
+        self.spans.is_empty()
     }
 }
 
@@ -115,16 +109,15 @@ impl LightBvh {
             heap.push(open(a));
             heap.push(open(b));
         }
-        let mut cut: Vec<(u32, f32)> = heap.into_iter().map(|o| (o.node, o.importance)).collect();
-        cut.sort_unstable_by_key(|&(node, _)| self.span(node as usize).0);
+        let mut cut: Vec<((u32, u32), f32)> = heap
+            .into_iter()
+            .map(|o| (self.span(o.node as usize), o.importance))
+            .collect();
+        cut.sort_unstable_by_key(|&((first, _), _)| first);
         let weights: Vec<f32> = cut.iter().map(|&(_, w)| w).collect();
         let table = AliasTable::new(&weights)?;
         Some(LightCut {
-            spans: cut
-                .iter()
-                .map(|&(node, _)| self.span(node as usize))
-                .collect(),
-            nodes: cut.into_iter().map(|(node, _)| node).collect(),
+            spans: cut.into_iter().map(|(span, _)| span).collect(),
             table,
         })
     }

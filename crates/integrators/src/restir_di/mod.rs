@@ -7,8 +7,9 @@
 //! 2. **Initial resampling**: `N_L` light candidates from the screen tile's cut of the light
 //!    hierarchy ([`tiles`], the default where the scene has a local emitter), the power-based
 //!    light sampler or the hierarchy's descent per receiver (stratified selection each way;
-//!    with `learn` on, from the second pass on, a mixture of the power sampler and what
-//!    lights delivered to the receiver's cell in earlier passes, [`learn`]), streamed into a
+//!    with `learn` on, from the second pass on, a mixture of what lights delivered to the
+//!    receiver's cell in earlier passes, [`learn`], and the tile's cut or the power sampler),
+//!    streamed into a
 //!    reservoir with weights `p̂/(N_L·p_L)` (with `--bsdf-samples resampled`, `N_B` BSDF
 //!    candidates beside them, both weighted by their shares of the light/BSDF split); the result
 //!    counts as confidence 1. Optional visibility reuse drops an occluded selection (biased).
@@ -420,7 +421,9 @@ impl Integrator for RestirDiIntegrator {
                 *last = Some(t.summary());
             }
             let cuts_time = cuts_start.elapsed();
-            self.clock.add("cuts", cuts_time);
+            if s.light_sampler.is_tiles() {
+                self.clock.add("cuts", cuts_time);
+            }
             let cell_pools = learned.as_ref().filter(|_| light_tiles.is_none()).map(|l| {
                 learn::CellPools::build(
                     l,

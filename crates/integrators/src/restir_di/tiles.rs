@@ -84,8 +84,8 @@ impl CutSummary {
         format!(
             "last pass: {} tiles of {TILE}×{TILE} pixels, each a cut of the light hierarchy ({} \
              nodes) into at most {CUT_NODES} nodes (mean {:.0}); {:.1} pools per tile (one per \
-             learned cell its receivers are in, mixing the cell's table with the cut), {:.0} \
-             draws per tile",
+             learned cell its receivers are in, mixing the cell's table with the cut; one \
+             without learning), {:.0} draws per tile",
             self.tiles,
             self.hierarchy_nodes,
             per(self.nodes),
@@ -123,7 +123,7 @@ impl LightTiles {
         if lights.emitter_count() == 0 {
             return None;
         }
-        lights.build_hierarchy();
+        let hierarchy_nodes = lights.build_hierarchy();
         let tiles_x = gbuf.width.div_ceil(TILE);
         let tiles_y = gbuf.height.div_ceil(TILE);
         let k = candidates.max(1) as usize;
@@ -215,7 +215,7 @@ impl LightTiles {
             pools,
             pool_of,
             nodes,
-            hierarchy_nodes: lights.build_hierarchy(),
+            hierarchy_nodes,
         })
     }
 
