@@ -445,8 +445,8 @@ mod lights {
         GBuffer::trace(scene, &ctx, false, false, true, &mut radiance).0
     }
 
-    /// Building the tiles' light cuts and their pools for one 128×128 pass (64 tiles, 8
-    /// candidates per pixel; one thread).
+    /// Building the tiles' pools from their light cuts (found once beforehand) for one 128×128
+    /// pass (64 tiles, 8 candidates per pixel; one thread).
     #[divan::bench(args = COUNTS)]
     fn tiles_build(bencher: Bencher, n: usize) {
         let scene = scene(n);
@@ -457,13 +457,17 @@ mod lights {
         let gbuf = pool.install(|| gbuffer(&scene));
         let filter = Filter::new(scene.filter);
         let ctx = context(&filter);
-        scene.lights.build_hierarchy();
+        let (w, h) = (gbuf.width, gbuf.height);
+        let cuts = pool
+            .install(|| tiles::TileCuts::probe(&scene, &ctx, w, h, false))
+            .expect("a local light");
         bencher.bench_local(|| {
             pool.install(|| {
                 black_box(tiles::LightTiles::build(
                     &scene,
                     &ctx,
                     &gbuf,
+                    &cuts,
                     8,
                     None,
                     restir_lights::Claim::Exact,

@@ -13,7 +13,8 @@ use std::sync::atomic::AtomicBool;
 use restir_integrators::restir_di::{BsdfDiffuse, BsdfSamples, Learn, LightSampler};
 use restir_integrators::reuse::MIS_NAMES;
 use restir_integrators::{
-    IntegratorOptions, RenderJob, RestirDiIntegrator, RestirDiSettings, make_integrator, render,
+    Integrator, IntegratorOptions, RenderJob, RestirDiIntegrator, RestirDiSettings,
+    make_integrator, render,
 };
 use restir_scene::parse_ron;
 
@@ -37,9 +38,15 @@ fn scene_with(wall: &str, cube: &str) -> common::Built {
 
 /// The test scene at `size`×`size` pixels.
 fn scene_sized(wall: &str, cube: &str, size: u32) -> common::Built {
+    scene_with_lens(wall, cube, size, 0.0)
+}
+
+/// [`scene_sized`] through a thin lens of radius `aperture`, focused halfway to the floor.
+fn scene_with_lens(wall: &str, cube: &str, size: u32, aperture: f32) -> common::Built {
     let ron = format!(
         r#"(
-        camera: (fov: 50, to_world: [LookAt(origin: (0, 5, 0.01), target: (0, 0, 0), up: (0, 0, -1))]),
+        camera: (fov: 50, aperture_radius: {aperture}, focus_distance: 2.5,
+                 to_world: [LookAt(origin: (0, 5, 0.01), target: (0, 0, 0), up: (0, 0, -1))]),
         film: (width: {size}, height: {size}, filter: Box),
         integrator: (max_depth: 2),
         shapes: [
@@ -545,18 +552,49 @@ fn xml_restir_integrator_and_parameters() {
 /// candidates by the power table's pmf instead of theirs (the wrong density) is caught by the
 /// same test, for each. The tiles are tested at 64×64 pixels: at 32×32 a 16×16 tile spans half
 /// the view, every light is within its reach, and its cut weighs the lights by power alone (so
-/// claiming the power pmf would not be wrong there).
+/// claiming the power pmf would not be wrong there). They are tested again through a wide lens,
+/// where many receivers fall outside the regions their tiles' cuts were made for (found from the
+/// lens's centre) and draw from cuts made in the pass for them.
 #[test]
 fn light_hierarchy_and_its_cuts_are_unbiased_and_a_wrong_pmf_is_caught() {
     let small = scene();
-    let large = scene_sized(
-        "Diffuse(reflectance: (0.9, 0.9, 0.9))",
-        "Diffuse(reflectance: (0.3, 0.6, 0.3))",
-        64,
-    );
+    let diffuse = "Diffuse(reflectance: (0.9, 0.9, 0.9))";
+    let green = "Diffuse(reflectance: (0.3, 0.6, 0.3))";
+    let large = scene_sized(diffuse, green, 64);
+    // Through a wide lens most receivers lie outside their tile's region (found by rays from
+    // the lens's centre) and draw from cuts made in the pass for them.
+    let lens = scene_with_lens(diffuse, green, 64, 1.0);
+    let outside = {
+        let mut settings = RestirDiSettings::new(
+            restir_integrators::path::PathSettings::from_desc(&lens.integrator),
+        );
+        settings.light_sampler = LightSampler::Tiles;
+        let integrator = RestirDiIntegrator::new(settings);
+        let job = RenderJob {
+            spp: 1,
+            ..RenderJob::default()
+        };
+        render(
+            &lens,
+            &integrator,
+            &job,
+            &AtomicBool::new(false),
+            &mut |_, _| {},
+        );
+        integrator.light_cuts().expect("tiles describe their cuts")
+    };
+    let share: f64 = outside
+        .split("last pass: ")
+        .nth(1)
+        .and_then(|s| s.split('%').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("{outside}"));
+    eprintln!("through the lens, {share}% of receivers outside their tile's region");
+    assert!(share > 10.0, "{outside}");
     for (scene, sampler, wrong_sampler) in [
         (&small, "bvh", LightSampler::BvhWithPowerPmf),
         (&large, "tiles", LightSampler::TilesWithPowerPmf),
+        (&lens, "tiles", LightSampler::TilesWithPowerPmf),
     ] {
         let reference = direct_reference(scene);
         for params in [

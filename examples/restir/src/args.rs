@@ -75,10 +75,10 @@ pub(crate) struct RestirArgs {
     /// restir-pt [default: 2].
     #[arg(long)]
     candidates: Option<u32>,
-    /// Where candidates' lights come from: power (the power-based sampler), tiles (per
-    /// 16×16-pixel tile, mixed with a distance-aware table), bvh (the light hierarchy: per
-    /// receiver, by power, distance and orientation) or auto (decided from the scene; power at
-    /// every light count measured so far) [default: auto].
+    /// restir-di: where candidates' lights come from: power (the power-based sampler), tiles
+    /// (per 16×16-pixel tile, a cut of the light hierarchy for the tile's receivers), bvh (the
+    /// light hierarchy: per receiver, a descent by power, distance and orientation) or auto
+    /// (tiles where the scene has a local light, else power) [default: auto].
     #[arg(long)]
     light_sampler: Option<String>,
     /// restir-di: on draws candidates' lights, from the second pass on, from a mixture of the

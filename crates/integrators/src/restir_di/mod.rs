@@ -98,6 +98,8 @@ pub struct RestirDiIntegrator {
     seen: Option<SeenEmission>,
     /// What the last pass's tiles' light cuts held (`light_sampler = tiles`).
     cuts: std::sync::Mutex<Option<tiles::CutSummary>>,
+    /// The tiles' regions and cuts, found once per render (`light_sampler = tiles`).
+    tile_cuts: std::sync::Mutex<Option<std::sync::Arc<tiles::TileCuts>>>,
 }
 
 /// What a pass looks up once per pixel: the initial sample resolved in world space and the BSDF.
@@ -129,6 +131,7 @@ impl RestirDiIntegrator {
             chain: PassChain::default(),
             lookups: Default::default(),
             cuts: Default::default(),
+            tile_cuts: Default::default(),
             seen: (settings.edge_rays > 1)
                 .then(|| SeenEmission::new(settings.edge_rays, settings.edge_mask_from_pass)),
         }
@@ -137,6 +140,37 @@ impl RestirDiIntegrator {
     /// The settings.
     pub fn settings(&self) -> &RestirDiSettings {
         &self.settings
+    }
+
+    /// The tiles' regions and cuts for this render's buffers, found at its first pass; adds
+    /// the rays that found them to `rays`. `None` if the scene has no local light.
+    fn tile_cuts(
+        &self,
+        scene: &Scene,
+        ctx: &PassContext,
+        gbuf: &GBuffer,
+        rays: &mut u64,
+    ) -> Option<std::sync::Arc<tiles::TileCuts>> {
+        let mut kept = self.tile_cuts.lock().ok()?;
+        if let Some(cuts) = kept
+            .as_ref()
+            .filter(|c| c.fits(ctx, gbuf.width, gbuf.height))
+        {
+            return Some(cuts.clone());
+        }
+        let hide = self.settings.path.hide_emitters;
+        let cuts = tiles::TileCuts::probe(scene, ctx, gbuf.width, gbuf.height, hide)?;
+        *rays += cuts.rays();
+        let cuts = std::sync::Arc::new(cuts);
+        *kept = Some(cuts.clone());
+        Some(cuts)
+    }
+
+    /// Forgets the tiles' regions (another render, or the next frame).
+    fn forget_tile_cuts(&self) {
+        if let Ok(mut kept) = self.tile_cuts.lock() {
+            *kept = None;
+        }
     }
 
     /// Bytes per pixel of one reservoir buffer.
@@ -311,6 +345,7 @@ impl Integrator for RestirDiIntegrator {
         self.chain.next_frame();
         self.reuse.next_frame(Some(motion));
         self.learning.reset();
+        self.forget_tile_cuts();
         if let Some(seen) = &self.seen {
             seen.clear();
         }
@@ -337,6 +372,7 @@ impl Integrator for RestirDiIntegrator {
             }
             + if self.settings.light_sampler.is_tiles() {
                 tiles::LightTiles::bytes_per_pixel(self.settings.candidates)
+                    + tiles::TileCuts::bytes_per_pixel()
             } else {
                 0
             }
@@ -349,6 +385,7 @@ impl Integrator for RestirDiIntegrator {
             // Another render: nothing of the passes before carries over.
             self.reuse.next_frame(None);
             self.learning.reset();
+            self.forget_tile_cuts();
             if let Some(seen) = &self.seen {
                 seen.clear();
             }
@@ -399,6 +436,7 @@ impl Integrator for RestirDiIntegrator {
             // cells' tables), else from the learned cells' pools (mixed with the power sampler).
             let cuts_start = std::time::Instant::now();
             let light_tiles = s.light_sampler.is_tiles().then(|| {
+                let cuts = self.tile_cuts(scene, ctx, &gbuf, &mut rays)?;
                 let claim = if s.light_sampler == LightSampler::TilesWithPowerPmf {
                     Claim::Power
                 } else if s.learn == Learn::WithoutDefensiveShare {
@@ -410,6 +448,7 @@ impl Integrator for RestirDiIntegrator {
                     scene,
                     ctx,
                     &gbuf,
+                    &cuts,
                     s.candidates,
                     learned.as_deref(),
                     claim,

@@ -3,30 +3,34 @@
 //! The power sampler ignores distance, so in a scene of many small lights most candidates land
 //! on lights far from the pixel; the light hierarchy's descent knows distance but costs a chain
 //! of node tests per candidate, at random places in memory, which grows with the emitter count.
-//! Here, once per pass, every 16×16-pixel tile of the film gets a cut of the light hierarchy for
-//! its primary hits ([`LightSet::light_cut`](restir_lights::LightSet::light_cut)): near lights
-//! one by one, far clusters whole, each weighted by its importance for every receiver of the
-//! tile. The cut is drawn from once per tile into a pool of points on lights
+//! Here, once per render, every 16×16-pixel tile of the film gets a region (what camera rays
+//! through its pixels' corners hit) and a cut of the light hierarchy for it
+//! ([`LightSet::light_cut`](restir_lights::LightSet::light_cut)): near lights one by one, far
+//! clusters whole, each weighted by its importance for every receiver of the region
+//! ([`TileCuts`]). Once per pass, the cut is drawn from into a pool of points on lights
 //! ([`LightSet::presample_cut`](restir_lights::LightSet::presample_cut)), and the tile's pixels
-//! take their candidates from the pool: a read from a small array per candidate. With learning
-//! across passes ([`super::learn`]) a tile has one pool per learned cell its receivers are in,
-//! drawn from the mixture of the cell's table and the tile's cut: the cut is the learned
-//! table's defensive part, in place of the power sampler.
+//! take their candidates from the pool: a read from a small array per candidate. A pass's
+//! receivers outside their tile's region (hits the corner rays missed) get a cut of their own,
+//! made in that pass. With learning across passes ([`super::learn`]) a tile has one pool per
+//! cut and learned cell its receivers are in, drawn from the mixture of the cell's table and
+//! the cut: the cut is the learned table's defensive part, in place of the power sampler.
 //!
-//! **Unbiased.** The cut's importance is conservative for the whole tile, so an emitter that
-//! can light any of its receivers keeps a positive probability (with learning, the cut's share
-//! of the mixture keeps it); each pool entry is an independent draw carrying its mixture's
-//! probability exactly. Targets, reuse and the light/BSDF split (which weighs by the power
-//! sampler's density) are untouched.
+//! **Unbiased.** A cut's importance is conservative for its whole region, and a receiver draws
+//! from a cut only if it lies in the cut's region, so an emitter that can light it keeps a
+//! positive probability (with learning, the cut's share of the mixture keeps it); each pool
+//! entry is an independent draw carrying its mixture's probability exactly. The regions depend
+//! on no pass's random numbers, so each pass is unbiased given them. Targets, reuse and the
+//! light/BSDF split (which weighs by the power sampler's density) are untouched.
 //!
-//! **Deterministic.** A tile's pools come from streams of the pass named by the tile's place
-//! on the film (and the cell), and a cropped render's region is aligned to the tiles
+//! **Deterministic.** The regions' rays are fixed by the film; a tile's pools come from
+//! streams of the pass named by the tile's place on the film (and the cut and the cell), and a
+//! cropped render's region is aligned to the tiles
 //! ([`PixelWindow::with_halo`](crate::PixelWindow::with_halo)), so every tile it holds sees the
 //! same receivers as in the whole render: crops, chains and thread counts give the same image.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
-use restir_lights::{Claim, LearnedDraw, LearnedSampler};
+use restir_lights::{Claim, LearnedDraw, LearnedSampler, LightCut};
 use restir_scene::Scene;
 
 use crate::pass::PassContext;
@@ -42,15 +46,62 @@ pub const USES_PER_ENTRY: usize = 8;
 /// within about 2.6° of their mean.
 const SAME_NORMAL: f32 = 0.999;
 
-/// A tile's pools: per learned cell its receivers are in (`None`: the cut alone), the draws.
+/// A tile's pools: per cut and learned cell its receivers are in (`None`: the cut alone), the
+/// draws.
 type TilePools = Vec<(Option<u32>, Vec<Option<LearnedDraw>>)>;
 
-/// What one tile's build gives: its cut's node count, its pools, and per receiver (a pixel of
-/// the G-buffer) the index of its pool.
-type TileBuild = (usize, TilePools, Vec<(usize, u16)>);
+/// What one tile's build gives: its pools, per receiver (a pixel of the G-buffer) the index of
+/// its pool, and the cut made in the pass for the receivers outside the tile's region.
+#[derive(Debug, Default)]
+struct TileBuild {
+    pools: TilePools,
+    index: Vec<(usize, u16)>,
+    fresh_nodes: usize,
+    fresh_receivers: usize,
+}
+
+impl TileBuild {
+    /// Adds the pools of receivers `members` (pixel, learned cell) drawing from `cut`: one per
+    /// cell, `k` candidates per receiver, from the streams `(tile, which cut)` names.
+    #[allow(clippy::too_many_arguments)]
+    fn add(
+        &mut self,
+        lights: &restir_lights::LightSet,
+        ctx: &PassContext,
+        cut: &LightCut,
+        members: &[(usize, Option<u32>)],
+        (key, which): (u64, u64),
+        k: usize,
+        learned: Option<&LearnedSampler>,
+        claim: Claim,
+        stage: u64,
+    ) {
+        // The members' cells in order (no cell first), each with its receivers' count.
+        let mut distinct: Vec<(Option<u32>, usize)> = Vec::new();
+        for &(_, c) in members {
+            match distinct.binary_search_by_key(&c, |&(d, _)| d) {
+                Ok(j) => distinct[j].1 += 1,
+                Err(j) => distinct.insert(j, (c, 1)),
+            }
+        }
+        let first = self.pools.len();
+        for &(c, m) in &distinct {
+            let mut pool = vec![None; (m * k).div_ceil(USES_PER_ENTRY).max(k)];
+            let stream =
+                restir_sampling::mix64(key ^ (which << 63)) ^ c.map_or(0, |c| u64::from(c) + 1);
+            let mut rng = ctx.pass_stream(stage, stream);
+            lights.presample_cut(cut, learned.zip(c), &mut rng, claim, &mut pool);
+            self.pools.push((c, pool));
+        }
+        for &(i, c) in members {
+            let j = distinct.binary_search_by_key(&c, |&(d, _)| d).unwrap_or(0);
+            self.index.push((i, (first + j) as u16));
+        }
+    }
+}
 
 /// Per-tile pools of draws from the tiles' light cuts, for one pass: per tile, one pool for
-/// each learned cell its receivers are in (and one for those in no cell).
+/// each cut and learned cell its receivers are in.
 #[derive(Debug)]
 pub struct LightTiles {
     tiles_x: usize,
@@ -58,19 +109,26 @@ pub struct LightTiles {
     pools: Vec<TilePools>,
     /// Per pixel of the G-buffer, the index of its pool in its tile's list.
     pool_of: Vec<u16>,
-    nodes: usize,
-    hierarchy_nodes: usize,
+    summary: CutSummary,
 }
 
 /// What one pass's tiles held, for `--stats`.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct CutSummary {
-    /// Tiles with a cut.
+    /// Tiles with a cut found once per render.
     pub tiles: usize,
-    /// Pools over all tiles (one per learned cell a tile's receivers are in).
-    pub pools: usize,
-    /// Nodes over all their cuts.
+    /// Nodes over those cuts.
     pub nodes: usize,
+    /// Receivers of the pass.
+    pub receivers: usize,
+    /// Cuts made in the pass for receivers outside their tile's region.
+    pub fresh_cuts: usize,
+    /// Nodes over those cuts.
+    pub fresh_nodes: usize,
+    /// Receivers outside their tile's region.
+    pub fresh_receivers: usize,
+    /// Pools over all tiles (one per cut and learned cell a tile's receivers are in).
+    pub pools: usize,
     /// Entries over all their pools.
     pub entries: usize,
     /// Nodes of the whole hierarchy.
@@ -80,18 +138,158 @@ pub struct CutSummary {
 impl CutSummary {
     /// One line: how the tiles cut the hierarchy and how large their pools were.
     pub fn describe(&self) -> String {
-        let per = |n: usize| n as f64 / self.tiles.max(1) as f64;
+        let per = |n: usize, of: usize| n as f64 / of.max(1) as f64;
         format!(
-            "last pass: {} tiles of {TILE}×{TILE} pixels, each a cut of the light hierarchy ({} \
-             nodes) into at most {CUT_NODES} nodes (mean {:.0}); {:.1} pools per tile (one per \
-             learned cell its receivers are in, mixing the cell's table with the cut; one \
-             without learning), {:.0} draws per tile",
+            "{} tiles of {TILE}×{TILE} pixels, each a cut of the light hierarchy ({} nodes) into \
+             at most {CUT_NODES} nodes (mean {:.0}), found once from camera rays through its \
+             pixels' corners; last pass: {:.2}% of receivers outside their tile's region, on {} \
+             cuts of their own (mean {:.0} nodes); {:.1} pools per tile (one per cut and learned \
+             cell its receivers are in, mixing the cell's table with the cut), {:.0} draws per \
+             tile",
             self.tiles,
             self.hierarchy_nodes,
-            per(self.nodes),
-            per(self.pools),
-            per(self.entries)
+            per(self.nodes, self.tiles),
+            100.0 * per(self.fresh_receivers, self.receivers),
+            self.fresh_cuts,
+            per(self.fresh_nodes, self.fresh_cuts),
+            per(self.pools, self.tiles),
+            per(self.entries, self.tiles)
         )
+    }
+}
+
+/// A tile's receivers summed up: their mean position, how far they spread from it, and their
+/// normal where they agree (zero where they do not).
+#[derive(Clone, Copy, Debug)]
+struct Region {
+    p: Vec3,
+    n: Vec3,
+    /// The largest squared distance of a point from `p`.
+    spread2: f32,
+}
+
+impl Region {
+    /// The region of points `(position, shading normal)`, `None` for none.
+    fn of(points: impl Iterator<Item = (Vec3, Vec3)> + Clone) -> Option<Self> {
+        let (mut sum_p, mut sum_n, mut count) = (Vec3::ZERO, Vec3::ZERO, 0usize);
+        for (p, n) in points.clone() {
+            sum_p += p;
+            sum_n += n;
+            count += 1;
+        }
+        if count == 0 {
+            return None;
+        }
+        let p = sum_p / count as f32;
+        let mean_n = sum_n.normalize_or_zero();
+        let (mut spread2, mut same) = (0.0f32, mean_n != Vec3::ZERO);
+        for (q, n) in points {
+            spread2 = spread2.max((q - p).length_squared());
+            same &= n.dot(mean_n) >= SAME_NORMAL;
+        }
+        Some(Self {
+            p,
+            n: if same { mean_n } else { Vec3::ZERO },
+            spread2,
+        })
+    }
+
+    /// Whether a receiver at `q` with normal `n` lies in the region (and, where the region has
+    /// one normal, shares it): then the region's cut keeps every light that can reach it.
+    #[inline]
+    fn holds(&self, q: Vec3, n: Vec3) -> bool {
+        (q - self.p).length_squared() <= self.spread2
+            && (self.n == Vec3::ZERO || n.dot(self.n) >= SAME_NORMAL)
+    }
+
+    /// The region's cut of the light hierarchy.
+    fn cut(&self, lights: &restir_lights::LightSet) -> Option<LightCut> {
+        // `light_cut` widens the radius by more than its rounding.
+        lights.light_cut(self.p, self.n, self.spread2.sqrt(), CUT_NODES)
+    }
+}
+
+/// The tiles' regions and cuts of the light hierarchy, found once per render from camera rays
+/// through the corners of each tile's pixels (at the lens's centre), which no pass's random
+/// numbers choose: every pass, every chain and every crop of a render sees the same ones.
+#[derive(Debug)]
+pub struct TileCuts {
+    /// The film coordinates of the buffers' first pixel and their size.
+    window: (u32, u32, usize, usize),
+    /// Per tile of the buffers, its region and cut (`None`: the probes hit nothing that a
+    /// light can reach).
+    tiles: Vec<Option<(Region, LightCut)>>,
+    /// Camera rays traced to find them.
+    rays: u64,
+}
+
+impl TileCuts {
+    /// Bytes per pixel of the regions and their cuts, at most.
+    pub fn bytes_per_pixel() -> usize {
+        let per_tile = std::mem::size_of::<Option<(Region, LightCut)>>()
+            + CUT_NODES * LightCut::BYTES_PER_NODE;
+        per_tile.div_ceil(TILE * TILE)
+    }
+
+    /// The tiles' regions and cuts for buffers `width × height` of pass `ctx` (only its crop
+    /// matters): per tile, the hits of camera rays through the film corners of its pixels
+    /// (`hide_emitters` as the G-buffer's rays). `None` if the scene has no local light.
+    pub fn probe(
+        scene: &Scene,
+        ctx: &PassContext,
+        width: usize,
+        height: usize,
+        hide_emitters: bool,
+    ) -> Option<Self> {
+        let lights = &scene.lights;
+        if lights.emitter_count() == 0 {
+            return None;
+        }
+        lights.build_hierarchy();
+        let (x0, y0) = ctx.film_xy(0, width.max(1));
+        let tiles_x = width.div_ceil(TILE);
+        let tiles_y = height.div_ceil(TILE);
+        let per_tile: Vec<(Option<(Region, LightCut)>, u64)> = (0..tiles_x * tiles_y)
+            .into_par_iter()
+            .map(|t| {
+                let (tx, ty) = (t % tiles_x, t / tiles_x);
+                let cols = tx * TILE..=((tx + 1) * TILE).min(width);
+                let rows = ty * TILE..=((ty + 1) * TILE).min(height);
+                let mut hits = Vec::with_capacity((TILE + 1) * (TILE + 1));
+                let mut rays = 0;
+                for y in rows {
+                    for x in cols.clone() {
+                        let film = Vec2::new((x0 as usize + x) as f32, (y0 as usize + y) as f32);
+                        let ray = scene.camera.generate_ray(film, Vec2::splat(0.5));
+                        let (hit, n) = scene.camera_intersect(&ray, hide_emitters);
+                        rays += n;
+                        if let Some(si) = hit {
+                            hits.push((si.p, si.shading.n));
+                        }
+                    }
+                }
+                let tile = Region::of(hits.iter().copied())
+                    .and_then(|region| Some((region, region.cut(lights)?)));
+                (tile, rays)
+            })
+            .collect();
+        let rays = per_tile.iter().map(|&(_, n)| n).sum();
+        Some(Self {
+            window: (x0, y0, width, height),
+            tiles: per_tile.into_iter().map(|(t, _)| t).collect(),
+            rays,
+        })
+    }
+
+    /// Whether these are the tiles of buffers `width × height` of pass `ctx`.
+    pub fn fits(&self, ctx: &PassContext, width: usize, height: usize) -> bool {
+        let (x0, y0) = ctx.film_xy(0, width.max(1));
+        self.window == (x0, y0, width, height)
+    }
+
+    /// Camera rays traced to find the regions.
+    pub fn rays(&self) -> u64 {
+        self.rays
     }
 }
 
@@ -104,16 +302,19 @@ impl LightTiles {
     }
 
     /// Builds the tiles' pools for the primary hits of `gbuf` with `candidates` candidates per
-    /// receiver, from the streams of stage `stage` of pass `ctx`: per tile, for the receivers
-    /// in each cell of `learned` (the distribution learned in earlier passes), draws from the
-    /// mixture of the cell's table and the tile's cut, and for receivers in no cell (or without
-    /// learning) from the cut alone. `None` if the scene has no local light. `claim` is
-    /// [`Claim::Exact`] but in the tests' negative controls.
+    /// receiver, from the streams of stage `stage` of pass `ctx`. A tile's receivers in its
+    /// region of `cuts` (found once per render) draw from its cut; the others (hits the corner
+    /// rays missed, a pixel filter's tails, a lens) from a cut made in this pass for them
+    /// alone. Per cut, the receivers in each cell of `learned` (the distribution learned in
+    /// earlier passes) draw from the mixture of the cell's table and the cut, those in no
+    /// cell (or without learning) from the cut alone. `None` if the scene has no local light.
+    /// `claim` is [`Claim::Exact`] but in the tests' negative controls.
     #[allow(clippy::too_many_arguments)]
     pub fn build(
         scene: &Scene,
         ctx: &PassContext,
         gbuf: &GBuffer,
+        cuts: &TileCuts,
         candidates: u32,
         learned: Option<&LearnedSampler>,
         claim: Claim,
@@ -133,89 +334,93 @@ impl LightTiles {
                 let (tx, ty) = (t % tiles_x, t / tiles_x);
                 let rows = ty * TILE..((ty + 1) * TILE).min(gbuf.height);
                 let cols = tx * TILE..((tx + 1) * TILE).min(gbuf.width);
-                let receivers = || {
-                    rows.clone().flat_map({
-                        let cols = cols.clone();
-                        move |y| cols.clone().map(move |x| y * gbuf.width + x)
-                    })
-                };
-                // Mean position and normal of the tile's hits, how far they spread, and the
-                // learned cell of each.
-                let (mut sum_p, mut sum_n) = (Vec3::ZERO, Vec3::ZERO);
-                let mut cells: Vec<(usize, Option<u32>)> = Vec::new();
-                for i in receivers() {
-                    if let Some(r) = gbuf.receiver(i) {
-                        sum_p += r.p;
-                        sum_n += r.n;
-                        cells.push((i, learned.and_then(|l| l.cell(r.p, r.n))));
+                let cached = cuts.tiles.get(t).and_then(Option::as_ref);
+                // The tile's receivers with their learned cells, those in the tile's region
+                // apart from the others.
+                let (mut inside, mut outside) = (Vec::new(), Vec::new());
+                for y in rows.clone() {
+                    for x in cols.clone() {
+                        let i = y * gbuf.width + x;
+                        if let Some(r) = gbuf.receiver(i) {
+                            let cell = learned.and_then(|l| l.cell(r.p, r.n));
+                            match cached {
+                                Some((region, _)) if region.holds(r.p, r.n) => {
+                                    inside.push((i, cell))
+                                }
+                                _ => outside.push((i, cell)),
+                            }
+                        }
                     }
                 }
-                let count = cells.len();
-                if count == 0 {
-                    return (0, Vec::new(), Vec::new());
-                }
-                let p = sum_p / count as f32;
-                let mean_n = sum_n.normalize_or_zero();
-                let (mut spread2, mut same) = (0.0f32, mean_n != Vec3::ZERO);
-                for &(i, _) in &cells {
-                    if let Some(r) = gbuf.receiver(i) {
-                        spread2 = spread2.max((r.p - p).length_squared());
-                        same &= r.n.dot(mean_n) >= SAME_NORMAL;
-                    }
-                }
-                let n = if same { mean_n } else { Vec3::ZERO };
-                let Some(cut) = lights.light_cut(p, n, spread2.sqrt(), CUT_NODES) else {
-                    return (0, Vec::new(), Vec::new());
-                };
-                // The tile's cells in order (no cell first), each with its receivers' count.
-                let mut distinct: Vec<(Option<u32>, usize)> = Vec::new();
-                for &(_, c) in &cells {
-                    match distinct.binary_search_by_key(&c, |&(d, _)| d) {
-                        Ok(j) => distinct[j].1 += 1,
-                        Err(j) => distinct.insert(j, (c, 1)),
-                    }
-                }
-                // The tile's streams are named by its place on the film and the cell.
+                // The tile's streams are named by its place on the film, the cut and the cell.
                 let (fx, fy) = ctx.film_xy(rows.start * gbuf.width + cols.start, gbuf.width);
                 let key = ((u64::from(fy) / TILE as u64) << 32) | (u64::from(fx) / TILE as u64);
-                let pools: TilePools = distinct
-                    .iter()
-                    .map(|&(c, m)| {
-                        let mut pool = vec![None; (m * k).div_ceil(USES_PER_ENTRY).max(k)];
-                        let stream =
-                            c.map_or(key, |c| restir_sampling::mix64(key) ^ (u64::from(c) + 1));
-                        let mut rng = ctx.pass_stream(stage, stream);
-                        let mixed = learned.zip(c);
-                        lights.presample_cut(&cut, mixed, &mut rng, claim, &mut pool);
-                        (c, pool)
-                    })
-                    .collect();
-                let index = cells
-                    .iter()
-                    .map(|&(i, c)| {
-                        let j = distinct.binary_search_by_key(&c, |&(d, _)| d).unwrap_or(0);
-                        (i, j as u16)
-                    })
-                    .collect();
-                (cut.len(), pools, index)
+                let mut build = TileBuild::default();
+                if let Some((_, cut)) = cached.filter(|_| !inside.is_empty()) {
+                    build.add(
+                        lights,
+                        ctx,
+                        cut,
+                        &inside,
+                        (key, 0),
+                        k,
+                        learned,
+                        claim,
+                        stage,
+                    );
+                }
+                let fresh = Region::of(
+                    outside
+                        .iter()
+                        .filter_map(|&(i, _)| gbuf.receiver(i).map(|r| (r.p, r.n))),
+                )
+                .and_then(|region| region.cut(lights));
+                if let Some(cut) = fresh {
+                    build.fresh_nodes = cut.len();
+                    build.fresh_receivers = outside.len();
+                    build.add(
+                        lights,
+                        ctx,
+                        &cut,
+                        &outside,
+                        (key, 1),
+                        k,
+                        learned,
+                        claim,
+                        stage,
+                    );
+                }
+                build
             })
             .collect();
-        let mut pool_of = vec![0u16; gbuf.width * gbuf.height];
-        let mut nodes = 0;
+        // A receiver without a pool (no light reaches it) draws from another sampler.
+        let mut pool_of = vec![u16::MAX; gbuf.width * gbuf.height];
+        let mut summary = CutSummary {
+            hierarchy_nodes,
+            ..CutSummary::default()
+        };
         let mut pools = Vec::with_capacity(per_tile.len());
-        for (n, tile, index) in per_tile {
-            nodes += n;
-            for (i, j) in index {
-                pool_of[i] = j;
+        for (t, build) in per_tile.into_iter().enumerate() {
+            if let Some((_, cut)) = cuts.tiles.get(t).and_then(Option::as_ref) {
+                summary.tiles += 1;
+                summary.nodes += cut.len();
             }
-            pools.push(tile);
+            summary.fresh_cuts += usize::from(build.fresh_nodes > 0);
+            summary.fresh_nodes += build.fresh_nodes;
+            summary.fresh_receivers += build.fresh_receivers;
+            for (i, j) in build.index {
+                pool_of[i] = j;
+                summary.receivers += 1;
+            }
+            summary.pools += build.pools.len();
+            summary.entries += build.pools.iter().map(|(_, p)| p.len()).sum::<usize>();
+            pools.push(build.pools);
         }
         Some(Self {
             tiles_x,
             pools,
             pool_of,
-            nodes,
-            hierarchy_nodes,
+            summary,
         })
     }
 
@@ -229,13 +434,31 @@ impl LightTiles {
 
     /// What the tiles hold, for `--stats`.
     pub fn summary(&self) -> CutSummary {
-        let with_pool = self.pools.iter().filter(|p| !p.is_empty());
-        CutSummary {
-            tiles: with_pool.clone().count(),
-            pools: with_pool.clone().map(Vec::len).sum(),
-            nodes: self.nodes,
-            entries: with_pool.flatten().map(|(_, p)| p.len()).sum(),
-            hierarchy_nodes: self.hierarchy_nodes,
-        }
+        self.summary
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_region_holds_its_points_and_not_what_lies_beyond() {
+        let floor: Vec<(Vec3, Vec3)> = (0..5)
+            .flat_map(|i| (0..5).map(move |j| (Vec3::new(i as f32, 0.0, j as f32), Vec3::Y)))
+            .collect();
+        let region = Region::of(floor.iter().copied()).unwrap();
+        assert_eq!(region.n, Vec3::Y);
+        assert!(floor.iter().all(|&(p, n)| region.holds(p, n)));
+        // Beyond the radius, or facing another way: another cut's receiver.
+        assert!(!region.holds(Vec3::new(5.0, 0.0, 5.0), Vec3::Y));
+        assert!(!region.holds(Vec3::new(2.0, 0.0, 2.0), Vec3::X));
+        // Points whose normals differ: the region has none, and any normal is held.
+        let mut corner = floor.clone();
+        corner.push((Vec3::new(0.0, 1.0, 0.0), Vec3::X));
+        let region = Region::of(corner.iter().copied()).unwrap();
+        assert_eq!(region.n, Vec3::ZERO);
+        assert!(region.holds(Vec3::new(2.0, 0.0, 2.0), -Vec3::Z));
+        assert!(Region::of(std::iter::empty()).is_none());
     }
 }
