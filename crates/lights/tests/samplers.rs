@@ -405,3 +405,35 @@ fn emitters_are_named_back() {
     assert!((total - 1.0).abs() < 1e-5, "{total}");
     assert!(named >= 4 * lights.emitters_with_environment(), "{named}");
 }
+
+/// A candidate on a sphere is evaluated where its name resolves (as reuse and shading evaluate
+/// it), with the source density there: its contact is the resolved point's and its weight
+/// `g` the same function of its name whichever sampler drew it. Receivers beside the spheres
+/// see them near their silhouettes, where a rounding of the point changes the cosine most.
+#[test]
+fn sphere_candidates_are_evaluated_where_their_names_resolve() {
+    let lights = scene();
+    let mut rng = Pcg32::new(21, 4);
+    let mut checked = 0;
+    for i in 0..4000u32 {
+        let at = At {
+            p: Vec3::new(8.0 * rng.next_f32() - 4.0, 8.0 * rng.next_f32() - 4.0, 2.0),
+            n: Vec3::Z,
+        };
+        let u = CandidateU::new(i % 8, 8, rng.next_f32(), rng.next_2d());
+        let power = PowerSampler.candidate(&lights, at, &u, &mut rng);
+        let tree = HierarchySampler::default().candidate(&lights, at, &u, &mut rng);
+        for c in [power, tree].into_iter().flatten() {
+            if !lights.named_by_parameters(c.point.light) {
+                continue;
+            }
+            let resolved = lights.resolve(&c.point).contact(&lights, at.p).unwrap();
+            assert_eq!(c.contact.p, resolved.p, "candidate {i}");
+            assert_eq!(c.contact.measure, resolved.measure, "candidate {i}");
+            let power_sa = lights.pdf_sa(c.point.light, at.p, resolved.p, resolved.ng);
+            assert_eq!(c.power_pdf_sa, power_sa, "candidate {i}");
+            checked += 1;
+        }
+    }
+    assert!(checked > 2000, "{checked}");
+}
