@@ -279,14 +279,16 @@ impl Shape {
                 })
             }
             Shape::Sphere(s) => {
-                let dir = warp::sample_uniform_sphere(u);
+                // The point its parameters name (see `sample_from`).
+                let param = Sphere::param_of(warp::sample_uniform_sphere(u));
+                let (p, dir) = s.point_at(param);
                 let n = if s.flip_normals { -dir } else { dir };
                 Some(PositionSample {
-                    p: s.center + s.radius * dir,
+                    p,
                     n,
                     ng: n,
                     prim: 0,
-                    param: Sphere::param_of(dir),
+                    param,
                 })
             }
             // Mitsuba's sample: φ = 2π·u.y, z = u.x.
@@ -320,9 +322,13 @@ impl Shape {
                 let b = dir.dot(to_c);
                 let disc = (r2 - (d2 - b * b)).max(0.0);
                 let t = b - disc.sqrt();
-                let p = ref_p + dir * t;
-                let n = ((p - s.center) / s.radius).normalize();
-                let uv = Sphere::param_of(n);
+                let hit = ref_p + dir * t;
+                let uv = Sphere::param_of(((hit - s.center) / s.radius).normalize());
+                // The sample is the point its parameters name, which is what a light sample
+                // kept by its name (a reservoir's) resolves to: near the silhouette a rounding
+                // of the point changes the cosine at the light by orders of magnitude, and a
+                // candidate weighed at one point and shaded at the other would be a firefly.
+                let (p, n) = s.point_at(uv);
                 let n = if s.flip_normals { -n } else { n };
                 let pdf = warp::uniform_cone_pdf(cos_max);
                 if pdf <= 0.0 || !pdf.is_finite() {

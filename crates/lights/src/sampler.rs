@@ -75,50 +75,17 @@ pub struct LightCandidate {
 }
 
 impl LightCandidate {
-    /// A light sample drawn for receiver `x` with solid-angle density `source_pdf_sa`, whose
-    /// power-sampler density is `power_pdf_sa`.
-    ///
-    /// A point on a curved analytic emitter (a sphere) is named by its parameters, which
-    /// resolve to a point a rounding away from the sampled one; near the emitter's silhouette
-    /// as seen from `x` that changes the cosine at the light by orders of magnitude. So the
-    /// candidate is evaluated where its name resolves, as reuse and shading will evaluate it:
-    /// the densities there, with the ratio of the source's selection to the power sampler's
-    /// kept. Otherwise a point sampled with cosine 10⁻⁹ weighed a target a thousand times below
-    /// the contribution shading found for it, and one such sample lit a pixel a hundred times
-    /// too brightly.
+    /// A light sample drawn with solid-angle density `source_pdf_sa`, whose power-sampler
+    /// density is `power_pdf_sa`.
     #[inline]
-    pub fn from_sample(
-        lights: &LightSet,
-        ls: &LightSample,
-        x: Vec3,
-        source_pdf_sa: f32,
-        power_pdf_sa: f32,
-    ) -> Option<Self> {
-        let point = LightPoint::from_light_sample(ls);
-        if !ls.delta && ls.dist.is_finite() && lights.named_by_parameters(ls.light) {
-            let contact = lights.resolve(&point).contact(lights, x)?;
-            let power = lights.pdf_sa(point.light, x, contact.p, contact.ng);
-            if !(power > 0.0 && power_pdf_sa > 0.0 && contact.measure > 0.0) {
-                return None;
-            }
-            let source = source_pdf_sa / power_pdf_sa * power;
-            return Some(Self {
-                point,
-                contact: Contact {
-                    pdf_sa: Some(power),
-                    ..contact
-                },
-                source_pdf: source * contact.measure,
-                power_pdf_sa: power,
-            });
-        }
+    pub fn from_sample(ls: &LightSample, source_pdf_sa: f32, power_pdf_sa: f32) -> Option<Self> {
         let measure = if ls.delta || !ls.dist.is_finite() {
             1.0
         } else {
             ls.ng.dot(ls.wi).abs() / (ls.dist * ls.dist)
         };
         Some(Self {
-            point,
+            point: LightPoint::from_light_sample(ls),
             contact: Contact {
                 wi: ls.wi,
                 p: ls.p,
@@ -149,7 +116,7 @@ impl LightCandidate {
             } => (point, resolved, pdf),
             Presampled::Light { light, pmf } => {
                 let ls = lights.sample_light(light, x, u)?;
-                return Self::from_sample(lights, &ls, x, ls.pdf_sa * pmf, ls.pdf_sa * pmf);
+                return Self::from_sample(&ls, ls.pdf_sa * pmf, ls.pdf_sa * pmf);
             }
         };
         let contact = resolved.contact(lights, x)?;
@@ -198,7 +165,7 @@ impl LightSampler for PowerSampler {
         _rng: &mut Pcg32,
     ) -> Option<LightCandidate> {
         let ls = lights.sample(at.p, u.select, u.point)?;
-        LightCandidate::from_sample(lights, &ls, at.p, ls.pdf_sa, ls.pdf_sa)
+        LightCandidate::from_sample(&ls, ls.pdf_sa, ls.pdf_sa)
     }
 }
 
@@ -229,7 +196,7 @@ impl LightSampler for HierarchySampler {
         } else {
             ls.pdf_sa
         };
-        LightCandidate::from_sample(lights, &ls, at.p, source, power_pdf_sa)
+        LightCandidate::from_sample(&ls, source, power_pdf_sa)
     }
 }
 

@@ -381,22 +381,6 @@ impl LightSet {
         }
     }
 
-    /// Whether light `light` is an emitter whose points a [`LightPoint`](crate::LightPoint)
-    /// names by the parameters of a curved analytic surface (a sphere, a cylinder), so that
-    /// resolving the name moves the point by a rounding.
-    #[inline]
-    pub fn named_by_parameters(&self, light: u32) -> bool {
-        match self.lights.get(light as usize) {
-            Some(Light::Area { shape, .. }) => {
-                matches!(
-                    self.shapes[*shape as usize],
-                    Shape::Sphere(_) | Shape::Cylinder(_)
-                )
-            }
-            _ => false,
-        }
-    }
-
     /// Probability that [`LightSet::sample`] picks light `light` (for a mesh, any of its
     /// triangles).
     #[inline]

@@ -406,12 +406,12 @@ fn emitters_are_named_back() {
     assert!(named >= 4 * lights.emitters_with_environment(), "{named}");
 }
 
-/// A candidate on a sphere is evaluated where its name resolves (as reuse and shading evaluate
-/// it), with the source density there: its contact is the resolved point's and its weight
-/// `g` the same function of its name whichever sampler drew it. Receivers beside the spheres
-/// see them near their silhouettes, where a rounding of the point changes the cosine most.
+/// A candidate on a sphere is the point its name resolves to (as reuse and shading evaluate
+/// it), so its weight is the same function of its name whichever sampler drew it. Receivers
+/// beside the spheres see them near their silhouettes, where a rounding of the point changes
+/// the cosine at the light most.
 #[test]
-fn sphere_candidates_are_evaluated_where_their_names_resolve() {
+fn sphere_candidates_are_the_points_their_names_resolve_to() {
     let lights = scene();
     let mut rng = Pcg32::new(21, 4);
     let mut checked = 0;
@@ -423,15 +423,29 @@ fn sphere_candidates_are_evaluated_where_their_names_resolve() {
         let u = CandidateU::new(i % 8, 8, rng.next_f32(), rng.next_2d());
         let power = PowerSampler.candidate(&lights, at, &u, &mut rng);
         let tree = HierarchySampler::default().candidate(&lights, at, &u, &mut rng);
-        for c in [power, tree].into_iter().flatten() {
-            if !lights.named_by_parameters(c.point.light) {
-                continue;
-            }
+        // The scene's first 30 lights are the spheres.
+        for c in [power, tree]
+            .into_iter()
+            .flatten()
+            .filter(|c| c.point.light < 30)
+        {
             let resolved = lights.resolve(&c.point).contact(&lights, at.p).unwrap();
             assert_eq!(c.contact.p, resolved.p, "candidate {i}");
-            assert_eq!(c.contact.measure, resolved.measure, "candidate {i}");
+            assert_eq!(c.contact.wi, resolved.wi, "candidate {i}");
+            let rel = (c.contact.measure - resolved.measure).abs() / resolved.measure;
+            assert!(
+                rel < 1e-5,
+                "candidate {i}: {} vs {}",
+                c.contact.measure,
+                resolved.measure
+            );
             let power_sa = lights.pdf_sa(c.point.light, at.p, resolved.p, resolved.ng);
-            assert_eq!(c.power_pdf_sa, power_sa, "candidate {i}");
+            let rel = (c.power_pdf_sa - power_sa).abs() / power_sa;
+            assert!(
+                rel < 1e-5,
+                "candidate {i}: {} vs {power_sa}",
+                c.power_pdf_sa
+            );
             checked += 1;
         }
     }
