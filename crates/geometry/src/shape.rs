@@ -68,6 +68,70 @@ impl Sphere {
         octahedral_encode(n)
     }
 
+    /// A point uniformly distributed over the sphere's area: the point its parameters name
+    /// (see [`Sphere::sample_from`]).
+    #[inline]
+    pub fn sample_uniform_area(&self, u: Vec2) -> PositionSample {
+        let param = Sphere::param_of(warp::sample_uniform_sphere(u));
+        let (p, dir) = self.point_at(param);
+        let n = if self.flip_normals { -dir } else { dir };
+        PositionSample {
+            p,
+            n,
+            ng: n,
+            prim: 0,
+            param,
+        }
+    }
+
+    /// Samples a point on the sphere as seen from `ref_p`, with a solid-angle pdf at `ref_p`:
+    /// from outside, the cone of directions it subtends; from inside, uniformly by area
+    /// ([`Shape::sample_from`]).
+    #[inline]
+    pub fn sample_from(&self, ref_p: Vec3, u: Vec2) -> Option<(PositionSample, f32)> {
+        let to_c = self.center - ref_p;
+        let d2 = to_c.length_squared();
+        let r2 = self.radius * self.radius;
+        if d2 <= r2 * (1.0 + 1e-4) {
+            let ps = self.sample_uniform_area(u);
+            let area = 4.0 * PI * self.radius * self.radius;
+            let pdf = area_to_solid_angle(1.0 / area, ref_p, ps.p, ps.n)?;
+            return Some((ps, pdf));
+        }
+        let dist = d2.sqrt();
+        let sin2_max = r2 / d2;
+        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+        let frame = Frame::from_normal(to_c / dist);
+        let local = warp::sample_uniform_cone(u, cos_max);
+        let dir = frame.to_world(local);
+        // Intersect the ray with the sphere; clamp tangential misses to the silhouette.
+        let b = dir.dot(to_c);
+        let disc = (r2 - (d2 - b * b)).max(0.0);
+        let t = b - disc.sqrt();
+        let hit = ref_p + dir * t;
+        let uv = Sphere::param_of(((hit - self.center) / self.radius).normalize());
+        // The sample is the point its parameters name, which is what a light sample
+        // kept by its name (a reservoir's) resolves to: near the silhouette a rounding
+        // of the point changes the cosine at the light by orders of magnitude, and a
+        // candidate weighed at one point and shaded at the other would be a firefly.
+        let (p, n) = self.point_at(uv);
+        let n = if self.flip_normals { -n } else { n };
+        let pdf = warp::uniform_cone_pdf(cos_max);
+        if pdf <= 0.0 || !pdf.is_finite() {
+            return None;
+        }
+        Some((
+            PositionSample {
+                p,
+                n,
+                ng: n,
+                prim: 0,
+                param: uv,
+            },
+            pdf,
+        ))
+    }
+
     /// Mitsuba's texture coordinates `(φ/2π, θ/π)` (θ from `+z`) of direction `n` from the
     /// centre.
     #[inline]
@@ -278,19 +342,7 @@ impl Shape {
                     param: b,
                 })
             }
-            Shape::Sphere(s) => {
-                // The point its parameters name (see `sample_from`).
-                let param = Sphere::param_of(warp::sample_uniform_sphere(u));
-                let (p, dir) = s.point_at(param);
-                let n = if s.flip_normals { -dir } else { dir };
-                Some(PositionSample {
-                    p,
-                    n,
-                    ng: n,
-                    prim: 0,
-                    param,
-                })
-            }
+            Shape::Sphere(s) => Some(s.sample_uniform_area(u)),
             // Mitsuba's sample: φ = 2π·u.y, z = u.x.
             Shape::Cylinder(_) => Some(self.position_at(0, Vec2::new(u.y, u.x))),
             Shape::SdfGrid(_) => None,
@@ -303,48 +355,7 @@ impl Shape {
     #[inline]
     pub fn sample_from(&self, ref_p: Vec3, u: Vec2) -> Option<(PositionSample, f32)> {
         match self {
-            Shape::Sphere(s) => {
-                let to_c = s.center - ref_p;
-                let d2 = to_c.length_squared();
-                let r2 = s.radius * s.radius;
-                if d2 <= r2 * (1.0 + 1e-4) {
-                    let ps = self.sample_uniform_area(u)?;
-                    let pdf = area_to_solid_angle(1.0 / self.area(), ref_p, ps.p, ps.n)?;
-                    return Some((ps, pdf));
-                }
-                let dist = d2.sqrt();
-                let sin2_max = r2 / d2;
-                let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
-                let frame = Frame::from_normal(to_c / dist);
-                let local = warp::sample_uniform_cone(u, cos_max);
-                let dir = frame.to_world(local);
-                // Intersect the ray with the sphere; clamp tangential misses to the silhouette.
-                let b = dir.dot(to_c);
-                let disc = (r2 - (d2 - b * b)).max(0.0);
-                let t = b - disc.sqrt();
-                let hit = ref_p + dir * t;
-                let uv = Sphere::param_of(((hit - s.center) / s.radius).normalize());
-                // The sample is the point its parameters name, which is what a light sample
-                // kept by its name (a reservoir's) resolves to: near the silhouette a rounding
-                // of the point changes the cosine at the light by orders of magnitude, and a
-                // candidate weighed at one point and shaded at the other would be a firefly.
-                let (p, n) = s.point_at(uv);
-                let n = if s.flip_normals { -n } else { n };
-                let pdf = warp::uniform_cone_pdf(cos_max);
-                if pdf <= 0.0 || !pdf.is_finite() {
-                    return None;
-                }
-                Some((
-                    PositionSample {
-                        p,
-                        n,
-                        ng: n,
-                        prim: 0,
-                        param: uv,
-                    },
-                    pdf,
-                ))
-            }
+            Shape::Sphere(s) => s.sample_from(ref_p, u),
             Shape::Mesh(_) | Shape::Cylinder(_) => {
                 let ps = self.sample_uniform_area(u)?;
                 // Uniform by area: the solid-angle density uses the geometric normal.

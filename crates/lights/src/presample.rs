@@ -5,6 +5,8 @@
 use glam::{Vec2, Vec3};
 
 use crate::table::Emitter;
+use restir_geometry::Shape;
+
 use crate::{Light, LightPoint, LightSet, Resolved};
 
 /// A light sample drawn without a receiver ([`LightSet::presample`]). Its density is the power
@@ -24,8 +26,26 @@ pub enum Presampled {
         /// lights) or density per unit solid angle (the environment), the selection included.
         pdf: f32,
     },
-    /// A light whose points are drawn per receiver ([`LightSet::sample_light`]: a sphere's by the
-    /// cone it subtends), with its selection probability.
+    /// A sphere light, whose points are drawn per receiver by the cone it subtends, with its
+    /// selection probability and what drawing needs of it inline: a pool's entry is read from
+    /// cache, where the light's and its shape's records may be far apart in memory (10⁵
+    /// spheres: two cache misses per candidate, half the cost of sampling).
+    Sphere {
+        /// Index of the light.
+        light: u32,
+        /// Selection probability.
+        pmf: f32,
+        /// The sphere's centre.
+        center: Vec3,
+        /// Its radius.
+        radius: f32,
+        /// Its emitted radiance.
+        radiance: Vec3,
+        /// Whether its normals point inwards.
+        flip_normals: bool,
+    },
+    /// A light whose points are drawn per receiver ([`LightSet::sample_light`]), with its
+    /// selection probability.
     Light {
         /// Index of the light.
         light: u32,
@@ -90,9 +110,18 @@ impl LightSet {
         };
         let pmf = self.table.pmf(light);
         match self.lights[light as usize] {
-            Light::Area { .. } | Light::Spot(_) | Light::Projector(_) => {
-                Some(Presampled::Light { light, pmf })
-            }
+            Light::Area { shape, radiance } => match &self.shapes[shape as usize] {
+                Shape::Sphere(s) => Some(Presampled::Sphere {
+                    light,
+                    pmf,
+                    center: s.center,
+                    radius: s.radius,
+                    radiance,
+                    flip_normals: s.flip_normals,
+                }),
+                _ => Some(Presampled::Light { light, pmf }),
+            },
+            Light::Spot(_) | Light::Projector(_) => Some(Presampled::Light { light, pmf }),
             Light::Point {
                 position,
                 intensity,

@@ -17,8 +17,10 @@
 //! monomorphised for each.
 
 use glam::{Vec2, Vec3};
+use restir_geometry::Sphere;
 use restir_sampling::{ONE_MINUS_EPSILON, Pcg32};
 
+use crate::light::area_light_sample;
 use crate::{Contact, LearnedDraw, LightPoint, LightSample, LightSet, Presampled, Resolved};
 
 /// A receiver as light selection sees it: its position and shading normal (zero if unknown).
@@ -116,6 +118,20 @@ impl LightCandidate {
             } => (point, resolved, pdf),
             Presampled::Light { light, pmf } => {
                 let ls = lights.sample_light(light, x, u)?;
+                return Self::from_sample(&ls, ls.pdf_sa * pmf, ls.pdf_sa * pmf);
+            }
+            Presampled::Sphere {
+                light,
+                pmf,
+                center,
+                radius,
+                radiance,
+                flip_normals,
+            } => {
+                // What `sample_light` does for the sphere, from the entry's copy of it.
+                let sphere = Sphere::new(center, radius, flip_normals);
+                let (ps, pdf_sa) = sphere.sample_from(x, u)?;
+                let ls = area_light_sample(light, radiance, x, ps, pdf_sa)?;
                 return Self::from_sample(&ls, ls.pdf_sa * pmf, ls.pdf_sa * pmf);
             }
         };
@@ -267,6 +283,21 @@ impl LightSampler for PoolSampler<'_> {
 fn without_selection(lights: &LightSet, e: Presampled) -> Presampled {
     match e {
         Presampled::Light { light, .. } => Presampled::Light { light, pmf: 1.0 },
+        Presampled::Sphere {
+            light,
+            center,
+            radius,
+            radiance,
+            flip_normals,
+            ..
+        } => Presampled::Sphere {
+            light,
+            pmf: 1.0,
+            center,
+            radius,
+            radiance,
+            flip_normals,
+        },
         Presampled::Fixed {
             point,
             resolved: resolved @ Resolved::Point { .. },

@@ -406,7 +406,8 @@ fn cut_samples_carry_the_cut_density() {
                 restir_lights::Presampled::Fixed { point, .. } => {
                     set.emitter_of(point.light, point.prim)
                 }
-                restir_lights::Presampled::Light { light, .. } => set.emitter_of(light, 0),
+                restir_lights::Presampled::Light { light, .. }
+                | restir_lights::Presampled::Sphere { light, .. } => set.emitter_of(light, 0),
             }
             .unwrap();
             let want = set.cut_pmf(&cut, e) / set.emitter_pmf(e);
