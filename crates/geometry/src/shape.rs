@@ -72,7 +72,12 @@ impl Sphere {
     /// (see [`Sphere::sample_from`]).
     #[inline]
     pub fn sample_uniform_area(&self, u: Vec2) -> PositionSample {
-        let param = Sphere::param_of(warp::sample_uniform_sphere(u));
+        self.position_at(Sphere::param_of(warp::sample_uniform_sphere(u)))
+    }
+
+    /// The surface point named by `param`, with its normal as the sphere orients it.
+    #[inline]
+    pub fn position_at(&self, param: Vec2) -> PositionSample {
         let (p, dir) = self.point_at(param);
         let n = if self.flip_normals { -dir } else { dir };
         PositionSample {
@@ -114,22 +119,11 @@ impl Sphere {
         // kept by its name (a reservoir's) resolves to: near the silhouette a rounding
         // of the point changes the cosine at the light by orders of magnitude, and a
         // candidate weighed at one point and shaded at the other would be a firefly.
-        let (p, n) = self.point_at(uv);
-        let n = if self.flip_normals { -n } else { n };
         let pdf = warp::uniform_cone_pdf(cos_max);
         if pdf <= 0.0 || !pdf.is_finite() {
             return None;
         }
-        Some((
-            PositionSample {
-                p,
-                n,
-                ng: n,
-                prim: 0,
-                param: uv,
-            },
-            pdf,
-        ))
+        Some((self.position_at(uv), pdf))
     }
 
     /// Mitsuba's texture coordinates `(φ/2π, θ/π)` (θ from `+z`) of direction `n` from the
@@ -292,17 +286,7 @@ impl Shape {
                     param,
                 }
             }
-            Shape::Sphere(s) => {
-                let (p, n) = s.point_at(param);
-                let n = if s.flip_normals { -n } else { n };
-                PositionSample {
-                    p,
-                    n,
-                    ng: n,
-                    prim: 0,
-                    param,
-                }
-            }
+            Shape::Sphere(s) => s.position_at(param),
             Shape::Cylinder(c) => {
                 let (p, n, _) = c.point_at(param);
                 PositionSample {
