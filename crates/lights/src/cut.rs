@@ -39,7 +39,7 @@ pub struct LightCut {
 
 impl LightCut {
     /// Bytes a cut keeps per node: its leaf span and its alias table's bin.
-    pub const BYTES_PER_NODE: usize = std::mem::size_of::<(u32, u32)>() + 12;
+    pub const BYTES_PER_NODE: usize = std::mem::size_of::<(u32, u32)>() + AliasTable::BYTES_PER_BIN;
 
     /// Number of nodes in the cut.
     pub fn len(&self) -> usize {

@@ -407,7 +407,8 @@ fn emitters_are_named_back() {
 }
 
 /// A candidate on a sphere is the point its name resolves to (as reuse and shading evaluate
-/// it), so its weight is the same function of its name whichever sampler drew it. Receivers
+/// it), so its weight is the same function of its name whichever sampler drew it (the power
+/// sampler, the hierarchy, a pool's entry). Receivers
 /// beside the spheres see them near their silhouettes, where a rounding of the point changes
 /// the cosine at the light most.
 #[test]
@@ -423,8 +424,12 @@ fn sphere_candidates_are_the_points_their_names_resolve_to() {
         let u = CandidateU::new(i % 8, 8, rng.next_f32(), rng.next_2d());
         let power = PowerSampler.candidate(&lights, at, &u, &mut rng);
         let tree = HierarchySampler::default().candidate(&lights, at, &u, &mut rng);
+        // A pool's entry carries its sphere and draws the point from that copy.
+        let pooled = lights
+            .presample(u.select, u.point)
+            .and_then(|e| LightCandidate::presampled(&lights, &e, at.p, rng.next_2d()));
         // The scene's first 30 lights are the spheres.
-        for c in [power, tree]
+        for c in [power, tree, pooled]
             .into_iter()
             .flatten()
             .filter(|c| c.point.light < 30)

@@ -205,6 +205,9 @@ struct AliasBin {
 }
 
 impl AliasTable {
+    /// Bytes the table keeps per weight.
+    pub const BYTES_PER_BIN: usize = std::mem::size_of::<AliasBin>();
+
     /// Builds from non-negative weights. `None` if empty, any weight is negative or non-finite,
     /// or all are zero.
     pub fn new(weights: &[f32]) -> Option<Self> {
