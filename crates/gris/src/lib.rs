@@ -238,6 +238,7 @@ pub use confidence::{cap_confidence, cap_confidence_relative};
 pub use mis::MisScheme;
 pub use resampling::{
     GrisInput, GrisResampler, PairwiseNeighbor, PairwiseResampler, PairwiseVariant, resample,
+    resample_observed,
 };
 pub use reservoir::{Reservoir, StreamingReservoir, Uniform, uniform_f64};
 pub use shift::{ShiftMap, Shifted};

@@ -85,6 +85,32 @@ impl<S: Copy + Send + Sync, G: Surfaces> ScreenReuse<S, G> {
         stages: Stages,
         current: &mut Vec<Reservoir<S>>,
     ) -> ReuseReport {
+        self.reuse_expected(
+            shift, settings, streams, surfaces, history, stages, current, None,
+        )
+    }
+
+    /// [`reuse`](Self::reuse); with `expected`, the last spatial round also writes each
+    /// pixel's expectation of its shading over that round's selection, `Σ_i w_i·f(Y_i)/p̂(Y_i)`
+    /// scaled by the MIS normalisation ([`restir_gris::resample_observed`]), where the samples
+    /// carry their ratio ([`ReuseShift::ratio`]). Shading with it in place of the selected
+    /// sample's `f(Y)·W_Y` has the same expectation and no more variance; the reservoirs are
+    /// the same either way. Left empty without spatial rounds.
+    #[allow(clippy::too_many_arguments)]
+    pub fn reuse_expected<R: ReuseShift<Sample = S>>(
+        &self,
+        shift: &R,
+        settings: &ReuseSettings,
+        streams: &impl Streams,
+        surfaces: &G,
+        history: Option<&History<S, G>>,
+        stages: Stages,
+        current: &mut Vec<Reservoir<S>>,
+        mut expected: Option<&mut crate::passes::Expected>,
+    ) -> ReuseReport {
+        if let Some(e) = expected.as_deref_mut() {
+            e.clear();
+        }
         let temporal = history.map(|h| {
             let start = Instant::now();
             let rays = passes::temporal(
@@ -107,6 +133,7 @@ impl<S: Copy + Send + Sync, G: Surfaces> ScreenReuse<S, G> {
             surfaces,
             stages.spatial,
             current,
+            expected,
         );
         ReuseReport {
             temporal,

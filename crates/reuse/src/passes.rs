@@ -13,7 +13,7 @@ use std::sync::{Arc, Mutex};
 
 use std::borrow::Borrow;
 
-use restir_gris::{Reservoir, resample};
+use restir_gris::{MisScheme, Reservoir, ShiftMap, resample, resample_observed};
 
 use crate::bands::Bands;
 use crate::duplication;
@@ -172,9 +172,58 @@ pub fn temporal<R: ReuseShift, G: Surfaces>(
     })
 }
 
+/// Per pixel, the expectation of its shading over the last spatial round's selection
+/// ([`ReuseShift::ratio`]), `None` where it is not known (no surface, a sample without its
+/// ratio, an MIS whose normalisation depends on the selection).
+pub type Expected = Vec<Option<[f32; 3]>>;
+
+/// One pixel's resampling, with the expectation of its shading over the selection when
+/// `expect` asks for it and every input carries its ratio.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(crate) fn resample_pixel<R: ReuseShift, M: ShiftMap<R::Sample>, D: Borrow<M::Domain>>(
+    map: &M,
+    mis: MisScheme,
+    canonical_domain: &M::Domain,
+    canonical: &Reservoir<R::Sample>,
+    neighbors: &[(D, &Reservoir<R::Sample>)],
+    next_u: impl FnMut() -> f32,
+    expect: bool,
+) -> (Reservoir<R::Sample>, Option<[f32; 3]>) {
+    if !expect {
+        let out = resample(map, mis, canonical_domain, canonical, neighbors, next_u);
+        return (out, None);
+    }
+    let mut sum = [0.0f64; 3];
+    let mut complete = true;
+    let (out, scale) = resample_observed(
+        map,
+        mis,
+        canonical_domain,
+        canonical,
+        neighbors,
+        next_u,
+        &mut |y: &R::Sample, w: f64| match R::ratio(y) {
+            Some(r) => {
+                for (s, r) in sum.iter_mut().zip(r) {
+                    *s += w * f64::from(r);
+                }
+            }
+            None => complete = false,
+        },
+    );
+    let expected = scale
+        .filter(|_| complete)
+        .map(|s| sum.map(|v| (v * f64::from(s)) as f32))
+        .filter(|e| e.iter().all(|v| v.is_finite()));
+    (out, expected)
+}
+
 /// `R` spatial rounds: each pixel with a surface resamples its reservoir with up to `k`
-/// similar neighbours of the previous round's buffer, writing a new buffer. Returns the rays
-/// traced.
+/// similar neighbours of the previous round's buffer, writing a new buffer. With `expected`,
+/// the last round also writes each pixel's expectation of its shading over the selection
+/// ([`Expected`]). Returns the rays traced.
+#[allow(clippy::too_many_arguments)]
 pub fn spatial<R: ReuseShift, G: Surfaces>(
     reuse: &R,
     settings: &ReuseSettings,
@@ -183,24 +232,47 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
     surfaces: &G,
     first_stage: u64,
     current: &mut Vec<Reservoir<R::Sample>>,
+    mut expected: Option<&mut Expected>,
 ) -> u64 {
     if settings.neighbors == 0 || settings.spatial_rounds == 0 {
         return 0;
     }
+    if let Some(e) = expected.as_deref_mut() {
+        e.clear();
+        e.resize(current.len(), None);
+    }
     if settings.reciprocal && reciprocal::shares_pair_shifts(settings.mis) {
-        return reciprocal::spatial(reuse, settings, streams, surfaces, first_stage, current);
+        return reciprocal::spatial(
+            reuse,
+            settings,
+            streams,
+            surfaces,
+            first_stage,
+            current,
+            expected,
+        );
     }
     let rule = settings.neighbor_rule();
     let bands = Bands::new(surfaces.width());
     let mut next = vec![Reservoir::empty(); current.len()];
+    let mut unused = Vec::new();
     let mut rays = 0;
     for round in 0..settings.spatial_rounds {
         let input = &*current;
-        rays += bands.run(&mut next[..], |first, out| {
+        let last = round + 1 == settings.spatial_rounds;
+        let expect = last && expected.is_some();
+        let slots: &mut [Option<[f32; 3]>] = match expected.as_deref_mut() {
+            Some(e) if last => e,
+            _ => {
+                unused.resize(current.len(), None);
+                &mut unused
+            }
+        };
+        rays += bands.run((&mut next[..], slots), |first, (out, slots)| {
             let mut rays = 0;
             let mut picked = Vec::with_capacity(rule.count);
             let mut neighbors = Vec::with_capacity(rule.count);
-            for (i, res) in out.iter_mut().enumerate() {
+            for (i, (res, slot)) in out.iter_mut().zip(slots).enumerate() {
                 let index = first + i;
                 let canonical = &input[index];
                 if !surfaces.has_surface(index) {
@@ -212,15 +284,17 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
                 neighbors.clear();
                 neighbors.extend(picked.iter().map(|&q| (reuse.domain(q, false), &input[q])));
                 let map = reuse.map(canonical);
-                *res = resample(
+                let (out, e) = resample_pixel::<R, _, _>(
                     &map,
                     settings.mis,
                     reuse.domain(index, false).borrow(),
                     canonical,
                     &neighbors,
                     || rng.next_f32(),
-                )
-                .with_confidence_cap(settings.mcap);
+                    expect,
+                );
+                *res = out.with_confidence_cap(settings.mcap);
+                *slot = e;
                 rays += R::rays(&map);
             }
             rays

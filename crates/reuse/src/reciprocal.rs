@@ -18,10 +18,11 @@
 
 use std::borrow::Borrow;
 
-use restir_gris::{MisScheme, Reservoir, ShiftMap, Shifted, resample};
+use restir_gris::{MisScheme, Reservoir, ShiftMap, Shifted};
 use restir_sampling::Pcg32;
 
 use crate::bands::Bands;
+use crate::passes::{Expected, resample_pixel};
 use crate::settings::ReuseSettings;
 use crate::shift::ReuseShift;
 use crate::surfaces::{Streams, Surfaces};
@@ -135,7 +136,8 @@ fn round_offsets(radius: f32, count: usize, rng: &mut Pcg32) -> Vec<(i64, i64)> 
 }
 
 /// `R` reciprocal spatial rounds (see the module docs); the settings must use a pairwise MIS
-/// ([`shares_pair_shifts`]). Returns the rays traced.
+/// ([`shares_pair_shifts`]). With `expected` (as long as the image), the last round also
+/// writes each pixel's expectation of its shading over the selection. Returns the rays traced.
 pub fn spatial<R: ReuseShift, G: Surfaces>(
     reuse: &R,
     settings: &ReuseSettings,
@@ -143,6 +145,7 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
     surfaces: &G,
     first_stage: u64,
     current: &mut Vec<Reservoir<R::Sample>>,
+    mut expected: Option<&mut Expected>,
 ) -> u64 {
     debug_assert!(shares_pair_shifts(settings.mis));
     let (w, h) = (surfaces.width() as i64, surfaces.height() as i64);
@@ -153,8 +156,11 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
     let mut rays = 0;
     let pairs_per_round = (settings.neighbors as usize).div_ceil(2);
     let mut table: Vec<Option<PairShifts<R::Sample>>> = Vec::new();
+    let mut unused = Vec::new();
     for round in 0..settings.spatial_rounds {
         let stage = first_stage + u64::from(round);
+        let last = round + 1 == settings.spatial_rounds;
+        let expect = last && expected.is_some();
         let offsets = round_offsets(
             settings.radius,
             pairs_per_round,
@@ -209,9 +215,16 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
 
         // Phase 2: every pixel resamples with its neighbours p + o_j and p − o_j.
         let table = &table;
-        bands.run(&mut next[..], |first, out| {
+        let slots: &mut [Option<[f32; 3]>] = match expected.as_deref_mut() {
+            Some(e) if last => e,
+            _ => {
+                unused.resize(n, None);
+                &mut unused
+            }
+        };
+        bands.run((&mut next[..], slots), |first, (out, slots)| {
             let mut neighbors = Vec::with_capacity(2 * m);
-            for (i, res) in out.iter_mut().enumerate() {
+            for (i, (res, slot)) in out.iter_mut().zip(slots).enumerate() {
                 let p = first + i;
                 let canonical = &input[p];
                 if !surfaces.has_surface(p) {
@@ -241,7 +254,7 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
                     }
                 }
                 let mut rng = streams.pixel(p, stage);
-                *res = resample(
+                let (out, e) = resample_pixel::<R, _, _>(
                     &CachedShifts {
                         table,
                         mismatched: settings.reciprocal_mismatched,
@@ -251,8 +264,10 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
                     canonical,
                     &neighbors,
                     || rng.next_f32(),
-                )
-                .with_confidence_cap(settings.mcap);
+                    expect,
+                );
+                *res = out.with_confidence_cap(settings.mcap);
+                *slot = e;
             }
             0
         });

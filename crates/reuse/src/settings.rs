@@ -62,11 +62,16 @@ pub struct ReuseSettings {
     /// Negative control only: temporal reuse across frames evaluates the previous frame's
     /// domains in the current frame's scene (lights where they are now; biased).
     pub temporal_current_scene: bool,
+    /// Whether shading takes the expectation over the last spatial round's selection, every
+    /// input with its resampling weight ([`crate::ScreenReuse::reuse_expected`]; default on),
+    /// rather than the selected sample alone: the same mean, no more variance, no more shifts.
+    pub shade_expected: bool,
 }
 
 impl Default for ReuseSettings {
     /// One round of four neighbours in two reciprocal pairs within 3 pixels, defensive pairwise
-    /// MIS, `M` capped at 20, no temporal reuse, 25° and 10 % similarity: chosen for ReSTIR DI
+    /// MIS, `M` capped at 20, no temporal reuse, 25° and 10 % similarity, shading every input
+    /// of the last round: chosen for ReSTIR DI
     /// and ReSTIR PT on their training families (the project repository's
     /// `docs/studies/2026-12-02-restir-di-light-pool-and-defaults.md` and
     /// `docs/studies/2026-12-02-restir-pt-defaults.md`; ReSTIR PT runs three rounds).
@@ -85,6 +90,7 @@ impl Default for ReuseSettings {
             reciprocal_mismatched: false,
             duplication: 0.0,
             temporal_current_scene: false,
+            shade_expected: true,
         }
     }
 }

@@ -36,6 +36,17 @@ pub trait ReuseShift: Sync {
     /// pass with `previous`.
     fn domain(&self, index: usize, previous: bool) -> Self::DomainRef<'_>;
 
+    /// The integrand over the target, `f(y)/p̂(y)` (RGB), of `sample` at the receiver it is
+    /// expressed in (its pixel's reservoir, or the shift's destination), when the sample
+    /// carries it. With it, the last spatial round also gives each pixel the expectation of
+    /// its shading over the round's selection ([`ScreenReuse::reuse_expected`](crate::ScreenReuse::reuse_expected)):
+    /// every input shaded with its resampling weight, at no extra shift. `None` (the default):
+    /// the host shades the selected sample.
+    fn ratio(sample: &Self::Sample) -> Option<[f32; 3]> {
+        let _ = sample;
+        None
+    }
+
     /// Whether two pixels hold the same sample (one of them shifted from the other, or both
     /// from a common one), for the duplication-aware history cap ([`crate::duplication`]).
     fn same_sample(a: &Self::Sample, b: &Self::Sample) -> bool;

@@ -18,13 +18,15 @@
 //!   [`GrisInput`]s. Most flexible.
 //! * [`PairwiseResampler`]: streaming (defensive / confidence-weighted) pairwise MIS, the way a
 //!   renderer's spatial pass uses it: it accumulates the canonical weight across neighbours.
-//! * [`resample`]: the whole step for any [`MisScheme`](crate::MisScheme), given a [`ShiftMap`](crate::ShiftMap) implementation.
+//! * [`resample`]: the whole step for any [`MisScheme`](crate::MisScheme), given a [`ShiftMap`](crate::ShiftMap) implementation;
+//!   [`resample_observed`] also gives what shading every input instead of the selected one
+//!   would give (the selection's expectation).
 
 mod pairwise;
 mod step;
 
 pub use pairwise::{PairwiseNeighbor, PairwiseResampler, PairwiseVariant};
-pub use step::resample;
+pub use step::{resample, resample_observed};
 
 use crate::mis::clean;
 use crate::reservoir::{Reservoir, StreamingReservoir, Uniform};
@@ -133,7 +135,23 @@ impl<S> GrisResampler<S> {
     /// Returns `true` if it was selected.
     #[inline]
     pub fn add(&mut self, input: GrisInput<S>, mis_weight: f32, u: impl Uniform) -> bool {
+        self.add_observed(input, mis_weight, u, &mut |_: &S, _: f64| {})
+    }
+
+    /// [`add`](Self::add), telling `observe` the input's shifted sample and its resampling
+    /// weight `w_i` first (see [`resample_observed`]).
+    #[inline]
+    pub fn add_observed(
+        &mut self,
+        input: GrisInput<S>,
+        mis_weight: f32,
+        u: impl Uniform,
+        observe: &mut impl FnMut(&S, f64),
+    ) -> bool {
         let w = input.resampling_weight(mis_weight);
+        if w > 0.0 {
+            observe(&input.sample, w);
+        }
         let index = self.inputs;
         self.inputs += 1;
         let taken = self.stream.push(

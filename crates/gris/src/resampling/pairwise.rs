@@ -137,6 +137,17 @@ impl<S> PairwiseResampler<S> {
 
     /// Adds one neighbour with uniform `u ∈ [0, 1)`; returns `true` if its sample was selected.
     pub fn add_neighbor(&mut self, neighbor: PairwiseNeighbor<S>, u: impl Uniform) -> bool {
+        self.add_neighbor_observed(neighbor, u, &mut |_: &S, _: f64| {})
+    }
+
+    /// [`add_neighbor`](Self::add_neighbor), telling `observe` the shifted sample and its
+    /// resampling weight (see [`super::resample_observed`]).
+    pub fn add_neighbor_observed(
+        &mut self,
+        neighbor: PairwiseNeighbor<S>,
+        u: impl Uniform,
+        observe: &mut impl FnMut(&S, f64),
+    ) -> bool {
         self.added += 1;
         let cc = self.canonical.confidence;
         let pc = self.canonical.own_target;
@@ -195,7 +206,7 @@ impl<S> PairwiseResampler<S> {
             jacobian: shifted.jacobian,
             confidence: ci,
         };
-        self.stream.add(input, m, u)
+        self.stream.add_observed(input, m, u, observe)
     }
 
     /// Unnormalised canonical weight accumulated so far (`Σ(1 − a_i)`, `1 + Σ(1 − a_i)`, or the
@@ -208,6 +219,17 @@ impl<S> PairwiseResampler<S> {
     /// `W = Σ w_i · scale / p̂_c(Y)` with `scale = 1/n` (plain, 1 if `n = 0`), `1/(n+1)`
     /// (defensive) or 1 (confidence-weighted), `n` = neighbours added.
     pub fn finalize(self, u: impl Uniform) -> Reservoir<S> {
+        self.finalize_observed(u, &mut |_: &S, _: f64| {}).0
+    }
+
+    /// [`finalize`](Self::finalize), telling `observe` the canonical sample and its resampling
+    /// weight; also returns the scale that turns the observed weights into the expectation
+    /// over the selection (see [`super::resample_observed`]).
+    pub fn finalize_observed(
+        self,
+        u: impl Uniform,
+        observe: &mut impl FnMut(&S, f64),
+    ) -> (Reservoir<S>, f32) {
         let n = self.added as f32;
         let (canonical_mis, scale) = match self.variant {
             PairwiseVariant::Plain if self.added == 0 => (1.0, 1.0),
@@ -221,10 +243,10 @@ impl<S> PairwiseResampler<S> {
         let canonical_confidence = self.canonical.confidence;
         match GrisInput::canonical(self.canonical) {
             Some(input) => {
-                stream.add(input, canonical_mis, u);
+                stream.add_observed(input, canonical_mis, u, observe);
             }
             None => stream.add_failed(canonical_confidence),
         }
-        stream.finalize_scaled(scale)
+        (stream.finalize_scaled(scale), scale)
     }
 }

@@ -79,7 +79,47 @@ where
     D: Borrow<M::Domain>,
     U: Uniform,
 {
-    match scheme {
+    resample_observed(
+        map,
+        scheme,
+        canonical_domain,
+        canonical,
+        neighbors,
+        next_u,
+        &mut |_: &S, _: f64| {},
+    )
+    .0
+}
+
+/// [`resample`], also telling `observe` every input that can be selected, `(Y_i, w_i)`: its
+/// sample shifted into the receiver and its resampling weight. Returns the output reservoir
+/// and, where the MIS normalisation is common to all inputs, the scale `s` that makes
+///
+/// ```text
+/// E[ f(Y)·W_Y | the inputs ] = s · Σ_i w_i · f(Y_i) / p̂_c(Y_i)
+/// ```
+///
+/// for any integrand `f` whose support the target covers: the estimate shading every input
+/// with its weight gives in place of the selected sample's `f(Y)·W_Y`. It has the same
+/// expectation and no more variance (it is the selection's conditional expectation; the
+/// Rao–Blackwell theorem). `None` for [`MisScheme::OneOverZ`] and [`MisScheme::Contribution`],
+/// whose normalisation depends on the selected sample; `Some(0.0)` when the output is empty.
+pub fn resample_observed<S, M, D, U>(
+    map: &M,
+    scheme: MisScheme,
+    canonical_domain: &M::Domain,
+    canonical: &Reservoir<S>,
+    neighbors: &[(D, &Reservoir<S>)],
+    next_u: impl FnMut() -> U,
+    observe: &mut impl FnMut(&S, f64),
+) -> (Reservoir<S>, Option<f32>)
+where
+    S: Clone,
+    M: ShiftMap<S>,
+    D: Borrow<M::Domain>,
+    U: Uniform,
+{
+    let (out, scale) = match scheme {
         MisScheme::Pairwise => pairwise(
             map,
             PairwiseVariant::Plain,
@@ -87,6 +127,7 @@ where
             canonical,
             neighbors,
             next_u,
+            observe,
         ),
         MisScheme::DefensivePairwise => pairwise(
             map,
@@ -95,6 +136,7 @@ where
             canonical,
             neighbors,
             next_u,
+            observe,
         ),
         MisScheme::ConfidenceWeightedPairwise => {
             let variant = PairwiseVariant::ConfidenceWeighted {
@@ -103,7 +145,15 @@ where
                     .map(|(_, r)| sanitize_non_negative(r.confidence))
                     .sum(),
             };
-            pairwise(map, variant, canonical_domain, canonical, neighbors, next_u)
+            pairwise(
+                map,
+                variant,
+                canonical_domain,
+                canonical,
+                neighbors,
+                next_u,
+                observe,
+            )
         }
         MisScheme::GeneralizedBalance => generalized_balance(
             map,
@@ -112,6 +162,7 @@ where
             canonical,
             neighbors,
             next_u,
+            observe,
         ),
         MisScheme::GeneralizedPower => generalized_balance(
             map,
@@ -120,11 +171,26 @@ where
             canonical,
             neighbors,
             next_u,
+            observe,
         ),
         MisScheme::ConstantBiased | MisScheme::OneOverZ | MisScheme::Contribution => {
-            constant_weights(map, scheme, canonical_domain, canonical, neighbors, next_u)
+            constant_weights(
+                map,
+                scheme,
+                canonical_domain,
+                canonical,
+                neighbors,
+                next_u,
+                observe,
+            )
         }
-    }
+    };
+    let scale = if out.sample.is_none() {
+        Some(0.0)
+    } else {
+        scale
+    };
+    (out, scale)
 }
 
 /// The pairwise family: every neighbour streams through a [`PairwiseResampler`] with its forward
@@ -136,7 +202,8 @@ fn pairwise<S, M, D, U>(
     canonical: &Reservoir<S>,
     neighbors: &[(D, &Reservoir<S>)],
     mut next_u: impl FnMut() -> U,
-) -> Reservoir<S>
+    observe: &mut impl FnMut(&S, f64),
+) -> (Reservoir<S>, Option<f32>)
 where
     S: Clone,
     M: ShiftMap<S>,
@@ -154,9 +221,10 @@ where
             shift_in(map, domain, canonical_domain, reservoir),
             canonical_sample_target_pdf,
         );
-        step.add_neighbor(neighbor, next_u());
+        step.add_neighbor_observed(neighbor, next_u(), observe);
     }
-    step.finalize(next_u())
+    let (out, scale) = step.finalize_observed(next_u(), observe);
+    (out, Some(scale))
 }
 
 /// What the generalized heuristics weigh a technique by at a sample.
@@ -189,7 +257,8 @@ fn generalized_balance<S, M, D, U>(
     canonical: &Reservoir<S>,
     neighbors: &[(D, &Reservoir<S>)],
     mut next_u: impl FnMut() -> U,
-) -> Reservoir<S>
+    observe: &mut impl FnMut(&S, f64),
+) -> (Reservoir<S>, Option<f32>)
 where
     S: Clone,
     M: ShiftMap<S>,
@@ -217,7 +286,7 @@ where
         Some(input) => {
             let own = heuristic.term(cc, pc_own);
             let m = balance(own, own + others(&input.sample, None));
-            stream.add(input, m, next_u());
+            stream.add_observed(input, m, next_u(), observe);
         }
         None => stream.add_failed(cc),
     }
@@ -234,9 +303,9 @@ where
             own + heuristic.term(cc, shifted.destination_target) + others(&shifted.sample, Some(i));
         let m = balance(own, den);
         let input = GrisInput::from_shift(shifted, reservoir);
-        stream.add(input, m, next_u());
+        stream.add_observed(input, m, next_u(), observe);
     }
-    stream.finalize()
+    (stream.finalize(), Some(1.0))
 }
 
 /// The constant-weight family (`ConstantBiased`, `OneOverZ`, `Contribution`): candidates are
@@ -250,7 +319,8 @@ fn constant_weights<S, M, D, U>(
     canonical: &Reservoir<S>,
     neighbors: &[(D, &Reservoir<S>)],
     mut next_u: impl FnMut() -> U,
-) -> Reservoir<S>
+    observe: &mut impl FnMut(&S, f64),
+) -> (Reservoir<S>, Option<f32>)
 where
     S: Clone,
     M: ShiftMap<S>,
@@ -266,7 +336,7 @@ where
     let mut selected_source_target = pc_own;
     match GrisInput::canonical(canonical.clone()) {
         Some(input) => {
-            stream.add(input, cc, next_u());
+            stream.add_observed(input, cc, next_u(), observe);
         }
         None => stream.add_failed(cc),
     }
@@ -276,7 +346,7 @@ where
                 let (j, t) = (shifted.jacobian, reservoir.own_target);
                 let c = sanitize_non_negative(reservoir.confidence);
                 let input = GrisInput::from_shift(shifted, reservoir);
-                if stream.add(input, c, next_u()) {
+                if stream.add_observed(input, c, next_u(), observe) {
                     selected_jacobian = j;
                     selected_source_target = t;
                 }
@@ -285,7 +355,7 @@ where
         }
     }
     let (Some(s), Some(y)) = (stream.selected_input(), stream.selected().cloned()) else {
-        return stream.finalize_scaled(0.0);
+        return (stream.finalize_scaled(0.0), Some(0.0));
     };
     let scale = match scheme {
         MisScheme::ConstantBiased => {
@@ -340,7 +410,9 @@ where
             r as f32
         }
     };
-    stream.finalize_scaled(scale)
+    // Only the biased constant scheme's normalisation is common to every input.
+    let common = (scheme == MisScheme::ConstantBiased).then_some(scale);
+    (stream.finalize_scaled(scale), common)
 }
 
 #[inline]
