@@ -10,7 +10,7 @@
 
 use std::sync::atomic::AtomicBool;
 
-use restir_integrators::restir_di::{BsdfDiffuse, BsdfSamples, Learn, LightSampler};
+use restir_integrators::restir_di::{BsdfDiffuse, BsdfSamples, Learn, LightSampler, Visibility};
 use restir_integrators::reuse::MIS_NAMES;
 use restir_integrators::{
     Integrator, IntegratorOptions, RenderJob, RestirDiIntegrator, RestirDiSettings,
@@ -401,6 +401,57 @@ fn light_pool_and_visible_targets() {
 }
 
 /// Negative controls: the same test catches the biased options.
+/// Shading every input of the last spatial round with its resampling weight (`shade =
+/// expected`, the default) is unbiased and less noisy than shading the selected sample alone.
+/// Its negative control shades every input where the targets lack visibility: occluded inputs
+/// then count, which brightens the shadows.
+#[test]
+fn shading_every_input_is_unbiased_and_a_target_without_visibility_is_caught() {
+    let scene = scene();
+    let reference = direct_reference(&scene);
+    let mut variances = Vec::new();
+    for shade in ["expected", "selected"] {
+        let params = [("shade", shade)];
+        let z = max_z(
+            &statistics(&scene, "restir-di", &params, 1, 200),
+            &reference,
+        );
+        eprintln!("shade {shade}: max |z| = {z:.2}");
+        assert!(z < Z_MAX, "shade {shade}: max |z| = {z:.2}");
+        // Summed per-pixel relative variance over seeds: the selection's noise is a pixel's
+        // own, which the blocks above average away.
+        let renders: Vec<_> = (0..24)
+            .map(|seed| render_image(&scene, "restir-di", &params, 1, seed_base() + seed))
+            .collect();
+        let n = renders.len() as f64;
+        let variance: f64 = (0..renders[0].pixels.len())
+            .map(|i| {
+                let v: Vec<f64> = renders.iter().map(|r| f64::from(r.pixels[i].x)).collect();
+                let mean = v.iter().sum::<f64>() / n;
+                let variance = v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0);
+                // Relative, so that the bright silhouettes (the same either way) do not
+                // outweigh the lit surfaces.
+                variance / (mean * mean + 0.01)
+            })
+            .sum();
+        variances.push(variance);
+    }
+    let ratio = variances[0] / variances[1];
+    eprintln!("per-pixel relative variance, expected / selected: {ratio:.3}");
+    assert!(ratio < 0.95, "{variances:?}");
+    let mut wrong = RestirDiSettings::new(restir_integrators::path::PathSettings::from_desc(
+        &scene.integrator,
+    ));
+    wrong.visibility = Visibility::Shading;
+    wrong.shade_ignoring_visibility = true;
+    let z = max_z(&settings_statistics(&scene, wrong, 200), &reference);
+    eprintln!("every input without visibility in the targets: max |z| = {z:.2}");
+    assert!(
+        z > 2.0 * Z_MAX,
+        "inputs shaded without their visibility should be visibly biased, max |z| = {z:.2}"
+    );
+}
+
 #[test]
 fn biased_options_show_their_bias() {
     let scene = scene();

@@ -164,6 +164,12 @@ pub(crate) struct RestirArgs {
     /// restir-di: the same as --visibility reuse (biased at shadow edges).
     #[arg(long)]
     visibility_reuse: bool,
+    /// restir-di and restir-pt: what shading takes from the last spatial round: expected (every
+    /// input with its resampling weight, the selection's expectation: the same mean, less
+    /// noise; restir-di with --visibility target) or selected (the selected sample alone)
+    /// [default: expected].
+    #[arg(long)]
+    shade: Option<String>,
     /// Spatial neighbours in reciprocal pairs that share their shifts (pairwise MIS):
     /// true or false [default: true].
     #[arg(long)]
@@ -241,6 +247,7 @@ impl RestirArgs {
             "visibility_reuse",
             self.visibility_reuse.then_some(ParamValue::Bool(true)),
         );
+        put("shade", self.shade.clone().map(ParamValue::Text));
         put("shift", self.shift.clone().map(ParamValue::Text));
         put("max_jacobian", self.max_jacobian.map(ParamValue::Number));
         put(

@@ -11,7 +11,7 @@ use restir_materials::Bsdf;
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
-use super::shift::visible;
+use super::shift::{DiSample, visible};
 use super::target::{evaluate, light_share};
 use super::{DiReservoir, RestirDiIntegrator};
 use crate::path::bsdf_sample_share;
@@ -83,7 +83,7 @@ impl RestirDiIntegrator {
                 1.0
             };
             let w = m * e.target / (nf * cand.source_pdf);
-            stream.add_candidate(cand.point, e.target, w, 0.0, u_pick);
+            stream.add_candidate(DiSample::new(cand.point, &e), e.target, w, 0.0, u_pick);
         }
         let mut rays = 0;
         // The BSDF candidates: a found light point is visible from the receiver.
@@ -123,18 +123,19 @@ impl RestirDiIntegrator {
                     bsdf_sample_share(pdf_b, split.bsdf, power_pdf_sa, split.light)
                 };
                 let w = m * e.target / (bs.pdf_sa * c.measure);
-                if stream.add_candidate(y, e.target, w, 0.0, u_pick) {
+                if stream.add_candidate(DiSample::new(y, &e), e.target, w, 0.0, u_pick) {
                     found = Some((y, resolved));
                 }
             }
         }
         let mut res = stream.finalize_recorded();
         res.confidence = 1.0;
-        let by_bsdf = found.is_some_and(|(y, _)| res.sample == Some(y));
+        let by_bsdf = found.is_some_and(|(y, _)| res.sample.map(|s| s.point) == Some(y));
         let resolved = if by_bsdf {
             found
         } else {
-            res.sample.map(|y| (y, scene.lights.resolve(&y)))
+            res.sample
+                .map(|y| (y.point, scene.lights.resolve(&y.point)))
         };
         if self.settings.visibility.tests_initial()
             && !by_bsdf

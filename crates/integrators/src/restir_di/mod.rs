@@ -62,6 +62,7 @@ use crate::reuse::seen::SeenEmission;
 use crate::reuse::settings::mis_name;
 use crate::stages::StageClock;
 use restir_reuse::{ScreenReuse, Stages};
+pub use shift::DiSample;
 use shift::{DiReuse, visible};
 use target::{StrategyCounts, evaluate};
 
@@ -76,8 +77,9 @@ const STAGES: Stages = Stages {
     spatial: 16,
 };
 
-/// The reservoir type: 16-byte sample, `W`, `M`, `p̂`.
-pub type DiReservoir = Reservoir<LightPoint>;
+/// The reservoir type: a light point with its colour at the receiver ([`DiSample`]), `W`, `M`,
+/// `p̂`.
+pub type DiReservoir = Reservoir<DiSample>;
 
 /// The ReSTIR DI estimator (`--integrator restir-di`).
 #[derive(Debug)]
@@ -86,7 +88,7 @@ pub struct RestirDiIntegrator {
     /// The strategy counts of the direct-light split and where BSDF samples go.
     counts: StrategyCounts,
     /// The neighbour pattern and the history of temporal reuse.
-    reuse: ScreenReuse<LightPoint, GBuffer>,
+    reuse: ScreenReuse<DiSample, GBuffer>,
     clock: StageClock,
     /// What earlier passes recorded, with `learn` on.
     learning: learn::Learning,
@@ -107,6 +109,8 @@ pub struct RestirDiIntegrator {
 struct Lookups {
     resolved: Vec<Option<(LightPoint, Resolved)>>,
     bsdfs: Vec<Option<Bsdf>>,
+    /// Each pixel's expected shading over the last spatial round's selection.
+    expected: restir_reuse::passes::Expected,
 }
 
 impl RestirDiIntegrator {
@@ -187,31 +191,44 @@ impl RestirDiIntegrator {
         bsdf: &Bsdf,
         ng: Vec3,
         res: &DiReservoir,
+        expected: Option<[f32; 3]>,
         cached: &Option<(LightPoint, Resolved)>,
         rng: &mut Pcg32,
     ) -> (Vec3, u64, Option<(LightPoint, Vec3)>) {
         let mut l = Vec3::ZERO;
         let mut delivered = None;
         let mut rays = 0;
-        if let Some(y) = &res.sample
+        let target_visibility = self.settings.visibility == Visibility::Target;
+        if let Some(e) = expected {
+            // Every input of the last spatial round shaded with its weight: the selection's
+            // expectation (`ScreenReuse::reuse_expected`).
+            l += Vec3::from_array(e);
+        }
+        if target_visibility {
+            // The target includes visibility, so the selected sample's contribution here is
+            // its ratio times its target (0 where occluded), with no ray and no evaluation.
+            if let Some(y) = &res.sample {
+                let selected = y.ratio * (res.own_target * res.ucw);
+                delivered = Some((y.point, selected));
+                if expected.is_none() {
+                    l += selected;
+                }
+            }
+        } else if expected.is_none()
+            && let Some(y) = &res.sample
             && let Some(c) = match cached {
-                Some((x, resolved)) if x == y => *resolved,
-                _ => scene.lights.resolve(y),
+                Some((x, resolved)) if *x == y.point => *resolved,
+                _ => scene.lights.resolve(&y.point),
             }
             .contact(&scene.lights, r.p)
         {
-            let e = evaluate(scene, r, bsdf, y, &c, None, self.counts);
-            if e.target > 0.0 {
-                // With visibility in the target, a selected sample is visible (its target
-                // at this receiver, `own_target`, includes the shadow ray already traced).
-                let known = self.settings.visibility == Visibility::Target;
-                if known || {
-                    rays += 1;
-                    visible(scene, r, ng, &c)
-                } {
-                    l += e.contribution * res.ucw;
-                    delivered = Some((*y, e.contribution * res.ucw));
-                }
+            let e = evaluate(scene, r, bsdf, &y.point, &c, None, self.counts);
+            if e.target > 0.0 && {
+                rays += 1;
+                visible(scene, r, ng, &c)
+            } {
+                l += e.contribution * res.ucw;
+                delivered = Some((y.point, e.contribution * res.ucw));
             }
         }
 
@@ -283,7 +300,7 @@ impl Integrator for RestirDiIntegrator {
         format!(
             "restir-di max_depth={} candidates={} light_sampler={} bsdf_candidates={} {} {} neighbors={} \
              radius={} spatial_rounds={} reciprocal={} mis={} mcap={} {} \
-             visibility={}{}{}",
+             visibility={} shade={}{}{}",
             s.path.max_depth,
             s.candidates,
             s.light_sampler.name().to_string()
@@ -312,6 +329,11 @@ impl Integrator for RestirDiIntegrator {
             s.reuse.mcap,
             s.reuse.describe_temporal(),
             s.visibility.name(),
+            if s.reuse.shade_expected {
+                "expected"
+            } else {
+                "selected"
+            },
             if s.edge_rays > 1 {
                 format!(" edge_rays={}", s.edge_rays)
             } else {
@@ -362,9 +384,14 @@ impl Integrator for RestirDiIntegrator {
         reservoirs * Self::RESERVOIR_BYTES
             + hits * hit_bytes
             + std::mem::size_of::<Vec3>()
-            + reciprocal::table_bytes_per_pixel::<LightPoint>(&self.settings.reuse)
+            + reciprocal::table_bytes_per_pixel::<DiSample>(&self.settings.reuse)
             + std::mem::size_of::<Option<(LightPoint, Resolved)>>()
             + std::mem::size_of::<Option<Bsdf>>()
+            + if self.settings.reuse.shade_expected {
+                std::mem::size_of::<Option<[f32; 3]>>()
+            } else {
+                0
+            }
             + if self.settings.learn.is_on() && !self.settings.light_sampler.is_tiles() {
                 learn::CellPools::bytes_per_pixel(self.settings.candidates)
             } else {
@@ -490,6 +517,7 @@ impl Integrator for RestirDiIntegrator {
             let Lookups {
                 mut resolved,
                 mut bsdfs,
+                mut expected,
             } = lookups;
             rays += bands.run(
                 (&mut current[..], (&mut resolved[..], &mut bsdfs[..])),
@@ -565,7 +593,14 @@ impl Integrator for RestirDiIntegrator {
                 resolved: &resolved,
                 bsdfs: &bsdfs,
             };
-            let report = self.reuse.reuse(
+            // Shading every input of the last round needs each input's value over its target,
+            // which is the sample's colour only when the target includes visibility.
+            let expect = (reuse.shade_expected && s.visibility == Visibility::Target)
+                || s.shade_ignoring_visibility;
+            if !expect {
+                expected.clear();
+            }
+            let report = self.reuse.reuse_expected(
                 &shift,
                 reuse,
                 ctx,
@@ -573,6 +608,7 @@ impl Integrator for RestirDiIntegrator {
                 history.as_ref(),
                 STAGES,
                 &mut current,
+                expect.then_some(&mut expected),
             );
             rays += self.clock.add_reuse(&report);
 
@@ -607,6 +643,7 @@ impl Integrator for RestirDiIntegrator {
                                 bsdf,
                                 ng,
                                 &current[index],
+                                expected.get(index).copied().flatten(),
                                 &resolved[index],
                                 &mut rng,
                             );
@@ -635,7 +672,11 @@ impl Integrator for RestirDiIntegrator {
 
             self.reuse.keep(reuse, gbuf, current);
             if let Ok(mut l) = self.lookups.lock() {
-                *l = Lookups { resolved, bsdfs };
+                *l = Lookups {
+                    resolved,
+                    bsdfs,
+                    expected,
+                };
             }
         }
         accum

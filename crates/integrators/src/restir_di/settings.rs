@@ -333,6 +333,11 @@ pub struct RestirDiSettings {
     /// Where visibility is tested (default in every target: chosen on the training family with
     /// the reuse defaults, `docs/studies/2026-12-02-restir-di-light-pool-and-defaults.md`).
     pub visibility: Visibility,
+    /// Negative control only: shading takes every input of the last spatial round with its
+    /// weight also where the targets lack visibility, which then counts occluded inputs
+    /// (biased).
+    #[doc(hidden)]
+    pub shade_ignoring_visibility: bool,
 }
 
 impl RestirDiSettings {
@@ -358,6 +363,7 @@ impl RestirDiSettings {
             bsdf_samples_decided_from: None,
             edge_rays: 4,
             edge_mask_from_pass: false,
+            shade_ignoring_visibility: false,
             visibility: Visibility::Target,
         }
     }

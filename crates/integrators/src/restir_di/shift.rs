@@ -15,6 +15,32 @@ use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::shift::ReuseShift;
 use crate::shadow::{self, ShadowTarget};
 
+/// A reservoir's sample: a point on a light, and its contribution over its target at the
+/// receiver whose reservoir holds it (or into which it was shifted): `F·m_L / p̂`, RGB of
+/// luminance 1, the light's colour as that receiver sees it. Shading every input of the last
+/// spatial round ([`ReuseShift::ratio`]) needs it for samples whose targets only the shifts
+/// evaluated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiSample {
+    /// The point on the light.
+    pub point: LightPoint,
+    /// `F·m_L / p̂` at the receiver (zero where the target is).
+    pub ratio: Vec3,
+}
+
+impl DiSample {
+    /// `point` with the ratio of its evaluation `e` at a receiver.
+    #[inline]
+    pub fn new(point: LightPoint, e: &super::target::Evaluated) -> Self {
+        let ratio = if e.target > 0.0 {
+            e.contribution / e.target
+        } else {
+            Vec3::ZERO
+        };
+        Self { point, ratio }
+    }
+}
+
 /// A receiver where ReSTIR DI's shift map works: a pixel's primary hit in this pass, or in the
 /// previous pass, which across frames lies in the previous frame's scene.
 #[derive(Clone, Copy)]
@@ -63,7 +89,7 @@ impl<'a> DiShift<'a> {
             scene,
             counts,
             motion,
-            canonical: canonical.sample,
+            canonical: canonical.sample.map(|s| s.point),
             canonical_resolved: std::cell::OnceCell::new(),
             visibility,
             rays: std::cell::Cell::new(0),
@@ -85,7 +111,7 @@ impl<'a> DiShift<'a> {
     }
 }
 
-impl<'a> ShiftMap<LightPoint> for DiShift<'a> {
+impl<'a> ShiftMap<DiSample> for DiShift<'a> {
     type Domain = DiDomain<'a>;
 
     #[inline(always)]
@@ -93,8 +119,9 @@ impl<'a> ShiftMap<LightPoint> for DiShift<'a> {
         &self,
         from: &DiDomain<'a>,
         to: &DiDomain<'a>,
-        x: &LightPoint,
-    ) -> Option<Shifted<LightPoint>> {
+        x: &DiSample,
+    ) -> Option<Shifted<DiSample>> {
+        let x = &x.point;
         let mut y = *x;
         if from.earlier != to.earlier
             && let Some(m) = self.motion
@@ -111,7 +138,13 @@ impl<'a> ShiftMap<LightPoint> for DiShift<'a> {
             to.scene.lights.resolve(&y)
         };
         let Some(c) = resolved.contact(&to.scene.lights, to.r.p) else {
-            return Some(Shifted::identity(y, 0.0));
+            return Some(Shifted::identity(
+                DiSample {
+                    point: y,
+                    ratio: Vec3::ZERO,
+                },
+                0.0,
+            ));
         };
         let looked_up;
         let bsdf = match to.bsdf {
@@ -121,14 +154,15 @@ impl<'a> ShiftMap<LightPoint> for DiShift<'a> {
                 &looked_up
             }
         };
-        let mut p = evaluate(to.scene, to.r, bsdf, &y, &c, None, self.counts).target;
+        let e = evaluate(to.scene, to.r, bsdf, &y, &c, None, self.counts);
+        let mut p = e.target;
         if self.visibility && p > 0.0 {
             self.rays.set(self.rays.get() + 1);
             if !shadow::visible(to.scene, to.r.p, to.ng, shadow_target(&c)) {
                 p = 0.0;
             }
         }
-        Some(Shifted::identity(y, p))
+        Some(Shifted::identity(DiSample::new(y, &e), p))
     }
 }
 
@@ -152,7 +186,7 @@ pub(super) struct DiReuse<'p> {
 }
 
 impl<'p> ReuseShift for DiReuse<'p> {
-    type Sample = LightPoint;
+    type Sample = DiSample;
     type Domain = DiDomain<'p>;
     type DomainRef<'d>
         = DiDomain<'p>
@@ -204,8 +238,13 @@ impl<'p> ReuseShift for DiReuse<'p> {
 
     /// The identity shift keeps the light point.
     #[inline]
-    fn same_sample(a: &LightPoint, b: &LightPoint) -> bool {
-        a == b
+    fn same_sample(a: &DiSample, b: &DiSample) -> bool {
+        a.point == b.point
+    }
+
+    #[inline]
+    fn ratio(sample: &DiSample) -> Option<[f32; 3]> {
+        Some(sample.ratio.to_array())
     }
 }
 

@@ -53,6 +53,12 @@ impl ReuseParams for ReuseSettings {
                 self.normal_cos = deg.to_radians().cos();
             }
             "depth_threshold" => self.depth_tolerance = p.positive()?,
+            "shade" => {
+                self.shade_expected = p.choice(
+                    &[("expected", true), ("selected", false)],
+                    "expected or selected",
+                )?;
+            }
             _ => return Ok(false),
         }
         Ok(true)
