@@ -19,7 +19,7 @@ use restir_integrators::{
 use restir_scene::parse_ron;
 
 mod common;
-use common::{block_statistics, max_z, render_image};
+use common::{block_statistics, max_z, pixel_relative_variance, render_image};
 
 const SIZE: u32 = 32;
 const BLOCK: u32 = 8;
@@ -418,22 +418,9 @@ fn shading_every_input_is_unbiased_and_a_target_without_visibility_is_caught() {
         );
         eprintln!("shade {shade}: max |z| = {z:.2}");
         assert!(z < Z_MAX, "shade {shade}: max |z| = {z:.2}");
-        // Summed per-pixel relative variance over seeds: the selection's noise is a pixel's
-        // own, which the blocks above average away.
-        let renders: Vec<_> = (0..24)
-            .map(|seed| render_image(&scene, "restir-di", &params, 1, seed_base() + seed))
-            .collect();
-        let n = renders.len() as f64;
-        let variance: f64 = (0..renders[0].pixels.len())
-            .map(|i| {
-                let v: Vec<f64> = renders.iter().map(|r| f64::from(r.pixels[i].x)).collect();
-                let mean = v.iter().sum::<f64>() / n;
-                let variance = v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0);
-                // Relative, so that the bright silhouettes (the same either way) do not
-                // outweigh the lit surfaces.
-                variance / (mean * mean + 0.01)
-            })
-            .sum();
+        // A pixel's own noise (the selection's), which the blocks above average away.
+        let render_one = |seed| render_image(&scene, "restir-di", &params, 1, seed);
+        let variance = pixel_relative_variance(render_one, 24, seed_base());
         variances.push(variance);
     }
     let ratio = variances[0] / variances[1];

@@ -415,6 +415,12 @@ impl Integrator for RestirPtIntegrator {
             + hits * hit_bytes
             + std::mem::size_of::<Vec3>()
             + reciprocal::table_bytes_per_pixel::<PathSample>(&self.settings.reuse)
+            // Each pixel's expected shading over the last round's selection.
+            + if self.settings.reuse.shade_expected {
+                std::mem::size_of::<Option<[f32; 3]>>()
+            } else {
+                0
+            }
             + self.di.as_ref().map_or(0, |d| d.buffer_bytes_per_pixel())
             // The silhouette mask, a ray count per pixel.
             + self.seen.as_ref().map_or(0, |_| std::mem::size_of::<u16>())
@@ -458,7 +464,8 @@ impl Integrator for RestirPtIntegrator {
                 pixels: n,
             };
             let initial = self.diag.as_ref().map(|_| current.clone());
-            let report = self.reuse.reuse(
+            let mut expected = Vec::new();
+            let report = self.reuse.reuse_expected(
                 &shift,
                 s,
                 ctx,
@@ -466,6 +473,7 @@ impl Integrator for RestirPtIntegrator {
                 history.as_ref(),
                 STAGES,
                 &mut current,
+                s.shade_expected.then_some(&mut expected),
             );
             rays += self.clock.add_reuse(&report);
             if let (Some(d), Some(initial)) = (&self.diag, &initial) {
@@ -476,7 +484,14 @@ impl Integrator for RestirPtIntegrator {
                 radiance
                     .par_iter_mut()
                     .zip(current.par_iter())
-                    .for_each(|(l, res)| *l += Self::shade(res))
+                    .enumerate()
+                    .for_each(|(i, (l, res))| {
+                        // Every input of the last round with its weight, where known.
+                        *l += match expected.get(i).copied().flatten() {
+                            Some(e) => Vec3::from_array(e),
+                            None => Self::shade(res),
+                        }
+                    })
             });
             self.reuse.keep(s, gbuf, current);
         }

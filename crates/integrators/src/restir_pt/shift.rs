@@ -306,4 +306,15 @@ impl ReuseShift for PtReuse<'_> {
     fn same_sample(a: &PathSample, b: &PathSample) -> bool {
         a.seed == b.seed && a.kind == b.kind && a.length == b.length
     }
+
+    /// A path's value at its pixel over its target there, `luminance(value)`.
+    #[inline]
+    fn ratio(sample: &PathSample) -> Option<[f32; 3]> {
+        let p = luminance(sample.value);
+        Some(if p > 0.0 && p.is_finite() {
+            (sample.value / p).to_array()
+        } else {
+            [0.0; 3]
+        })
+    }
 }

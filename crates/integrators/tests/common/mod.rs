@@ -143,6 +143,29 @@ pub fn block_statistics(
     restir_testkit::block_statistics(|s| block_means(&render_one(s), block), seeds, seed_base)
 }
 
+/// The per-pixel relative variance (of each channel, over `mean² + 0.01`), summed over the
+/// image and its channels, across `seeds` renders with seeds `seed_base`, `seed_base + 1`, …:
+/// a pixel's own noise, which block means average away, without the bright pixels outweighing
+/// the rest.
+pub fn pixel_relative_variance(
+    render_one: impl Fn(u64) -> Image,
+    seeds: u64,
+    seed_base: u64,
+) -> f64 {
+    let renders: Vec<Image> = (0..seeds).map(|s| render_one(seed_base + s)).collect();
+    let n = renders.len() as f64;
+    let mut total = 0.0;
+    for i in 0..renders[0].pixels.len() {
+        for c in 0..3 {
+            let v: Vec<f64> = renders.iter().map(|r| f64::from(r.pixels[i][c])).collect();
+            let mean = v.iter().sum::<f64>() / n;
+            let variance = v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0);
+            total += variance / (mean * mean + 0.01);
+        }
+    }
+    total
+}
+
 /// The largest |z| over blocks between two sets of block statistics (the test kit's).
 pub fn max_z(a: &[(f64, f64)], b: &[(f64, f64)]) -> f64 {
     restir_testkit::max_z(a, b)
