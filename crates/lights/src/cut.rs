@@ -247,21 +247,27 @@ impl LightSet {
             let u_select = ((j as f32 + u0) / n).min(restir_sampling::ONE_MINUS_EPSILON);
             let u_leaf = rng.next_f64();
             let u = rng.next_2d();
+            // The emitter and, without a learned table, its probability (the cut's, known at
+            // the pick); with one, the mixture's is looked up below.
             let picked = match learned {
-                Some((l, c)) if u_select < share => l.sample_table(
-                    c,
-                    (u_select / share).min(restir_sampling::ONE_MINUS_EPSILON),
-                ),
+                Some((l, c)) if u_select < share => l
+                    .sample_table(
+                        c,
+                        (u_select / share).min(restir_sampling::ONE_MINUS_EPSILON),
+                    )
+                    .map(|e| (e, None)),
                 _ => {
                     let v = ((u_select - share) / (1.0 - share))
                         .clamp(0.0, restir_sampling::ONE_MINUS_EPSILON);
-                    self.pick_from_cut(cut, v, u_leaf).map(|(e, _)| e)
+                    self.pick_from_cut(cut, v, u_leaf)
+                        .map(|(e, pmf)| (e, learned.is_none().then_some(pmf)))
                 }
             };
-            *slot = picked.and_then(|e| {
+            *slot = picked.and_then(|(e, known)| {
                 let power = self.emitter_pmf(e);
                 let table = learned.map_or(0.0, |(l, c)| l.table_probability(self, c, e));
-                let mixture = share * table + (1.0 - share) * self.cut_pmf(cut, e);
+                let mixture =
+                    known.unwrap_or_else(|| share * table + (1.0 - share) * self.cut_pmf(cut, e));
                 let claimed = match claim {
                     Claim::Exact => mixture,
                     Claim::Power => power,
