@@ -69,6 +69,40 @@ pub trait DirectLighting: Sync {
 
     /// Whether `sample` is visible from the surface of pixel `index` (a shadow ray).
     fn visible(&self, surfaces: &Self::Surfaces, index: usize, sample: &Self::Sample) -> bool;
+
+    /// [`target`](Self::target) and [`contribution`](Self::contribution) together, which the
+    /// shifts need when shading takes every input of the last round
+    /// ([`ReuseSettings::shade_expected`] with [`Visibility::Target`]). Override it when the
+    /// two share work (a target that is the contribution's luminance, say).
+    fn target_and_contribution(
+        &self,
+        surfaces: &Self::Surfaces,
+        index: usize,
+        sample: &Self::Sample,
+    ) -> (f32, [f32; 3]) {
+        (
+            self.target(surfaces, index, sample),
+            self.contribution(surfaces, index, sample),
+        )
+    }
+}
+
+/// A host's light sample as the reservoirs hold it: with its contribution over its target at
+/// the pixel whose reservoir holds it (or into which it was shifted), when shading takes every
+/// input of the last round.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Carried<S> {
+    sample: S,
+    ratio: Option<[f32; 3]>,
+}
+
+/// `contribution / target`, zero where the target is.
+fn ratio(target: f32, contribution: [f32; 3]) -> [f32; 3] {
+    if target > 0.0 && target.is_finite() {
+        contribution.map(|c| c / target)
+    } else {
+        [0.0; 3]
+    }
 }
 
 /// Where visibility enters.
@@ -131,10 +165,12 @@ impl<G> Copy for Pixel<'_, G> {}
 struct DirectShift<'a, H> {
     host: &'a H,
     visibility: bool,
+    /// Whether shifted samples carry their ratio at the destination.
+    carry: bool,
     rays: Cell<u64>,
 }
 
-impl<'a, H: DirectLighting> ShiftMap<H::Sample> for DirectShift<'a, H> {
+impl<'a, H: DirectLighting> ShiftMap<Carried<H::Sample>> for DirectShift<'a, H> {
     type Domain = Pixel<'a, H::Surfaces>;
 
     #[inline]
@@ -142,16 +178,23 @@ impl<'a, H: DirectLighting> ShiftMap<H::Sample> for DirectShift<'a, H> {
         &self,
         _from: &Self::Domain,
         to: &Self::Domain,
-        x: &H::Sample,
-    ) -> Option<Shifted<H::Sample>> {
-        let mut p = self.host.target(to.surfaces, to.index, x);
+        x: &Carried<H::Sample>,
+    ) -> Option<Shifted<Carried<H::Sample>>> {
+        let x = &x.sample;
+        let (mut p, ratio) = if self.carry {
+            let (p, f) = self.host.target_and_contribution(to.surfaces, to.index, x);
+            (p, Some(ratio(p, f)))
+        } else {
+            (self.host.target(to.surfaces, to.index, x), None)
+        };
         if self.visibility && p > 0.0 {
             self.rays.set(self.rays.get() + 1);
             if !self.host.visible(to.surfaces, to.index, x) {
                 p = 0.0;
             }
         }
-        Some(Shifted::identity(*x, p))
+        let sample = Carried { sample: *x, ratio };
+        Some(Shifted::identity(sample, p))
     }
 }
 
@@ -161,10 +204,11 @@ struct DirectReuse<'a, H: DirectLighting> {
     current: &'a H::Surfaces,
     previous: Option<&'a H::Surfaces>,
     visibility: bool,
+    carry: bool,
 }
 
 impl<'a, H: DirectLighting> ReuseShift for DirectReuse<'a, H> {
-    type Sample = H::Sample;
+    type Sample = Carried<H::Sample>;
     type Domain = Pixel<'a, H::Surfaces>;
     type DomainRef<'d>
         = Pixel<'a, H::Surfaces>
@@ -176,10 +220,11 @@ impl<'a, H: DirectLighting> ReuseShift for DirectReuse<'a, H> {
         Self: 'm;
 
     #[inline]
-    fn map(&self, _canonical: &Reservoir<H::Sample>) -> DirectShift<'a, H> {
+    fn map(&self, _canonical: &Reservoir<Carried<H::Sample>>) -> DirectShift<'a, H> {
         DirectShift {
             host: self.host,
             visibility: self.visibility,
+            carry: self.carry,
             rays: Cell::new(0),
         }
     }
@@ -198,8 +243,13 @@ impl<'a, H: DirectLighting> ReuseShift for DirectReuse<'a, H> {
     }
 
     #[inline]
-    fn same_sample(a: &H::Sample, b: &H::Sample) -> bool {
-        a == b
+    fn same_sample(a: &Carried<H::Sample>, b: &Carried<H::Sample>) -> bool {
+        a.sample == b.sample
+    }
+
+    #[inline]
+    fn ratio(sample: &Carried<H::Sample>) -> Option<[f32; 3]> {
+        sample.ratio
     }
 }
 
@@ -218,7 +268,7 @@ pub struct DirectPass {
 /// for temporal reuse) and the pass itself.
 pub struct RestirDi<H: DirectLighting> {
     settings: DirectSettings,
-    reuse: ScreenReuse<H::Sample, H::Surfaces>,
+    reuse: ScreenReuse<Carried<H::Sample>, H::Surfaces>,
 }
 
 impl<H: DirectLighting> std::fmt::Debug for RestirDi<H> {
@@ -251,6 +301,9 @@ impl<H: DirectLighting> RestirDi<H> {
         let n = surfaces.width() * surfaces.height();
         let bands = Bands::new(surfaces.width());
         let visibility = s.visibility == Visibility::Target;
+        // Shading every input of the last round needs each one's contribution over its
+        // target, with visibility in both.
+        let carry = visibility && s.reuse.shade_expected;
         let mut current = vec![Reservoir::empty(); n];
         let mut rays = bands.run(&mut current[..], |first, out| {
             let mut rays = 0;
@@ -259,7 +312,17 @@ impl<H: DirectLighting> RestirDi<H> {
                 if surfaces.has_surface(index) {
                     let mut rng = streams.pixel(index, STAGE_INITIAL);
                     let (r, nr) = initial(host, &surfaces, index, s, &mut rng);
-                    *res = r;
+                    *res = Reservoir {
+                        sample: r.sample.map(|x| Carried {
+                            sample: x,
+                            ratio: carry.then(|| {
+                                ratio(r.own_target, host.contribution(&surfaces, index, &x))
+                            }),
+                        }),
+                        ucw: r.ucw,
+                        confidence: r.confidence,
+                        own_target: r.own_target,
+                    };
                     rays += nr;
                 }
             }
@@ -271,8 +334,10 @@ impl<H: DirectLighting> RestirDi<H> {
             current: &surfaces,
             previous: history.as_ref().map(|h| &h.surfaces),
             visibility,
+            carry,
         };
-        let report = self.reuse.reuse(
+        let mut expected = Vec::new();
+        let report = self.reuse.reuse_expected(
             &shift,
             &s.reuse,
             streams,
@@ -280,6 +345,7 @@ impl<H: DirectLighting> RestirDi<H> {
             history.as_ref(),
             STAGES,
             &mut current,
+            carry.then_some(&mut expected),
         );
         rays += report.rays();
         let mut radiance = vec![[0.0; 3]; n];
@@ -287,8 +353,12 @@ impl<H: DirectLighting> RestirDi<H> {
             let mut rays = 0;
             for (i, l) in out.iter_mut().enumerate() {
                 let index = first + i;
+                if let Some(e) = expected.get(index).copied().flatten() {
+                    *l = e;
+                    continue;
+                }
                 let res = &current[index];
-                let Some(x) = &res.sample else {
+                let Some(Carried { sample: x, .. }) = &res.sample else {
                     continue;
                 };
                 if !visibility {

@@ -211,6 +211,19 @@ impl DirectLighting for Lights<'_> {
             .map_or([0.0; 3], |s| self.unshadowed(s, x).to_array())
     }
 
+    /// The target is the contribution's luminance: one evaluation gives both.
+    fn target_and_contribution(
+        &self,
+        surfaces: &GBuffer,
+        index: usize,
+        x: &LightPoint,
+    ) -> (f32, [f32; 3]) {
+        surfaces.surface(index).map_or((0.0, [0.0; 3]), |s| {
+            let f = self.unshadowed(s, x);
+            (luminance(f), f.to_array())
+        })
+    }
+
     fn visible(&self, surfaces: &GBuffer, index: usize, x: &LightPoint) -> bool {
         surfaces
             .surface(index)

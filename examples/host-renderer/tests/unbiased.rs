@@ -58,6 +58,16 @@ fn restir_di_through_the_host_traits_is_unbiased() {
             },
         ),
         (
+            "the selected sample shaded",
+            DirectSettings {
+                reuse: ReuseSettings {
+                    shade_expected: false,
+                    ..ReuseSettings::default()
+                },
+                ..DirectSettings::default()
+            },
+        ),
+        (
             "balance heuristic, two rounds, no reciprocal pairs",
             DirectSettings {
                 reuse: ReuseSettings {
