@@ -99,7 +99,9 @@
 //! With a [`ShiftMap`] implementation, [`resample`] does the whole GRIS step for any
 //! [`MisScheme`]; [`PairwiseResampler`] is the streaming form a spatial-reuse pass uses (a
 //! runnable spatial-reuse example: `cargo run -p restir-gris --example pairwise`, source in
-//! `crates/gris/examples/pairwise.rs`).
+//! `crates/gris/examples/pairwise.rs`). [`resample_observed`] also reports every input with its
+//! resampling weight, from which a renderer shades the selection's expectation instead of the
+//! selected sample (the same mean, no more variance; `docs/GRIS.md` §3.3).
 //!
 //! # Which target is which
 //!
@@ -217,7 +219,8 @@
 //! # Modules
 //!
 //! * [`reservoir`] — [`Reservoir`] (stored) and [`StreamingReservoir`] (running WRS state).
-//! * [`resampling`] — [`GrisResampler`], [`PairwiseResampler`], [`resample`].
+//! * [`resampling`] — [`GrisResampler`], [`PairwiseResampler`], [`resample`],
+//!   [`resample_observed`].
 //! * [`mis`] — every MIS weight with its formula and source; [`MisScheme`].
 //! * [`confidence`] — M-capping.
 //! * [`shift`] — the [`ShiftMap`] contract and [`Shifted`].
