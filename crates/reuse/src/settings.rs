@@ -150,6 +150,32 @@ impl ReuseSettings {
         }
     }
 
+    /// Whether shading takes the expectation over the last spatial round's selection: asked
+    /// for ([`Self::shade_expected`]), with spatial rounds, and with an MIS whose normalisation
+    /// all inputs share (not 1/Z or contribution MIS). An estimator may need more (ReSTIR DI:
+    /// visibility in the target).
+    pub fn shades_expected(&self) -> bool {
+        self.shade_expected
+            && self.spatial_rounds > 0
+            && self.neighbors > 0
+            && !matches!(self.mis, MisScheme::OneOverZ | MisScheme::Contribution)
+    }
+
+    /// `shade=…` in an estimator's one-line description: `expected` when
+    /// [`Self::shades_expected`] and the estimator's own condition `also` hold, else `selected`
+    /// (with why, when the expectation was asked for).
+    pub fn describe_shading(&self, also: bool) -> String {
+        if self.shades_expected() && also {
+            "shade=expected".into()
+        } else if self.shade_expected {
+            "shade=selected (the expectation needs spatial rounds, a pairwise or balance MIS and \
+             visibility in the target)"
+                .into()
+        } else {
+            "shade=selected".into()
+        }
+    }
+
     /// `temporal=…` in an estimator's one-line description: `false`, or `true` with the
     /// temporal MIS (and the duplication strength when it is on).
     pub fn describe_temporal(&self) -> String {

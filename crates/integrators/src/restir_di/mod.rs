@@ -300,7 +300,7 @@ impl Integrator for RestirDiIntegrator {
         format!(
             "restir-di max_depth={} candidates={} light_sampler={} bsdf_candidates={} {} {} neighbors={} \
              radius={} spatial_rounds={} reciprocal={} mis={} mcap={} {} \
-             visibility={} shade={}{}{}",
+             visibility={} {}{}{}",
             s.path.max_depth,
             s.candidates,
             s.light_sampler.name().to_string()
@@ -329,11 +329,7 @@ impl Integrator for RestirDiIntegrator {
             s.reuse.mcap,
             s.reuse.describe_temporal(),
             s.visibility.name(),
-            if s.reuse.shade_expected {
-                "expected"
-            } else {
-                "selected"
-            },
+            s.reuse.describe_shading(s.visibility == Visibility::Target),
             if s.edge_rays > 1 {
                 format!(" edge_rays={}", s.edge_rays)
             } else {

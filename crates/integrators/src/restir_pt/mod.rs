@@ -347,7 +347,7 @@ impl Integrator for RestirPtIntegrator {
         let s = &self.settings;
         format!(
             "restir-pt max_depth={} candidates={} neighbors={} radius={} spatial_rounds={} \
-             reciprocal={} mis={} mcap={} {} shift={} reconnection={} max_jacobian={} \
+             reciprocal={} mis={} mcap={} {} {} shift={} reconnection={} max_jacobian={} \
              direct={}{}{}",
             s.path.max_depth,
             s.candidates,
@@ -358,6 +358,7 @@ impl Integrator for RestirPtIntegrator {
             mis_name(s.reuse.mis),
             s.reuse.mcap,
             s.reuse.describe_temporal(),
+            s.reuse.describe_shading(true),
             s.shift.name(),
             match s.reconnection {
                 Reconnection::Fixed => format!("fixed near_distance={}", s.near_distance),
