@@ -46,6 +46,8 @@ impl ReuseReport {
 pub struct ScreenReuse<S, G: Surfaces> {
     pattern: NeighborPattern,
     history: HistorySlot<S, G>,
+    /// The spatial rounds' buffers, kept between passes.
+    scratch: std::sync::Mutex<passes::Scratch<S>>,
 }
 
 impl<S, G: Surfaces> std::fmt::Debug for ScreenReuse<S, G> {
@@ -61,6 +63,7 @@ impl<S, G: Surfaces> Default for ScreenReuse<S, G> {
         Self {
             pattern: NeighborPattern::new(),
             history: HistorySlot::default(),
+            scratch: Default::default(),
         }
     }
 }
@@ -125,6 +128,14 @@ impl<S: Copy + Send + Sync, G: Surfaces> ScreenReuse<S, G> {
             (rays, start.elapsed())
         });
         let start = Instant::now();
+        // A pass of another thread (a split render's parts share nothing but this) or a
+        // poisoned lock gets buffers of its own.
+        let mut own = passes::Scratch::default();
+        let mut kept = self.scratch.try_lock();
+        let scratch = match kept.as_deref_mut() {
+            Ok(s) => s,
+            Err(_) => &mut own,
+        };
         let rays = passes::spatial(
             shift,
             settings,
@@ -134,6 +145,7 @@ impl<S: Copy + Send + Sync, G: Surfaces> ScreenReuse<S, G> {
             stages.spatial,
             current,
             expected,
+            scratch,
         );
         ReuseReport {
             temporal,

@@ -172,6 +172,46 @@ pub fn temporal<R: ReuseShift, G: Surfaces>(
     })
 }
 
+/// The buffers the spatial rounds write, kept from one pass to the next so that a pass does not
+/// allocate them again (a fresh buffer of an image's size is mapped and faulted in page by
+/// page: a few per cent of a pass).
+pub struct Scratch<S> {
+    /// The round's output reservoirs (after a pass: the buffer the last round read).
+    pub(crate) next: Vec<Reservoir<S>>,
+    /// The reciprocal rounds' shift table.
+    pub(crate) table: Vec<Option<reciprocal::PairShifts<S>>>,
+    /// The expectation slots of the rounds before the last.
+    pub(crate) unused: Expected,
+}
+
+impl<S> Default for Scratch<S> {
+    fn default() -> Self {
+        Self {
+            next: Vec::new(),
+            table: Vec::new(),
+            unused: Vec::new(),
+        }
+    }
+}
+
+impl<S> std::fmt::Debug for Scratch<S> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Scratch")
+            .field("pixels", &self.next.len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl<S: Copy> Scratch<S> {
+    /// `next` as `n` empty reservoirs, its memory reused.
+    pub(crate) fn next(&mut self, n: usize) -> Vec<Reservoir<S>> {
+        let mut next = std::mem::take(&mut self.next);
+        next.clear();
+        next.resize(n, Reservoir::empty());
+        next
+    }
+}
+
 /// Per pixel, the expectation of its shading over the last spatial round's selection
 /// ([`ReuseShift::ratio`]), `None` where it is not known (no surface, a sample without its
 /// ratio, an MIS whose normalisation depends on the selection).
@@ -222,7 +262,7 @@ pub(crate) fn resample_pixel<R: ReuseShift, M: ShiftMap<R::Sample>, D: Borrow<M:
 /// `R` spatial rounds: each pixel with a surface resamples its reservoir with up to `k`
 /// similar neighbours of the previous round's buffer, writing a new buffer. With `expected`,
 /// the last round also writes each pixel's expectation of its shading over the selection
-/// ([`Expected`]). Returns the rays traced.
+/// ([`Expected`]). The buffers come from `scratch` and go back to it. Returns the rays traced.
 #[allow(clippy::too_many_arguments)]
 pub fn spatial<R: ReuseShift, G: Surfaces>(
     reuse: &R,
@@ -233,6 +273,7 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
     first_stage: u64,
     current: &mut Vec<Reservoir<R::Sample>>,
     mut expected: Option<&mut Expected>,
+    scratch: &mut Scratch<R::Sample>,
 ) -> u64 {
     if settings.neighbors == 0 || settings.spatial_rounds == 0 {
         return 0;
@@ -250,12 +291,13 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
             first_stage,
             current,
             expected,
+            scratch,
         );
     }
     let rule = settings.neighbor_rule();
     let bands = Bands::new(surfaces.width());
-    let mut next = vec![Reservoir::empty(); current.len()];
-    let mut unused = Vec::new();
+    let mut next = scratch.next(current.len());
+    let unused = &mut scratch.unused;
     let mut rays = 0;
     for round in 0..settings.spatial_rounds {
         let input = &*current;
@@ -265,7 +307,7 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
             Some(e) if last => e,
             _ => {
                 unused.resize(current.len(), None);
-                &mut unused
+                &mut unused[..]
             }
         };
         rays += bands.run((&mut next[..], slots), |first, (out, slots)| {
@@ -301,5 +343,6 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
         });
         std::mem::swap(current, &mut next);
     }
+    scratch.next = next;
     rays
 }

@@ -22,7 +22,7 @@ use restir_gris::{MisScheme, Reservoir, ShiftMap, Shifted};
 use restir_sampling::Pcg32;
 
 use crate::bands::Bands;
-use crate::passes::{Expected, resample_pixel};
+use crate::passes::{Expected, Scratch, resample_pixel};
 use crate::settings::ReuseSettings;
 use crate::shift::ReuseShift;
 use crate::surfaces::{Streams, Surfaces};
@@ -52,7 +52,7 @@ pub fn table_bytes_per_pixel<S>(settings: &ReuseSettings) -> usize {
 
 /// The two shifts of a pair `(a, b = a + o_j)`: `a`'s sample into `b` and `b`'s into `a`.
 #[derive(Clone, Copy, Debug)]
-struct PairShifts<S> {
+pub(crate) struct PairShifts<S> {
     a_into_b: Option<Shifted<S>>,
     b_into_a: Option<Shifted<S>>,
 }
@@ -137,7 +137,9 @@ fn round_offsets(radius: f32, count: usize, rng: &mut Pcg32) -> Vec<(i64, i64)> 
 
 /// `R` reciprocal spatial rounds (see the module docs); the settings must use a pairwise MIS
 /// ([`shares_pair_shifts`]). With `expected` (as long as the image), the last round also
-/// writes each pixel's expectation of its shading over the selection. Returns the rays traced.
+/// writes each pixel's expectation of its shading over the selection. The buffers come from
+/// `scratch` and go back to it. Returns the rays traced.
+#[allow(clippy::too_many_arguments)]
 pub fn spatial<R: ReuseShift, G: Surfaces>(
     reuse: &R,
     settings: &ReuseSettings,
@@ -146,17 +148,18 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
     first_stage: u64,
     current: &mut Vec<Reservoir<R::Sample>>,
     mut expected: Option<&mut Expected>,
+    scratch: &mut Scratch<R::Sample>,
 ) -> u64 {
     debug_assert!(shares_pair_shifts(settings.mis));
     let (w, h) = (surfaces.width() as i64, surfaces.height() as i64);
     let bands = Bands::new(surfaces.width());
     let similarity = settings.similarity();
     let n = current.len();
-    let mut next = vec![Reservoir::empty(); n];
+    let mut next = scratch.next(n);
     let mut rays = 0;
     let pairs_per_round = (settings.neighbors as usize).div_ceil(2);
-    let mut table: Vec<Option<PairShifts<R::Sample>>> = Vec::new();
-    let mut unused = Vec::new();
+    let mut table = std::mem::take(&mut scratch.table);
+    let unused = &mut scratch.unused;
     for round in 0..settings.spatial_rounds {
         let stage = first_stage + u64::from(round);
         let last = round + 1 == settings.spatial_rounds;
@@ -219,7 +222,7 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
             Some(e) if last => e,
             _ => {
                 unused.resize(n, None);
-                &mut unused
+                &mut unused[..]
             }
         };
         bands.run((&mut next[..], slots), |first, (out, slots)| {
@@ -273,6 +276,8 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
         });
         std::mem::swap(current, &mut next);
     }
+    scratch.next = next;
+    scratch.table = table;
     rays
 }
 

@@ -111,6 +111,10 @@ struct Lookups {
     bsdfs: Vec<Option<Bsdf>>,
     /// Each pixel's expected shading over the last spatial round's selection.
     expected: restir_reuse::passes::Expected,
+    /// The pass's radiance, its reservoirs and its G-buffer, when no history keeps them.
+    radiance: Vec<Vec3>,
+    current: Vec<DiReservoir>,
+    gbuf: Option<GBuffer>,
 }
 
 impl RestirDiIntegrator {
@@ -415,10 +419,25 @@ impl Integrator for RestirDiIntegrator {
         }
         let reuse = &s.reuse;
         let n = accum.len();
-        let mut radiance = vec![Vec3::ZERO; n];
+        // The last pass's buffers, reused (a fresh buffer is faulted in page by page).
+        let Lookups {
+            mut resolved,
+            mut bsdfs,
+            mut expected,
+            mut radiance,
+            mut current,
+            gbuf: recycled,
+        } = self
+            .lookups
+            .lock()
+            .map(|mut l| std::mem::take(&mut *l))
+            .unwrap_or_default();
+        radiance.clear();
+        radiance.resize(n, Vec3::ZERO);
         let keep = s.path.max_segments() >= 2;
         let (gbuf, mut rays) = self.clock.time("primary", || {
-            GBuffer::trace(scene, ctx, s.path.hide_emitters, true, keep, &mut radiance)
+            let hide = s.path.hide_emitters;
+            GBuffer::trace_into(scene, ctx, hide, true, keep, &mut radiance, recycled)
         });
         // The seen emission on emitter silhouettes from more camera rays (`radiance` holds the
         // G-buffer's seen emission only, nothing else yet).
@@ -497,24 +516,15 @@ impl Integrator for RestirDiIntegrator {
                     STAGE_LEARN_POOL,
                 )
             });
-            let mut current = vec![DiReservoir::empty(); n];
+            current.clear();
+            current.resize(n, DiReservoir::empty());
             // Each pixel's initial sample resolved in world space and its BSDF (textures looked
             // up), which the shifts into its neighbours and its shading would otherwise look up
-            // again; the buffers of the last pass are reused.
-            let mut lookups = self
-                .lookups
-                .lock()
-                .map(|mut l| std::mem::take(&mut *l))
-                .unwrap_or_default();
-            lookups.resolved.clear();
-            lookups.resolved.resize(n, None);
-            lookups.bsdfs.clear();
-            lookups.bsdfs.resize(n, None);
-            let Lookups {
-                mut resolved,
-                mut bsdfs,
-                mut expected,
-            } = lookups;
+            // again.
+            resolved.clear();
+            resolved.resize(n, None);
+            bsdfs.clear();
+            bsdfs.resize(n, None);
             rays += bands.run(
                 (&mut current[..], (&mut resolved[..], &mut bsdfs[..])),
                 |first, (out, (cache, bsdfs))| {
@@ -665,20 +675,29 @@ impl Integrator for RestirDiIntegrator {
                 // What this pass learned serves the passes after it, never this one.
                 self.clock.time("learn", || self.learning.record(records));
             }
-
-            self.reuse.keep(reuse, gbuf, current);
-            if let Ok(mut l) = self.lookups.lock() {
-                *l = Lookups {
-                    resolved,
-                    bsdfs,
-                    expected,
-                };
-            }
         }
         accum
             .par_iter_mut()
             .zip(radiance.par_iter())
             .for_each(|(a, l)| *a += l.as_dvec3());
+        // The history keeps the surfaces and reservoirs with temporal reuse; else the next
+        // pass reuses their memory.
+        let (gbuf, current) = if keep && reuse.temporal {
+            self.reuse.keep(reuse, gbuf, current);
+            (None, Vec::new())
+        } else {
+            (Some(gbuf), current)
+        };
+        if let Ok(mut l) = self.lookups.lock() {
+            *l = Lookups {
+                resolved,
+                bsdfs,
+                expected,
+                radiance,
+                current,
+                gbuf,
+            };
+        }
         rays
     }
 }

@@ -160,12 +160,50 @@ impl GBuffer {
         keep_hits: bool,
         radiance: &mut [Vec3],
     ) -> (Self, u64) {
+        Self::trace_into(
+            scene,
+            ctx,
+            hide_emitters,
+            add_seen,
+            keep_hits,
+            radiance,
+            None,
+        )
+    }
+
+    /// [`GBuffer::trace`] into the memory of `recycled`, a buffer an earlier pass no longer
+    /// needs (a fresh buffer of an image's size is faulted in page by page, a few per cent of
+    /// a pass).
+    pub fn trace_into(
+        scene: &Scene,
+        ctx: &PassContext,
+        hide_emitters: bool,
+        add_seen: bool,
+        keep_hits: bool,
+        radiance: &mut [Vec3],
+        recycled: Option<GBuffer>,
+    ) -> (Self, u64) {
+        /// `v` as `n` copies of `value`, its memory reused.
+        fn refill<T: Clone>(mut v: Vec<T>, value: T, n: usize) -> Vec<T> {
+            v.clear();
+            v.resize(n, value);
+            v
+        }
         let add_seen = add_seen && !hide_emitters;
         let (w, h) = ctx.resolution(scene);
         let (w, h) = (w as usize, h as usize);
-        let mut receivers = vec![Receiver::EMPTY; w * h];
-        let mut ng = vec![Vec3::ZERO; w * h];
-        let mut shape = vec![u32::MAX; w * h];
+        let old = recycled.unwrap_or(GBuffer {
+            width: 0,
+            height: 0,
+            receivers: Vec::new(),
+            ng: Vec::new(),
+            shape: Vec::new(),
+            keys: Vec::new(),
+        });
+        let mut receivers = refill(old.receivers, Receiver::EMPTY, w * h);
+        let mut ng = refill(old.ng, Vec3::ZERO, w * h);
+        let mut shape = refill(old.shape, u32::MAX, w * h);
+        let mut keys = old.keys;
         let lights = &scene.lights;
         let bands = Bands::new(w);
         let buffers = (
@@ -199,7 +237,8 @@ impl GBuffer {
             }
             rays
         });
-        let keys = receivers.par_iter().map(Receiver::key).collect();
+        keys.clear();
+        keys.par_extend(receivers.par_iter().map(Receiver::key));
         (
             Self {
                 width: w,
