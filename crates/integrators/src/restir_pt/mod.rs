@@ -81,6 +81,18 @@ pub struct RestirPtIntegrator {
     diag: Option<diag::Diag>,
     /// More camera rays for the seen emission on emitter silhouettes (`edge_rays > 1`).
     seen: Option<SeenEmission>,
+    /// The last pass's buffers that no history keeps, reused by the next pass (a fresh buffer
+    /// of an image's size is faulted in page by page).
+    recycled: std::sync::Mutex<Recycled>,
+}
+
+/// A pass's buffers, kept for the next one.
+#[derive(Debug, Default)]
+struct Recycled {
+    gbuf: Option<GBuffer>,
+    current: Vec<PtReservoir>,
+    radiance: Vec<Vec3>,
+    expected: restir_reuse::passes::Expected,
 }
 
 impl RestirPtIntegrator {
@@ -106,6 +118,7 @@ impl RestirPtIntegrator {
             diag: diag::Diag::from_env(),
             seen: (settings.edge_rays > 1)
                 .then(|| SeenEmission::new(settings.edge_rays, settings.edge_mask_from_pass)),
+            recycled: Default::default(),
         }
     }
 
@@ -206,17 +219,30 @@ impl RestirPtIntegrator {
         let s = &self.settings;
         let (w, h) = ctx.resolution(scene);
         let n = w as usize * h as usize;
-        let mut radiance = vec![Vec3::ZERO; n];
+        let (recycled, mut current, mut radiance) = self
+            .recycled
+            .lock()
+            .map(|mut r| {
+                (
+                    r.gbuf.take(),
+                    std::mem::take(&mut r.current),
+                    std::mem::take(&mut r.radiance),
+                )
+            })
+            .unwrap_or_default();
+        radiance.clear();
+        radiance.resize(n, Vec3::ZERO);
         let keep = self.max_depth() >= 2;
         let (gbuf, mut rays) = self.clock.time("primary", || {
             // With `direct = restir-di` the ReSTIR DI pass adds the emitters the camera sees.
-            GBuffer::trace(
+            GBuffer::trace_into(
                 scene,
                 ctx,
                 s.path.hide_emitters,
                 s.direct != DirectLight::RestirDi,
                 keep,
                 &mut radiance,
+                recycled,
             )
         });
         if let Some(d) = &self.diag {
@@ -232,7 +258,8 @@ impl RestirPtIntegrator {
                 seen.supersample(scene, ctx, &mut radiance)
             });
         }
-        let mut current = vec![PtReservoir::empty(); n];
+        current.clear();
+        current.resize(n, PtReservoir::empty());
         if keep {
             let bands = Bands::new(gbuf.width);
             let start = std::time::Instant::now();
@@ -465,7 +492,11 @@ impl Integrator for RestirPtIntegrator {
                 pixels: n,
             };
             let initial = self.diag.as_ref().map(|_| current.clone());
-            let mut expected = Vec::new();
+            let mut expected = self
+                .recycled
+                .lock()
+                .map(|mut r| std::mem::take(&mut r.expected))
+                .unwrap_or_default();
             let report = self.reuse.reuse_expected(
                 &shift,
                 s,
@@ -494,12 +525,23 @@ impl Integrator for RestirPtIntegrator {
                         }
                     })
             });
-            self.reuse.keep(s, gbuf, current);
+            if s.temporal {
+                self.reuse.keep(s, gbuf, current);
+            } else if let Ok(mut r) = self.recycled.lock() {
+                r.gbuf = Some(gbuf);
+                r.current = current;
+            }
+            if let Ok(mut r) = self.recycled.lock() {
+                r.expected = expected;
+            }
         }
         accum
             .par_iter_mut()
             .zip(radiance.par_iter())
             .for_each(|(a, l)| *a += l.as_dvec3());
+        if let Ok(mut r) = self.recycled.lock() {
+            r.radiance = radiance;
+        }
         rays
     }
 }
