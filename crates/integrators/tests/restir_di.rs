@@ -504,9 +504,10 @@ fn same_image_for_one_and_two_threads() {
 }
 
 /// An estimator that keeps something between passes (what it learned, the default; the
-/// temporal history) renders the same image each time it renders: a render that does not
-/// continue the passes before starts afresh. Controls: learning and temporal reuse do change
-/// the image (against the estimator without them).
+/// temporal history; the buffers a pass reuses) renders the same image each time it renders: a
+/// render that does not continue the passes before starts afresh, also at another size.
+/// Controls: learning and temporal reuse do change the image (against the estimator without
+/// them).
 #[test]
 fn a_second_render_with_the_same_estimator_is_the_same_image() {
     let scene = scene();
@@ -520,6 +521,20 @@ fn a_second_render_with_the_same_estimator_is_the_same_image() {
         );
         let plain = render_image(&scene, "restir-di", &[("learn", "off")], 4, 5);
         assert!(plain.pixels != a.pixels, "{params:?}: changed nothing");
+        // A render of another size after it, in the buffers the first one left: the same
+        // image as a fresh estimator's.
+        let larger = scene_sized(
+            "Diffuse(reflectance: (0.9, 0.9, 0.9))",
+            "Diffuse(reflectance: (0.3, 0.6, 0.3))",
+            48,
+        );
+        let after = common::render_with(&larger, est.as_ref(), 2, 7);
+        let fresh = common::make(&larger, "restir-di", params);
+        let alone = common::render_with(&larger, fresh.as_ref(), 2, 7);
+        assert!(
+            after.pixels == alone.pixels,
+            "{params:?}: a render after one of another size differs"
+        );
     }
 }
 

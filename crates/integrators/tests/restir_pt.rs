@@ -912,8 +912,9 @@ fn duplication_aware_confidence_is_biased_and_labelled() {
 }
 
 /// With temporal reuse, rendering twice with one estimator gives the same image twice: a render
-/// that does not continue the passes before starts without their history. Control: temporal
-/// reuse changes the image.
+/// that does not continue the passes before starts without their history; without it, a render
+/// of another size in the buffers the one before left is a fresh estimator's image. Control:
+/// temporal reuse changes the image.
 #[test]
 fn a_second_temporal_render_with_the_same_estimator_is_the_same_image() {
     let scene = scene();
@@ -924,4 +925,22 @@ fn a_second_temporal_render_with_the_same_estimator_is_the_same_image() {
     assert!(a.pixels == b.pixels, "the second render differs");
     let plain = common::make(&scene, "restir-pt", &params[..1]);
     assert!(common::render_with(&scene, plain.as_ref(), 3, 9).pixels != a.pixels);
+    // Without temporal reuse the next pass reuses a pass's buffers: a render of another size
+    // in the buffers of the one before is the same image as a fresh estimator's.
+    let other = build(&scene_text("").replace(
+        &format!("width: {SIZE}, height: {SIZE}"),
+        "width: 40, height: 32",
+    ));
+    let after = common::render_with(&other, plain.as_ref(), 2, 9);
+    assert_eq!(
+        (after.width, after.height),
+        (40, 32),
+        "the size did not change"
+    );
+    let fresh = common::make(&other, "restir-pt", &params[..1]);
+    let alone = common::render_with(&other, fresh.as_ref(), 2, 9);
+    assert!(
+        after.pixels == alone.pixels,
+        "a render after one of another size differs"
+    );
 }
