@@ -520,6 +520,7 @@ fn shading_every_input_is_unbiased_and_less_noisy() {
     let scene = scene();
     let reference = statistics(&scene, "path", &[], 128, 64);
     let mut variances = Vec::new();
+    let mut images = Vec::new();
     for shade in ["expected", "selected"] {
         // The defaults' reuse (as `unbiased_at_the_defaults`).
         let params = [
@@ -538,7 +539,12 @@ fn shading_every_input_is_unbiased_and_less_noisy() {
         assert!(z < Z_MAX, "shade {shade}: max |z| = {z:.2}");
         let render_one = |seed| render_image(&scene, "restir-pt", &params, 1, seed);
         variances.push(pixel_relative_variance(render_one, 24, 2000));
+        images.push(render_one(2000).pixels);
     }
+    assert!(
+        images[0] != images[1],
+        "shading every input changed nothing"
+    );
     let ratio = variances[0] / variances[1];
     eprintln!("per-pixel relative variance, expected / selected: {ratio:.3}");
     assert!(ratio < 1.01, "{variances:?}");

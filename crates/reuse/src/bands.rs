@@ -2,7 +2,7 @@
 //! of [`BAND_ROWS`] image rows, run in parallel over one or several per-pixel buffers at once
 //! ([`Bands::run`]), each band told the index of its first pixel.
 
-use rayon::iter::Zip;
+use rayon::iter::{Either, Map, RepeatN, Zip, repeat_n};
 use rayon::prelude::*;
 use rayon::slice::ChunksMut;
 
@@ -32,6 +32,25 @@ impl<'a, T: Send> BandBuffers for &'a mut [T] {
     type Iter = ChunksMut<'a, T>;
     fn split(self, len: usize) -> Self::Iter {
         self.par_chunks_mut(len)
+    }
+}
+
+/// The bands of a buffer that may be absent.
+type OptionalBands<'a, T> = Either<
+    Map<ChunksMut<'a, T>, fn(&'a mut [T]) -> Option<&'a mut [T]>>,
+    Map<RepeatN<()>, fn(()) -> Option<&'a mut [T]>>,
+>;
+
+/// A buffer that may be absent: its bands, or `None` for every band (beside another buffer,
+/// which decides how many bands there are).
+impl<'a, T: Send> BandBuffers for Option<&'a mut [T]> {
+    type Band = Option<&'a mut [T]>;
+    type Iter = OptionalBands<'a, T>;
+    fn split(self, len: usize) -> Self::Iter {
+        match self {
+            Some(buffer) => Either::Left(buffer.par_chunks_mut(len).map(Some as fn(_) -> _)),
+            None => Either::Right(repeat_n((), usize::MAX).map((|()| None) as fn(_) -> _)),
+        }
     }
 }
 

@@ -180,8 +180,6 @@ pub struct Scratch<S> {
     pub(crate) next: Vec<Reservoir<S>>,
     /// The reciprocal rounds' shift table.
     pub(crate) table: Vec<Option<reciprocal::PairShifts<S>>>,
-    /// The expectation slots of the rounds before the last.
-    pub(crate) unused: Expected,
 }
 
 impl<S> Default for Scratch<S> {
@@ -189,7 +187,6 @@ impl<S> Default for Scratch<S> {
         Self {
             next: Vec::new(),
             table: Vec::new(),
-            unused: Vec::new(),
         }
     }
 }
@@ -297,24 +294,18 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
     let rule = settings.neighbor_rule();
     let bands = Bands::new(surfaces.width());
     let mut next = scratch.next(current.len());
-    let unused = &mut scratch.unused;
     let mut rays = 0;
     for round in 0..settings.spatial_rounds {
         let input = &*current;
         let last = round + 1 == settings.spatial_rounds;
-        let expect = last && expected.is_some();
-        let slots: &mut [Option<[f32; 3]>] = match expected.as_deref_mut() {
-            Some(e) if last => e,
-            _ => {
-                unused.resize(current.len(), None);
-                &mut unused[..]
-            }
-        };
-        rays += bands.run((&mut next[..], slots), |first, (out, slots)| {
+        // The expectation's slots, in the last round only.
+        let slots = expected.as_deref_mut().filter(|_| last).map(|e| &mut e[..]);
+        let expect = slots.is_some();
+        rays += bands.run((&mut next[..], slots), |first, (out, mut slots)| {
             let mut rays = 0;
             let mut picked = Vec::with_capacity(rule.count);
             let mut neighbors = Vec::with_capacity(rule.count);
-            for (i, (res, slot)) in out.iter_mut().zip(slots).enumerate() {
+            for (i, res) in out.iter_mut().enumerate() {
                 let index = first + i;
                 let canonical = &input[index];
                 if !surfaces.has_surface(index) {
@@ -336,7 +327,9 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
                     expect,
                 );
                 *res = out.with_confidence_cap(settings.mcap);
-                *slot = e;
+                if let Some(slots) = slots.as_deref_mut() {
+                    slots[i] = e;
+                }
                 rays += R::rays(&map);
             }
             rays

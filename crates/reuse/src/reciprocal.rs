@@ -159,11 +159,9 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
     let mut rays = 0;
     let pairs_per_round = (settings.neighbors as usize).div_ceil(2);
     let mut table = std::mem::take(&mut scratch.table);
-    let unused = &mut scratch.unused;
     for round in 0..settings.spatial_rounds {
         let stage = first_stage + u64::from(round);
         let last = round + 1 == settings.spatial_rounds;
-        let expect = last && expected.is_some();
         let offsets = round_offsets(
             settings.radius,
             pairs_per_round,
@@ -218,16 +216,12 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
 
         // Phase 2: every pixel resamples with its neighbours p + o_j and p − o_j.
         let table = &table;
-        let slots: &mut [Option<[f32; 3]>] = match expected.as_deref_mut() {
-            Some(e) if last => e,
-            _ => {
-                unused.resize(n, None);
-                &mut unused[..]
-            }
-        };
-        bands.run((&mut next[..], slots), |first, (out, slots)| {
+        // The expectation's slots, in the last round only.
+        let slots = expected.as_deref_mut().filter(|_| last).map(|e| &mut e[..]);
+        let expect = slots.is_some();
+        bands.run((&mut next[..], slots), |first, (out, mut slots)| {
             let mut neighbors = Vec::with_capacity(2 * m);
-            for (i, (res, slot)) in out.iter_mut().zip(slots).enumerate() {
+            for (i, res) in out.iter_mut().enumerate() {
                 let p = first + i;
                 let canonical = &input[p];
                 if !surfaces.has_surface(p) {
@@ -270,7 +264,9 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
                     expect,
                 );
                 *res = out.with_confidence_cap(settings.mcap);
-                *slot = e;
+                if let Some(slots) = slots.as_deref_mut() {
+                    slots[i] = e;
+                }
             }
             0
         });

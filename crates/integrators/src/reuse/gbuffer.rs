@@ -192,14 +192,7 @@ impl GBuffer {
         let add_seen = add_seen && !hide_emitters;
         let (w, h) = ctx.resolution(scene);
         let (w, h) = (w as usize, h as usize);
-        let old = recycled.unwrap_or(GBuffer {
-            width: 0,
-            height: 0,
-            receivers: Vec::new(),
-            ng: Vec::new(),
-            shape: Vec::new(),
-            keys: Vec::new(),
-        });
+        let old = recycled.unwrap_or_default();
         let mut receivers = refill(old.receivers, Receiver::EMPTY, w * h);
         let mut ng = refill(old.ng, Vec3::ZERO, w * h);
         let mut shape = refill(old.shape, u32::MAX, w * h);

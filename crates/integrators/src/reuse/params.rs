@@ -56,7 +56,7 @@ impl ReuseParams for ReuseSettings {
             "shade" => {
                 self.shade_expected = p.choice(
                     &[("expected", true), ("selected", false)],
-                    "expected or selected",
+                    "one of expected, selected",
                 )?;
             }
             _ => return Ok(false),
