@@ -14,14 +14,17 @@
 //! and pass the similarity test (which is symmetric). The choice depends on the surfaces and the
 //! pass's stream only, never on reservoirs, so the reuse stays unbiased. A round runs in two
 //! phases: the shifts of every pair `(p, p + o_j)`, stored per pixel and offset, then each
-//! pixel's resampling with a [`ShiftMap`] that reads them.
+//! pixel's resampling with a [`ShiftMap`] that reads them. Both run chunk of rows by chunk of
+//! rows, so the table holds the pairs of one chunk and of the rows its pixels' neighbours reach
+//! (64 rows and the radius above and below on up to 4 threads; 16 rows per thread beyond), not
+//! the whole image's: per-pixel buffer estimates do not count it.
 
 use std::borrow::Borrow;
 
 use restir_gris::{MisScheme, Reservoir, ShiftMap, Shifted};
 use restir_sampling::Pcg32;
 
-use crate::bands::Bands;
+use crate::bands::{BAND_ROWS, Bands};
 use crate::passes::{Expected, Scratch, resample_pixel};
 use crate::settings::ReuseSettings;
 use crate::shift::ReuseShift;
@@ -34,20 +37,6 @@ pub fn shares_pair_shifts(scheme: MisScheme) -> bool {
         scheme,
         MisScheme::Pairwise | MisScheme::DefensivePairwise | MisScheme::ConfidenceWeightedPairwise
     )
-}
-
-/// Bytes per pixel of the shift table the reciprocal rounds of `settings` keep (0 when they do
-/// not run), for an estimator's `buffer_bytes_per_pixel`.
-pub fn table_bytes_per_pixel<S>(settings: &ReuseSettings) -> usize {
-    let runs = settings.reciprocal
-        && shares_pair_shifts(settings.mis)
-        && settings.neighbors > 0
-        && settings.spatial_rounds > 0;
-    if runs {
-        (settings.neighbors as usize).div_ceil(2) * std::mem::size_of::<Option<PairShifts<S>>>()
-    } else {
-        0
-    }
 }
 
 /// The two shifts of a pair `(a, b = a + o_j)`: `a`'s sample into `b` and `b`'s into `a`.
@@ -109,6 +98,49 @@ impl<S: Copy> ShiftMap<S> for CachedShifts<'_, S> {
         } else {
             pair.b_into_a
         }
+    }
+}
+
+/// The rows of a round, resampled chunk by chunk: the table holds the pairs of one chunk's
+/// rows and of the rows its neighbours reach, not the image's (at 1800×1080 pixels and 4
+/// neighbours a whole image's table of light samples held 300 MB).
+#[derive(Clone, Copy, Debug)]
+struct Window {
+    height: usize,
+    /// Rows per chunk: enough bands for every thread.
+    chunk: usize,
+    /// How many rows above and below a pixel its neighbours lie.
+    reach: usize,
+}
+
+impl Window {
+    fn new(height: usize, reach: usize) -> Self {
+        let chunk = (8 * BAND_ROWS * rayon::current_num_threads()).max(64);
+        Self {
+            height,
+            chunk,
+            reach,
+        }
+    }
+
+    /// Rows the table holds at most.
+    fn rows(&self) -> usize {
+        (self.chunk + 2 * self.reach).min(self.height)
+    }
+
+    /// The chunks, `(first row, end row)`, in order.
+    fn chunks(self) -> impl Iterator<Item = (usize, usize)> {
+        (0..self.height)
+            .step_by(self.chunk)
+            .map(move |r| (r, (r + self.chunk).min(self.height)))
+    }
+
+    /// The rows whose pairs the pixels of `chunk` read.
+    fn reached(&self, (first, end): (usize, usize)) -> (usize, usize) {
+        (
+            first.saturating_sub(self.reach),
+            (end + self.reach).min(self.height),
+        )
     }
 }
 
@@ -183,93 +215,130 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
             surfaces.similar(a, b, &similarity).then_some(b)
         };
 
-        // Phase 1: the shifts of every pair (a, a + o_j), at entry a·m + j.
-        table.clear();
-        table.resize(n * m, None);
-        rays += bands.run_strided(&mut table[..], m, |first, out| {
-            let mut rays = 0;
-            for (i, entries) in out.chunks_mut(m).enumerate() {
-                let a = first + i;
-                for (entry, &o) in entries.iter_mut().zip(&offsets) {
-                    let Some(b) = partner(a, o) else {
-                        continue;
-                    };
-                    let (da, db) = (reuse.domain(a, false), reuse.domain(b, false));
-                    let (ra, rb) = (&input[a], &input[b]);
-                    let map_a = reuse.map(ra);
-                    let a_into_b = ra
-                        .sample
-                        .as_ref()
-                        .and_then(|y| map_a.shift(da.borrow(), db.borrow(), y));
-                    rays += R::rays(&map_a);
-                    let map_b = reuse.map(rb);
-                    let b_into_a = rb
-                        .sample
-                        .as_ref()
-                        .and_then(|y| map_b.shift(db.borrow(), da.borrow(), y));
-                    rays += R::rays(&map_b);
-                    *entry = Some(PairShifts { a_into_b, b_into_a });
-                }
-            }
-            rays
-        });
-
-        // Phase 2: every pixel resamples with its neighbours p + o_j and p − o_j.
-        let table = &table;
+        // The rows a pixel's pairs reach: its neighbours p ± o_j lie within `reach` rows.
+        let reach = offsets
+            .iter()
+            .map(|&(_, oy)| oy.unsigned_abs() as usize)
+            .max();
+        let reach = reach.unwrap_or(0);
+        let window = Window::new(surfaces.height(), reach);
         // The expectation's slots, in the last round only.
-        let slots = expected.as_deref_mut().filter(|_| last).map(|e| &mut e[..]);
+        let mut slots = expected.as_deref_mut().filter(|_| last).map(|e| &mut e[..]);
         let expect = slots.is_some();
-        bands.run((&mut next[..], slots), |first, (out, mut slots)| {
-            let mut neighbors = Vec::with_capacity(2 * m);
-            for (i, res) in out.iter_mut().enumerate() {
-                let p = first + i;
-                let canonical = &input[p];
-                if !surfaces.has_surface(p) {
-                    *res = *canonical;
-                    continue;
-                }
-                neighbors.clear();
-                for (j, &(ox, oy)) in offsets.iter().enumerate() {
-                    // Pair (p, p + o_j), entered at p; pair (p − o_j, p), entered at p − o_j.
-                    if table[p * m + j].is_some()
-                        && let Some(q) = step(p, (ox, oy))
-                    {
-                        let slot = Slot::Neighbor {
-                            entry: p * m + j,
-                            canonical_is_a: true,
-                        };
-                        neighbors.push((slot, &input[q]));
-                    }
-                    if let Some(q) = step(p, (-ox, -oy))
-                        && table[q * m + j].is_some()
-                    {
-                        let slot = Slot::Neighbor {
-                            entry: q * m + j,
-                            canonical_is_a: false,
-                        };
-                        neighbors.push((slot, &input[q]));
-                    }
-                }
-                let mut rng = streams.pixel(p, stage);
-                let (out, e) = resample_pixel::<R, _, _>(
-                    &CachedShifts {
-                        table,
-                        mismatched: settings.reciprocal_mismatched,
-                    },
-                    settings.mis,
-                    &Slot::Canonical,
-                    canonical,
-                    &neighbors,
-                    || rng.next_f32(),
-                    expect,
+        let width = surfaces.width();
+        table.clear();
+        table.resize(window.rows() * width * m, None);
+        // Rows of the image whose pairs' shifts the table holds: [held.0, held.1).
+        let mut held = (0usize, 0usize);
+        for chunk in window.chunks() {
+            // Phase 1: the shifts of every pair (a, a + o_j) of rows the chunk's pixels reach,
+            // at entry (a − the window's first pixel)·m + j. Rows the window held for the
+            // chunk before are moved to its front, not shifted again.
+            let want = window.reached(chunk);
+            let keep = (want.0.max(held.0), held.1.min(want.1));
+            if keep.0 < keep.1 {
+                table.copy_within(
+                    (keep.0 - held.0) * width * m..(keep.1 - held.0) * width * m,
+                    (keep.0 - want.0) * width * m,
                 );
-                *res = out.with_confidence_cap(settings.mcap);
-                if let Some(slots) = slots.as_deref_mut() {
-                    slots[i] = e;
-                }
             }
-            0
-        });
+            let fresh = if keep.0 < keep.1 { keep.1 } else { want.0 };
+            let first_fresh = fresh * width;
+            let fresh_entries =
+                &mut table[(fresh - want.0) * width * m..(want.1 - want.0) * width * m];
+            rays += bands.run_strided(fresh_entries, m, |first, out| {
+                let mut rays = 0;
+                for (i, entries) in out.chunks_mut(m).enumerate() {
+                    let a = first_fresh + first + i;
+                    for (entry, &o) in entries.iter_mut().zip(&offsets) {
+                        *entry = None;
+                        let Some(b) = partner(a, o) else {
+                            continue;
+                        };
+                        let (da, db) = (reuse.domain(a, false), reuse.domain(b, false));
+                        let (ra, rb) = (&input[a], &input[b]);
+                        let map_a = reuse.map(ra);
+                        let a_into_b = ra
+                            .sample
+                            .as_ref()
+                            .and_then(|y| map_a.shift(da.borrow(), db.borrow(), y));
+                        rays += R::rays(&map_a);
+                        let map_b = reuse.map(rb);
+                        let b_into_a = rb
+                            .sample
+                            .as_ref()
+                            .and_then(|y| map_b.shift(db.borrow(), da.borrow(), y));
+                        rays += R::rays(&map_b);
+                        *entry = Some(PairShifts { a_into_b, b_into_a });
+                    }
+                }
+                rays
+            });
+            held = want;
+
+            // Phase 2: every pixel of the chunk resamples with its neighbours p + o_j and
+            // p − o_j.
+            let table = &table[..];
+            let base = want.0 * width;
+            let (lo, hi) = (chunk.0 * width, chunk.1 * width);
+            let chunk_slots = slots.as_deref_mut().map(|s| &mut s[lo..hi]);
+            bands.run(
+                (&mut next[lo..hi], chunk_slots),
+                |first, (out, mut slots)| {
+                    let mut neighbors = Vec::with_capacity(2 * m);
+                    for (i, res) in out.iter_mut().enumerate() {
+                        let p = lo + first + i;
+                        let canonical = &input[p];
+                        if !surfaces.has_surface(p) {
+                            *res = *canonical;
+                            continue;
+                        }
+                        neighbors.clear();
+                        for (j, &(ox, oy)) in offsets.iter().enumerate() {
+                            // Pair (p, p + o_j), entered at p; pair (p − o_j, p), entered at
+                            // p − o_j.
+                            let at_p = (p - base) * m + j;
+                            if table[at_p].is_some()
+                                && let Some(q) = step(p, (ox, oy))
+                            {
+                                let slot = Slot::Neighbor {
+                                    entry: at_p,
+                                    canonical_is_a: true,
+                                };
+                                neighbors.push((slot, &input[q]));
+                            }
+                            if let Some(q) = step(p, (-ox, -oy))
+                                && table[(q - base) * m + j].is_some()
+                            {
+                                let slot = Slot::Neighbor {
+                                    entry: (q - base) * m + j,
+                                    canonical_is_a: false,
+                                };
+                                neighbors.push((slot, &input[q]));
+                            }
+                        }
+                        let mut rng = streams.pixel(p, stage);
+                        let (out, e) = resample_pixel::<R, _, _>(
+                            &CachedShifts {
+                                table,
+                                mismatched: settings.reciprocal_mismatched,
+                            },
+                            settings.mis,
+                            &Slot::Canonical,
+                            canonical,
+                            &neighbors,
+                            || rng.next_f32(),
+                            expect,
+                        );
+                        *res = out.with_confidence_cap(settings.mcap);
+                        if let Some(slots) = slots.as_deref_mut() {
+                            slots[i] = e;
+                        }
+                    }
+                    0
+                },
+            );
+        }
         std::mem::swap(current, &mut next);
     }
     scratch.next = next;

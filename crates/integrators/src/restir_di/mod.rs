@@ -57,7 +57,6 @@ use crate::pass::{Integrator, PassContext};
 use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
 use crate::reuse::chain::PassChain;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
-use crate::reuse::reciprocal;
 use crate::reuse::seen::SeenEmission;
 use crate::reuse::settings::mis_name;
 use crate::stages::StageClock;
@@ -384,7 +383,6 @@ impl Integrator for RestirDiIntegrator {
         reservoirs * Self::RESERVOIR_BYTES
             + hits * hit_bytes
             + std::mem::size_of::<Vec3>()
-            + reciprocal::table_bytes_per_pixel::<DiSample>(&self.settings.reuse)
             + std::mem::size_of::<Option<(LightPoint, Resolved)>>()
             + std::mem::size_of::<Option<Bsdf>>()
             + if self.settings.reuse.shade_expected {
