@@ -476,6 +476,31 @@ fn edge_rays_unbiased() {
     );
 }
 
+/// The emission seen through delta lobes: a small lamp and the environment seen through a
+/// smooth glass sphere. The walks leave those paths out and the silhouette stage adds them
+/// (with the mask's camera rays where the lamp's image in the glass has an edge, and where the
+/// glass's reflection and transmission see different things): unbiased. The negative control
+/// keeps them in the walks too, so they count twice (brighter where the glass shows the lamp).
+#[test]
+fn emission_through_delta_lobes_unbiased() {
+    let scene = scene_with(
+        r#"(geometry: Sphere(center: (0.6, 1.45, 0.4), radius: 0.25), emission: Some((20, 20, 20))),
+            (geometry: Sphere(center: (0.3, 1.22, 2.45), radius: 0.45),
+             material: Some(Inline(Dielectric()))),"#,
+    );
+    let reference = statistics(&scene, "path", &[], 128, 64);
+    let z = max_z(&statistics(&scene, "restir-pt", &[], 1, 300), &reference);
+    eprintln!("lamp through glass: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "lamp through glass: max |z| = {z:.2}");
+    let control = [("delta_emission_twice", "true")];
+    let z = max_z(
+        &statistics(&scene, "restir-pt", &control, 1, 300),
+        &reference,
+    );
+    eprintln!("emission through glass counted twice: max |z| = {z:.2}");
+    assert!(z > Z_MAX, "counting it twice should be biased: {z:.2}");
+}
+
 /// The defaults (two candidates, three rounds of two reciprocal pairs within 3 pixels).
 #[test]
 fn unbiased_at_the_defaults() {

@@ -443,7 +443,7 @@ impl Integrator for RestirDiIntegrator {
             && !s.path.hide_emitters
         {
             rays += self.clock.time("silhouettes", || {
-                seen.supersample(scene, ctx, &mut radiance)
+                seen.supersample(scene, ctx, &gbuf, None, &mut radiance)
             });
         }
         let w = gbuf.width;

@@ -44,7 +44,7 @@ use crate::bands::Bands;
 use crate::motion::FrameMotion;
 use crate::reuse::chain::PassChain;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
-use crate::reuse::seen::SeenEmission;
+use crate::reuse::seen::{DeltaChains, SeenEmission};
 use restir_reuse::{ScreenReuse, Stages};
 
 use crate::pass::{Integrator, PassContext};
@@ -149,11 +149,30 @@ impl RestirPtIntegrator {
         }
     }
 
+    /// Where the walks leave out the emission seen through delta lobes (paths whose every
+    /// bounce is a delta lobe, ended on an emitter): when the silhouette stage estimates it
+    /// instead, with the camera rays of its mask (`edge_rays` above 1, the camera's emitters
+    /// shown, direct light not from ReSTIR DI) and the scene has a delta lobe.
+    pub fn delta_chains(&self, scene: &Scene) -> Option<DeltaChains> {
+        let s = &self.settings;
+        (self.seen.is_some()
+            && s.direct != DirectLight::RestirDi
+            && !s.path.hide_emitters
+            && self.max_depth() >= 2
+            && scene.bsdfs().iter().any(|b| b.flags().is_delta()))
+        .then(|| DeltaChains {
+            max_segments: self.max_depth(),
+            rr_depth: s.path.rr_depth,
+        })
+    }
+
     /// The walks' rules for `scene`.
     pub fn walker<'a>(&self, scene: &'a Scene) -> Walker<'a> {
         let d = self.settings.near_distance * scene.lights.scene_radius();
         Walker {
             scene,
+            seen_through_delta: self.delta_chains(scene).is_some()
+                && !self.settings.delta_emission_twice,
             shift: self.effective_shift(scene),
             max_depth: self.max_depth(),
             rr_depth: self.settings.path.rr_depth,
@@ -253,8 +272,9 @@ impl RestirPtIntegrator {
             && s.direct != DirectLight::RestirDi
             && !s.path.hide_emitters
         {
+            let chains = self.delta_chains(scene);
             rays += self.clock.time("silhouettes", || {
-                seen.supersample(scene, ctx, &mut radiance)
+                seen.supersample(scene, ctx, &gbuf, chains.as_ref(), &mut radiance)
             });
         }
         current.clear();

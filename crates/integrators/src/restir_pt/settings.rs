@@ -107,6 +107,9 @@ pub struct RestirPtSettings {
     pub shift: ShiftKind,
     /// Negative control only: skip the hybrid shift's invertibility checks (biased).
     pub skip_invertibility: bool,
+    /// Negative control only: the walks keep the emission seen through delta lobes that the
+    /// silhouette stage adds too (counted twice; biased).
+    pub delta_emission_twice: bool,
 }
 
 impl RestirPtSettings {
@@ -134,6 +137,7 @@ impl RestirPtSettings {
             temporal_stale_suffix: false,
             shift: ShiftKind::Hybrid,
             skip_invertibility: false,
+            delta_emission_twice: false,
         }
     }
 
@@ -144,6 +148,7 @@ impl RestirPtSettings {
             && (!self.edge_mask_from_pass || self.edge_rays <= 1)
             && (!self.one_sided_jacobian || self.max_jacobian <= 0.0)
             && !self.skip_invertibility
+            && !self.delta_emission_twice
             && (!self.reuse.temporal
                 || !(self.temporal_ignore_motion || self.temporal_stale_suffix))
     }
@@ -186,6 +191,7 @@ impl RestirPtSettings {
             "temporal_ignore_motion" => self.temporal_ignore_motion = p.boolean()?,
             "temporal_stale_suffix" => self.temporal_stale_suffix = p.boolean()?,
             "skip_invertibility" => self.skip_invertibility = p.boolean()?,
+            "delta_emission_twice" => self.delta_emission_twice = p.boolean()?,
             _ => return self.reuse.apply(key, p),
         }
         Ok(true)

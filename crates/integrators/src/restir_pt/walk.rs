@@ -142,6 +142,10 @@ pub struct Walker<'a> {
     /// reconnection vertex; the vertex reconnected from is rough), which makes the shift
     /// non-bijective (biased).
     pub skip_invertibility: bool,
+    /// Whether the walks leave out the emission seen through delta lobes (a path whose every
+    /// bounce took a delta lobe, ended on an emitter or the environment): the silhouette stage
+    /// estimates it with the camera rays of its mask (`reuse/seen.rs`).
+    pub seen_through_delta: bool,
 }
 
 /// The two bits of a bounce's lobe stored in [`PathSample::lobes`].
@@ -184,6 +188,7 @@ impl Walker<'_> {
             inv_q: 1.0,
             eta_scale: 1.0,
             lobes: 0,
+            all_delta: true,
             rc: None,
         };
         if let Some(s) = replay
@@ -274,6 +279,7 @@ impl Walker<'_> {
             }
             w.lobes |= bits << shift;
         }
+        w.all_delta &= bs.lobe.is_delta();
         let factor = bs.f / bs.pdf_sa;
         let next_beta = w.beta * factor;
         let beta_rr = next_beta * w.inv_q;
@@ -386,6 +392,7 @@ impl Walker<'_> {
                     inv_q: 1.0,
                     eta_scale: 1.0,
                     lobes: 0,
+                    all_delta: false,
                     rc: None,
                 };
                 let out = loop {
@@ -535,6 +542,8 @@ pub(super) struct Walk<'s> {
     pub(super) eta_scale: f32,
     /// Lobe bits of the bounces so far ([`PathSample::lobes`]).
     pub(super) lobes: u32,
+    /// Whether every bounce from the primary hit so far took a delta lobe.
+    pub(super) all_delta: bool,
     /// The reconnection vertex, once found.
     pub(super) rc: Option<Rc>,
 }

@@ -22,15 +22,18 @@
 //! no random numbers), never on a pass's samples, so every pixel's estimate stays unbiased and
 //! a split render (chains, tiles) gets the same counts.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
-use restir_sampling::luminance;
+use restir_geometry::{Ray, offset_ray_origin};
+use restir_sampling::{Pcg32, luminance};
 use restir_scene::Scene;
 
 use crate::film::Filter;
 use crate::pass::PassContext;
+use crate::reuse::gbuffer::{GBuffer, Receiver};
 
 /// A film window (width, height, x0, y0) and its mask: each pixel's camera rays for the seen
 /// emission (0 off the mask).
@@ -55,24 +58,140 @@ pub struct SeenEmission {
     from_pass: bool,
     /// The mask and the window it was made for: (width, height, x0, y0).
     mask: Mutex<Option<WindowMask>>,
+    /// Whether the last pass followed the camera rays through delta lobes (for `--stats`).
+    followed_delta: AtomicBool,
 }
 
-/// What a camera ray sees, for the mask: 0 a surface that does not emit, `1 + light` an
-/// emitter's shape, `u32::MAX` the environment (or nothing); the luminance of the emission it
-/// sees (0 on a surface that does not emit); the rays traced.
-fn seen_id(scene: &Scene, film: Vec2) -> (u32, f32, u64) {
+/// What a camera ray sees, for the mask, twice: through the delta lobes of the surfaces it
+/// meets with `chains` (the first lobe of every bounce, then the last: a smooth dielectric's
+/// reflection and its transmission), once without. Each is 0 a surface that does not emit,
+/// `1 + light` an emitter's shape, `u32::MAX` the environment (or nothing), with the luminance
+/// of the emission seen (through the lobes, times their weights). Also returns the rays traced.
+fn seen_id(scene: &Scene, film: Vec2, chains: Option<&DeltaChains>) -> ([(u32, f32); 2], u64) {
     let ray = scene.camera.generate_ray(film, Vec2::splat(0.5));
-    let (hit, rays) = scene.camera_intersect(&ray, false);
+    let (hit, mut rays) = scene.camera_intersect(&ray, false);
     let lights = &scene.lights;
-    let (id, seen) = match hit {
-        None => (u32::MAX, lights.environment_radiance(ray.d)),
-        Some(si) => lights
-            .light_on_shape(si.shape)
-            .map_or((0, Vec3::ZERO), |l| {
-                (l + 1, lights.area_radiance(l, si.shading.n, -ray.d))
-            }),
+    let Some(si) = hit else {
+        let seen = (u32::MAX, luminance(lights.environment_radiance(ray.d)));
+        return ([seen; 2], rays);
     };
-    (id, luminance(seen), rays)
+    if let Some(l) = lights.light_on_shape(si.shape) {
+        let seen = (
+            l + 1,
+            luminance(lights.area_radiance(l, si.shading.n, -ray.d)),
+        );
+        return ([seen; 2], rays);
+    }
+    let Some(chains) = chains else {
+        return ([(0, 0.0); 2], rays);
+    };
+    let r = Receiver::at_hit(scene, &si, -ray.d, si.t);
+    let mut probe = |u_lobe: f32| {
+        let (le, id, n) = chains.probe(scene, &r, si.ng, u_lobe);
+        rays += n;
+        (id, luminance(le))
+    };
+    let seen = [probe(1e-4), probe(1.0 - 1e-4)];
+    (seen, rays)
+}
+
+/// The emission the camera sees through delta lobes (smooth glass, mirrors, a smooth plastic's
+/// coat): the paths of `max_segments` segments at most whose every bounce is a delta lobe,
+/// ended on an emitter or the environment. An estimator whose other samples leave these paths
+/// out (ReSTIR PT's walks, `docs/RESTIR_PT.md`) adds them here, with the silhouette mask's
+/// camera rays where they show an emitter's edge or where the lobes' choice decides between an
+/// emitter and a dark surface.
+#[derive(Clone, Copy, Debug)]
+pub struct DeltaChains {
+    /// Longest path in segments from the camera.
+    pub max_segments: u32,
+    /// Russian roulette from this bounce on.
+    pub rr_depth: u32,
+}
+
+impl DeltaChains {
+    /// Probe bounces at most (the mask's rays only).
+    const PROBE_BOUNCES: u32 = 8;
+
+    /// One estimate of the emission reached from receiver `r` (geometric normal `ng`) through
+    /// delta lobes: each bounce draws a lobe with `rng`; the walk ends at a lobe that is not
+    /// delta (what lies behind belongs to the other samples), a miss, Russian roulette or the
+    /// segment limit. Returns it and the rays traced.
+    pub fn follow(&self, scene: &Scene, r: &Receiver, ng: Vec3, rng: &mut Pcg32) -> (Vec3, u64) {
+        let (le, _, rays) = self.walk(scene, r, ng, self.max_segments, |_| {
+            (rng.next_f32(), rng.next_2d(), rng.next_f32())
+        });
+        (le, rays)
+    }
+
+    /// The emission through the delta lobes drawn with `u_lobe` at every bounce (no Russian
+    /// roulette, at most [`Self::PROBE_BOUNCES`]), the id of what the last ray saw as
+    /// [`seen_id`] gives it, and the rays.
+    fn probe(&self, scene: &Scene, r: &Receiver, ng: Vec3, u_lobe: f32) -> (Vec3, u32, u64) {
+        let segments = self.max_segments.min(Self::PROBE_BOUNCES + 1);
+        let chains = Self {
+            rr_depth: u32::MAX,
+            ..*self
+        };
+        chains.walk(scene, r, ng, segments, |_| (u_lobe, Vec2::splat(0.5), 0.0))
+    }
+
+    /// The walk behind [`Self::follow`] and [`Self::probe`]: `u(bounce)` gives a bounce's lobe
+    /// number, direction numbers and roulette number.
+    fn walk(
+        &self,
+        scene: &Scene,
+        r: &Receiver,
+        ng: Vec3,
+        max_segments: u32,
+        mut u: impl FnMut(u32) -> (f32, Vec2, f32),
+    ) -> (Vec3, u32, u64) {
+        let (mut r, mut ng) = (*r, ng);
+        let (mut beta, mut sum, mut eta_scale) = (Vec3::ONE, Vec3::ZERO, 1.0f32);
+        let (mut id, mut rays) = (0, 0);
+        // `j`: the vertex the bounce leaves; its ray's emission ends a path of j + 1 segments.
+        let mut j = 1;
+        while j < max_segments {
+            let bsdf = r.resolve_bsdf(scene);
+            if !bsdf.flags().is_delta() {
+                break;
+            }
+            let (u_lobe, u_dir, u_rr) = u(j);
+            let Some(bs) = bsdf.sample(r.wo, u_lobe, u_dir) else {
+                break;
+            };
+            if !bs.lobe.is_delta() || !(bs.pdf_sa > 0.0) {
+                break;
+            }
+            beta *= bs.f / bs.pdf_sa;
+            eta_scale *= bs.eta;
+            if j >= self.rr_depth {
+                let q = (beta.max_element() * eta_scale * eta_scale).min(0.95);
+                if !(q > 0.0) || u_rr >= q {
+                    break;
+                }
+                beta /= q;
+            }
+            if !(beta.max_element() > 0.0 && beta.is_finite()) {
+                break;
+            }
+            let d = r.frame().to_world(bs.wi);
+            let hit = scene.intersect(&Ray::new(offset_ray_origin(r.p, ng, d), d));
+            rays += 1;
+            if let Some((_, le, _)) = scene.lights.reached(r.p, d, hit.as_ref()) {
+                sum += beta * le;
+            }
+            let Some(si) = hit else {
+                id = u32::MAX;
+                break;
+            };
+            id = scene.lights.light_on_shape(si.shape).map_or(0, |l| l + 1);
+            r = Receiver::at_hit(scene, &si, -d, si.t);
+            ng = si.ng;
+            j += 1;
+        }
+        (sum, id, rays)
+    }
 }
 
 /// How far, in whole pixels, a pixel's filter reaches beyond its own square.
@@ -91,6 +210,7 @@ impl SeenEmission {
             rays,
             from_pass,
             mask: Mutex::new(None),
+            followed_delta: AtomicBool::new(false),
         }
     }
 
@@ -106,16 +226,23 @@ impl SeenEmission {
             .collect();
         let most = on.iter().copied().max().unwrap_or(0);
         let mean = on.iter().map(|&n| f64::from(n)).sum::<f64>() / on.len().max(1) as f64;
-        Some(format!(
-            "{} of {} pixels on emitter silhouettes ({:.2} %), {mean:.1} camera rays each on average \
+        Some(
+            format!(
+                "{} of {} pixels on emitter silhouettes ({:.2} %), {mean:.1} camera rays each on average \
              (edge_rays {}: in proportion to the luminance contrast each straddles, at most {most} \
              here, at most {} allowed)",
-            on.len(),
-            w * h,
-            100.0 * on.len() as f64 / f64::from((w * h).max(1)),
-            self.rays,
-            self.rays * MAX_RAYS_FACTOR
-        ))
+                on.len(),
+                w * h,
+                100.0 * on.len() as f64 / f64::from((w * h).max(1)),
+                self.rays,
+                self.rays * MAX_RAYS_FACTOR
+            ) + if self.followed_delta.load(Ordering::Relaxed) {
+                "; the emission seen through delta lobes (the scene has some) estimated here on every \
+             pixel, the probes following each lobe's first and last choice"
+            } else {
+                ""
+            },
+        )
     }
 
     /// Forgets the mask (the camera or the scene moved).
@@ -133,20 +260,25 @@ impl SeenEmission {
     /// film and a border of `reach` pixels (the filter sees past it), so an emitter showing as
     /// a sliver thinner than a pixel between two pixel centres is seen; a pixel's value depends
     /// on its own neighbourhood only. Returns it and the rays traced.
-    fn contrast(scene: &Scene, reach: i32, (w, h): (u32, u32)) -> (Vec<f32>, u64) {
+    fn contrast(
+        scene: &Scene,
+        reach: i32,
+        (w, h): (u32, u32),
+        chains: Option<&DeltaChains>,
+    ) -> (Vec<f32>, u64) {
         let (wi, hi) = (w as i32, h as i32);
         let side = |n: i32| 2 * n - 1 + 4 * reach;
         let (bw, bh) = (side(wi), side(hi));
         let lo = 1 - 2 * reach;
-        let ids: Vec<(u32, f32, u64)> = (0..(bw * bh) as usize)
+        let ids: Vec<([(u32, f32); 2], u64)> = (0..(bw * bh) as usize)
             .into_par_iter()
             .map(|i| {
                 let (px, py) = ((i as i32 % bw) + lo, (i as i32 / bw) + lo);
                 let film = Vec2::new(px as f32 * 0.5, py as f32 * 0.5);
-                seen_id(scene, film)
+                seen_id(scene, film, chains)
             })
             .collect();
-        let rays = ids.iter().map(|&(_, _, r)| r).sum();
+        let rays = ids.iter().map(|&(_, r)| r).sum();
         // Only area emitters: an environment behind a silhouette is about as bright as the
         // surface it lights, and there the seen emission and the reflected light of one camera
         // ray are anticorrelated (whichever the ray sees, the pixel gets about the same), so
@@ -158,13 +290,13 @@ impl SeenEmission {
                 // The probes within the filter's reach of the pixel's centre.
                 let (x, y) = (i as i32 % wi, i as i32 / wi);
                 let (qx, qy) = (2 * x, 2 * y);
-                let c = ids[((qy + 2 * reach) * bw + qx + 2 * reach) as usize].0;
+                let c = ids[((qy + 2 * reach) * bw + qx + 2 * reach) as usize].0[0].0;
                 let mut any_emitter = false;
                 let mut differs = false;
                 let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
                 for py in qy..=qy + 4 * reach {
                     let row = &ids[(py * bw + qx) as usize..=(py * bw + qx + 4 * reach) as usize];
-                    for &(v, l, _) in row {
+                    for &(v, l) in row.iter().flat_map(|(seen, _)| seen) {
                         differs |= v != c;
                         any_emitter |= emits(v);
                         lo = lo.min(l);
@@ -197,7 +329,12 @@ impl SeenEmission {
     /// [`MAX_RAYS_FACTOR`] times `edge_rays`. A window smaller than the film probes the whole
     /// film, for that mean, and takes its pixels' contrasts from it, so a tile gets the untiled
     /// render's counts. Made once per window; returns it and the rays traced.
-    fn mask(&self, scene: &Scene, ctx: &PassContext) -> (Arc<Vec<u16>>, u64) {
+    fn mask(
+        &self,
+        scene: &Scene,
+        ctx: &PassContext,
+        chains: Option<&DeltaChains>,
+    ) -> (Arc<Vec<u16>>, u64) {
         let (w, h) = ctx.resolution(scene);
         let (x0, y0) = ctx
             .crop
@@ -212,7 +349,7 @@ impl SeenEmission {
         }
         let reach = filter_reach(ctx.filter);
         let (fw, fh) = scene.camera.resolution();
-        let (film, rays) = Self::contrast(scene, reach, (fw, fh));
+        let (film, rays) = Self::contrast(scene, reach, (fw, fh), chains);
         let mean = Self::mean_contrast(&film);
         // A pixel's contrast depends on its own neighbourhood only: a window takes the film's
         // values (none beyond the film).
@@ -244,12 +381,26 @@ impl SeenEmission {
     }
 
     /// Replaces the seen emission in `radiance` (what the G-buffer's camera rays added, and
-    /// nothing else yet) by the mean over this many camera rays on the silhouette pixels.
-    /// Returns the rays traced. Does nothing when the film splats: every camera ray of the pass
-    /// goes through the pass's shared offset in its pixel, so more rays would repeat the
-    /// G-buffer's, and the splatting already averages each pixel over its neighbours' rays.
-    pub fn supersample(&self, scene: &Scene, ctx: &PassContext, radiance: &mut [Vec3]) -> u64 {
-        if ctx.shared_offset.is_some() {
+    /// nothing else yet) by the mean over this many camera rays on the silhouette pixels, and,
+    /// with `chains`, adds on every pixel the emission its camera rays see through delta lobes
+    /// (the G-buffer's ray continued from its hit `gbuf`, and each extra ray's). Returns the
+    /// rays traced. When the film splats every camera ray of the pass goes through the pass's
+    /// shared offset in its pixel, so more rays would repeat the G-buffer's (and the splatting
+    /// already averages each pixel over its neighbours' rays): there a silhouette pixel gets no
+    /// more camera rays, and only the delta lobes' continuations of the G-buffer's ray are drawn
+    /// as many times as the mask says.
+    pub fn supersample(
+        &self,
+        scene: &Scene,
+        ctx: &PassContext,
+        gbuf: &GBuffer,
+        chains: Option<&DeltaChains>,
+        radiance: &mut [Vec3],
+    ) -> u64 {
+        self.followed_delta
+            .store(chains.is_some(), Ordering::Relaxed);
+        let splatted = ctx.shared_offset.is_some();
+        if splatted && chains.is_none() {
             return 0;
         }
         let (mask, mut rays) = if self.from_pass {
@@ -259,31 +410,61 @@ impl SeenEmission {
                 .map(|l| if l.max_element() > 0.0 { n } else { 0 });
             (Arc::new(mask.collect()), 0)
         } else {
-            self.mask(scene, ctx)
+            self.mask(scene, ctx, chains)
         };
         let (w, _) = ctx.resolution(scene);
         let lights = &scene.lights;
         rays += radiance
             .par_iter_mut()
             .enumerate()
-            .filter(|(i, _)| mask[*i] > 1)
+            .filter(|(i, _)| mask[*i] > 1 || chains.is_some())
             .map(|(i, l)| {
-                let n = u32::from(mask[i]);
-                let (x, y) = ((i % w as usize) as u32, (i / w as usize) as u32);
                 let mut rng = ctx.stage_rng(i, STAGE_SEEN);
-                let mut sum = *l;
                 let mut rays = 0;
+                // The G-buffer's ray: its seen emission, and behind its hit's delta lobes.
+                let receiver = chains.and_then(|c| Some((c, gbuf.receiver(i)?, gbuf.ng[i])));
+                let behind = |rng: &mut Pcg32, rays: &mut u64| {
+                    receiver.map_or(Vec3::ZERO, |(c, r, ng)| {
+                        let (le, n) = c.follow(scene, r, ng, rng);
+                        *rays += n;
+                        le
+                    })
+                };
+                let first = *l + behind(&mut rng, &mut rays);
+                let n = u32::from(mask[i]).max(1);
+                if splatted {
+                    // The same camera ray: only what lies behind delta lobes differs.
+                    let mut sum = first;
+                    if receiver.is_some() {
+                        for _ in 1..n {
+                            sum += *l + behind(&mut rng, &mut rays);
+                        }
+                        *l = sum / n as f32;
+                    } else {
+                        *l = sum;
+                    }
+                    return rays;
+                }
+                let (x, y) = ((i % w as usize) as u32, (i / w as usize) as u32);
+                let mut sum = first;
                 for _ in 1..n {
                     let film = ctx.film_position(x, y, &mut rng);
                     let ray = scene.camera.generate_ray(film, rng.next_2d());
                     let (hit, n) = scene.camera_intersect(&ray, false);
                     rays += n;
-                    sum += match hit {
-                        None => lights.environment_radiance(ray.d),
-                        Some(si) => lights.light_on_shape(si.shape).map_or(Vec3::ZERO, |light| {
-                            lights.area_radiance(light, si.shading.n, -ray.d)
-                        }),
+                    let Some(si) = hit else {
+                        sum += lights.environment_radiance(ray.d);
+                        continue;
                     };
+                    if let Some(light) = lights.light_on_shape(si.shape) {
+                        sum += lights.area_radiance(light, si.shading.n, -ray.d);
+                    }
+                    if let Some(c) = chains {
+                        let r = Receiver::at_hit(scene, &si, -ray.d, si.t);
+                        let (le, n) = c.follow(scene, &r, si.ng, &mut rng);
+                        sum += le;
+                        rays += n;
+                    }
                 }
                 *l = sum / n as f32;
                 rays

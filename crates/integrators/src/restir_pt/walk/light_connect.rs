@@ -78,6 +78,10 @@ impl Walker<'_> {
         hit_here: bool,
         sink: &mut dyn FnMut(PathSample, Vec3),
     ) -> Option<Replayed> {
+        if self.seen_through_delta && w.all_delta {
+            // The silhouette stage's (a replay ending here has no value).
+            return None;
+        }
         let scene = self.scene;
         let (y, le, light_pdf_sa) = self.scene.lights.reached(w.cur.r.p, step.d, hit)?;
         let mis = step.prev.emission_weight(light_pdf_sa);
