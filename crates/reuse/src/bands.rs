@@ -71,16 +71,6 @@ impl Bands {
         }
     }
 
-    /// The bands of `rows` image rows (at least 1) of an image `width` pixels wide: for a stage
-    /// that visits its band's pixels in blocks (screen tiles whose data should stay in cache
-    /// while their pixels are visited).
-    #[inline]
-    pub fn of_rows(width: usize, rows: usize) -> Self {
-        Self {
-            len: width * rows.max(1),
-        }
-    }
-
     /// Pixels per band (the chunk length of `par_chunks_mut`).
     #[inline]
     pub fn pixels(self) -> usize {

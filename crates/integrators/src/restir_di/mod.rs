@@ -523,16 +523,12 @@ impl Integrator for RestirDiIntegrator {
             resolved.resize(n, None);
             bsdfs.clear();
             bsdfs.resize(n, None);
-            // Bands of whole tile rows, visited tile by tile: a tile's pool (tens of
-            // kilobytes) stays in cache while its pixels draw from it, where raster order over
-            // a row of tiles would fetch every pool once per image row.
-            let tile_bands = Bands::of_rows(w, tiles::TILE);
-            rays += tile_bands.run(
+            rays += bands.run(
                 (&mut current[..], (&mut resolved[..], &mut bsdfs[..])),
                 |first, (out, (cache, bsdfs))| {
                     let mut rays = 0;
-                    for i in tiles::tile_order(w, out.len()) {
-                        let (res, cached, pixel_bsdf) = (&mut out[i], &mut cache[i], &mut bsdfs[i]);
+                    let pixels = out.iter_mut().zip(cache).zip(bsdfs);
+                    for (i, ((res, cached), pixel_bsdf)) in pixels.enumerate() {
                         let index = first + i;
                         if let Some(r) = gbuf.receiver(index) {
                             let bsdf = r.resolve_bsdf(scene);

@@ -46,20 +46,6 @@ pub const USES_PER_ENTRY: usize = 8;
 /// within about 2.6° of their mean.
 const SAME_NORMAL: f32 = 0.999;
 
-/// The pixels of a band of `len` pixels of rows `width` wide (at most [`TILE`] rows, starting
-/// on a tile row), tile by tile: each tile's rows left to right, the tiles left to right.
-pub fn tile_order(width: usize, len: usize) -> impl Iterator<Item = usize> {
-    let rows = len.div_ceil(width.max(1));
-    (0..width.div_ceil(TILE)).flat_map(move |tx| {
-        let cols = tx * TILE..((tx + 1) * TILE).min(width);
-        (0..rows).flat_map(move |y| {
-            cols.clone()
-                .map(move |x| y * width + x)
-                .filter(move |&i| i < len)
-        })
-    })
-}
-
 /// A tile's pools: per cut and learned cell its receivers are in (`None`: the cut alone), the
 /// draws.
 type TilePools = Vec<(Option<u32>, Vec<Option<LearnedDraw>>)>;
@@ -455,22 +441,6 @@ impl LightTiles {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn tile_order_visits_every_pixel_of_a_band_once_tile_by_tile() {
-        for (width, len) in [(40, 40 * TILE), (40, 40 * 5), (7, 7 * 3), (16, 16 * TILE)] {
-            let order: Vec<usize> = tile_order(width, len).collect();
-            let mut sorted = order.clone();
-            sorted.sort_unstable();
-            assert_eq!(sorted, (0..len).collect::<Vec<_>>());
-            // Tile by tile: the tile column never decreases.
-            assert!(
-                order
-                    .windows(2)
-                    .all(|p| p[0] % width / TILE <= p[1] % width / TILE)
-            );
-        }
-    }
 
     #[test]
     fn a_region_holds_its_points_and_not_what_lies_beyond() {
