@@ -160,14 +160,14 @@ impl DeltaChains {
             let Some(bs) = bsdf.sample(r.wo, u_lobe, u_dir) else {
                 break;
             };
-            if !bs.lobe.is_delta() || !(bs.pdf_sa > 0.0) {
+            if !bs.lobe.is_delta() || bs.pdf_sa.is_nan() || bs.pdf_sa <= 0.0 {
                 break;
             }
             beta *= bs.f / bs.pdf_sa;
             eta_scale *= bs.eta;
             if j >= self.rr_depth {
                 let q = (beta.max_element() * eta_scale * eta_scale).min(0.95);
-                if !(q > 0.0) || u_rr >= q {
+                if q.is_nan() || q <= 0.0 || u_rr >= q {
                     break;
                 }
                 beta /= q;
