@@ -117,6 +117,15 @@ pub fn bsdf_sample_share(
     power_share(bsdf_samples * bsdf_pdf, light_samples * light_pdf) / bsdf_samples
 }
 
+/// Russian roulette's survival probability after a bounce: the largest channel of the
+/// throughput `beta_max` times the squared product of the relative indices of refraction crossed
+/// (radiance scales with it through a refraction, so glass does not end paths early), at most
+/// 0.95. Every estimator's walks use it.
+#[inline]
+pub fn rr_survival(beta_max: f32, eta_scale: f32) -> f32 {
+    (beta_max * eta_scale * eta_scale).min(0.95)
+}
+
 /// Radiance arriving along `ray` (a camera ray, or a continuation from `prev`), estimated with one
 /// path. `depth` is the number of segments already traced before `ray`. Returns the estimate and
 /// the number of rays traced.
@@ -231,7 +240,7 @@ pub fn trace_path<S: Sampler>(
             break;
         }
         if depth >= settings.rr_depth {
-            let q = (bmax * eta_scale * eta_scale).min(0.95);
+            let q = rr_survival(bmax, eta_scale);
             if u_rr >= q {
                 break;
             }

@@ -17,7 +17,8 @@
 //! pixel's resampling with a [`ShiftMap`] that reads them. Both run chunk of rows by chunk of
 //! rows, so the table holds the pairs of one chunk and of the rows its pixels' neighbours reach
 //! (64 rows and the radius above and below on up to 4 threads; 16 rows per thread beyond), not
-//! the whole image's: per-pixel buffer estimates do not count it.
+//! the whole image's. [`table_bytes_per_pixel`] bounds it for memory estimates: on many
+//! threads the window spans most of a film.
 
 use std::borrow::Borrow;
 
@@ -37,6 +38,21 @@ pub fn shares_pair_shifts(scheme: MisScheme) -> bool {
         scheme,
         MisScheme::Pairwise | MisScheme::DefensivePairwise | MisScheme::ConfidenceWeightedPairwise
     )
+}
+
+/// Bytes per pixel of the shift table the reciprocal rounds of `settings` keep at most (0 when
+/// they do not run), for an estimator's `buffer_bytes_per_pixel`: the whole film's, which the
+/// window of rows reaches when the threads are many or the film is short.
+pub fn table_bytes_per_pixel<S>(settings: &ReuseSettings) -> usize {
+    let runs = settings.reciprocal
+        && shares_pair_shifts(settings.mis)
+        && settings.neighbors > 0
+        && settings.spatial_rounds > 0;
+    if runs {
+        (settings.neighbors as usize).div_ceil(2) * std::mem::size_of::<Option<PairShifts<S>>>()
+    } else {
+        0
+    }
 }
 
 /// The two shifts of a pair `(a, b = a + o_j)`: `a`'s sample into `b` and `b`'s into `a`.

@@ -54,9 +54,10 @@ pub use settings::{
 use crate::bands::Bands;
 use crate::motion::FrameMotion;
 use crate::pass::{Integrator, PassContext};
-use crate::path::{EmissionMis, PathSettings, PrevVertex, trace_path};
+use crate::path::{EmissionMis, PathSettings, PrevVertex, rr_survival, trace_path};
 use crate::reuse::chain::PassChain;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
+use crate::reuse::reciprocal;
 use crate::reuse::seen::SeenEmission;
 use crate::reuse::settings::mis_name;
 use crate::stages::StageClock;
@@ -276,7 +277,7 @@ impl RestirDiIntegrator {
             };
             let path = if cont { settings } else { &direct_only };
             if cont && settings.rr_depth <= 1 {
-                let q = (beta.max_element() * bs.eta * bs.eta).min(0.95);
+                let q = rr_survival(beta.max_element(), bs.eta);
                 if u_rr >= q {
                     continue;
                 }
@@ -383,6 +384,7 @@ impl Integrator for RestirDiIntegrator {
         reservoirs * Self::RESERVOIR_BYTES
             + hits * hit_bytes
             + std::mem::size_of::<Vec3>()
+            + reciprocal::table_bytes_per_pixel::<DiSample>(&self.settings.reuse)
             + std::mem::size_of::<Option<(LightPoint, Resolved)>>()
             + std::mem::size_of::<Option<Bsdf>>()
             + if self.settings.reuse.shade_expected {

@@ -44,6 +44,7 @@ use crate::bands::Bands;
 use crate::motion::FrameMotion;
 use crate::reuse::chain::PassChain;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
+use crate::reuse::reciprocal;
 use crate::reuse::seen::{DeltaChains, SeenEmission};
 use restir_reuse::{ScreenReuse, Stages};
 
@@ -461,6 +462,7 @@ impl Integrator for RestirPtIntegrator {
         reservoirs * Self::RESERVOIR_BYTES
             + hits * hit_bytes
             + std::mem::size_of::<Vec3>()
+            + reciprocal::table_bytes_per_pixel::<PathSample>(&self.settings.reuse)
             // Each pixel's expected shading over the last round's selection.
             + if self.settings.reuse.shade_expected {
                 std::mem::size_of::<Option<[f32; 3]>>()

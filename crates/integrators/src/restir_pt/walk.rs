@@ -41,7 +41,7 @@ use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
 use super::sample::{Kind, PathSample, Reconnection, ShiftKind, Vertex, connectible, smooth};
-use crate::path::{EmissionMis, PrevVertex};
+use crate::path::{EmissionMis, PrevVertex, rr_survival};
 use crate::reuse::gbuffer::Receiver;
 use crate::shadow::{ShadowTarget, visible};
 
@@ -289,7 +289,7 @@ impl Walker<'_> {
         }
         w.eta_scale *= bs.eta;
         if w.replay.is_none() && w.j >= self.rr_depth {
-            let q = (bmax * w.eta_scale * w.eta_scale).min(0.95);
+            let q = rr_survival(bmax, w.eta_scale);
             if u.rr >= q {
                 return None;
             }

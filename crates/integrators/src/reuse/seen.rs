@@ -33,6 +33,7 @@ use restir_scene::Scene;
 
 use crate::film::Filter;
 use crate::pass::PassContext;
+use crate::path::rr_survival;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 
 /// A film window (width, height, x0, y0) and its mask: each pixel's camera rays for the seen
@@ -118,7 +119,7 @@ impl DeltaChains {
     /// delta (what lies behind belongs to the other samples), a miss, Russian roulette or the
     /// segment limit. Returns it and the rays traced.
     pub fn follow(&self, scene: &Scene, r: &Receiver, ng: Vec3, rng: &mut Pcg32) -> (Vec3, u64) {
-        let (le, _, rays) = self.walk(scene, r, ng, self.max_segments, |_| {
+        let (le, _, rays) = self.walk(scene, r, ng, self.max_segments, || {
             (rng.next_f32(), rng.next_2d(), rng.next_f32())
         });
         (le, rays)
@@ -133,10 +134,10 @@ impl DeltaChains {
             rr_depth: u32::MAX,
             ..*self
         };
-        chains.walk(scene, r, ng, segments, |_| (u_lobe, Vec2::splat(0.5), 0.0))
+        chains.walk(scene, r, ng, segments, || (u_lobe, Vec2::splat(0.5), 0.0))
     }
 
-    /// The walk behind [`Self::follow`] and [`Self::probe`]: `u(bounce)` gives a bounce's lobe
+    /// The walk behind [`Self::follow`] and [`Self::probe`]: `u()` gives each bounce's lobe
     /// number, direction numbers and roulette number.
     fn walk(
         &self,
@@ -144,7 +145,7 @@ impl DeltaChains {
         r: &Receiver,
         ng: Vec3,
         max_segments: u32,
-        mut u: impl FnMut(u32) -> (f32, Vec2, f32),
+        mut u: impl FnMut() -> (f32, Vec2, f32),
     ) -> (Vec3, u32, u64) {
         let (mut r, mut ng) = (*r, ng);
         let (mut beta, mut sum, mut eta_scale) = (Vec3::ONE, Vec3::ZERO, 1.0f32);
@@ -156,7 +157,7 @@ impl DeltaChains {
             if !bsdf.flags().is_delta() {
                 break;
             }
-            let (u_lobe, u_dir, u_rr) = u(j);
+            let (u_lobe, u_dir, u_rr) = u();
             let Some(bs) = bsdf.sample(r.wo, u_lobe, u_dir) else {
                 break;
             };
@@ -166,7 +167,7 @@ impl DeltaChains {
             beta *= bs.f / bs.pdf_sa;
             eta_scale *= bs.eta;
             if j >= self.rr_depth {
-                let q = (beta.max_element() * eta_scale * eta_scale).min(0.95);
+                let q = rr_survival(beta.max_element(), eta_scale);
                 if q.is_nan() || q <= 0.0 || u_rr >= q {
                     break;
                 }
