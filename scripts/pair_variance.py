@@ -18,7 +18,8 @@ cost does not. Prints, per scene and as the median over scenes, each configurati
 relative to the first, also in plain squared error (MSE: `(a − b)² / 2` without the denominator,
 which weighs bright pixels as a viewer does), and the share of its squared error in the 1 % of
 pixels where it is largest (how concentrated the noise is; from two renders, so it reads a little
-high for every configuration alike). A configuration is `label=passes=flags`. Renders are kept in `--out` and
+high for every configuration alike). A configuration is `label=passes=flags`; flags that start
+with `@PATH` render with the binary at PATH instead of `--bin` (two builds in one run). Renders are kept in `--out` and
 reused when their stats file exists, so an interrupted run resumes.
 
     python3 scripts/pair_variance.py --bin target/release/restir --size 640x360 --threads 1 \\
@@ -66,7 +67,10 @@ def render(a, scene, flags, passes, seed, out):
     stats = out + ".json"
     if not os.path.exists(stats):
         w, h = a.size.split("x")
-        cmd = [a.bin, "render", scene, *shlex.split(flags), "--spp", str(passes), "--seed",
+        words = shlex.split(flags)
+        # A configuration may name its own binary first (`@PATH`), to compare builds in one run.
+        binary = words.pop(0)[1:] if words and words[0].startswith("@") else a.bin
+        cmd = [binary, "render", scene, *words, "--spp", str(passes), "--seed",
                str(seed), "--width", w, "--height", h, "--threads", str(a.threads), "--quiet",
                "-o", out, "--stats", stats + ".tmp"]
         p = subprocess.Popen(cmd, stderr=subprocess.PIPE)

@@ -459,7 +459,7 @@ mod lights {
         let ctx = context(&filter);
         let (w, h) = (gbuf.width, gbuf.height);
         let cuts = pool
-            .install(|| tiles::TileCuts::probe(&scene, &ctx, w, h, false))
+            .install(|| tiles::TileCuts::probe(&scene, &ctx, w, h, false, tiles::OwnLights::Apart))
             .expect("a local light");
         bencher.bench_local(|| {
             pool.install(|| {
@@ -484,7 +484,13 @@ mod lights {
         let scene = scene(n);
         let cut = scene
             .lights
-            .light_cut(Vec3::new(0.0, 0.5, 0.0), Vec3::ZERO, 0.5, tiles::CUT_NODES)
+            .light_cut(
+                Vec3::new(0.0, 0.5, 0.0),
+                Vec3::ZERO,
+                0.5,
+                tiles::CUT_NODES,
+                None,
+            )
             .expect("a cut");
         let input = receivers();
         bencher.counter(ItemsCount::new(BATCH)).bench_local(|| {

@@ -752,3 +752,88 @@ fn learning_across_passes_is_unbiased_and_a_pmf_without_the_defensive_share_is_c
         "a pmf forgetting the defensive share should be visibly biased, max |z| = {z:.2}"
     );
 }
+
+/// A 64×64 scene of emitters the camera sees: a diffuse emissive cube (convex: it cannot light
+/// its own surface) and a diffuse emissive V-shaped trough open at its bottom, one mesh whose
+/// two faces light each other (the gap keeps them apart, so no estimate divides by a distance
+/// near zero), beside a panel light and a point light.
+fn scene_with_emitters_in_view() -> common::Built {
+    let ron = r#"(
+        camera: (fov: 50, to_world: [LookAt(origin: (0, 5, 0.01), target: (0, 0, 0), up: (0, 0, -1))]),
+        film: (width: 64, height: 64, filter: Box),
+        integrator: (max_depth: 2),
+        shapes: [
+            (geometry: Rectangle, to_world: [Scale((3, 3, 1)), Rotate(axis: (1, 0, 0), angle: -90)],
+             material: Some(Inline(Diffuse(reflectance: (0.6, 0.5, 0.4))))),
+            (geometry: Rectangle, to_world: [Scale((0.8, 0.8, 1)), Rotate(axis: (1, 0, 0), angle: 90),
+             Translate((-1.2, 2.5, 0))], emission: Some((1.5, 1.5, 1.5))),
+            (geometry: Cube, to_world: [Scale((0.45, 0.45, 0.45)), Translate((-0.8, 0.5, 0.8))],
+             material: Some(Inline(Diffuse(reflectance: (0.8, 0.8, 0.8)))),
+             emission: Some((0.3, 0.6, 0.9))),
+            (geometry: Mesh(
+                positions: [(0.2, 0.8, -1.4), (0.7, 0.2, -1.4), (0.7, 0.2, -0.1), (0.2, 0.8, -0.1),
+                            (0.9, 0.2, -1.4), (1.4, 0.8, -1.4), (1.4, 0.8, -0.1), (0.9, 0.2, -0.1)],
+                indices: [(0, 2, 1), (0, 3, 2), (4, 6, 5), (4, 7, 6)]),
+             material: Some(Inline(Diffuse(reflectance: (0.8, 0.8, 0.8)))),
+             emission: Some((1.0, 0.7, 0.4))),
+        ],
+        lights: [
+            Point(position: (-0.2, 1.6, 1.2), intensity: (1.5, 2, 3)),
+        ],
+    )"#;
+    let desc = parse_ron(ron, "di-own-light.ron".as_ref()).unwrap();
+    common::build(&desc, ".".as_ref(), "di-own-light.ron".as_ref())
+}
+
+/// Receivers on a light that cannot light its own surface (the cube) draw from a cut of their
+/// own tile region that leaves that light only a small share of the selections; the trough,
+/// which lights itself, is not treated so. Both render unbiased (alone and with two rounds of
+/// reuse); the negative control, which leaves every light no selection at all for the
+/// receivers on it, loses the trough's light on itself and fails the same test.
+#[test]
+fn receivers_on_a_light_are_unbiased_and_dropping_a_light_that_lights_itself_is_caught() {
+    let scene = scene_with_emitters_in_view();
+    let mut settings = RestirDiSettings::new(restir_integrators::path::PathSettings::from_desc(
+        &scene.integrator,
+    ));
+    settings.light_sampler = LightSampler::Tiles;
+    let integrator = RestirDiIntegrator::new(settings);
+    let job = RenderJob {
+        spp: 1,
+        ..RenderJob::default()
+    };
+    render(
+        &scene,
+        &integrator,
+        &job,
+        &AtomicBool::new(false),
+        &mut |_, _| {},
+    );
+    let cuts = integrator.light_cuts().expect("tiles describe their cuts");
+    eprintln!("{cuts}");
+    // The panel and the cube (flat and convex), not the trough.
+    assert!(
+        cuts.contains("2 lights cannot light their own surface"),
+        "{cuts}"
+    );
+    assert!(!cuts.contains(" 0 tiles have a region"), "{cuts}");
+    // Emitters in view make the reference noisier than the other tests': twice their seeds.
+    let reference = statistics(&scene, "path", &[], 256, 96);
+    for params in [
+        &[("light_sampler", "tiles"), ("candidates", "4")][..],
+        &[("light_sampler", "tiles"), ("spatial_rounds", "2")][..],
+    ] {
+        let z = max_z(&statistics(&scene, "restir-di", params, 1, 200), &reference);
+        eprintln!("{params:?}: max |z| = {z:.2}");
+        assert!(z < Z_MAX, "{params:?}: max |z| = {z:.2}");
+    }
+    let mut wrong = settings;
+    wrong.light_sampler = LightSampler::TilesDroppingOwnLight;
+    wrong.candidates = 4;
+    let z = max_z(&settings_statistics(&scene, wrong, 200), &reference);
+    eprintln!("every light dropped for the receivers on it: max |z| = {z:.2}");
+    assert!(
+        z > 2.0 * Z_MAX,
+        "dropping a light that lights itself should be visibly biased, max |z| = {z:.2}"
+    );
+}

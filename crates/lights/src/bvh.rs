@@ -179,6 +179,8 @@ impl Node {
 #[derive(Clone, Copy, Debug)]
 struct Item {
     entry: u32,
+    /// The light the entry belongs to.
+    light: u32,
     lo: Vec3,
     hi: Vec3,
     cone: Cone,
@@ -194,6 +196,11 @@ pub(crate) struct LightBvh {
     trails: Vec<u64>,
     /// Per node, the leaves under it: `(first, count)` in depth-first leaf order.
     spans: Vec<(u32, u32)>,
+    /// Per node, the light all its entries belong to, or `u32::MAX` where they belong to
+    /// several.
+    node_light: Vec<u32>,
+    /// Per light, whether it cannot light a point of its own surface (`own.rs`).
+    pub(crate) self_unlit: Vec<bool>,
     /// Per entry of the table, its leaf's position in depth-first order; `u32::MAX` outside.
     ordinals: Vec<u32>,
     /// The entries in depth-first leaf order.
@@ -235,6 +242,7 @@ impl LightBvh {
                     ref p, ng, shading, ..
                 } => Some(Item {
                     entry,
+                    light: e.light(),
                     lo: p[0].min(p[1]).min(p[2]),
                     hi: p[0].max(p[1]).max(p[2]),
                     cone: match table.constant_normal(ng, shading) {
@@ -259,6 +267,7 @@ impl LightBvh {
                         };
                         Some(Item {
                             entry,
+                            light,
                             lo,
                             hi,
                             cone: Cone::ALL,
@@ -269,6 +278,7 @@ impl LightBvh {
                     | Light::Spot(crate::Spot { position, .. })
                     | Light::Projector(crate::Projector { position, .. }) => Some(Item {
                         entry,
+                        light,
                         lo: position,
                         hi: position,
                         cone: Cone::ALL,
@@ -292,6 +302,8 @@ impl LightBvh {
             nodes: Vec::with_capacity(2 * items.len()),
             trails: vec![u64::MAX; entries.len()],
             spans: Vec::with_capacity(2 * items.len()),
+            node_light: Vec::with_capacity(2 * items.len()),
+            self_unlit: crate::own::self_unlit(lights, shapes, table),
             ordinals: vec![u32::MAX; entries.len()],
             by_ordinal: Vec::with_capacity(items.len()),
             prefix: vec![0.0],
@@ -358,6 +370,7 @@ impl LightBvh {
                 index: entry,
                 leaf: true,
             });
+            self.node_light.push(items[0].light);
             self.trails[entry as usize] = trail;
             let ordinal = self.by_ordinal.len() as u32;
             self.spans.push((ordinal, 1));
@@ -377,6 +390,10 @@ impl LightBvh {
         });
         let first = self.by_ordinal.len() as u32;
         self.spans.push((first, items.len() as u32));
+        let light = items[0].light;
+        let one_light = items.iter().all(|it| it.light == light);
+        self.node_light
+            .push(if one_light { light } else { u32::MAX });
         // Median split of the centroids along their widest axis.
         let extent = chi - clo;
         let axis = if extent.x >= extent.y && extent.x >= extent.z {
@@ -528,6 +545,12 @@ impl LightBvh {
         let r = 0.5 * (node.hi - node.lo).length();
         let d = (0.5 * (node.lo + node.hi) - p).length();
         if d <= r { 1.0 } else { r / d }
+    }
+
+    /// The light all of node `i`'s entries belong to, if one.
+    #[inline]
+    pub(crate) fn node_light(&self, i: usize) -> Option<u32> {
+        Some(self.node_light[i]).filter(|&l| l != u32::MAX)
     }
 
     /// Node `i`'s leaves, `(first, count)` in depth-first order.

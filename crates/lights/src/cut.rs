@@ -25,6 +25,7 @@ use glam::{Vec2, Vec3};
 use restir_sampling::AliasTable;
 
 use crate::bvh::LightBvh;
+use crate::own::OwnLight;
 use crate::{LearnedDraw, LearnedSampler, LightSample, LightSet};
 
 /// The hierarchy cut for one region of receivers ([`LightSet::light_cut`]).
@@ -79,13 +80,27 @@ impl Ord for Open {
 impl LightBvh {
     /// The cut of at most `max_nodes` nodes for receivers within `spread` of `p` with normal
     /// `n` (zero: normals differ); `None` if no node can light the region.
-    fn cut(&self, p: Vec3, n: Vec3, spread: f32, max_nodes: usize) -> Option<LightCut> {
+    ///
+    /// With `own`, every receiver lies on that light: its own nodes are not split, and together
+    /// they keep `own.share` of the selections (in proportion to their importance), the other
+    /// nodes the rest; where no other node can light the region they keep all of it.
+    fn cut(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        spread: f32,
+        max_nodes: usize,
+        own: Option<OwnLight>,
+    ) -> Option<LightCut> {
         if !self.has_nodes() {
             return None;
         }
+        let own_light = own.map(|o| o.light);
+        let is_own = |node: usize| own_light.is_some() && self.node_light(node) == own_light;
         let open = |node: usize| {
             let importance = self.region_importance(node, p, n, spread);
             let priority = match self.children(node) {
+                Some(_) if is_own(node) => 0.0,
                 Some(_) => importance * self.angular_size(node, p),
                 None => -1.0,
             };
@@ -112,10 +127,34 @@ impl LightBvh {
             heap.push(open(a));
             heap.push(open(b));
         }
-        let mut cut: Vec<((u32, u32), f32)> = heap
+        let mut cut: Vec<((u32, u32), f32, bool)> = heap
             .into_iter()
-            .map(|o| (self.span(o.node as usize), o.importance))
+            .map(|o| {
+                let node = o.node as usize;
+                (self.span(node), o.importance, is_own(node))
+            })
             .collect();
+        if let Some(own) = own {
+            let (mut w_own, mut w_other) = (0.0f64, 0.0f64);
+            for &(_, w, mine) in &cut {
+                if mine {
+                    w_own += f64::from(w);
+                } else {
+                    w_other += f64::from(w);
+                }
+            }
+            if w_own > 0.0 && w_other > 0.0 {
+                let share = f64::from(own.share.clamp(0.0, 0.5));
+                let scale = (share / (1.0 - share) * w_other / w_own) as f32;
+                for (_, w, mine) in &mut cut {
+                    if *mine {
+                        *w *= scale;
+                    }
+                }
+            }
+        }
+        let mut cut: Vec<((u32, u32), f32)> =
+            cut.into_iter().map(|(span, w, _)| (span, w)).collect();
         cut.sort_unstable_by_key(|&((first, _), _)| first);
         let weights: Vec<f32> = cut.iter().map(|&(_, w)| w).collect();
         let table = AliasTable::new(&weights)?;
@@ -176,10 +215,38 @@ impl LightSet {
     /// The light hierarchy cut into at most `max_nodes` nodes for receivers within `spread` of
     /// `p` whose shading normal is `n` (zero if they differ), built once for a region and
     /// sampled by [`LightSet::sample_cut`]. `None` if no local light can light the region.
-    pub fn light_cut(&self, p: Vec3, n: Vec3, spread: f32, max_nodes: usize) -> Option<LightCut> {
+    ///
+    /// `own`: every receiver of the region lies on that light, whose emitters then keep
+    /// `own.share` of the selections (the rest goes to the lights that can reach the
+    /// receivers); meant for lights that cannot light their own surface
+    /// ([`LightSet::self_unlit`]), unbiased for any light as long as the share is positive.
+    pub fn light_cut(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        spread: f32,
+        max_nodes: usize,
+        own: Option<OwnLight>,
+    ) -> Option<LightCut> {
         // Rounding must not leave a receiver of the region outside its grown boxes.
         let spread = spread * (1.0 + 1e-4) + 1e-6 * p.abs().max_element();
-        self.hierarchy().cut(p, n, spread, max_nodes.max(1))
+        self.hierarchy().cut(p, n, spread, max_nodes.max(1), own)
+    }
+
+    /// Whether light `light` cannot light a point of its own surface: an outward sphere, or a
+    /// mesh of at most 4096 emitting triangles with every corner behind every triangle's plane
+    /// (a lamp's bulb, a flat panel). Decided once, when the hierarchy is built.
+    pub fn self_unlit(&self, light: u32) -> bool {
+        self.hierarchy()
+            .self_unlit
+            .get(light as usize)
+            .copied()
+            .unwrap_or(false)
+    }
+
+    /// How many lights cannot light their own surface ([`LightSet::self_unlit`]).
+    pub fn self_unlit_count(&self) -> usize {
+        self.hierarchy().self_unlit.iter().filter(|&&b| b).count()
     }
 
     /// Picks a light for a receiver at `ref_p` from a cut of its region (`u_select ∈ [0, 1)`

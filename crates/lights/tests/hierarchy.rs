@@ -324,7 +324,7 @@ fn cut_follows_its_pmf() {
     let level = sidak_level(0.01, RECEIVERS.len() * CUT_SIZES.len());
     for (i, &(p, n)) in RECEIVERS.iter().enumerate() {
         for (j, &nodes) in CUT_SIZES.iter().enumerate() {
-            let cut = set.light_cut(p, n, SPREAD, nodes).unwrap();
+            let cut = set.light_cut(p, n, SPREAD, nodes, None).unwrap();
             assert!(cut.len() <= nodes.max(1));
             let pmf = cut_pmfs(&set, &cut);
             let total: f64 = pmf.iter().sum();
@@ -353,7 +353,7 @@ fn cut_keeps_every_light_that_can_reach_the_region() {
     let mut zero_somewhere = 0;
     for &(p, n) in &RECEIVERS {
         for &nodes in &CUT_SIZES {
-            let cut = set.light_cut(p, n, SPREAD, nodes).unwrap();
+            let cut = set.light_cut(p, n, SPREAD, nodes, None).unwrap();
             for _ in 0..32 {
                 let d = restir_sampling::warp::sample_uniform_sphere(rng.next_2d());
                 let q = p + d * SPREAD * rng.next_f32().cbrt();
@@ -381,7 +381,7 @@ fn cut_samples_carry_the_cut_density() {
     let (_, set) = scene();
     let mut rng = Pcg32::new(13, 1);
     for &(p, n) in &RECEIVERS {
-        let cut = set.light_cut(p, n, SPREAD, 64).unwrap();
+        let cut = set.light_cut(p, n, SPREAD, 64, None).unwrap();
         let mut checked = 0;
         for _ in 0..4000 {
             let Some((s, power_pdf)) =
@@ -422,11 +422,50 @@ fn cut_samples_carry_the_cut_density() {
 fn negative_control_cut_against_power_pmf_is_rejected() {
     let (_, set) = scene();
     let (p, n) = RECEIVERS[0];
-    let cut = set.light_cut(p, n, SPREAD, 256).unwrap();
+    let cut = set.light_cut(p, n, SPREAD, 256, None).unwrap();
     let power: Vec<f64> = (0..set.emitter_count())
         .map(|e| set.emitter_pmf(e) as f64)
         .collect();
     let outcome = cut_histogram(&set, &cut, 78).chi2(&power).unwrap();
     eprintln!("power pmf: {outcome}");
     assert!(outcome.p_value < 1e-6, "{outcome}");
+}
+
+/// A cut for receivers on a light that cannot light its own surface (the larger sphere) leaves
+/// that light its small fixed share instead of the most probability (it is the nearest), and
+/// its picks still follow its pmf.
+#[test]
+fn cut_for_receivers_on_a_light_leaves_it_its_share_and_follows_its_pmf() {
+    let (_, set) = scene();
+    let sphere = 300u32;
+    assert!(set.self_unlit(sphere), "an outward sphere");
+    assert!(set.self_unlit(0), "a flat quad");
+    assert!(!set.self_unlit(302), "a point light has no surface");
+    let centre = Vec3::new(1.0, 1.0, 1.5);
+    let n = Vec3::new(0.0, 0.6, 0.8);
+    let p = centre + 0.2 * n;
+    let entry = (0..set.emitter_count())
+        .find(|&e| set.entry_light(e) == sphere)
+        .unwrap();
+    let plain = set.light_cut(p, Vec3::ZERO, 0.1, 256, None).unwrap();
+    let own = restir_lights::OwnLight {
+        light: sphere,
+        share: restir_lights::OWN_LIGHT_SHARE,
+    };
+    let cut = set.light_cut(p, Vec3::ZERO, 0.1, 256, Some(own)).unwrap();
+    let (before, after) = (set.cut_pmf(&plain, entry), set.cut_pmf(&cut, entry));
+    eprintln!("the sphere's probability: {before} alone, {after} for receivers on it");
+    assert!(before > 0.25, "{before}");
+    assert!(
+        after > 0.0 && after <= restir_lights::OWN_LIGHT_SHARE,
+        "{after}"
+    );
+    let pmf = cut_pmfs(&set, &cut);
+    let total: f64 = pmf.iter().sum();
+    assert!((total - 1.0).abs() < 1e-4, "Σ pmf = {total}");
+    let outcome = cut_histogram(&set, &cut, 91 + seed_offset())
+        .chi2(&pmf)
+        .unwrap();
+    eprintln!("{outcome}");
+    assert!(outcome.accepts(0.01), "{outcome}");
 }

@@ -190,7 +190,7 @@ fn mixed_pools(
     claim: Claim,
 ) -> Vec<Vec<Option<LearnedDraw>>> {
     let cut = lights
-        .light_cut(AT.p + Vec3::new(0.2, 0.1, 0.0), AT.n, 0.5, nodes)
+        .light_cut(AT.p + Vec3::new(0.2, 0.1, 0.0), AT.n, 0.5, nodes, None)
         .unwrap();
     let mut rng = Pcg32::new(23, 7);
     (0..RECEIVERS)

@@ -167,7 +167,12 @@ impl RestirDiIntegrator {
             return Some(cuts.clone());
         }
         let hide = self.settings.path.hide_emitters;
-        let cuts = tiles::TileCuts::probe(scene, ctx, gbuf.width, gbuf.height, hide)?;
+        let own = if self.settings.light_sampler == LightSampler::TilesDroppingOwnLight {
+            tiles::OwnLights::DroppedEverywhere
+        } else {
+            tiles::OwnLights::Apart
+        };
+        let cuts = tiles::TileCuts::probe(scene, ctx, gbuf.width, gbuf.height, hide, own)?;
         *rays += cuts.rays();
         let cuts = std::sync::Arc::new(cuts);
         *kept = Some(cuts.clone());

@@ -52,6 +52,11 @@ pub enum LightSampler {
     /// weighted as if the power table had drawn them (biased).
     #[doc(hidden)]
     TilesWithPowerPmf,
+    /// A negative control for the tests, never a choice: the tiles' cuts leaving every light no
+    /// selection for the receivers on it, whether or not it can light itself (biased where one
+    /// does).
+    #[doc(hidden)]
+    TilesDroppingOwnLight,
     /// A negative control for the tests, never a choice: the power sampler's pool with the
     /// selection probability of whole lights (spheres, point lights, the environment) left out
     /// of their candidates' density (biased).
@@ -70,7 +75,12 @@ impl LightSampler {
 
     /// Whether candidates come from the tiles' light cuts ([`super::tiles`]).
     pub fn is_tiles(self) -> bool {
-        matches!(self, LightSampler::Tiles | LightSampler::TilesWithPowerPmf)
+        matches!(
+            self,
+            LightSampler::Tiles
+                | LightSampler::TilesWithPowerPmf
+                | LightSampler::TilesDroppingOwnLight
+        )
     }
 
     /// Whether candidates come from the light hierarchy.
@@ -87,6 +97,7 @@ impl LightSampler {
             LightSampler::Bvh => "bvh",
             LightSampler::BvhWithPowerPmf => "bvh-with-power-pmf",
             LightSampler::TilesWithPowerPmf => "tiles-with-power-pmf",
+            LightSampler::TilesDroppingOwnLight => "tiles-dropping-own-light",
             LightSampler::PoolWithoutSelection => "pool-without-selection",
         }
     }

@@ -11,12 +11,17 @@
 //! ([`LightSet::presample_cut`](restir_lights::LightSet::presample_cut)), and the tile's pixels
 //! take their candidates from the pool: a read from a small array per candidate. A pass's
 //! receivers outside their tile's region (hits the corner rays missed) get a cut of their own,
-//! made in that pass. With learning across passes ([`super::learn`]) a tile has one pool per
+//! made in that pass. The probes that hit a light which cannot light its own surface (a lamp
+//! in view, [`LightSet::self_unlit`](restir_lights::LightSet::self_unlit)) make a second region
+//! of the tile, whose cut leaves that light a small share of its selections
+//! ([`OwnLight`]): it is the nearest light of every receiver on it, and would otherwise take
+//! most of them without lighting any. With learning across passes ([`super::learn`]) a tile has one pool per
 //! cut and learned cell its receivers are in, drawn from the mixture of the cell's table and
 //! the cut: the cut is the learned table's defensive part, in place of the power sampler.
 //!
 //! **Unbiased.** A cut's importance is conservative for its whole region, and a receiver draws
-//! from a cut only if it lies in the cut's region, so an emitter that can light it keeps a
+//! from a cut only if it lies in the cut's region (for a region on a light, only if it lies on
+//! that light, which keeps its positive share), so an emitter that can light it keeps a
 //! positive probability (with learning, the cut's share of the mixture keeps it); each pool
 //! entry is an independent draw carrying its mixture's probability exactly. The regions depend
 //! on no pass's random numbers, so each pass is unbiased given them. Targets, reuse and the
@@ -30,7 +35,7 @@
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
-use restir_lights::{Claim, LearnedDraw, LearnedSampler, LightCut};
+use restir_lights::{Claim, LearnedDraw, LearnedSampler, LightCut, OWN_LIGHT_SHARE, OwnLight};
 use restir_scene::Scene;
 
 use crate::pass::PassContext;
@@ -133,6 +138,10 @@ pub struct CutSummary {
     pub entries: usize,
     /// Nodes of the whole hierarchy.
     pub hierarchy_nodes: usize,
+    /// Tiles with a region of receivers on a light that cannot light itself.
+    pub on_light: usize,
+    /// Lights that cannot light their own surface.
+    pub self_unlit: usize,
 }
 
 impl CutSummary {
@@ -140,12 +149,14 @@ impl CutSummary {
     pub fn describe(&self) -> String {
         let per = |n: usize, of: usize| n as f64 / of.max(1) as f64;
         format!(
-            "{} tiles of {TILE}×{TILE} pixels, each a cut of the light hierarchy ({} nodes) into \
-             at most {CUT_NODES} nodes (mean {:.0}), found once from camera rays through its \
-             pixels' corners; last pass: {:.2}% of receivers outside their tile's region, on {} \
+            "{} tiles of {TILE}×{TILE} pixels, each with a cut of the light hierarchy ({} nodes) \
+             into at most {CUT_NODES} nodes per region (mean {:.0} nodes per tile), found once \
+             from camera rays through its pixels' corners; last pass: {:.2}% of receivers \
+             outside their tile's regions, on {} \
              cuts of their own (mean {:.0} nodes); {:.1} pools per tile (one per cut and learned \
              cell its receivers are in, mixing the cell's table with the cut), {:.0} draws per \
-             tile",
+             tile; {} lights cannot light their own surface, and {} tiles have a region of \
+             receivers on one, whose cut leaves it {:.1}% of the selections",
             self.tiles,
             self.hierarchy_nodes,
             per(self.nodes, self.tiles),
@@ -153,19 +164,25 @@ impl CutSummary {
             self.fresh_cuts,
             per(self.fresh_nodes, self.fresh_cuts),
             per(self.pools, self.tiles),
-            per(self.entries, self.tiles)
+            per(self.entries, self.tiles),
+            self.self_unlit,
+            self.on_light,
+            100.0 * OWN_LIGHT_SHARE
         )
     }
 }
 
-/// A tile's receivers summed up: their mean position, how far they spread from it, and their
-/// normal where they agree (zero where they do not).
+/// A tile's receivers summed up: their mean position, how far they spread from it, their
+/// normal where they agree (zero where they do not), and the light they all lie on where its
+/// cut treats it apart ([`OwnLight`]).
 #[derive(Clone, Copy, Debug)]
 struct Region {
     p: Vec3,
     n: Vec3,
     /// The largest squared distance of a point from `p`.
     spread2: f32,
+    /// The light every receiver of the region lies on, and the share its own emitters keep.
+    on: Option<OwnLight>,
 }
 
 impl Region {
@@ -191,21 +208,109 @@ impl Region {
             p,
             n: if same { mean_n } else { Vec3::ZERO },
             spread2,
+            on: None,
         })
     }
 
-    /// Whether a receiver at `q` with normal `n` lies in the region (and, where the region has
-    /// one normal, shares it): then the region's cut keeps every light that can reach it.
+    /// Whether a receiver at `q` with normal `n`, on light `on` (if on one), lies in the
+    /// region (and, where the region has one normal, shares it; where it lies on a light, lies
+    /// on it too): then the region's cut gives every light that can reach it the probability
+    /// the cut was made to give.
     #[inline]
-    fn holds(&self, q: Vec3, n: Vec3) -> bool {
+    fn holds(&self, q: Vec3, n: Vec3, on: Option<u32>) -> bool {
         (q - self.p).length_squared() <= self.spread2
             && (self.n == Vec3::ZERO || n.dot(self.n) >= SAME_NORMAL)
+            && self.on.is_none_or(|o| on == Some(o.light))
     }
 
     /// The region's cut of the light hierarchy.
     fn cut(&self, lights: &restir_lights::LightSet) -> Option<LightCut> {
         // `light_cut` widens the radius by more than its rounding.
-        lights.light_cut(self.p, self.n, self.spread2.sqrt(), CUT_NODES)
+        lights.light_cut(self.p, self.n, self.spread2.sqrt(), CUT_NODES, self.on)
+    }
+}
+
+/// How the tiles treat receivers on a light ([`OwnLight`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OwnLights {
+    /// Receivers on a light that cannot light its own surface get a region of their own, whose
+    /// cut leaves that light [`OWN_LIGHT_SHARE`] of its selections.
+    Apart,
+    /// Every light, whether or not it can light itself, is left no selection at all for the
+    /// receivers on it (a negative control of the tests: biased where a light lights itself).
+    #[doc(hidden)]
+    DroppedEverywhere,
+}
+
+impl OwnLights {
+    /// The own-light rule for a region on light `light`, if it has one.
+    fn of(self, lights: &restir_lights::LightSet, light: u32) -> Option<OwnLight> {
+        match self {
+            OwnLights::Apart => lights.self_unlit(light).then_some(OwnLight {
+                light,
+                share: OWN_LIGHT_SHARE,
+            }),
+            OwnLights::DroppedEverywhere => Some(OwnLight { light, share: 0.0 }),
+        }
+    }
+}
+
+/// A tile's regions with their cuts: the one of its receivers on a light that its cut treats
+/// apart (the light the most of its probes hit, if any), and the one of the others.
+#[derive(Debug, Default)]
+struct TileRegions {
+    on_light: Option<(Region, LightCut)>,
+    rest: Option<(Region, LightCut)>,
+}
+
+impl TileRegions {
+    /// The regions of the probes' hits `(position, shading normal, the light the hit lies on)`.
+    fn of(
+        lights: &restir_lights::LightSet,
+        hits: &[(Vec3, Vec3, Option<u32>)],
+        own: OwnLights,
+    ) -> Self {
+        // The light the most hits lie on, among those whose cut treats it apart (the lowest
+        // index on a tie).
+        let mut counts: Vec<(u32, usize)> = Vec::new();
+        for &(_, _, on) in hits {
+            if let Some(l) = on {
+                match counts.binary_search_by_key(&l, |&(k, _)| k) {
+                    Ok(j) => counts[j].1 += 1,
+                    Err(j) => counts.insert(j, (l, 1)),
+                }
+            }
+        }
+        counts.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+        let own_light = counts.iter().find_map(|&(l, _)| own.of(lights, l));
+        let on =
+            |hit: &&(Vec3, Vec3, Option<u32>)| own_light.is_some_and(|o| hit.2 == Some(o.light));
+        let with_cut =
+            |region: Option<Region>| region.and_then(|region| Some((region, region.cut(lights)?)));
+        let on_light = own_light.and_then(|o| {
+            let region = Region::of(hits.iter().filter(on).map(|h| (h.0, h.1)))?;
+            with_cut(Some(Region {
+                on: Some(o),
+                ..region
+            }))
+        });
+        let rest = with_cut(Region::of(
+            hits.iter().filter(|h| !on(h)).map(|h| (h.0, h.1)),
+        ));
+        Self { on_light, rest }
+    }
+
+    /// The region (0: the one on a light, 1: the rest) and cut that hold a receiver at `q`
+    /// with normal `n` on light `on`, if one does.
+    fn holding(&self, q: Vec3, n: Vec3, on: Option<u32>) -> Option<(u64, &LightCut)> {
+        [&self.on_light, &self.rest]
+            .into_iter()
+            .zip([2, 0])
+            .find_map(|(t, which)| {
+                t.as_ref()
+                    .filter(|(region, _)| region.holds(q, n, on))
+                    .map(|(_, cut)| (which, cut))
+            })
     }
 }
 
@@ -216,9 +321,9 @@ impl Region {
 pub struct TileCuts {
     /// The film coordinates of the buffers' first pixel and their size.
     window: (u32, u32, usize, usize),
-    /// Per tile of the buffers, its region and cut (`None`: the probes hit nothing that a
+    /// Per tile of the buffers, its regions and cuts (none: the probes hit nothing that a
     /// light can reach).
-    tiles: Vec<Option<(Region, LightCut)>>,
+    tiles: Vec<TileRegions>,
     /// Camera rays traced to find them.
     rays: u64,
 }
@@ -226,20 +331,22 @@ pub struct TileCuts {
 impl TileCuts {
     /// Bytes per pixel of the regions and their cuts, at most.
     pub fn bytes_per_pixel() -> usize {
-        let per_tile = std::mem::size_of::<Option<(Region, LightCut)>>()
-            + CUT_NODES * LightCut::BYTES_PER_NODE;
+        let per_tile =
+            std::mem::size_of::<TileRegions>() + 2 * CUT_NODES * LightCut::BYTES_PER_NODE;
         per_tile.div_ceil(TILE * TILE)
     }
 
     /// The tiles' regions and cuts for buffers `width × height` of pass `ctx` (only its crop
     /// matters): per tile, the hits of camera rays through the film corners of its pixels
-    /// (`hide_emitters` as the G-buffer's rays). `None` if the scene has no local light.
+    /// (`hide_emitters` as the G-buffer's rays), those on a light that `own` treats apart in a
+    /// region of their own. `None` if the scene has no local light.
     pub fn probe(
         scene: &Scene,
         ctx: &PassContext,
         width: usize,
         height: usize,
         hide_emitters: bool,
+        own: OwnLights,
     ) -> Option<Self> {
         let lights = &scene.lights;
         if lights.emitter_count() == 0 {
@@ -249,7 +356,7 @@ impl TileCuts {
         let (x0, y0) = ctx.film_xy(0, width.max(1));
         let tiles_x = width.div_ceil(TILE);
         let tiles_y = height.div_ceil(TILE);
-        let per_tile: Vec<(Option<(Region, LightCut)>, u64)> = (0..tiles_x * tiles_y)
+        let per_tile: Vec<(TileRegions, u64)> = (0..tiles_x * tiles_y)
             .into_par_iter()
             .map(|t| {
                 let (tx, ty) = (t % tiles_x, t / tiles_x);
@@ -264,13 +371,11 @@ impl TileCuts {
                         let (hit, n) = scene.camera_intersect(&ray, hide_emitters);
                         rays += n;
                         if let Some(si) = hit {
-                            hits.push((si.p, si.shading.n));
+                            hits.push((si.p, si.shading.n, lights.light_on_shape(si.shape)));
                         }
                     }
                 }
-                let tile = Region::of(hits.iter().copied())
-                    .and_then(|region| Some((region, region.cut(lights)?)));
-                (tile, rays)
+                (TileRegions::of(lights, &hits, own), rays)
             })
             .collect();
         let rays = per_tile.iter().map(|&(_, n)| n).sum();
@@ -334,20 +439,20 @@ impl LightTiles {
                 let (tx, ty) = (t % tiles_x, t / tiles_x);
                 let rows = ty * TILE..((ty + 1) * TILE).min(gbuf.height);
                 let cols = tx * TILE..((tx + 1) * TILE).min(gbuf.width);
-                let cached = cuts.tiles.get(t).and_then(Option::as_ref);
-                // The tile's receivers with their learned cells, those in the tile's region
-                // apart from the others.
-                let (mut inside, mut outside) = (Vec::new(), Vec::new());
+                let cached = cuts.tiles.get(t);
+                // The tile's receivers with their learned cells, per region of the tile that
+                // holds them (on a light: 2, the rest: 0), and those outside them.
+                let (mut inside, mut on_light, mut outside) = (Vec::new(), Vec::new(), Vec::new());
                 for y in rows.clone() {
                     for x in cols.clone() {
                         let i = y * gbuf.width + x;
                         if let Some(r) = gbuf.receiver(i) {
                             let cell = learned.and_then(|l| l.cell(r.p, r.n));
-                            match cached {
-                                Some((region, _)) if region.holds(r.p, r.n) => {
-                                    inside.push((i, cell))
-                                }
-                                _ => outside.push((i, cell)),
+                            let on = lights.light_on_shape(r.at.shape);
+                            match cached.and_then(|c| c.holding(r.p, r.n, on)) {
+                                Some((2, _)) => on_light.push((i, cell)),
+                                Some(_) => inside.push((i, cell)),
+                                None => outside.push((i, cell)),
                             }
                         }
                     }
@@ -356,18 +461,23 @@ impl LightTiles {
                 let (fx, fy) = ctx.film_xy(rows.start * gbuf.width + cols.start, gbuf.width);
                 let key = ((u64::from(fy) / TILE as u64) << 32) | (u64::from(fx) / TILE as u64);
                 let mut build = TileBuild::default();
-                if let Some((_, cut)) = cached.filter(|_| !inside.is_empty()) {
-                    build.add(
-                        lights,
-                        ctx,
-                        cut,
-                        &inside,
-                        (key, 0),
-                        k,
-                        learned,
-                        claim,
-                        stage,
-                    );
+                for (members, which, region) in [
+                    (&inside, 0, cached.and_then(|c| c.rest.as_ref())),
+                    (&on_light, 2, cached.and_then(|c| c.on_light.as_ref())),
+                ] {
+                    if let Some((_, cut)) = region.filter(|_| !members.is_empty()) {
+                        build.add(
+                            lights,
+                            ctx,
+                            cut,
+                            members,
+                            (key, which),
+                            k,
+                            learned,
+                            claim,
+                            stage,
+                        );
+                    }
                 }
                 let fresh = Region::of(
                     outside
@@ -397,13 +507,17 @@ impl LightTiles {
         let mut pool_of = vec![u16::MAX; gbuf.width * gbuf.height];
         let mut summary = CutSummary {
             hierarchy_nodes,
+            self_unlit: lights.self_unlit_count(),
             ..CutSummary::default()
         };
         let mut pools = Vec::with_capacity(per_tile.len());
         for (t, build) in per_tile.into_iter().enumerate() {
-            if let Some((_, cut)) = cuts.tiles.get(t).and_then(Option::as_ref) {
-                summary.tiles += 1;
-                summary.nodes += cut.len();
+            if let Some(tile) = cuts.tiles.get(t) {
+                let regions =
+                    [&tile.rest, &tile.on_light].map(|r| r.as_ref().map(|(_, c)| c.len()));
+                summary.tiles += usize::from(regions.iter().any(Option::is_some));
+                summary.nodes += regions.iter().flatten().sum::<usize>();
+                summary.on_light += usize::from(regions[1].is_some());
             }
             summary.fresh_cuts += usize::from(build.fresh_nodes > 0);
             summary.fresh_nodes += build.fresh_nodes;
@@ -449,16 +563,16 @@ mod tests {
             .collect();
         let region = Region::of(floor.iter().copied()).unwrap();
         assert_eq!(region.n, Vec3::Y);
-        assert!(floor.iter().all(|&(p, n)| region.holds(p, n)));
+        assert!(floor.iter().all(|&(p, n)| region.holds(p, n, None)));
         // Beyond the radius, or facing another way: another cut's receiver.
-        assert!(!region.holds(Vec3::new(5.0, 0.0, 5.0), Vec3::Y));
-        assert!(!region.holds(Vec3::new(2.0, 0.0, 2.0), Vec3::X));
+        assert!(!region.holds(Vec3::new(5.0, 0.0, 5.0), Vec3::Y, None));
+        assert!(!region.holds(Vec3::new(2.0, 0.0, 2.0), Vec3::X, None));
         // Points whose normals differ: the region has none, and any normal is held.
         let mut corner = floor.clone();
         corner.push((Vec3::new(0.0, 1.0, 0.0), Vec3::X));
         let region = Region::of(corner.iter().copied()).unwrap();
         assert_eq!(region.n, Vec3::ZERO);
-        assert!(region.holds(Vec3::new(2.0, 0.0, 2.0), -Vec3::Z));
+        assert!(region.holds(Vec3::new(2.0, 0.0, 2.0), -Vec3::Z, None));
         assert!(Region::of(std::iter::empty()).is_none());
     }
 }
