@@ -600,6 +600,27 @@ fn xml_restir_integrator_and_parameters() {
     );
 }
 
+/// What `--stats` says of the tiles' cuts after one pass of ReSTIR DI with `tiles` on `scene`.
+fn tiles_description(scene: &common::Built) -> String {
+    let mut settings = RestirDiSettings::new(restir_integrators::path::PathSettings::from_desc(
+        &scene.integrator,
+    ));
+    settings.light_sampler = LightSampler::Tiles;
+    let integrator = RestirDiIntegrator::new(settings);
+    let job = RenderJob {
+        spp: 1,
+        ..RenderJob::default()
+    };
+    render(
+        scene,
+        &integrator,
+        &job,
+        &AtomicBool::new(false),
+        &mut |_, _| {},
+    );
+    integrator.light_cuts().expect("tiles describe their cuts")
+}
+
 /// The light hierarchy as the candidate source, by a descent per receiver (`bvh`) or from the
 /// tiles' cuts (`tiles`), is unbiased (alone and with two rounds of reuse); weighting its
 /// candidates by the power table's pmf instead of theirs (the wrong density) is caught by the
@@ -617,25 +638,7 @@ fn light_hierarchy_and_its_cuts_are_unbiased_and_a_wrong_pmf_is_caught() {
     // Through a wide lens most receivers lie outside their tile's region (found by rays from
     // the lens's centre) and draw from cuts made in the pass for them.
     let lens = scene_with_lens(diffuse, green, 64, 1.0);
-    let outside = {
-        let mut settings = RestirDiSettings::new(
-            restir_integrators::path::PathSettings::from_desc(&lens.integrator),
-        );
-        settings.light_sampler = LightSampler::Tiles;
-        let integrator = RestirDiIntegrator::new(settings);
-        let job = RenderJob {
-            spp: 1,
-            ..RenderJob::default()
-        };
-        render(
-            &lens,
-            &integrator,
-            &job,
-            &AtomicBool::new(false),
-            &mut |_, _| {},
-        );
-        integrator.light_cuts().expect("tiles describe their cuts")
-    };
+    let outside = tiles_description(&lens);
     let share: f64 = outside
         .split("last pass: ")
         .nth(1)
@@ -793,23 +796,7 @@ fn scene_with_emitters_in_view() -> common::Built {
 #[test]
 fn receivers_on_a_light_are_unbiased_and_dropping_a_light_that_lights_itself_is_caught() {
     let scene = scene_with_emitters_in_view();
-    let mut settings = RestirDiSettings::new(restir_integrators::path::PathSettings::from_desc(
-        &scene.integrator,
-    ));
-    settings.light_sampler = LightSampler::Tiles;
-    let integrator = RestirDiIntegrator::new(settings);
-    let job = RenderJob {
-        spp: 1,
-        ..RenderJob::default()
-    };
-    render(
-        &scene,
-        &integrator,
-        &job,
-        &AtomicBool::new(false),
-        &mut |_, _| {},
-    );
-    let cuts = integrator.light_cuts().expect("tiles describe their cuts");
+    let cuts = tiles_description(&scene);
     eprintln!("{cuts}");
     // The panel and the cube (flat and convex), not the trough.
     assert!(
@@ -827,7 +814,9 @@ fn receivers_on_a_light_are_unbiased_and_dropping_a_light_that_lights_itself_is_
         eprintln!("{params:?}: max |z| = {z:.2}");
         assert!(z < Z_MAX, "{params:?}: max |z| = {z:.2}");
     }
-    let mut wrong = settings;
+    let mut wrong = RestirDiSettings::new(restir_integrators::path::PathSettings::from_desc(
+        &scene.integrator,
+    ));
     wrong.light_sampler = LightSampler::TilesDroppingOwnLight;
     wrong.candidates = 4;
     let z = max_z(&settings_statistics(&scene, wrong, 200), &reference);
