@@ -430,6 +430,7 @@ mod lights {
     fn context(filter: &Filter) -> PassContext<'_> {
         PassContext {
             shared_offset: None,
+            samples: None,
             seed: 0,
             pass: 0,
             filter,

@@ -51,6 +51,7 @@ fn measure(scene: &Scene, integrator: &dyn Integrator, budget: f64) -> Measureme
     let mut run = |accum: &mut [DVec3]| {
         let ctx = PassContext {
             shared_offset: None,
+            samples: None,
             seed: 0,
             pass,
             filter: &filter,

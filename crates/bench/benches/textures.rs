@@ -145,6 +145,7 @@ fn cornell_flag(budget: f64) {
         scene.features.has_textures = c == 1;
         let ctx = PassContext {
             shared_offset: None,
+            samples: None,
             seed: 0,
             pass: pass / 2,
             filter: &filter,
@@ -200,6 +201,7 @@ fn sponza(budget: f64) {
         let scene = if c == 0 { &textured_scene } else { &constant };
         let ctx = PassContext {
             shared_offset: None,
+            samples: None,
             seed: 0,
             pass: pass / 2,
             filter: &filter,

@@ -27,7 +27,9 @@
 //! of each pass's estimate squared, in CIE XYZ as Mitsuba does: with `N` passes of mean `m` and
 //! second moment `m₂`, `(m₂ − m²)/(N − 1)` estimates the variance of the pixel's value.
 
-use glam::{DVec3, Vec2};
+use std::sync::Mutex;
+
+use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
 use restir_image::srgb;
 use restir_sampling::{Distribution1D, warp};
@@ -224,6 +226,43 @@ fn pixel_integrals(filter: FilterDesc, k: i32) -> (f64, f64) {
     })
 }
 
+/// An estimate of a camera ray that did not go through the pass's shared offset: a splatting film
+/// adds it with the filter's weights at its own position (`offset` within pixel `pixel` of the
+/// pass's buffer).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FilmSample {
+    /// The pixel (row-major index into the pass's buffer).
+    pub pixel: u32,
+    /// Where within the pixel its ray went, in `[0, 1)²`.
+    pub offset: Vec2,
+    /// The estimate.
+    pub value: Vec3,
+}
+
+/// Where a pass of a splatting film puts its [`FilmSample`]s ([`crate::PassContext::samples`]).
+#[derive(Debug, Default)]
+pub struct FilmSamples(Mutex<Vec<FilmSample>>);
+
+impl FilmSamples {
+    /// Adds `samples`.
+    pub fn add(&self, samples: impl IntoIterator<Item = FilmSample>) {
+        if let Ok(mut v) = self.0.lock() {
+            v.extend(samples);
+        }
+    }
+
+    /// The samples added, by pixel (in the order each pixel's came).
+    fn take(&self) -> Vec<FilmSample> {
+        let mut v = self
+            .0
+            .lock()
+            .map(|mut v| std::mem::take(&mut *v))
+            .unwrap_or_default();
+        v.sort_by_key(|s| s.pixel);
+        v
+    }
+}
+
 /// What a splatting film keeps: the filter, and per column and row the inverse of the filter's
 /// expected weight over the film.
 #[derive(Clone, Debug)]
@@ -261,6 +300,35 @@ impl Splat {
             inv_norm_y: inv_norm(height),
             pass: vec![DVec3::ZERO; n],
             rows: vec![DVec3::ZERO; n],
+        }
+    }
+
+    /// Adds `samples` (by pixel), each with the filter's weights at its own position, to `out`,
+    /// normalised as [`Splat::gather`] normalises: so a pixel's value is linear in every
+    /// estimate of the pass, wherever its ray went.
+    fn scatter(&self, samples: &[FilmSample], out: &mut [DVec3]) {
+        let (w, h) = (self.inv_norm_x.len(), self.inv_norm_y.len());
+        let r = self.reach;
+        for s in samples {
+            let (qx, qy) = (s.pixel as usize % w, s.pixel as usize / w);
+            if qy >= h {
+                continue;
+            }
+            let value = s.value.as_dvec3();
+            // Pixel `p` weighs the ray `q − p + u − ½` from its centre.
+            let weight = |q: usize, p: usize, u: f32| {
+                profile(self.filter, q as f64 - p as f64 + f64::from(u) - 0.5)
+            };
+            for y in qy.saturating_sub(r)..(qy + r + 1).min(h) {
+                let wy = weight(qy, y, s.offset.y) * self.inv_norm_y[y];
+                if wy == 0.0 {
+                    continue;
+                }
+                for x in qx.saturating_sub(r)..(qx + r + 1).min(w) {
+                    let wx = weight(qx, x, s.offset.x) * self.inv_norm_x[x];
+                    out[y * w + x] += value * (wx * wy);
+                }
+            }
         }
     }
 
@@ -416,31 +484,38 @@ impl Film {
         self.passes
     }
 
-    /// Adds one pass: `pass` gets the filter (for jittering camera rays) and a row-major buffer
-    /// to which it adds one estimate per pixel; its result is returned. When splatting,
-    /// `offset` is where within its pixel every ray of the pass went (in `[0, 1)²`; ignored
-    /// when sampling).
+    /// Adds one pass: `pass` gets the filter (for jittering camera rays), where to put estimates
+    /// of rays that went elsewhere than `offset` (when splatting; [`FilmSample`]) and a
+    /// row-major buffer to which it adds one estimate per pixel; its result is returned. When
+    /// splatting, `offset` is where within its pixel every ray of the pass went (in `[0, 1)²`;
+    /// ignored when sampling).
     pub fn add_pass<R>(
         &mut self,
         offset: Vec2,
-        pass: impl FnOnce(&Filter, &mut [DVec3]) -> R,
+        pass: impl FnOnce(&Filter, Option<&FilmSamples>, &mut [DVec3]) -> R,
     ) -> R {
         let r = match (&mut self.splat, &mut self.moment) {
-            (None, None) => pass(&self.filter, &mut self.sums),
+            (None, None) => pass(&self.filter, None, &mut self.sums),
             (None, Some(m)) => {
                 m.pass.fill(DVec3::ZERO);
-                let r = pass(&self.filter, &mut m.pass);
+                let r = pass(&self.filter, None, &mut m.pass);
                 m.add_to(&mut self.sums);
                 r
             }
             (Some(s), moment) => {
                 s.pass.fill(DVec3::ZERO);
-                let r = pass(&self.filter, &mut s.pass);
+                let samples = FilmSamples::default();
+                let r = pass(&self.filter, Some(&samples), &mut s.pass);
+                let samples = samples.take();
                 match moment {
-                    None => s.gather(offset, &mut self.sums),
+                    None => {
+                        s.gather(offset, &mut self.sums);
+                        s.scatter(&samples, &mut self.sums);
+                    }
                     Some(m) => {
                         m.pass.fill(DVec3::ZERO);
                         s.gather(offset, &mut m.pass);
+                        s.scatter(&samples, &mut m.pass);
                         m.add_to(&mut self.sums);
                     }
                 }
@@ -518,8 +593,8 @@ mod tests {
         let mut film = Film::new(1, 1, FilterDesc::Box).with_second_moment();
         assert!(plain.moments().is_none());
         for v in passes {
-            plain.add_pass(Vec2::ZERO, |_, sums| sums[0] += v);
-            film.add_pass(Vec2::ZERO, |_, sums| sums[0] += v);
+            plain.add_pass(Vec2::ZERO, |_, _, sums| sums[0] += v);
+            film.add_pass(Vec2::ZERO, |_, _, sums| sums[0] += v);
         }
         assert_eq!(film.image(), plain.image());
         let m = film.moments().unwrap();
@@ -584,17 +659,37 @@ mod tests {
 
     /// Renders `passes` passes of the separable image `line(x)·line(y)` on a film, each pass's
     /// estimates exact at the rays' positions; returns the film and each pixel's per-pass
-    /// values' sample variance.
-    fn splat_passes(filter: FilterDesc, (w, h): (u32, u32), passes: u32) -> (Film, Vec<f64>) {
+    /// values' sample variance. With `own`, every third pixel's estimate is the mean of three
+    /// rays, one through the shared offset and two through offsets of their own
+    /// ([`FilmSample`]s).
+    fn splat_passes(
+        filter: FilterDesc,
+        (w, h): (u32, u32),
+        passes: u32,
+        own: bool,
+    ) -> (Film, Vec<f64>) {
         let mut film = Film::new(w, h, filter).with_second_moment();
         let mut rng = restir_sampling::Pcg32::new(7, 3);
+        let at = |i: usize, u: Vec2| {
+            let (x, y) = ((i % w as usize) as f64, (i / w as usize) as f64);
+            line(x + f64::from(u.x)) * line(y + f64::from(u.y))
+        };
         for _ in 0..passes {
             let u = rng.next_2d();
-            film.add_pass(u, |_, sums| {
+            let extra: Vec<[Vec2; 2]> =
+                (0..w * h).map(|_| [rng.next_2d(), rng.next_2d()]).collect();
+            film.add_pass(u, |_, samples, sums| {
                 for (i, v) in sums.iter_mut().enumerate() {
-                    let (x, y) = ((i % w as usize) as f64, (i / w as usize) as f64);
-                    let l = line(x + f64::from(u.x)) * line(y + f64::from(u.y));
-                    *v += DVec3::splat(l);
+                    if !(own && i % 3 == 0) {
+                        *v += DVec3::splat(at(i, u));
+                        continue;
+                    }
+                    *v += DVec3::splat(at(i, u) / 3.0);
+                    samples.unwrap().add(extra[i].map(|offset| FilmSample {
+                        pixel: i as u32,
+                        offset,
+                        value: Vec3::splat((at(i, offset) / 3.0) as f32),
+                    }));
                 }
             });
         }
@@ -607,17 +702,19 @@ mod tests {
     }
 
     /// A splatting film's pixels converge to the filter-weighted radiance over the film, at the
-    /// border too, within 4.5 standard errors; normalising by the filter's whole integral
+    /// border too, within 4.5 standard errors, also where some estimates come from rays through
+    /// offsets of their own; normalising by the filter's whole integral
     /// instead (ignoring the border) is caught.
     #[test]
     fn splatting_is_unbiased() {
         let (w, h) = (12, 9);
         let passes = 20_000;
-        for filter in [
-            FilterDesc::Gaussian { stddev: 0.5 },
-            FilterDesc::Tent { radius: 1.5 },
+        for (filter, own) in [
+            (FilterDesc::Gaussian { stddev: 0.5 }, false),
+            (FilterDesc::Tent { radius: 1.5 }, false),
+            (FilterDesc::Gaussian { stddev: 0.5 }, true),
         ] {
-            let (film, var) = splat_passes(filter, (w, h), passes);
+            let (film, var) = splat_passes(filter, (w, h), passes, own);
             let image = film.image();
             let ex: Vec<f64> = (0..w)
                 .map(|x| expected_line(filter, f64::from(x) + 0.5, w))
@@ -666,7 +763,7 @@ mod tests {
         ] {
             for _ in 0..50 {
                 let mut film = Film::new(9, 7, filter);
-                film.add_pass(rng.next_2d(), |_, sums| sums.fill(DVec3::ONE));
+                film.add_pass(rng.next_2d(), |_, _, sums| sums.fill(DVec3::ONE));
                 let reach = film.reconstruction().reach() as usize;
                 for (i, p) in film.image().pixels.iter().enumerate() {
                     let (x, y) = (i % 9, i / 9);
@@ -694,12 +791,12 @@ mod tests {
         let mut whole = Film::new(film.0, film.1, filter);
         let mut part = Film::new(region.width, region.height, filter);
         for u in [Vec2::new(0.1, 0.7), Vec2::new(0.9, 0.3)] {
-            whole.add_pass(u, |_, sums| {
+            whole.add_pass(u, |_, _, sums| {
                 for (i, v) in sums.iter_mut().enumerate() {
                     *v += value(i as u32 % film.0, i as u32 / film.0);
                 }
             });
-            part.add_pass(u, |_, sums| {
+            part.add_pass(u, |_, _, sums| {
                 for (i, v) in sums.iter_mut().enumerate() {
                     let (x, y) = (i as u32 % region.width, i as u32 / region.width);
                     *v += value(x + region.x0, y + region.y0);
@@ -725,7 +822,7 @@ mod tests {
         let mut film = Film::new(2, 1, FilterDesc::Box);
         assert_eq!(film.image().pixels, vec![glam::Vec3::ZERO; 2]);
         for v in [1.0, 2.0, 6.0] {
-            film.add_pass(Vec2::ZERO, |_, sums| {
+            film.add_pass(Vec2::ZERO, |_, _, sums| {
                 sums[0] += DVec3::splat(v);
                 sums[1] += DVec3::new(v, 0.0, -v);
             });

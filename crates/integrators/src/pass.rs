@@ -32,6 +32,10 @@ pub struct PassContext<'a> {
     /// Where within its pixel every camera ray of the pass goes, when the film splats
     /// (`restir_integrators::film::Reconstruction`); `None`: each ray samples `filter`.
     pub shared_offset: Option<Vec2>,
+    /// Where the pass may put estimates of camera rays through offsets of their own
+    /// ([`crate::film::FilmSample`]), when the film splats; `None` if it may not (every ray then
+    /// goes through `shared_offset`).
+    pub samples: Option<&'a crate::film::FilmSamples>,
     /// The part of the film this pass renders, if not all of it: pixel indices and coordinates
     /// the integrator sees are then the region's, and the random streams and camera rays are
     /// those of the same pixels in the whole film.

@@ -224,12 +224,13 @@ pub fn render_part(
     while film.passes() < spp {
         let pass = part.first_pass + film.passes();
         let offset = PassContext::shared_offset_of(job.seed, pass);
-        rays += film.add_pass(offset, |filter, sums| {
+        rays += film.add_pass(offset, |filter, samples, sums| {
             let ctx = PassContext {
                 seed: job.seed,
                 pass,
                 filter,
                 shared_offset: splats.then_some(offset),
+                samples,
                 crop,
             };
             integrator.render_pass(scene, &ctx, sums)

@@ -327,6 +327,7 @@ fn gbuffer(scene: &Scene, pass: u32) -> GBuffer {
     let filter = Filter::new(scene.filter);
     let ctx = PassContext {
         shared_offset: None,
+        samples: None,
         seed: 7,
         pass,
         filter: &filter,
@@ -411,6 +412,7 @@ fn restir_pt_shift_across_frames_is_invertible() {
     let filter = Filter::new(s1.filter);
     let ctx = |pass| PassContext {
         shared_offset: None,
+        samples: None,
         seed: 3,
         pass,
         filter: &filter,

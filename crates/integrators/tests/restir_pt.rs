@@ -232,6 +232,7 @@ fn check_shifts(scene: &common::Built, pt: &RestirPtIntegrator) -> ShiftStats {
     for pass in 0..4 {
         let ctx = PassContext {
             shared_offset: None,
+            samples: None,
             seed: 7,
             pass,
             filter: &filter,
@@ -470,6 +471,42 @@ fn edge_rays_unbiased() {
         &reference,
     );
     eprintln!("edge rays where the pass's own ray saw the lamp: max |z| = {z:.2}");
+    assert!(
+        z > Z_MAX,
+        "a mask from the pass's own rays should be biased: {z:.2}"
+    );
+}
+
+/// The same on a splatting film (Mitsuba's default Gaussian): the pixels within the filter's
+/// reach of any pixel whose filter sees the lamp get `edge_rays` times the filter's variance
+/// factor camera rays (32 → 10), all but the G-buffer's through offsets the pass shares, each
+/// splatted from there with its share. Unbiased; the mask from the pass's own rays is caught.
+#[test]
+fn edge_rays_on_a_splatting_film_unbiased() {
+    let scene = build(
+        &scene_text(
+            r#"(geometry: Sphere(center: (0.6, 1.45, 0.4), radius: 0.25), emission: Some((20, 20, 20))),"#,
+        )
+        .replace("filter: Box", "filter: Gaussian(stddev: 0.5)"),
+    );
+    // The extra rays change the image.
+    let one = |rays| render_image(&scene, "restir-pt", &[("edge_rays", rays)], 1, 5);
+    assert_ne!(one("1"), one("32"));
+    let reference = statistics(&scene, "path", &[], 128, 64);
+    for rays in ["1", "32"] {
+        let z = max_z(
+            &statistics(&scene, "restir-pt", &[("edge_rays", rays)], 1, 300),
+            &reference,
+        );
+        eprintln!("splatting, edge_rays = {rays}: max |z| = {z:.2}");
+        assert!(z < Z_MAX, "splatting, edge_rays = {rays}: max |z| = {z:.2}");
+    }
+    let control = [("edge_rays", "32"), ("edge_mask_from_pass", "true")];
+    let z = max_z(
+        &statistics(&scene, "restir-pt", &control, 1, 300),
+        &reference,
+    );
+    eprintln!("splatting, edge rays where the pass's own ray saw the lamp: max |z| = {z:.2}");
     assert!(
         z > Z_MAX,
         "a mask from the pass's own rays should be biased: {z:.2}"

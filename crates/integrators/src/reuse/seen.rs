@@ -22,7 +22,7 @@
 //! no random numbers), never on a pass's samples, so every pixel's estimate stays unbiased and
 //! a split render (chains, tiles) gets the same counts.
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 
 use glam::{Vec2, Vec3};
@@ -31,7 +31,7 @@ use restir_geometry::{Ray, offset_ray_origin};
 use restir_sampling::{Pcg32, luminance};
 use restir_scene::Scene;
 
-use crate::film::Filter;
+use crate::film::{FilmSample, Filter, Reconstruction};
 use crate::pass::PassContext;
 use crate::path::rr_survival;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
@@ -61,6 +61,9 @@ pub struct SeenEmission {
     mask: Mutex<Option<WindowMask>>,
     /// Whether the last pass followed the camera rays through delta lobes (for `--stats`).
     followed_delta: AtomicBool,
+    /// The camera rays of a pixel near emitters on the current mask's splatting film (0: the
+    /// film samples), for `--stats`.
+    splatted_rays: AtomicU32,
 }
 
 /// What a camera ray sees, for the mask, twice: through the delta lobes of the surfaces it
@@ -195,6 +198,27 @@ impl DeltaChains {
     }
 }
 
+/// The largest value within `r` pixels (along each axis) of every pixel of a `w × h` image.
+fn spread_max(v: &[f32], (w, h): (usize, usize), r: usize) -> Vec<f32> {
+    let window = |line: &[f32], i: usize| {
+        line[i.saturating_sub(r)..(i + r + 1).min(line.len())]
+            .iter()
+            .fold(0.0f32, |a, &b| a.max(b))
+    };
+    let rows: Vec<f32> = v
+        .chunks(w)
+        .flat_map(|row| (0..w).map(move |x| window(row, x)))
+        .collect();
+    let mut out = vec![0.0; w * h];
+    for x in 0..w {
+        let column: Vec<f32> = (0..h).map(|y| rows[y * w + x]).collect();
+        for y in 0..h {
+            out[y * w + x] = window(&column, y);
+        }
+    }
+    out
+}
+
 /// How far, in whole pixels, a pixel's filter reaches beyond its own square.
 fn filter_reach(filter: &Filter) -> i32 {
     let radius = match filter {
@@ -212,6 +236,28 @@ impl SeenEmission {
             from_pass,
             mask: Mutex::new(None),
             followed_delta: AtomicBool::new(false),
+            splatted_rays: AtomicU32::new(0),
+        }
+    }
+
+    /// The camera rays of a pixel near emitters on a splatting film (`variance_factor` its
+    /// [`Reconstruction::Splatted`] factor): each of its rays reaches several pixels, so `rays`
+    /// times the factor (rounded, at least 1) gives a pixel about the variance `rays` give a
+    /// sampled film's silhouette pixel.
+    fn splat_rays(&self, variance_factor: f64) -> u32 {
+        (f64::from(self.rays) * variance_factor)
+            .round()
+            .clamp(1.0, f64::from(u16::MAX)) as u32
+    }
+
+    /// The splatting film's [`Self::splat_rays`] for `scene`, `None` when the film samples.
+    fn splat_count(&self, scene: &Scene, ctx: &PassContext) -> Option<u32> {
+        ctx.shared_offset?;
+        match Reconstruction::decide(scene.filter) {
+            Reconstruction::Splatted {
+                variance_factor, ..
+            } => Some(self.splat_rays(variance_factor)),
+            Reconstruction::Sampled => None,
         }
     }
 
@@ -227,6 +273,25 @@ impl SeenEmission {
             .collect();
         let most = on.iter().copied().max().unwrap_or(0);
         let mean = on.iter().map(|&n| f64::from(n)).sum::<f64>() / on.len().max(1) as f64;
+        let splatted = self.splatted_rays.load(Ordering::Relaxed);
+        let delta = if self.followed_delta.load(Ordering::Relaxed) {
+            "; the emission seen through delta lobes (the scene has some) estimated here on every \
+             pixel, the probes following each lobe's first and last choice"
+        } else {
+            ""
+        };
+        if splatted > 0 {
+            return Some(format!(
+                "{} of {} pixels within the splatting filter's reach of a pixel whose filter sees \
+                 an emitter ({:.2} %), {splatted} camera rays each (edge_rays {} times the \
+                 filter's variance factor), all but the G-buffer's through offsets the pass \
+                 shares{delta}",
+                on.len(),
+                w * h,
+                100.0 * on.len() as f64 / f64::from((w * h).max(1)),
+                self.rays,
+            ));
+        }
         Some(
             format!(
                 "{} of {} pixels on emitter silhouettes ({:.2} %), {mean:.1} camera rays each on average \
@@ -237,12 +302,7 @@ impl SeenEmission {
                 100.0 * on.len() as f64 / f64::from((w * h).max(1)),
                 self.rays,
                 self.rays * MAX_RAYS_FACTOR
-            ) + if self.followed_delta.load(Ordering::Relaxed) {
-                "; the emission seen through delta lobes (the scene has some) estimated here on every \
-             pixel, the probes following each lobe's first and last choice"
-            } else {
-                ""
-            },
+            ) + delta,
         )
     }
 
@@ -261,11 +321,15 @@ impl SeenEmission {
     /// film and a border of `reach` pixels (the filter sees past it), so an emitter showing as
     /// a sliver thinner than a pixel between two pixel centres is seen; a pixel's value depends
     /// on its own neighbourhood only. Returns it and the rays traced.
+    ///
+    /// With `any` (a splatting film), a pixel's value is 1 wherever those probes see an area
+    /// emitter at all, edge or not, and 0 elsewhere.
     fn contrast(
         scene: &Scene,
         reach: i32,
         (w, h): (u32, u32),
         chains: Option<&DeltaChains>,
+        any: bool,
     ) -> (Vec<f32>, u64) {
         let (wi, hi) = (w as i32, h as i32);
         let side = |n: i32| 2 * n - 1 + 4 * reach;
@@ -304,7 +368,9 @@ impl SeenEmission {
                         hi = hi.max(l);
                     }
                 }
-                if differs && any_emitter {
+                if any {
+                    f32::from(u8::from(any_emitter))
+                } else if differs && any_emitter {
                     (hi - lo).max(0.0)
                 } else {
                     0.0
@@ -348,9 +414,21 @@ impl SeenEmission {
         {
             return (Arc::clone(mask), 0);
         }
-        let reach = filter_reach(ctx.filter);
+        // A splatting film spreads each ray over the pixels within its reach `R`, and a pixel's
+        // value stays steady only where all the rays it gathers went through the same offsets:
+        // so every pixel whose filter (`R + 1` whole pixels) sees an emitter at all, and the `R`
+        // pixels around it, get the same count (below), and what lies beyond sees no emitter.
+        let splat = self.splat_count(scene, ctx);
+        self.splatted_rays
+            .store(splat.unwrap_or(0), Ordering::Relaxed);
+        let splat_reach = splat.map(|_| Reconstruction::decide(scene.filter).reach() as i32);
+        let reach = splat_reach.map_or_else(|| filter_reach(ctx.filter), |r| r + 1);
         let (fw, fh) = scene.camera.resolution();
-        let (film, rays) = Self::contrast(scene, reach, (fw, fh), chains);
+        let (film, rays) = Self::contrast(scene, reach, (fw, fh), chains, splat.is_some());
+        let film = match splat_reach {
+            Some(r) if r > 0 => spread_max(&film, (fw as usize, fh as usize), r as usize),
+            _ => film,
+        };
         let mean = Self::mean_contrast(&film);
         // A pixel's contrast depends on its own neighbourhood only: a window takes the film's
         // values (none beyond the film).
@@ -370,6 +448,10 @@ impl SeenEmission {
                     if c <= 0.0 || mean <= 0.0 {
                         return 0;
                     }
+                    if let Some(n) = splat {
+                        // One count: the pixels' rays then share their offsets (`supersample`).
+                        return n as u16;
+                    }
                     let n = (f64::from(self.rays) * f64::from(c) / mean).round();
                     n.clamp(1.0, most) as u16
                 })
@@ -385,11 +467,22 @@ impl SeenEmission {
     /// nothing else yet) by the mean over this many camera rays on the silhouette pixels, and,
     /// with `chains`, adds on every pixel the emission its camera rays see through delta lobes
     /// (the G-buffer's ray continued from its hit `gbuf`, and each extra ray's). Returns the
-    /// rays traced. When the film splats every camera ray of the pass goes through the pass's
-    /// shared offset in its pixel, so more rays would repeat the G-buffer's (and the splatting
-    /// already averages each pixel over its neighbours' rays): there a silhouette pixel gets no
-    /// more camera rays, and only the delta lobes' continuations of the G-buffer's ray are drawn
-    /// as many times as the mask says.
+    /// rays traced.
+    ///
+    /// When the film splats, every G-buffer ray of the pass goes through the pass's shared
+    /// offset in its pixel, and each ray reaches several pixels. The mask is then every pixel
+    /// within the filter's reach of a pixel whose filter sees an area emitter, each with
+    /// `edge_rays` times the filter's variance factor camera rays (rounded; for the Gaussian of
+    /// σ = 0.5, 32 → 10 and 4 → 1), so that a pixel there has about the variance `edge_rays`
+    /// give a sampled film's. The G-buffer ray keeps its share of the seen emission in
+    /// `radiance`; every other ray goes through one of the offsets the pass shares (a lattice
+    /// shifted by the pass's offset: each uniform, and together they keep the filter weights a
+    /// pixel gathers summing to about the same, as the shared offset does) and is put in
+    /// `ctx.samples` with its share, to be splatted from there
+    /// ([`crate::film::FilmSample`]). Beyond the mask no pixel's filter sees an emitter, so
+    /// pixels with one ray and pixels with several never mix where the emission is not zero.
+    /// Without `ctx.samples`, or with one ray, no camera ray is added, and only the delta
+    /// lobes' continuations of the G-buffer's ray are drawn as many times as the mask says.
     pub fn supersample(
         &self,
         scene: &Scene,
@@ -401,7 +494,13 @@ impl SeenEmission {
         self.followed_delta
             .store(chains.is_some(), Ordering::Relaxed);
         let splatted = ctx.shared_offset.is_some();
-        if splatted && chains.is_none() {
+        // Splatting, more camera rays go through offsets of their own, which the film must take
+        // ([`PassContext::samples`]); without them (or where one ray gives a pixel the variance
+        // `rays` give a sampled film's) only what lies behind the G-buffer ray's delta lobes is
+        // drawn again.
+        let splat = self.splat_count(scene, ctx).unwrap_or(1);
+        let own_offsets = splatted && splat > 1 && ctx.samples.is_some();
+        if splatted && !own_offsets && chains.is_none() {
             return 0;
         }
         let (mask, mut rays) = if self.from_pass {
@@ -415,7 +514,22 @@ impl SeenEmission {
         };
         let (w, _) = ctx.resolution(scene);
         let lights = &scene.lights;
-        rays += radiance
+        let (crop_x, crop_y) = ctx
+            .crop
+            .as_ref()
+            .map_or((0, 0), |c| (c.region.x0, c.region.y0));
+        // Splatting, the extra rays of every pixel go through the same offsets within their
+        // pixels, a lattice shifted by the pass's shared offset (each offset uniform), so that
+        // the weights a pixel gathers from its neighbours' rays sum about the same at each.
+        let shared = ctx.shared_offset.unwrap_or(Vec2::ZERO);
+        let offsets: Vec<Vec2> = (0..splat)
+            .map(|j| {
+                let step = Vec2::new(j as f32 / splat as f32, (j as f32 * 0.618_034).fract());
+                let u = shared + step;
+                (u - u.floor()).min(Vec2::splat(restir_sampling::ONE_MINUS_EPSILON))
+            })
+            .collect();
+        let samples = radiance
             .par_iter_mut()
             .enumerate()
             .filter(|(i, _)| mask[*i] > 1 || chains.is_some())
@@ -433,7 +547,8 @@ impl SeenEmission {
                 };
                 let first = *l + behind(&mut rng, &mut rays);
                 let n = u32::from(mask[i]).max(1);
-                if splatted {
+                let mut own = Vec::new();
+                if splatted && !own_offsets {
                     // The same camera ray: only what lies behind delta lobes differs.
                     let mut sum = first;
                     if receiver.is_some() {
@@ -444,33 +559,64 @@ impl SeenEmission {
                     } else {
                         *l = sum;
                     }
-                    return rays;
+                    return (rays, own);
                 }
                 let (x, y) = ((i % w as usize) as u32, (i / w as usize) as u32);
+                // Splatting, the G-buffer's ray keeps its share of the pixel's seen emission at
+                // the shared offset, and each other ray goes through another offset of the pass,
+                // with its share, to be splatted from there.
+                if own_offsets {
+                    *l = first / n as f32;
+                }
                 let mut sum = first;
-                for _ in 1..n {
-                    let film = ctx.film_position(x, y, &mut rng);
-                    let ray = scene.camera.generate_ray(film, rng.next_2d());
-                    let (hit, n) = scene.camera_intersect(&ray, false);
-                    rays += n;
-                    let Some(si) = hit else {
-                        sum += lights.environment_radiance(ray.d);
-                        continue;
+                for j in 1..n {
+                    let (film, offset) = if own_offsets {
+                        let offset = offsets[(j as usize).min(offsets.len() - 1)];
+                        let corner = Vec2::new((x + crop_x) as f32, (y + crop_y) as f32);
+                        (corner + offset, Some(offset))
+                    } else {
+                        (ctx.film_position(x, y, &mut rng), None)
                     };
-                    if let Some(light) = lights.light_on_shape(si.shape) {
-                        sum += lights.area_radiance(light, si.shading.n, -ray.d);
+                    let before = sum;
+                    let ray = scene.camera.generate_ray(film, rng.next_2d());
+                    let (hit, traced) = scene.camera_intersect(&ray, false);
+                    rays += traced;
+                    match hit {
+                        None => sum += lights.environment_radiance(ray.d),
+                        Some(si) => {
+                            if let Some(light) = lights.light_on_shape(si.shape) {
+                                sum += lights.area_radiance(light, si.shading.n, -ray.d);
+                            }
+                            if let Some(c) = chains {
+                                let r = Receiver::at_hit(scene, &si, -ray.d, si.t);
+                                let (le, traced) = c.follow(scene, &r, si.ng, &mut rng);
+                                sum += le;
+                                rays += traced;
+                            }
+                        }
                     }
-                    if let Some(c) = chains {
-                        let r = Receiver::at_hit(scene, &si, -ray.d, si.t);
-                        let (le, n) = c.follow(scene, &r, si.ng, &mut rng);
-                        sum += le;
-                        rays += n;
+                    if let Some(offset) = offset {
+                        own.push(FilmSample {
+                            pixel: i as u32,
+                            offset,
+                            value: (sum - before) / n as f32,
+                        });
                     }
                 }
-                *l = sum / n as f32;
-                rays
+                if !own_offsets {
+                    *l = sum / n as f32;
+                }
+                (rays, own)
             })
-            .sum::<u64>();
+            .collect::<Vec<_>>();
+        let mut own = Vec::new();
+        for (n, s) in samples {
+            rays += n;
+            own.extend(s);
+        }
+        if let Some(sink) = ctx.samples.filter(|_| !own.is_empty()) {
+            sink.add(own);
+        }
         rays
     }
 }
