@@ -309,27 +309,37 @@ impl Splat {
     fn scatter(&self, samples: &[FilmSample], out: &mut [DVec3]) {
         let (w, h) = (self.inv_norm_x.len(), self.inv_norm_y.len());
         let r = self.reach;
+        // The samples of each row of the pass (they come by pixel).
+        let mut starts = vec![0usize; h + 1];
         for s in samples {
-            let (qx, qy) = (s.pixel as usize % w, s.pixel as usize / w);
-            if qy >= h {
-                continue;
+            let y = (s.pixel as usize / w).min(h);
+            if y < h {
+                starts[y + 1] += 1;
             }
-            let value = s.value.as_dvec3();
-            // Pixel `p` weighs the ray `q − p + u − ½` from its centre.
-            let weight = |q: usize, p: usize, u: f32| {
-                profile(self.filter, q as f64 - p as f64 + f64::from(u) - 0.5)
-            };
-            for y in qy.saturating_sub(r)..(qy + r + 1).min(h) {
+        }
+        for y in 0..h {
+            starts[y + 1] += starts[y];
+        }
+        // Pixel `p` weighs the ray `q − p + u − ½` from its centre.
+        let weight = |q: usize, p: usize, u: f32| {
+            profile(self.filter, q as f64 - p as f64 + f64::from(u) - 0.5)
+        };
+        // Each row of `out` adds the samples of the rows within reach, in their order, so the
+        // sums are the same for any thread count.
+        out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            let rows = y.saturating_sub(r)..(y + r + 1).min(h);
+            for s in &samples[starts[rows.start]..starts[rows.end]] {
+                let (qx, qy) = (s.pixel as usize % w, s.pixel as usize / w);
                 let wy = weight(qy, y, s.offset.y) * self.inv_norm_y[y];
                 if wy == 0.0 {
                     continue;
                 }
+                let value = s.value.as_dvec3() * wy;
                 for x in qx.saturating_sub(r)..(qx + r + 1).min(w) {
-                    let wx = weight(qx, x, s.offset.x) * self.inv_norm_x[x];
-                    out[y * w + x] += value * (wx * wy);
+                    row[x] += value * (weight(qx, x, s.offset.x) * self.inv_norm_x[x]);
                 }
             }
-        }
+        });
     }
 
     /// Adds the pass's pixel values, made from its estimates (in `self.pass`) whose rays went
