@@ -102,23 +102,30 @@ fn settings_statistics_spp(
     spp: u32,
     seeds: u64,
 ) -> Vec<(f64, f64)> {
-    let render_one = |seed| {
-        let integrator = RestirDiIntegrator::new(settings);
-        let job = RenderJob {
-            spp,
-            seed,
-            ..RenderJob::default()
-        };
-        render(
-            scene,
-            &integrator,
-            &job,
-            &AtomicBool::new(false),
-            &mut |_, _| {},
-        )
-        .image
-    };
+    let render_one = |seed| render_with(scene, &RestirDiIntegrator::new(settings), spp, seed);
     block_statistics(render_one, seeds, seed_base(), BLOCK)
+}
+
+/// One render of `scene` by `integrator`: `spp` passes from `seed`.
+fn render_with(
+    scene: &common::Built,
+    integrator: &RestirDiIntegrator,
+    spp: u32,
+    seed: u64,
+) -> restir_integrators::Image {
+    let job = RenderJob {
+        spp,
+        seed,
+        ..RenderJob::default()
+    };
+    render(
+        scene,
+        integrator,
+        &job,
+        &AtomicBool::new(false),
+        &mut |_, _| {},
+    )
+    .image
 }
 
 fn direct_reference(scene: &common::Built) -> Vec<(f64, f64)> {
@@ -607,17 +614,7 @@ fn tiles_description(scene: &common::Built) -> String {
     ));
     settings.light_sampler = LightSampler::Tiles;
     let integrator = RestirDiIntegrator::new(settings);
-    let job = RenderJob {
-        spp: 1,
-        ..RenderJob::default()
-    };
-    render(
-        scene,
-        &integrator,
-        &job,
-        &AtomicBool::new(false),
-        &mut |_, _| {},
-    );
+    render_with(scene, &integrator, 1, 0);
     integrator.light_cuts().expect("tiles describe their cuts")
 }
 
