@@ -335,8 +335,13 @@ impl Splat {
                     continue;
                 }
                 let value = s.value.as_dvec3() * wy;
-                for x in qx.saturating_sub(r)..(qx + r + 1).min(w) {
-                    row[x] += value * (weight(qx, x, s.offset.x) * self.inv_norm_x[x]);
+                let first = qx.saturating_sub(r);
+                let span = first..(qx + r + 1).min(w);
+                for (x, (v, inv)) in span
+                    .clone()
+                    .zip(row[span.clone()].iter_mut().zip(&self.inv_norm_x[span]))
+                {
+                    *v += value * (weight(qx, x, s.offset.x) * inv);
                 }
             }
         });
