@@ -12,7 +12,7 @@ use std::sync::atomic::AtomicBool;
 
 use glam::{DVec3, Vec3};
 use restir_integrators::{
-    Image, Integrator, PassContext, PixelWindow, RenderJob, RenderPart, render, render_part,
+    Image, Integrator, PassContext, PixelWindow, RenderJob, RenderPart, render_part,
 };
 use restir_scene::Scene;
 use restir_testkit::{block_means, block_statistics, max_z};
@@ -97,19 +97,7 @@ fn part(
 }
 
 fn whole(scene: &Scene, integrator: &dyn Integrator, seed: u64, spp: u32) -> Image {
-    let job = RenderJob {
-        spp,
-        seed,
-        ..RenderJob::default()
-    };
-    render(
-        scene,
-        integrator,
-        &job,
-        &AtomicBool::new(false),
-        &mut |_, _| {},
-    )
-    .image
+    common::render_with(scene, integrator, spp, seed)
 }
 
 /// `Σ nᵢ·imageᵢ / Σ nᵢ` in f64, what `restir merge` computes for chains.

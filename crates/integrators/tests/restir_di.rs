@@ -8,13 +8,10 @@
 //! its negative controls (the candidates weighted by the power table's pmf) fail it, and so does ReSTIR DI at
 //! its defaults on this scene of one dominant light, where `auto` takes the path tracer.
 
-use std::sync::atomic::AtomicBool;
-
 use restir_integrators::restir_di::{BsdfDiffuse, BsdfSamples, Learn, LightSampler, Visibility};
 use restir_integrators::reuse::MIS_NAMES;
 use restir_integrators::{
-    Integrator, IntegratorOptions, RenderJob, RestirDiIntegrator, RestirDiSettings,
-    make_integrator, render,
+    Integrator, IntegratorOptions, RestirDiIntegrator, RestirDiSettings, make_integrator,
 };
 use restir_scene::parse_ron;
 
@@ -102,30 +99,9 @@ fn settings_statistics_spp(
     spp: u32,
     seeds: u64,
 ) -> Vec<(f64, f64)> {
-    let render_one = |seed| render_with(scene, &RestirDiIntegrator::new(settings), spp, seed);
+    let render_one =
+        |seed| common::render_with(scene, &RestirDiIntegrator::new(settings), spp, seed);
     block_statistics(render_one, seeds, seed_base(), BLOCK)
-}
-
-/// One render of `scene` by `integrator`: `spp` passes from `seed`.
-fn render_with(
-    scene: &common::Built,
-    integrator: &RestirDiIntegrator,
-    spp: u32,
-    seed: u64,
-) -> restir_integrators::Image {
-    let job = RenderJob {
-        spp,
-        seed,
-        ..RenderJob::default()
-    };
-    render(
-        scene,
-        integrator,
-        &job,
-        &AtomicBool::new(false),
-        &mut |_, _| {},
-    )
-    .image
 }
 
 fn direct_reference(scene: &common::Built) -> Vec<(f64, f64)> {
@@ -614,7 +590,7 @@ fn tiles_description(scene: &common::Built) -> String {
     ));
     settings.light_sampler = LightSampler::Tiles;
     let integrator = RestirDiIntegrator::new(settings);
-    render_with(scene, &integrator, 1, 0);
+    common::render_with(scene, &integrator, 1, 0);
     integrator.light_cuts().expect("tiles describe their cuts")
 }
 
