@@ -300,8 +300,9 @@ impl TileRegions {
         Self { on_light, rest }
     }
 
-    /// The region (0: the one on a light, 1: the rest) and cut that hold a receiver at `q`
-    /// with normal `n` on light `on`, if one does.
+    /// The region that holds a receiver at `q` with normal `n` on light `on`, if one does, as
+    /// its pools' stream key (2: the one on a light, 0: the rest, whose key a tile without a
+    /// light in view has always had) with its cut.
     fn holding(&self, q: Vec3, n: Vec3, on: Option<u32>) -> Option<(u64, &LightCut)> {
         [&self.on_light, &self.rest]
             .into_iter()

@@ -522,98 +522,103 @@ impl SeenEmission {
         // pixels, a lattice shifted by the pass's shared offset (each offset uniform), so that
         // the weights a pixel gathers from its neighbours' rays sum about the same at each.
         let shared = ctx.shared_offset.unwrap_or(Vec2::ZERO);
-        let offsets: Vec<Vec2> = (0..splat)
+        let offsets: Vec<Vec2> = (0..if own_offsets { splat } else { 0 })
             .map(|j| {
                 let step = Vec2::new(j as f32 / splat as f32, (j as f32 * 0.618_034).fract());
                 let u = shared + step;
                 (u - u.floor()).min(Vec2::splat(restir_sampling::ONE_MINUS_EPSILON))
             })
             .collect();
-        let samples = radiance
+        // Per worker, the rays traced and the samples through offsets of their own (the film
+        // orders them by pixel).
+        let (traced, own) = radiance
             .par_iter_mut()
             .enumerate()
             .filter(|(i, _)| mask[*i] > 1 || chains.is_some())
-            .map(|(i, l)| {
-                let mut rng = ctx.stage_rng(i, STAGE_SEEN);
-                let mut rays = 0;
-                // The G-buffer's ray: its seen emission, and behind its hit's delta lobes.
-                let receiver = chains.and_then(|c| Some((c, gbuf.receiver(i)?, gbuf.ng[i])));
-                let behind = |rng: &mut Pcg32, rays: &mut u64| {
-                    receiver.map_or(Vec3::ZERO, |(c, r, ng)| {
-                        let (le, n) = c.follow(scene, r, ng, rng);
-                        *rays += n;
-                        le
-                    })
-                };
-                let first = *l + behind(&mut rng, &mut rays);
-                let n = u32::from(mask[i]).max(1);
-                let mut own = Vec::new();
-                if splatted && !own_offsets {
-                    // The same camera ray: only what lies behind delta lobes differs.
-                    let mut sum = first;
-                    if receiver.is_some() {
-                        for _ in 1..n {
-                            sum += *l + behind(&mut rng, &mut rays);
-                        }
-                        *l = sum / n as f32;
-                    } else {
-                        *l = sum;
-                    }
-                    return (rays, own);
-                }
-                let (x, y) = ((i % w as usize) as u32, (i / w as usize) as u32);
-                // Splatting, the G-buffer's ray keeps its share of the pixel's seen emission at
-                // the shared offset, and each other ray goes through another offset of the pass,
-                // with its share, to be splatted from there.
-                if own_offsets {
-                    *l = first / n as f32;
-                }
-                let mut sum = first;
-                for j in 1..n {
-                    let (film, offset) = if own_offsets {
-                        let offset = offsets[(j as usize).min(offsets.len() - 1)];
-                        let corner = Vec2::new((x + crop_x) as f32, (y + crop_y) as f32);
-                        (corner + offset, Some(offset))
-                    } else {
-                        (ctx.film_position(x, y, &mut rng), None)
+            .fold(
+                || (0u64, Vec::new()),
+                |(mut rays, mut own), (i, l)| {
+                    let mut rng = ctx.stage_rng(i, STAGE_SEEN);
+                    // The G-buffer's ray: its seen emission, and behind its hit's delta lobes.
+                    let receiver = chains.and_then(|c| Some((c, gbuf.receiver(i)?, gbuf.ng[i])));
+                    let behind = |rng: &mut Pcg32, rays: &mut u64| {
+                        receiver.map_or(Vec3::ZERO, |(c, r, ng)| {
+                            let (le, n) = c.follow(scene, r, ng, rng);
+                            *rays += n;
+                            le
+                        })
                     };
-                    let before = sum;
-                    let ray = scene.camera.generate_ray(film, rng.next_2d());
-                    let (hit, traced) = scene.camera_intersect(&ray, false);
-                    rays += traced;
-                    match hit {
-                        None => sum += lights.environment_radiance(ray.d),
-                        Some(si) => {
-                            if let Some(light) = lights.light_on_shape(si.shape) {
-                                sum += lights.area_radiance(light, si.shading.n, -ray.d);
+                    let first = *l + behind(&mut rng, &mut rays);
+                    let n = u32::from(mask[i]).max(1);
+                    if splatted && !own_offsets {
+                        // The same camera ray: only what lies behind delta lobes differs.
+                        let mut sum = first;
+                        if receiver.is_some() {
+                            for _ in 1..n {
+                                sum += *l + behind(&mut rng, &mut rays);
                             }
-                            if let Some(c) = chains {
-                                let r = Receiver::at_hit(scene, &si, -ray.d, si.t);
-                                let (le, traced) = c.follow(scene, &r, si.ng, &mut rng);
-                                sum += le;
-                                rays += traced;
+                            *l = sum / n as f32;
+                        } else {
+                            *l = sum;
+                        }
+                        return (rays, own);
+                    }
+                    let (x, y) = ((i % w as usize) as u32, (i / w as usize) as u32);
+                    // Splatting, the G-buffer's ray keeps its share of the pixel's seen emission at
+                    // the shared offset, and each other ray goes through another offset of the pass,
+                    // with its share, to be splatted from there.
+                    if own_offsets {
+                        *l = first / n as f32;
+                    }
+                    let mut sum = first;
+                    for j in 1..n {
+                        let (film, offset) = if own_offsets {
+                            let offset = offsets[(j as usize).min(offsets.len() - 1)];
+                            let corner = Vec2::new((x + crop_x) as f32, (y + crop_y) as f32);
+                            (corner + offset, Some(offset))
+                        } else {
+                            (ctx.film_position(x, y, &mut rng), None)
+                        };
+                        let before = sum;
+                        let ray = scene.camera.generate_ray(film, rng.next_2d());
+                        let (hit, traced) = scene.camera_intersect(&ray, false);
+                        rays += traced;
+                        match hit {
+                            None => sum += lights.environment_radiance(ray.d),
+                            Some(si) => {
+                                if let Some(light) = lights.light_on_shape(si.shape) {
+                                    sum += lights.area_radiance(light, si.shading.n, -ray.d);
+                                }
+                                if let Some(c) = chains {
+                                    let r = Receiver::at_hit(scene, &si, -ray.d, si.t);
+                                    let (le, traced) = c.follow(scene, &r, si.ng, &mut rng);
+                                    sum += le;
+                                    rays += traced;
+                                }
                             }
                         }
+                        if let Some(offset) = offset {
+                            own.push(FilmSample {
+                                pixel: i as u32,
+                                offset,
+                                value: (sum - before) / n as f32,
+                            });
+                        }
                     }
-                    if let Some(offset) = offset {
-                        own.push(FilmSample {
-                            pixel: i as u32,
-                            offset,
-                            value: (sum - before) / n as f32,
-                        });
+                    if !own_offsets {
+                        *l = sum / n as f32;
                     }
-                }
-                if !own_offsets {
-                    *l = sum / n as f32;
-                }
-                (rays, own)
-            })
-            .collect::<Vec<_>>();
-        let mut own = Vec::new();
-        for (n, s) in samples {
-            rays += n;
-            own.extend(s);
-        }
+                    (rays, own)
+                },
+            )
+            .reduce(
+                || (0, Vec::new()),
+                |(a, mut x), (b, y)| {
+                    x.extend(y);
+                    (a + b, x)
+                },
+            );
+        rays += traced;
         if let Some(sink) = ctx.samples.filter(|_| !own.is_empty()) {
             sink.add(own);
         }
