@@ -234,10 +234,11 @@ pub fn make_integrator(
         ));
     }
     let (integrator, unused_params): (Box<dyn Integrator>, _) = match name {
-        "path" => (
-            Box::new(PathIntegrator { settings }),
-            params.iter().cloned().collect(),
-        ),
+        "path" => {
+            let mut settings = settings;
+            let unused = params.apply(|key, p| settings.apply_one(key, p))?;
+            (Box::new(PathIntegrator { settings }), unused)
+        }
         "restir-di" => {
             let mut s = RestirDiSettings::new(settings);
             let unused = s.apply(&params)?;

@@ -7,11 +7,13 @@
 
 use glam::{DVec3, Vec2, Vec3};
 use restir_geometry::{Ray, offset_ray_origin};
+use restir_lights::{LightSet, NeeSelection};
 use restir_sampling::Sampler;
 use restir_sampling::warp::{power_heuristic, power_share};
 use restir_scene::{IntegratorDesc, SamplerKind, Scene};
 
 use crate::bands::Bands;
+use crate::params::{Param, ParamError};
 use crate::pass::{Integrator, PassContext};
 use crate::shadow::{ShadowTarget, visible};
 
@@ -26,6 +28,9 @@ pub struct PathSettings {
     pub hide_emitters: bool,
     /// Where the path tracer's numbers come from (ReSTIR DI and PT draw independent ones).
     pub sampler: SamplerKind,
+    /// How next-event estimation picks its light (the path tracer's and ReSTIR PT's walks;
+    /// `--light-sampler`).
+    pub nee: NeeSelection,
 }
 
 impl PathSettings {
@@ -36,6 +41,19 @@ impl PathSettings {
             rr_depth: desc.rr_depth.max(1),
             hide_emitters: desc.hide_emitters,
             sampler: desc.sampler,
+            nee: NeeSelection::Power,
+        }
+    }
+
+    /// One parameter of the path tracer's (`light_sampler`: next-event estimation's light
+    /// selection); whether `key` is one.
+    pub fn apply_one(&mut self, key: &str, p: &Param) -> Result<bool, ParamError> {
+        match key {
+            "light_sampler" => {
+                self.nee = p.choice(NeeSelection::NAMES, "power or bvh")?;
+                Ok(true)
+            }
+            _ => Ok(false),
         }
     }
 
@@ -48,7 +66,10 @@ impl PathSettings {
 
 /// Random numbers each bounce consumes, whatever happens at it: light selection (1), point on the
 /// light (2), BSDF lobe (1), BSDF direction (2), Russian roulette (1). A fixed budget keeps the
-/// numbers of bounce `k` at a known offset in the stream, so paths can be replayed.
+/// numbers of bounce `k` at a known offset in the stream, so paths can be replayed. The light
+/// hierarchy's descent takes the low bits of its selection number from the roulette's number
+/// ([`LightSet::sample_nee`]): the two decisions are correlated, each alone uniform, so every
+/// term keeps its expectation.
 pub const RANDOMS_PER_BOUNCE: usize = 7;
 
 /// The state a path carries from a surface to the next one, enough to weight an emitter the
@@ -57,6 +78,8 @@ pub const RANDOMS_PER_BOUNCE: usize = 7;
 pub struct PrevVertex {
     /// Position of the scattering vertex.
     pub p: Vec3,
+    /// Its shading normal, as next-event estimation there saw it ([`LightSet::pdf_nee`]).
+    pub n: Vec3,
     /// Solid-angle pdf of the sampled direction.
     pub pdf_sa: f32,
     /// Whether the sampled lobe was a delta lobe (no light sampling could have produced it).
@@ -84,6 +107,26 @@ pub enum EmissionMis {
 }
 
 impl PrevVertex {
+    /// The density with which light sampling at this vertex would have produced the point `p`
+    /// (normal `n`) of `light`'s primitive `prim`: next-event estimation's selection `nee` for
+    /// [`EmissionMis::Power`], the power sampler's for [`EmissionMis::Counted`] (ReSTIR DI's
+    /// light strategy weighs by it, whatever drew its candidates).
+    #[inline]
+    pub fn light_pdf(
+        &self,
+        lights: &LightSet,
+        nee: NeeSelection,
+        light: (u32, u32),
+        p: Vec3,
+        n: Vec3,
+    ) -> f32 {
+        let how = match self.mis {
+            EmissionMis::Power => nee,
+            EmissionMis::Counted { .. } => NeeSelection::Power,
+        };
+        lights.pdf_nee(how, light, self.p, self.n, p, n)
+    }
+
     /// The weight of emission reached from this vertex, whose light-sampling density (solid
     /// angle, selection included) is `light_pdf_sa`. Emission behind a delta lobe gets 1.
     #[inline]
@@ -159,7 +202,8 @@ pub fn trace_path<S: Sampler>(
                         let env = lights
                             .environment()
                             .expect("feature summary says there is one");
-                        let em_pdf = lights.pdf_sa(env, pv.p, pv.p + ray.d, -ray.d);
+                        let em_pdf =
+                            pv.light_pdf(lights, settings.nee, (env, 0), pv.p + ray.d, -ray.d);
                         pv.emission_weight(em_pdf)
                     }
                     _ => 1.0,
@@ -177,7 +221,8 @@ pub fn trace_path<S: Sampler>(
             if le != Vec3::ZERO {
                 let w = match prev {
                     Some(pv) if !pv.delta => {
-                        let em_pdf = lights.pdf_sa(light, pv.p, si.p, si.ng);
+                        let em_pdf =
+                            pv.light_pdf(lights, settings.nee, (light, si.prim), si.p, si.ng);
                         pv.emission_weight(em_pdf)
                     }
                     _ => 1.0,
@@ -202,7 +247,8 @@ pub fn trace_path<S: Sampler>(
 
         // Next-event estimation.
         if bsdf.has_smooth_lobe()
-            && let Some(ls) = lights.sample(si.p, u_select, u_light)
+            && let Some(ls) =
+                lights.sample_nee(settings.nee, si.p, si.shading.n, (u_select, u_rr), u_light)
         {
             let wi = si.shading.to_local(ls.wi);
             let f = bsdf.eval(wo, wi);
@@ -228,6 +274,7 @@ pub fn trace_path<S: Sampler>(
         let d = si.shading.to_world(bs.wi);
         prev = Some(PrevVertex {
             p: si.p,
+            n: si.shading.n,
             pdf_sa: bs.pdf_sa,
             delta: bs.lobe.is_delta(),
             mis: EmissionMis::Power,
@@ -277,10 +324,11 @@ impl Integrator for PathIntegrator {
 
     fn describe(&self) -> String {
         format!(
-            "path max_depth={} rr_depth={} sampler={}",
+            "path max_depth={} rr_depth={} sampler={} light_sampler={}",
             self.settings.max_depth,
             self.settings.rr_depth,
-            self.settings.sampler.name()
+            self.settings.sampler.name(),
+            self.settings.nee.name()
         )
     }
 

@@ -406,6 +406,7 @@ fn restir_pt_shift_across_frames_is_invertible() {
         rr_depth: 5,
         hide_emitters: false,
         sampler: restir_scene::SamplerKind::Independent,
+        nee: restir_lights::NeeSelection::Power,
     }));
     let motion = FrameMotion::new(s0.clone(), &s1, desc.animation.as_ref().unwrap(), T0, T1);
     assert!(!motion.scene_is_still());

@@ -161,6 +161,7 @@ fn integrator(max_depth: i32) -> RestirPtIntegrator {
         rr_depth: 3,
         hide_emitters: false,
         sampler: restir_scene::SamplerKind::Independent,
+        nee: restir_lights::NeeSelection::Power,
     }))
 }
 

@@ -6,6 +6,7 @@
 //! | `light.rs` | [`Light`] (diffuse area lights on shapes, one-sided as in Mitsuba; point, spot ([`Spot`]), projector ([`Projector`]), directional, constant and image environment lights, [`EnvMap`] being Mitsuba's `envmap`), [`LightSample`] (a point on one light drawn for a receiver, [`LightSet::sample_light`]) and the densities of points reached another way ([`LightSet::pdf_sa`]) |
 //! | `set.rs` | [`LightSet`]: every light of a scene with the shapes area lights lie on (emitters know their shapes, as in Mitsuba 3's scene, so no caller hands the shape list around), each light's power, the environment's share of selections |
 //! | `select.rs` | which light: the power sampler ([`LightSet::sample`], [`LightSet::select`], [`LightSet::pmf`]) over one flat emitter table (`table.rs`: every emissive triangle, every other light), and the light hierarchy over the same entries (`bvh.rs`: [`LightSet::sample_hierarchy`], [`LightSet::hierarchy_pmf`]) |
+//! | `nee.rs` | next-event estimation's light selection ([`NeeSelection`]: by power or by the hierarchy; [`LightSet::sample_nee`], [`LightSet::pdf_nee`]), for the path tracer and ReSTIR PT's walks |
 //! | `cut.rs` | the hierarchy cut once for a region of receivers ([`LightCut`], [`LightSet::light_cut`]): a node by an alias table over the cut, an emitter of it by power, with the exact probability of any entry ([`LightSet::cut_pmf`]) |
 //! | `point.rs` | a light sample named without its receiver ([`LightPoint`], what a reservoir holds), resolved in world space ([`LightSet::resolve`], [`Resolved`]) and seen from a receiver ([`Contact`]) |
 //! | `learned.rs` | a selection learned across passes: per cell of a world-space grid, what each emitter (a triangle, another light, the environment) delivered after its shadow ray ([`LightRecords`]), sampled in a mixture with the power sampler with its exact probability ([`LearnedSampler`]) |
@@ -50,6 +51,7 @@ mod cut;
 mod envmap;
 mod learned;
 mod light;
+mod nee;
 mod own;
 mod point;
 mod presample;
@@ -65,6 +67,7 @@ pub use cut::{Claim, LightCut};
 pub use envmap::{EnvMap, EnvMapError};
 pub use learned::{CellKey, EmitterGroups, LearnGrid, LearnedDraw, LearnedSampler, LightRecords};
 pub use light::{Light, LightSample};
+pub use nee::NeeSelection;
 pub use own::{OWN_LIGHT_SHARE, OwnLight};
 pub use point::{LightPoint, Resolved};
 pub use presample::Presampled;

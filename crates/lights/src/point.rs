@@ -15,7 +15,7 @@ use glam::{Vec2, Vec3};
 use restir_geometry::SurfaceInteraction;
 
 use crate::contact::{Contact, nonzero, point_contact};
-use crate::{Light, LightSample, LightSet, Projector, Spot};
+use crate::{Light, LightSample, LightSet, NeeSelection, Projector, Spot};
 
 /// A ReSTIR DI sample: 16 bytes.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -160,23 +160,25 @@ impl LightSet {
         }
     }
 
-    /// The light point a ray from `p` in unit direction `d` reaches: the emitter of `hit`, or
-    /// the environment when it is `None` (a miss). Returns the point, its radiance towards `p`
-    /// and [`LightSet::sample`]'s density of it from `p` (solid angle, the selection included);
+    /// The light point a ray from `p` (shading normal `n`) in unit direction `d` reaches: the
+    /// emitter of `hit`, or the environment when it is `None` (a miss). Returns the point, its
+    /// radiance towards `p` and the density with which next-event estimation by `how` at `p`
+    /// samples it ([`LightSet::pdf_nee`]: solid angle, the selection included);
     /// `None` when no light is there (a surface that is no light, the back of a one-sided
     /// emitter, a miss in a scene without an environment). An environment's radiance may be
     /// zero in direction `d`.
     #[inline]
     pub fn reached(
         &self,
-        p: Vec3,
+        how: NeeSelection,
+        (p, n): (Vec3, Vec3),
         d: Vec3,
         hit: Option<&SurfaceInteraction>,
     ) -> Option<(LightPoint, Vec3, f32)> {
         match hit {
             None => self.environment().map(|env| {
                 let le = self.environment_radiance(d);
-                let pdf = self.pdf_sa(env, p, p + d, -d);
+                let pdf = self.pdf_nee(how, (env, 0), p, n, p + d, -d);
                 (
                     LightPoint::environment(env, self.environment_param(d)),
                     le,
@@ -186,7 +188,7 @@ impl LightSet {
             Some(si) => self.light_on_shape(si.shape).and_then(|light| {
                 let le = self.area_radiance(light, si.shading.n, -d);
                 (le != Vec3::ZERO).then(|| {
-                    let pdf = self.pdf_sa(light, p, si.p, si.ng);
+                    let pdf = self.pdf_nee(how, (light, si.prim), p, n, si.p, si.ng);
                     let y = LightPoint {
                         light,
                         prim: si.prim,

@@ -24,7 +24,7 @@
 
 use glam::{Affine3A, Quat, Vec3};
 use restir_geometry::{Shape, Sphere};
-use restir_lights::{Light, LightSet};
+use restir_lights::{Light, LightSet, NeeSelection};
 use restir_sampling::Pcg32;
 use restir_testkit::{Histogram, sidak_level};
 
@@ -192,6 +192,44 @@ fn sample_densities_agree() {
             checked += 1;
         }
         assert!(checked > 1000, "{checked}");
+    }
+}
+
+/// Next-event estimation's samples (`LightSet::sample_nee`) carry the density `pdf_nee`
+/// reports for the same point, by power and by the hierarchy, for triangles and spheres; the
+/// two differ (the hierarchy decides by distance and orientation).
+#[test]
+fn nee_samples_carry_the_density_pdf_nee_reports() {
+    let (_, set) = scene();
+    let mut rng = Pcg32::new(11, 0);
+    for how in [NeeSelection::Power, NeeSelection::Hierarchy] {
+        let mut checked = 0;
+        let mut differ = 0;
+        for &(p, n) in &RECEIVERS {
+            for _ in 0..20_000 {
+                let u = (rng.next_f32(), rng.next_f32());
+                let Some(s) = set.sample_nee(how, p, n, u, rng.next_2d()) else {
+                    continue;
+                };
+                if s.delta {
+                    continue;
+                }
+                let pdf = set.pdf_nee(how, (s.light, s.prim), p, n, s.p, s.ng);
+                assert!(
+                    (s.pdf_sa - pdf).abs() <= 1e-3 * pdf,
+                    "{}: {} vs {pdf}",
+                    how.name(),
+                    s.pdf_sa
+                );
+                let power = set.pdf_sa(s.light, p, s.p, s.ng);
+                differ += usize::from((power - pdf).abs() > 1e-2 * pdf);
+                checked += 1;
+            }
+        }
+        assert!(checked > 10_000, "{checked}");
+        if how == NeeSelection::Hierarchy {
+            assert!(differ > checked / 2, "{differ} of {checked}");
+        }
     }
 }
 

@@ -6,7 +6,7 @@
 use glam::Vec3;
 use restir_geometry::{Ray, offset_ray_origin};
 use restir_gris::{Reservoir, StreamingReservoir};
-use restir_lights::{At, CandidateU, LightPoint, LightSampler, Resolved};
+use restir_lights::{At, CandidateU, LightPoint, LightSampler, NeeSelection, Resolved};
 use restir_materials::Bsdf;
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
@@ -104,7 +104,9 @@ impl RestirDiIntegrator {
                 let d = r.frame().to_world(bs.wi);
                 rays += 1;
                 let hit = scene.intersect(&Ray::new(offset_ray_origin(r.p, ng, d), d));
-                let Some((y, _, power_pdf_sa)) = scene.lights.reached(r.p, d, hit.as_ref()) else {
+                let Some((y, _, power_pdf_sa)) = scene
+                    .lights
+                    .reached(NeeSelection::Power, (r.p, r.n), d, hit.as_ref()) else {
                     continue;
                 };
                 let resolved = scene.lights.resolve(&y);

@@ -273,6 +273,7 @@ impl RestirDiIntegrator {
             let ray = Ray::new(offset_ray_origin(r.p, ng, d), d);
             let prev = PrevVertex {
                 p: r.p,
+                n: r.n,
                 pdf_sa: bs.pdf_sa,
                 delta,
                 mis: EmissionMis::Counted {

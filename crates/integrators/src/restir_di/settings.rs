@@ -582,6 +582,7 @@ mod tests {
             rr_depth: 5,
             hide_emitters: false,
             sampler: restir_scene::SamplerKind::Independent,
+            nee: restir_lights::NeeSelection::Power,
         })
     }
 

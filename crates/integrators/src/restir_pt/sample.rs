@@ -33,7 +33,7 @@ use restir_sampling::{Pcg32, warp::power_heuristic};
 use restir_scene::Scene;
 
 use crate::reuse::gbuffer::Receiver;
-use restir_lights::{LightPoint, Resolved};
+use restir_lights::{LightPoint, NeeSelection, Resolved};
 
 use crate::shadow::ShadowTarget;
 
@@ -280,6 +280,7 @@ pub fn smooth(bsdf: &Bsdf) -> bool {
 #[inline]
 pub fn evaluate_unshadowed(
     scene: &Scene,
+    nee: NeeSelection,
     r: &Receiver,
     bsdf1: &Bsdf,
     s: &PathSample,
@@ -296,7 +297,7 @@ pub fn evaluate_unshadowed(
             if f == Vec3::ZERO {
                 return (Vec3::ZERO, None);
             }
-            let light_pdf_sa = || scene.lights.pdf_sa(s.id, r.p, c.p, c.ng);
+            let light_pdf_sa = || scene.lights.pdf_nee(nee, (s.id, s.prim), r.p, r.n, c.p, c.ng);
             let w = match (s.kind, c.delta) {
                 (Kind::DirectNee, true) => 1.0,
                 (Kind::DirectNee, false) => power_heuristic(light_pdf_sa(), bsdf1.pdf_sa(r.wo, wi)),

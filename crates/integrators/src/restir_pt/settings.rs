@@ -192,6 +192,7 @@ impl RestirPtSettings {
             "temporal_stale_suffix" => self.temporal_stale_suffix = p.boolean()?,
             "skip_invertibility" => self.skip_invertibility = p.boolean()?,
             "delta_emission_twice" => self.delta_emission_twice = p.boolean()?,
+            _ if self.path.apply_one(key, p)? => {}
             _ => return self.reuse.apply(key, p),
         }
         Ok(true)
@@ -211,6 +212,7 @@ mod tests {
             rr_depth: 5,
             hide_emitters: false,
             sampler: restir_scene::SamplerKind::Independent,
+            nee: restir_lights::NeeSelection::Power,
         });
         let p = |a: &str, b: &str| ParamSet::from(&[(a, b)][..]);
         let unknown = s

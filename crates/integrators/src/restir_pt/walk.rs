@@ -36,6 +36,7 @@
 
 use glam::{Vec2, Vec3};
 use restir_geometry::{Frame, Ray, SurfaceInteraction, offset_ray_origin};
+use restir_lights::NeeSelection;
 use restir_materials::{Bsdf, LobeFlags};
 use restir_sampling::Pcg32;
 use restir_scene::Scene;
@@ -146,6 +147,8 @@ pub struct Walker<'a> {
     /// bounce took a delta lobe, ended on an emitter or the environment): the silhouette stage
     /// estimates it with the camera rays of its mask (`reuse/seen.rs`).
     pub seen_through_delta: bool,
+    /// How light sampling at a vertex picks its light.
+    pub nee: NeeSelection,
 }
 
 /// The two bits of a bounce's lobe stored in [`PathSample::lobes`].
@@ -267,7 +270,7 @@ impl Walker<'_> {
         frame: &Frame,
         u: &BounceRandoms,
     ) -> Option<BsdfStep> {
-        let (p, wo) = (w.cur.r.p, w.cur.r.wo);
+        let (p, n, wo) = (w.cur.r.p, w.cur.r.n, w.cur.r.wo);
         let bs = bsdf.sample(wo, u.lobe, u.dir)?;
         let bits = lobe_bits(bs.lobe);
         if w.j <= 16 {
@@ -308,6 +311,7 @@ impl Walker<'_> {
             next_beta,
             prev: PrevVertex {
                 p,
+                n,
                 pdf_sa: bs.pdf_sa,
                 delta: bs.lobe.is_delta(),
                 mis: EmissionMis::Power,
@@ -350,7 +354,13 @@ impl Walker<'_> {
                 if s.light_pdf_sa <= 0.0 {
                     return None;
                 }
-                let ls = scene.lights.sample(xk.p, u.select, u.light)?;
+                let ls = scene.lights.sample_nee(
+                    self.nee,
+                    xk.p,
+                    xk.shading.n,
+                    (u.select, u.rr),
+                    u.light,
+                )?;
                 if ls.delta || !(ls.pdf_sa > 0.0 && ls.pdf_sa.is_finite()) {
                     return None;
                 }
@@ -371,7 +381,12 @@ impl Walker<'_> {
                 s.dir = dir;
                 if s.kind == Kind::HitAtX3 {
                     let (_, le, light_pdf_sa) =
-                        self.scene.lights.reached(xk.p, dir, hit.as_ref())?;
+                        self.scene.lights.reached(
+                            self.nee,
+                            (xk.p, xk.shading.n),
+                            dir,
+                            hit.as_ref(),
+                        )?;
                     s.radiance = le;
                     s.light_pdf_sa = light_pdf_sa;
                     return Some(1.0);

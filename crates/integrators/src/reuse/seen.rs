@@ -28,6 +28,7 @@ use std::sync::{Arc, Mutex};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use restir_geometry::{Ray, offset_ray_origin};
+use restir_lights::NeeSelection;
 use restir_sampling::{Pcg32, luminance};
 use restir_scene::Scene;
 
@@ -182,7 +183,9 @@ impl DeltaChains {
             let d = r.frame().to_world(bs.wi);
             let hit = scene.intersect(&Ray::new(offset_ray_origin(r.p, ng, d), d));
             rays += 1;
-            if let Some((_, le, _)) = scene.lights.reached(r.p, d, hit.as_ref()) {
+            if let Some((_, le, _)) = scene
+                .lights
+                .reached(NeeSelection::Power, (r.p, r.n), d, hit.as_ref()) {
                 sum += beta * le;
             }
             let Some(si) = hit else {

@@ -27,7 +27,13 @@ impl Walker<'_> {
     ) -> Option<Replayed> {
         let scene = self.scene;
         let cur = w.cur;
-        let ls = scene.lights.sample(cur.r.p, u.select, u.light)?;
+        let ls = scene.lights.sample_nee(
+            self.nee,
+            cur.r.p,
+            cur.r.n,
+            (u.select, u.rr),
+            u.light,
+        )?;
         let direct = PathSample::direct(LightPoint::from_light_sample(&ls), Kind::DirectNee);
         let eligible =
             w.rc.is_none() && self.end_eligible(w.j + 1, &cur, &resolve_vertex(scene, &direct));
@@ -83,7 +89,10 @@ impl Walker<'_> {
             return None;
         }
         let scene = self.scene;
-        let (y, le, light_pdf_sa) = self.scene.lights.reached(w.cur.r.p, step.d, hit)?;
+        let (y, le, light_pdf_sa) =
+            self.scene
+                .lights
+                .reached(self.nee, (w.cur.r.p, w.cur.r.n), step.d, hit)?;
         let mis = step.prev.emission_weight(light_pdf_sa);
         let direct = PathSample::direct(y, Kind::DirectHit);
         let eligible =

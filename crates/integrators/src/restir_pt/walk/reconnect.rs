@@ -100,7 +100,7 @@ impl Walker<'_> {
             Some((p, n)) => geometry_term(prev.r.p.into(), p.into(), n.into()),
             None => 0.0,
         };
-        let (f, target) = evaluate_unshadowed(self.scene, &prev.r, &prev.bsdf, s, v);
+        let (f, target) = evaluate_unshadowed(self.scene, self.nee, &prev.r, &prev.bsdf, s, v);
         (geometry, beta * f, target)
     }
 }

@@ -1,0 +1,88 @@
+//! Next-event estimation by the light hierarchy (`light_sampler = bvh` for the path tracer and
+//! ReSTIR PT) estimates the image the power sampler does, block by block over many seeds: the
+//! light samples divide by the hierarchy's density, and an emitter a BSDF ray reaches is weighed
+//! against that same density. The scene has what the hierarchy decides by: a large dim light
+//! near a glossy floor, small bright lights far above it (some facing away), a sphere light (a
+//! light sampled whole) and an environment (which keeps its share). The control weighs BSDF
+//! rays' emitters against the power sampler's density while the hierarchy draws the light
+//! samples: the two strategies' weights no longer sum to one, and the statistic sees it.
+
+use restir_integrators::path::{PathIntegrator, PathSettings};
+use restir_lights::NeeSelection;
+use restir_scene::parse_ron;
+
+mod common;
+use common::{block_statistics, make, max_z, render_image, render_with};
+
+const SIZE: u32 = 32;
+const BLOCK: u32 = 8;
+const Z_MAX: f64 = 4.5;
+
+fn scene(max_depth: i32) -> common::Built {
+    let mut small = String::new();
+    for i in 0..16 {
+        let (x, z) = ((i % 4) as f32 - 1.5, (i / 4) as f32 - 1.5);
+        // Every fourth faces up, away from everything below it.
+        let angle = if i % 4 == 3 { -90 } else { 90 };
+        small.push_str(&format!(
+            "(geometry: Rectangle, to_world: [Scale((0.06, 0.06, 1)), Rotate(axis: (1, 0, 0), angle: {angle}), \
+             Translate(({x}, 3.0, {z}))], emission: Some(({r}, 200, 150))),\n",
+            r = 100 + 20 * i
+        ));
+    }
+    let ron = format!(
+        r#"(
+        camera: (fov: 45, to_world: [LookAt(origin: (0, 2, 4), target: (0, 0, 0), up: (0, 1, 0))]),
+        film: (width: {SIZE}, height: {SIZE}, filter: Box),
+        integrator: (max_depth: {max_depth}),
+        shapes: [
+            (geometry: Rectangle, to_world: [Scale((3, 3, 1)), Rotate(axis: (1, 0, 0), angle: -90)],
+             material: Some(Inline(RoughConductor(roughness: (alpha: 0.15))))),
+            (geometry: Cube, to_world: [Scale((0.4, 0.4, 0.4)), Translate((0.6, 0.4, -0.4))],
+             material: Some(Inline(Diffuse(reflectance: (0.6, 0.5, 0.4))))),
+            (geometry: Rectangle, to_world: [Scale((0.8, 0.5, 1)), Rotate(axis: (1, 0, 0), angle: 30),
+             Translate((-0.6, 0.7, -1.0))], emission: Some((1.5, 1.2, 1.0))),
+            (geometry: Sphere(center: (1.2, 0.9, 0.6), radius: 0.1), emission: Some((60, 80, 100))),
+            {small}
+        ],
+        lights: [Constant(radiance: (0.05, 0.06, 0.08))],
+    )"#
+    );
+    let desc = parse_ron(&ron, "nee.ron".as_ref()).unwrap();
+    common::build(&desc, ".".as_ref(), "nee.ron".as_ref())
+}
+
+#[test]
+fn hierarchy_nee_is_unbiased_and_weighing_against_the_power_density_is_caught() {
+    let s = scene(3);
+    let stats = |render: &dyn Fn(u64) -> restir_image::Image, seeds, base| {
+        block_statistics(render, seeds, base, BLOCK)
+    };
+    let reference = stats(&|seed| render_image(&s, "path", &[], 64, seed), 32, 0x1000);
+
+    let bvh = stats(
+        &|seed| render_image(&s, "path", &[("light_sampler", "bvh")], 64, seed),
+        32,
+        0x2000,
+    );
+    let z = max_z(&bvh, &reference);
+    eprintln!("path, bvh against power: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "path with bvh: max |z| = {z:.2}");
+
+    let pt = make(&s, "restir-pt", &[("light_sampler", "bvh")]);
+    let pt_stats = stats(&|seed| render_with(&s, pt.as_ref(), 2, seed), 200, 0x3000);
+    let z = max_z(&pt_stats, &reference);
+    eprintln!("restir-pt, bvh against path, power: max |z| = {z:.2}");
+    assert!(z < Z_MAX, "restir-pt with bvh: max |z| = {z:.2}");
+
+    let control = PathIntegrator {
+        settings: PathSettings {
+            nee: NeeSelection::HierarchyWeighedByPower,
+            ..PathSettings::from_desc(&s.integrator)
+        },
+    };
+    let wrong = stats(&|seed| render_with(&s, &control, 64, seed), 32, 0x4000);
+    let z = max_z(&wrong, &reference);
+    eprintln!("control, weighed against the power density: max |z| = {z:.2}");
+    assert!(z > Z_MAX, "the control was not detected: max |z| = {z:.2}");
+}
