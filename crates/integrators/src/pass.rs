@@ -240,11 +240,32 @@ impl PassContext<'_> {
         }
     }
 
+    /// The film position of pixel `index`'s own camera ray in this pass (pixel `(x, y)` of the
+    /// pass's buffers): [`PassContext::film_position`] with the numbers of the pixel's
+    /// Owen-scrambled Sobol sequence at this pass (its first two dimensions), so that over the
+    /// passes a pixel's camera rays are stratified over its filter, whatever sampler draws the
+    /// estimator's other numbers. Still draws two numbers from `rng` (the budget of the
+    /// pixel's stream is unchanged); with a pixel sequence as `rng` the position is the same.
+    #[inline]
+    pub fn pixel_film_position<S: Sampler>(
+        &self,
+        index: usize,
+        (x, y): (u32, u32),
+        rng: &mut S,
+    ) -> Vec2 {
+        let _ = rng.next_2d();
+        self.film_position(x, y, &mut self.pixel_sequence(index))
+    }
+
     /// The position within their pixels that every camera ray of pass `pass` of a render with
-    /// seed `seed` goes through when the film splats: uniform in `[0, 1)²`, the same in every
-    /// part of a split render.
+    /// seed `seed` goes through when the film splats: point `pass` of a (0, 2)-sequence
+    /// Owen-scrambled by the seed, so each pass's offset is uniform in `[0, 1)²` and those of
+    /// the first `2^k` passes are stratified over the pixel; the same in every part of a split
+    /// render.
     pub fn shared_offset_of(seed: u64, pass: u32) -> Vec2 {
-        SeededStreams { seed, pass }.pass(STAGE_FILM).next_2d()
+        let mut rng = SeededStreams { seed, pass: 0 }.pass(STAGE_FILM);
+        let scramble = u64::from(rng.next_u32()) << 32 | u64::from(rng.next_u32());
+        OwenSobol::new(scramble, pass).next_2d()
     }
 }
 
@@ -328,6 +349,74 @@ mod tests {
             y0,
             width: x1 - x0,
             height: y1 - y0,
+        }
+    }
+
+    /// Cell of `p` (in `[0, 1)²`) on an `nx × ny` grid.
+    fn cell(p: Vec2, nx: usize, ny: usize) -> usize {
+        ((p.x * nx as f32) as usize).min(nx - 1) + nx * ((p.y * ny as f32) as usize).min(ny - 1)
+    }
+
+    /// The splatting film's shared offsets: the first 4 and 16 passes of every seed fill every
+    /// elementary interval of their count once (a (0, 2)-sequence), and a fixed pass's offset is
+    /// uniform over seeds (chi-square on 8×8 cells). The control: offsets drawn twice as dense
+    /// towards one corner are rejected by the same chi-square.
+    #[test]
+    fn shared_offsets_are_uniform_and_stratified_over_passes() {
+        for seed in 0..200u64 {
+            for k in [2u32, 4] {
+                let n = 1usize << k;
+                let points: Vec<Vec2> = (0..n as u32)
+                    .map(|pass| PassContext::shared_offset_of(seed, pass))
+                    .collect();
+                for a in 0..=k {
+                    let (nx, ny) = (1usize << a, 1usize << (k - a));
+                    let mut seen = vec![false; n];
+                    for &p in &points {
+                        assert!(!std::mem::replace(&mut seen[cell(p, nx, ny)], true));
+                    }
+                }
+            }
+        }
+        let histogram = |warp: fn(Vec2) -> Vec2| {
+            let mut h = restir_testkit::Histogram::new(64);
+            for seed in 0..20_000u64 {
+                h.record(Some(cell(warp(PassContext::shared_offset_of(seed, 3)), 8, 8)));
+            }
+            h.chi2(&[1.0 / 64.0; 64]).unwrap()
+        };
+        let uniform = histogram(|p| p);
+        assert!(uniform.accepts(1e-3), "{uniform}");
+        let skewed = histogram(|p| p * p);
+        assert!(!skewed.accepts(1e-3), "the control passed: {skewed}");
+    }
+
+    /// A pixel's own camera rays over the passes are stratified over its box filter (one in each
+    /// quadrant in the first 4 passes) whatever stream draws the pass's other numbers, and the
+    /// stream's budget is unchanged (it is where it would be after `film_position`).
+    #[test]
+    fn pixel_film_positions_are_stratified_over_passes() {
+        let filter = Filter::Box;
+        for index in [0usize, 7, 1234] {
+            let (x, y) = (index as u32 % 100, index as u32 / 100);
+            let mut seen = [false; 4];
+            for pass in 0..4 {
+                let ctx = PassContext {
+                    seed: 5,
+                    pass,
+                    filter: &filter,
+                    shared_offset: None,
+                    samples: None,
+                    crop: None,
+                };
+                let mut rng = ctx.pixel_rng(index);
+                let p = ctx.pixel_film_position(index, (x, y), &mut rng);
+                let within = p - Vec2::new(x as f32, y as f32);
+                assert!(!std::mem::replace(&mut seen[cell(within, 2, 2)], true));
+                let mut other = ctx.pixel_rng(index);
+                let _ = ctx.film_position(x, y, &mut other);
+                assert_eq!(rng.next_u32(), other.next_u32());
+            }
         }
     }
 

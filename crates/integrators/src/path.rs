@@ -344,7 +344,7 @@ impl Integrator for PathIntegrator {
                 let (l, r) = match self.settings.sampler {
                     SamplerKind::Independent => {
                         let mut rng = ctx.pixel_rng(index);
-                        let film = ctx.film_position(x, y, &mut rng);
+                        let film = ctx.pixel_film_position(index, (x, y), &mut rng);
                         trace_camera_path(scene, &self.settings, film, &mut rng)
                     }
                     SamplerKind::Sobol => {

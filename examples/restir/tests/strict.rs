@@ -107,8 +107,8 @@ fn flags_the_estimator_does_not_use() {
         "error: --shift is not an option of the integrator 'restir-di' (used by: restir-pt)",
     );
     fails_with(
-        &["render", s(&c), "-o", s(&out), "--light-sampler", "power"],
-        "error: --light-sampler is not an option of the integrator 'path' (used by: restir-di)",
+        &["render", s(&c), "-o", s(&out), "--learn", "on"],
+        "error: --learn is not an option of the integrator 'path' (used by: restir-di)",
     );
     assert!(!out.exists());
 }

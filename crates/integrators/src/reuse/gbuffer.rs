@@ -209,7 +209,7 @@ impl GBuffer {
                 let index = first + i;
                 let (x, y) = ((index % w) as u32, (index / w) as u32);
                 let mut rng = ctx.pixel_rng(index);
-                let film = ctx.film_position(x, y, &mut rng);
+                let film = ctx.pixel_film_position(index, (x, y), &mut rng);
                 let ray = scene.camera.generate_ray(film, rng.next_2d());
                 let (hit, n) = scene.camera_intersect(&ray, hide_emitters);
                 rays += n;
