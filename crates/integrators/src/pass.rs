@@ -381,7 +381,11 @@ mod tests {
         let histogram = |warp: fn(Vec2) -> Vec2| {
             let mut h = restir_testkit::Histogram::new(64);
             for seed in 0..20_000u64 {
-                h.record(Some(cell(warp(PassContext::shared_offset_of(seed, 3)), 8, 8)));
+                h.record(Some(cell(
+                    warp(PassContext::shared_offset_of(seed, 3)),
+                    8,
+                    8,
+                )));
             }
             h.chi2(&[1.0 / 64.0; 64]).unwrap()
         };

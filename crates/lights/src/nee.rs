@@ -11,6 +11,8 @@ use crate::{LightSample, LightSet};
 
 /// How next-event estimation picks the light it samples.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+// The hidden variant is the tests' negative control, not a stand-in for future variants.
+#[allow(clippy::manual_non_exhaustive)]
 pub enum NeeSelection {
     /// The power sampler ([`LightSet::sample`]): every emitter in proportion to its power,
     /// wherever the vertex is.

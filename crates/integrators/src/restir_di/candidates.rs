@@ -104,9 +104,11 @@ impl RestirDiIntegrator {
                 let d = r.frame().to_world(bs.wi);
                 rays += 1;
                 let hit = scene.intersect(&Ray::new(offset_ray_origin(r.p, ng, d), d));
-                let Some((y, _, power_pdf_sa)) = scene
-                    .lights
-                    .reached(NeeSelection::Power, (r.p, r.n), d, hit.as_ref()) else {
+                let Some((y, _, power_pdf_sa)) =
+                    scene
+                        .lights
+                        .reached(NeeSelection::Power, (r.p, r.n), d, hit.as_ref())
+                else {
                     continue;
                 };
                 let resolved = scene.lights.resolve(&y);

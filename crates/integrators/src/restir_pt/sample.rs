@@ -297,7 +297,11 @@ pub fn evaluate_unshadowed(
             if f == Vec3::ZERO {
                 return (Vec3::ZERO, None);
             }
-            let light_pdf_sa = || scene.lights.pdf_nee(nee, (s.id, s.prim), r.p, r.n, c.p, c.ng);
+            let light_pdf_sa = || {
+                scene
+                    .lights
+                    .pdf_nee(nee, (s.id, s.prim), r.p, r.n, c.p, c.ng)
+            };
             let w = match (s.kind, c.delta) {
                 (Kind::DirectNee, true) => 1.0,
                 (Kind::DirectNee, false) => power_heuristic(light_pdf_sa(), bsdf1.pdf_sa(r.wo, wi)),

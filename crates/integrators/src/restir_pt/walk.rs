@@ -380,13 +380,12 @@ impl Walker<'_> {
                 let hit = scene.intersect(&Ray::new(offset_ray_origin(xk.p, xk.ng, dir), dir));
                 s.dir = dir;
                 if s.kind == Kind::HitAtX3 {
-                    let (_, le, light_pdf_sa) =
-                        self.scene.lights.reached(
-                            self.nee,
-                            (xk.p, xk.shading.n),
-                            dir,
-                            hit.as_ref(),
-                        )?;
+                    let (_, le, light_pdf_sa) = self.scene.lights.reached(
+                        self.nee,
+                        (xk.p, xk.shading.n),
+                        dir,
+                        hit.as_ref(),
+                    )?;
                     s.radiance = le;
                     s.light_pdf_sa = light_pdf_sa;
                     return Some(1.0);

@@ -183,9 +183,11 @@ impl DeltaChains {
             let d = r.frame().to_world(bs.wi);
             let hit = scene.intersect(&Ray::new(offset_ray_origin(r.p, ng, d), d));
             rays += 1;
-            if let Some((_, le, _)) = scene
-                .lights
-                .reached(NeeSelection::Power, (r.p, r.n), d, hit.as_ref()) {
+            if let Some((_, le, _)) =
+                scene
+                    .lights
+                    .reached(NeeSelection::Power, (r.p, r.n), d, hit.as_ref())
+            {
                 sum += beta * le;
             }
             let Some(si) = hit else {

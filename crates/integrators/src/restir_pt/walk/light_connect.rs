@@ -27,13 +27,9 @@ impl Walker<'_> {
     ) -> Option<Replayed> {
         let scene = self.scene;
         let cur = w.cur;
-        let ls = scene.lights.sample_nee(
-            self.nee,
-            cur.r.p,
-            cur.r.n,
-            (u.select, u.rr),
-            u.light,
-        )?;
+        let ls = scene
+            .lights
+            .sample_nee(self.nee, cur.r.p, cur.r.n, (u.select, u.rr), u.light)?;
         let direct = PathSample::direct(LightPoint::from_light_sample(&ls), Kind::DirectNee);
         let eligible =
             w.rc.is_none() && self.end_eligible(w.j + 1, &cur, &resolve_vertex(scene, &direct));
