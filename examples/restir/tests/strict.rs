@@ -110,6 +110,11 @@ fn flags_the_estimator_does_not_use() {
         &["render", s(&c), "-o", s(&out), "--learn", "on"],
         "error: --learn is not an option of the integrator 'path' (used by: restir-di)",
     );
+    // The path tracer's next-event estimation takes two of ReSTIR DI's light samplers.
+    fails_with(
+        &["render", s(&c), "-o", s(&out), "--light-sampler", "tiles"],
+        "error: light_sampler = 'tiles': expected power or bvh",
+    );
     assert!(!out.exists());
 }
 
