@@ -6,7 +6,7 @@
 use glam::{Vec2, Vec3};
 use restir_geometry::area_to_solid_angle;
 
-use crate::table::Emitter;
+use crate::table::{Emitter, triangle_area};
 use crate::{LightSample, LightSet};
 
 /// How next-event estimation picks the light it samples.
@@ -104,8 +104,7 @@ impl LightSet {
         }
         match self.table.entries()[entry] {
             Emitter::Triangle { p: ref tri, .. } => {
-                let area = 0.5 * (tri[1] - tri[0]).cross(tri[2] - tri[0]).length();
-                area_to_solid_angle(pmf / area, ref_p, p, n).unwrap_or(0.0)
+                area_to_solid_angle(pmf / triangle_area(tri), ref_p, p, n).unwrap_or(0.0)
             }
             Emitter::Whole { light } => {
                 // The light's own density of the point, without its power selection.

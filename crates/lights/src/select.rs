@@ -9,7 +9,7 @@ use restir_geometry::area_to_solid_angle;
 
 use crate::bvh::LightBvh;
 use crate::light::area_light_sample;
-use crate::table::Emitter;
+use crate::table::{Emitter, triangle_area};
 use crate::{EmitterGroups, Light, LightSample, LightSet};
 
 impl LightSet {
@@ -147,8 +147,7 @@ impl LightSet {
                 };
                 let shape = &self.shapes[shape as usize];
                 let ps = self.table.triangle_point(p, ng, shading, shape, prim, u);
-                let area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
-                let pdf_sa = area_to_solid_angle(pmf / area, ref_p, ps.p, ps.ng)?;
+                let pdf_sa = area_to_solid_angle(pmf / triangle_area(p), ref_p, ps.p, ps.ng)?;
                 let power_pdf =
                     area_to_solid_angle(self.area_pdf[light as usize], ref_p, ps.p, ps.ng)?;
                 Some((

@@ -72,6 +72,13 @@ impl Emitter {
     }
 }
 
+/// The area of a triangle entry with corners `p` (a uniform point on it has density one over
+/// it).
+#[inline]
+pub(crate) fn triangle_area(p: &[Vec3; 3]) -> f32 {
+    0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length()
+}
+
 /// Triangle `t`'s shading normal: `Some(n)` where it is the same everywhere on it, as
 /// [`restir_geometry::TriangleMesh::point_at`] orients it (`ng` without vertex normals), `None`
 /// where it varies.
