@@ -166,6 +166,12 @@ impl Camera {
         2.0 * self.tan_half.y / self.resolution.1 as f32
     }
 
+    /// Whether every ray passes through one point (a pinhole or an orthographic camera, no
+    /// lens): then a point's film position is where every camera ray that reaches it starts.
+    pub fn is_pinhole(&self) -> bool {
+        self.orthographic || self.aperture_radius <= 0.0
+    }
+
     /// The camera position.
     pub fn origin(&self) -> Vec3 {
         self.origin

@@ -58,7 +58,7 @@ use crate::path::{EmissionMis, PathSettings, PrevVertex, rr_survival, trace_path
 use crate::reuse::chain::PassChain;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::reciprocal;
-use crate::reuse::seen::SeenEmission;
+use crate::reuse::seen::{SeenEmission, SplatRays};
 use crate::reuse::settings::mis_name;
 use crate::stages::StageClock;
 use restir_reuse::{ScreenReuse, Stages};
@@ -140,8 +140,13 @@ impl RestirDiIntegrator {
             lookups: Default::default(),
             cuts: Default::default(),
             tile_cuts: Default::default(),
-            seen: (settings.edge_rays > 1)
-                .then(|| SeenEmission::new(settings.edge_rays, settings.edge_mask_from_pass)),
+            seen: (settings.edge_rays > 1).then(|| {
+                SeenEmission::new(
+                    settings.edge_rays,
+                    SplatRays::Each,
+                    settings.edge_mask_from_pass,
+                )
+            }),
         }
     }
 

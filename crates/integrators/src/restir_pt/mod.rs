@@ -45,7 +45,7 @@ use crate::motion::FrameMotion;
 use crate::reuse::chain::PassChain;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::reciprocal;
-use crate::reuse::seen::{DeltaChains, SeenEmission};
+use crate::reuse::seen::{DeltaChains, SeenEmission, SplatRays};
 use restir_reuse::{ScreenReuse, Stages};
 
 use crate::pass::{Integrator, PassContext};
@@ -116,8 +116,13 @@ impl RestirPtIntegrator {
             chain: PassChain::default(),
             clock: StageClock::default(),
             diag: diag::Diag::from_env(),
-            seen: (settings.edge_rays > 1)
-                .then(|| SeenEmission::new(settings.edge_rays, settings.edge_mask_from_pass)),
+            seen: (settings.edge_rays > 1).then(|| {
+                SeenEmission::new(
+                    settings.edge_rays,
+                    SplatRays::VarianceMatched,
+                    settings.edge_mask_from_pass,
+                )
+            }),
             recycled: Default::default(),
         }
     }

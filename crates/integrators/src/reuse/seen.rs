@@ -37,12 +37,34 @@ use crate::pass::PassContext;
 use crate::path::rr_survival;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 
+mod image;
+use image::EmitterImage;
+
 /// A film window (width, height, x0, y0) and its mask: each pixel's camera rays for the seen
 /// emission (0 off the mask).
 type WindowMask = (Window, Arc<Vec<u16>>);
 
 /// A film window: width, height and the film position of its first pixel.
 type Window = (u32, u32, u32, u32);
+
+/// How many camera rays a mask pixel of a splatting film gets.
+///
+/// There every ray of a pass goes through offsets the pass shares, and each reaches the pixels
+/// within the filter's reach; a pixel gathers its neighbours' rays through the same offsets, so
+/// its seen emission varies with where those offsets fall, about as much as one ray's would on
+/// a sampled film (independent positions would lower it by the filter's variance factor, 0.31
+/// for the Gaussian of σ = 0.5, but the shared offsets do not). Which count pays depends on
+/// what else a pass's pixel estimate costs and holds (measured per estimator: `docs/RESTIR_DI.md`,
+/// `docs/RESTIR_PT.md`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SplatRays {
+    /// `edge_rays` on every mask pixel (ReSTIR DI: its passes are cheap and their reflected
+    /// light quiet, so the seen emission is most of a silhouette pixel's error).
+    Each,
+    /// `edge_rays` times the filter's variance factor, rounded, at least 1 (ReSTIR PT: 32 → 10;
+    /// its passes' walks hold most of their error and cost).
+    VarianceMatched,
+}
 
 /// The most camera rays a silhouette pixel gets, in multiples of `edge_rays`.
 pub const MAX_RAYS_FACTOR: u32 = 8;
@@ -56,6 +78,9 @@ pub struct SeenEmission {
     /// Camera rays for the seen emission on a silhouette pixel, the G-buffer's included: the
     /// mean over the film's silhouette pixels (each gets a count in proportion to its contrast).
     rays: u32,
+    /// On a splatting film, whether a mask pixel's rays are `rays` times the filter's variance
+    /// factor (ReSTIR PT) or `rays` (ReSTIR DI); see [`SplatRays`].
+    splat: SplatRays,
     /// Negative control: the pixels whose own camera ray saw emission instead of the mask.
     from_pass: bool,
     /// The mask and the window it was made for: (width, height, x0, y0).
@@ -234,10 +259,12 @@ fn filter_reach(filter: &Filter) -> i32 {
 }
 
 impl SeenEmission {
-    /// `rays` camera rays per silhouette pixel (more than 1).
-    pub fn new(rays: u32, from_pass: bool) -> Self {
+    /// `rays` camera rays per silhouette pixel (more than 1), `splat` those of a splatting
+    /// film's mask pixel.
+    pub fn new(rays: u32, splat: SplatRays, from_pass: bool) -> Self {
         Self {
             rays,
+            splat,
             from_pass,
             mask: Mutex::new(None),
             followed_delta: AtomicBool::new(false),
@@ -246,11 +273,13 @@ impl SeenEmission {
     }
 
     /// The camera rays of a pixel near emitters on a splatting film (`variance_factor` its
-    /// [`Reconstruction::Splatted`] factor): each of its rays reaches several pixels, so `rays`
-    /// times the factor (rounded, at least 1) gives a pixel about the variance `rays` give a
-    /// sampled film's silhouette pixel.
+    /// [`Reconstruction::Splatted`] factor), as [`SplatRays`] says.
     fn splat_rays(&self, variance_factor: f64) -> u32 {
-        (f64::from(self.rays) * variance_factor)
+        let factor = match self.splat {
+            SplatRays::VarianceMatched => variance_factor,
+            SplatRays::Each => 1.0,
+        };
+        (f64::from(self.rays) * factor)
             .round()
             .clamp(1.0, f64::from(u16::MAX)) as u32
     }
@@ -288,13 +317,16 @@ impl SeenEmission {
         if splatted > 0 {
             return Some(format!(
                 "{} of {} pixels within the splatting filter's reach of a pixel whose filter sees \
-                 an emitter ({:.2} %), {splatted} camera rays each (edge_rays {} times the \
-                 filter's variance factor), all but the G-buffer's through offsets the pass \
-                 shares{delta}",
+                 an emitter ({:.2} %), {splatted} camera rays each ({}), all but the G-buffer's through \
+                 offsets the pass shares{delta}",
                 on.len(),
                 w * h,
                 100.0 * on.len() as f64 / f64::from((w * h).max(1)),
-                self.rays,
+                match self.splat {
+                    SplatRays::Each => format!("edge_rays {}", self.rays),
+                    SplatRays::VarianceMatched =>
+                        format!("edge_rays {} times the filter's variance factor", self.rays),
+                },
             ));
         }
         Some(
@@ -336,15 +368,38 @@ impl SeenEmission {
         chains: Option<&DeltaChains>,
         any: bool,
     ) -> (Vec<f32>, u64) {
+        Self::contrast_probing(scene, reach, (w, h), chains, any, true)
+    }
+
+    /// [`Self::contrast`], tracing only the probes near an emitter's image (`near_only`, the
+    /// same values) or every probe.
+    fn contrast_probing(
+        scene: &Scene,
+        reach: i32,
+        (w, h): (u32, u32),
+        chains: Option<&DeltaChains>,
+        any: bool,
+        near_only: bool,
+    ) -> (Vec<f32>, u64) {
         let (wi, hi) = (w as i32, h as i32);
         let side = |n: i32| 2 * n - 1 + 4 * reach;
         let (bw, bh) = (side(wi), side(hi));
         let lo = 1 - 2 * reach;
+        // Probes whose every neighbour within two reaches sees no emitter decide nothing: a
+        // pixel is on the mask only if a probe within its reach sees one, and then its value
+        // depends on the probes within its reach alone. So only the probes near an emitter's
+        // image are traced; the others are taken as a surface that does not emit.
+        let near = near_only
+            .then(|| EmitterImage::of(scene, chains, (lo as f32 * 0.5, reach), (bw, bh)))
+            .flatten();
         let ids: Vec<([(u32, f32); 2], u64)> = (0..(bw * bh) as usize)
             .into_par_iter()
             .map(|i| {
                 let (px, py) = ((i as i32 % bw) + lo, (i as i32 / bw) + lo);
                 let film = Vec2::new(px as f32 * 0.5, py as f32 * 0.5);
+                if near.as_ref().is_some_and(|n| !n.covers(film)) {
+                    return ([(0, 0.0); 2], 0);
+                }
                 seen_id(scene, film, chains)
             })
             .collect();
@@ -359,6 +414,10 @@ impl SeenEmission {
             .map(|i| {
                 // The probes within the filter's reach of the pixel's centre.
                 let (x, y) = (i as i32 % wi, i as i32 / wi);
+                let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                if near.as_ref().is_some_and(|n| !n.covers(centre)) {
+                    return 0.0; // no emitter's image within two reaches
+                }
                 let (qx, qy) = (2 * x, 2 * y);
                 let c = ids[((qy + 2 * reach) * bw + qx + 2 * reach) as usize].0[0].0;
                 let mut any_emitter = false;
@@ -371,6 +430,9 @@ impl SeenEmission {
                         any_emitter |= emits(v);
                         lo = lo.min(l);
                         hi = hi.max(l);
+                    }
+                    if any && any_emitter {
+                        break;
                     }
                 }
                 if any {
@@ -476,10 +538,9 @@ impl SeenEmission {
     ///
     /// When the film splats, every G-buffer ray of the pass goes through the pass's shared
     /// offset in its pixel, and each ray reaches several pixels. The mask is then every pixel
-    /// within the filter's reach of a pixel whose filter sees an area emitter, each with
-    /// `edge_rays` times the filter's variance factor camera rays (rounded; for the Gaussian of
-    /// σ = 0.5, 32 → 10 and 4 → 1), so that a pixel there has about the variance `edge_rays`
-    /// give a sampled film's. The G-buffer ray keeps its share of the seen emission in
+    /// within the filter's reach of a pixel whose filter sees an area emitter, each with the
+    /// camera rays [`SplatRays`] gives (ReSTIR DI's 4 stay 4; ReSTIR PT's 32 become 10 for the
+    /// Gaussian of σ = 0.5). The G-buffer ray keeps its share of the seen emission in
     /// `radiance`; every other ray goes through one of the offsets the pass shares (a lattice
     /// shifted by the pass's offset: each uniform, and together they keep the filter weights a
     /// pixel gathers summing to about the same, as the shared offset does) and is put in
