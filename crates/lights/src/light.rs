@@ -242,17 +242,25 @@ impl LightSet {
             return 0.0;
         }
         match self.lights[light as usize] {
-            Light::Area { shape, .. } => match &self.shapes[shape as usize] {
-                Shape::Mesh(_) => {
-                    area_to_solid_angle(self.area_pdf[light as usize], ref_p, p, n).unwrap_or(0.0)
-                }
-                s => pmf * s.pdf_sa_from(ref_p, p, n),
-            },
-            Light::Constant { .. } => pmf * warp::UNIFORM_SPHERE_PDF,
+            Light::Area { shape, .. } if matches!(self.shapes[shape as usize], Shape::Mesh(_)) => {
+                area_to_solid_angle(self.area_pdf[light as usize], ref_p, p, n).unwrap_or(0.0)
+            }
+            _ => pmf * self.pdf_on_light(light, ref_p, p, n),
+        }
+    }
+
+    /// The solid-angle density with which [`LightSet::sample_light`] returns point `p`
+    /// (geometric normal `n`; for the environment, the direction back from it) of light `light`
+    /// from `ref_p`, without any selection of the light. Zero for delta lights.
+    #[inline]
+    pub(crate) fn pdf_on_light(&self, light: u32, ref_p: Vec3, p: Vec3, n: Vec3) -> f32 {
+        match self.lights[light as usize] {
+            Light::Area { shape, .. } => self.shapes[shape as usize].pdf_sa_from(ref_p, p, n),
+            Light::Constant { .. } => warp::UNIFORM_SPHERE_PDF,
             Light::Envmap => self
                 .envmap
                 .as_ref()
-                .map_or(0.0, |m| pmf * m.pdf(-n.normalize_or_zero())),
+                .map_or(0.0, |m| m.pdf(-n.normalize_or_zero())),
             Light::Point { .. }
             | Light::Spot(_)
             | Light::Projector(_)

@@ -106,15 +106,7 @@ impl LightSet {
             Emitter::Triangle { p: ref tri, .. } => {
                 area_to_solid_angle(pmf / triangle_area(tri), ref_p, p, n).unwrap_or(0.0)
             }
-            Emitter::Whole { light } => {
-                // The light's own density of the point, without its power selection.
-                let power = self.pmf(light);
-                if power > 0.0 {
-                    pmf * (self.pdf_sa(light, ref_p, p, n) / power)
-                } else {
-                    0.0
-                }
-            }
+            Emitter::Whole { light } => pmf * self.pdf_on_light(light, ref_p, p, n),
         }
     }
 }
