@@ -30,7 +30,8 @@ pub struct PassContext<'a> {
     /// The pixel filter, for jittering camera rays.
     pub filter: &'a Filter,
     /// Where within its pixel every camera ray of the pass goes, when the film splats
-    /// (`restir_integrators::film::Reconstruction`); `None`: each ray samples `filter`.
+    /// (`restir_integrators::film::Reconstruction`; drawn by [`crate::film::Film::shared_offset`]);
+    /// `None`: each ray samples `filter`.
     pub shared_offset: Option<Vec2>,
     /// Where the pass may put estimates of camera rays through offsets of their own
     /// ([`crate::film::FilmSample`]), when the film splats; `None` if it may not (every ray then
@@ -257,11 +258,12 @@ impl PassContext<'_> {
         self.film_position(x, y, &mut self.pixel_sequence(index))
     }
 
-    /// The position within their pixels that every camera ray of pass `pass` of a render with
-    /// seed `seed` goes through when the film splats: point `pass` of a (0, 2)-sequence
-    /// Owen-scrambled by the seed, so each pass's offset is uniform in `[0, 1)²` and those of
-    /// the first `2^k` passes are stratified over the pixel; the same in every part of a split
-    /// render.
+    /// The uniform point from which a splatting film draws the position within their pixels
+    /// that every camera ray of pass `pass` of a render with seed `seed` goes through
+    /// ([`crate::film::Film::shared_offset`]): point `pass` of a (0, 2)-sequence Owen-scrambled
+    /// by the seed, so each pass's point is uniform in `[0, 1)²` and those of the first `2^k`
+    /// passes are stratified over the pixel (the film's map keeps that, axis by axis); the same
+    /// in every part of a split render.
     pub fn shared_offset_of(seed: u64, pass: u32) -> Vec2 {
         let mut rng = SeededStreams { seed, pass: 0 }.pass(STAGE_FILM);
         let scramble = u64::from(rng.next_u32()) << 32 | u64::from(rng.next_u32());

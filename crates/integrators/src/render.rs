@@ -223,7 +223,7 @@ pub fn render_part(
     let spp = job.spp.max(1);
     while film.passes() < spp {
         let pass = part.first_pass + film.passes();
-        let offset = PassContext::shared_offset_of(job.seed, pass);
+        let offset = film.shared_offset(PassContext::shared_offset_of(job.seed, pass));
         rays += film.add_pass(offset, |filter, samples, sums| {
             let ctx = PassContext {
                 seed: job.seed,

@@ -541,9 +541,10 @@ impl SeenEmission {
     /// within the filter's reach of a pixel whose filter sees an area emitter, each with the
     /// camera rays [`SplatRays`] gives (ReSTIR DI's 4 stay 4; ReSTIR PT's 32 become 10 for the
     /// Gaussian of σ = 0.5). The G-buffer ray keeps its share of the seen emission in
-    /// `radiance`; every other ray goes through one of the offsets the pass shares (a lattice
-    /// shifted by the pass's offset: each uniform, and together they keep the filter weights a
-    /// pixel gathers summing to about the same, as the shared offset does) and is put in
+    /// `radiance`; every other ray goes through one of the offsets the pass shares
+    /// ([`crate::film::FilmSamples::offsets`]: each distributed as the shared offset is, and
+    /// together they keep the filter weights a pixel gathers summing to about the same) and is
+    /// put in
     /// `ctx.samples` with its share, to be splatted from there
     /// ([`crate::film::FilmSample`]). Beyond the mask no pixel's filter sees an emitter, so
     /// pixels with one ray and pixels with several never mix where the emission is not zero.
@@ -585,16 +586,12 @@ impl SeenEmission {
             .as_ref()
             .map_or((0, 0), |c| (c.region.x0, c.region.y0));
         // Splatting, the extra rays of every pixel go through the same offsets within their
-        // pixels, a lattice shifted by the pass's shared offset (each offset uniform), so that
-        // the weights a pixel gathers from its neighbours' rays sum about the same at each.
-        let shared = ctx.shared_offset.unwrap_or(Vec2::ZERO);
-        let offsets: Vec<Vec2> = (0..if own_offsets { splat } else { 0 })
-            .map(|j| {
-                let step = Vec2::new(j as f32 / splat as f32, (j as f32 * 0.618_034).fract());
-                let u = shared + step;
-                (u - u.floor()).min(Vec2::splat(restir_sampling::ONE_MINUS_EPSILON))
-            })
-            .collect();
+        // pixels, which the film gives (the first is the pass's shared offset), so that the
+        // weights a pixel gathers from its neighbours' rays sum about the same at each.
+        let offsets: Vec<Vec2> = match ctx.samples.filter(|_| own_offsets) {
+            Some(film) => film.offsets(splat),
+            None => Vec::new(),
+        };
         // Per worker, the rays traced and the samples through offsets of their own (the film
         // orders them by pixel).
         let (traced, own) = radiance
