@@ -282,32 +282,9 @@ impl SplatOffsets {
         )
     }
 
-    /// The uniform point [`SplatOffsets::warp`] maps to `u`.
-    fn unwarp(&self, u: Vec2) -> Vec2 {
-        Vec2::new(self.axis.invert(u.x), self.axis.invert(u.y))
-    }
-
     /// `1 / q(u)`: what an estimate through offset `u` is multiplied by.
     pub fn inverse_density(&self, u: Vec2) -> f64 {
         1.0 / (f64::from(self.axis.pdf(u.x)) * f64::from(self.axis.pdf(u.y)))
-    }
-
-    /// `n` offsets for a pass's camera rays through a pixel, the first `shared`: a rank-1
-    /// lattice shifted by the uniform point `shared` comes from, each mapped by
-    /// [`SplatOffsets::warp`]. Each is distributed with density `q` as `shared` is, and together
-    /// they cover the pixel evenly.
-    fn lattice(&self, shared: Vec2, n: u32) -> Vec<Vec2> {
-        let v = self.unwarp(shared);
-        (0..n)
-            .map(|j| {
-                if j == 0 {
-                    return shared;
-                }
-                let step = Vec2::new(j as f32 / n as f32, (j as f32 * 0.618_034).fract());
-                let u = v + step;
-                self.warp((u - u.floor()).min(Vec2::splat(restir_sampling::ONE_MINUS_EPSILON)))
-            })
-            .collect()
     }
 }
 
@@ -325,22 +302,21 @@ pub struct FilmSample {
 }
 
 /// Where a pass of a splatting film puts its [`FilmSample`]s ([`crate::PassContext::samples`]),
-/// and the offsets their rays go through.
+/// and how it draws their offsets.
 #[derive(Debug)]
 pub struct FilmSamples {
     samples: Mutex<Vec<FilmSample>>,
-    /// The pass's shared offset and how the film draws offsets.
-    shared: Vec2,
     offsets: Arc<SplatOffsets>,
 }
 
 impl FilmSamples {
-    /// `n` offsets for the camera rays of a pixel in this pass, the first the pass's shared
-    /// offset: each distributed as the film draws its shared offsets, and together covering the
-    /// pixel evenly, so that the filter weights a pixel gathers from its neighbours' rays keep
-    /// summing to about the same ([`SplatOffsets`]). The same for every pixel of the pass.
-    pub fn offsets(&self, n: u32) -> Vec<Vec2> {
-        self.offsets.lattice(self.shared, n)
+    /// The offset within its pixel of a camera ray for the uniform point `v` of `[0, 1)²`,
+    /// drawn as the film draws its shared offsets ([`SplatOffsets`]). A ray whose estimate is
+    /// added here must go through such an offset, and every pixel that takes rays through
+    /// offsets of their own must take the same ones: then the filter weights a pixel gathers
+    /// from its neighbours' rays still sum to a constant, as they do at the shared offset.
+    pub fn offset(&self, v: Vec2) -> Vec2 {
+        self.offsets.warp(v)
     }
 
     /// Adds `samples`.
@@ -638,7 +614,6 @@ impl Film {
                 s.pass.fill(DVec3::ZERO);
                 let samples = FilmSamples {
                     samples: Mutex::default(),
-                    shared: offset,
                     offsets: s.offsets.clone(),
                 };
                 let r = pass(&self.filter, Some(&samples), &mut s.pass);
@@ -891,8 +866,9 @@ mod tests {
     /// Under constant radiance every pass gives the radiance, to 10⁻³, away from the border
     /// (where a pixel misses the estimates outside the film), for the Gaussian and for tents
     /// whose weights sum to a constant (radius 1) or not (radius 1.5); also where every pixel's
-    /// estimate is the mean of four rays through the pass's offsets ([`FilmSamples::offsets`];
-    /// pixels with one ray and pixels with several sum to it only together). The control: offsets drawn uniformly, as before they were
+    /// estimate is the mean of four rays through offsets of their own that all pixels share
+    /// ([`FilmSamples::offset`]; pixels with one ray and pixels with several sum to it only
+    /// together). The control: offsets drawn uniformly, as before they were
     /// drawn by the weights they gather, leave more than 1 % for the Gaussian.
     #[test]
     fn constant_radiance_stays_noiseless() {
@@ -908,19 +884,18 @@ mod tests {
                 let own = pass % 2 == 1;
                 let mut film = Film::new(w, h, filter);
                 let v = rng.next_2d();
+                let points: Vec<Vec2> = (0..4).map(|_| rng.next_2d()).collect();
                 film.add_pass(film.shared_offset(v), |_, samples, sums| {
                     for (i, s) in sums.iter_mut().enumerate() {
                         if !own {
                             *s += DVec3::ONE;
                             continue;
                         }
-                        // The shared offset's share, and three rays through the pass's others.
-                        *s += DVec3::splat(0.25);
+                        // Four rays through the pass's offsets of their own.
                         let samples = samples.unwrap();
-                        let rays = samples.offsets(4).into_iter().skip(1);
-                        samples.add(rays.map(|offset| FilmSample {
+                        samples.add(points.iter().map(|&v| FilmSample {
                             pixel: i as u32,
-                            offset,
+                            offset: samples.offset(v),
                             value: Vec3::splat(0.25),
                         }));
                     }

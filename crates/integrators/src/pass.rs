@@ -17,6 +17,10 @@ use crate::motion::FrameMotion;
 /// The pass stream of the film's shared offset ([`PassContext::shared_offset_of`]).
 const STAGE_FILM: u64 = 0xF11E;
 
+/// The pass stream of the scramble of the film's extra camera rays
+/// ([`PassContext::film_ray_points`]).
+const STAGE_FILM_RAYS: u64 = 0xF11F;
+
 /// Separates the pixel sequences' scrambles from the random streams of the same seed.
 const SEQUENCE_SALT: u64 = 0x50B0_1000_5EED;
 
@@ -268,6 +272,27 @@ impl PassContext<'_> {
         let mut rng = SeededStreams { seed, pass: 0 }.pass(STAGE_FILM);
         let scramble = u64::from(rng.next_u32()) << 32 | u64::from(rng.next_u32());
         OwenSobol::new(scramble, pass).next_2d()
+    }
+
+    /// The uniform points from which a splatting film draws the offsets of `n` more camera
+    /// rays per pixel in this pass, each shared by every pixel that takes them
+    /// ([`crate::film::FilmSamples::offset`]): points `n·pass` to `n·pass + n − 1` of a
+    /// (0, 2)-sequence Owen-scrambled by the seed (not the shared offsets' sequence). Each is
+    /// uniform, those of one pass cover the pixel evenly, and those of the first passes together
+    /// are the sequence's first points: stratified over the pixel as one sequence of `n` times
+    /// the passes (when `n` and the pass count are powers of two, a (0, m, 2)-net); the same in
+    /// every part of a split render.
+    pub fn film_ray_points(&self, n: u32) -> Vec<Vec2> {
+        let mut rng = SeededStreams {
+            seed: self.seed,
+            pass: 0,
+        }
+        .pass(STAGE_FILM_RAYS);
+        let scramble = u64::from(rng.next_u32()) << 32 | u64::from(rng.next_u32());
+        let first = self.pass.wrapping_mul(n);
+        (0..n)
+            .map(|j| OwenSobol::new(scramble, first.wrapping_add(j)).next_2d())
+            .collect()
     }
 }
 

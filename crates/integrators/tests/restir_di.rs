@@ -342,8 +342,8 @@ fn edge_rays_unbiased() {
 }
 
 /// The same on a splatting film (Mitsuba's default Gaussian): every pixel within the filter's
-/// reach of a pixel whose filter sees a lamp gets `edge_rays` camera rays, all but the
-/// G-buffer's through offsets the pass shares, each splatted from there with its share.
+/// reach of a pixel whose filter sees a lamp gets `edge_rays` camera rays in place of the
+/// G-buffer's, through offsets the mask's pixels share, each splatted from there with its share.
 /// Unbiased; the mask from the pass's own rays is caught.
 #[test]
 fn edge_rays_on_a_splatting_film_unbiased() {

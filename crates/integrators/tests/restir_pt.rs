@@ -480,8 +480,8 @@ fn edge_rays_unbiased() {
 
 /// The same on a splatting film (Mitsuba's default Gaussian): the pixels within the filter's
 /// reach of any pixel whose filter sees the lamp get `edge_rays` times the filter's variance
-/// factor camera rays (32 → 10), all but the G-buffer's through offsets the pass shares, each
-/// splatted from there with its share. Unbiased; the mask from the pass's own rays is caught.
+/// factor camera rays (32 → 10) in place of the G-buffer's, through offsets the mask's pixels
+/// share, each splatted from there with its share. Unbiased; the mask from the pass's own rays is caught.
 #[test]
 fn edge_rays_on_a_splatting_film_unbiased() {
     let scene = build(

@@ -317,8 +317,9 @@ impl SeenEmission {
         if splatted > 0 {
             return Some(format!(
                 "{} of {} pixels within the splatting filter's reach of a pixel whose filter sees \
-                 an emitter ({:.2} %), {splatted} camera rays each ({}), all but the G-buffer's through \
-                 offsets the pass shares{delta}",
+                 an emitter ({:.2} %), {splatted} camera rays each ({}) for the seen emission in \
+                 place of the G-buffer's, through offsets the mask's pixels share that follow one \
+                 stratified sequence over the passes{delta}",
                 on.len(),
                 w * h,
                 100.0 * on.len() as f64 / f64::from((w * h).max(1)),
@@ -530,6 +531,33 @@ impl SeenEmission {
         (mask, rays)
     }
 
+    /// The emission a camera ray through film position `film` sees, through the delta lobes of
+    /// the surface it meets with `chains`, and the rays traced.
+    fn seen_through(
+        scene: &Scene,
+        film: Vec2,
+        chains: Option<&DeltaChains>,
+        rng: &mut Pcg32,
+    ) -> (Vec3, u64) {
+        let ray = scene.camera.generate_ray(film, rng.next_2d());
+        let (hit, mut rays) = scene.camera_intersect(&ray, false);
+        let lights = &scene.lights;
+        let Some(si) = hit else {
+            return (lights.environment_radiance(ray.d), rays);
+        };
+        let mut le = Vec3::ZERO;
+        if let Some(light) = lights.light_on_shape(si.shape) {
+            le += lights.area_radiance(light, si.shading.n, -ray.d);
+        }
+        if let Some(c) = chains {
+            let r = Receiver::at_hit(scene, &si, -ray.d, si.t);
+            let (behind, traced) = c.follow(scene, &r, si.ng, rng);
+            le += behind;
+            rays += traced;
+        }
+        (le, rays)
+    }
+
     /// Replaces the seen emission in `radiance` (what the G-buffer's camera rays added, and
     /// nothing else yet) by the mean over this many camera rays on the silhouette pixels, and,
     /// with `chains`, adds on every pixel the emission its camera rays see through delta lobes
@@ -540,16 +568,17 @@ impl SeenEmission {
     /// offset in its pixel, and each ray reaches several pixels. The mask is then every pixel
     /// within the filter's reach of a pixel whose filter sees an area emitter, each with the
     /// camera rays [`SplatRays`] gives (ReSTIR DI's 4 stay 4; ReSTIR PT's 32 become 10 for the
-    /// Gaussian of σ = 0.5). The G-buffer ray keeps its share of the seen emission in
-    /// `radiance`; every other ray goes through one of the offsets the pass shares
-    /// ([`crate::film::FilmSamples::offsets`]: each distributed as the shared offset is, and
-    /// together they keep the filter weights a pixel gathers summing to about the same) and is
-    /// put in
-    /// `ctx.samples` with its share, to be splatted from there
-    /// ([`crate::film::FilmSample`]). Beyond the mask no pixel's filter sees an emitter, so
-    /// pixels with one ray and pixels with several never mix where the emission is not zero.
-    /// Without `ctx.samples`, or with one ray, no camera ray is added, and only the delta
-    /// lobes' continuations of the G-buffer's ray are drawn as many times as the mask says.
+    /// Gaussian of σ = 0.5). These rays take the place of the G-buffer's for the seen emission
+    /// (its share in `radiance` is dropped): ray `j` of every mask pixel goes through the same
+    /// offset, drawn by the film from point `j` of the pass's block of a stratified sequence
+    /// ([`PassContext::film_ray_points`], [`crate::film::FilmSamples::offset`]), so the filter
+    /// weights a pixel gathers keep a constant sum and the rays of all passes together cover
+    /// the pixel as one sequence's first points do, and is put in `ctx.samples` with its share,
+    /// to be splatted from there ([`crate::film::FilmSample`]). Beyond the mask no pixel's
+    /// filter sees an emitter, so pixels with one ray and pixels with several never mix where
+    /// the emission is not zero. Without `ctx.samples`, or with one ray, no camera ray is
+    /// added, and only the delta lobes' continuations of the G-buffer's ray are drawn as many
+    /// times as the mask says.
     pub fn supersample(
         &self,
         scene: &Scene,
@@ -580,16 +609,19 @@ impl SeenEmission {
             self.mask(scene, ctx, chains)
         };
         let (w, _) = ctx.resolution(scene);
-        let lights = &scene.lights;
         let (crop_x, crop_y) = ctx
             .crop
             .as_ref()
             .map_or((0, 0), |c| (c.region.x0, c.region.y0));
-        // Splatting, the extra rays of every pixel go through the same offsets within their
-        // pixels, which the film gives (the first is the pass's shared offset), so that the
-        // weights a pixel gathers from its neighbours' rays sum about the same at each.
+        // Splatting, the mask pixels' rays go through offsets of their own that every mask pixel
+        // shares, so that the weights a pixel gathers from its neighbours' rays keep a constant
+        // sum, and that over the passes follow one stratified sequence.
         let offsets: Vec<Vec2> = match ctx.samples.filter(|_| own_offsets) {
-            Some(film) => film.offsets(splat),
+            Some(film) => ctx
+                .film_ray_points(splat)
+                .into_iter()
+                .map(|v| film.offset(v))
+                .collect(),
             None => Vec::new(),
         };
         // Per worker, the rays traced and the samples through offsets of their own (the film
@@ -611,9 +643,28 @@ impl SeenEmission {
                             le
                         })
                     };
-                    let first = *l + behind(&mut rng, &mut rays);
                     let n = u32::from(mask[i]).max(1);
-                    if splatted && !own_offsets {
+                    let (x, y) = ((i % w as usize) as u32, (i / w as usize) as u32);
+                    if own_offsets && n > 1 {
+                        // Splatting, the G-buffer's ray leaves the seen emission to the pixel's
+                        // rays through the offsets of their own, each put in the film with its
+                        // share, to be splatted from there.
+                        *l = Vec3::ZERO;
+                        let corner = Vec2::new((x + crop_x) as f32, (y + crop_y) as f32);
+                        for &offset in &offsets[..(n as usize).min(offsets.len())] {
+                            let (le, traced) =
+                                Self::seen_through(scene, corner + offset, chains, &mut rng);
+                            rays += traced;
+                            own.push(FilmSample {
+                                pixel: i as u32,
+                                offset,
+                                value: le / n as f32,
+                            });
+                        }
+                        return (rays, own);
+                    }
+                    let first = *l + behind(&mut rng, &mut rays);
+                    if splatted {
                         // The same camera ray: only what lies behind delta lobes differs.
                         let mut sum = first;
                         if receiver.is_some() {
@@ -626,51 +677,15 @@ impl SeenEmission {
                         }
                         return (rays, own);
                     }
-                    let (x, y) = ((i % w as usize) as u32, (i / w as usize) as u32);
-                    // Splatting, the G-buffer's ray keeps its share of the pixel's seen emission at
-                    // the shared offset, and each other ray goes through another offset of the pass,
-                    // with its share, to be splatted from there.
-                    if own_offsets {
-                        *l = first / n as f32;
-                    }
+                    // Sampling, the G-buffer's ray and `n − 1` more at positions of their own.
                     let mut sum = first;
-                    for j in 1..n {
-                        let (film, offset) = if own_offsets {
-                            let offset = offsets[(j as usize).min(offsets.len() - 1)];
-                            let corner = Vec2::new((x + crop_x) as f32, (y + crop_y) as f32);
-                            (corner + offset, Some(offset))
-                        } else {
-                            (ctx.film_position(x, y, &mut rng), None)
-                        };
-                        let before = sum;
-                        let ray = scene.camera.generate_ray(film, rng.next_2d());
-                        let (hit, traced) = scene.camera_intersect(&ray, false);
+                    for _ in 1..n {
+                        let film = ctx.film_position(x, y, &mut rng);
+                        let (le, traced) = Self::seen_through(scene, film, chains, &mut rng);
+                        sum += le;
                         rays += traced;
-                        match hit {
-                            None => sum += lights.environment_radiance(ray.d),
-                            Some(si) => {
-                                if let Some(light) = lights.light_on_shape(si.shape) {
-                                    sum += lights.area_radiance(light, si.shading.n, -ray.d);
-                                }
-                                if let Some(c) = chains {
-                                    let r = Receiver::at_hit(scene, &si, -ray.d, si.t);
-                                    let (le, traced) = c.follow(scene, &r, si.ng, &mut rng);
-                                    sum += le;
-                                    rays += traced;
-                                }
-                            }
-                        }
-                        if let Some(offset) = offset {
-                            own.push(FilmSample {
-                                pixel: i as u32,
-                                offset,
-                                value: (sum - before) / n as f32,
-                            });
-                        }
                     }
-                    if !own_offsets {
-                        *l = sum / n as f32;
-                    }
+                    *l = sum / n as f32;
                     (rays, own)
                 },
             )
