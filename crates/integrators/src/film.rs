@@ -241,7 +241,7 @@ const OFFSET_QUADRATURE: usize = 16;
 /// Gaussian of σ = 0.5. Drawn uniformly, that variation is noise on every pixel of a pass, as
 /// large on a flat bright region (an emitter seen directly, a sky) as on an edge, and a
 /// renderer that makes few passes keeps more of it. Drawn with a density `q(u)` proportional
-/// to `W(u)` (per axis, from a table of its averages over [`OFFSET_BINS`] bins) and each
+/// to `W(u)` (per axis, from a table of its averages over 1024 bins) and each
 /// estimate divided by `q(u)`, a region of constant radiance gets its radiance in every pass
 /// (to within `W`'s variation inside a bin: under 10⁻³), and every pixel's expected value is
 /// unchanged, since `E_q[g(u)/q(u)] = ∫ g(u) du` for what the pixel gathers, `g`.
