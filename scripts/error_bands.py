@@ -31,7 +31,7 @@ from scipy import ndimage
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from pair_variance import read_rgb, render  # noqa: E402
+from pair_variance import parse_configs, read_rgb, render  # noqa: E402
 
 SEEDS = (11, 12)
 
@@ -88,12 +88,7 @@ def main():
     ap.add_argument("--config", action="append", required=True, help="label=passes=flags")
     ap.add_argument("scene")
     a = ap.parse_args()
-    configs = []
-    for c in a.config:
-        parts = c.split("=", 2)
-        if len(parts) != 3 or not parts[1].isdigit():
-            sys.exit(f"--config {c!r}: expected label=passes=flags")
-        configs.append((parts[0], int(parts[1]), parts[2]))
+    configs = parse_configs(a.config)
     os.makedirs(a.out, exist_ok=True)
     name = os.path.splitext(os.path.basename(a.scene))[0]
     first_bin = configs[0][2].split()[0] if configs[0][2].startswith("@") else ""

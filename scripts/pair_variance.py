@@ -62,6 +62,17 @@ def read_rgb(path):
     return np.stack(chans, -1).astype(np.float64)
 
 
+def parse_configs(strings):
+    """`label=passes=flags` strings as (label, passes, flags); exits on a malformed one."""
+    configs = []
+    for c in strings:
+        parts = c.split("=", 2)
+        if len(parts) != 3 or not parts[1].isdigit():
+            sys.exit(f"--config {c!r}: expected label=passes=flags")
+        configs.append((parts[0], int(parts[1]), parts[2]))
+    return configs
+
+
 def render(a, scene, flags, passes, seed, out):
     """Renders once unless `out`'s stats exist; returns (image, CPU seconds without loading)."""
     stats = out + ".json"
@@ -140,12 +151,7 @@ def main():
     seeds = [int(s) for s in a.seeds.split(",")]
     if len(seeds) != 2:
         sys.exit("--seeds takes two seeds")
-    configs = []
-    for c in a.config:
-        parts = c.split("=", 2)
-        if len(parts) != 3 or not parts[1].isdigit():
-            sys.exit(f"--config {c!r}: expected label=passes=flags")
-        configs.append((parts[0], int(parts[1]), parts[2]))
+    configs = parse_configs(a.config)
     os.makedirs(a.out, exist_ok=True)
     base = configs[0][0]
     ratios = {label: [] for label, _, _ in configs}
