@@ -600,7 +600,9 @@ impl SeenEmission {
             return 0;
         }
         let (mask, mut rays) = if self.from_pass {
-            let n = self.rays.min(u32::from(u16::MAX)) as u16;
+            // The counts the mask would give (a splatting film's for its pixels near emitters).
+            let n = if splatted { splat } else { self.rays };
+            let n = n.min(u32::from(u16::MAX)) as u16;
             let mask = radiance
                 .iter()
                 .map(|l| if l.max_element() > 0.0 { n } else { 0 });
@@ -651,14 +653,15 @@ impl SeenEmission {
                         // share, to be splatted from there.
                         *l = Vec3::ZERO;
                         let corner = Vec2::new((x + crop_x) as f32, (y + crop_y) as f32);
-                        for &offset in &offsets[..(n as usize).min(offsets.len())] {
+                        let count = offsets.len() as f32;
+                        for &offset in &offsets {
                             let (le, traced) =
                                 Self::seen_through(scene, corner + offset, chains, &mut rng);
                             rays += traced;
                             own.push(FilmSample {
                                 pixel: i as u32,
                                 offset,
-                                value: le / n as f32,
+                                value: le / count,
                             });
                         }
                         return (rays, own);
