@@ -11,6 +11,9 @@ use restir_scene::FilterDesc;
 
 use super::{pixel_integrals, profile};
 
+/// Rows of the film a task of [`Splat::scatter`] adds to.
+const SCATTER_ROWS: usize = 16;
+
 /// Bins per axis of the table [`SplatOffsets`] draws from.
 const OFFSET_BINS: usize = 1024;
 
@@ -193,27 +196,42 @@ impl Splat {
         let weight = |q: usize, p: usize, u: f32| {
             profile(self.filter, q as f64 - p as f64 + f64::from(u) - 0.5)
         };
-        // Each row of `out` adds the samples of the rows within reach, in their order, so the
-        // sums are the same for any thread count.
-        out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-            let rows = y.saturating_sub(r)..(y + r + 1).min(h);
-            for s in &samples[starts[rows.start]..starts[rows.end]] {
-                let (qx, qy) = (s.pixel as usize % w, s.pixel as usize / w);
-                let wy = weight(qy, y, s.offset.y) * self.inv_norm_y[y];
-                if wy == 0.0 {
-                    continue;
+        // Bands of rows in parallel; within a band each sample's horizontal weights are found
+        // once for all the band's rows within its reach. Each pixel adds the samples within
+        // reach in their order, so the sums are the same for any thread count (and the same as
+        // row by row).
+        out.par_chunks_mut(w * SCATTER_ROWS)
+            .enumerate()
+            .for_each(|(band, chunk)| {
+                let y0 = band * SCATTER_ROWS;
+                let y1 = y0 + chunk.len() / w;
+                let mut wx = vec![0.0f64; 2 * r + 1];
+                let rows = y0.saturating_sub(r)..(y1 + r).min(h);
+                for s in &samples[starts[rows.start]..starts[rows.end]] {
+                    let (qx, qy) = (s.pixel as usize % w, s.pixel as usize / w);
+                    let first = qx.saturating_sub(r);
+                    let span = first..(qx + r + 1).min(w);
+                    for (x, wx) in span.clone().zip(wx.iter_mut()) {
+                        *wx = weight(qx, x, s.offset.x);
+                    }
+                    let inverse_density = self.offsets.inverse_density(s.offset);
+                    for y in qy.saturating_sub(r).max(y0)..(qy + r + 1).min(y1) {
+                        let wy = weight(qy, y, s.offset.y) * self.inv_norm_y[y];
+                        if wy == 0.0 {
+                            continue;
+                        }
+                        let value = s.value.as_dvec3() * (wy * inverse_density);
+                        let row = &mut chunk[(y - y0) * w..(y - y0 + 1) * w];
+                        for ((v, inv), wx) in row[span.clone()]
+                            .iter_mut()
+                            .zip(&self.inv_norm_x[span.clone()])
+                            .zip(&wx)
+                        {
+                            *v += value * (wx * inv);
+                        }
+                    }
                 }
-                let value = s.value.as_dvec3() * (wy * self.offsets.inverse_density(s.offset));
-                let first = qx.saturating_sub(r);
-                let span = first..(qx + r + 1).min(w);
-                for (x, (v, inv)) in span
-                    .clone()
-                    .zip(row[span.clone()].iter_mut().zip(&self.inv_norm_x[span]))
-                {
-                    *v += value * (weight(qx, x, s.offset.x) * inv);
-                }
-            }
-        });
+            });
     }
 
     /// Adds the pass's pixel values, made from its estimates (in `self.pass`) whose rays went
