@@ -269,9 +269,14 @@ impl PassContext<'_> {
     /// passes are stratified over the pixel (the film's map keeps that, axis by axis); the same
     /// in every part of a split render.
     pub fn shared_offset_of(seed: u64, pass: u32) -> Vec2 {
-        let mut rng = SeededStreams { seed, pass: 0 }.pass(STAGE_FILM);
-        let scramble = u64::from(rng.next_u32()) << 32 | u64::from(rng.next_u32());
-        OwenSobol::new(scramble, pass).next_2d()
+        OwenSobol::new(Self::film_scramble(seed, STAGE_FILM), pass).next_2d()
+    }
+
+    /// The scramble of a film sequence of the render with seed `seed`, one per `stage`: the
+    /// same for every pass and in every part of a split render.
+    fn film_scramble(seed: u64, stage: u64) -> u64 {
+        let mut rng = SeededStreams { seed, pass: 0 }.pass(stage);
+        u64::from(rng.next_u32()) << 32 | u64::from(rng.next_u32())
     }
 
     /// The uniform points from which a splatting film draws the offsets of `n` more camera
@@ -283,12 +288,7 @@ impl PassContext<'_> {
     /// the passes (when `n` and the pass count are powers of two, a (0, m, 2)-net); the same in
     /// every part of a split render.
     pub fn film_ray_points(&self, n: u32) -> Vec<Vec2> {
-        let mut rng = SeededStreams {
-            seed: self.seed,
-            pass: 0,
-        }
-        .pass(STAGE_FILM_RAYS);
-        let scramble = u64::from(rng.next_u32()) << 32 | u64::from(rng.next_u32());
+        let scramble = Self::film_scramble(self.seed, STAGE_FILM_RAYS);
         let first = self.pass.wrapping_mul(n);
         (0..n)
             .map(|j| OwenSobol::new(scramble, first.wrapping_add(j)).next_2d())
