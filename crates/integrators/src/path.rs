@@ -254,7 +254,7 @@ pub fn trace_path<S: Sampler>(
             let f = bsdf.eval(wo, wi);
             if f != Vec3::ZERO {
                 rays += 1;
-                if visible(scene, si.p, si.ng, ShadowTarget::new(ls.p, ls.wi, ls.dist)) {
+                if visible(scene, si.p, si.ng, ShadowTarget::of_sample(&ls)) {
                     let w = if ls.delta {
                         1.0
                     } else {

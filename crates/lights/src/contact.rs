@@ -24,6 +24,9 @@ pub struct Contact {
     /// The power sampler's density of the sample per unit solid angle at the receiver (selection
     /// included), where it is known without a lookup (mesh lights, the environment).
     pub pdf_sa: Option<f32>,
+    /// The area light whose surface `p` lies on (for where a shadow ray toward it may end,
+    /// [`LightSet::shadow_end`](crate::LightSet::shadow_end)); `None` for other lights.
+    pub light: Option<u32>,
 }
 
 /// A point emitter at `p` seen from `x`, sending `intensity(direction from p to x, unnormalised)`
@@ -50,6 +53,7 @@ pub(crate) fn point_contact(
         delta: true,
         ng: Vec3::ZERO,
         pdf_sa: None,
+        light: None,
     })
 }
 

@@ -74,6 +74,8 @@ pub enum Resolved {
         /// The power sampler's density per unit area (mesh lights; `None` on a sphere, whose
         /// density depends on the receiver).
         pdf_area: Option<f32>,
+        /// Index of the light.
+        light: u32,
     },
     /// A point light.
     Point {
@@ -122,6 +124,7 @@ impl LightSet {
                     ng: ps.ng,
                     le: radiance,
                     pdf_area: self.mesh_area_density(sample.light),
+                    light: sample.light,
                 }
             }
             Light::Point {
@@ -220,6 +223,7 @@ impl Resolved {
                 ng,
                 le,
                 pdf_area,
+                light,
             } => {
                 let to = p - x;
                 let d2 = to.length_squared();
@@ -241,6 +245,7 @@ impl Resolved {
                     delta: false,
                     ng,
                     pdf_sa: pdf_area.filter(|_| measure > 0.0).map(|a| a / measure),
+                    light: Some(light),
                 })
             }
             Resolved::Point { p, intensity } => point_contact(p, x, |_| Some(intensity)),
@@ -262,6 +267,7 @@ impl Resolved {
                 delta,
                 ng: -wi,
                 pdf_sa: (!delta).then_some(pdf),
+                light: None,
             }),
         }
     }

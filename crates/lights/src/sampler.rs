@@ -97,6 +97,7 @@ impl LightCandidate {
                 delta: ls.delta,
                 ng: ls.ng,
                 pdf_sa: Some(power_pdf_sa),
+                light: (!ls.delta && ls.dist.is_finite()).then_some(ls.light),
             },
             source_pdf: if ls.delta {
                 source_pdf_sa

@@ -92,6 +92,8 @@ pub struct LightSet {
     pub(crate) scene_radius: f32,
     /// The light hierarchy over the table's entries, built on first use.
     pub(crate) hierarchy: OnceLock<LightBvh>,
+    /// Per light, where shadow rays toward it may end ([`LightSet::shadow_end`]).
+    pub(crate) clear: Vec<Option<crate::clear::ClearBox>>,
 }
 
 fn valid(v: Vec3) -> bool {
@@ -264,6 +266,7 @@ impl LightSet {
             })
             .collect();
         let table = EmitterTable::new(&lights, &shapes, &powers, environment);
+        let clear = crate::clear::clear_boxes(&lights, &shapes);
         let mut set = Self {
             shapes,
             area_pdf: vec![0.0; lights.len()],
@@ -278,6 +281,7 @@ impl LightSet {
             scene_radius,
             mesh_areas,
             hierarchy: OnceLock::new(),
+            clear,
         };
         set.update_area_pdfs();
         Ok(set)

@@ -43,15 +43,24 @@ pub struct EnvironmentShare {
 }
 
 impl Scene {
-    /// How light samples are drawn, in one line for `--stats`: the emitter table's size and the
-    /// environment's share, with what decided it.
+    /// How light samples are drawn, in one line for `--stats`: the emitter table's size, the
+    /// lights whose shadow rays end at their clear boxes, and the environment's share, with what
+    /// decided it.
     pub fn light_selection(&self) -> String {
         let lights = &self.lights;
-        let table = format!(
+        let mut table = format!(
             "{} lights, {} entries in one alias table (one per emissive triangle or other light)",
             lights.len(),
             lights.emitter_count()
         );
+        let clear = lights.clear_lights();
+        if clear > 0 {
+            table += &format!(
+                "; shadow rays toward {clear} of them (convex meshes of at most {} triangles \
+                 that nothing else comes near) end where they enter the light's bounds",
+                restir_lights::MAX_CLEAR_TRIANGLES
+            );
+        }
         match (lights.environment(), self.features.environment_share) {
             (None, _) => table,
             (Some(_), Some(d)) => format!(

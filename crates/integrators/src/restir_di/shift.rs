@@ -257,5 +257,5 @@ pub(super) fn visible(scene: &Scene, r: &Receiver, ng: Vec3, c: &Contact) -> boo
 /// The shadow ray's end at light point `c`.
 #[inline]
 pub(super) fn shadow_target(c: &Contact) -> ShadowTarget {
-    ShadowTarget::new(c.p, c.wi, c.dist)
+    ShadowTarget::of_contact(c)
 }

@@ -158,7 +158,7 @@ fn direct(scene: &Scene, si: &SurfaceInteraction, bsdf: &Bsdf, wo: Vec3, rng: &m
     let f = bsdf.eval(wo, si.shading.to_local(ls.wi));
     if ls.pdf_sa <= 0.0
         || f == Vec3::ZERO
-        || !visible(scene, si.p, si.ng, ShadowTarget::new(ls.p, ls.wi, ls.dist))
+        || !visible(scene, si.p, si.ng, ShadowTarget::of_sample(&ls))
     {
         return Vec3::ZERO;
     }

@@ -308,7 +308,7 @@ pub fn evaluate_unshadowed(
                 (_, true) => 0.0,
                 (_, false) => power_heuristic(bsdf1.pdf_sa(r.wo, wi), light_pdf_sa()),
             };
-            (f * c.le * w, Some(ShadowTarget::new(c.p, c.wi, c.dist)))
+            (f * c.le * w, Some(ShadowTarget::of_contact(&c)))
         }
         Vertex::Surface(si) => {
             let to = si.p - r.p;

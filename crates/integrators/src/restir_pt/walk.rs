@@ -365,7 +365,7 @@ impl Walker<'_> {
                     return None;
                 }
                 *rays += 1;
-                let seen = visible(scene, xk.p, xk.ng, ShadowTarget::new(ls.p, ls.wi, ls.dist));
+                let seen = visible(scene, xk.p, xk.ng, ShadowTarget::of_sample(&ls));
                 let jacobian = s.light_pdf_sa / ls.pdf_sa;
                 s.dir = ls.wi;
                 s.radiance = if seen { ls.le } else { Vec3::ZERO };

@@ -42,12 +42,7 @@ impl Walker<'_> {
             return None;
         }
         w.rays += 1;
-        if !visible(
-            scene,
-            cur.r.p,
-            cur.ng,
-            ShadowTarget::new(ls.p, ls.wi, ls.dist),
-        ) {
+        if !visible(scene, cur.r.p, cur.ng, ShadowTarget::of_sample(&ls)) {
             return None;
         }
         let mis = if ls.delta {
