@@ -11,8 +11,9 @@ use restir_scene::Scene;
 pub enum ShadowTarget {
     /// A point at a finite distance.
     Point(Vec3),
-    /// A point on the surface of area light `light`, whose geometric normal there is `ng`: the
-    /// ray may end where it enters the light's clear box ([`restir_lights::LightSet::shadow_end`]).
+    /// A point on primitive `prim` of area light `light`, whose geometric normal there is `ng`:
+    /// the ray may end where it enters the clear box of the primitive's part of the light
+    /// ([`restir_lights::LightSet::shadow_end`]).
     OnLight {
         /// The point.
         p: Vec3,
@@ -20,6 +21,8 @@ pub enum ShadowTarget {
         ng: Vec3,
         /// Index of the light.
         light: u32,
+        /// The primitive of the light's shape that `p` lies on.
+        prim: u32,
     },
     /// A direction to infinity.
     Direction(Vec3),
@@ -41,10 +44,11 @@ impl ShadowTarget {
     #[inline]
     pub fn of_contact(c: &Contact) -> Self {
         match c.light {
-            Some(light) if c.dist.is_finite() => ShadowTarget::OnLight {
+            Some((light, prim)) if c.dist.is_finite() => ShadowTarget::OnLight {
                 p: c.p,
                 ng: c.ng,
                 light,
+                prim,
             },
             _ => Self::new(c.p, c.wi, c.dist),
         }
@@ -60,6 +64,7 @@ impl ShadowTarget {
                 p: ls.p,
                 ng: ls.ng,
                 light: ls.light,
+                prim: ls.prim,
             }
         }
     }
@@ -75,9 +80,12 @@ pub fn visible(scene: &Scene, p: Vec3, ng: Vec3, target: ShadowTarget) -> bool {
             p: q,
             ng: nq,
             light,
+            prim,
         } => {
             let (ray, t_max) = shadow_ray_between(p, ng, q);
-            let end = scene.lights.shadow_end(light, ray.o, ray.d, t_max, q, nq);
+            let end = scene
+                .lights
+                .shadow_end(light, prim, ray.o, ray.d, t_max, q, nq);
             (ray, end)
         }
         ShadowTarget::Direction(d) => shadow_ray_towards(p, ng, d, f32::INFINITY),

@@ -1,4 +1,4 @@
-//! Where a shadow ray toward a point on a light may stop: at the light's clear box.
+//! Where a shadow ray toward a point on a light may stop: at the clear box of the light's part.
 //!
 //! A shadow ray toward a point `y` on an emissive mesh ends at `y`, so its last stretch runs
 //! through the mesh's own part of the scene's BVH: near `y` the traversal descends into the
@@ -7,20 +7,23 @@
 //! large share of every shadow ray's cost.
 //!
 //! For some lights it can be skipped without changing any answer. Decided once, when the set is
-//! built, a light on a mesh has a **clear box** when
+//! built, a mesh light is cut into **parts**, the triangles joined by vertices at the same
+//! position (a lamp, or each bulb of a string of bulbs in one mesh), and a part has a **clear
+//! box** when
 //!
-//! 1. **the mesh is convex**: every vertex lies on the inner side of every triangle's plane
-//!    (the side of the mesh's centroid), so the mesh is part of the boundary of its convex hull;
-//! 2. **nothing else is near it**: no primitive of another shape has a bounding box that meets
-//!    the mesh's bounding box grown by a margin (the clear box).
+//! 1. **the part is convex**: every vertex lies on the inner side of every triangle's plane
+//!    (the side of the part's centroid), so the part is part of the boundary of its convex hull;
+//! 2. **nothing else is near it**: no primitive but the part's own (another shape's, or another
+//!    part's of the same mesh) has a bounding box that meets the part's bounding box grown by a
+//!    margin (the clear box).
 //!
 //! Then, for a receiver `x` strictly in front of the plane of `y`'s triangle (the side away
-//! from the centroid), the segment from `x` to `y` meets no triangle of the mesh before `y`:
-//! the whole mesh lies in the closed inner half-space of that plane, which the segment touches
+//! from the centroid), the segment from `x` to `y` meets no triangle of the part before `y`:
+//! the whole part lies in the closed inner half-space of that plane, which the segment touches
 //! only at `y`. Nor does any other primitive cross the clear box. So when `x` is outside the
 //! clear box, `y` is visible from `x` exactly when nothing blocks the segment up to where it
 //! enters the box, and the shadow ray may end there ([`LightSet::shadow_end`]). The answer is
-//! the same, not an approximation; only rounding at the very end of the ray, where the mesh's
+//! the same, not an approximation; only rounding at the very end of the ray, where the part's
 //! neighbouring triangles could otherwise be grazed, differs, in the ray's favour.
 
 use glam::Vec3;
@@ -28,7 +31,7 @@ use restir_geometry::Shape;
 
 use crate::{Light, LightSet};
 
-/// Meshes of more triangles are not checked for convexity (the check costs triangles times
+/// Parts of more triangles are not checked for convexity (the check costs triangles times
 /// vertices).
 pub const MAX_CLEAR_TRIANGLES: usize = 1024;
 
@@ -61,64 +64,191 @@ impl ClearBox {
     }
 }
 
-/// The clear box of each light (`None` for lights without one), for `lights` on `shapes`.
-pub(crate) fn clear_boxes(lights: &[Light], shapes: &[Shape]) -> Vec<Option<ClearBox>> {
-    let mut boxes: Vec<Option<ClearBox>> = lights
-        .iter()
-        .map(|l| match *l {
-            Light::Area { shape, .. } => match shapes.get(shape as usize) {
-                Some(Shape::Mesh(m)) => convex_box(m.positions(), m.indices()),
-                _ => None,
-            },
-            _ => None,
-        })
-        .collect();
-    // Whose box is met by another shape's primitive: the candidates sorted by the low x of
-    // their boxes, each primitive's box compared with those whose x-range can meet it.
-    let mut order: Vec<(f32, u32)> = boxes
+/// Where shadow rays toward one light may end: the clear boxes of its mesh's parts (a part: the
+/// triangles joined by shared vertices, say one bulb of a string of bulbs).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct LightClear {
+    /// The clear parts' boxes.
+    boxes: Vec<ClearBox>,
+    /// Per triangle, its part's box in `boxes` (`NO_BOX`: its part has none); `None` when the
+    /// whole mesh is one clear part, `boxes[0]`.
+    of_prim: Option<Vec<u32>>,
+}
+
+/// A triangle whose part has no clear box.
+const NO_BOX: u32 = u32::MAX;
+
+impl LightClear {
+    /// The clear box of the part that triangle `prim` belongs to.
+    #[inline]
+    fn of(&self, prim: u32) -> Option<&ClearBox> {
+        match &self.of_prim {
+            None => self.boxes.first(),
+            Some(of) => self.boxes.get(*of.get(prim as usize)? as usize),
+        }
+    }
+}
+
+/// Each triangle's part of `mesh` (triangles joined by vertices at the same position), numbered
+/// from 0, and the number of parts.
+fn parts(positions: &[Vec3], indices: &[[u32; 3]]) -> (Vec<u32>, usize) {
+    // Vertices at the same position are one (a seam of a uv-mapped bulb splits its vertices).
+    let mut first_at = std::collections::HashMap::with_capacity(positions.len());
+    let same: Vec<u32> = positions
         .iter()
         .enumerate()
-        .filter_map(|(i, b)| b.map(|b| (b.lo.x, i as u32)))
+        .map(|(i, p)| {
+            *first_at
+                .entry(p.to_array().map(f32::to_bits))
+                .or_insert(i as u32)
+        })
         .collect();
+    let mut parent: Vec<u32> = (0..positions.len() as u32).collect();
+    fn root(parent: &mut [u32], mut v: u32) -> u32 {
+        while parent[v as usize] != v {
+            let up = parent[parent[v as usize] as usize];
+            parent[v as usize] = up;
+            v = up;
+        }
+        v
+    }
+    for t in indices {
+        let a = root(&mut parent, same[t[0] as usize]);
+        for &v in &t[1..] {
+            let b = root(&mut parent, same[v as usize]);
+            if a != b {
+                parent[b as usize] = a;
+            }
+        }
+    }
+    let mut label = vec![u32::MAX; positions.len()];
+    let mut count = 0;
+    let of: Vec<u32> = indices
+        .iter()
+        .map(|t| {
+            let r = root(&mut parent, same[t[0] as usize]) as usize;
+            if label[r] == u32::MAX {
+                label[r] = count;
+                count += 1;
+            }
+            label[r]
+        })
+        .collect();
+    (of, count as usize)
+}
+
+/// A mesh light's parts as found: each triangle's part, and each part's box where the part is
+/// convex.
+type Parts = (Vec<u32>, Vec<Option<ClearBox>>);
+
+/// Where shadow rays toward each light may end (`None` for lights without a clear part), for
+/// `lights` on `shapes`.
+pub(crate) fn clear_boxes(lights: &[Light], shapes: &[Shape]) -> Vec<Option<LightClear>> {
+    // Per light on a valid mesh: each triangle's part, and each part's box if it is convex.
+    let mut found: Vec<Option<Parts>> = lights
+        .iter()
+        .map(|l| {
+            let Light::Area { shape, .. } = *l else {
+                return None;
+            };
+            let Some(Shape::Mesh(m)) = shapes.get(shape as usize) else {
+                return None;
+            };
+            let (of, count) = parts(m.positions(), m.indices());
+            let mut members: Vec<Vec<[u32; 3]>> = vec![Vec::new(); count];
+            for (t, &k) in m.indices().iter().zip(&of) {
+                members[k as usize].push(*t);
+            }
+            let boxes: Vec<Option<ClearBox>> = members
+                .iter()
+                .map(|tris| convex_box(m.positions(), tris))
+                .collect();
+            boxes.iter().any(Option::is_some).then_some((of, boxes))
+        })
+        .collect();
+    // Which boxes another primitive's box meets: the boxes sorted by their low x, each
+    // primitive's box compared with those whose x-range can meet it.
+    let mut order: Vec<(f32, u32, u32)> = Vec::new();
+    for (light, f) in found.iter().enumerate() {
+        if let Some((_, boxes)) = f {
+            for (k, b) in boxes.iter().enumerate() {
+                if let Some(b) = b {
+                    order.push((b.lo.x, light as u32, k as u32));
+                }
+            }
+        }
+    }
     if order.is_empty() {
-        return boxes;
+        return vec![None; lights.len()];
     }
     order.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let box_of = |found: &[Option<Parts>], light: u32, k: u32| {
+        found[light as usize]
+            .as_ref()
+            .and_then(|(_, b)| b[k as usize])
+    };
     let widest = order
         .iter()
-        .filter_map(|&(_, i)| boxes[i as usize].map(|b| b.hi.x - b.lo.x))
+        .filter_map(|&(_, l, k)| box_of(&found, l, k).map(|b| b.hi.x - b.lo.x))
         .fold(0.0f32, f32::max);
     let own_shape = |light: u32| match lights[light as usize] {
         Light::Area { shape, .. } => shape,
         _ => u32::MAX,
     };
-    let mut met = vec![false; lights.len()];
+    let mut met = Vec::new();
     for (si, shape) in shapes.iter().enumerate() {
         for ti in 0..shape.primitive_count() as u32 {
             let (lo, hi) = shape.primitive_bounds(ti);
-            let first = order.partition_point(|&(x, _)| x < lo.x - widest);
-            let last = order.partition_point(|&(x, _)| x <= hi.x);
-            for &(_, light) in &order[first..last.max(first)] {
-                if met[light as usize] || own_shape(light) == si as u32 {
-                    continue;
-                }
-                let Some(b) = boxes[light as usize] else {
+            let first = order.partition_point(|&(x, _, _)| x < lo.x - widest);
+            let last = order.partition_point(|&(x, _, _)| x <= hi.x);
+            for &(_, light, k) in &order[first..last.max(first)] {
+                let Some(b) = box_of(&found, light, k) else {
                     continue;
                 };
+                // A part's own triangles do not count.
+                if own_shape(light) == si as u32
+                    && found[light as usize]
+                        .as_ref()
+                        .is_some_and(|(of, _)| of[ti as usize] == k)
+                {
+                    continue;
+                }
                 // Not provably apart (NaN bounds count as meeting).
-                let apart = lo.cmpgt(b.hi).any() || hi.cmplt(b.lo).any();
-                if !apart {
-                    met[light as usize] = true;
+                if !(lo.cmpgt(b.hi).any() || hi.cmplt(b.lo).any()) {
+                    met.push((light, k));
                 }
             }
         }
     }
-    for (b, met) in boxes.iter_mut().zip(met) {
-        if met {
-            *b = None;
+    for (light, k) in met {
+        if let Some((_, boxes)) = &mut found[light as usize] {
+            boxes[k as usize] = None;
         }
     }
-    boxes
+    found
+        .into_iter()
+        .map(|f| {
+            let (of, boxes) = f?;
+            if boxes.len() == 1 {
+                return boxes[0].map(|b| LightClear {
+                    boxes: vec![b],
+                    of_prim: None,
+                });
+            }
+            let mut index = vec![NO_BOX; boxes.len()];
+            let mut kept = Vec::new();
+            for (k, b) in boxes.iter().enumerate() {
+                if let Some(b) = b {
+                    index[k] = kept.len() as u32;
+                    kept.push(*b);
+                }
+            }
+            (!kept.is_empty()).then(|| LightClear {
+                boxes: kept,
+                of_prim: Some(of.iter().map(|&k| index[k as usize]).collect()),
+            })
+        })
+        .collect()
 }
 
 /// The grown bounding box of a convex mesh, or `None` when the mesh is too large to check,
@@ -193,23 +323,35 @@ fn convex_box(positions: &[Vec3], indices: &[[u32; 3]]) -> Option<ClearBox> {
 }
 
 impl LightSet {
-    /// Where a shadow ray from `o` along unit `d` toward point `y` on light `light` (whose
-    /// surface's geometric normal there is `ng`, either orientation) may end instead of
-    /// `t_max`: where it enters the light's clear box, when the light has one (see the
+    /// Where a shadow ray from `o` along unit `d` toward point `y` on triangle `prim` of light
+    /// `light` (whose geometric normal there is `ng`, either orientation) may end instead of
+    /// `t_max`: where it enters the clear box of the triangle's part, when it has one (see the
     /// module's documentation), `o` lies outside it and in front of `y`'s triangle; `t_max`
     /// otherwise. Whether the segment up to the returned distance is blocked is whether `y`
     /// is visible from `o`.
     #[inline]
-    pub fn shadow_end(&self, light: u32, o: Vec3, d: Vec3, t_max: f32, y: Vec3, ng: Vec3) -> f32 {
+    #[allow(clippy::too_many_arguments)] // the ray, its end and the point it ends on
+    pub fn shadow_end(
+        &self,
+        light: u32,
+        prim: u32,
+        o: Vec3,
+        d: Vec3,
+        t_max: f32,
+        y: Vec3,
+        ng: Vec3,
+    ) -> f32 {
         match self.clear.get(light as usize) {
-            Some(Some(b)) => b.end(o, d, t_max, y, ng),
+            Some(Some(c)) => c.of(prim).map_or(t_max, |b| b.end(o, d, t_max, y, ng)),
             _ => t_max,
         }
     }
 
-    /// How many lights have a clear box (shadow rays toward them end where they enter it).
-    pub fn clear_lights(&self) -> usize {
-        self.clear.iter().filter(|b| b.is_some()).count()
+    /// How many lights have a part with a clear box, and how many such parts they have
+    /// (shadow rays toward a point on one end where they enter its box).
+    pub fn clear_parts(&self) -> (usize, usize) {
+        let lights = self.clear.iter().flatten();
+        (lights.clone().count(), lights.map(|c| c.boxes.len()).sum())
     }
 }
 
@@ -302,7 +444,8 @@ mod tests {
                 rng.next_f32() * 5.0 - 0.5,
                 rng.next_f32() * 8.0 - 4.0,
             );
-            for (mesh, b) in [(&lamp, boxes[0].unwrap()), (&crowded, forged)] {
+            let lamp_box = boxes[0].as_ref().unwrap().boxes[0];
+            for (mesh, b) in [(&lamp, lamp_box), (&crowded, forged)] {
                 let k = (rng.next_f32() * mesh.triangle_count() as f32) as usize;
                 let [a, bb, c] = mesh.triangle(k.min(mesh.triangle_count() - 1));
                 let (u, v) = (rng.next_f32(), rng.next_f32());
@@ -369,6 +512,64 @@ mod tests {
             }
         }
         (p, t)
+    }
+
+    /// One mesh of three bulbs, each with its vertices split along a seam (as a uv-mapped
+    /// mesh has them), one of them with an occluder beside it: two parts get clear boxes, the
+    /// crowded one none, and each triangle finds its own part's box.
+    #[test]
+    fn each_part_of_a_string_of_bulbs_has_its_own_box() {
+        let centres = [
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(4.0, 0.0, 0.0),
+        ];
+        let (mut p, mut t) = (Vec::new(), Vec::new());
+        for c in centres {
+            let b = bulb(c, 0.3, 12, 8);
+            let base = p.len() as u32;
+            p.extend_from_slice(b.positions());
+            // Every triangle's first corner a copy of the vertex at the same place.
+            for tri in b.indices() {
+                p.push(b.positions()[tri[0] as usize]);
+                let copy = p.len() as u32 - 1;
+                t.push([copy, base + tri[1], base + tri[2]]);
+            }
+        }
+        let string = TriangleMesh::new(p, None, None, t, false).unwrap();
+        let per_bulb = string.triangle_count() / 3;
+        let (of, count) = parts(string.positions(), string.indices());
+        assert_eq!(count, 3);
+        assert!((0..3).all(|k| {
+            of[k * per_bulb..(k + 1) * per_bulb]
+                .iter()
+                .all(|&x| x == of[k * per_bulb])
+        }));
+        let shapes = vec![
+            Shape::Mesh(string),
+            tri(
+                Vec3::new(4.31, -0.2, -0.2),
+                Vec3::new(4.31, 0.2, -0.2),
+                Vec3::new(4.31, 0.0, 0.3),
+            ),
+        ];
+        let lights = vec![Light::Area {
+            shape: 0,
+            radiance: Vec3::ONE,
+        }];
+        let clear = clear_boxes(&lights, &shapes);
+        let c = clear[0].as_ref().expect("two clear parts");
+        assert_eq!(c.boxes.len(), 2);
+        for (k, centre) in centres.iter().enumerate() {
+            let b = c.of((k * per_bulb + 5) as u32);
+            if k == 2 {
+                assert!(b.is_none());
+            } else {
+                let b = b.unwrap();
+                assert!(b.lo.cmplt(*centre).all() && b.hi.cmpgt(*centre).all());
+                assert!((b.hi - b.lo).max_element() < 0.7);
+            }
+        }
     }
 
     #[test]

@@ -24,9 +24,10 @@ pub struct Contact {
     /// The power sampler's density of the sample per unit solid angle at the receiver (selection
     /// included), where it is known without a lookup (mesh lights, the environment).
     pub pdf_sa: Option<f32>,
-    /// The area light whose surface `p` lies on (for where a shadow ray toward it may end,
+    /// The area light whose surface `p` lies on and the primitive of its shape `p` lies on
+    /// (for where a shadow ray toward it may end,
     /// [`LightSet::shadow_end`](crate::LightSet::shadow_end)); `None` for other lights.
-    pub light: Option<u32>,
+    pub light: Option<(u32, u32)>,
 }
 
 /// A point emitter at `p` seen from `x`, sending `intensity(direction from p to x, unnormalised)`

@@ -74,8 +74,6 @@ pub enum Resolved {
         /// The power sampler's density per unit area (mesh lights; `None` on a sphere, whose
         /// density depends on the receiver).
         pdf_area: Option<f32>,
-        /// Index of the light.
-        light: u32,
     },
     /// A point light.
     Point {
@@ -124,7 +122,6 @@ impl LightSet {
                     ng: ps.ng,
                     le: radiance,
                     pdf_area: self.mesh_area_density(sample.light),
-                    light: sample.light,
                 }
             }
             Light::Point {
@@ -206,16 +203,17 @@ impl LightSet {
     /// Where `sample` lies as seen from `x` ([`LightSet::resolve`] then [`Resolved::contact`]).
     #[inline]
     pub fn contact(&self, sample: &LightPoint, x: Vec3) -> Option<Contact> {
-        self.resolve(sample).contact(self, x)
+        self.resolve(sample).contact(self, sample, x)
     }
 }
 
 impl Resolved {
     /// The sample as seen from `x`, or `None` if it cannot contribute there (behind a one-sided
     /// emitter, outside a spot light's cone or a projector's frustum, at zero distance). `lights` is the set that resolved
-    /// it (a spot light's profile and texture are read there).
+    /// it (a spot light's profile and texture are read there), `point` the name it was resolved
+    /// from (the light and primitive a shadow ray toward it ends on).
     #[inline]
-    pub fn contact(&self, lights: &LightSet, x: Vec3) -> Option<Contact> {
+    pub fn contact(&self, lights: &LightSet, point: &LightPoint, x: Vec3) -> Option<Contact> {
         match *self {
             Resolved::Surface {
                 p,
@@ -223,7 +221,6 @@ impl Resolved {
                 ng,
                 le,
                 pdf_area,
-                light,
             } => {
                 let to = p - x;
                 let d2 = to.length_squared();
@@ -245,7 +242,7 @@ impl Resolved {
                     delta: false,
                     ng,
                     pdf_sa: pdf_area.filter(|_| measure > 0.0).map(|a| a / measure),
-                    light: Some(light),
+                    light: Some((point.light, point.prim)),
                 })
             }
             Resolved::Point { p, intensity } => point_contact(p, x, |_| Some(intensity)),

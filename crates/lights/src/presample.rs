@@ -101,7 +101,6 @@ impl LightSet {
                         ng: ps.ng,
                         le: radiance,
                         pdf_area: Some(pdf_area),
-                        light,
                     },
                     pdf: pdf_area,
                 });

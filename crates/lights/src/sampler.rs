@@ -97,7 +97,7 @@ impl LightCandidate {
                 delta: ls.delta,
                 ng: ls.ng,
                 pdf_sa: Some(power_pdf_sa),
-                light: (!ls.delta && ls.dist.is_finite()).then_some(ls.light),
+                light: (!ls.delta && ls.dist.is_finite()).then_some((ls.light, ls.prim)),
             },
             source_pdf: if ls.delta {
                 source_pdf_sa
@@ -136,7 +136,7 @@ impl LightCandidate {
                 return Self::from_sample(&ls, ls.pdf_sa * pmf, ls.pdf_sa * pmf);
             }
         };
-        let contact = resolved.contact(lights, x)?;
+        let contact = resolved.contact(lights, &point, x)?;
         // Area lights: the area density over the measure factor is the solid-angle density.
         if contact.measure <= 0.0 {
             return None;

@@ -93,7 +93,7 @@ pub struct LightSet {
     /// The light hierarchy over the table's entries, built on first use.
     pub(crate) hierarchy: OnceLock<LightBvh>,
     /// Per light, where shadow rays toward it may end ([`LightSet::shadow_end`]).
-    pub(crate) clear: Vec<Option<crate::clear::ClearBox>>,
+    pub(crate) clear: Vec<Option<crate::clear::LightClear>>,
 }
 
 fn valid(v: Vec3) -> bool {

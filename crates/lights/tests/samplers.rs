@@ -434,7 +434,10 @@ fn sphere_candidates_are_the_points_their_names_resolve_to() {
             .flatten()
             .filter(|c| c.point.light < 30)
         {
-            let resolved = lights.resolve(&c.point).contact(&lights, at.p).unwrap();
+            let resolved = lights
+                .resolve(&c.point)
+                .contact(&lights, &c.point, at.p)
+                .unwrap();
             assert_eq!(c.contact.p, resolved.p, "candidate {i}");
             assert_eq!(c.contact.wi, resolved.wi, "candidate {i}");
             let rel = (c.contact.measure - resolved.measure).abs() / resolved.measure;

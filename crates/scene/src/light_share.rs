@@ -53,11 +53,12 @@ impl Scene {
             lights.len(),
             lights.emitter_count()
         );
-        let clear = lights.clear_lights();
+        let (clear, parts) = lights.clear_parts();
         if clear > 0 {
             table += &format!(
-                "; shadow rays toward {clear} of them (convex meshes of at most {} triangles \
-                 that nothing else comes near) end where they enter the light's bounds",
+                "; shadow rays toward {parts} parts of {clear} of them (convex parts of at most \
+                 {} triangles that nothing else comes near) end where they enter the part's \
+                 bounds",
                 restir_lights::MAX_CLEAR_TRIANGLES
             );
         }

@@ -112,7 +112,7 @@ impl RestirDiIntegrator {
                     continue;
                 };
                 let resolved = scene.lights.resolve(&y);
-                let Some(c) = resolved.contact(&scene.lights, r.p) else {
+                let Some(c) = resolved.contact(&scene.lights, &y, r.p) else {
                     continue;
                 };
                 let e = evaluate(scene, r, bsdf, &y, &c, None, self.counts);
@@ -143,9 +143,9 @@ impl RestirDiIntegrator {
         };
         if self.settings.visibility.tests_initial()
             && !by_bsdf
-            && let Some((_, y)) = &resolved
+            && let Some((point, y)) = &resolved
         {
-            let visible = y.contact(&scene.lights, r.p).is_some_and(|c| {
+            let visible = y.contact(&scene.lights, point, r.p).is_some_and(|c| {
                 rays += 1;
                 visible(scene, r, ng, &c)
             });

@@ -234,7 +234,7 @@ impl RestirDiIntegrator {
                 Some((x, resolved)) if *x == y.point => *resolved,
                 _ => scene.lights.resolve(&y.point),
             }
-            .contact(&scene.lights, r.p)
+            .contact(&scene.lights, &y.point, r.p)
         {
             let e = evaluate(scene, r, bsdf, &y.point, &c, None, self.counts);
             if e.target > 0.0 && {

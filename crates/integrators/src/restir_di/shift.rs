@@ -137,7 +137,7 @@ impl<'a> ShiftMap<DiSample> for DiShift<'a> {
         } else {
             to.scene.lights.resolve(&y)
         };
-        let Some(c) = resolved.contact(&to.scene.lights, to.r.p) else {
+        let Some(c) = resolved.contact(&to.scene.lights, &y, to.r.p) else {
             return Some(Shifted::identity(
                 DiSample {
                     point: y,

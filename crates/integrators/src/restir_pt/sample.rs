@@ -289,7 +289,7 @@ pub fn evaluate_unshadowed(
     let frame1 = r.frame();
     match v {
         Vertex::Light(resolved) => {
-            let Some(c) = resolved.contact(&scene.lights, r.p) else {
+            let Some(c) = resolved.contact(&scene.lights, &s.light_point(), r.p) else {
                 return (Vec3::ZERO, None);
             };
             let wi = frame1.to_local(c.wi);
