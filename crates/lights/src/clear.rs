@@ -29,6 +29,7 @@
 use glam::Vec3;
 use restir_geometry::Shape;
 
+use crate::corners::Corners;
 use crate::{Light, LightSet};
 
 /// Parts of more triangles are not checked for convexity (the check costs triangles times
@@ -258,34 +259,18 @@ fn convex_box(positions: &[Vec3], indices: &[[u32; 3]]) -> Option<ClearBox> {
         return None;
     }
     // Only the vertices the triangles use.
-    let mut ids: Vec<u32> = indices.iter().flatten().copied().collect();
-    ids.sort_unstable();
-    ids.dedup();
-    let used: Vec<Vec3> = ids
-        .iter()
-        .map(|&v| positions.get(v as usize).copied())
-        .collect::<Option<_>>()?;
-    if !used.iter().all(|v| v.is_finite()) {
+    let ids = indices.iter().flatten().map(|&v| v as usize);
+    if ids.clone().any(|v| v >= positions.len()) {
         return None;
     }
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    let mut sum = Vec3::ZERO;
-    for &v in &used {
-        lo = lo.min(v);
-        hi = hi.max(v);
-        sum += v;
-    }
-    let centroid = sum / used.len() as f32;
+    let corners = Corners::of(ids.map(|v| positions[v]))?;
+    let (lo, hi, centroid) = (corners.lo, corners.hi, corners.centroid);
     let size = (hi - lo).length();
     if !(size > 0.0 && size.is_finite()) {
         return None;
     }
-    // Rounding in the planes' normals and offsets, relative to the mesh's size.
+    // Rounding in the planes' normals and offsets, relative to the part's size.
     let tol = 1e-5 * size;
-    // The vertices by coordinate, for a loop over them that runs in SIMD lanes.
-    let xs: Vec<f32> = used.iter().map(|v| v.x).collect();
-    let ys: Vec<f32> = used.iter().map(|v| v.y).collect();
-    let zs: Vec<f32> = used.iter().map(|v| v.z).collect();
     for t in indices {
         let [a, b, c] = t.map(|v| positions[v as usize]);
         let n = (b - a).cross(c - a);
@@ -299,15 +284,7 @@ fn convex_box(positions: &[Vec3], indices: &[[u32; 3]]) -> Option<ClearBox> {
         if h.abs() <= tol {
             return None;
         }
-        let n = if h > 0.0 { n } else { -n };
-        let limit = n.dot(a) + tol;
-        let outside = xs
-            .iter()
-            .zip(&ys)
-            .zip(&zs)
-            .filter(|&((&x, &y), &z)| n.x * x + n.y * y + n.z * z > limit)
-            .count();
-        if outside > 0 {
+        if !corners.behind(if h > 0.0 { n } else { -n }, a, tol) {
             return None;
         }
     }

@@ -16,6 +16,7 @@ use glam::Vec3;
 use restir_geometry::Shape;
 
 use crate::Light;
+use crate::corners::Corners;
 use crate::table::{Emitter, EmitterTable};
 
 /// The share of a cut's selections that a light keeps for receivers on its own surface when
@@ -68,25 +69,13 @@ pub(crate) fn self_unlit(lights: &[Light], shapes: &[Shape], table: &EmitterTabl
 /// Whether every corner of `triangles` lies behind every triangle's plane (its normal `ng`
 /// pointing out), up to 10⁻⁴ of the triangles' extent.
 fn convex(triangles: &[([Vec3; 3], Vec3)]) -> bool {
-    let mut corners: Vec<[u32; 3]> = triangles
+    let Some(corners) = Corners::of(triangles.iter().flat_map(|(p, _)| p.iter().copied())) else {
+        return false;
+    };
+    let tolerance = 1e-4 * (corners.hi - corners.lo).length();
+    triangles
         .iter()
-        .flat_map(|(p, _)| p.iter().map(|c| c.to_array().map(f32::to_bits)))
-        .collect();
-    corners.sort_unstable();
-    corners.dedup();
-    let corners: Vec<Vec3> = corners
-        .into_iter()
-        .map(|c| Vec3::from_array(c.map(f32::from_bits)))
-        .collect();
-    let (lo, hi) = corners.iter().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), &c| (lo.min(c), hi.max(c)),
-    );
-    let tolerance = 1e-4 * (hi - lo).length();
-    triangles.iter().all(|&(p, ng)| {
-        let plane = ng.dot(p[0]);
-        ng.is_finite() && corners.iter().all(|&c| ng.dot(c) - plane <= tolerance)
-    })
+        .all(|&(p, ng)| corners.behind(ng, p[0], tolerance))
 }
 
 #[cfg(test)]
