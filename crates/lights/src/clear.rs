@@ -305,7 +305,8 @@ impl LightSet {
     /// `t_max`: where it enters the clear box of the triangle's part, when it has one (see the
     /// module's documentation), `o` lies outside it and in front of `y`'s triangle; `t_max`
     /// otherwise. Whether the segment up to the returned distance is blocked is whether `y`
-    /// is visible from `o`.
+    /// is visible from `o`, given that the set's shapes are all that can block a ray
+    /// ([`LightSet::new`]).
     #[inline]
     #[allow(clippy::too_many_arguments)] // the ray, its end and the point it ends on
     pub fn shadow_end(

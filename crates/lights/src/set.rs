@@ -101,7 +101,9 @@ fn valid(v: Vec3) -> bool {
 }
 
 impl LightSet {
-    /// Builds the set. `scene_bounds` sizes lights at infinity (directional power, shadow-ray
+    /// Builds the set. `shapes` are all of the scene's shapes, occluders included (area lights
+    /// name theirs by index, and [`LightSet::shadow_end`] is exact only when nothing else can
+    /// block a ray). `scene_bounds` sizes lights at infinity (directional power, shadow-ray
     /// length).
     pub fn new(
         lights: Vec<Light>,
