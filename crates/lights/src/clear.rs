@@ -434,11 +434,14 @@ mod tests {
                 };
                 let y = a + u * (bb - a) + v * (c - a);
                 let ng = (bb - a).cross(c - a).normalize();
-                if ng.dot(x - y) <= 0.0 {
-                    continue; // the back of the bulb's triangle: no contact
-                }
                 let (ray, t_max) = shadow_ray_between(x, Vec3::ZERO, y);
                 let end = b.end(ray.o, ray.d, t_max, y, ng);
+                if ng.dot(x - y) <= 0.0 {
+                    // Behind the point's triangle the ray crosses the bulb: it must keep its
+                    // whole length (a shading normal could still make this a contact).
+                    assert_eq!(end, t_max, "x {x} y {y}");
+                    continue;
+                }
                 let full = accel.occluded(&ray, t_max);
                 let short = accel.occluded(&ray, end);
                 if std::ptr::eq(mesh, &lamp) {
@@ -492,9 +495,10 @@ mod tests {
         (p, t)
     }
 
-    /// One mesh of three bulbs, each with its vertices split along a seam (as a uv-mapped
-    /// mesh has them), one of them with an occluder beside it: two parts get clear boxes, the
-    /// crowded one none, and each triangle finds its own part's box.
+    /// One mesh of three bulbs, each split along a seam into two halves that share no vertex
+    /// index, only positions (as a uv-mapped mesh has them), one of them with an occluder
+    /// beside it: three parts, two with clear boxes, the crowded one none, and each triangle
+    /// finds its own part's box.
     #[test]
     fn each_part_of_a_string_of_bulbs_has_its_own_box() {
         let centres = [
@@ -505,13 +509,19 @@ mod tests {
         let (mut p, mut t) = (Vec::new(), Vec::new());
         for c in centres {
             let b = bulb(c, 0.3, 12, 8);
+            // The bulb's vertices twice: the half with x above the centre uses the copy.
             let base = p.len() as u32;
             p.extend_from_slice(b.positions());
-            // Every triangle's first corner a copy of the vertex at the same place.
+            p.extend_from_slice(b.positions());
+            let n = b.positions().len() as u32;
             for tri in b.indices() {
-                p.push(b.positions()[tri[0] as usize]);
-                let copy = p.len() as u32 - 1;
-                t.push([copy, base + tri[1], base + tri[2]]);
+                let mid = tri
+                    .iter()
+                    .map(|&v| b.positions()[v as usize].x)
+                    .sum::<f32>()
+                    / 3.0;
+                let copy = if mid > c.x { n } else { 0 };
+                t.push(tri.map(|v| base + copy + v));
             }
         }
         let string = TriangleMesh::new(p, None, None, t, false).unwrap();
