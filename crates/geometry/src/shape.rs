@@ -104,25 +104,38 @@ impl Sphere {
             return Some((ps, pdf));
         }
         let dist = d2.sqrt();
-        let sin2_max = r2 / d2;
-        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
-        let frame = Frame::from_normal(to_c / dist);
-        let local = warp::sample_uniform_cone(u, cos_max);
-        let dir = frame.to_world(local);
-        // Intersect the ray with the sphere; clamp tangential misses to the silhouette.
-        let b = dir.dot(to_c);
-        let disc = (r2 - (d2 - b * b)).max(0.0);
-        let t = b - disc.sqrt();
-        let hit = ref_p + dir * t;
-        let uv = Sphere::param_of(((hit - self.center) / self.radius).normalize());
+        let (_, one_minus_cos_max) = cone_of(r2, d2);
+        let pdf = 1.0 / (2.0 * PI * one_minus_cos_max);
+        if !(pdf > 0.0 && pdf.is_finite()) {
+            return None;
+        }
+        // θ from the axis towards the centre, uniform in solid angle over the cone:
+        // 1 − cos θ = u·(1 − cos θmax), and sin²θ = (1 − cos θ)(1 + cos θ), both without the
+        // cancellation that `1 − cos` suffers for a small or distant sphere.
+        let one_minus_cos = u.x * one_minus_cos_max;
+        let cos_theta = 1.0 - one_minus_cos;
+        let sin2_theta = one_minus_cos * (2.0 - one_minus_cos);
+        // The angle α at the centre between the direction back to `ref_p` and the point where
+        // that direction first meets the sphere, from the law of sines (Pharr, Jakob and
+        // Humphreys, *Physically Based Rendering*, 4th ed., §6.2.4): no ray-sphere
+        // intersection, whose `d² − b²` loses the point on a sphere far smaller than its
+        // distance.
+        let inv_sin_max = dist / self.radius;
+        let cos_alpha = sin2_theta * inv_sin_max
+            + cos_theta * (1.0 - (sin2_theta * inv_sin_max * inv_sin_max).min(1.0)).sqrt();
+        let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
+        let (sin_phi, cos_phi) = (2.0 * PI * u.y).sin_cos();
+        let back = Frame::from_normal(to_c * (-1.0 / dist));
+        let n = back.to_world(Vec3::new(
+            sin_alpha * cos_phi,
+            sin_alpha * sin_phi,
+            cos_alpha,
+        ));
         // The sample is the point its parameters name, which is what a light sample
         // kept by its name (a reservoir's) resolves to: near the silhouette a rounding
         // of the point changes the cosine at the light by orders of magnitude, and a
         // candidate weighed at one point and shaded at the other would be a firefly.
-        let pdf = warp::uniform_cone_pdf(cos_max);
-        if pdf <= 0.0 || !pdf.is_finite() {
-            return None;
-        }
+        let uv = Sphere::param_of(n);
         Some((self.position_at(uv), pdf))
     }
 
@@ -161,6 +174,17 @@ pub fn octahedral_decode(e: Vec2) -> Vec3 {
     let x = x + if x >= 0.0 { -t } else { t };
     let y = y + if y >= 0.0 { -t } else { t };
     Vec3::new(x, y, z).normalize()
+}
+
+/// The cone of directions a sphere of squared radius `r2` subtends from a point at squared
+/// distance `d2` from its centre: `(sin²θmax, 1 − cos θmax)`, the second as
+/// `sin²θmax / (1 + cos θmax)`, exact where `1 − cos θmax` would round to a few ulps or to 0
+/// (a sphere a thousand times smaller than its distance).
+#[inline]
+fn cone_of(r2: f32, d2: f32) -> (f32, f32) {
+    let sin2_max = r2 / d2;
+    let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+    (sin2_max, sin2_max / (1.0 + cos_max))
 }
 
 /// A point sampled on a shape.
@@ -361,8 +385,9 @@ impl Shape {
                 if d2 <= r2 * (1.0 + 1e-4) {
                     return area_to_solid_angle(1.0 / self.area(), ref_p, p, n).unwrap_or(0.0);
                 }
-                let cos_max = (1.0 - r2 / d2).max(0.0).sqrt();
-                warp::uniform_cone_pdf(cos_max)
+                let (_, one_minus_cos_max) = cone_of(r2, d2);
+                let pdf = 1.0 / (2.0 * PI * one_minus_cos_max);
+                if pdf.is_finite() { pdf } else { 0.0 }
             }
             Shape::Mesh(_) | Shape::Cylinder(_) => {
                 area_to_solid_angle(1.0 / self.area(), ref_p, p, n).unwrap_or(0.0)

@@ -10,7 +10,8 @@
 //!   the reference point (lights are one-sided; the test shapes are convex). Delta-light samples
 //!   are tested as one more cell with probability `Σ_delta pmf`; failed samples (back faces) as
 //!   the remainder `1 − Σ`.
-//! - **Sphere lights** seen from inside (uniform area sampling) and from outside (cone sampling).
+//! - **Sphere lights** seen from inside (uniform area sampling) and from outside (cone sampling),
+//!   also a sphere thousands of times smaller than its distance.
 //!
 //! A test fails when `p < sidak_level(0.01, CHI2_TESTS)` or at once when a sample lands where the
 //! density is zero. The negative control (uniform light selection instead of power-proportional)
@@ -24,7 +25,7 @@ use restir_sampling::{Pcg32, luminance};
 use restir_testkit::{Chi2Error, Chi2Outcome, Histogram, Quadrature, SphereGrid, sidak_level};
 
 /// Chi-square hypothesis tests in this file (negative controls excluded).
-const CHI2_TESTS: usize = 6;
+const CHI2_TESTS: usize = 8;
 
 fn assert_accepted(what: &str, outcome: Result<Chi2Outcome, Chi2Error>) {
     let level = sidak_level(0.01, CHI2_TESTS);
@@ -397,6 +398,110 @@ fn sphere_light_inside_and_outside() {
         let hist = sample_directions(&set, ref_p, &grid, 30 + k as u64, 500_000);
         assert_accepted(&format!("sphere light, {name}"), hist.chi2(&p));
     }
+}
+
+/// Where a sample `p` from `ref_p` falls in the cone of a sphere at `center` whose
+/// `1 − cos θmax` is `one_minus_max`: cell `(bin of (1 − cos θ) / (1 − cos θmax), bin of φ
+/// about the axis)` on a `BINS × BINS` grid (uniform in solid angle over the cone: every cell
+/// equally likely), in f64 from the point's offset across the axis (`1 − cos θ` without
+/// cancellation), or `None` outside the cone.
+fn cone_cell(ref_p: Vec3, center: Vec3, one_minus_max: f64, p: Vec3) -> Option<usize> {
+    const BINS: usize = 16;
+    let axis = (center - ref_p).as_dvec3().normalize();
+    let d = (p - ref_p).as_dvec3();
+    let across = d - axis * d.dot(axis);
+    let sin2 = across.length_squared() / d.length_squared();
+    let one_minus = sin2 / (1.0 + (1.0 - sin2).max(0.0).sqrt());
+    let t = one_minus / one_minus_max;
+    let (s, c) = (
+        axis.any_orthonormal_vector(),
+        axis.cross(axis.any_orthonormal_vector()),
+    );
+    let phi = across.dot(c).atan2(across.dot(s)) + std::f64::consts::PI;
+    let phi_bin = ((phi / (2.0 * std::f64::consts::PI) * BINS as f64) as usize).min(BINS - 1);
+    (t <= 1.0 + 1e-3).then(|| (t * BINS as f64).min(BINS as f64 - 1.0) as usize * BINS + phi_bin)
+}
+
+/// A sphere a thousand and ten thousand times smaller than its distance is sampled uniformly in
+/// the cone it subtends, on its side facing the receiver, with the density `pdf_sa` reports
+/// (`1 / (2π(1 − cos θmax))`, where `1 − cos θmax` is a few ulps of 1 or rounds to 0). The
+/// negative control is the former construction, a ray through the cone intersected with the
+/// sphere: its `d² − b²` loses the point, and is rejected at the larger sphere; at the smaller
+/// its cone rounds to nothing and it draws no sample at all.
+#[test]
+fn sphere_far_smaller_than_its_distance() {
+    let ref_p = Vec3::new(0.3, -0.2, 0.1);
+    let dir = Vec3::new(0.48, 0.6, 0.64);
+    for (k, sin_max) in [1e-3f32, 1e-4].into_iter().enumerate() {
+        let dist = 40.0f32;
+        let center = ref_p + dir * dist;
+        let sphere = Sphere::new(center, dist * sin_max, false);
+        let shape = Shape::Sphere(sphere);
+        let one_minus_max = {
+            let s2 = (sin_max as f64).powi(2);
+            s2 / (1.0 + (1.0 - s2).sqrt())
+        };
+        let mut rng = Pcg32::new(50 + k as u64, 3);
+        let n = 200_000;
+        let mut hist = Histogram::new(16 * 16);
+        let mut control = Histogram::new(16 * 16);
+        for _ in 0..n {
+            let u = rng.next_2d();
+            let (ps, pdf) = shape.sample_from(ref_p, u).expect("a sample");
+            let r = (ps.p - center).length() / sphere.radius;
+            assert!((r - 1.0).abs() < 1e-3, "on the sphere: {r}");
+            assert!(
+                ps.n.dot(ref_p - ps.p) > 0.0,
+                "on the side facing the receiver"
+            );
+            let want = 1.0 / (2.0 * std::f64::consts::PI * one_minus_max);
+            assert!((pdf as f64 / want - 1.0).abs() < 1e-4, "{pdf} vs {want}");
+            assert!((shape.pdf_sa_from(ref_p, ps.p, ps.n) / pdf - 1.0).abs() < 1e-4);
+            hist.record(cone_cell(ref_p, center, one_minus_max, ps.p));
+            match intersected_cone_sample(ref_p, center, sphere.radius, u) {
+                Some(p) => control.record(cone_cell(ref_p, center, one_minus_max, p)),
+                None => control.record_remainder(),
+            }
+        }
+        let uniform = vec![1.0 / 256.0; 256];
+        assert_accepted(
+            &format!("sphere at sin θmax = {sin_max}"),
+            hist.chi2(&uniform),
+        );
+        let rejected = match control.chi2(&uniform) {
+            Ok(o) => {
+                eprintln!("intersected cone at sin θmax = {sin_max}: {o}");
+                o.p_value < 1e-6
+            }
+            Err(e) => {
+                eprintln!("intersected cone at sin θmax = {sin_max}: {e}");
+                true
+            }
+        };
+        assert!(
+            rejected,
+            "the intersected cone passed at sin θmax = {sin_max}"
+        );
+    }
+}
+
+/// The negative control of [`sphere_far_smaller_than_its_distance`]: a direction uniform in the
+/// cone (its `1 − cos θmax` as `1 − √(1 − sin²θmax)`) intersected with the sphere, tangential
+/// misses clamped to the silhouette; `None` where the cone rounds to nothing.
+fn intersected_cone_sample(ref_p: Vec3, center: Vec3, radius: f32, u: Vec2) -> Option<Vec3> {
+    let to_c = center - ref_p;
+    let d2 = to_c.length_squared();
+    let r2 = radius * radius;
+    let cos_max = (1.0 - r2 / d2).max(0.0).sqrt();
+    if cos_max >= 1.0 {
+        return None;
+    }
+    let w = restir_sampling::warp::sample_uniform_cone(u, cos_max);
+    let frame = restir_geometry::Frame::from_normal(to_c / d2.sqrt());
+    let d = frame.to_world(w);
+    let b = d.dot(to_c);
+    let disc = (r2 - (d2 - b * b)).max(0.0);
+    Some(ref_p + d * (b - disc.sqrt()))
 }
 
 /// A mesh light whose vertex normals differ from its face normal (as in any smooth-shaded mesh):
