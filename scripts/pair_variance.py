@@ -34,8 +34,11 @@ discarded render at the same sample count (the JIT compiles for it); its time is
 CPU time around `mi.render` (scene loading and compiling excluded), and its row is named
 `mitsuba`. The conversion and loading are `scripts/mitsuba_equal_time.py`'s.
 
-Only for unbiased configurations: a bias is invisible to it (use `restir compare` against a
-converged reference, or the statistical tests, for that).
+Only for unbiased configurations: a bias is invisible to its variances (use `restir compare`
+against a converged reference, or the statistical tests, for that). With `--bias` it prints, per
+scene and seed, each configuration's image sum against the first's, relative and in standard
+errors of that difference (from the spread of 16×16-pixel block sums): a quick screen for a
+difference between two configurations that both claim to be unbiased, not a proof of either.
 """
 
 import argparse
@@ -135,6 +138,18 @@ def mitsuba_renders(a, scene, name, seeds):
     return images, cpu
 
 
+def mean_difference(x, y, block=16):
+    """The sum over the image of `x − y` relative to `y`'s, and in standard errors estimated from
+    the spread of its `block × block`-pixel sums (reuse correlates neighbouring pixels, so
+    per-pixel errors would understate it; blocks wider than the reuse radius do not)."""
+    d = (x - y).sum(-1)
+    h, w = d.shape[0] // block * block, d.shape[1] // block * block
+    sums = d[:h, :w].reshape(h // block, block, w // block, block).sum((1, 3)).ravel()
+    total = float(sums.sum())
+    se = float(np.sqrt(sums.var() * sums.size))
+    return total / max(float(y.sum()), 1e-30), total / se if se > 0 else 0.0
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--bin", default="target/release/restir")
@@ -146,6 +161,8 @@ def main():
     ap.add_argument("--mitsuba", help="also render with this Mitsuba 3 integrator (e.g. direct)")
     ap.add_argument("--mitsuba-spp", type=int, default=16)
     ap.add_argument("--mitsuba-variant", default="llvm_ad_rgb")
+    ap.add_argument("--bias", action="store_true",
+                    help="also print each configuration's image sum against the first's, per seed")
     ap.add_argument("scenes", nargs="+")
     a = ap.parse_args()
     seeds = [int(s) for s in a.seeds.split(",")]
@@ -195,6 +212,12 @@ def main():
         for (label, _, _), cell in zip(rows, cells):
             print(f"    {cell}  eff {eff[label] / eff[base]:.2f}x "
                   f"(MSE {eff_mse[label] / eff_mse[base]:.2f}x)", flush=True)
+        if a.bias:
+            for label, _, _ in configs[1:]:
+                parts = [mean_difference(images[label][k], images[base][k]) for k in range(2)]
+                print(f"    {label} - {base}, image sum: " + ", ".join(
+                    f"seed {seed} {100 * rel:+.2f} % ({z:+.1f} s.e.)"
+                    for seed, (rel, z) in zip(seeds, parts)))
     print(f"median over {len(a.scenes)} scenes (range), efficiency relative to {base}, "
           "in relative variance and in MSE:")
     for label, r in ratios.items():
