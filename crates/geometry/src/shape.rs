@@ -104,9 +104,9 @@ impl Sphere {
             return Some((ps, pdf));
         }
         let dist = d2.sqrt();
-        let (_, one_minus_cos_max) = cone_of(r2, d2);
-        let pdf = 1.0 / (2.0 * PI * one_minus_cos_max);
-        if !(pdf > 0.0 && pdf.is_finite()) {
+        let one_minus_cos_max = one_minus_cos_max(r2, d2);
+        let pdf = uniform_cone_density(one_minus_cos_max);
+        if pdf == 0.0 {
             return None;
         }
         // θ from the axis towards the centre, uniform in solid angle over the cone:
@@ -176,15 +176,26 @@ pub fn octahedral_decode(e: Vec2) -> Vec3 {
     Vec3::new(x, y, z).normalize()
 }
 
-/// The cone of directions a sphere of squared radius `r2` subtends from a point at squared
-/// distance `d2` from its centre: `(sin²θmax, 1 − cos θmax)`, the second as
-/// `sin²θmax / (1 + cos θmax)`, exact where `1 − cos θmax` would round to a few ulps or to 0
-/// (a sphere a thousand times smaller than its distance).
+/// `1 − cos θmax` of the cone of directions a sphere of squared radius `r2` subtends from a
+/// point at squared distance `d2` from its centre, as `sin²θmax / (1 + cos θmax)`: exact where
+/// `1 − cos θmax` would round to a few ulps or to 0 (a sphere a thousand times smaller than its
+/// distance).
 #[inline]
-fn cone_of(r2: f32, d2: f32) -> (f32, f32) {
+fn one_minus_cos_max(r2: f32, d2: f32) -> f32 {
     let sin2_max = r2 / d2;
-    let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
-    (sin2_max, sin2_max / (1.0 + cos_max))
+    sin2_max / (1.0 + (1.0 - sin2_max).max(0.0).sqrt())
+}
+
+/// The density, per unit solid angle, of directions uniform in a cone whose `1 − cos θmax` is
+/// `one_minus_cos_max`; 0 for an empty cone.
+#[inline]
+fn uniform_cone_density(one_minus_cos_max: f32) -> f32 {
+    let pdf = 1.0 / (2.0 * PI * one_minus_cos_max);
+    if pdf > 0.0 && pdf.is_finite() {
+        pdf
+    } else {
+        0.0
+    }
 }
 
 /// A point sampled on a shape.
@@ -385,9 +396,7 @@ impl Shape {
                 if d2 <= r2 * (1.0 + 1e-4) {
                     return area_to_solid_angle(1.0 / self.area(), ref_p, p, n).unwrap_or(0.0);
                 }
-                let (_, one_minus_cos_max) = cone_of(r2, d2);
-                let pdf = 1.0 / (2.0 * PI * one_minus_cos_max);
-                if pdf.is_finite() { pdf } else { 0.0 }
+                uniform_cone_density(one_minus_cos_max(r2, d2))
             }
             Shape::Mesh(_) | Shape::Cylinder(_) => {
                 area_to_solid_angle(1.0 / self.area(), ref_p, p, n).unwrap_or(0.0)
