@@ -105,12 +105,41 @@ impl Setup {
                 }
             }
         }
-        values.map(|v| {
-            let n = v.len() as f64;
-            let mean = v.iter().sum::<f64>() / n;
-            let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
-            (mean, (var / n).sqrt())
-        })
+        values.map(|v| mean_and_se(&v))
+    }
+}
+
+/// The mean of `v` and its standard error from the sample variance.
+fn mean_and_se(v: &[f64]) -> (f64, f64) {
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
+/// Asserts that each channel's estimate `(mean, se)` of `what` lies within 4 standard errors of
+/// `exact`, and (the negative control) that a value off by the factor `1 + off` does not: the
+/// statistic can see an error of that size. `se` is floored at `floor` times the value.
+fn assert_matches(what: &str, est: [(f64, f64); 3], exact: [f64; 3], off: f64, floor: f64) {
+    for c in 0..3 {
+        let (mean, se) = est[c];
+        let se = se.max(floor * exact[c]);
+        let z = (mean - exact[c]) / se;
+        eprintln!(
+            "{what} channel {c}: mean {mean:.6} exact {:.6} (ratio {:.5}), se {se:.2e}, z {z:.2}",
+            exact[c],
+            mean / exact[c]
+        );
+        assert!(
+            z.abs() < 4.0,
+            "{what} channel {c}: {mean} vs exact {} ({z:.2} standard errors)",
+            exact[c]
+        );
+        let z_wrong = (mean - (1.0 + off) * exact[c]) / se;
+        assert!(
+            z_wrong.abs() > 4.0,
+            "{what} channel {c}: the test cannot tell an error of {off} ({z_wrong:.2} standard errors)"
+        );
     }
 }
 
@@ -164,27 +193,14 @@ fn closed_form_matches_numerical_integration() {
 fn rectangle_light_over_diffuse_plane_matches_form_factor() {
     for (i, setup) in SETUPS.iter().enumerate() {
         let exact = setup.exact();
-        let est = setup.estimate(12, 512);
-        for c in 0..3 {
-            let (mean, se) = est[c];
-            let z = (mean - exact[c]) / se;
-            eprintln!(
-                "setup {i} channel {c}: mean {mean:.6} exact {:.6} (ratio {:.5}), se {se:.2e}, z {z:.2}",
-                exact[c],
-                mean / exact[c]
-            );
-            assert!(
-                z.abs() < 4.0,
-                "setup {i} channel {c}: {mean} vs exact {} ({z:.2} standard errors)",
-                exact[c]
-            );
-            // Negative control: a value 2 % off must be rejected by the same statistic.
-            let z_wrong = (mean - 1.02 * exact[c]) / se;
-            assert!(
-                z_wrong.abs() > 4.0,
-                "setup {i} channel {c}: the test cannot tell a 2 % error ({z_wrong:.2} standard errors)"
-            );
-        }
+        // Negative control: a value 2 % off must be rejected by the same statistic.
+        assert_matches(
+            &format!("setup {i}"),
+            setup.estimate(12, 512),
+            exact,
+            0.02,
+            0.0,
+        );
     }
 }
 
@@ -260,12 +276,7 @@ fn render_means(scene: &common::Built, name: &str, seeds: u64, spp: u32) -> [(f6
             m.push(out.image.pixels.iter().map(|p| p[c] as f64).sum::<f64>() / n);
         }
     }
-    means.map(|v| {
-        let n = v.len() as f64;
-        let mean = v.iter().sum::<f64>() / n;
-        let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
-        (mean, (var / n).sqrt())
-    })
+    means.map(|v| mean_and_se(&v))
 }
 
 /// A sphere light a thousand times smaller than its distance (sin θmax = 10⁻³: a lamp of 4 cm
@@ -284,28 +295,9 @@ fn small_distant_sphere_light_matches_closed_form() {
     let exact = setup.exact();
     let scene = setup.scene();
     for (name, seeds, spp) in [("path", 16, 64), ("restir-di", 16, 16)] {
+        // The estimates hardly vary here (se ~10⁻⁶ of the value): rounding of the order of
+        // 10⁻⁵ is allowed beside the 4 standard errors; a value 1 % off must be rejected.
         let est = render_means(&scene, name, seeds, spp);
-        for c in 0..3 {
-            let (mean, se) = est[c];
-            // The estimates hardly vary here (se ~10⁻⁶ of the value): rounding of the order of
-            // 10⁻⁵ is allowed beside the 4 standard errors.
-            let se = se.max(2.5e-6 * exact[c]);
-            let z = (mean - exact[c]) / se;
-            eprintln!(
-                "{name} channel {c}: mean {mean:.6} exact {:.6} (ratio {:.5}), se {se:.2e}, z {z:.2}",
-                exact[c],
-                mean / exact[c]
-            );
-            assert!(
-                z.abs() < 4.0,
-                "{name} channel {c}: {mean} vs exact {} ({z:.2} standard errors)",
-                exact[c]
-            );
-            let z_wrong = (mean - 1.01 * exact[c]) / se;
-            assert!(
-                z_wrong.abs() > 4.0,
-                "{name} channel {c}: the test cannot tell a 1 % error ({z_wrong:.2} standard errors)"
-            );
-        }
+        assert_matches(name, est, exact, 0.01, 2.5e-6);
     }
 }
