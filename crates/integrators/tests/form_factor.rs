@@ -37,6 +37,27 @@ fn rectangle_form_factor(x0: f64, x1: f64, z0: f64, z1: f64, h: f64) -> f64 {
     g(x1, z1) - g(x0, z1) - g(x1, z0) + g(x0, z0)
 }
 
+/// The plane `y = 0` (diffuse, `albedo`, facing up: the rectangle `[-1, 1]²` turned −90° about
+/// x) under `emitter` (a RON shape), seen by a camera that looks at a tiny region around the
+/// origin, direct light only.
+fn plane_scene(albedo: [f64; 3], emitter: &str) -> common::Built {
+    let [ar, ag, ab] = albedo;
+    let ron = format!(
+        r#"(
+        camera: (fov: 0.05, to_world: [LookAt(origin: (-2, 0.3, 0.1), target: (0, 0, 0), up: (0, 1, 0))]),
+        film: (width: 8, height: 8, filter: Box),
+        integrator: (max_depth: 2),
+        shapes: [
+            (geometry: Rectangle, to_world: [Scale((4, 4, 1)), Rotate(axis: (1, 0, 0), angle: -90)],
+             material: Some(Inline(Diffuse(reflectance: ({ar}, {ag}, {ab}))))),
+            {emitter},
+        ],
+    )"#
+    );
+    let desc = parse_ron(&ron, "form-factor.ron".as_ref()).unwrap();
+    common::build(&desc, ".".as_ref(), "form-factor.ron".as_ref())
+}
+
 /// A rectangle emitter `[x0, x1] × [z0, z1]` at height `h` facing down onto the plane `y = 0`.
 struct Setup {
     x: (f64, f64),
@@ -56,26 +77,16 @@ impl Setup {
         let (cx, cz) = ((self.x.0 + self.x.1) / 2.0, (self.z.0 + self.z.1) / 2.0);
         let (sx, sz) = ((self.x.1 - self.x.0) / 2.0, (self.z.1 - self.z.0) / 2.0);
         let [lr, lg, lb] = self.radiance;
-        let [ar, ag, ab] = self.albedo;
         let h = self.h;
         // Rectangle: [-1, 1]² in z = 0 with normal +z. Rotating +90° about x sends +z to −y
-        // (facing down) and y to z; −90° sends +z to +y (the floor faces up).
-        let ron = format!(
-            r#"(
-            camera: (fov: 0.05, to_world: [LookAt(origin: (-2, 0.3, 0.1), target: (0, 0, 0), up: (0, 1, 0))]),
-            film: (width: 8, height: 8, filter: Box),
-            integrator: (max_depth: 2),
-            shapes: [
-                (geometry: Rectangle, to_world: [Scale((4, 4, 1)), Rotate(axis: (1, 0, 0), angle: -90)],
-                 material: Some(Inline(Diffuse(reflectance: ({ar}, {ag}, {ab}))))),
-                (geometry: Rectangle,
-                 to_world: [Scale(({sx}, {sz}, 1)), Rotate(axis: (1, 0, 0), angle: 90), Translate(({cx}, {h}, {cz}))],
-                 emission: Some(({lr}, {lg}, {lb}))),
-            ],
-        )"#
-        );
-        let desc = parse_ron(&ron, "form-factor.ron".as_ref()).unwrap();
-        common::build(&desc, ".".as_ref(), "form-factor.ron".as_ref())
+        // (facing down) and y to z.
+        plane_scene(
+            self.albedo,
+            &format!(
+                "(geometry: Rectangle, to_world: [Scale(({sx}, {sz}, 1)), Rotate(axis: (1, 0, 0), angle: 90), \
+                 Translate(({cx}, {h}, {cz}))], emission: Some(({lr}, {lg}, {lb})))"
+            ),
+        )
     }
 
     /// Per channel: the mean of all pixel estimates over `seeds` renders and its standard error.
@@ -226,22 +237,13 @@ impl SphereSetup {
     fn scene(&self) -> common::Built {
         let [cx, cy, cz] = self.center;
         let [lr, lg, lb] = self.radiance;
-        let [ar, ag, ab] = self.albedo;
         let r = self.r;
-        let ron = format!(
-            r#"(
-            camera: (fov: 0.05, to_world: [LookAt(origin: (-2, 0.3, 0.1), target: (0, 0, 0), up: (0, 1, 0))]),
-            film: (width: 8, height: 8, filter: Box),
-            integrator: (max_depth: 2),
-            shapes: [
-                (geometry: Rectangle, to_world: [Scale((4, 4, 1)), Rotate(axis: (1, 0, 0), angle: -90)],
-                 material: Some(Inline(Diffuse(reflectance: ({ar}, {ag}, {ab}))))),
-                (geometry: Sphere(center: ({cx}, {cy}, {cz}), radius: {r}), emission: Some(({lr}, {lg}, {lb}))),
-            ],
-        )"#
-        );
-        let desc = parse_ron(&ron, "sphere-light.ron".as_ref()).unwrap();
-        common::build(&desc, ".".as_ref(), "sphere-light.ron".as_ref())
+        plane_scene(
+            self.albedo,
+            &format!(
+                "(geometry: Sphere(center: ({cx}, {cy}, {cz}), radius: {r}), emission: Some(({lr}, {lg}, {lb})))"
+            ),
+        )
     }
 }
 
