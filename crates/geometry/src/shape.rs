@@ -105,7 +105,7 @@ impl Sphere {
         }
         let dist = d2.sqrt();
         let one_minus_cos_max = one_minus_cos_max(r2, d2);
-        let pdf = uniform_cone_density(one_minus_cos_max);
+        let pdf = warp::uniform_cone_pdf_of(one_minus_cos_max);
         if pdf == 0.0 {
             return None;
         }
@@ -184,18 +184,6 @@ pub fn octahedral_decode(e: Vec2) -> Vec3 {
 fn one_minus_cos_max(r2: f32, d2: f32) -> f32 {
     let sin2_max = r2 / d2;
     sin2_max / (1.0 + (1.0 - sin2_max).max(0.0).sqrt())
-}
-
-/// The density, per unit solid angle, of directions uniform in a cone whose `1 − cos θmax` is
-/// `one_minus_cos_max`; 0 for an empty cone.
-#[inline]
-fn uniform_cone_density(one_minus_cos_max: f32) -> f32 {
-    let pdf = 1.0 / (2.0 * PI * one_minus_cos_max);
-    if pdf > 0.0 && pdf.is_finite() {
-        pdf
-    } else {
-        0.0
-    }
 }
 
 /// A point sampled on a shape.
@@ -396,7 +384,7 @@ impl Shape {
                 if d2 <= r2 * (1.0 + 1e-4) {
                     return area_to_solid_angle(1.0 / self.area(), ref_p, p, n).unwrap_or(0.0);
                 }
-                uniform_cone_density(one_minus_cos_max(r2, d2))
+                warp::uniform_cone_pdf_of(one_minus_cos_max(r2, d2))
             }
             Shape::Mesh(_) | Shape::Cylinder(_) => {
                 area_to_solid_angle(1.0 / self.area(), ref_p, p, n).unwrap_or(0.0)

@@ -252,8 +252,8 @@ pub(crate) fn clear_boxes(lights: &[Light], shapes: &[Shape]) -> Vec<Option<Ligh
         .collect()
 }
 
-/// The grown bounding box of a convex mesh, or `None` when the mesh is too large to check,
-/// flat, degenerate, not finite or not convex.
+/// The grown bounding box of a convex part (triangles `indices` of a mesh's `positions`), or
+/// `None` when the part is too large to check, flat, degenerate, not finite or not convex.
 fn convex_box(positions: &[Vec3], indices: &[[u32; 3]]) -> Option<ClearBox> {
     if indices.is_empty() || indices.len() > MAX_CLEAR_TRIANGLES {
         return None;

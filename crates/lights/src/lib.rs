@@ -8,7 +8,7 @@
 //! | `select.rs` | which light: the power sampler ([`LightSet::sample`], [`LightSet::select`], [`LightSet::pmf`]) over one flat emitter table (`table.rs`: every emissive triangle, every other light), and the light hierarchy over the same entries (`bvh.rs`: [`LightSet::sample_hierarchy`], [`LightSet::hierarchy_pmf`]) |
 //! | `nee.rs` | next-event estimation's light selection ([`NeeSelection`]: by power or by the hierarchy; [`LightSet::sample_nee`], [`LightSet::pdf_nee`]), for the path tracer and ReSTIR PT's walks |
 //! | `cut.rs` | the hierarchy cut once for a region of receivers ([`LightCut`], [`LightSet::light_cut`]): a node by an alias table over the cut, an emitter of it by power, with the exact probability of any entry ([`LightSet::cut_pmf`]) |
-//! | `clear.rs` | where a shadow ray toward a light may end: at the clear box of a convex emissive mesh that nothing else comes near ([`LightSet::shadow_end`]) |
+//! | `clear.rs` | where a shadow ray toward a light may end: at the clear box of a convex part of an emissive mesh that nothing else comes near ([`LightSet::shadow_end`]) |
 //! | `corners.rs` | the distinct corners of some triangles and whether they all lie behind a plane: the convexity tests of `own.rs` and `clear.rs` |
 //! | `point.rs` | a light sample named without its receiver ([`LightPoint`], what a reservoir holds), resolved in world space ([`LightSet::resolve`], [`Resolved`]) and seen from a receiver ([`Contact`]) |
 //! | `learned.rs` | a selection learned across passes: per cell of a world-space grid, what each emitter (a triangle, another light, the environment) delivered after its shadow ray ([`LightRecords`]), sampled in a mixture with the power sampler with its exact probability ([`LearnedSampler`]) |

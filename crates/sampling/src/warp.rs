@@ -116,9 +116,18 @@ pub fn sample_uniform_cone(u: Vec2, cos_theta_max: f32) -> Vec3 {
 /// Solid-angle pdf of [`sample_uniform_cone`]: `1 / (2π (1 − cos θmax))` inside the cone.
 #[inline]
 pub fn uniform_cone_pdf(cos_theta_max: f32) -> f32 {
-    let solid_angle = 2.0 * PI * (1.0 - cos_theta_max);
-    if solid_angle > 0.0 {
-        1.0 / solid_angle
+    uniform_cone_pdf_of(1.0 - cos_theta_max)
+}
+
+/// [`uniform_cone_pdf`] of a cone given by `1 − cos θmax` (which a narrow cone should compute
+/// without cancellation, e.g. as `sin²θmax / (1 + cos θmax)`); 0 for an empty cone or one too
+/// narrow for the density to be finite.
+#[inline]
+pub fn uniform_cone_pdf_of(one_minus_cos_theta_max: f32) -> f32 {
+    let solid_angle = 2.0 * PI * one_minus_cos_theta_max;
+    let pdf = 1.0 / solid_angle;
+    if solid_angle > 0.0 && pdf.is_finite() {
+        pdf
     } else {
         0.0
     }
