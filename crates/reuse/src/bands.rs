@@ -71,6 +71,14 @@ impl Bands {
         }
     }
 
+    /// The bands of `rows` image rows (at least one) of an image `width` pixels wide: for a loop
+    /// whose pixels share data by blocks of rows (a screen tile's pool of light samples).
+    pub fn of_rows(width: usize, rows: usize) -> Self {
+        Self {
+            len: width * rows.max(1),
+        }
+    }
+
     /// Pixels per band (the chunk length of `par_chunks_mut`).
     #[inline]
     pub fn pixels(self) -> usize {

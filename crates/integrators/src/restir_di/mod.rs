@@ -536,12 +536,21 @@ impl Integrator for RestirDiIntegrator {
             resolved.resize(n, None);
             bsdfs.clear();
             bsdfs.resize(n, None);
-            rays += bands.run(
+            // Bands of a tile's height, walked tile by tile: a tile's pixels draw from the same
+            // pool, which then stays in cache (the pools of a whole row of tiles do not, with
+            // many candidates). Each pixel's numbers are its own, so the order changes nothing.
+            let tile_bands = Bands::of_rows(w, tiles::TILE);
+            rays += tile_bands.run(
                 (&mut current[..], (&mut resolved[..], &mut bsdfs[..])),
                 |first, (out, (cache, bsdfs))| {
                     let mut rays = 0;
-                    let pixels = out.iter_mut().zip(cache).zip(bsdfs);
-                    for (i, ((res, cached), pixel_bsdf)) in pixels.enumerate() {
+                    let rows = out.len() / w.max(1);
+                    let order = (0..w.div_ceil(tiles::TILE)).flat_map(|tx| {
+                        let cols = tx * tiles::TILE..((tx + 1) * tiles::TILE).min(w);
+                        (0..rows).flat_map(move |y| cols.clone().map(move |x| y * w + x))
+                    });
+                    for i in order {
+                        let (res, cached, pixel_bsdf) = (&mut out[i], &mut cache[i], &mut bsdfs[i]);
                         let index = first + i;
                         if let Some(r) = gbuf.receiver(index) {
                             let bsdf = r.resolve_bsdf(scene);
