@@ -243,11 +243,13 @@ pub fn make_integrator(
             let mut s = RestirDiSettings::new(settings);
             let unused = s.apply(&params)?;
             s.resolve(&scene.features);
+            notes.extend(s.reuse.pair_neighbors());
             (Box::new(RestirDiIntegrator::new(s)), unused)
         }
         "restir-pt" => {
             let mut s = RestirPtSettings::new(settings);
             let unused = s.apply(&params)?;
+            notes.extend(s.reuse.pair_neighbors());
             (Box::new(RestirPtIntegrator::new(s)), unused)
         }
         "auto" => {

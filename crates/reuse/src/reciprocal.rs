@@ -44,11 +44,7 @@ pub fn shares_pair_shifts(scheme: MisScheme) -> bool {
 /// they do not run), for an estimator's `buffer_bytes_per_pixel`: the whole film's, which the
 /// window of rows reaches when the threads are many or the film is short.
 pub fn table_bytes_per_pixel<S>(settings: &ReuseSettings) -> usize {
-    let runs = settings.reciprocal
-        && shares_pair_shifts(settings.mis)
-        && settings.neighbors > 0
-        && settings.spatial_rounds > 0;
-    if runs {
+    if settings.runs_reciprocal() {
         (settings.neighbors as usize).div_ceil(2) * std::mem::size_of::<Option<PairShifts<S>>>()
     } else {
         0

@@ -116,6 +116,32 @@ impl ReuseSettings {
             .saturating_mul(self.radius.ceil().min(u32::MAX as f32) as u32)
     }
 
+    /// Whether the spatial rounds run in reciprocal pairs ([`crate::reciprocal`]): asked for,
+    /// with a pairwise MIS, neighbours and rounds.
+    pub fn runs_reciprocal(&self) -> bool {
+        self.reciprocal
+            && crate::reciprocal::shares_pair_shifts(self.mis)
+            && self.neighbors > 0
+            && self.spatial_rounds > 0
+    }
+
+    /// Reciprocal rounds take neighbours in pairs (`p ± o_j`), so an odd count asks for one
+    /// more than a round can take alone: raises it to the even count the rounds use and returns
+    /// a note saying so (the settings line then names the count used), or `None` when nothing
+    /// changed.
+    pub fn pair_neighbors(&mut self) -> Option<String> {
+        if !self.runs_reciprocal() || self.neighbors % 2 == 0 {
+            return None;
+        }
+        let asked = self.neighbors;
+        self.neighbors = asked.saturating_add(1);
+        Some(format!(
+            "neighbors = {asked}: reciprocal reuse takes neighbours in pairs, so {} are used \
+             (reciprocal = false takes {asked})",
+            self.neighbors
+        ))
+    }
+
     /// The neighbour rule of the spatial rounds.
     pub fn neighbor_rule(&self) -> NeighborRule {
         NeighborRule {
@@ -212,5 +238,32 @@ mod tests {
         assert_eq!(s.halo(), 9);
         s.neighbors = 0;
         assert_eq!(s.halo(), 0);
+    }
+
+    /// An odd neighbour count becomes the even count reciprocal rounds use, with a note; even
+    /// counts and rounds that are not reciprocal keep theirs, silently.
+    #[test]
+    fn odd_neighbors_are_paired_aloud() {
+        let mut s = ReuseSettings {
+            neighbors: 5,
+            ..ReuseSettings::default()
+        };
+        let note = s.pair_neighbors().expect("a note");
+        assert_eq!(s.neighbors, 6);
+        assert!(note.contains("so 6 are used"), "{note}");
+        assert_eq!(s.pair_neighbors(), None);
+        let mut plain = ReuseSettings {
+            neighbors: 5,
+            reciprocal: false,
+            ..ReuseSettings::default()
+        };
+        assert_eq!(plain.pair_neighbors(), None);
+        assert_eq!(plain.neighbors, 5);
+        let mut balance = ReuseSettings {
+            neighbors: 3,
+            mis: MisScheme::GeneralizedBalance,
+            ..ReuseSettings::default()
+        };
+        assert_eq!(balance.pair_neighbors(), None);
     }
 }
