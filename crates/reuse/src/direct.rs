@@ -120,7 +120,7 @@ pub enum Visibility {
 pub struct DirectSettings {
     /// Light candidates per pixel in initial resampling, `M` (default 8).
     pub candidates: u32,
-    /// The temporal and spatial reuse (default [`ReuseSettings::default`]).
+    /// The temporal and spatial reuse (default [`ReuseSettings::direct`]).
     pub reuse: ReuseSettings,
     /// Where visibility enters (default [`Visibility::Target`]).
     pub visibility: Visibility,
@@ -130,7 +130,7 @@ impl Default for DirectSettings {
     fn default() -> Self {
         Self {
             candidates: 8,
-            reuse: ReuseSettings::default(),
+            reuse: ReuseSettings::direct(),
             visibility: Visibility::Target,
         }
     }

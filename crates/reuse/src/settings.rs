@@ -68,13 +68,19 @@ pub struct ReuseSettings {
     pub shade_expected: bool,
 }
 
+/// Spatial neighbours per round of ReSTIR DI's reuse ([`ReuseSettings::direct`]): four
+/// reciprocal pairs. On the project's DI training family at 640×360 (equal CPU time, 8 passes)
+/// eight are 1.13× four's efficiency at the median and gain on every member (1.07–1.26×); twelve
+/// are 1.16× but as low as 1.01× (the project repository's `docs/RESTIR_DI.md`, "The defaults at
+/// a user's size").
+pub const DIRECT_NEIGHBORS: u32 = 8;
+
 impl Default for ReuseSettings {
     /// One round of four neighbours in two reciprocal pairs within 3 pixels, defensive pairwise
     /// MIS, `M` capped at 20, no temporal reuse, 25° and 10 % similarity, shading every input
-    /// of the last round: chosen for ReSTIR DI
-    /// and ReSTIR PT on their training families (the project repository's
-    /// `docs/studies/2026-12-02-restir-di-light-pool-and-defaults.md` and
-    /// `docs/studies/2026-12-02-restir-pt-defaults.md`; ReSTIR PT runs three rounds).
+    /// of the last round: ReSTIR PT's, which runs three such rounds, chosen on its training family
+    /// (the project repository's `docs/studies/2026-12-02-restir-pt-defaults.md`). ReSTIR DI
+    /// takes [`ReuseSettings::direct`].
     fn default() -> Self {
         Self {
             neighbors: 4,
@@ -96,6 +102,16 @@ impl Default for ReuseSettings {
 }
 
 impl ReuseSettings {
+    /// ReSTIR DI's reuse: the [default](ReuseSettings::default) with [`DIRECT_NEIGHBORS`]
+    /// neighbours (the rest chosen on the DI training family too: the project repository's
+    /// `docs/studies/2026-12-02-restir-di-light-pool-and-defaults.md`).
+    pub fn direct() -> Self {
+        Self {
+            neighbors: DIRECT_NEIGHBORS,
+            ..Self::default()
+        }
+    }
+
     /// Whether reuse is unbiased with these settings.
     pub fn is_unbiased(&self) -> bool {
         self.mis.is_unbiased()
@@ -265,5 +281,6 @@ mod tests {
             ..ReuseSettings::default()
         };
         assert_eq!(balance.pair_neighbors(), None);
+        assert_eq!(ReuseSettings::direct().neighbors, DIRECT_NEIGHBORS);
     }
 }

@@ -71,8 +71,8 @@ pub(crate) struct RenderArgs {
 #[derive(clap::Args, Debug)]
 #[command(next_help_heading = "ReSTIR")]
 pub(crate) struct RestirArgs {
-    /// Initial candidates per pixel: light samples for restir-di [default: 8], paths for
-    /// restir-pt [default: 2].
+    /// Initial candidates per pixel: light samples for restir-di [default: 8; 12 from the
+    /// tiles' cuts without learning], paths for restir-pt [default: 2].
     #[arg(long)]
     candidates: Option<u32>,
     /// restir-di: where candidates' lights come from: power (the power-based sampler), tiles
@@ -130,7 +130,8 @@ pub(crate) struct RestirArgs {
     /// little of the environment (under 25 % of its pilot samples unoccluded) [default: auto].
     #[arg(long)]
     bsdf_samples: Option<String>,
-    /// Spatial neighbours per round [default: 4].
+    /// Spatial neighbours per round, in reciprocal pairs (an odd count is raised to the next
+    /// even one) [default: 8 for restir-di, 4 for restir-pt].
     #[arg(long, alias = "neighbours")]
     neighbors: Option<u32>,
     /// Spatial reuse radius in pixels [default: 3].

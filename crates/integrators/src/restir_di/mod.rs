@@ -313,11 +313,11 @@ impl Integrator for RestirDiIntegrator {
     fn describe(&self) -> String {
         let s = &self.settings;
         format!(
-            "restir-di max_depth={} candidates={} light_sampler={} bsdf_candidates={} {} {} neighbors={} \
+            "restir-di max_depth={} {} light_sampler={} bsdf_candidates={} {} {} neighbors={} \
              radius={} spatial_rounds={} reciprocal={} mis={} mcap={} {} \
              visibility={} {}{}{}",
             s.path.max_depth,
-            s.candidates,
+            s.candidates_label(),
             s.light_sampler.name().to_string()
                 + &if s.learn.is_on() {
                     format!(

@@ -1,9 +1,10 @@
 //! ReSTIR DI settings and their parsing from named parameters (XML scenes and the command line
 //! use the same names; the names Lajolla ReSTIR ports use are accepted too). The reuse settings
-//! are [`ReuseSettings`]. Two defaults are rules of the scene summary, decided once when the
+//! are [`ReuseSettings`]. Some defaults are rules of the scene summary, decided once when the
 //! integrator is made ([`RestirDiSettings::resolve`]): the candidate source
-//! ([`AUTO_LIGHT_SAMPLER`] where the scene has a local emitter) and learning across passes (up
-//! to [`LEARN_MAX_EMITTERS`] emitters).
+//! ([`AUTO_LIGHT_SAMPLER`] where the scene has a local emitter), learning across passes (up
+//! to [`LEARN_MAX_EMITTERS`] emitters) and, from those, the candidate count
+//! ([`CANDIDATES_WITHOUT_LEARNING`] for the tiles' cuts without learning).
 
 use crate::reuse::params::ReuseParams;
 use restir_scene::SceneFeatures;
@@ -28,6 +29,14 @@ pub const AUTO_LIGHT_SAMPLER: LightSampler = LightSampler::Tiles;
 /// variance 1.10–1.27×: a cell's records then spread over more emitters than a table tells
 /// apart); the bound sits between the two, where the rule lives.
 pub const LEARN_MAX_EMITTERS: usize = 50_000;
+
+/// Light candidates per pixel where the candidates were not named and learning is off (the
+/// default [`RestirDiSettings::candidates`] is for learned candidates). Without learning a
+/// tile's candidates come from its cut of the light hierarchy, which knows no visibility and, on
+/// scenes of more than [`LEARN_MAX_EMITTERS`] emitters, spreads over many lights of similar
+/// unshadowed contribution; more of them pay there. Chosen on the DI training family at 640×360
+/// (`docs/RESTIR_DI.md`, "Candidates").
+pub const CANDIDATES_WITHOUT_LEARNING: u32 = 12;
 
 /// Where initial candidates' lights come from (`--light-sampler`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -293,9 +302,17 @@ pub struct RestirDiSettings {
     pub path: PathSettings,
     /// Spatial and temporal reuse.
     pub reuse: ReuseSettings,
-    /// Light candidates per pixel in initial resampling, `N_L` (default 8, chosen by an
-    /// equal-CPU-time sweep on a training family of generated scenes; `docs/studies/2026-12-01-restir-di-defaults.md`).
+    /// Light candidates per pixel in initial resampling, `N_L` (default 8 with learning, chosen
+    /// by an equal-CPU-time sweep on a training family of generated scenes,
+    /// `docs/studies/2026-12-01-restir-di-defaults.md`; [`CANDIDATES_WITHOUT_LEARNING`] where
+    /// [`RestirDiSettings::resolve`] finds learning off).
     pub candidates: u32,
+    /// Whether `candidates` was named (a parameter or the command line); else
+    /// [`RestirDiSettings::resolve`] decides it from the learning decision.
+    pub candidates_named: bool,
+    /// Whether [`RestirDiSettings::resolve`] raised the count to
+    /// [`CANDIDATES_WITHOUT_LEARNING`] (`--stats` says why).
+    pub candidates_decided: bool,
     /// Where candidates' lights come from (default the power sampler).
     pub light_sampler: LightSampler,
     /// Whether candidates come from a light distribution learned across passes (default `auto`:
@@ -352,14 +369,17 @@ pub struct RestirDiSettings {
 }
 
 impl RestirDiSettings {
-    /// The defaults: 8 candidates from the power sampler's pool, one round of reuse over two
-    /// reciprocal pairs within 3 pixels, visibility in every target, one BSDF sample (chosen on
-    /// a training family of generated scenes; `docs/RESTIR_DI.md`).
+    /// The defaults: 8 candidates (12 from the tiles' cuts without learning, decided by
+    /// [`RestirDiSettings::resolve`]), one round of reuse over four reciprocal pairs within 3
+    /// pixels ([`ReuseSettings::direct`]), visibility in every target, one BSDF sample (chosen
+    /// on a training family of generated scenes; `docs/RESTIR_DI.md`).
     pub fn new(path: PathSettings) -> Self {
         Self {
             path,
-            reuse: ReuseSettings::default(),
+            reuse: ReuseSettings::direct(),
             candidates: 8,
+            candidates_named: false,
+            candidates_decided: false,
             light_sampler: LightSampler::Auto,
             learn: Learn::Auto,
             learn_share: 0.5,
@@ -381,8 +401,10 @@ impl RestirDiSettings {
 
     /// Decides the scene-dependent defaults from the scene summary: an `auto` light sampler
     /// becomes [`AUTO_LIGHT_SAMPLER`] where the scene has a local emitter (else the power
-    /// table), `auto` learning is on up to [`LEARN_MAX_EMITTERS`] emitters (else off), and
-    /// receivers without a glossy lobe take BSDF samples when the scene has an environment.
+    /// table), `auto` learning is on up to [`LEARN_MAX_EMITTERS`] emitters (else off),
+    /// receivers without a glossy lobe take BSDF samples when the scene has an environment, and
+    /// candidates that were not named become [`CANDIDATES_WITHOUT_LEARNING`] where they come
+    /// from the tiles' cuts without learning.
     pub fn resolve(&mut self, features: &SceneFeatures) {
         if self.learn == Learn::Auto {
             self.learn_decided_from = Some(features.emitter_count);
@@ -419,6 +441,22 @@ impl RestirDiSettings {
                 LightSampler::Power
             };
         }
+        if !self.candidates_named && !self.learn.is_on() && self.light_sampler == LightSampler::Tiles
+        {
+            self.candidates = CANDIDATES_WITHOUT_LEARNING;
+            self.candidates_decided = true;
+        }
+    }
+
+    /// `candidates=N`, with why when [`RestirDiSettings::resolve`] raised it, for the settings
+    /// line.
+    pub fn candidates_label(&self) -> String {
+        let why = if self.candidates_decided {
+            " (auto: tiles without learning)"
+        } else {
+            ""
+        };
+        format!("candidates={}{why}", self.candidates)
     }
 
     /// Why learning is on or off when `auto` decided it (`auto: N emitters <= 50000`), for the
@@ -488,6 +526,7 @@ impl RestirDiSettings {
                 "candidates" | "light_candidates" | "initial_candidates" | "num_candidates"
                 | "reservoir_size" | "reservior_size" => {
                     self.candidates = p.count(1)?;
+                    self.candidates_named = true;
                     true
                 }
                 "light_sampler" => {
@@ -675,6 +714,36 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert_eq!(err, "bsdf_samples = 'resampled' needs visibility = target");
+    }
+
+    /// Candidates that were not named become `CANDIDATES_WITHOUT_LEARNING` where they come from
+    /// the tiles' cuts without learning, and the settings line says why; named ones, learned
+    /// ones and the power sampler's keep their count.
+    #[test]
+    fn auto_candidates_follow_the_learning_decision() {
+        let at = |emitters: usize, params: &[(&str, &str)]| {
+            let mut s = settings();
+            s.apply(&ParamSet::from(params)).unwrap();
+            s.resolve(&SceneFeatures {
+                emitter_count: emitters,
+                ..SceneFeatures::default()
+            });
+            (s.candidates, s.candidates_label())
+        };
+        let many = LEARN_MAX_EMITTERS + 1;
+        assert_eq!(
+            at(many, &[]),
+            (
+                CANDIDATES_WITHOUT_LEARNING,
+                format!("candidates={CANDIDATES_WITHOUT_LEARNING} (auto: tiles without learning)")
+            )
+        );
+        assert_eq!(at(1000, &[]), (8, "candidates=8".to_string()));
+        assert_eq!(at(1000, &[("learn", "off")]).0, CANDIDATES_WITHOUT_LEARNING);
+        assert_eq!(at(many, &[("learn", "on")]).0, 8);
+        assert_eq!(at(many, &[("light_sampler", "power")]).0, 8);
+        assert_eq!(at(many, &[("candidates", "8")]), (8, "candidates=8".to_string()));
+        assert_eq!(at(many, &[("reservior_size", "32")]).0, 32);
     }
 
     /// `learn = auto` learns up to `LEARN_MAX_EMITTERS` emitters and not above; a named choice
