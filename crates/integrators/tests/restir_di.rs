@@ -600,9 +600,15 @@ fn xml_restir_integrator_and_parameters() {
     assert!(made.unused_params.is_empty());
     let d = made.integrator.describe();
     assert!(d.starts_with("restir-di max_depth=2 candidates=16"), "{d}");
+    // Reciprocal pairs take neighbours two at a time: five become six, said in a note.
     assert!(
-        d.contains("neighbors=5") && d.contains("spatial_rounds=2"),
+        d.contains("neighbors=6") && d.contains("spatial_rounds=2"),
         "{d}"
+    );
+    assert!(
+        made.notes.iter().any(|n| n.contains("so 6 are used")),
+        "{:?}",
+        made.notes
     );
     let options = IntegratorOptions {
         params: vec![("neighbors", "2")].into(),
