@@ -58,7 +58,7 @@ use crate::path::{EmissionMis, PathSettings, PrevVertex, rr_survival, trace_path
 use crate::reuse::chain::PassChain;
 use crate::reuse::gbuffer::{GBuffer, Receiver};
 use crate::reuse::reciprocal;
-use crate::reuse::seen::{SeenEmission, SplatRays};
+use crate::reuse::seen::{SILHOUETTE_BUDGET, SeenEmission, SplatRays};
 use crate::reuse::settings::mis_name;
 use crate::stages::StageClock;
 use restir_reuse::{ScreenReuse, Stages};
@@ -144,6 +144,7 @@ impl RestirDiIntegrator {
                 SeenEmission::new(
                     settings.edge_rays,
                     SplatRays::Each,
+                    Some(SILHOUETTE_BUDGET),
                     settings.edge_mask_from_pass,
                 )
             }),

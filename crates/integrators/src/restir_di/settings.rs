@@ -352,7 +352,8 @@ pub struct RestirDiSettings {
     pub bsdf_samples_decided_from: Option<Option<f32>>,
     /// Camera rays for the emission seen on emitter silhouettes, the G-buffer's included
     /// (`crate::reuse::seen`; 1: the G-buffer's only; default 4, chosen on the training family:
-    /// a hall's squared error 3.6× lower at the same cost).
+    /// a hall's squared error 3.6× lower at the same cost; on a sampling film whose mask is
+    /// small, raised by [`crate::reuse::seen::SILHOUETTE_BUDGET`]).
     pub edge_rays: u32,
     /// Negative control only: choose the pixels that get `edge_rays` by what the pass's own
     /// camera ray saw (an emitter) instead of a mask made without the pass's samples (biased).

@@ -120,6 +120,7 @@ impl RestirPtIntegrator {
                 SeenEmission::new(
                     settings.edge_rays,
                     SplatRays::VarianceMatched,
+                    None,
                     settings.edge_mask_from_pass,
                 )
             }),

@@ -18,8 +18,11 @@
 //! allocation). `n` is `edge_rays` times the pixel's contrast over the mean contrast of the
 //! film's silhouette pixels, at least 1 and at most [`MAX_RAYS_FACTOR`] times `edge_rays`: the
 //! rays `edge_rays` pays for on average, moved from dim lights' silhouettes to bright ones'.
-//! The counts depend on the camera, the film and the scene only (camera rays every half pixel,
-//! no random numbers), never on a pass's samples, so every pixel's estimate stays unbiased and
+//! An estimator may give the mask a budget ([`SILHOUETTE_BUDGET`], ReSTIR DI): on a sampling
+//! film whose mask is a small part of the image, the mean is raised until the extra rays come to
+//! that many per film pixel, at most [`MAX_BUDGET_RAISE`] times `edge_rays`, since there they
+//! cost little beside a pass. The counts depend on the camera, the film and the scene only
+//! (camera rays every half pixel, no random numbers), never on a pass's samples, so every pixel's estimate stays unbiased and
 //! a split render (chains, tiles) gets the same counts.
 
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -66,8 +69,21 @@ pub enum SplatRays {
     VarianceMatched,
 }
 
-/// The most camera rays a silhouette pixel gets, in multiples of `edge_rays`.
+/// The most camera rays a silhouette pixel gets, in multiples of its mean count.
 pub const MAX_RAYS_FACTOR: u32 = 8;
+
+/// ReSTIR DI's budget for the silhouettes' extra camera rays on a sampling film, per film pixel
+/// and pass: the mask's mean count is raised to `1 + budget / share` (`share` the film's fraction
+/// of mask pixels), at least `edge_rays` and at most [`MAX_BUDGET_RAISE`] times it. Chosen on
+/// the DI training family at 640×360 (8 passes, seeds 11 and 12, 1 thread): on its halls (2 and 5
+/// % of the film on silhouettes) 16 rays are 1.03–1.05× the relative efficiency of 4 and 3.0–3.6×
+/// its efficiency in squared error, for a pass 1–5 % dearer; on the training Sponza with 2000
+/// lamps (a splatting film, 27 % of it in the mask, which keeps `edge_rays`) 8 and 16 rays would
+/// cost 0.93× and 0.79× (`docs/RESTIR_DI.md`, "Silhouettes").
+pub const SILHOUETTE_BUDGET: f32 = 0.75;
+
+/// How far [`SILHOUETTE_BUDGET`] may raise the mean count, in multiples of `edge_rays`.
+pub const MAX_BUDGET_RAISE: u32 = 4;
 
 /// Random-stream stage of the extra camera rays.
 const STAGE_SEEN: u64 = 117;
@@ -81,6 +97,11 @@ pub struct SeenEmission {
     /// On a splatting film, whether a mask pixel's rays are `rays` times the filter's variance
     /// factor (ReSTIR PT) or `rays` (ReSTIR DI); see [`SplatRays`].
     splat: SplatRays,
+    /// Extra camera rays per film pixel the mask may spend on a sampling film
+    /// ([`SILHOUETTE_BUDGET`]; `None`: the mean stays `rays`).
+    budget: Option<f32>,
+    /// The mean count the current mask was made with on a sampling film, for `--stats`.
+    mean_rays: AtomicU32,
     /// Negative control: the pixels whose own camera ray saw emission instead of the mask.
     from_pass: bool,
     /// The mask and the window it was made for: (width, height, x0, y0).
@@ -260,11 +281,14 @@ fn filter_reach(filter: &Filter) -> i32 {
 
 impl SeenEmission {
     /// `rays` camera rays per silhouette pixel (more than 1), `splat` those of a splatting
-    /// film's mask pixel.
-    pub fn new(rays: u32, splat: SplatRays, from_pass: bool) -> Self {
+    /// film's mask pixel, `budget` the extra rays per film pixel that may raise the mean on a
+    /// sampling film.
+    pub fn new(rays: u32, splat: SplatRays, budget: Option<f32>, from_pass: bool) -> Self {
         Self {
             rays,
             splat,
+            budget,
+            mean_rays: AtomicU32::new(rays),
             from_pass,
             mask: Mutex::new(None),
             followed_delta: AtomicBool::new(false),
@@ -308,6 +332,8 @@ impl SeenEmission {
         let most = on.iter().copied().max().unwrap_or(0);
         let mean = on.iter().map(|&n| f64::from(n)).sum::<f64>() / on.len().max(1) as f64;
         let splatted = self.splatted_rays.load(Ordering::Relaxed);
+        let decided = self.mean_rays.load(Ordering::Relaxed);
+        let budget = self.budget.unwrap_or(0.0);
         let delta = if self.followed_delta.load(Ordering::Relaxed) {
             "; the emission seen through delta lobes (the scene has some) estimated here on every \
              pixel, the probes following each lobe's first and last choice"
@@ -333,13 +359,18 @@ impl SeenEmission {
         Some(
             format!(
                 "{} of {} pixels on emitter silhouettes ({:.2} %), {mean:.1} camera rays each on average \
-             (edge_rays {}: in proportion to the luminance contrast each straddles, at most {most} \
+             (edge_rays {}{}: in proportion to the luminance contrast each straddles, at most {most} \
              here, at most {} allowed)",
                 on.len(),
                 w * h,
                 100.0 * on.len() as f64 / f64::from((w * h).max(1)),
                 self.rays,
-                self.rays * MAX_RAYS_FACTOR
+                if decided == self.rays {
+                    String::new()
+                } else {
+                    format!(", raised to {decided} by the budget of {budget} extra rays per film pixel")
+                },
+                decided * MAX_RAYS_FACTOR
             ) + delta,
         )
     }
@@ -448,6 +479,25 @@ impl SeenEmission {
         (contrast, rays)
     }
 
+    /// The mean count of a sampling film's mask pixels: `rays`, or with a budget `1 + budget /
+    /// share` (`share` the fraction of the film's pixels with a contrast) between `rays` and
+    /// [`MAX_BUDGET_RAISE`] times it. From the whole film's contrasts, so a window gets the
+    /// untiled render's counts.
+    fn mean_rays_for(&self, contrast: &[f32]) -> u32 {
+        let Some(budget) = self.budget else {
+            return self.rays;
+        };
+        let on = contrast.iter().filter(|&&c| c > 0.0).count();
+        if on == 0 {
+            return self.rays;
+        }
+        let share = on as f64 / contrast.len() as f64;
+        let most = self.rays.saturating_mul(MAX_BUDGET_RAISE);
+        (1.0 + f64::from(budget) / share)
+            .round()
+            .clamp(f64::from(self.rays), f64::from(most)) as u32
+    }
+
     /// The mean contrast over the pixels of the mask (0 without any), summed in order so that
     /// it does not depend on the thread count.
     fn mean_contrast(contrast: &[f32]) -> f64 {
@@ -498,6 +548,8 @@ impl SeenEmission {
             _ => film,
         };
         let mean = Self::mean_contrast(&film);
+        let rays_mean = self.mean_rays_for(&film);
+        self.mean_rays.store(rays_mean, Ordering::Relaxed);
         // A pixel's contrast depends on its own neighbourhood only: a window takes the film's
         // values (none beyond the film).
         let film_contrast = |x: u32, y: u32| {
@@ -508,7 +560,7 @@ impl SeenEmission {
                 0.0
             }
         };
-        let most = f64::from((self.rays * MAX_RAYS_FACTOR).min(u32::from(u16::MAX)));
+        let most = f64::from((rays_mean * MAX_RAYS_FACTOR).min(u32::from(u16::MAX)));
         let mask: Arc<Vec<u16>> = Arc::new(
             (0..w * h)
                 .map(|i| {
@@ -520,7 +572,7 @@ impl SeenEmission {
                         // One count: the pixels' rays then share their offsets (`supersample`).
                         return n as u16;
                     }
-                    let n = (f64::from(self.rays) * f64::from(c) / mean).round();
+                    let n = (f64::from(rays_mean) * f64::from(c) / mean).round();
                     n.clamp(1.0, most) as u16
                 })
                 .collect(),
@@ -704,5 +756,28 @@ impl SeenEmission {
             sink.add(own);
         }
         rays
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A film with `on` of its 1000 pixels on silhouettes.
+    fn film(on: usize) -> Vec<f32> {
+        (0..1000).map(|i| if i < on { 2.0 } else { 0.0 }).collect()
+    }
+
+    /// The budget raises a small mask's mean count to `1 + budget / share`, between `edge_rays`
+    /// and `MAX_BUDGET_RAISE` times it; without a budget, or without a mask, it stays.
+    #[test]
+    fn the_budget_raises_a_small_masks_mean_within_its_bounds() {
+        let di = SeenEmission::new(4, SplatRays::Each, Some(0.75), false);
+        assert_eq!(di.mean_rays_for(&film(20)), 16, "2 %: 38.5, capped at 4 × 4");
+        assert_eq!(di.mean_rays_for(&film(100)), 9, "10 %: 8.5, rounded");
+        assert_eq!(di.mean_rays_for(&film(500)), 4, "50 %: 2.5, at least edge_rays");
+        assert_eq!(di.mean_rays_for(&film(0)), 4);
+        let pt = SeenEmission::new(32, SplatRays::VarianceMatched, None, false);
+        assert_eq!(pt.mean_rays_for(&film(20)), 32);
     }
 }
