@@ -115,9 +115,9 @@ pub(crate) struct RestirArgs {
     /// restir-di and restir-pt: camera rays for the emission seen on pixels that an emitter's
     /// silhouette crosses (1: no more rays): with a sampled filter the pixel's own ray and the
     /// rest; with a splatted one (the Gaussian) that many rays in place of the pixel's own,
-    /// divided by the filter's variance factor for restir-pt; restir-di raises the mean on a
-    /// sampled film whose silhouettes are a small part of it, up to 4 times [default: 4 for
-    /// restir-di, 32 for restir-pt].
+    /// divided by the filter's variance factor for restir-pt; restir-di raises the count where
+    /// silhouettes are a small part of the film, up to 4 times [default: 4 for restir-di, 32
+    /// for restir-pt].
     #[arg(long)]
     edge_rays: Option<u32>,
     /// restir-di: whether receivers without a glossy lobe take the BSDF samples too (off: light

@@ -35,7 +35,7 @@ pub const LEARN_MAX_EMITTERS: usize = 50_000;
 /// tile's candidates come from its cut of the light hierarchy, which knows no visibility and, on
 /// scenes of more than [`LEARN_MAX_EMITTERS`] emitters, spreads over many lights of similar
 /// unshadowed contribution; more of them pay there. Chosen on the DI training family at 640×360
-/// (`docs/RESTIR_DI.md`, "Candidates").
+/// (`docs/RESTIR_DI.md`, "Eight neighbours, and 12 candidates from cuts without learning").
 pub const CANDIDATES_WITHOUT_LEARNING: u32 = 12;
 
 /// Where initial candidates' lights come from (`--light-sampler`).
@@ -352,8 +352,8 @@ pub struct RestirDiSettings {
     pub bsdf_samples_decided_from: Option<Option<f32>>,
     /// Camera rays for the emission seen on emitter silhouettes, the G-buffer's included
     /// (`crate::reuse::seen`; 1: the G-buffer's only; default 4, chosen on the training family:
-    /// a hall's squared error 3.6× lower at the same cost; on a sampling film whose mask is
-    /// small, raised by [`crate::reuse::seen::SILHOUETTE_BUDGET`]).
+    /// a hall's squared error 3.6× lower at the same cost; where the mask is a small part of
+    /// the film, raised by [`crate::reuse::seen::SILHOUETTE_BUDGET`]).
     pub edge_rays: u32,
     /// Negative control only: choose the pixels that get `edge_rays` by what the pass's own
     /// camera ray saw (an emitter) instead of a mask made without the pass's samples (biased).
@@ -442,7 +442,9 @@ impl RestirDiSettings {
                 LightSampler::Power
             };
         }
-        if !self.candidates_named && !self.learn.is_on() && self.light_sampler == LightSampler::Tiles
+        if !self.candidates_named
+            && !self.learn.is_on()
+            && self.light_sampler == LightSampler::Tiles
         {
             self.candidates = CANDIDATES_WITHOUT_LEARNING;
             self.candidates_decided = true;
@@ -743,7 +745,10 @@ mod tests {
         assert_eq!(at(1000, &[("learn", "off")]).0, CANDIDATES_WITHOUT_LEARNING);
         assert_eq!(at(many, &[("learn", "on")]).0, 8);
         assert_eq!(at(many, &[("light_sampler", "power")]).0, 8);
-        assert_eq!(at(many, &[("candidates", "8")]), (8, "candidates=8".to_string()));
+        assert_eq!(
+            at(many, &[("candidates", "8")]),
+            (8, "candidates=8".to_string())
+        );
         assert_eq!(at(many, &[("reservior_size", "32")]).0, 32);
     }
 

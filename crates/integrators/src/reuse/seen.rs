@@ -18,12 +18,12 @@
 //! allocation). `n` is `edge_rays` times the pixel's contrast over the mean contrast of the
 //! film's silhouette pixels, at least 1 and at most [`MAX_RAYS_FACTOR`] times `edge_rays`: the
 //! rays `edge_rays` pays for on average, moved from dim lights' silhouettes to bright ones'.
-//! An estimator may give the mask a budget ([`SILHOUETTE_BUDGET`], ReSTIR DI): on a sampling
-//! film whose mask is a small part of the image, the mean is raised until the extra rays come to
-//! that many per film pixel, at most [`MAX_BUDGET_RAISE`] times `edge_rays`, since there they
-//! cost little beside a pass. The counts depend on the camera, the film and the scene only
-//! (camera rays every half pixel, no random numbers), never on a pass's samples, so every pixel's estimate stays unbiased and
-//! a split render (chains, tiles) gets the same counts.
+//! An estimator may give the mask a budget ([`SILHOUETTE_BUDGET`], ReSTIR DI): where the mask
+//! is a small part of the film, the mean is raised until the extra rays come to that many per
+//! film pixel, at most [`MAX_BUDGET_RAISE`] times `edge_rays`, since there they cost little
+//! beside a pass. The counts depend on the camera, the film and the scene only
+//! (camera rays every half pixel, no random numbers), never on a pass's samples, so every
+//! pixel's estimate stays unbiased and a split render (chains, tiles) gets the same counts.
 
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
@@ -72,14 +72,15 @@ pub enum SplatRays {
 /// The most camera rays a silhouette pixel gets, in multiples of its mean count.
 pub const MAX_RAYS_FACTOR: u32 = 8;
 
-/// ReSTIR DI's budget for the silhouettes' extra camera rays on a sampling film, per film pixel
-/// and pass: the mask's mean count is raised to `1 + budget / share` (`share` the film's fraction
-/// of mask pixels), at least `edge_rays` and at most [`MAX_BUDGET_RAISE`] times it. Chosen on
-/// the DI training family at 640×360 (8 passes, seeds 11 and 12, 1 thread): on its halls (2 and 5
-/// % of the film on silhouettes) 16 rays are 1.03–1.05× the relative efficiency of 4 and 3.0–3.6×
-/// its efficiency in squared error, for a pass 1–5 % dearer; on the training Sponza with 2000
-/// lamps (a splatting film, 27 % of it in the mask, which keeps `edge_rays`) 8 and 16 rays would
-/// cost 0.93× and 0.79× (`docs/RESTIR_DI.md`, "Silhouettes").
+/// ReSTIR DI's budget for the silhouettes' extra camera rays, per film pixel and pass: the
+/// mask's mean count (on a splatting film, its one count) is raised to `1 + budget / share`
+/// (`share` the film's fraction of mask pixels), at least `edge_rays` and at most
+/// [`MAX_BUDGET_RAISE`] times it. Chosen on the DI training family at 640×360 (8 passes, seeds
+/// 11 and 12, 1 thread): on its halls (2 and 5 % of the film on silhouettes) 16 rays are
+/// 1.03–1.05× the relative efficiency of 4 and 3.0–3.6× its efficiency in squared error, for a
+/// pass 1–5 % dearer; on the training Sponza with 2000 lamps (a splatting film, 27 % of it in
+/// the mask, which the budget leaves at 4) 8 and 16 rays would cost 0.93× and 0.79×
+/// (`docs/RESTIR_DI.md`, "Silhouettes").
 pub const SILHOUETTE_BUDGET: f32 = 0.75;
 
 /// How far [`SILHOUETTE_BUDGET`] may raise the mean count, in multiples of `edge_rays`.
@@ -97,8 +98,8 @@ pub struct SeenEmission {
     /// On a splatting film, whether a mask pixel's rays are `rays` times the filter's variance
     /// factor (ReSTIR PT) or `rays` (ReSTIR DI); see [`SplatRays`].
     splat: SplatRays,
-    /// Extra camera rays per film pixel the mask may spend on a sampling film
-    /// ([`SILHOUETTE_BUDGET`]; `None`: the mean stays `rays`).
+    /// Extra camera rays per film pixel the mask may spend ([`SILHOUETTE_BUDGET`]; `None`: the
+    /// counts stay as `rays` and `splat` give them).
     budget: Option<f32>,
     /// The mean count the current mask was made with on a sampling film, for `--stats`.
     mean_rays: AtomicU32,
@@ -281,8 +282,7 @@ fn filter_reach(filter: &Filter) -> i32 {
 
 impl SeenEmission {
     /// `rays` camera rays per silhouette pixel (more than 1), `splat` those of a splatting
-    /// film's mask pixel, `budget` the extra rays per film pixel that may raise the mean on a
-    /// sampling film.
+    /// film's mask pixel, `budget` the extra rays per film pixel that may raise them.
     pub fn new(rays: u32, splat: SplatRays, budget: Option<f32>, from_pass: bool) -> Self {
         Self {
             rays,
@@ -350,6 +350,11 @@ impl SeenEmission {
                 w * h,
                 100.0 * on.len() as f64 / f64::from((w * h).max(1)),
                 match self.splat {
+                    SplatRays::Each if splatted != self.rays => format!(
+                        "edge_rays {}, raised to {splatted} by the budget of {budget} extra rays \
+                         per film pixel",
+                        self.rays
+                    ),
                     SplatRays::Each => format!("edge_rays {}", self.rays),
                     SplatRays::VarianceMatched =>
                         format!("edge_rays {} times the filter's variance factor", self.rays),
@@ -368,7 +373,9 @@ impl SeenEmission {
                 if decided == self.rays {
                     String::new()
                 } else {
-                    format!(", raised to {decided} by the budget of {budget} extra rays per film pixel")
+                    format!(
+                        ", raised to {decided} by the budget of {budget} extra rays per film pixel"
+                    )
                 },
                 decided * MAX_RAYS_FACTOR
             ) + delta,
@@ -479,23 +486,23 @@ impl SeenEmission {
         (contrast, rays)
     }
 
-    /// The mean count of a sampling film's mask pixels: `rays`, or with a budget `1 + budget /
-    /// share` (`share` the fraction of the film's pixels with a contrast) between `rays` and
-    /// [`MAX_BUDGET_RAISE`] times it. From the whole film's contrasts, so a window gets the
-    /// untiled render's counts.
-    fn mean_rays_for(&self, contrast: &[f32]) -> u32 {
+    /// The mean count of the mask's pixels from the count `base` they would get: `base`, or
+    /// with a budget `1 + budget / share` (`share` the fraction of the film's pixels in the
+    /// mask) between `base` and [`MAX_BUDGET_RAISE`] times it. From the whole film's contrasts,
+    /// so a window gets the untiled render's counts.
+    fn raised(&self, base: u32, contrast: &[f32]) -> u32 {
         let Some(budget) = self.budget else {
-            return self.rays;
+            return base;
         };
         let on = contrast.iter().filter(|&&c| c > 0.0).count();
         if on == 0 {
-            return self.rays;
+            return base;
         }
         let share = on as f64 / contrast.len() as f64;
-        let most = self.rays.saturating_mul(MAX_BUDGET_RAISE);
+        let most = base.saturating_mul(MAX_BUDGET_RAISE);
         (1.0 + f64::from(budget) / share)
             .round()
-            .clamp(f64::from(self.rays), f64::from(most)) as u32
+            .clamp(f64::from(base), f64::from(most)) as u32
     }
 
     /// The mean contrast over the pixels of the mask (0 without any), summed in order so that
@@ -537,8 +544,6 @@ impl SeenEmission {
         // so every pixel whose filter (`R + 1` whole pixels) sees an emitter at all, and the `R`
         // pixels around it, get the same count (below), and what lies beyond sees no emitter.
         let splat = self.splat_count(scene, ctx);
-        self.splatted_rays
-            .store(splat.unwrap_or(0), Ordering::Relaxed);
         let splat_reach = splat.map(|_| Reconstruction::decide(scene.filter).reach() as i32);
         let reach = splat_reach.map_or_else(|| filter_reach(ctx.filter), |r| r + 1);
         let (fw, fh) = scene.camera.resolution();
@@ -548,8 +553,11 @@ impl SeenEmission {
             _ => film,
         };
         let mean = Self::mean_contrast(&film);
-        let rays_mean = self.mean_rays_for(&film);
+        let rays_mean = self.raised(self.rays, &film);
         self.mean_rays.store(rays_mean, Ordering::Relaxed);
+        let splat = splat.map(|n| self.raised(n, &film));
+        self.splatted_rays
+            .store(splat.unwrap_or(0), Ordering::Relaxed);
         // A pixel's contrast depends on its own neighbourhood only: a window takes the film's
         // values (none beyond the film).
         let film_contrast = |x: u32, y: u32| {
@@ -662,6 +670,11 @@ impl SeenEmission {
         } else {
             self.mask(scene, ctx, chains)
         };
+        // The count the mask decided (the budget may have raised it), the same for every pass.
+        let splat = match self.splatted_rays.load(Ordering::Relaxed) {
+            n if splatted && !self.from_pass && n > 0 => n,
+            _ => splat,
+        };
         let (w, _) = ctx.resolution(scene);
         let (crop_x, crop_y) = ctx
             .crop
@@ -773,11 +786,11 @@ mod tests {
     #[test]
     fn the_budget_raises_a_small_masks_mean_within_its_bounds() {
         let di = SeenEmission::new(4, SplatRays::Each, Some(0.75), false);
-        assert_eq!(di.mean_rays_for(&film(20)), 16, "2 %: 38.5, capped at 4 × 4");
-        assert_eq!(di.mean_rays_for(&film(100)), 9, "10 %: 8.5, rounded");
-        assert_eq!(di.mean_rays_for(&film(500)), 4, "50 %: 2.5, at least edge_rays");
-        assert_eq!(di.mean_rays_for(&film(0)), 4);
+        assert_eq!(di.raised(4, &film(20)), 16, "2 %: 38.5, capped at 4 × 4");
+        assert_eq!(di.raised(4, &film(100)), 9, "10 %: 8.5, rounded");
+        assert_eq!(di.raised(4, &film(500)), 4, "50 %: 2.5, at least edge_rays");
+        assert_eq!(di.raised(4, &film(0)), 4);
         let pt = SeenEmission::new(32, SplatRays::VarianceMatched, None, false);
-        assert_eq!(pt.mean_rays_for(&film(20)), 32);
+        assert_eq!(pt.raised(32, &film(20)), 32);
     }
 }
