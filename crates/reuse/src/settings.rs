@@ -146,7 +146,7 @@ impl ReuseSettings {
     /// a note saying so (the settings line then names the count used), or `None` when nothing
     /// changed.
     pub fn pair_neighbors(&mut self) -> Option<String> {
-        if !self.runs_reciprocal() || self.neighbors % 2 == 0 {
+        if !self.runs_reciprocal() || self.neighbors.is_multiple_of(2) {
             return None;
         }
         let asked = self.neighbors;
