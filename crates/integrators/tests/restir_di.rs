@@ -683,7 +683,10 @@ fn light_hierarchy_and_its_cuts_are_unbiased_and_a_wrong_pmf_is_caught() {
             &[("light_sampler", sampler), ("candidates", "4")][..],
             &[("light_sampler", sampler), ("spatial_rounds", "2")][..],
         ] {
-            let z = max_z(&statistics(scene, "restir-di", params, 1, 200), &reference);
+            // 400 renders: with eight neighbours in each of two rounds a rare bright sample
+            // reaches many pixels of a pass, and 200 renders' spread understates the tail (at
+            // 200, max |z| 4.52 on the 64×64 tiles; at 800, 3.08).
+            let z = max_z(&statistics(scene, "restir-di", params, 1, 400), &reference);
             eprintln!("{params:?}: max |z| = {z:.2}");
             assert!(z < Z_MAX, "{params:?}: max |z| = {z:.2}");
         }
