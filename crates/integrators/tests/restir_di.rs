@@ -380,6 +380,52 @@ fn edge_rays_on_a_splatting_film_unbiased() {
     );
 }
 
+/// On a splatting film whose silhouettes are a small part of it, the silhouette budget raises
+/// the one count of the mask's pixels (here to 8, the sphere lamp alone, 11 % of the film in the
+/// mask), and every pass takes that many of the stratified sequence's offsets: still unbiased,
+/// and the mask from the pass's own rays still caught.
+#[test]
+fn raised_edge_rays_on_a_splatting_film_unbiased() {
+    let scene = build(
+        &scene_text(
+            "Diffuse(reflectance: (0.9, 0.9, 0.9))",
+            "Diffuse(reflectance: (0.3, 0.6, 0.3))",
+            SIZE,
+            0.0,
+        )
+        .replace("filter: Box", "filter: Gaussian(stddev: 0.5)")
+        .replace(
+            "emission: Some((1.5, 1.5, 1.5))",
+            "material: Some(Inline(Black))",
+        ),
+    );
+    let mut settings = RestirDiSettings::new(restir_integrators::path::PathSettings::from_desc(
+        &scene.integrator,
+    ));
+    settings.resolve(&scene.scene.features);
+    let integrator = RestirDiIntegrator::new(settings);
+    common::render_with(&scene, &integrator, 1, 0);
+    let said = integrator.silhouettes().expect("a mask");
+    assert!(said.contains("raised to 8"), "{said}");
+    let reference = direct_reference(&scene);
+    let z = max_z(&statistics(&scene, "restir-di", &[], 1, 200), &reference);
+    eprintln!("splatting, edge rays raised to 8: max |z| = {z:.2}");
+    assert!(
+        z < Z_MAX,
+        "splatting, edge rays raised to 8: max |z| = {z:.2}"
+    );
+    let control = [("edge_mask_from_pass", "true")];
+    let z = max_z(
+        &statistics(&scene, "restir-di", &control, 1, 200),
+        &reference,
+    );
+    eprintln!("splatting, raised, the mask from the pass's own rays: max |z| = {z:.2}");
+    assert!(
+        z > Z_MAX,
+        "a mask from the pass's own rays should be biased: {z:.2}"
+    );
+}
+
 /// The candidates come from the power sampler's pool of presampled lights (the default): the
 /// MIS loop above covers it; here the pool's negative control — whole lights' candidates
 /// (the sphere, the point light, the environment) weighted without their selection probability

@@ -279,7 +279,7 @@ pub fn spatial<R: ReuseShift, G: Surfaces>(
         e.clear();
         e.resize(current.len(), None);
     }
-    if settings.reciprocal && reciprocal::shares_pair_shifts(settings.mis) {
+    if settings.runs_reciprocal() {
         return reciprocal::spatial(
             reuse,
             settings,
