@@ -149,7 +149,8 @@ pub struct AutoIntegrator {
 
 impl AutoIntegrator {
     /// Chooses for `scene` with paths of `path` and makes the chosen estimator.
-    pub fn new(scene: &Scene, path: PathSettings) -> Self {
+    pub fn new(scene: &Scene, mut path: PathSettings) -> Self {
+        path.resolve_nee(&scene.features);
         let (choice, why) = choose(scene, &path);
         let chosen: Box<dyn Integrator> = match choice {
             Choice::Path => Box::new(PathIntegrator { settings: path }),

@@ -237,6 +237,7 @@ pub fn make_integrator(
         "path" => {
             let mut settings = settings;
             let unused = params.apply(|key, p| settings.apply_one(key, p))?;
+            settings.resolve_nee(&scene.features);
             (Box::new(PathIntegrator { settings }), unused)
         }
         "restir-di" => {
@@ -249,6 +250,7 @@ pub fn make_integrator(
         "restir-pt" => {
             let mut s = RestirPtSettings::new(settings);
             let unused = s.apply(&params)?;
+            s.path.resolve_nee(&scene.features);
             notes.extend(s.reuse.pair_neighbors());
             (Box::new(RestirPtIntegrator::new(s)), unused)
         }

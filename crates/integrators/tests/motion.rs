@@ -409,6 +409,7 @@ fn restir_pt_shift_across_frames_is_invertible() {
         hide_emitters: false,
         sampler: restir_scene::SamplerKind::Independent,
         nee: restir_lights::NeeSelection::Power,
+        nee_rule: restir_integrators::path::NeeRule::Named,
     }));
     let motion = FrameMotion::new(s0.clone(), &s1, desc.animation.as_ref().unwrap(), T0, T1);
     assert!(!motion.scene_is_still());

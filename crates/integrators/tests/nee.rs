@@ -8,6 +8,7 @@
 //! samples: the two strategies' weights no longer sum to one, and the statistic sees it.
 
 use restir_integrators::path::{PathIntegrator, PathSettings};
+use restir_integrators::{IntegratorOptions, Param, ParamSource, make_integrator};
 use restir_lights::NeeSelection;
 use restir_scene::parse_ron;
 
@@ -58,7 +59,11 @@ fn hierarchy_nee_is_unbiased_and_weighing_against_the_power_density_is_caught() 
     let stats = |render: &dyn Fn(u64) -> restir_image::Image, seeds, base| {
         block_statistics(render, seeds, base, BLOCK)
     };
-    let reference = stats(&|seed| render_image(&s, "path", &[], 64, seed), 32, 0x1000);
+    let reference = stats(
+        &|seed| render_image(&s, "path", &[("light_sampler", "power")], 64, seed),
+        32,
+        0x1000,
+    );
 
     let bvh = stats(
         &|seed| render_image(&s, "path", &[("light_sampler", "bvh")], 64, seed),
@@ -78,6 +83,7 @@ fn hierarchy_nee_is_unbiased_and_weighing_against_the_power_density_is_caught() 
     let control = PathIntegrator {
         settings: PathSettings {
             nee: NeeSelection::HierarchyWeighedByPower,
+            nee_rule: restir_integrators::path::NeeRule::Named,
             ..PathSettings::from_desc(&s.integrator)
         },
     };
@@ -85,4 +91,60 @@ fn hierarchy_nee_is_unbiased_and_weighing_against_the_power_density_is_caught() 
     let z = max_z(&wrong, &reference);
     eprintln!("control, weighed against the power density: max |z| = {z:.2}");
     assert!(z > Z_MAX, "the control was not detected: max |z| = {z:.2}");
+}
+
+/// `light_sampler = auto` (the default) gives the path tracer and ReSTIR PT the hierarchy for
+/// this scene's 18 small lights (rectangles and a sphere, at most two emitters each) and the
+/// power sampler to a scene whose one light is a tessellated box (12 triangles), and says
+/// which and why in the settings line; a named selection stays as named.
+#[test]
+fn auto_decides_by_the_emitters_a_light_holds() {
+    let s = scene(3);
+    for name in ["path", "restir-pt"] {
+        let line = make(&s, name, &[]).describe();
+        assert!(
+            line.contains("light_sampler=bvh (auto: 18 local lights, 35 emitters)"),
+            "{line}"
+        );
+        let line = make(&s, name, &[("light_sampler", "power")]).describe();
+        assert!(
+            line.contains("light_sampler=power") && !line.contains("auto:"),
+            "{line}"
+        );
+    }
+    let ron = r#"(
+        camera: (fov: 45, to_world: [LookAt(origin: (0, 2, 4), target: (0, 0, 0), up: (0, 1, 0))]),
+        film: (width: 8, height: 8, filter: Box),
+        integrator: (max_depth: 3),
+        shapes: [
+            (geometry: Rectangle, to_world: [Scale((3, 3, 1)), Rotate(axis: (1, 0, 0), angle: -90)],
+             material: Some(Inline(Diffuse(reflectance: (0.5, 0.5, 0.5))))),
+            (geometry: Cube, to_world: [Scale((0.2, 0.2, 0.2)), Translate((0, 1.5, 0))],
+             emission: Some((5, 5, 5))),
+        ],
+    )"#;
+    let desc = parse_ron(ron, "lamp.ron".as_ref()).unwrap();
+    let lamp = common::build(&desc, ".".as_ref(), "lamp.ron".as_ref());
+    let line = make(&lamp, "path", &[]).describe();
+    assert!(
+        line.contains("light_sampler=power (auto: 1 local light, 12 emitters)"),
+        "{line}"
+    );
+    let line = make(&lamp, "path", &[("light_sampler", "bvh")]).describe();
+    assert!(
+        line.contains("light_sampler=bvh") && !line.contains("auto:"),
+        "{line}"
+    );
+    let options = IntegratorOptions {
+        name: Some("path".into()),
+        max_depth: None,
+        params: vec![Param::new("light_sampler", "near", ParamSource::Caller)]
+            .into_iter()
+            .collect(),
+        sampler: None,
+    };
+    let err = make_integrator(&lamp, &lamp.integrator, &options)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("expected power, bvh or auto"), "{err}");
 }

@@ -162,6 +162,7 @@ fn integrator(max_depth: i32) -> RestirPtIntegrator {
         hide_emitters: false,
         sampler: restir_scene::SamplerKind::Independent,
         nee: restir_lights::NeeSelection::Power,
+        nee_rule: restir_integrators::path::NeeRule::Named,
     }))
 }
 
@@ -843,7 +844,10 @@ fn xml_restir_pt_integrator_and_parameters() {
     let made = make_integrator(&scene, &scene.integrator, &IntegratorOptions::default()).unwrap();
     assert!(made.unused_params.is_empty());
     let d = made.integrator.describe();
-    assert!(d.starts_with("restir-pt max_depth=6 candidates=4"), "{d}");
+    assert!(
+        d.starts_with("restir-pt max_depth=6 light_sampler=power (auto: 0 local lights, 0 emitters) candidates=4"),
+        "{d}"
+    );
     assert!(
         d.contains("neighbors=5") && d.contains("spatial_rounds=2") && d.contains("mis=balance"),
         "{d}"

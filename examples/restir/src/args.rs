@@ -79,7 +79,9 @@ pub(crate) struct RestirArgs {
     /// (per 16×16-pixel tile, a cut of the light hierarchy for the tile's receivers), bvh (the
     /// light hierarchy: per receiver, a descent by power, distance and orientation) or auto
     /// (tiles where the scene has a local light, else power) [default: auto]. path and
-    /// restir-pt: how next-event estimation picks its light, power or bvh [default: power].
+    /// restir-pt: how next-event estimation picks its light, power, bvh or auto (bvh where
+    /// the scene has two or more local lights of at most two emitters each on average, else
+    /// power) [default: auto].
     #[arg(long)]
     light_sampler: Option<String>,
     /// restir-di: on draws candidates' lights, from the second pass on, from a mixture of the

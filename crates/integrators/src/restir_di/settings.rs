@@ -625,6 +625,7 @@ mod tests {
             hide_emitters: false,
             sampler: restir_scene::SamplerKind::Independent,
             nee: restir_lights::NeeSelection::Power,
+            nee_rule: crate::path::NeeRule::Named,
         })
     }
 

@@ -400,10 +400,11 @@ impl Integrator for RestirPtIntegrator {
     fn describe(&self) -> String {
         let s = &self.settings;
         format!(
-            "restir-pt max_depth={} candidates={} neighbors={} radius={} spatial_rounds={} \
+            "restir-pt max_depth={} {} candidates={} neighbors={} radius={} spatial_rounds={} \
              reciprocal={} mis={} mcap={} {} {} shift={} reconnection={} max_jacobian={} \
              direct={}{}{}",
             s.path.max_depth,
+            s.path.nee_label(),
             s.candidates,
             s.reuse.neighbors,
             s.reuse.radius,

@@ -213,6 +213,7 @@ mod tests {
             hide_emitters: false,
             sampler: restir_scene::SamplerKind::Independent,
             nee: restir_lights::NeeSelection::Power,
+            nee_rule: crate::path::NeeRule::Named,
         });
         let p = |a: &str, b: &str| ParamSet::from(&[(a, b)][..]);
         let unknown = s
