@@ -17,12 +17,16 @@
 //!    one light takes at least [`DOMINANT_LIGHT_SHARE`] of the light selections: the reservoirs
 //!    have little to choose from and their cost is not repaid
 //!    (`docs/studies/2026-12-02-never-worse.md`: ReSTIR DI 0.57–0.60× the path tracer there).
-//! 4. **ReSTIR DI** otherwise (many lights, or no light dominating).
+//! 4. **ReSTIR PT** when no light dominates and paths longer than two segments are asked for:
+//!    ReSTIR DI estimates the indirect light with one path-traced continuation per pass, at the
+//!    cost of its reservoirs' pass. On the DI training family rendered with `max_depth` −1
+//!    (640×360, 1 thread; the pilot's indirect shares 6–44 %), ReSTIR PT was 1.97–6.8× the
+//!    path tracer and ReSTIR DI 0.85–3.9× (`docs/RESTIR_PT.md`, "Never worse").
+//! 5. **ReSTIR DI** otherwise: direct light only (`max_depth` 2) from many lights, or no light
+//!    dominating.
 //!
 //! Rule 2 comes before rule 3 because the glossy rooms where ReSTIR PT gains 2–5× are lit by one
-//! area light. Which of ReSTIR PT and ReSTIR DI is better on a scene that both rules would give
-//! to a ReSTIR estimator (many lights and glossy surfaces in view) is not measured; `auto` takes
-//! ReSTIR PT there.
+//! area light.
 //!
 //! `auto` runs the chosen estimator at its defaults and takes no estimator parameters (name the
 //! estimator to configure it); the depth settings (`max_depth`, `rr_depth`, `hide_emitters`)
@@ -123,20 +127,26 @@ pub fn choose(scene: &Scene, path: &PathSettings) -> (Choice, String) {
         return (Choice::RestirPt, view.clone());
     }
     let view = view.map_or("direct light only (max_depth 2)".to_string(), |v| v);
-    match dominant_light(f) {
-        Some(why) => (Choice::Path, format!("{view}; {why}")),
-        None => (
-            Choice::RestirDi,
-            format!(
-                "{view}; no light dominates the selections among {} emitters (the largest takes \
-                 {:.0}%; the path tracer from {:.0}% with at most {} emitters)",
-                f.emitter_count,
-                100.0 * f.largest_light_share,
-                100.0 * DOMINANT_LIGHT_SHARE,
-                FEW_EMITTERS
-            ),
-        ),
+    if let Some(why) = dominant_light(f) {
+        return (Choice::Path, format!("{view}; {why}"));
     }
+    let many = format!(
+        "no light dominates the selections among {} emitters (the largest takes {:.0}%; the path \
+         tracer from {:.0}% with at most {} emitters)",
+        f.emitter_count,
+        100.0 * f.largest_light_share,
+        100.0 * DOMINANT_LIGHT_SHARE,
+        FEW_EMITTERS
+    );
+    if path.max_segments() > 2 {
+        // Rule 4: ReSTIR DI would estimate the indirect light with one path-traced
+        // continuation per pass, at the cost of its reservoirs' pass.
+        return (
+            Choice::RestirPt,
+            format!("{view}; {many}; indirect light asked for (max_depth above 2)"),
+        );
+    }
+    (Choice::RestirDi, format!("{view}; {many}"))
 }
 
 /// The `auto` estimator: the estimator [`choose`] picked, at its defaults, and why.

@@ -133,10 +133,10 @@ impl PathSettings {
             NeeRule::Named => format!("light_sampler={}", self.nee.name()),
             NeeRule::Auto => "light_sampler=auto".to_string(),
             NeeRule::Decided { lights, emitters } => format!(
-                "light_sampler={} (auto: {lights} local light{}, {emitters} emitter{})",
+                "light_sampler={} (auto: {emitters} emitter{} in {lights} local light{})",
                 self.nee.name(),
-                if lights == 1 { "" } else { "s" },
-                if emitters == 1 { "" } else { "s" }
+                if emitters == 1 { "" } else { "s" },
+                if lights == 1 { "" } else { "s" }
             ),
         }
     }

@@ -103,7 +103,7 @@ fn auto_decides_by_the_emitters_a_light_holds() {
     for name in ["path", "restir-pt"] {
         let line = make(&s, name, &[]).describe();
         assert!(
-            line.contains("light_sampler=bvh (auto: 18 local lights, 35 emitters)"),
+            line.contains("light_sampler=bvh (auto: 35 emitters in 18 local lights)"),
             "{line}"
         );
         let line = make(&s, name, &[("light_sampler", "power")]).describe();
@@ -127,7 +127,7 @@ fn auto_decides_by_the_emitters_a_light_holds() {
     let lamp = common::build(&desc, ".".as_ref(), "lamp.ron".as_ref());
     let line = make(&lamp, "path", &[]).describe();
     assert!(
-        line.contains("light_sampler=power (auto: 1 local light, 12 emitters)"),
+        line.contains("light_sampler=power (auto: 12 emitters in 1 local light)"),
         "{line}"
     );
     let line = make(&lamp, "path", &[("light_sampler", "bvh")]).describe();

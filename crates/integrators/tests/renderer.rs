@@ -237,6 +237,40 @@ fn auto_picks_restir_di_on_many_lights() {
     );
 }
 
+/// The same scene with indirect light asked for (`max_depth` −1): no light dominates and the
+/// paths are longer than two segments, so `auto` renders with ReSTIR PT, bit for bit its image,
+/// and says why; with `max_depth` 2 it stays with ReSTIR DI (above).
+#[test]
+fn auto_picks_restir_pt_for_many_lights_with_indirect_light() {
+    let loaded = many_lights(16);
+    let run = |name: &str| {
+        Renderer::new(&loaded)
+            .spp(1)
+            .max_depth(-1)
+            .integrator(name)
+            .render()
+            .unwrap()
+    };
+    let (auto, pt) = (run("auto"), run("restir-pt"));
+    assert_eq!(
+        (auto.estimator.asked.as_str(), auto.estimator.ran.as_str()),
+        ("auto", "restir-pt")
+    );
+    assert!(
+        auto.estimator
+            .why
+            .contains("no light dominates the selections")
+            && auto
+                .estimator
+                .why
+                .contains("indirect light asked for (max_depth above 2)"),
+        "{:?}",
+        auto.estimator
+    );
+    assert_eq!(auto.estimator.settings, pt.estimator.settings);
+    assert_eq!(bits(&auto.image.pixels), bits(&pt.image.pixels));
+}
+
 /// `fallback`, the parameter that let ReSTIR DI and PT hand a scene to the path tracer, is an
 /// error naming what replaced it, from the caller and from a scene file (with its line); `auto`
 /// takes no estimator parameters.

@@ -117,11 +117,24 @@ fn direct_reference(scene: &common::Built) -> Vec<(f64, f64)> {
 }
 
 /// With `max_depth > 2` the first BSDF sample continues as a path: indirect light is added by
-/// the path tracer's estimator and the total stays unbiased.
+/// the path tracer's estimator and the total stays unbiased. The scene's three small lights
+/// give the continuations' next-event estimation the light hierarchy (`auto`); the reference
+/// is the path tracer with the power sampler.
 #[test]
 fn unbiased_with_indirect_light() {
     let scene = scene();
-    let reference = statistics(&scene, "path", &[("max_depth", "-1")], 128, 48);
+    let line = common::make(&scene, "restir-di", &[("max_depth", "-1")]).describe();
+    assert!(
+        line.contains("continuation_light_sampler=bvh (auto"),
+        "{line}"
+    );
+    let reference = statistics(
+        &scene,
+        "path",
+        &[("max_depth", "-1"), ("light_sampler", "power")],
+        128,
+        48,
+    );
     let di = statistics(
         &scene,
         "restir-di",

@@ -845,7 +845,7 @@ fn xml_restir_pt_integrator_and_parameters() {
     assert!(made.unused_params.is_empty());
     let d = made.integrator.describe();
     assert!(
-        d.starts_with("restir-pt max_depth=6 light_sampler=power (auto: 0 local lights, 0 emitters) candidates=4"),
+        d.starts_with("restir-pt max_depth=6 light_sampler=power (auto: 0 emitters in 0 local lights) candidates=4"),
         "{d}"
     );
     assert!(

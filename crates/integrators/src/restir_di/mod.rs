@@ -314,10 +314,15 @@ impl Integrator for RestirDiIntegrator {
     fn describe(&self) -> String {
         let s = &self.settings;
         format!(
-            "restir-di max_depth={} {} light_sampler={} bsdf_candidates={} {} {} neighbors={} \
+            "restir-di max_depth={}{} {} light_sampler={} bsdf_candidates={} {} {} neighbors={} \
              radius={} spatial_rounds={} reciprocal={} mis={} mcap={} {} \
              visibility={} {}{}{}",
             s.path.max_depth,
+            if s.path.max_segments() > 2 {
+                format!(" continuation_{}", s.path.nee_label())
+            } else {
+                String::new()
+            },
             s.candidates_label(),
             s.light_sampler.name().to_string()
                 + &if s.learn.is_on() {
