@@ -110,10 +110,10 @@ fn flags_the_estimator_does_not_use() {
         &["render", s(&c), "-o", s(&out), "--learn", "on"],
         "error: --learn is not an option of the integrator 'path' (used by: restir-di)",
     );
-    // The path tracer's next-event estimation takes two of ReSTIR DI's light samplers.
+    // The path tracer's next-event estimation takes three of ReSTIR DI's light samplers.
     fails_with(
         &["render", s(&c), "-o", s(&out), "--light-sampler", "tiles"],
-        "error: light_sampler = 'tiles': expected power or bvh",
+        "error: light_sampler = 'tiles': expected power, bvh or auto",
     );
     assert!(!out.exists());
 }
