@@ -75,6 +75,13 @@ pub struct ReuseSettings {
 /// a user's size").
 pub const DIRECT_NEIGHBORS: u32 = 8;
 
+/// ReSTIR DI's spatial radius in pixels ([`ReuseSettings::direct`]): with eight neighbours in
+/// reciprocal pairs, 2 pixels are 1.05× the efficiency of 3 at the median of the project's DI
+/// training family at 640×360 (0.97–1.13×, equal CPU time, 8 passes; the same cost per pass),
+/// and 1.03× on its test family, where every member gains (1.01–1.08×; the project
+/// repository's `docs/RESTIR_DI.md`, "The defaults at a user's size").
+pub const DIRECT_RADIUS: f32 = 2.0;
+
 impl Default for ReuseSettings {
     /// One round of four neighbours in two reciprocal pairs within 3 pixels, defensive pairwise
     /// MIS, `M` capped at 20, no temporal reuse, 25° and 10 % similarity, shading every input
@@ -103,11 +110,12 @@ impl Default for ReuseSettings {
 
 impl ReuseSettings {
     /// ReSTIR DI's reuse: the [default](ReuseSettings::default) with [`DIRECT_NEIGHBORS`]
-    /// neighbours (the rest chosen on the DI training family too: the project repository's
+    /// neighbours within [`DIRECT_RADIUS`] pixels (the rest chosen on the DI training family too: the project repository's
     /// `docs/studies/2026-12-02-restir-di-light-pool-and-defaults.md`).
     pub fn direct() -> Self {
         Self {
             neighbors: DIRECT_NEIGHBORS,
+            radius: DIRECT_RADIUS,
             ..Self::default()
         }
     }

@@ -137,7 +137,7 @@ pub(crate) struct RestirArgs {
     /// even one) [default: 8 for restir-di, 4 for restir-pt].
     #[arg(long, alias = "neighbours")]
     neighbors: Option<u32>,
-    /// Spatial reuse radius in pixels [default: 3].
+    /// Spatial reuse radius in pixels [default: 2 for restir-di, 3 for restir-pt].
     #[arg(long)]
     radius: Option<f32>,
     /// Spatial reuse rounds [default: 1 for restir-di, 3 for restir-pt].
