@@ -57,8 +57,8 @@ pub enum NeeRule {
 /// triangles, spheres, points), and the power sampler otherwise (one light; lamps tessellated
 /// into many triangles). Chosen on the DI training family at 640×360 (the path tracer, direct
 /// light, 16 passes, seeds 11 and 12, 1 thread): with the hierarchy, the seven members of
-/// rectangles and spheres (1–2 emitters a light, 10³–10⁵ lights) are 1.16–1.64× as efficient,
-/// the five of emissive meshes and garlands (110–12 500 triangles a light) 0.45–1.33×, and
+/// rectangles and spheres (1–2 emitters a light, 10³–10⁵ lights) are 1.16–1.75× as efficient,
+/// the five of emissive meshes and garlands (110–12 500 triangles a light) 0.44–1.33×, and
 /// 0.51–0.91× in squared error (`docs/RESTIR_PT.md`, "Next-event estimation's light
 /// selection").
 pub const AUTO_NEE_MAX_EMITTERS_PER_LIGHT: usize = 2;
@@ -125,6 +125,16 @@ impl PathSettings {
         let emitters = features.emitter_count;
         self.nee = auto_nee(lights, emitters);
         self.nee_rule = NeeRule::Decided { lights, emitters };
+    }
+
+    /// These settings with next-event estimation decided for the scene `features` describes
+    /// when it is still `auto` (estimators made without [`PathSettings::resolve_nee`], as a
+    /// library may make them, decide it when they render).
+    pub fn resolved(mut self, features: &SceneFeatures) -> Self {
+        if self.nee_rule == NeeRule::Auto {
+            self.resolve_nee(features);
+        }
+        self
     }
 
     /// `light_sampler=NAME`, with what decided it when `auto` did, for settings lines.
@@ -419,22 +429,23 @@ impl Integrator for PathIntegrator {
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
         let (w, _) = ctx.resolution(scene);
         let w = w as usize;
+        let settings = self.settings.resolved(&scene.features);
         let bands = Bands::new(w);
         bands.run(accum, |first, chunk| {
             let mut rays = 0;
             for (i, px) in chunk.iter_mut().enumerate() {
                 let index = first + i;
                 let (x, y) = ((index % w) as u32, (index / w) as u32);
-                let (l, r) = match self.settings.sampler {
+                let (l, r) = match settings.sampler {
                     SamplerKind::Independent => {
                         let mut rng = ctx.pixel_rng(index);
                         let film = ctx.pixel_film_position(index, (x, y), &mut rng);
-                        trace_camera_path(scene, &self.settings, film, &mut rng)
+                        trace_camera_path(scene, &settings, film, &mut rng)
                     }
                     SamplerKind::Sobol => {
                         let mut rng = ctx.pixel_sequence(index);
                         let film = ctx.film_position(x, y, &mut rng);
-                        trace_camera_path(scene, &self.settings, film, &mut rng)
+                        trace_camera_path(scene, &settings, film, &mut rng)
                     }
                 };
                 *px += l.as_dvec3();

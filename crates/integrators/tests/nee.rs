@@ -8,7 +8,7 @@
 //! samples: the two strategies' weights no longer sum to one, and the statistic sees it.
 
 use restir_integrators::path::{PathIntegrator, PathSettings};
-use restir_integrators::{IntegratorOptions, Param, ParamSource, make_integrator};
+use restir_integrators::{Integrator, IntegratorOptions, Param, ParamSource, make_integrator};
 use restir_lights::NeeSelection;
 use restir_scene::parse_ron;
 
@@ -112,6 +112,21 @@ fn auto_decides_by_the_emitters_a_light_holds() {
             "{line}"
         );
     }
+    // A path tracer made without `make_integrator` (as a library may make one) decides when it
+    // renders: the same image as the one `make_integrator` decided for.
+    let made = make(&s, "path", &[]);
+    let direct = PathIntegrator {
+        settings: PathSettings::from_desc(&s.integrator),
+    };
+    assert!(direct.describe().contains("light_sampler=auto"));
+    let (a, b) = (
+        render_with(&s, made.as_ref(), 2, 7),
+        render_with(&s, &direct, 2, 7),
+    );
+    assert!(
+        a.pixels == b.pixels,
+        "an undecided selection renders another image"
+    );
     let ron = r#"(
         camera: (fov: 45, to_world: [LookAt(origin: (0, 2, 4), target: (0, 0, 0), up: (0, 1, 0))]),
         film: (width: 8, height: 8, filter: Box),

@@ -248,7 +248,7 @@ impl RestirDiIntegrator {
         }
 
         // BSDF samples; the first continues the path when indirect light or delta lobes need it.
-        let settings = &self.settings.path;
+        let settings = &self.settings.path.resolved(&scene.features);
         let max_depth = settings.max_segments();
         let continues = max_depth > 2 || scene.features.has_delta_lobes;
         let n_b = self.counts.samples_at(bsdf).bsdf as u32;

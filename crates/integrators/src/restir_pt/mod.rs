@@ -187,7 +187,7 @@ impl RestirPtIntegrator {
             rule: self.settings.reconnection,
             footprint2: self.settings.footprint * scene.camera.pixel_angle().powi(2),
             skip_invertibility: self.settings.skip_invertibility,
-            nee: self.settings.path.nee,
+            nee: self.settings.path.resolved(&scene.features).nee,
         }
     }
 
