@@ -110,7 +110,8 @@ impl Default for ReuseSettings {
 
 impl ReuseSettings {
     /// ReSTIR DI's reuse: the [default](ReuseSettings::default) with [`DIRECT_NEIGHBORS`]
-    /// neighbours within [`DIRECT_RADIUS`] pixels (the rest chosen on the DI training family too: the project repository's
+    /// neighbours within [`DIRECT_RADIUS`] pixels (the rest chosen on the DI training family
+    /// too: the project repository's
     /// `docs/studies/2026-12-02-restir-di-light-pool-and-defaults.md`).
     pub fn direct() -> Self {
         Self {

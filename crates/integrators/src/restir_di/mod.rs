@@ -196,12 +196,14 @@ impl RestirDiIntegrator {
     pub const RESERVOIR_BYTES: usize = std::mem::size_of::<DiReservoir>();
 
     /// Shading at receiver `r` with its final reservoir: the reservoir's sample with a shadow
-    /// ray, the BSDF samples, and the continuation. Returns radiance, rays, and the reservoir's
-    /// sample with what it delivered (when it was visible and lit the receiver).
+    /// ray, the BSDF samples, and the continuation (paths of `settings`, their light selection
+    /// decided for the scene once per pass). Returns radiance, rays, and the reservoir's sample with what
+    /// it delivered (when it was visible and lit the receiver).
     #[allow(clippy::too_many_arguments)] // the pixel and what the pass looked up for it
     fn shade(
         &self,
         scene: &Scene,
+        settings: &PathSettings,
         r: &Receiver,
         bsdf: &Bsdf,
         ng: Vec3,
@@ -248,7 +250,6 @@ impl RestirDiIntegrator {
         }
 
         // BSDF samples; the first continues the path when indirect light or delta lobes need it.
-        let settings = &self.settings.path.resolved(&scene.features);
         let max_depth = settings.max_segments();
         let continues = max_depth > 2 || scene.features.has_delta_lobes;
         let n_b = self.counts.samples_at(bsdf).bsdf as u32;
@@ -644,8 +645,10 @@ impl Integrator for RestirDiIntegrator {
             );
             rays += self.clock.add_reuse(&report);
 
-            // Shading.
+            // Shading; the continuations' light selection decided once for the pass (a no-op
+            // where `resolve` decided it).
             let start = std::time::Instant::now();
+            let path = s.path.resolved(&scene.features);
             let grid = s
                 .learn
                 .is_on()
@@ -671,6 +674,7 @@ impl Integrator for RestirDiIntegrator {
                             };
                             let (li, nr, delivered) = self.shade(
                                 scene,
+                                &path,
                                 r,
                                 bsdf,
                                 ng,

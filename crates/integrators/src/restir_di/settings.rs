@@ -402,10 +402,10 @@ impl RestirDiSettings {
 
     /// Decides the scene-dependent defaults from the scene summary: the continuations'
     /// next-event estimation takes the path tracer's rule ([`PathSettings::resolve_nee`]), an
-    /// `auto` light sampler becomes [`AUTO_LIGHT_SAMPLER`] where the scene has a local emitter (else the power
-    /// table), `auto` learning is on up to [`LEARN_MAX_EMITTERS`] emitters (else off),
-    /// receivers without a glossy lobe take BSDF samples when the scene has an environment, and
-    /// candidates that were not named become [`CANDIDATES_WITHOUT_LEARNING`] where they come
+    /// `auto` light sampler becomes [`AUTO_LIGHT_SAMPLER`] where the scene has a local emitter
+    /// (else the power table), `auto` learning is on up to [`LEARN_MAX_EMITTERS`] emitters (else
+    /// off), receivers without a glossy lobe take BSDF samples when the scene has an environment,
+    /// and candidates that were not named become [`CANDIDATES_WITHOUT_LEARNING`] where they come
     /// from the tiles' cuts without learning.
     pub fn resolve(&mut self, features: &SceneFeatures) {
         self.path.resolve_nee(features);
