@@ -47,8 +47,8 @@ use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
 pub use settings::{
-    AUTO_LIGHT_SAMPLER, BsdfDiffuse, BsdfSamples, CANDIDATES_WITHOUT_LEARNING, LEARN_MAX_EMITTERS,
-    Learn, LightSampler, RESAMPLE_BELOW_VISIBLE, RestirDiSettings, Visibility,
+    AUTO_LIGHT_SAMPLER, BsdfDiffuse, BsdfSamples, LEARN_MAX_EMITTERS, Learn, LightSampler,
+    RESAMPLE_BELOW_VISIBLE, RestirDiSettings, TILE_CANDIDATES, Visibility,
 };
 
 use crate::bands::Bands;

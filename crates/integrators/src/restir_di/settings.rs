@@ -3,8 +3,8 @@
 //! are [`ReuseSettings`]. Some defaults are rules of the scene summary, decided once when the
 //! integrator is made ([`RestirDiSettings::resolve`]): the candidate source
 //! ([`AUTO_LIGHT_SAMPLER`] where the scene has a local emitter), learning across passes (up
-//! to [`LEARN_MAX_EMITTERS`] emitters) and, from those, the candidate count
-//! ([`CANDIDATES_WITHOUT_LEARNING`] for the tiles' cuts without learning).
+//! to [`LEARN_MAX_EMITTERS`] emitters) and, from the source, the candidate count
+//! ([`TILE_CANDIDATES`] for the tiles' cuts).
 
 use crate::reuse::params::ReuseParams;
 use restir_scene::SceneFeatures;
@@ -30,13 +30,15 @@ pub const AUTO_LIGHT_SAMPLER: LightSampler = LightSampler::Tiles;
 /// apart); the bound sits between the two, where the rule lives.
 pub const LEARN_MAX_EMITTERS: usize = 50_000;
 
-/// Light candidates per pixel where the candidates were not named and learning is off (the
-/// default [`RestirDiSettings::candidates`] is for learned candidates). Without learning a
-/// tile's candidates come from its cut of the light hierarchy, which knows no visibility and, on
-/// scenes of more than [`LEARN_MAX_EMITTERS`] emitters, spreads over many lights of similar
-/// unshadowed contribution; more of them pay there. Chosen on the DI training family at 640×360
-/// (`docs/RESTIR_DI.md`, "Eight neighbours, and 12 candidates from cuts without learning").
-pub const CANDIDATES_WITHOUT_LEARNING: u32 = 12;
+/// Light candidates per pixel where the candidates were not named and come from the tiles' cuts
+/// (the default light sampler), learning across passes or not; the default
+/// [`RestirDiSettings::candidates`] is for the power sampler's pool. Chosen on the DI training
+/// family (`docs/RESTIR_DI.md`, "Eight neighbours, and 12 candidates from the tiles' cuts"):
+/// without learning a tile's cut knows no visibility and, on 10⁵ lights, spreads over many of
+/// similar unshadowed contribution, so more candidates pay (1.25× eight at 640×360); with
+/// learning 12 pay too (1.07× eight at the median of the nine learning members at 640×360 and
+/// at 320×240, up to 1.30× on the glossy hall and 1.52× on 10⁴ spheres at the smaller film).
+pub const TILE_CANDIDATES: u32 = 12;
 
 /// Where initial candidates' lights come from (`--light-sampler`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -302,16 +304,16 @@ pub struct RestirDiSettings {
     pub path: PathSettings,
     /// Spatial and temporal reuse.
     pub reuse: ReuseSettings,
-    /// Light candidates per pixel in initial resampling, `N_L` (default 8 with learning, chosen
-    /// by an equal-CPU-time sweep on a training family of generated scenes,
-    /// `docs/studies/2026-12-01-restir-di-defaults.md`; [`CANDIDATES_WITHOUT_LEARNING`] where
-    /// [`RestirDiSettings::resolve`] finds learning off).
+    /// Light candidates per pixel in initial resampling, `N_L` (default 8 from the power
+    /// sampler's pool, chosen by an equal-CPU-time sweep on a training family of generated
+    /// scenes, `docs/studies/2026-12-01-restir-di-defaults.md`; [`TILE_CANDIDATES`] where
+    /// [`RestirDiSettings::resolve`] finds the tiles' cuts the source).
     pub candidates: u32,
     /// Whether `candidates` was named (a parameter or the command line); else
-    /// [`RestirDiSettings::resolve`] decides it from the learning decision.
+    /// [`RestirDiSettings::resolve`] decides it from the light sampler.
     pub candidates_named: bool,
     /// Whether [`RestirDiSettings::resolve`] raised the count to
-    /// [`CANDIDATES_WITHOUT_LEARNING`] (`--stats` says why).
+    /// [`TILE_CANDIDATES`] (`--stats` says why).
     pub candidates_decided: bool,
     /// Where candidates' lights come from (default the power sampler).
     pub light_sampler: LightSampler,
@@ -370,8 +372,8 @@ pub struct RestirDiSettings {
 }
 
 impl RestirDiSettings {
-    /// The defaults: 8 candidates (12 from the tiles' cuts without learning, decided by
-    /// [`RestirDiSettings::resolve`]), one round of reuse over four reciprocal pairs within 3
+    /// The defaults: 8 candidates (12 from the tiles' cuts, decided by
+    /// [`RestirDiSettings::resolve`]), one round of reuse over four reciprocal pairs within 2
     /// pixels ([`ReuseSettings::direct`]), visibility in every target, one BSDF sample (chosen
     /// on a training family of generated scenes; `docs/RESTIR_DI.md`).
     pub fn new(path: PathSettings) -> Self {
@@ -405,8 +407,8 @@ impl RestirDiSettings {
     /// `auto` light sampler becomes [`AUTO_LIGHT_SAMPLER`] where the scene has a local emitter
     /// (else the power table), `auto` learning is on up to [`LEARN_MAX_EMITTERS`] emitters (else
     /// off), receivers without a glossy lobe take BSDF samples when the scene has an environment,
-    /// and candidates that were not named become [`CANDIDATES_WITHOUT_LEARNING`] where they come
-    /// from the tiles' cuts without learning.
+    /// and candidates that were not named become [`TILE_CANDIDATES`] where they come
+    /// from the tiles' cuts (with learning or without).
     pub fn resolve(&mut self, features: &SceneFeatures) {
         self.path.resolve_nee(features);
         if self.learn == Learn::Auto {
@@ -444,11 +446,8 @@ impl RestirDiSettings {
                 LightSampler::Power
             };
         }
-        if !self.candidates_named
-            && !self.learn.is_on()
-            && self.light_sampler == LightSampler::Tiles
-        {
-            self.candidates = CANDIDATES_WITHOUT_LEARNING;
+        if !self.candidates_named && self.light_sampler == LightSampler::Tiles {
+            self.candidates = TILE_CANDIDATES;
             self.candidates_decided = true;
         }
     }
@@ -457,7 +456,7 @@ impl RestirDiSettings {
     /// line.
     pub fn candidates_label(&self) -> String {
         let why = if self.candidates_decided {
-            " (auto: tiles without learning)"
+            " (auto: the tiles' cuts)"
         } else {
             ""
         };
@@ -722,11 +721,11 @@ mod tests {
         assert_eq!(err, "bsdf_samples = 'resampled' needs visibility = target");
     }
 
-    /// Candidates that were not named become `CANDIDATES_WITHOUT_LEARNING` where they come from
-    /// the tiles' cuts without learning, and the settings line says why; named ones, learned
-    /// ones and the power sampler's keep their count.
+    /// Candidates that were not named become `TILE_CANDIDATES` where they come from the tiles'
+    /// cuts, learning or not, and the settings line says why; named ones and the power sampler's
+    /// keep their count.
     #[test]
-    fn auto_candidates_follow_the_learning_decision() {
+    fn auto_candidates_follow_the_light_sampler() {
         let at = |emitters: usize, params: &[(&str, &str)]| {
             let mut s = settings();
             s.apply(&ParamSet::from(params)).unwrap();
@@ -737,16 +736,15 @@ mod tests {
             (s.candidates, s.candidates_label())
         };
         let many = LEARN_MAX_EMITTERS + 1;
-        assert_eq!(
-            at(many, &[]),
-            (
-                CANDIDATES_WITHOUT_LEARNING,
-                format!("candidates={CANDIDATES_WITHOUT_LEARNING} (auto: tiles without learning)")
-            )
+        let tiles = (
+            TILE_CANDIDATES,
+            format!("candidates={TILE_CANDIDATES} (auto: the tiles' cuts)"),
         );
-        assert_eq!(at(1000, &[]), (8, "candidates=8".to_string()));
-        assert_eq!(at(1000, &[("learn", "off")]).0, CANDIDATES_WITHOUT_LEARNING);
-        assert_eq!(at(many, &[("learn", "on")]).0, 8);
+        assert_eq!(at(many, &[]), tiles);
+        assert_eq!(at(1000, &[]), tiles);
+        assert_eq!(at(1000, &[("learn", "off")]), tiles);
+        assert_eq!(at(many, &[("learn", "on")]), tiles);
+        assert_eq!(at(0, &[]), (8, "candidates=8".to_string()));
         assert_eq!(at(many, &[("light_sampler", "power")]).0, 8);
         assert_eq!(
             at(many, &[("candidates", "8")]),
