@@ -129,8 +129,8 @@ pub(crate) struct RestirArgs {
     bsdf_diffuse: Option<String>,
     /// restir-di: where BSDF samples go: candidates of initial resampling beside the light
     /// candidates, spread by reuse (resampled; needs --visibility target), or traced at shading
-    /// beside the reservoirs (separate); auto resamples for direct light where the receivers see
-    /// little of the environment (under 25 % of its pilot samples unoccluded) [default: auto].
+    /// beside the reservoirs (separate); auto resamples for direct light where an environment
+    /// lights the scene beside local lights [default: auto].
     #[arg(long)]
     bsdf_samples: Option<String>,
     /// Spatial neighbours per round, in reciprocal pairs (an odd count is raised to the next

@@ -48,7 +48,7 @@ use restir_scene::Scene;
 
 pub use settings::{
     AUTO_LIGHT_SAMPLER, BsdfDiffuse, BsdfSamples, LEARN_MAX_EMITTERS, Learn, LightSampler,
-    RESAMPLE_BELOW_VISIBLE, RestirDiSettings, TILE_CANDIDATES, Visibility,
+    RestirDiSettings, TILE_CANDIDATES, Visibility,
 };
 
 use crate::bands::Bands;

@@ -202,20 +202,14 @@ impl BsdfDiffuse {
     }
 }
 
-/// `auto` resamples BSDF samples with the light candidates when less than this fraction of the
-/// environment pilot's samples at the camera's receivers are unoccluded (chosen on the training
-/// family: its halls, lit by garlands and through windows, see 3–6 %, scenes under an open sky
-/// 65–80 %).
-pub const RESAMPLE_BELOW_VISIBLE: f32 = 0.25;
-
 /// Where ReSTIR DI's BSDF samples go (`--bsdf-samples`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BsdfSamples {
     /// Decided from the scene summary ([`RestirDiSettings::resolve`]): `resampled` for direct
-    /// light (`max_depth` 2) with visibility in every target when the scene's receivers see
-    /// little of its environment (less than [`RESAMPLE_BELOW_VISIBLE`] of the pilot's samples of
-    /// it unoccluded), else `separate` (also where nothing resolves it): with indirect light the
-    /// continuation traces a BSDF ray of its own, which resampling does not save.
+    /// light (`max_depth` 2) with visibility in every target when the scene has an environment
+    /// beside its local lights (where diffuse receivers take BSDF samples), else `separate`
+    /// (also where nothing resolves it): with indirect light the continuation traces a BSDF ray
+    /// of its own, which resampling does not save.
     Auto,
     /// Traced at shading and added to the reservoir's light strategy with their MIS weights; the
     /// reservoirs hold the light strategy's share of the direct light.
@@ -345,13 +339,13 @@ pub struct RestirDiSettings {
     /// Whether `bsdf_diffuse` was auto and [`RestirDiSettings::resolve`] decided it (`--stats`
     /// says why).
     pub bsdf_diffuse_decided: bool,
-    /// Where the BSDF samples go (default auto: resampled with the light candidates where the
-    /// receivers see little of an environment; `docs/RESTIR_DI.md`).
+    /// Where the BSDF samples go (default auto: resampled with the light candidates for the
+    /// direct light of a scene with an environment beside its local lights;
+    /// `docs/RESTIR_DI.md`).
     pub bsdf_samples: BsdfSamples,
-    /// When `bsdf_samples` was auto and [`RestirDiSettings::resolve`] decided it: the fraction
-    /// of the environment pilot's samples that were unoccluded (`None`: no pilot, no
-    /// environment).
-    pub bsdf_samples_decided_from: Option<Option<f32>>,
+    /// When `bsdf_samples` was auto and [`RestirDiSettings::resolve`] decided it: whether the
+    /// scene has an environment beside local lights.
+    pub bsdf_samples_decided_from: Option<bool>,
     /// Camera rays for the emission seen on emitter silhouettes, the G-buffer's included
     /// (`crate::reuse::seen`; 1: the G-buffer's only; default 4, chosen on the training family:
     /// a hall's squared error 3.6× lower at the same cost; where the mask is a small part of
@@ -428,16 +422,15 @@ impl RestirDiSettings {
             };
         }
         if self.bsdf_samples == BsdfSamples::Auto {
-            let visible = features.environment_share.map(|e| e.visible);
-            self.bsdf_samples_decided_from = Some(visible);
-            self.bsdf_samples = if self.visibility == Visibility::Target
-                && self.path.max_segments() <= 2
-                && visible.is_some_and(|v| v < RESAMPLE_BELOW_VISIBLE)
-            {
-                BsdfSamples::Resampled
-            } else {
-                BsdfSamples::Separate
-            };
+            let beside = features.environment_share.is_some();
+            self.bsdf_samples_decided_from = Some(beside);
+            self.bsdf_samples =
+                if self.visibility == Visibility::Target && self.path.max_segments() <= 2 && beside
+                {
+                    BsdfSamples::Resampled
+                } else {
+                    BsdfSamples::Separate
+                };
         }
         if self.light_sampler == LightSampler::Auto {
             self.light_sampler = if features.emitter_count > 0 {
@@ -488,23 +481,12 @@ impl RestirDiSettings {
     pub fn bsdf_samples_label(&self) -> String {
         let why = match self.bsdf_samples_decided_from {
             None => String::new(),
-            Some(None) => " (auto: no environment beside local lights)".to_string(),
-            Some(_) if self.visibility != Visibility::Target => {
+            Some(true) if self.visibility != Visibility::Target => {
                 " (auto: visibility not in every target)".to_string()
             }
-            Some(_) if self.path.max_segments() > 2 => " (auto: indirect light)".to_string(),
-            Some(Some(v)) => {
-                let cmp = if v < RESAMPLE_BELOW_VISIBLE {
-                    "<"
-                } else {
-                    ">="
-                };
-                format!(
-                    " (auto: {:.0} % of environment samples unoccluded {cmp} {:.0} %)",
-                    100.0 * v,
-                    100.0 * RESAMPLE_BELOW_VISIBLE
-                )
-            }
+            Some(true) if self.path.max_segments() > 2 => " (auto: indirect light)".to_string(),
+            Some(false) => " (auto: no environment beside local lights)".to_string(),
+            Some(true) => " (auto: an environment beside local lights)".to_string(),
         };
         format!("bsdf_samples={}{why}", self.bsdf_samples.name())
     }
@@ -670,11 +652,11 @@ mod tests {
         );
     }
 
-    /// `bsdf_samples = auto` resamples for direct light with visibility in every target where
-    /// less than `RESAMPLE_BELOW_VISIBLE` of the environment pilot's samples were unoccluded;
+    /// `bsdf_samples = auto` resamples for direct light with visibility in every target where an
+    /// environment lights the scene beside local lights, whatever share of it the receivers see;
     /// `resampled` with another visibility is an error naming what it needs.
     #[test]
-    fn auto_bsdf_samples_are_decided_by_the_environment_seen() {
+    fn auto_bsdf_samples_are_decided_by_an_environment_beside_local_lights() {
         let at = |visible: Option<f32>, max_depth: i32, visibility: Visibility| {
             let mut s = settings();
             s.path.max_depth = max_depth;
@@ -690,17 +672,21 @@ mod tests {
             });
             (s.bsdf_samples, s.bsdf_samples_label())
         };
-        let room = at(Some(0.05), 2, Visibility::Target);
-        assert_eq!(room.0, BsdfSamples::Resampled);
+        for visible in [0.05, 0.7] {
+            let (samples, label) = at(Some(visible), 2, Visibility::Target);
+            assert_eq!(samples, BsdfSamples::Resampled, "{visible}");
+            assert_eq!(
+                label,
+                "bsdf_samples=resampled (auto: an environment beside local lights)"
+            );
+        }
+        let without = at(None, 2, Visibility::Target);
+        assert_eq!(without.0, BsdfSamples::Separate);
         assert!(
-            room.1
-                .contains("5 % of environment samples unoccluded < 25 %"),
+            without.1.contains("no environment beside local lights"),
             "{}",
-            room.1
+            without.1
         );
-        let open = at(Some(0.7), 2, Visibility::Target);
-        assert_eq!(open.0, BsdfSamples::Separate);
-        assert_eq!(at(None, 2, Visibility::Target).0, BsdfSamples::Separate);
         let indirect = at(Some(0.05), -1, Visibility::Target);
         assert_eq!(indirect.0, BsdfSamples::Separate);
         assert!(indirect.1.contains("indirect light"), "{}", indirect.1);
