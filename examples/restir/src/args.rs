@@ -72,7 +72,7 @@ pub(crate) struct RenderArgs {
 #[command(next_help_heading = "ReSTIR")]
 pub(crate) struct RestirArgs {
     /// Initial candidates per pixel: light samples for restir-di [default: 12 from the tiles'
-    /// cuts, 8 from the power sampler], paths for restir-pt [default: 2].
+    /// cuts, 8 from the other sources], paths for restir-pt [default: 2].
     #[arg(long)]
     candidates: Option<u32>,
     /// restir-di: where candidates' lights come from: power (the power-based sampler), tiles

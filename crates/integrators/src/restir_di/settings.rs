@@ -32,12 +32,12 @@ pub const LEARN_MAX_EMITTERS: usize = 50_000;
 
 /// Light candidates per pixel where the candidates were not named and come from the tiles' cuts
 /// (the default light sampler), learning across passes or not; the default
-/// [`RestirDiSettings::candidates`] is for the power sampler's pool. Chosen on the DI training
+/// [`RestirDiSettings::candidates`] is for the other sources. Chosen on the DI training
 /// family (`docs/RESTIR_DI.md`, "Eight neighbours, and 12 candidates from the tiles' cuts"):
 /// without learning a tile's cut knows no visibility and, on 10⁵ lights, spreads over many of
 /// similar unshadowed contribution, so more candidates pay (1.25× eight at 640×360); with
 /// learning 12 pay too (1.07× eight at the median of the nine learning members at 640×360 and
-/// at 320×240, up to 1.30× on the glossy hall and 1.52× on 10⁴ spheres at the smaller film).
+/// at 320×240, up to 1.31× on the glossy hall and 1.52× on 10⁴ spheres at the smaller film).
 pub const TILE_CANDIDATES: u32 = 12;
 
 /// Where initial candidates' lights come from (`--light-sampler`).
@@ -299,7 +299,7 @@ pub struct RestirDiSettings {
     /// Spatial and temporal reuse.
     pub reuse: ReuseSettings,
     /// Light candidates per pixel in initial resampling, `N_L` (default 8 from the power
-    /// sampler's pool, chosen by an equal-CPU-time sweep on a training family of generated
+    /// sampler's pool or the light hierarchy, chosen by an equal-CPU-time sweep on a training family of generated
     /// scenes, `docs/studies/2026-12-01-restir-di-defaults.md`; [`TILE_CANDIDATES`] where
     /// [`RestirDiSettings::resolve`] finds the tiles' cuts the source).
     pub candidates: u32,
