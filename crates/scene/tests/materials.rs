@@ -330,3 +330,73 @@ fn material_edits_keep_the_feature_summary() {
     );
     assert!(scene.set_shape_material(0, n as u32 + 5).is_err());
 }
+
+#[test]
+fn lajollas_roughness_is_its_ggx_alpha_squared() {
+    // Lajolla's files give rough plastics and dielectrics a `roughness` r: GGX with α = r²
+    // (r clamped to [0.01, 1]), where Mitsuba's give `alpha`.
+    let rough = |bsdf: &str| match load(bsdf) {
+        Ok((desc, warnings)) => {
+            assert!(warnings.is_empty(), "{bsdf}: {warnings:?}");
+            match &desc.materials[0].material {
+                MaterialDesc::RoughPlastic { roughness, .. }
+                | MaterialDesc::RoughDielectric { roughness, .. } => roughness.clone(),
+                m => panic!("{m:?}"),
+            }
+        }
+        Err(e) => panic!("{bsdf}: {e}"),
+    };
+    let r = rough(
+        r#"<bsdf type="roughplastic" id="m"><rgb name="diffuseReflectance" value="0.8 0.6 0.2"/><float name="roughness" value="0.3"/></bsdf>"#,
+    );
+    assert_eq!(r.distribution, MicrofacetDesc::Ggx);
+    assert!((r.alpha - 0.09).abs() < 1e-7, "{}", r.alpha);
+    let r = rough(
+        r#"<bsdf type="roughdielectric" id="m"><float name="roughness" value="0.001"/></bsdf>"#,
+    );
+    assert!(
+        (r.alpha - 1e-4).abs() < 1e-9,
+        "clamped to 0.01: {}",
+        r.alpha
+    );
+    let r = rough(
+        r#"<bsdf type="roughplastic" id="m"><string name="distribution" value="beckmann"/><float name="roughness" value="0.5"/></bsdf>"#,
+    );
+    assert_eq!(
+        r.distribution,
+        MicrofacetDesc::Beckmann,
+        "a named distribution stays"
+    );
+    assert!((r.alpha - 0.25).abs() < 1e-7);
+    // Without it, Mitsuba's `alpha` and Beckmann, as before.
+    let r = rough(r#"<bsdf type="roughplastic" id="m"><float name="alpha" value="0.3"/></bsdf>"#);
+    assert_eq!((r.distribution, r.alpha), (MicrofacetDesc::Beckmann, 0.3));
+    // A conductor has no Lajolla roughness: the property stays unknown (a warning).
+    let (_, warnings) =
+        load(r#"<bsdf type="roughconductor" id="m"><float name="roughness" value="0.3"/></bsdf>"#)
+            .unwrap();
+    assert!(
+        warnings.iter().any(|w| w.contains("roughness")),
+        "{warnings:?}"
+    );
+    for (bsdf, what) in [
+        (
+            r#"<bsdf type="roughplastic" id="m"><float name="alpha" value="0.1"/><float name="roughness" value="0.3"/></bsdf>"#,
+            "not both",
+        ),
+        (
+            r#"<bsdf type="roughplastic" id="m"><float name="roughness" value="-0.3"/></bsdf>"#,
+            "non-negative",
+        ),
+        (
+            r#"<bsdf type="roughdielectric" id="m"><texture type="checkerboard" name="roughness"/></bsdf>"#,
+            "textured roughness",
+        ),
+    ] {
+        let e = error(bsdf);
+        assert!(
+            e.starts_with("t.xml:3") && e.contains(what),
+            "{bsdf}: got '{e}', want t.xml:3 … {what}"
+        );
+    }
+}

@@ -8,6 +8,9 @@ use super::props::{ColorUse, PROPERTY_TAGS, Props, Value};
 use super::{Importer, Result, elements, snake_case};
 use crate::desc::*;
 
+/// The smallest roughness Lajolla's rough materials use (its `roughness`, clamped).
+const LAJOLLA_MIN_ROUGHNESS: f32 = 0.01;
+
 /// The `<bsdf>` types the importer reads.
 const BSDF_TYPES: &[&str] = &[
     "diffuse",
@@ -297,7 +300,7 @@ impl<'a> Importer<'a> {
             MaterialDesc::RoughConductor {
                 ior,
                 specular_reflectance,
-                roughness: self.roughness(node, props, true)?,
+                roughness: self.roughness(node, props, true, false)?,
             }
         })
     }
@@ -325,7 +328,7 @@ impl<'a> Importer<'a> {
                 ext_ior,
                 specular_reflectance,
                 specular_transmittance,
-                roughness: self.roughness(node, props, true)?,
+                roughness: self.roughness(node, props, true, true)?,
             }
         })
     }
@@ -364,7 +367,7 @@ impl<'a> Importer<'a> {
             diffuse_reflectance,
             specular_reflectance,
             nonlinear,
-            roughness: self.roughness(node, props, false)?,
+            roughness: self.roughness(node, props, false, true)?,
         })
     }
 
@@ -398,8 +401,15 @@ impl<'a> Importer<'a> {
         Ok(ConductorIorDesc { material, eta, k })
     }
 
-    /// `distribution`, `alpha` or `alpha_u`/`alpha_v`, and `sample_visible`.
-    fn roughness(&self, node: Node, props: &Props, anisotropic: bool) -> Result<RoughnessDesc> {
+    /// `distribution`, `alpha` or `alpha_u`/`alpha_v`, and `sample_visible`; with `lajolla`
+    /// (`roughplastic`, `roughdielectric`), Lajolla's `roughness` in place of `alpha`.
+    fn roughness(
+        &self,
+        node: Node,
+        props: &Props,
+        anisotropic: bool,
+        lajolla: bool,
+    ) -> Result<RoughnessDesc> {
         let mut r = RoughnessDesc::default();
         if let Some(p) = props.get("distribution") {
             let Value::Str(d) = &p.value else {
@@ -449,6 +459,35 @@ impl<'a> Importer<'a> {
         let a = given("alpha")?;
         let au = given("alpha_u")?;
         let av = given("alpha_v")?;
+        if lajolla && (props.get("roughness").is_some() || textured("roughness")) {
+            // Lajolla's files give `roughness` r where Mitsuba's give alpha: Lajolla's rough
+            // plastic and rough dielectric use GGX with α = r², r clamped to [0.01, 1].
+            let at = props.node_or("roughness", node);
+            if textured("roughness") {
+                return Err(self.err(
+                    at,
+                    format!(
+                        "{}: a textured roughness (Lajolla's α = roughness²) is not supported; give alpha as a texture",
+                        props.what
+                    ),
+                ));
+            }
+            if a.is_some() || au.is_some() || av.is_some() {
+                return Err(self.err(
+                    at,
+                    format!(
+                        "{}: give either alpha (Mitsuba) or roughness (Lajolla, α = roughness²), not both",
+                        props.what
+                    ),
+                ));
+            }
+            let rough = alpha("roughness")?.unwrap_or(0.0);
+            r.alpha = rough.clamp(LAJOLLA_MIN_ROUGHNESS, 1.0).powi(2);
+            if props.get("distribution").is_none() {
+                r.distribution = MicrofacetDesc::Ggx;
+            }
+            return self.sample_visible(node, props, r);
+        }
         match (au, av) {
             (None, None) => r.alpha = a.unwrap_or(defaults::ALPHA),
             (Some(u), Some(v)) => {
@@ -480,6 +519,11 @@ impl<'a> Importer<'a> {
                 ));
             }
         }
+        self.sample_visible(node, props, r)
+    }
+
+    /// `sample_visible`, read for `r`.
+    fn sample_visible(&self, node: Node, props: &Props, r: RoughnessDesc) -> Result<RoughnessDesc> {
         if props.bool("sample_visible")? == Some(false) {
             self.warn(
                 node,

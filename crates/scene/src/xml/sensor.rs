@@ -30,6 +30,22 @@ impl<'a> Importer<'a> {
             }
         };
         cam.to_world = props.transform("to_world")?;
+        if ty == "perspective" {
+            // Mitsuba 3's principal point offset (a fraction of the film) is read so that its
+            // default, 0, passes quietly; any other value would move the image: an error.
+            for name in ["principal_point_offset_x", "principal_point_offset_y"] {
+                if let Some(v) = props.float(name)?
+                    && v != 0.0
+                {
+                    return Err(self.err(
+                        props.node_or(name, node),
+                        format!(
+                            "sensor 'perspective': {name} {v} is not supported (only 0, its default)"
+                        ),
+                    ));
+                }
+            }
+        }
         if ty == "thinlens" {
             cam.aperture_radius = props
                 .float("aperture_radius")?
@@ -270,5 +286,27 @@ impl<'a> Importer<'a> {
         }
         props.finish();
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// Mitsuba 3's `principal_point_offset_x`/`_y` at their default, 0, load without a
+    /// warning; any other value is an error naming the line.
+    #[test]
+    fn principal_point_offsets_other_than_zero_are_errors() {
+        let load = |body: &str| {
+            let xml = format!("<scene>\n<sensor type=\"perspective\">\n{body}\n</sensor></scene>");
+            crate::xml::parse_xml(&xml, "t.xml".as_ref(), &[])
+                .map(|(_, w)| w.len())
+                .map_err(|e| e.to_string())
+        };
+        let zero = r#"<float name="principal_point_offset_x" value="0.000000"/><float name="principal_point_offset_y" value="-0.000000"/>"#;
+        assert_eq!(load(zero), Ok(0));
+        let e = load(r#"<float name="principal_point_offset_y" value="0.1"/>"#).unwrap_err();
+        assert!(
+            e.starts_with("t.xml:3") && e.contains("principal_point_offset_y 0.1"),
+            "{e}"
+        );
     }
 }
