@@ -166,7 +166,10 @@ impl AutoIntegrator {
             Choice::Path => Box::new(PathIntegrator { settings: path }),
             Choice::RestirDi => {
                 let mut s = RestirDiSettings::new(path);
-                s.resolve(&scene.features);
+                s.resolve(
+                    &scene.features,
+                    &crate::film::Reconstruction::decide(scene.filter),
+                );
                 Box::new(RestirDiIntegrator::new(s))
             }
             Choice::RestirPt => Box::new(RestirPtIntegrator::new(RestirPtSettings::new(path))),

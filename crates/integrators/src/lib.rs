@@ -243,7 +243,7 @@ pub fn make_integrator(
         "restir-di" => {
             let mut s = RestirDiSettings::new(settings);
             let unused = s.apply(&params)?;
-            s.resolve(&scene.features);
+            s.resolve(&scene.features, &film::Reconstruction::decide(scene.filter));
             notes.extend(s.reuse.pair_neighbors());
             (Box::new(RestirDiIntegrator::new(s)), unused)
         }

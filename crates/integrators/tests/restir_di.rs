@@ -415,7 +415,10 @@ fn raised_edge_rays_on_a_splatting_film_unbiased() {
     let mut settings = RestirDiSettings::new(restir_integrators::path::PathSettings::from_desc(
         &scene.integrator,
     ));
-    settings.resolve(&scene.scene.features);
+    settings.resolve(
+        &scene.scene.features,
+        &restir_integrators::film::Reconstruction::decide(scene.scene.filter),
+    );
     let integrator = RestirDiIntegrator::new(settings);
     common::render_with(&scene, &integrator, 1, 0);
     let said = integrator.silhouettes().expect("a mask");

@@ -137,7 +137,8 @@ pub(crate) struct RestirArgs {
     /// even one) [default: 8 for restir-di, 4 for restir-pt].
     #[arg(long, alias = "neighbours")]
     neighbors: Option<u32>,
-    /// Spatial reuse radius in pixels [default: 2 for restir-di, 3 for restir-pt].
+    /// Spatial reuse radius in pixels [default: 2 for restir-di, widened by the filter's reach on
+    /// a film that splats it (4 with Mitsuba's Gaussian), 3 for restir-pt].
     #[arg(long)]
     radius: Option<f32>,
     /// Spatial reuse rounds [default: 1 for restir-di, 3 for restir-pt].

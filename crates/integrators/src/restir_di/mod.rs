@@ -316,7 +316,7 @@ impl Integrator for RestirDiIntegrator {
         let s = &self.settings;
         format!(
             "restir-di max_depth={}{} {} light_sampler={} bsdf_candidates={} {} {} neighbors={} \
-             radius={} spatial_rounds={} reciprocal={} mis={} mcap={} {} \
+             {} spatial_rounds={} reciprocal={} mis={} mcap={} {} \
              visibility={} {}{}{}",
             s.path.max_depth,
             if s.path.max_segments() > 2 {
@@ -344,7 +344,7 @@ impl Integrator for RestirDiIntegrator {
             s.bsdf_diffuse_label(),
             s.bsdf_samples_label(),
             s.reuse.neighbors,
-            s.reuse.radius,
+            s.radius_label(),
             s.reuse.spatial_rounds,
             s.reuse.reciprocal,
             mis_name(s.reuse.mis),

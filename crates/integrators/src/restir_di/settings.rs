@@ -9,9 +9,11 @@
 use crate::reuse::params::ReuseParams;
 use restir_scene::SceneFeatures;
 
+use crate::film::Reconstruction;
 use crate::params::{Param, ParamError, ParamProblem, ParamSet};
 use crate::path::PathSettings;
 use crate::reuse::settings::ReuseSettings;
+use restir_reuse::settings::DIRECT_RADIUS;
 
 /// The candidate source `light_sampler = auto` takes for a scene with local emitters (emissive
 /// triangles and other lights besides the environment): the screen tiles' cuts of the light
@@ -309,6 +311,12 @@ pub struct RestirDiSettings {
     /// Whether [`RestirDiSettings::resolve`] raised the count to
     /// [`TILE_CANDIDATES`] (`--stats` says why).
     pub candidates_decided: bool,
+    /// Whether the reuse radius was named; else [`RestirDiSettings::resolve`] widens it by a
+    /// splatting film's reach.
+    pub radius_named: bool,
+    /// The splatting film's reach [`RestirDiSettings::resolve`] widened the radius by, if it
+    /// did (`--stats` says why).
+    pub radius_widened_by: Option<u32>,
     /// Where candidates' lights come from (default the power sampler).
     pub light_sampler: LightSampler,
     /// Whether candidates come from a light distribution learned across passes (default `auto`:
@@ -377,6 +385,8 @@ impl RestirDiSettings {
             candidates: 8,
             candidates_named: false,
             candidates_decided: false,
+            radius_named: false,
+            radius_widened_by: None,
             light_sampler: LightSampler::Auto,
             learn: Learn::Auto,
             learn_share: 0.5,
@@ -402,9 +412,21 @@ impl RestirDiSettings {
     /// (else the power table), `auto` learning is on up to [`LEARN_MAX_EMITTERS`] emitters (else
     /// off), receivers without a glossy lobe take BSDF samples when the scene has an environment,
     /// and candidates that were not named become [`TILE_CANDIDATES`] where they come
-    /// from the tiles' cuts (with learning or without).
-    pub fn resolve(&mut self, features: &SceneFeatures) {
+    /// from the tiles' cuts (with learning or without). On a film that splats its filter
+    /// (`film`), a radius that was not named becomes [`DIRECT_RADIUS`] plus the filter's reach:
+    /// chosen on the DI training family's halls and Sponza with lamps under Mitsuba's Gaussian
+    /// (reach 2), where 4 pixels are 1.15× 2 at the median (`docs/RESTIR_DI.md`).
+    pub fn resolve(&mut self, features: &SceneFeatures, film: &Reconstruction) {
         self.path.resolve_nee(features);
+        if !self.radius_named
+            && let Reconstruction::Splatted { reach, .. } = *film
+            && reach > 0
+        {
+            // A splatting film already blends each pixel with those within its reach, so the
+            // reuse reaches past it.
+            self.reuse.radius = DIRECT_RADIUS + reach as f32;
+            self.radius_widened_by = Some(reach);
+        }
         if self.learn == Learn::Auto {
             self.learn_decided_from = Some(features.emitter_count);
             self.learn = if features.emitter_count <= LEARN_MAX_EMITTERS {
@@ -442,6 +464,18 @@ impl RestirDiSettings {
         if !self.candidates_named && self.light_sampler == LightSampler::Tiles {
             self.candidates = TILE_CANDIDATES;
             self.candidates_decided = true;
+        }
+    }
+
+    /// `radius=R`, with why when [`RestirDiSettings::resolve`] widened it, for the settings
+    /// line.
+    pub fn radius_label(&self) -> String {
+        match self.radius_widened_by {
+            Some(reach) => format!(
+                "radius={} (auto: {DIRECT_RADIUS} + a splatting film's reach of {reach})",
+                self.reuse.radius
+            ),
+            None => format!("radius={}", self.reuse.radius),
         }
     }
 
@@ -579,6 +613,10 @@ impl RestirDiSettings {
                     };
                     true
                 }
+                "radius" | "max_radius" | "spatial_radius" => {
+                    self.radius_named = true;
+                    self.reuse.apply(key, p)?
+                }
                 _ => self.reuse.apply(key, p)?,
             })
         })?;
@@ -661,15 +699,18 @@ mod tests {
             let mut s = settings();
             s.path.max_depth = max_depth;
             s.visibility = visibility;
-            s.resolve(&SceneFeatures {
-                environment_share: visible.map(|visible| restir_scene::EnvironmentShare {
-                    power_share: 0.5,
-                    share: 0.5,
-                    receivers: 1000,
-                    visible,
-                }),
-                ..SceneFeatures::default()
-            });
+            s.resolve(
+                &SceneFeatures {
+                    environment_share: visible.map(|visible| restir_scene::EnvironmentShare {
+                        power_share: 0.5,
+                        share: 0.5,
+                        receivers: 1000,
+                        visible,
+                    }),
+                    ..SceneFeatures::default()
+                },
+                &Reconstruction::Sampled,
+            );
             (s.bsdf_samples, s.bsdf_samples_label())
         };
         for visible in [0.05, 0.7] {
@@ -707,6 +748,40 @@ mod tests {
         assert_eq!(err, "bsdf_samples = 'resampled' needs visibility = target");
     }
 
+    /// A radius that was not named is widened by a splatting film's reach, and the settings
+    /// line says why; a sampled film and a named radius keep theirs.
+    #[test]
+    fn auto_radius_follows_a_splatting_film() {
+        let gaussian = Reconstruction::decide(restir_scene::FilterDesc::Gaussian { stddev: 0.5 });
+        assert_eq!(gaussian.reach(), 2);
+        let at = |film: &Reconstruction, params: &[(&str, &str)]| {
+            let mut s = settings();
+            s.apply(&ParamSet::from(params)).unwrap();
+            s.resolve(&SceneFeatures::default(), film);
+            (s.reuse.radius, s.radius_label())
+        };
+        assert_eq!(
+            at(&gaussian, &[]),
+            (
+                DIRECT_RADIUS + 2.0,
+                format!(
+                    "radius={} (auto: {DIRECT_RADIUS} + a splatting film's reach of 2)",
+                    DIRECT_RADIUS + 2.0
+                )
+            )
+        );
+        let plain = (DIRECT_RADIUS, format!("radius={DIRECT_RADIUS}"));
+        assert_eq!(at(&Reconstruction::Sampled, &[]), plain);
+        assert_eq!(
+            at(&gaussian, &[("radius", "2")]),
+            (2.0, "radius=2".to_string())
+        );
+        assert_eq!(
+            at(&gaussian, &[("max_radius", "7")]),
+            (7.0, "radius=7".to_string())
+        );
+    }
+
     /// Candidates that were not named become `TILE_CANDIDATES` where they come from the tiles'
     /// cuts, learning or not, and the settings line says why; named ones and the power sampler's
     /// keep their count.
@@ -715,10 +790,13 @@ mod tests {
         let at = |emitters: usize, params: &[(&str, &str)]| {
             let mut s = settings();
             s.apply(&ParamSet::from(params)).unwrap();
-            s.resolve(&SceneFeatures {
-                emitter_count: emitters,
-                ..SceneFeatures::default()
-            });
+            s.resolve(
+                &SceneFeatures {
+                    emitter_count: emitters,
+                    ..SceneFeatures::default()
+                },
+                &Reconstruction::Sampled,
+            );
             (s.candidates, s.candidates_label())
         };
         let many = LEARN_MAX_EMITTERS + 1;
@@ -746,10 +824,13 @@ mod tests {
         let at = |emitters: usize, learn: Learn| {
             let mut s = settings();
             s.learn = learn;
-            s.resolve(&SceneFeatures {
-                emitter_count: emitters,
-                ..SceneFeatures::default()
-            });
+            s.resolve(
+                &SceneFeatures {
+                    emitter_count: emitters,
+                    ..SceneFeatures::default()
+                },
+                &Reconstruction::Sampled,
+            );
             s.learn
         };
         assert_eq!(settings().learn, Learn::Auto);
@@ -760,10 +841,13 @@ mod tests {
         assert!(!Learn::Auto.is_on());
         // The settings line says what auto decided from.
         let mut s = settings();
-        s.resolve(&SceneFeatures {
-            emitter_count: 103_680,
-            ..SceneFeatures::default()
-        });
+        s.resolve(
+            &SceneFeatures {
+                emitter_count: 103_680,
+                ..SceneFeatures::default()
+            },
+            &Reconstruction::Sampled,
+        );
         assert_eq!(s.learn_decided_from, Some(103_680));
         assert_eq!(
             s.learn_reason().as_deref(),
