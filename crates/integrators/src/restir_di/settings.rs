@@ -415,7 +415,8 @@ impl RestirDiSettings {
     /// from the tiles' cuts (with learning or without). On a film that splats its filter
     /// (`film`), a radius that was not named becomes [`DIRECT_RADIUS`] plus the filter's reach:
     /// chosen on the DI training family's halls and Sponza with lamps under Mitsuba's Gaussian
-    /// (reach 2), where 4 pixels are 1.15× 2 at the median (`docs/RESTIR_DI.md`).
+    /// (reach 2), where 3 pixels are 1.11× 2 and 4 are 1.03× 3 at the median
+    /// (`docs/RESTIR_DI.md`).
     pub fn resolve(&mut self, features: &SceneFeatures, film: &Reconstruction) {
         self.path.resolve_nee(features);
         if !self.radius_named
