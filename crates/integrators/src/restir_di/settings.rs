@@ -6,7 +6,7 @@
 //! to [`LEARN_MAX_EMITTERS`] emitters) and, from the source, the candidate count
 //! ([`TILE_CANDIDATES`] for the tiles' cuts).
 
-use crate::reuse::params::ReuseParams;
+use crate::reuse::params::{RADIUS_NAMES, ReuseParams};
 use restir_scene::SceneFeatures;
 
 use crate::film::Reconstruction;
@@ -614,7 +614,7 @@ impl RestirDiSettings {
                     };
                     true
                 }
-                "radius" | "max_radius" | "spatial_radius" => {
+                k if RADIUS_NAMES.contains(&k) => {
                     self.radius_named = true;
                     self.reuse.apply(key, p)?
                 }

@@ -13,6 +13,9 @@ impl Param {
     }
 }
 
+/// The names of the spatial radius ([`ReuseSettings::radius`]).
+pub const RADIUS_NAMES: &[&str] = &["radius", "max_radius", "spatial_radius"];
+
 /// Reading [`ReuseSettings`] from an estimator's parameters.
 pub trait ReuseParams {
     /// Reads parameter `p` (normalized name `key`) if it is a reuse setting; returns whether
@@ -31,7 +34,7 @@ impl ReuseParams for ReuseSettings {
             | "neighbour_select"
             | "num_neighbors"
             | "spatial_neighbors" => self.neighbors = p.count(0)?,
-            "radius" | "max_radius" | "spatial_radius" => self.radius = p.positive()?,
+            k if RADIUS_NAMES.contains(&k) => self.radius = p.positive()?,
             "spatial_rounds" | "spatial_iteration" | "spatial_iterations" | "spatial_passes" => {
                 self.spatial_rounds = p.count(0)?;
             }
