@@ -57,6 +57,8 @@ pub enum CameraError {
     Transform,
     /// Aperture radius or focus distance is negative, zero where it must not be, or not finite.
     Lens,
+    /// The clip planes are not `0 ≤ near < far` with a finite near plane.
+    Clip(f32, f32),
 }
 
 impl core::fmt::Display for CameraError {
@@ -66,6 +68,10 @@ impl core::fmt::Display for CameraError {
             CameraError::Resolution(w, h) => write!(f, "film resolution {w}×{h} has a zero side"),
             CameraError::Transform => write!(f, "camera transform is degenerate or not finite"),
             CameraError::Lens => write!(f, "aperture radius and focus distance must be positive"),
+            CameraError::Clip(n, far) => write!(
+                f,
+                "near_clip {n} and far_clip {far} must satisfy 0 ≤ near_clip < far_clip"
+            ),
         }
     }
 }
@@ -87,6 +93,10 @@ pub struct Camera {
     aperture_radius: f32,
     focus_distance: f32,
     orthographic: bool,
+    /// Camera-space depth (`z`) of the near clip plane; 0 for none.
+    near_clip: f32,
+    /// Camera-space depth of the far clip plane; infinite for none.
+    far_clip: f32,
 }
 
 impl Camera {
@@ -136,7 +146,27 @@ impl Camera {
             aperture_radius,
             focus_distance,
             orthographic: false,
+            near_clip: 0.0,
+            far_clip: f32::INFINITY,
         })
+    }
+
+    /// The camera with clip planes at camera-space depths `near` and `far` (Mitsuba's
+    /// `near_clip` and `far_clip`): a camera ray sees only what lies between the two planes
+    /// perpendicular to the viewing axis, so a camera ray starts on the near plane and ends on
+    /// the far one. `0` and infinity clip nothing (the default).
+    pub fn with_clip(mut self, near: f32, far: f32) -> Result<Self, CameraError> {
+        if !(near >= 0.0 && near.is_finite() && far > near) {
+            return Err(CameraError::Clip(near, far));
+        }
+        self.near_clip = near;
+        self.far_clip = far;
+        Ok(self)
+    }
+
+    /// The clip planes' camera-space depths `(near, far)` ([`Camera::with_clip`]).
+    pub fn clip(&self) -> (f32, f32) {
+        (self.near_clip, self.far_clip)
     }
 
     /// Mitsuba 3's `orthographic` sensor
@@ -203,7 +233,9 @@ impl Camera {
     }
 
     /// The primary ray through film position `film` (in pixels, `(0, 0)` at the top-left corner),
-    /// with `u_lens` choosing the point on the aperture. The direction is unit length.
+    /// with `u_lens` choosing the point on the aperture. The direction is unit length; the ray
+    /// starts on the near clip plane and its `t_max` ends it on the far one
+    /// ([`Camera::with_clip`]; without clip planes, at the lens and unbounded).
     #[inline]
     pub fn generate_ray(&self, film: Vec2, u_lens: Vec2) -> Ray {
         let (w, h) = self.resolution;
@@ -213,23 +245,49 @@ impl Camera {
             (1.0 - 2.0 * s.y) * self.tan_half.y,
             1.0,
         );
-        if self.orthographic {
+        // The ray in camera space: from `o_local` along `d_local`, whose `z` is positive.
+        let ray = if self.orthographic {
             let o = self
                 .to_world
                 .transform_point3(Vec3::new(local.x, local.y, 0.0));
             let d = self.to_world.transform_vector3(Vec3::Z).normalize();
-            return Ray::new(o, d);
-        }
-        if self.aperture_radius > 0.0 {
+            (Ray::new(o, d), Vec3::new(local.x, local.y, 0.0), Vec3::Z)
+        } else if self.aperture_radius > 0.0 {
             let lens = self.aperture_radius * restir_sampling::warp::sample_concentric_disk(u_lens);
             let focus = local * self.focus_distance;
             let o_local = Vec3::new(lens.x, lens.y, 0.0);
             let o = self.to_world.transform_point3(o_local);
             let d = self.to_world.transform_vector3(focus - o_local).normalize();
-            return Ray::new(o, d);
+            (Ray::new(o, d), o_local, focus - o_local)
+        } else {
+            let d = self.to_world.transform_vector3(local).normalize();
+            (Ray::new(self.origin, d), Vec3::ZERO, local)
+        };
+        self.clipped(ray)
+    }
+
+    /// A camera ray (world space, and its origin and direction in camera space) moved to start
+    /// on the near clip plane and to end on the far one, both measured in camera space so that
+    /// a scaled `to_world` scales them alike.
+    #[inline]
+    fn clipped(&self, (mut ray, o_local, d_local): (Ray, Vec3, Vec3)) -> Ray {
+        if self.near_clip == 0.0 && self.far_clip == f32::INFINITY {
+            return ray;
         }
-        let d = self.to_world.transform_vector3(local).normalize();
-        Ray::new(self.origin, d)
+        let at_depth = |z: f32| {
+            self.to_world
+                .transform_point3(o_local + d_local * (z / d_local.z))
+        };
+        let near = if self.near_clip > 0.0 {
+            at_depth(self.near_clip)
+        } else {
+            ray.o
+        };
+        if self.far_clip.is_finite() {
+            ray.t_max = (at_depth(self.far_clip) - near).dot(ray.d);
+        }
+        ray.o = near;
+        ray
     }
 }
 

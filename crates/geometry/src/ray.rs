@@ -4,20 +4,29 @@
 
 use glam::Vec3;
 
-/// A ray `o + t·d`. `d` need not be normalised, but every ray the renderer spawns has a unit `d`.
+/// A ray `o + t·d` for `0 < t < t_max`. `d` need not be normalised, but every ray the renderer
+/// spawns has a unit `d`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
     /// Origin.
     pub o: Vec3,
     /// Direction.
     pub d: Vec3,
+    /// Where the ray ends ([`f32::INFINITY`] but for camera rays with a far clip plane):
+    /// [`Camera::generate_ray`](crate::Camera::generate_ray) sets it, the scene's closest-hit
+    /// queries honour it.
+    pub t_max: f32,
 }
 
 impl Ray {
-    /// A ray from `o` along `d`.
+    /// A ray from `o` along `d`, unbounded.
     #[inline]
     pub fn new(o: Vec3, d: Vec3) -> Self {
-        Self { o, d }
+        Self {
+            o,
+            d,
+            t_max: f32::INFINITY,
+        }
     }
 
     /// The point at parameter `t`.

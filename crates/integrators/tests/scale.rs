@@ -1,8 +1,8 @@
 //! Scale invariance: one scene in units 10⁻⁶, 10⁻³, 1, 10³ and 10⁶ times as large renders the
 //! same image within noise with every estimator (the path tracer, ReSTIR DI, ReSTIR PT). The
-//! scene is scaled whole — shapes, the camera's position, the sphere lights — with the point
-//! light's intensity scaled by the square of the factor (its irradiance falls off with the
-//! squared distance); area lights and the environment keep their radiance. Means over
+//! scene is scaled whole — shapes, the camera's position and clip planes, the sphere lights —
+//! with the point light's intensity scaled by the square of the factor (its irradiance falls off
+//! with the squared distance); area lights and the environment keep their radiance. Means over
 //! independent renders are compared block by block with the standard error measured across
 //! seeds (the pattern of `tests/restir_di.rs`), each scale against unit scale with its own
 //! seeds. Negative control: the unit scene with every light 3 % dimmer — the size of the
@@ -57,7 +57,8 @@ fn scene(s: f32, dim: f32) -> common::Built {
         .collect();
     let ron = format!(
         r#"(
-        camera: (fov: 50, to_world: [LookAt(origin: {cam}, target: {target}, up: (0, 1, 0))]),
+        camera: (fov: 50, to_world: [LookAt(origin: {cam}, target: {target}, up: (0, 1, 0))],
+                 near_clip: {near}, far_clip: {far}),
         film: (width: {SIZE}, height: {SIZE}, filter: Box),
         integrator: (max_depth: 3),
         shapes: [
@@ -78,6 +79,8 @@ fn scene(s: f32, dim: f32) -> common::Built {
         ],
     )"#,
         cam = p(0.3, 1.6, 3.2),
+        near = 0.01 * s,
+        far = 1e4 * s,
         target = p(0.0, 0.3, 0.0),
         sphere = p(1.2, 1.3, -0.6),
         radius = 0.08 * s,

@@ -424,6 +424,7 @@ impl Scene {
                 desc.camera.focus_distance,
             )
         }
+        .and_then(|c| c.with_clip(desc.camera.near_clip, desc.camera.far_clip))
         .map_err(|e| whole(format!("camera: {e}")))?;
         match desc.film.filter {
             FilterDesc::Box => {}

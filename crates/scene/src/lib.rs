@@ -115,10 +115,10 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// The closest surface hit by `ray`.
+    /// The closest surface hit by `ray` before its `t_max`.
     #[inline(always)]
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
-        let hit: Hit = self.accel.intersect(ray, f32::INFINITY)?;
+        let hit: Hit = self.accel.intersect(ray, ray.t_max)?;
         Some(self.accel.surface_interaction(&self.shapes, &hit, ray))
     }
 
@@ -153,10 +153,10 @@ impl Scene {
                 si.t = (si.p - ray.o).length() / ray.d.length();
                 return (Some(si), rays);
             }
-            next = Ray::new(
-                restir_geometry::offset_ray_origin(si.p, si.ng, ray.d),
-                ray.d,
-            );
+            let o = restir_geometry::offset_ray_origin(si.p, si.ng, ray.d);
+            // What is left of a camera ray that ends at the far clip plane.
+            let t_max = ray.t_max - (o - ray.o).dot(ray.d) / ray.d.length_squared();
+            next = Ray { o, d: ray.d, t_max };
         }
         unreachable!("the loop returns at MAX_SKIPS")
     }

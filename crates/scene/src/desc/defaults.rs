@@ -27,6 +27,10 @@ pub fn fov_of_focal_length(mm: f32) -> f32 {
 pub const APERTURE_RADIUS: f32 = 0.0;
 /// Distance of the plane in focus (`thinlens`).
 pub const FOCUS_DISTANCE: f32 = 1.0;
+/// Mitsuba 3's `near_clip` when a sensor does not name one (camera-space depth).
+pub const NEAR_CLIP: f32 = 1e-2;
+/// Mitsuba 3's `far_clip` when a sensor does not name one (camera-space depth).
+pub const FAR_CLIP: f32 = 1e4;
 
 /// Film width in pixels (`hdrfilm`).
 pub const FILM_WIDTH: u32 = 768;
@@ -172,6 +176,18 @@ pub(crate) fn envmap_scale() -> f32 {
 }
 pub(crate) fn spot_cutoff_angle() -> f32 {
     SPOT_CUTOFF_ANGLE
+}
+pub(crate) fn near_clip() -> f32 {
+    NEAR_CLIP
+}
+pub(crate) fn far_clip() -> f32 {
+    FAR_CLIP
+}
+pub(crate) fn is_near_clip(v: &f32) -> bool {
+    *v == NEAR_CLIP
+}
+pub(crate) fn is_far_clip(v: &f32) -> bool {
+    *v == FAR_CLIP
 }
 pub(crate) fn emission() -> V3 {
     EMISSION

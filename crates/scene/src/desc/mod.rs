@@ -127,6 +127,20 @@ pub struct CameraDesc {
     /// unused). Written only when set, so perspective scenes read as before.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub orthographic: bool,
+    /// Mitsuba's `near_clip`: the camera-space depth of the plane before which the camera sees
+    /// nothing ([`defaults::NEAR_CLIP`], Mitsuba's, in both formats).
+    #[serde(
+        default = "defaults::near_clip",
+        skip_serializing_if = "defaults::is_near_clip"
+    )]
+    pub near_clip: f32,
+    /// Mitsuba's `far_clip`: the camera-space depth of the plane past which the camera sees
+    /// nothing, so that what lies beyond is seen as a miss ([`defaults::FAR_CLIP`]).
+    #[serde(
+        default = "defaults::far_clip",
+        skip_serializing_if = "defaults::is_far_clip"
+    )]
+    pub far_clip: f32,
 }
 
 impl Default for CameraDesc {
@@ -138,6 +152,8 @@ impl Default for CameraDesc {
             aperture_radius: defaults::APERTURE_RADIUS,
             focus_distance: defaults::FOCUS_DISTANCE,
             orthographic: false,
+            near_clip: defaults::NEAR_CLIP,
+            far_clip: defaults::FAR_CLIP,
         }
     }
 }

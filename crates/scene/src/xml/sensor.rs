@@ -46,6 +46,35 @@ impl<'a> Importer<'a> {
                 }
             }
         }
+        // Mitsuba 3's clip planes (every sensor here is one of its projective cameras), with
+        // its defaults and its rule that 0 < near_clip < far_clip.
+        let near = props.float("near_clip")?;
+        let far = props.float("far_clip")?;
+        let (n, f) = (
+            near.unwrap_or(defaults::NEAR_CLIP),
+            far.unwrap_or(defaults::FAR_CLIP),
+        );
+        if !(n > 0.0 && n < f && f.is_finite()) {
+            let at = if near.is_some() {
+                props.node_or("near_clip", node)
+            } else {
+                props.node_or("far_clip", node)
+            };
+            return Err(self.err(
+                at,
+                format!(
+                    "sensor '{ty}': near_clip {n} and far_clip {f} must satisfy 0 < near_clip < far_clip (defaults {} and {})",
+                    defaults::NEAR_CLIP,
+                    defaults::FAR_CLIP
+                ),
+            ));
+        }
+        (cam.near_clip, cam.far_clip) = (n, f);
+        if ty != "thinlens" {
+            // Mitsuba 3's perspective and orthographic sensors read a focus distance, which
+            // they do not use: read, so it passes quietly.
+            props.float("focus_distance")?;
+        }
         if ty == "thinlens" {
             cam.aperture_radius = props
                 .float("aperture_radius")?
@@ -229,6 +258,23 @@ impl<'a> Importer<'a> {
             ));
         }
         film.filename = props.string("filename")?;
+        // The output's channels and their type come from the output file's name; what an EXR
+        // holds here (R, G, B in 32-bit floats) passes quietly.
+        for (name, quiet) in [
+            ("pixel_format", &["rgb"][..]),
+            ("component_format", &["float32", "float16"][..]),
+        ] {
+            if let Some(v) = props.string(name)?
+                && !quiet.contains(&v.as_str())
+            {
+                self.warn(
+                    props.node_or(name, node),
+                    format!(
+                        "film '{ty}': {name} '{v}' is not what is written (EXR files hold R, G, B as 32-bit floats)"
+                    ),
+                );
+            }
+        }
         film.filter = FilterDesc::default();
         for c in elements(node) {
             match c.tag_name().name() {
@@ -237,12 +283,19 @@ impl<'a> Importer<'a> {
                     let fp = self.props(c, format!("rfilter '{fty}'"))?;
                     film.filter = match fty.as_str() {
                         "box" => {
-                            // Lajolla's box filter `width`; Mitsuba's box is one pixel.
+                            // Mitsuba 3's box is one pixel; Lajolla's `width` and Mitsuba 0.6's
+                            // `radius` may say so, a wider box is not supported.
+                            let named = fp.node_or("width", fp.node_or("radius", c));
                             if let Some(w) =
                                 fp.float("width")?.or(fp.float("radius")?.map(|r| 2.0 * r))
                                 && (w - 1.0).abs() > 1e-6
                             {
-                                self.warn(c, format!("box filter width {w} is treated as 1 pixel"));
+                                return Err(self.err(
+                                    named,
+                                    format!(
+                                        "rfilter 'box': a width of {w} pixels is not supported (only 1, Mitsuba 3's box; a wider filter: 'tent' or 'gaussian')"
+                                    ),
+                                ));
                             }
                             FilterDesc::Box
                         }

@@ -81,6 +81,20 @@ impl<'a> Importer<'a> {
                     ));
                 }
                 let raw = props.bool("raw")?.unwrap_or(false);
+                // Mitsuba 3's storage format: `variant` (floats, its default) is how textures
+                // are kept here; `fixed` (8- or 16-bit integers) would round a float image's
+                // texels.
+                match props.string("format")?.as_deref() {
+                    None | Some("variant") => {}
+                    Some(f) => {
+                        return Err(self.err(
+                            props.node_or("format", node),
+                            format!(
+                                "texture 'bitmap': format '{f}' is not supported (textures are kept as floats, Mitsuba's 'variant')"
+                            ),
+                        ));
+                    }
+                }
                 let filter = match props.string("filter_type")? {
                     None => FilterType::default(),
                     Some(f) => FilterType::from_name(&f).ok_or_else(|| {

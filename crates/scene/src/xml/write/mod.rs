@@ -12,7 +12,8 @@
 //! the world's); a material of an area light that has none is left out (both renderers make it
 //! black); `Black` is a diffuse bsdf of reflectance 0; `face_normals` is written for mesh files
 //! only (built-in shapes are flat-faced or analytic: it changes nothing there, and Mitsuba
-//! rejects it); a pinhole camera's focus distance is left out; the film's output file name is a
+//! rejects it); a pinhole camera's focus distance is left out, and clip planes at Mitsuba's
+//! defaults too; the film's output file name is a
 //! comment (Mitsuba's `hdrfilm` refuses one); a material whose name is also a shape's id (one
 //! namespace in Mitsuba, two here) gets the id `<name>-bsdf`.
 //!
@@ -360,6 +361,20 @@ impl Writer<'_> {
             self.transform("to_world", &cam.to_world, item)?;
         } else {
             self.perspective_sensor(cam, thin, item)?;
+        }
+        // Clip planes other than Mitsuba's defaults.
+        let clips = [
+            ("near_clip", cam.near_clip, defaults::NEAR_CLIP),
+            ("far_clip", cam.far_clip, defaults::FAR_CLIP),
+        ];
+        for (name, value, default) in clips {
+            if value != default {
+                finite(item, name, &[value])?;
+                if value <= 0.0 {
+                    return refuse(item, format!("{name} {value}: Mitsuba needs it positive"));
+                }
+                self.float(name, value);
+            }
         }
         self.sensor_rest(desc)
     }
