@@ -318,6 +318,25 @@ fn every_model_filter_camera_and_light_round_trips() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Clip planes other than Mitsuba's defaults are written and read back; the defaults are left
+/// out.
+#[test]
+fn clip_planes_round_trip() {
+    let dir = temp_dir("clip");
+    for camera in ["fov: 45", "fov: 45, orthographic: true"] {
+        for clips in ["", ", near_clip: 0.5, far_clip: 40"] {
+            let ron = format!("(camera: ({camera}{clips}), shapes: [(geometry: Rectangle)])");
+            let source = dir.join("clip.ron");
+            std::fs::write(&source, &ron).unwrap();
+            let (desc, _) = load_desc(&source, &[]).unwrap();
+            let text = round_trip(&desc, &source, &dir.join("clip.xml"), None);
+            assert_eq!(text.contains("near_clip"), !clips.is_empty(), "{text}");
+            assert_eq!(text.contains("far_clip"), !clips.is_empty(), "{text}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn what_mitsuba_cannot_say_is_refused_by_name() {
     let base = restir_scene::parse_ron(
@@ -349,6 +368,11 @@ fn what_mitsuba_cannot_say_is_refused_by_name() {
     };
     let e = write(&d);
     assert!(e.contains("shape 0: an inline triangle mesh"), "{e}");
+
+    let mut d = base.clone();
+    d.camera.near_clip = 0.0;
+    let e = write(&d);
+    assert!(e.contains("near_clip 0: Mitsuba needs it positive"), "{e}");
 
     let mut d = base.clone();
     d.shapes[0].material = Some(restir_scene::MaterialRef::Ref("nowhere".into()));
