@@ -166,9 +166,11 @@ impl AutoIntegrator {
             Choice::Path => Box::new(PathIntegrator { settings: path }),
             Choice::RestirDi => {
                 let mut s = RestirDiSettings::new(path);
+                let (w, h) = scene.camera.resolution();
                 s.resolve(
                     &scene.features,
                     &crate::film::Reconstruction::decide(scene.filter),
+                    u64::from(w) * u64::from(h),
                 );
                 Box::new(RestirDiIntegrator::new(s))
             }

@@ -243,7 +243,12 @@ pub fn make_integrator(
         "restir-di" => {
             let mut s = RestirDiSettings::new(settings);
             let unused = s.apply(&params)?;
-            s.resolve(&scene.features, &film::Reconstruction::decide(scene.filter));
+            let (w, h) = scene.camera.resolution();
+            s.resolve(
+                &scene.features,
+                &film::Reconstruction::decide(scene.filter),
+                u64::from(w) * u64::from(h),
+            );
             notes.extend(s.reuse.pair_neighbors());
             (Box::new(RestirDiIntegrator::new(s)), unused)
         }

@@ -72,7 +72,8 @@ pub struct ReuseSettings {
 /// reciprocal pairs. On the project's DI training family at 640×360 (equal CPU time, 8 passes)
 /// eight are 1.13× four's efficiency at the median and gain on every member (1.07–1.26×); twelve
 /// are 1.16× but as low as 1.01× (the project repository's `docs/RESTIR_DI.md`, "The defaults at
-/// a user's size").
+/// a user's size"). The renderer takes twelve on films of 1280×720 pixels and more, where they
+/// pay on every member (its `docs/RESTIR_DI.md`, "Twelve neighbours on large films").
 pub const DIRECT_NEIGHBORS: u32 = 8;
 
 /// ReSTIR DI's spatial radius in pixels ([`ReuseSettings::direct`]): with eight neighbours in

@@ -134,7 +134,8 @@ pub(crate) struct RestirArgs {
     #[arg(long)]
     bsdf_samples: Option<String>,
     /// Spatial neighbours per round, in reciprocal pairs (an odd count is raised to the next
-    /// even one) [default: 8 for restir-di, 4 for restir-pt].
+    /// even one) [default: 8 for restir-di, 12 on a film of at least 1280×720 pixels; 4 for
+    /// restir-pt].
     #[arg(long, alias = "neighbours")]
     neighbors: Option<u32>,
     /// Spatial reuse radius in pixels [default: 2 for restir-di, widened by the filter's reach on

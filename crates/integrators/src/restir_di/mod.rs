@@ -315,7 +315,7 @@ impl Integrator for RestirDiIntegrator {
     fn describe(&self) -> String {
         let s = &self.settings;
         format!(
-            "restir-di max_depth={}{} {} light_sampler={} bsdf_candidates={} {} {} neighbors={} \
+            "restir-di max_depth={}{} {} light_sampler={} bsdf_candidates={} {} {} {} \
              {} spatial_rounds={} reciprocal={} mis={} mcap={} {} \
              visibility={} {}{}{}",
             s.path.max_depth,
@@ -343,7 +343,7 @@ impl Integrator for RestirDiIntegrator {
             s.bsdf_candidates,
             s.bsdf_diffuse_label(),
             s.bsdf_samples_label(),
-            s.reuse.neighbors,
+            s.neighbors_label(),
             s.radius_label(),
             s.reuse.spatial_rounds,
             s.reuse.reciprocal,

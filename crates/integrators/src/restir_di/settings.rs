@@ -6,7 +6,7 @@
 //! to [`LEARN_MAX_EMITTERS`] emitters) and, from the source, the candidate count
 //! ([`TILE_CANDIDATES`] for the tiles' cuts).
 
-use crate::reuse::params::{RADIUS_NAMES, ReuseParams};
+use crate::reuse::params::{NEIGHBOR_NAMES, RADIUS_NAMES, ReuseParams};
 use restir_scene::SceneFeatures;
 
 use crate::film::Reconstruction;
@@ -41,6 +41,16 @@ pub const LEARN_MAX_EMITTERS: usize = 50_000;
 /// learning 12 pay too (1.07× eight at the median of the nine learning members at 640×360 and
 /// at 320×240, up to 1.31× on the glossy hall and 1.52× on 10⁴ spheres at the smaller film).
 pub const TILE_CANDIDATES: u32 = 12;
+
+/// Spatial neighbours per round where they were not named and the film has at least
+/// [`LARGE_FILM_PIXELS`] pixels (else [`restir_reuse::settings::DIRECT_NEIGHBORS`], 8). A film of
+/// smaller pixels sees more alike surfaces within the reuse radius, so more neighbours pay:
+/// chosen on the DI training family at 1280×720 (`docs/RESTIR_DI.md`, "Twelve neighbours on
+/// large films").
+pub const LARGE_FILM_NEIGHBORS: u32 = 12;
+
+/// The film size in pixels (1280×720) from which [`LARGE_FILM_NEIGHBORS`] neighbours are taken.
+pub const LARGE_FILM_PIXELS: u64 = 1280 * 720;
 
 /// Where initial candidates' lights come from (`--light-sampler`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -314,6 +324,11 @@ pub struct RestirDiSettings {
     /// Whether the reuse radius was named; else [`RestirDiSettings::resolve`] widens it by a
     /// splatting film's reach.
     pub radius_named: bool,
+    /// Whether the neighbour count was named; else [`RestirDiSettings::resolve`] raises it to
+    /// [`LARGE_FILM_NEIGHBORS`] on a film of at least [`LARGE_FILM_PIXELS`] pixels.
+    pub neighbors_named: bool,
+    /// Whether [`RestirDiSettings::resolve`] raised the neighbour count (`--stats` says why).
+    pub neighbors_raised: bool,
     /// The splatting film's reach [`RestirDiSettings::resolve`] widened the radius by, if it
     /// did (`--stats` says why).
     pub radius_widened_by: Option<u32>,
@@ -386,6 +401,8 @@ impl RestirDiSettings {
             candidates_named: false,
             candidates_decided: false,
             radius_named: false,
+            neighbors_named: false,
+            neighbors_raised: false,
             radius_widened_by: None,
             light_sampler: LightSampler::Auto,
             learn: Learn::Auto,
@@ -416,9 +433,15 @@ impl RestirDiSettings {
     /// (`film`), a radius that was not named becomes [`DIRECT_RADIUS`] plus the filter's reach:
     /// chosen on the DI training family's halls and Sponza with lamps under Mitsuba's Gaussian
     /// (reach 2), where 3 pixels are 1.11× 2 and 4 are 1.03× 3 at the median
-    /// (`docs/RESTIR_DI.md`).
-    pub fn resolve(&mut self, features: &SceneFeatures, film: &Reconstruction) {
+    /// (`docs/RESTIR_DI.md`). On a film of `pixels` ≥ [`LARGE_FILM_PIXELS`] (the camera's whole
+    /// film, so that the parts of a split render agree) neighbours that were not named become
+    /// [`LARGE_FILM_NEIGHBORS`].
+    pub fn resolve(&mut self, features: &SceneFeatures, film: &Reconstruction, pixels: u64) {
         self.path.resolve_nee(features);
+        if !self.neighbors_named && pixels >= LARGE_FILM_PIXELS {
+            self.reuse.neighbors = LARGE_FILM_NEIGHBORS;
+            self.neighbors_raised = true;
+        }
         if !self.radius_named
             && let Reconstruction::Splatted { reach, .. } = *film
             && reach > 0
@@ -465,6 +488,19 @@ impl RestirDiSettings {
         if !self.candidates_named && self.light_sampler == LightSampler::Tiles {
             self.candidates = TILE_CANDIDATES;
             self.candidates_decided = true;
+        }
+    }
+
+    /// `neighbors=N`, with why when [`RestirDiSettings::resolve`] raised it, for the settings
+    /// line.
+    pub fn neighbors_label(&self) -> String {
+        if self.neighbors_raised {
+            format!(
+                "neighbors={} (auto: a film of at least 1280×720 pixels)",
+                self.reuse.neighbors
+            )
+        } else {
+            format!("neighbors={}", self.reuse.neighbors)
         }
     }
 
@@ -618,6 +654,10 @@ impl RestirDiSettings {
                     self.radius_named = true;
                     self.reuse.apply(key, p)?
                 }
+                k if NEIGHBOR_NAMES.contains(&k) => {
+                    self.neighbors_named = true;
+                    self.reuse.apply(key, p)?
+                }
                 _ => self.reuse.apply(key, p)?,
             })
         })?;
@@ -639,6 +679,9 @@ mod tests {
     use restir_gris::MisScheme;
 
     use super::*;
+
+    /// A film below [`LARGE_FILM_PIXELS`] (640×360).
+    const SMALL: u64 = 640 * 360;
 
     fn settings() -> RestirDiSettings {
         RestirDiSettings::new(PathSettings {
@@ -711,6 +754,7 @@ mod tests {
                     ..SceneFeatures::default()
                 },
                 &Reconstruction::Sampled,
+                SMALL,
             );
             (s.bsdf_samples, s.bsdf_samples_label())
         };
@@ -758,7 +802,7 @@ mod tests {
         let at = |film: &Reconstruction, params: &[(&str, &str)]| {
             let mut s = settings();
             s.apply(&ParamSet::from(params)).unwrap();
-            s.resolve(&SceneFeatures::default(), film);
+            s.resolve(&SceneFeatures::default(), film, SMALL);
             (s.reuse.radius, s.radius_label())
         };
         assert_eq!(
@@ -783,6 +827,42 @@ mod tests {
         );
     }
 
+    /// Neighbours that were not named become `LARGE_FILM_NEIGHBORS` on a film of at least
+    /// `LARGE_FILM_PIXELS` pixels, and the settings line says why; smaller films keep eight,
+    /// named counts stay.
+    #[test]
+    fn auto_neighbors_follow_the_film_size() {
+        let at = |pixels: u64, params: &[(&str, &str)]| {
+            let mut s = settings();
+            s.apply(&ParamSet::from(params)).unwrap();
+            s.resolve(&SceneFeatures::default(), &Reconstruction::Sampled, pixels);
+            (s.reuse.neighbors, s.neighbors_label())
+        };
+        assert_eq!(
+            at(1280 * 720, &[]),
+            (
+                LARGE_FILM_NEIGHBORS,
+                format!(
+                    "neighbors={LARGE_FILM_NEIGHBORS} (auto: a film of at least 1280×720 pixels)"
+                )
+            )
+        );
+        assert_eq!(at(1800 * 1080, &[]).0, LARGE_FILM_NEIGHBORS);
+        let eight = restir_reuse::settings::DIRECT_NEIGHBORS;
+        assert_eq!(
+            at(1280 * 720 - 1, &[]),
+            (eight, format!("neighbors={eight}"))
+        );
+        assert_eq!(at(SMALL, &[]).0, eight);
+        for name in ["neighbors", "spatial_neighbors", "num_neighbors"] {
+            assert_eq!(
+                at(1800 * 1080, &[(name, "8")]),
+                (8, "neighbors=8".to_string()),
+                "{name}"
+            );
+        }
+    }
+
     /// Candidates that were not named become `TILE_CANDIDATES` where they come from the tiles'
     /// cuts, learning or not, and the settings line says why; named ones and the power sampler's
     /// keep their count.
@@ -797,6 +877,7 @@ mod tests {
                     ..SceneFeatures::default()
                 },
                 &Reconstruction::Sampled,
+                SMALL,
             );
             (s.candidates, s.candidates_label())
         };
@@ -831,6 +912,7 @@ mod tests {
                     ..SceneFeatures::default()
                 },
                 &Reconstruction::Sampled,
+                SMALL,
             );
             s.learn
         };
@@ -848,6 +930,7 @@ mod tests {
                 ..SceneFeatures::default()
             },
             &Reconstruction::Sampled,
+            SMALL,
         );
         assert_eq!(s.learn_decided_from, Some(103_680));
         assert_eq!(

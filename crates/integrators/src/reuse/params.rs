@@ -16,6 +16,18 @@ impl Param {
 /// The names of the spatial radius ([`ReuseSettings::radius`]).
 pub const RADIUS_NAMES: &[&str] = &["radius", "max_radius", "spatial_radius"];
 
+/// The names of the spatial neighbour count ([`ReuseSettings::neighbors`]).
+pub const NEIGHBOR_NAMES: &[&str] = &[
+    "neighbors",
+    "neighbours",
+    "neighbors_per_pixel",
+    "neighbours_per_pixel",
+    "neighbor_select",
+    "neighbour_select",
+    "num_neighbors",
+    "spatial_neighbors",
+];
+
 /// Reading [`ReuseSettings`] from an estimator's parameters.
 pub trait ReuseParams {
     /// Reads parameter `p` (normalized name `key`) if it is a reuse setting; returns whether
@@ -26,14 +38,7 @@ pub trait ReuseParams {
 impl ReuseParams for ReuseSettings {
     fn apply(&mut self, key: &str, p: &Param) -> Result<bool, ParamError> {
         match key {
-            "neighbors"
-            | "neighbours"
-            | "neighbors_per_pixel"
-            | "neighbours_per_pixel"
-            | "neighbor_select"
-            | "neighbour_select"
-            | "num_neighbors"
-            | "spatial_neighbors" => self.neighbors = p.count(0)?,
+            k if NEIGHBOR_NAMES.contains(&k) => self.neighbors = p.count(0)?,
             k if RADIUS_NAMES.contains(&k) => self.radius = p.positive()?,
             "spatial_rounds" | "spatial_iteration" | "spatial_iterations" | "spatial_passes" => {
                 self.spatial_rounds = p.count(0)?;
