@@ -47,8 +47,8 @@ use restir_sampling::Pcg32;
 use restir_scene::Scene;
 
 pub use settings::{
-    AUTO_LIGHT_SAMPLER, BsdfDiffuse, BsdfSamples, LEARN_MAX_EMITTERS, Learn, LightSampler,
-    RestirDiSettings, TILE_CANDIDATES, Visibility,
+    AUTO_LIGHT_SAMPLER, BsdfDiffuse, BsdfSamples, LARGE_FILM_NEIGHBORS, LARGE_FILM_PIXELS,
+    LEARN_MAX_EMITTERS, Learn, LightSampler, RestirDiSettings, TILE_CANDIDATES, Visibility,
 };
 
 use crate::bands::Bands;
