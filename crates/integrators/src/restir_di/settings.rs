@@ -683,6 +683,18 @@ mod tests {
     /// A film below [`LARGE_FILM_PIXELS`] (640×360).
     const SMALL: u64 = 640 * 360;
 
+    /// `s` resolved for a scene of `emitters` emitters and nothing else, on a small sampled film.
+    fn resolve_with_emitters(s: &mut RestirDiSettings, emitters: usize) {
+        s.resolve(
+            &SceneFeatures {
+                emitter_count: emitters,
+                ..SceneFeatures::default()
+            },
+            &Reconstruction::Sampled,
+            SMALL,
+        );
+    }
+
     fn settings() -> RestirDiSettings {
         RestirDiSettings::new(PathSettings {
             max_depth: 2,
@@ -871,14 +883,7 @@ mod tests {
         let at = |emitters: usize, params: &[(&str, &str)]| {
             let mut s = settings();
             s.apply(&ParamSet::from(params)).unwrap();
-            s.resolve(
-                &SceneFeatures {
-                    emitter_count: emitters,
-                    ..SceneFeatures::default()
-                },
-                &Reconstruction::Sampled,
-                SMALL,
-            );
+            resolve_with_emitters(&mut s, emitters);
             (s.candidates, s.candidates_label())
         };
         let many = LEARN_MAX_EMITTERS + 1;
@@ -906,14 +911,7 @@ mod tests {
         let at = |emitters: usize, learn: Learn| {
             let mut s = settings();
             s.learn = learn;
-            s.resolve(
-                &SceneFeatures {
-                    emitter_count: emitters,
-                    ..SceneFeatures::default()
-                },
-                &Reconstruction::Sampled,
-                SMALL,
-            );
+            resolve_with_emitters(&mut s, emitters);
             s.learn
         };
         assert_eq!(settings().learn, Learn::Auto);
@@ -924,14 +922,7 @@ mod tests {
         assert!(!Learn::Auto.is_on());
         // The settings line says what auto decided from.
         let mut s = settings();
-        s.resolve(
-            &SceneFeatures {
-                emitter_count: 103_680,
-                ..SceneFeatures::default()
-            },
-            &Reconstruction::Sampled,
-            SMALL,
-        );
+        resolve_with_emitters(&mut s, 103_680);
         assert_eq!(s.learn_decided_from, Some(103_680));
         assert_eq!(
             s.learn_reason().as_deref(),
