@@ -209,18 +209,22 @@ fn render_entry(
 /// for the HTML page (seed 0 of every configuration and budget) adds 12.
 pub const BYTES_PER_PIXEL: u64 = 24 + 12 + 12 + 6 * 12;
 
-/// Refuses a scene whose renders would need more than `max_gib` GiB: [`BYTES_PER_PIXEL`], the
-/// largest buffers of the configurations that render it with the splatting film's, and the
-/// images kept for the page.
+/// Refuses a scene whose renders would need more than `max_gib` GiB: [`BYTES_PER_PIXEL`] and
+/// the splatting film's `film_per_pixel`, the largest buffers of the configurations that render
+/// it (`largest_buffers` bytes), and the images kept for the page.
 fn check_memory(
     name: &str,
     (w, h): (u32, u32),
+    film_per_pixel: u64,
     largest_buffers: u64,
     kept_images: u64,
     max_gib: f64,
 ) -> Result<(), BenchError> {
-    let per_pixel = BYTES_PER_PIXEL + largest_buffers + 12 * kept_images;
-    let need = (w as u64 * h as u64).saturating_mul(per_pixel);
+    let pixels = w as u64 * h as u64;
+    let need = pixels
+        .saturating_mul(BYTES_PER_PIXEL + film_per_pixel + 12 * kept_images)
+        .saturating_add(largest_buffers);
+    let per_pixel = need.div_ceil(pixels.max(1));
     if need as f64 / (1u64 << 30) as f64 > max_gib {
         return Err(BenchError::Memory {
             scene: name.to_string(),
@@ -260,6 +264,8 @@ pub fn run_suite(
         let max_bytes = opts.max_memory_gib * (1u64 << 30) as f64;
         let loaded =
             load_suite_scene(entry, &opts.suite_dir, Some(max_bytes as u64)).map_err(at_scene)?;
+        let (w, h) = loaded.scene.camera.resolution();
+        let threads = rayon::current_num_threads();
         let mut largest_buffers = 0u64;
         let mut configs = 0u64;
         for (ci, config) in suite.integrators.iter().enumerate() {
@@ -268,15 +274,15 @@ pub fn run_suite(
             }
             let integrator = build_integrator(&loaded, config, entry)
                 .map_err(|e| e.at(file, config_line(ci)))?;
-            largest_buffers = largest_buffers.max(integrator.buffer_bytes_per_pixel() as u64);
+            largest_buffers = largest_buffers.max(integrator.buffer_bytes(w, h, threads));
             configs += 1;
         }
-        let (w, h) = loaded.scene.camera.resolution();
         let film = Reconstruction::decide(loaded.scene.filter).buffer_bytes_per_pixel() as u64;
         check_memory(
             &loaded.name,
             (w, h),
-            largest_buffers + film,
+            film,
+            largest_buffers,
             configs * suite.budgets.len() as u64,
             opts.max_memory_gib,
         )

@@ -210,8 +210,8 @@ impl Integrator for AutoIntegrator {
         self.chosen.describe()
     }
 
-    fn buffer_bytes_per_pixel(&self) -> usize {
-        self.chosen.buffer_bytes_per_pixel()
+    fn buffer_bytes(&self, width: u32, height: u32, threads: usize) -> u64 {
+        self.chosen.buffer_bytes(width, height, threads)
     }
 
     fn halo(&self) -> u32 {

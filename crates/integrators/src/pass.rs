@@ -307,9 +307,11 @@ pub trait Integrator: Sync + Send + std::fmt::Debug {
     fn describe(&self) -> String {
         self.name().to_string()
     }
-    /// Bytes per pixel of the per-pass buffers the estimator keeps besides the image (reservoirs,
-    /// primary hits).
-    fn buffer_bytes_per_pixel(&self) -> usize {
+    /// Bytes of the per-pass buffers the estimator keeps besides the image (reservoirs, primary
+    /// hits, tables of shifts) for a film of `width × height` pixels rendered on `threads`
+    /// threads, at most.
+    fn buffer_bytes(&self, width: u32, height: u32, threads: usize) -> u64 {
+        let _ = (width, height, threads);
         0
     }
     /// How far, in pixels, a pixel's estimate in one pass reaches for other pixels' samples

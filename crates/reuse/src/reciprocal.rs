@@ -17,8 +17,7 @@
 //! pixel's resampling with a [`ShiftMap`] that reads them. Both run chunk of rows by chunk of
 //! rows, so the table holds the pairs of one chunk and of the rows its pixels' neighbours reach
 //! (64 rows and the radius above and below on up to 4 threads; 16 rows per thread beyond), not
-//! the whole image's. [`table_bytes_per_pixel`] bounds it for memory estimates: on many
-//! threads the window spans most of a film.
+//! the whole image's. [`table_bytes`] bounds it for memory estimates.
 
 use std::borrow::Borrow;
 
@@ -40,15 +39,24 @@ pub fn shares_pair_shifts(scheme: MisScheme) -> bool {
     )
 }
 
-/// Bytes per pixel of the shift table the reciprocal rounds of `settings` keep at most (0 when
-/// they do not run), for an estimator's `buffer_bytes_per_pixel`: the whole film's, which the
-/// window of rows reaches when the threads are many or the film is short.
-pub fn table_bytes_per_pixel<S>(settings: &ReuseSettings) -> usize {
-    if settings.runs_reciprocal() {
-        (settings.neighbors as usize).div_ceil(2) * std::mem::size_of::<Option<PairShifts<S>>>()
-    } else {
-        0
+/// Bytes of the shift table the reciprocal rounds of `settings` keep at most (0 when they do not
+/// run) for a film of `width × height` pixels on `threads` threads, for an estimator's
+/// `buffer_bytes`: the pairs of the window of rows a round holds, which spans the whole film
+/// only when the film is short or the threads are many.
+pub fn table_bytes<S>(
+    settings: &ReuseSettings,
+    width: usize,
+    height: usize,
+    threads: usize,
+) -> u64 {
+    if !settings.runs_reciprocal() {
+        return 0;
     }
+    // A round's offsets lie in the disk of the radius, so no pair reaches further in rows.
+    let reach = settings.radius.max(0.0).ceil() as usize;
+    let rows = Window::with_threads(height, reach, threads).rows();
+    let entries = (settings.neighbors as usize).div_ceil(2);
+    (rows * width * entries * std::mem::size_of::<Option<PairShifts<S>>>()) as u64
 }
 
 /// The two shifts of a pair `(a, b = a + o_j)`: `a`'s sample into `b` and `b`'s into `a`.
@@ -126,8 +134,13 @@ struct Window {
 }
 
 impl Window {
+    /// The window of a round on the current pool's threads.
     fn new(height: usize, reach: usize) -> Self {
-        let chunk = (8 * BAND_ROWS * rayon::current_num_threads()).max(64);
+        Self::with_threads(height, reach, rayon::current_num_threads())
+    }
+
+    fn with_threads(height: usize, reach: usize, threads: usize) -> Self {
+        let chunk = (8 * BAND_ROWS * threads).max(64);
         Self {
             height,
             chunk,
@@ -376,5 +389,30 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The memory estimate counts the rows a round's table holds, not the film's: a 4K film's
+    /// table is the window's few rows (and a short film's all of them).
+    #[test]
+    fn table_bytes_count_the_window_of_rows() {
+        let mut settings = ReuseSettings::direct();
+        settings.neighbors = 12;
+        settings.radius = 2.5;
+        assert!(settings.runs_reciprocal());
+        let entry = std::mem::size_of::<Option<PairShifts<[f32; 4]>>>() as u64;
+        let bytes = |s: &ReuseSettings, w, h, threads| table_bytes::<[f32; 4]>(s, w, h, threads);
+        let s = &settings;
+        // 64 rows per chunk on up to 4 threads, and 3 rows (the radius) above and below.
+        assert_eq!(bytes(s, 3840, 2160, 2), 70 * 3840 * 6 * entry);
+        assert_eq!(bytes(s, 3840, 2160, 4), 70 * 3840 * 6 * entry);
+        // 16 rows per thread beyond.
+        assert_eq!(bytes(s, 3840, 2160, 8), 134 * 3840 * 6 * entry);
+        assert_eq!(bytes(s, 640, 50, 2), 50 * 640 * 6 * entry);
+        assert_eq!(bytes(s, 640, 2160, 1000), 2160 * 640 * 6 * entry);
+        let off = ReuseSettings {
+            reciprocal: false,
+            ..settings
+        };
+        assert_eq!(bytes(&off, 3840, 2160, 2), 0);
     }
 }

@@ -60,11 +60,13 @@ pub(crate) fn run(args: RenderArgs) -> Result<Rendered, String> {
     } = load(&args)?;
     let scene = &loaded.scene;
     let (integrator, options) = make(&args, &loaded)?;
+    let pool = strict::thread_pool(args.threads)?;
+    let threads = pool.current_num_threads();
     let Settled {
         output,
         plan,
         time_limit,
-    } = settle(&args, &mut job, scene, integrator.as_ref())?;
+    } = settle(&args, &mut job, scene, integrator.as_ref(), threads)?;
     let spp = job.spp;
     let output = prepare_outputs(&args, output, frame_plan.as_ref())?;
     keep_moment_where_written(
@@ -75,9 +77,6 @@ pub(crate) fn run(args: RenderArgs) -> Result<Rendered, String> {
         plan.is_some(),
         frame_plan.is_some(),
     );
-
-    let pool = strict::thread_pool(args.threads)?;
-    let threads = pool.current_num_threads();
 
     // Ctrl-C finishes the current pass and still writes the image; a second one aborts.
     let cancel = interrupt::install(output.clone(), args.quiet);
@@ -230,12 +229,13 @@ fn make(
 }
 
 /// Settles the job's passes and time limit, the output file and the part of a split render,
-/// and checks the output's format and the estimator's memory.
+/// and checks the output's format and the estimator's memory on `threads` threads.
 fn settle(
     args: &RenderArgs,
     job: &mut RenderJob,
     scene: &Scene,
     integrator: &dyn Integrator,
+    threads: usize,
 ) -> Result<Settled, String> {
     let spp = args.spp.unwrap_or(job.spp);
     if spp == 0 {
@@ -302,8 +302,8 @@ fn settle(
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
     strict::check_memory(
-        width,
-        height,
+        (width, height),
+        threads,
         integrator,
         &Reconstruction::decide(scene.filter),
         moment,

@@ -19,7 +19,10 @@ struct Stats<'a> {
     integrator_settings: String,
     /// What was asked for, what ran and why.
     estimator: EstimatorStats,
-    buffer_bytes_per_pixel: usize,
+    /// The estimator's per-pass buffers for this film on these threads, at most: in all and
+    /// per pixel (rounded up).
+    buffer_bytes: u64,
+    buffer_bytes_per_pixel: u64,
     /// Triangles and analytic spheres in the scene.
     triangles: usize,
     spheres: usize,
@@ -105,12 +108,15 @@ impl Report<'_> {
     /// Writes the `--stats` JSON to `path`.
     pub(crate) fn write_stats(&self, path: &Path) -> Result<(), String> {
         let (scene, integrator, out) = (self.scene, self.integrator, self.out);
+        let (width, height) = (out.image.width, out.image.height);
+        let buffer_bytes = integrator.buffer_bytes(width, height, self.threads);
         let stats = Stats {
             scene: self.scene_file.display().to_string(),
             integrator: integrator.name(),
             integrator_settings: integrator.describe(),
             estimator: (&out.estimator).into(),
-            buffer_bytes_per_pixel: integrator.buffer_bytes_per_pixel(),
+            buffer_bytes,
+            buffer_bytes_per_pixel: buffer_bytes.div_ceil((width as u64 * height as u64).max(1)),
             triangles: scene
                 .shapes
                 .iter()
@@ -128,8 +134,8 @@ impl Report<'_> {
             seconds: out.seconds,
             load_seconds: self.load_seconds,
             spp: out.passes,
-            width: out.image.width,
-            height: out.image.height,
+            width,
+            height,
             rays: out.rays,
             mrays_per_second: self.mrays_per_second(),
             nonfinite_pixels: out.nonfinite_pixels,

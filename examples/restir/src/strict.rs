@@ -81,22 +81,24 @@ pub const MOMENT_BYTES_PER_PIXEL: u64 = 24 + 24;
 pub const DEFAULT_MAX_MEMORY_GIB: f64 = 8.0;
 
 /// Refuses, before anything is allocated, a film whose estimated memory (film, pass and output
-/// images, the splatting film's buffers, the estimator's per-pixel buffers) exceeds `max_gib`
-/// GiB.
+/// images, the splatting film's buffers, the estimator's buffers on `threads` threads) exceeds
+/// `max_gib` GiB.
 pub fn check_memory(
-    width: u32,
-    height: u32,
+    (width, height): (u32, u32),
+    threads: usize,
     integrator: &dyn Integrator,
     reconstruction: &Reconstruction,
     moment: bool,
     max_gib: f64,
 ) -> Result<(), String> {
     let pixels = width as u64 * height as u64;
-    let per_pixel = FILM_BYTES_PER_PIXEL
+    let film = FILM_BYTES_PER_PIXEL
         + reconstruction.buffer_bytes_per_pixel() as u64
-        + integrator.buffer_bytes_per_pixel() as u64
         + if moment { MOMENT_BYTES_PER_PIXEL } else { 0 };
-    let need = pixels.saturating_mul(per_pixel);
+    let need = pixels
+        .saturating_mul(film)
+        .saturating_add(integrator.buffer_bytes(width, height, threads));
+    let per_pixel = need.div_ceil(pixels.max(1));
     let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
     if gib(need) > max_gib {
         return Err(format!(

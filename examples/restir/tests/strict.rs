@@ -222,6 +222,50 @@ fn huge_films_are_refused_before_allocating() {
     );
 }
 
+/// ReSTIR's table of shifts holds a window of rows, so a 4K film's estimate counts the window,
+/// not the film: ReSTIR DI at 3840×2160 with twelve neighbours is estimated at well under 8 GiB
+/// (with the whole film's table, 1121 bytes per pixel, 8.7 GiB, it was refused at the default
+/// limit), and on more threads the window and the estimate grow.
+#[test]
+fn restir_tables_count_their_window_of_rows() {
+    let dir = temp_dir("memory-window");
+    let out = dir.0.join("o.exr");
+    let c = cornell();
+    let per_pixel = |threads: &str| -> u64 {
+        let o = restir(&[
+            "render",
+            s(&c),
+            "-o",
+            s(&out),
+            "--integrator",
+            "restir-di",
+            "--width",
+            "3840",
+            "--height",
+            "2160",
+            "--threads",
+            threads,
+            "--max-memory",
+            "0.01",
+        ]);
+        assert!(!o.status.success());
+        let err = String::from_utf8_lossy(&o.stderr);
+        let n = err
+            .split(" GiB (")
+            .nth(1)
+            .and_then(|t| t.split(' ').next())
+            .and_then(|n| n.parse().ok());
+        n.unwrap_or_else(|| panic!("no bytes per pixel in: {err}"))
+    };
+    let (two, many) = (per_pixel("2"), per_pixel("64"));
+    assert!(two < 800, "{two} bytes per pixel at 3840×2160 on 2 threads");
+    assert!(
+        (two as f64 * 3840.0 * 2160.0) / ((1u64 << 30) as f64) < 6.0,
+        "{two} bytes per pixel"
+    );
+    assert!(many > two, "64 threads: {many}, 2 threads: {two}");
+}
+
 /// A splatting film's two buffers (a pass's estimates and their rows gathered, 48 bytes per
 /// pixel) count against `--max-memory`: the Cornell box with Mitsuba's default Gaussian filter
 /// needs 96 bytes per pixel where the box filter needs 48.

@@ -195,6 +195,36 @@ impl RestirDiIntegrator {
     /// Bytes per pixel of one reservoir buffer.
     pub const RESERVOIR_BYTES: usize = std::mem::size_of::<DiReservoir>();
 
+    /// Bytes per pixel of the per-pass buffers that follow the film (all but the reciprocal
+    /// rounds' table of shifts, which holds a window of rows).
+    fn bytes_per_pixel(&self) -> usize {
+        let reservoirs = if self.settings.reuse.temporal { 3 } else { 2 };
+        let hits = if self.settings.reuse.temporal { 2 } else { 1 };
+        let hit_bytes = GBuffer::BYTES_PER_PIXEL;
+        reservoirs * Self::RESERVOIR_BYTES
+            + hits * hit_bytes
+            + std::mem::size_of::<Vec3>()
+            + std::mem::size_of::<Option<(LightPoint, Resolved)>>()
+            + std::mem::size_of::<Option<Bsdf>>()
+            + if self.settings.reuse.shade_expected {
+                std::mem::size_of::<Option<[f32; 3]>>()
+            } else {
+                0
+            }
+            + if self.settings.learn.is_on() && !self.settings.light_sampler.is_tiles() {
+                learn::CellPools::bytes_per_pixel(self.settings.candidates)
+            } else {
+                0
+            }
+            + if self.settings.light_sampler.is_tiles() {
+                tiles::LightTiles::bytes_per_pixel(self.settings.candidates)
+                    + tiles::TileCuts::bytes_per_pixel()
+            } else {
+                0
+            }
+            + self.seen.as_ref().map_or(0, |_| std::mem::size_of::<u16>())
+    }
+
     /// Shading at receiver `r` with its final reservoir: the reservoir's sample with a shadow
     /// ray, the BSDF samples, and the continuation (paths of `settings`, their light selection
     /// decided for the scene once per pass). Returns radiance, rays, and the reservoir's sample with what
@@ -395,33 +425,10 @@ impl Integrator for RestirDiIntegrator {
         self.settings.reuse.halo()
     }
 
-    fn buffer_bytes_per_pixel(&self) -> usize {
-        let reservoirs = if self.settings.reuse.temporal { 3 } else { 2 };
-        let hits = if self.settings.reuse.temporal { 2 } else { 1 };
-        let hit_bytes = GBuffer::BYTES_PER_PIXEL;
-        reservoirs * Self::RESERVOIR_BYTES
-            + hits * hit_bytes
-            + std::mem::size_of::<Vec3>()
-            + reciprocal::table_bytes_per_pixel::<DiSample>(&self.settings.reuse)
-            + std::mem::size_of::<Option<(LightPoint, Resolved)>>()
-            + std::mem::size_of::<Option<Bsdf>>()
-            + if self.settings.reuse.shade_expected {
-                std::mem::size_of::<Option<[f32; 3]>>()
-            } else {
-                0
-            }
-            + if self.settings.learn.is_on() && !self.settings.light_sampler.is_tiles() {
-                learn::CellPools::bytes_per_pixel(self.settings.candidates)
-            } else {
-                0
-            }
-            + if self.settings.light_sampler.is_tiles() {
-                tiles::LightTiles::bytes_per_pixel(self.settings.candidates)
-                    + tiles::TileCuts::bytes_per_pixel()
-            } else {
-                0
-            }
-            + self.seen.as_ref().map_or(0, |_| std::mem::size_of::<u16>())
+    fn buffer_bytes(&self, width: u32, height: u32, threads: usize) -> u64 {
+        let (w, h) = (width as usize, height as usize);
+        (w * h) as u64 * self.bytes_per_pixel() as u64
+            + reciprocal::table_bytes::<DiSample>(&self.settings.reuse, w, h, threads)
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {

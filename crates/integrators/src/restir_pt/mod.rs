@@ -136,6 +136,28 @@ impl RestirPtIntegrator {
     /// Bytes per pixel of one reservoir buffer.
     pub const RESERVOIR_BYTES: usize = std::mem::size_of::<PtReservoir>();
 
+    /// Bytes per pixel of the per-pass buffers that follow the film (all but the reciprocal
+    /// rounds' table of shifts, which holds a window of rows, and the direct light's buffers).
+    fn bytes_per_pixel(&self) -> usize {
+        let hit_bytes = GBuffer::BYTES_PER_PIXEL;
+        let (reservoirs, hits) = if self.settings.reuse.temporal {
+            (3, 2)
+        } else {
+            (2, 1)
+        };
+        reservoirs * Self::RESERVOIR_BYTES
+            + hits * hit_bytes
+            + std::mem::size_of::<Vec3>()
+            // Each pixel's expected shading over the last round's selection.
+            + if self.settings.reuse.shade_expected {
+                std::mem::size_of::<Option<[f32; 3]>>()
+            } else {
+                0
+            }
+            // The silhouette mask, a ray count per pixel.
+            + self.seen.as_ref().map_or(0, |_| std::mem::size_of::<u16>())
+    }
+
     fn max_depth(&self) -> u32 {
         self.settings.path.max_segments()
     }
@@ -460,26 +482,14 @@ impl Integrator for RestirPtIntegrator {
         }
     }
 
-    fn buffer_bytes_per_pixel(&self) -> usize {
-        let hit_bytes = GBuffer::BYTES_PER_PIXEL;
-        let (reservoirs, hits) = if self.settings.reuse.temporal {
-            (3, 2)
-        } else {
-            (2, 1)
-        };
-        reservoirs * Self::RESERVOIR_BYTES
-            + hits * hit_bytes
-            + std::mem::size_of::<Vec3>()
-            + reciprocal::table_bytes_per_pixel::<PathSample>(&self.settings.reuse)
-            // Each pixel's expected shading over the last round's selection.
-            + if self.settings.reuse.shade_expected {
-                std::mem::size_of::<Option<[f32; 3]>>()
-            } else {
-                0
-            }
-            + self.di.as_ref().map_or(0, |d| d.buffer_bytes_per_pixel())
-            // The silhouette mask, a ray count per pixel.
-            + self.seen.as_ref().map_or(0, |_| std::mem::size_of::<u16>())
+    fn buffer_bytes(&self, width: u32, height: u32, threads: usize) -> u64 {
+        let (w, h) = (width as usize, height as usize);
+        (w * h) as u64 * self.bytes_per_pixel() as u64
+            + reciprocal::table_bytes::<PathSample>(&self.settings.reuse, w, h, threads)
+            + self
+                .di
+                .as_ref()
+                .map_or(0, |d| d.buffer_bytes(width, height, threads))
     }
 
     fn render_pass(&self, scene: &Scene, ctx: &PassContext, accum: &mut [DVec3]) -> u64 {
