@@ -365,6 +365,7 @@ mod lights {
                 to_world: Vec::new(),
                 material: None,
                 emission: Some([l, l, l]),
+                emission_texture: None,
                 flip_normals: false,
                 face_normals: false,
                 location: Default::default(),

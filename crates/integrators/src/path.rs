@@ -311,7 +311,7 @@ pub fn trace_path<S: Sampler>(
         if let Some(light) = lights.light_on_shape(si.shape)
             && !(depth == 0 && settings.hide_emitters)
         {
-            let le = lights.area_radiance(light, si.shading.n, -ray.d);
+            let le = lights.area_radiance(light, &si, -ray.d);
             if le != Vec3::ZERO {
                 let w = match prev {
                     Some(pv) if !pv.delta => {

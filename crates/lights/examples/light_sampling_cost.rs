@@ -75,6 +75,7 @@ fn main() {
     let lights = vec![Light::Area {
         shape: 0,
         radiance: Vec3::ONE,
+        texture: None,
     }];
     let set = LightSet::new(lights, shapes.clone(), (lo, hi)).expect("a light set");
     if mode == "hierarchy" {

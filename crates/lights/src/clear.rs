@@ -408,8 +408,16 @@ mod tests {
         }
         let radiance = Vec3::ONE;
         let lights = vec![
-            Light::Area { shape: 0, radiance },
-            Light::Area { shape: 1, radiance },
+            Light::Area {
+                shape: 0,
+                radiance,
+                texture: None,
+            },
+            Light::Area {
+                shape: 1,
+                radiance,
+                texture: None,
+            },
         ];
         let boxes = clear_boxes(&lights, &shapes);
         assert!(boxes[0].is_some() && boxes[1].is_none(), "{boxes:?}");
@@ -544,6 +552,7 @@ mod tests {
         let lights = vec![Light::Area {
             shape: 0,
             radiance: Vec3::ONE,
+            texture: None,
         }];
         let clear = clear_boxes(&lights, &shapes);
         let c = clear[0].as_ref().expect("two clear parts");

@@ -3,7 +3,7 @@
 //!
 //! | file | what it holds |
 //! |---|---|
-//! | `light.rs` | [`Light`] (diffuse area lights on shapes, one-sided as in Mitsuba; point, spot ([`Spot`]), projector ([`Projector`]), directional, constant and image environment lights, [`EnvMap`] being Mitsuba's `envmap`), [`LightSample`] (a point on one light drawn for a receiver, [`LightSet::sample_light`]) and the densities of points reached another way ([`LightSet::pdf_sa`]) |
+//! | `light.rs` | [`Light`] (diffuse area lights on shapes, one-sided as in Mitsuba, their radiance uniform or a [`LightTexture`] over the shape's uv; point, spot ([`Spot`]), projector ([`Projector`]), directional, constant and image environment lights, [`EnvMap`] being Mitsuba's `envmap`), [`LightSample`] (a point on one light drawn for a receiver, [`LightSet::sample_light`]) and the densities of points reached another way ([`LightSet::pdf_sa`]) |
 //! | `set.rs` | [`LightSet`]: every light of a scene with the shapes area lights lie on (emitters know their shapes, as in Mitsuba 3's scene, so no caller hands the shape list around), each light's power, the environment's share of selections |
 //! | `select.rs` | which light: the power sampler ([`LightSet::sample`], [`LightSet::select`], [`LightSet::pmf`]) over one flat emitter table (`table.rs`: every emissive triangle, every other light), and the light hierarchy over the same entries (`bvh.rs`: [`LightSet::sample_hierarchy`], [`LightSet::hierarchy_pmf`]) |
 //! | `nee.rs` | next-event estimation's light selection ([`NeeSelection`]: by power or by the hierarchy; [`LightSet::sample_nee`], [`LightSet::pdf_nee`]), for the path tracer and ReSTIR PT's walks |
@@ -12,8 +12,8 @@
 //! | `corners.rs` | the distinct corners of some triangles and whether they all lie behind a plane: the convexity tests of `own.rs` and `clear.rs` |
 //! | `point.rs` | a light sample named without its receiver ([`LightPoint`], what a reservoir holds), resolved in world space ([`LightSet::resolve`], [`Resolved`]) and seen from a receiver ([`Contact`]) |
 //! | `learned.rs` | a selection learned across passes: per cell of a world-space grid, what each emitter (a triangle, another light, the environment) delivered after its shadow ray ([`LightRecords`]), sampled in a mixture with the power sampler with its exact probability ([`LearnedSampler`]) |
-//! | `spot.rs` | [`Spot`], Mitsuba's `spot` emitter (a point light with an angular falloff and an optional projected [`SpotTexture`]) |
-//! | `projector.rs` | [`Projector`], Mitsuba's `projector` emitter (a pinhole throwing an irradiance image, a [`SpotTexture`] or a constant, through a perspective frustum) |
+//! | `spot.rs` | [`Spot`], Mitsuba's `spot` emitter (a point light with an angular falloff and an optional projected [`LightTexture`]) |
+//! | `projector.rs` | [`Projector`], Mitsuba's `projector` emitter (a pinhole throwing an irradiance image, a [`LightTexture`] or a constant, through a perspective frustum) |
 //! | `presample.rs` | samples drawn without a receiver ([`LightSet::presample`], [`Presampled`]), for pools of presampled candidates |
 //! | `sampler.rs` | one interface over all of these for a receiver's candidates ([`LightSampler`]: power, hierarchy, presampled pool, a cut of the hierarchy for a screen tile, the learned cell), each candidate with the density that drew it and the power sampler's ([`LightCandidate`]) |
 //!
@@ -71,7 +71,7 @@ pub use contact::Contact;
 pub use cut::{Claim, LightCut};
 pub use envmap::{EnvMap, EnvMapError};
 pub use learned::{CellKey, EmitterGroups, LearnGrid, LearnedDraw, LearnedSampler, LightRecords};
-pub use light::{Light, LightSample};
+pub use light::{Light, LightSample, LightTexture};
 pub use nee::NeeSelection;
 pub use own::{OWN_LIGHT_SHARE, OwnLight};
 pub use point::{LightPoint, Resolved};
@@ -82,7 +82,7 @@ pub use sampler::{
     PoolSampler, PowerSampler,
 };
 pub use set::{LightError, LightSet};
-pub use spot::{Spot, SpotError, SpotTexture};
+pub use spot::{Spot, SpotError};
 
 /// The largest emission any light may have, in each channel of its radiance, intensity or
 /// irradiance and in its power: 10²⁶. The estimators multiply emission by BSDF values,
@@ -114,10 +114,12 @@ mod tests {
             Light::Area {
                 shape: 0,
                 radiance: Vec3::splat(1.0),
+                texture: None,
             },
             Light::Area {
                 shape: 1,
                 radiance: Vec3::new(5.0, 1.0, 1.0),
+                texture: None,
             },
             Light::Point {
                 position: Vec3::new(0.0, 1.0, 1.0),
@@ -142,10 +144,12 @@ mod tests {
             Light::Area {
                 shape: 0,
                 radiance: Vec3::ZERO,
+                texture: None,
             },
             Light::Area {
                 shape: 1,
                 radiance: Vec3::new(5.0, 1.0, 1.0),
+                texture: None,
             },
         ];
         let set = LightSet::new(
@@ -227,6 +231,7 @@ mod tests {
             Light::Area {
                 shape: 0,
                 radiance: Vec3::splat(1.0),
+                texture: None,
             },
             Light::Constant {
                 radiance: Vec3::splat(0.2),
@@ -234,6 +239,7 @@ mod tests {
             Light::Area {
                 shape: 1,
                 radiance: Vec3::new(5.0, 1.0, 1.0),
+                texture: None,
             },
         ];
         let mut set = LightSet::new(
@@ -312,5 +318,70 @@ mod tests {
             (mean - exact).abs() < 4.0 * se,
             "{mean} vs {exact} (se {se})"
         );
+    }
+
+    /// A texture whose value is its lookup point: `(u, v, 1)`.
+    #[derive(Debug)]
+    struct UvTexture;
+
+    impl LightTexture for UvTexture {
+        fn eval(&self, uv: glam::Vec2) -> Vec3 {
+            uv.extend(1.0)
+        }
+
+        fn mean(&self) -> Vec3 {
+            Vec3::new(0.5, 0.5, 1.0)
+        }
+    }
+
+    /// A textured area light emits its texture at the point's uv wherever the point is met: a
+    /// light sample, the same point resolved again, and a BSDF ray's hit; a set without the
+    /// texture it names is an error.
+    #[test]
+    fn textured_area_light_reads_its_texture_where_it_is_met() {
+        let (shapes, _) = setup();
+        let lights = vec![Light::Area {
+            shape: 0,
+            radiance: Vec3::new(0.5, 0.5, 1.0),
+            texture: Some(0),
+        }];
+        let bounds = (Vec3::splat(-3.0), Vec3::splat(3.0));
+        assert_eq!(
+            LightSet::new(lights.clone(), shapes.clone(), bounds).err(),
+            Some(LightError::MissingLightTexture(0, 0))
+        );
+        let textures: Vec<std::sync::Arc<dyn LightTexture>> = vec![std::sync::Arc::new(UvTexture)];
+        let set = LightSet::with_textures(lights, None, textures, shapes.clone(), bounds).unwrap();
+        let accel = restir_geometry::Accel::build(&shapes);
+        let mut rng = Pcg32::new(9, 0);
+        let receiver = Vec3::new(0.1, -0.2, 0.0);
+        let mut distinct = Vec::new();
+        for _ in 0..64 {
+            let s = set
+                .sample(receiver, rng.next_f32(), rng.next_2d())
+                .expect("the quad faces the receiver");
+            let uv = restir_geometry::surface_at(&shapes, 0, s.prim, s.param).uv;
+            assert!((s.le - uv.extend(1.0)).length() < 1e-5, "{} at {uv}", s.le);
+            distinct.push(s.le.x);
+            let point = LightPoint {
+                light: s.light,
+                prim: s.prim,
+                param: s.param,
+            };
+            match set.resolve(&point) {
+                Resolved::Surface { le, .. } => assert_eq!(le, s.le),
+                other => panic!("{other:?}"),
+            }
+            let ray = restir_geometry::Ray::new(receiver, s.wi);
+            let hit = accel
+                .intersect(&ray, f32::INFINITY)
+                .expect("the sample is on the quad");
+            let si = accel.surface_interaction(&shapes, &hit, &ray);
+            let le = set.area_radiance(0, &si, -s.wi);
+            assert!((le - s.le).length() < 1e-3, "{le} vs {}", s.le);
+        }
+        // The texture varies over the light (not its mean everywhere).
+        distinct.sort_by(f32::total_cmp);
+        assert!(distinct[63] - distinct[0] > 0.5, "{distinct:?}");
     }
 }

@@ -4,22 +4,39 @@
 //! radiance and coordinates.
 
 use glam::{Vec2, Vec3};
-use restir_geometry::{PositionSample, Shape, area_to_solid_angle};
+use restir_geometry::{PositionSample, Shape, SurfaceInteraction, area_to_solid_angle, surface_at};
 use restir_sampling::warp;
 
 use crate::contact::{Contact, nonzero, point_contact};
 use crate::table::Emitter;
 use crate::{EnvMap, LightSet, Projector, Spot};
 
+/// A texture a light emits or projects: an area light's radiance over its surface's uv
+/// ([`Light::Area`]), a spot light's or projector's image ([`crate::Spot`],
+/// [`crate::Projector`]); the renderer's textures (the scene crate's bitmaps and checkerboards)
+/// evaluated at `uv`, linear RGB.
+pub trait LightTexture: Send + Sync + core::fmt::Debug {
+    /// The texture's value at `uv`.
+    fn eval(&self, uv: Vec2) -> Vec3;
+
+    /// The texture's mean over the unit square (a projector's or a textured area light's power,
+    /// for its selection weight).
+    fn mean(&self) -> Vec3;
+}
+
 /// An emitter.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Light {
-    /// Uniform radiance leaving the front side of a shape.
+    /// Radiance leaving the front side of a shape: uniform, or a texture over the shape's uv.
     Area {
         /// Index of the shape in the scene's shape list.
         shape: u32,
-        /// Emitted radiance (linear RGB).
+        /// Emitted radiance (linear RGB); with a texture, the texture's mean (what the
+        /// selection weights and bounds count).
         radiance: Vec3,
+        /// The radiance as a texture over the shape's uv (index into the set's textures, as
+        /// [`crate::Spot::texture`]); `None`: uniform `radiance`.
+        texture: Option<u32>,
     },
     /// An isotropic point light of intensity `intensity` (W/sr).
     Point {
@@ -82,13 +99,38 @@ pub struct LightSample {
 }
 
 impl LightSet {
-    /// Radiance leaving an area light's surface point with shading normal `n` towards unit `w`
-    /// (pointing away from the light). One-sided: zero behind the surface.
+    /// Radiance leaving area light `light` at surface point `si` (a hit on its shape) towards
+    /// unit `w` (pointing away from the light). One-sided: zero behind the shading normal.
     #[inline]
-    pub fn area_radiance(&self, light: u32, n: Vec3, w: Vec3) -> Vec3 {
+    pub fn area_radiance(&self, light: u32, si: &SurfaceInteraction, w: Vec3) -> Vec3 {
         match self.lights[light as usize] {
-            Light::Area { radiance, .. } if n.dot(w) > 0.0 => radiance,
+            Light::Area {
+                radiance, texture, ..
+            } if si.shading.n.dot(w) > 0.0 => match texture {
+                None => radiance,
+                Some(t) => self.light_textures[t as usize].eval(si.uv),
+            },
             _ => Vec3::ZERO,
+        }
+    }
+
+    /// The radiance area light `light` (shape `shape`, radiance `radiance` and `texture` as
+    /// [`Light::Area`] holds them) emits at the point `(prim, param)` of its shape.
+    #[inline]
+    pub(crate) fn area_le(
+        &self,
+        shape: u32,
+        radiance: Vec3,
+        texture: Option<u32>,
+        prim: u32,
+        param: Vec2,
+    ) -> Vec3 {
+        match texture {
+            None => radiance,
+            Some(t) => {
+                let uv = surface_at(&self.shapes, shape, prim, param).uv;
+                self.light_textures[t as usize].eval(uv)
+            }
         }
     }
 
@@ -160,9 +202,14 @@ impl LightSet {
     #[inline]
     pub fn sample_light(&self, light: u32, ref_p: Vec3, u: Vec2) -> Option<LightSample> {
         match self.lights[light as usize] {
-            Light::Area { shape, radiance } => {
+            Light::Area {
+                shape,
+                radiance,
+                texture,
+            } => {
                 let (ps, pdf_sa) = self.shapes[shape as usize].sample_from(ref_p, u)?;
-                area_light_sample(light, radiance, ref_p, ps, pdf_sa)
+                let le = self.area_le(shape, radiance, texture, ps.prim, ps.param);
+                area_light_sample(light, le, ref_p, ps, pdf_sa)
             }
             Light::Point {
                 position,
@@ -275,7 +322,7 @@ impl LightSet {
         spot.intensity_towards(
             w,
             spot.texture
-                .and_then(|t| self.spot_textures.get(t as usize)),
+                .and_then(|t| self.light_textures.get(t as usize)),
         )
     }
 
@@ -287,7 +334,7 @@ impl LightSet {
             w,
             projector
                 .texture
-                .and_then(|t| self.spot_textures.get(t as usize)),
+                .and_then(|t| self.light_textures.get(t as usize)),
         )
     }
 }

@@ -109,7 +109,11 @@ impl LightSet {
     #[inline]
     pub fn resolve(&self, sample: &LightPoint) -> Resolved {
         match self.lights()[sample.light as usize] {
-            Light::Area { shape, radiance } => {
+            Light::Area {
+                shape,
+                radiance,
+                texture,
+            } => {
                 let ps = self.area_point(
                     &self.shapes[shape as usize],
                     sample.light,
@@ -120,7 +124,7 @@ impl LightSet {
                     p: ps.p,
                     n: ps.n,
                     ng: ps.ng,
-                    le: radiance,
+                    le: self.area_le(shape, radiance, texture, sample.prim, sample.param),
                     pdf_area: self.mesh_area_density(sample.light),
                 }
             }
@@ -186,7 +190,7 @@ impl LightSet {
                 )
             }),
             Some(si) => self.light_on_shape(si.shape).and_then(|light| {
-                let le = self.area_radiance(light, si.shading.n, -d);
+                let le = self.area_radiance(light, si, -d);
                 (le != Vec3::ZERO).then(|| {
                     let pdf = self.pdf_nee(how, (light, si.prim), p, n, si.p, si.ng);
                     let y = LightPoint {

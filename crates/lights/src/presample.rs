@@ -83,11 +83,17 @@ impl LightSet {
                 ng,
                 shading,
             }) => {
-                let Light::Area { shape, radiance } = self.lights[light as usize] else {
+                let Light::Area {
+                    shape: s,
+                    radiance,
+                    texture,
+                } = self.lights[light as usize]
+                else {
                     return None;
                 };
-                let shape = &self.shapes[shape as usize];
+                let shape = &self.shapes[s as usize];
                 let ps = self.table.triangle_point(p, ng, shading, shape, prim, u);
+                let radiance = self.area_le(s, radiance, texture, prim, ps.param);
                 let pdf_area = self.area_pdf[light as usize];
                 return Some(Presampled::Fixed {
                     point: LightPoint {
@@ -110,7 +116,11 @@ impl LightSet {
         };
         let pmf = self.table.pmf(light);
         match self.lights[light as usize] {
-            Light::Area { shape, radiance } => match &self.shapes[shape as usize] {
+            Light::Area {
+                shape,
+                radiance,
+                texture: None,
+            } => match &self.shapes[shape as usize] {
                 Shape::Sphere(s) => Some(Presampled::Sphere {
                     light,
                     pmf,
@@ -121,7 +131,11 @@ impl LightSet {
                 }),
                 _ => Some(Presampled::Light { light, pmf }),
             },
-            Light::Spot(_) | Light::Projector(_) => Some(Presampled::Light { light, pmf }),
+            // A textured area light's points are drawn, and their radiance looked up, when
+            // they are resolved.
+            Light::Area { .. } | Light::Spot(_) | Light::Projector(_) => {
+                Some(Presampled::Light { light, pmf })
+            }
             Light::Point {
                 position,
                 intensity,

@@ -23,7 +23,7 @@ use glam::{Mat3, Mat4, Vec2, Vec3};
 use restir_geometry::FovAxis;
 use restir_sampling::luminance;
 
-use crate::SpotTexture;
+use crate::LightTexture;
 
 /// Why a projector's parameters are unusable.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -133,7 +133,7 @@ impl Projector {
     /// The intensity the projector sends in world direction `w` (from the light, any length),
     /// with its texture `texture` (the set's entry for [`Projector::texture`]).
     #[inline]
-    pub fn intensity_towards(&self, w: Vec3, texture: Option<&Arc<dyn SpotTexture>>) -> Vec3 {
+    pub fn intensity_towards(&self, w: Vec3, texture: Option<&Arc<dyn LightTexture>>) -> Vec3 {
         let local = self.to_local * w;
         let Some(uv) = self.uv(local) else {
             return Vec3::ZERO;

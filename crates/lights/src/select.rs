@@ -50,11 +50,17 @@ impl LightSet {
         else {
             return None;
         };
-        let Light::Area { shape, radiance } = self.lights[light as usize] else {
+        let Light::Area {
+            shape: s,
+            radiance,
+            texture,
+        } = self.lights[light as usize]
+        else {
             return None;
         };
-        let shape = &self.shapes[shape as usize];
+        let shape = &self.shapes[s as usize];
         let ps = self.table.triangle_point(p, ng, shading, shape, prim, u);
+        let radiance = self.area_le(s, radiance, texture, prim, ps.param);
         let pdf_sa = area_to_solid_angle(self.area_pdf[light as usize], ref_p, ps.p, ps.ng)?;
         area_light_sample(light, radiance, ref_p, ps, pdf_sa)
     }
@@ -142,11 +148,17 @@ impl LightSet {
                 ng,
                 shading,
             } => {
-                let Light::Area { shape, radiance } = self.lights[light as usize] else {
+                let Light::Area {
+                    shape: s,
+                    radiance,
+                    texture,
+                } = self.lights[light as usize]
+                else {
                     return None;
                 };
-                let shape = &self.shapes[shape as usize];
+                let shape = &self.shapes[s as usize];
                 let ps = self.table.triangle_point(p, ng, shading, shape, prim, u);
+                let radiance = self.area_le(s, radiance, texture, prim, ps.param);
                 let pdf_sa = area_to_solid_angle(pmf / triangle_area(p), ref_p, ps.p, ps.ng)?;
                 let power_pdf =
                     area_to_solid_angle(self.area_pdf[light as usize], ref_p, ps.p, ps.ng)?;

@@ -12,7 +12,7 @@ use restir_sampling::luminance;
 use crate::bvh::LightBvh;
 use crate::light::bounding_sphere;
 use crate::table::EmitterTable;
-use crate::{EnvMap, Light, SpotTexture};
+use crate::{EnvMap, Light, LightTexture};
 
 /// Why a light set could not be built.
 #[derive(Clone, Debug, PartialEq)]
@@ -27,9 +27,9 @@ pub enum LightError {
     TooBright(usize, &'static str, f32),
     /// An `Envmap` light without an [`EnvMap`], or an [`EnvMap`] without an `Envmap` light.
     EnvmapMismatch,
-    /// A spot light or a projector names a texture the set was not given (light, texture
-    /// index).
-    MissingSpotTexture(usize, u32),
+    /// An area light, a spot light or a projector names a texture the set was not given
+    /// (light, texture index).
+    MissingLightTexture(usize, u32),
 }
 
 impl core::fmt::Display for LightError {
@@ -51,11 +51,8 @@ impl core::fmt::Display for LightError {
             LightError::EnvmapMismatch => {
                 write!(f, "an envmap light needs exactly one environment image")
             }
-            LightError::MissingSpotTexture(i, t) => {
-                write!(
-                    f,
-                    "light {i}: projected texture {t} was not given to the light set"
-                )
+            LightError::MissingLightTexture(i, t) => {
+                write!(f, "light {i}: texture {t} was not given to the light set")
             }
         }
     }
@@ -86,9 +83,9 @@ pub struct LightSet {
     pub(crate) environment: Option<u32>,
     /// The image of the `Envmap` light, if there is one.
     pub(crate) envmap: Option<Arc<EnvMap>>,
-    /// The textures spot lights and projectors project ([`crate::Spot::texture`] and
-    /// [`crate::Projector::texture`] index them).
-    pub(crate) spot_textures: Vec<Arc<dyn SpotTexture>>,
+    /// The textures area lights emit and spot lights and projectors project (their `texture`
+    /// indexes them).
+    pub(crate) light_textures: Vec<Arc<dyn LightTexture>>,
     pub(crate) scene_radius: f32,
     /// The light hierarchy over the table's entries, built on first use.
     pub(crate) hierarchy: OnceLock<LightBvh>,
@@ -124,13 +121,13 @@ impl LightSet {
         Self::with_textures(lights, envmap, Vec::new(), shapes, scene_bounds)
     }
 
-    /// Builds the set with the image of its [`Light::Envmap`] and the textures its spot lights
-    /// and projectors project ([`crate::Spot::texture`] and [`crate::Projector::texture`] index
-    /// `spot_textures`; an error if one names a texture beyond them).
+    /// Builds the set with the image of its [`Light::Envmap`] and the textures its area lights
+    /// emit and its spot lights and projectors project (their `texture` indexes
+    /// `light_textures`; an error if one names a texture beyond them).
     pub fn with_textures(
         lights: Vec<Light>,
         envmap: Option<EnvMap>,
-        spot_textures: Vec<Arc<dyn SpotTexture>>,
+        light_textures: Vec<Arc<dyn LightTexture>>,
         shapes: impl Into<Arc<[Shape]>>,
         scene_bounds: (Vec3, Vec3),
     ) -> Result<Self, LightError> {
@@ -162,12 +159,21 @@ impl LightSet {
                 Light::Directional { .. } | Light::Constant { .. } | Light::Envmap => None,
             });
             let power = match *l {
-                Light::Area { shape, radiance } => {
+                Light::Area {
+                    shape,
+                    radiance,
+                    texture,
+                } => {
                     let s = shapes
                         .get(shape as usize)
                         .ok_or(LightError::MissingShape(shape))?;
                     if !valid(radiance) {
                         return Err(LightError::BadParameter(i, "radiance"));
+                    }
+                    if let Some(t) = texture
+                        && t as usize >= light_textures.len()
+                    {
+                        return Err(LightError::MissingLightTexture(i, t));
                     }
                     shape_light[shape as usize] = Some(i as u32);
                     if let Shape::Mesh(m) = s {
@@ -189,9 +195,9 @@ impl LightSet {
                         return Err(LightError::BadParameter(i, "intensity"));
                     }
                     if let Some(t) = s.texture
-                        && t as usize >= spot_textures.len()
+                        && t as usize >= light_textures.len()
                     {
-                        return Err(LightError::MissingSpotTexture(i, t));
+                        return Err(LightError::MissingLightTexture(i, t));
                     }
                     // The untextured power: a texture's mean is not counted (a selection
                     // weight only).
@@ -202,9 +208,9 @@ impl LightSet {
                         return Err(LightError::BadParameter(i, "irradiance"));
                     }
                     let mean = match p.texture {
-                        Some(t) => spot_textures
+                        Some(t) => light_textures
                             .get(t as usize)
-                            .ok_or(LightError::MissingSpotTexture(i, t))?
+                            .ok_or(LightError::MissingLightTexture(i, t))?
                             .mean(),
                         None => Vec3::ONE,
                     };
@@ -279,7 +285,7 @@ impl LightSet {
             shape_light,
             environment,
             envmap: envmap.map(Arc::new),
-            spot_textures,
+            light_textures,
             scene_radius,
             mesh_areas,
             hierarchy: OnceLock::new(),

@@ -18,17 +18,8 @@
 use core::f32::consts::PI;
 use std::sync::Arc;
 
+use crate::LightTexture;
 use glam::{Mat3, Vec2, Vec3};
-
-/// A texture projected by a spot light or a projector ([`crate::Projector`]): the renderer's
-/// textures (the scene crate's bitmaps) evaluated at `uv`, linear RGB.
-pub trait SpotTexture: Send + Sync + core::fmt::Debug {
-    /// The texture's value at `uv`.
-    fn eval(&self, uv: Vec2) -> Vec3;
-
-    /// The texture's mean over the unit square (a projector's power, for its selection weight).
-    fn mean(&self) -> Vec3;
-}
 
 /// Why a spot light's parameters are unusable.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -156,7 +147,7 @@ impl Spot {
     /// The intensity the light sends in world direction `w` (from the light, any length), with
     /// its texture `texture` (the set's entry for [`Spot::texture`]).
     #[inline]
-    pub fn intensity_towards(&self, w: Vec3, texture: Option<&Arc<dyn SpotTexture>>) -> Vec3 {
+    pub fn intensity_towards(&self, w: Vec3, texture: Option<&Arc<dyn LightTexture>>) -> Vec3 {
         let local = self.to_local * w;
         let falloff = self.falloff(local);
         if falloff <= 0.0 {

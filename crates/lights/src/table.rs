@@ -177,7 +177,9 @@ impl EmitterTable {
                 continue;
             }
             let mesh = match *l {
-                crate::Light::Area { shape, radiance } => match shapes.get(shape as usize) {
+                crate::Light::Area {
+                    shape, radiance, ..
+                } => match shapes.get(shape as usize) {
                     Some(Shape::Mesh(m)) => Some((m, radiance)),
                     _ => None,
                 },
@@ -331,7 +333,9 @@ impl EmitterTable {
             .iter()
             .map(|e| match *e {
                 Emitter::Triangle { light, prim, .. } => match lights[light as usize] {
-                    crate::Light::Area { shape, radiance } => match &shapes[shape as usize] {
+                    crate::Light::Area {
+                        shape, radiance, ..
+                    } => match &shapes[shape as usize] {
                         Shape::Mesh(m) => triangle_weight(radiance, m, prim as usize),
                         _ => 0.0,
                     },
@@ -476,6 +480,7 @@ mod tests {
         let lights = [Light::Area {
             shape: 0,
             radiance: Vec3::ONE,
+            texture: None,
         }];
         EmitterTable::new(&lights, std::slice::from_ref(shape), &[1.0], None)
     }
@@ -557,6 +562,7 @@ mod tests {
         let lights = [Light::Area {
             shape: 0,
             radiance: Vec3::new(1.0, 2.0, 0.5),
+            texture: None,
         }];
         let t = EmitterTable::new(&lights, std::slice::from_ref(&shape), &[1.0], None);
         let w = t.weights(&lights, std::slice::from_ref(&shape), &[1.0]);

@@ -103,6 +103,7 @@ fn scene() -> (Vec<Shape>, LightSet) {
         Light::Area {
             shape: 0,
             radiance: Vec3::splat(1.0),
+            texture: None,
         },
         Light::Point {
             position: Vec3::new(0.3, 0.2, -1.7),
@@ -111,22 +112,27 @@ fn scene() -> (Vec<Shape>, LightSet) {
         Light::Area {
             shape: 1,
             radiance: Vec3::new(4.0, 2.0, 1.0),
+            texture: None,
         },
         Light::Area {
             shape: 2,
             radiance: Vec3::splat(0.5),
+            texture: None,
         },
         Light::Area {
             shape: 3,
             radiance: Vec3::splat(3.0),
+            texture: None,
         },
         Light::Area {
             shape: 4,
             radiance: Vec3::new(2.0, 0.5, 0.5),
+            texture: None,
         },
         Light::Area {
             shape: 6,
             radiance: Vec3::new(1.0, 2.0, 3.0),
+            texture: None,
         },
     ];
     let set = LightSet::new(lights, &shapes[..], (Vec3::splat(-3.0), Vec3::splat(3.0))).unwrap();
@@ -315,7 +321,9 @@ fn light_selection_follows_pmf() {
     let n_lights = set.len();
     // pmf ∝ power: π · area · luminance(radiance) for area lights, 4π · luminance(I) for points.
     let power = |l: &Light| match *l {
-        Light::Area { shape, radiance } => PI * shapes[shape as usize].area() * luminance(radiance),
+        Light::Area {
+            shape, radiance, ..
+        } => PI * shapes[shape as usize].area() * luminance(radiance),
         Light::Point { intensity, .. } => 4.0 * PI * luminance(intensity),
         _ => unreachable!(),
     };
@@ -383,6 +391,7 @@ fn sphere_light_inside_and_outside() {
         let light = Light::Area {
             shape: 0,
             radiance: Vec3::splat(2.0),
+            texture: None,
         };
         let set = LightSet::new(
             vec![light],
@@ -529,6 +538,7 @@ fn mesh_light_with_shading_normals() {
     let light = Light::Area {
         shape: 0,
         radiance: Vec3::ONE,
+        texture: None,
     };
     let set = LightSet::new(
         vec![light],

@@ -54,6 +54,7 @@ fn scene() -> (Vec<Shape>, LightSet) {
         lights.push(Light::Area {
             shape: i,
             radiance: Vec3::new(1.0, 0.8, 0.6) * scale,
+            texture: None,
         });
     }
     for (c, r) in [
@@ -64,6 +65,7 @@ fn scene() -> (Vec<Shape>, LightSet) {
         lights.push(Light::Area {
             shape: shapes.len() as u32 - 1,
             radiance: Vec3::splat(20.0),
+            texture: None,
         });
     }
     lights.push(Light::Point {
@@ -271,6 +273,7 @@ fn pmf_sums_to_one_over_omnidirectional_lights() {
             lights.push(Light::Area {
                 shape: shapes.len() as u32 - 1,
                 radiance: Vec3::splat(1.0 + 1000.0 * rng.next_f32()),
+                texture: None,
             });
         }
     }

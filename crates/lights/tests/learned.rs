@@ -35,6 +35,7 @@ fn scene() -> LightSet {
         lights.push(Light::Area {
             shape: i,
             radiance: Vec3::splat(10f32.powf(2.0 * rng.next_f32())),
+            texture: None,
         });
     }
     lights.push(Light::Point {

@@ -16,7 +16,7 @@ use std::sync::Arc;
 
 use glam::{Mat4, Vec2, Vec3};
 use restir_geometry::{FovAxis, Shape};
-use restir_lights::{Light, LightError, LightSet, Projector, SpotTexture};
+use restir_lights::{Light, LightError, LightSet, LightTexture, Projector};
 use restir_sampling::{Pcg32, luminance, warp};
 use restir_testkit::{Grid2D, Histogram, Quadrature, RunningStats, sidak_level, trials};
 
@@ -44,7 +44,7 @@ fn tan_half() -> (f64, f64) {
 /// A grey texture `u·(1 + v)`, mean ¾, brighter to the right (`u`) and at the bottom (`v`).
 #[derive(Debug)]
 struct Ramp;
-impl SpotTexture for Ramp {
+impl LightTexture for Ramp {
     fn eval(&self, uv: Vec2) -> Vec3 {
         Vec3::splat(uv.x * (1.0 + uv.y))
     }
@@ -56,7 +56,7 @@ fn ramp(u: f64, v: f64) -> f64 {
     u * (1.0 + v)
 }
 
-fn set_with(texture: Option<Arc<dyn SpotTexture>>) -> LightSet {
+fn set_with(texture: Option<Arc<dyn LightTexture>>) -> LightSet {
     let projector = Projector::new(
         to_world(),
         IRRADIANCE,
@@ -188,7 +188,7 @@ fn power_is_unbiased() {
     let (tx, ty) = tan_half();
     for (texture, mean) in [
         (None, 1.0),
-        (Some(Arc::new(Ramp) as Arc<dyn SpotTexture>), 0.75),
+        (Some(Arc::new(Ramp) as Arc<dyn LightTexture>), 0.75),
     ] {
         let textured = texture.is_some();
         let set = set_with(texture);
@@ -297,6 +297,6 @@ fn image_is_projected_upright() {
             (Vec3::ZERO, Vec3::ONE)
         )
         .err(),
-        Some(LightError::MissingSpotTexture(0, 0))
+        Some(LightError::MissingLightTexture(0, 0))
     );
 }

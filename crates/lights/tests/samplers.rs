@@ -36,6 +36,7 @@ fn scene() -> LightSet {
         lights.push(Light::Area {
             shape: i,
             radiance: Vec3::splat(10f32.powf(2.0 * rng.next_f32())),
+            texture: None,
         });
     }
     for (k, x) in [-2.0f32, 2.5].into_iter().enumerate() {
@@ -49,6 +50,7 @@ fn scene() -> LightSet {
         lights.push(Light::Area {
             shape: 30 + k as u32,
             radiance: Vec3::splat(3.0 + k as f32),
+            texture: None,
         });
     }
     lights.push(Light::Point {

@@ -14,7 +14,7 @@ use std::sync::Arc;
 
 use glam::{Mat4, Vec2, Vec3};
 use restir_geometry::Shape;
-use restir_lights::{Light, LightError, LightSet, Spot, SpotTexture};
+use restir_lights::{Light, LightError, LightSet, LightTexture, Spot};
 use restir_sampling::{Pcg32, luminance, warp};
 use restir_testkit::{Histogram, RunningStats, sidak_level, trials};
 
@@ -30,7 +30,7 @@ fn to_world() -> Mat4 {
     common::tilted_frame(POSITION)
 }
 
-fn set_with(texture: Option<Arc<dyn SpotTexture>>) -> LightSet {
+fn set_with(texture: Option<Arc<dyn LightTexture>>) -> LightSet {
     let spot = Spot::new(
         to_world(),
         INTENSITY,
@@ -236,6 +236,6 @@ fn texture_is_projected_along_the_frame() {
             (Vec3::ZERO, Vec3::ONE)
         )
         .err(),
-        Some(LightError::MissingSpotTexture(0, 0))
+        Some(LightError::MissingLightTexture(0, 0))
     );
 }

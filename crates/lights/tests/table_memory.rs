@@ -48,6 +48,7 @@ fn bytes_per_emissive_triangle() {
             vec![Light::Area {
                 shape: 0,
                 radiance: Vec3::ONE,
+                texture: None,
             }],
             shapes.clone(),
             bounds,

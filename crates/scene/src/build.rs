@@ -481,6 +481,8 @@ impl Scene {
         let mut shapes = Vec::with_capacity(desc.shapes.len());
         let mut shape_bsdf = Vec::with_capacity(desc.shapes.len());
         let mut lights = Vec::new();
+        // The textures lights emit (area lights) and project (spot lights, projectors).
+        let mut light_textures = Vec::new();
         for (i, sd) in desc.shapes.iter().enumerate() {
             let (shape, dropped) = build_shape(sd, base_dir, &mut cache.budget)
                 .map_err(|e| at(&sd.location, format!("shape {i}: {e}")))?;
@@ -515,6 +517,14 @@ impl Scene {
                 crate::texture::bind(&mut cache.textures, t, i as u32, &shape)
                     .map_err(|e| at(&sd.location, format!("shape {i}{}: {e}", mesh_file(sd))))?;
             }
+            if sd.emission_texture.is_some() && sd.emission.is_none() {
+                return Err(at(
+                    &sd.location,
+                    format!(
+                        "shape {i}: an emission_texture needs emission, its factor ((1, 1, 1) for the texture's values)"
+                    ),
+                ));
+            }
             if let Some(e) = &sd.emission {
                 let radiance = v3(e);
                 if !radiance.is_finite() || radiance.min_element() < 0.0 {
@@ -540,6 +550,21 @@ impl Scene {
                         ),
                     ));
                 }
+                // A textured radiance: the light's `radiance` is the texture's mean (times the
+                // factor), what its selection weights count.
+                let (radiance, texture) = match &sd.emission_texture {
+                    Some(t) => {
+                        let (index, mean) = crate::spot::emission_texture(
+                            t,
+                            radiance,
+                            base_dir,
+                            &mut light_textures,
+                        )
+                        .map_err(|e| at(&sd.location, format!("shape {i}: {e}")))?;
+                        (mean, Some(index))
+                    }
+                    None => (radiance, None),
+                };
                 if radiance.max_element() > 0.0 && shape.area() > 0.0 {
                     let entries = match &shape {
                         Shape::Mesh(m) => m.triangle_count(),
@@ -552,6 +577,7 @@ impl Scene {
                     lights.push(Light::Area {
                         shape: shapes.len() as u32,
                         radiance,
+                        texture,
                     });
                 }
             }
@@ -559,7 +585,6 @@ impl Scene {
             shape_bsdf.push(bsdf);
         }
         let mut envmap = None;
-        let mut spot_textures = Vec::new();
         for l in &desc.lights {
             let light = match l {
                 LightDesc::Point {
@@ -580,7 +605,7 @@ impl Scene {
                     radiance: v3(radiance),
                 },
                 LightDesc::Spot { location, .. } | LightDesc::Projector { location, .. } => {
-                    crate::spot::spot_light(l, base_dir, &mut spot_textures)
+                    crate::spot::spot_light(l, base_dir, &mut light_textures)
                         .map_err(|e| at(location, e))?
                 }
                 LightDesc::Envmap {
@@ -617,7 +642,7 @@ impl Scene {
         let light_set = LightSet::with_textures(
             lights,
             envmap,
-            spot_textures,
+            light_textures,
             shapes.clone(),
             accel.bounds(),
         )

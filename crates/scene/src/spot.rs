@@ -1,18 +1,18 @@
 //! Mitsuba's `spot` and `projector` emitters from their descriptions ([`LightDesc::Spot`],
-//! [`LightDesc::Projector`]): the light set's [`Spot`] and [`Projector`], and their projected
-//! textures as [`SpotTexture`]s (the scene's own bitmap and checkerboard lookups, so wrap modes,
-//! filters and `to_uv` are the materials' ones).
+//! [`LightDesc::Projector`]): the light set's [`Spot`] and [`Projector`]; their projected
+//! textures and area emitters' radiance textures as [`LightTexture`]s (the scene's own bitmap
+//! and checkerboard lookups, so wrap modes, filters and `to_uv` are the materials' ones).
 
 use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
-use restir_lights::{Light, Projector, Spot, SpotTexture};
+use restir_lights::{Light, LightTexture, Projector, Spot};
 
 use crate::desc::{LightDesc, TextureDesc, defaults, transform_matrix};
 use crate::texture::Texture;
 
-impl SpotTexture for Texture {
+impl LightTexture for Texture {
     fn eval(&self, uv: Vec2) -> Vec3 {
         Texture::eval(self, uv)
     }
@@ -29,7 +29,7 @@ impl SpotTexture for Texture {
 pub(crate) fn spot_light(
     desc: &LightDesc,
     base_dir: &Path,
-    textures: &mut Vec<Arc<dyn SpotTexture>>,
+    textures: &mut Vec<Arc<dyn LightTexture>>,
 ) -> Result<Light, String> {
     match desc {
         LightDesc::Spot {
@@ -93,13 +93,53 @@ pub(crate) fn spot_light(
     }
 }
 
+/// The radiance texture `t` of an area emitter, times `factor` (its `emission`), loaded into
+/// `textures`: its index there and its mean (what the light's selection weights count). Errors
+/// are the message without the location.
+pub(crate) fn emission_texture(
+    t: &TextureDesc,
+    factor: Vec3,
+    base_dir: &Path,
+    textures: &mut Vec<Arc<dyn LightTexture>>,
+) -> Result<(u32, Vec3), String> {
+    let (index, _) = load(t, "area", base_dir, textures)?;
+    if factor != Vec3::ONE {
+        let texture = textures[index as usize].clone();
+        textures[index as usize] = Arc::new(Scaled { texture, factor });
+    }
+    let mean = textures[index as usize].mean();
+    if !mean.is_finite() || mean.min_element() < 0.0 {
+        return Err(format!(
+            "area emitter texture: its mean radiance {mean} must be finite and non-negative"
+        ));
+    }
+    Ok((index, mean))
+}
+
+/// A light's texture times a constant factor.
+#[derive(Debug)]
+struct Scaled {
+    texture: Arc<dyn LightTexture>,
+    factor: Vec3,
+}
+
+impl LightTexture for Scaled {
+    fn eval(&self, uv: Vec2) -> Vec3 {
+        self.texture.eval(uv) * self.factor
+    }
+
+    fn mean(&self) -> Vec3 {
+        self.texture.mean() * self.factor
+    }
+}
+
 /// Loads texture `t` of a `plugin` emitter into `textures`: its index there and its resolution
 /// (`(1, 1)` for a checkerboard, as Mitsuba's textures other than bitmaps).
 fn load(
     t: &TextureDesc,
     plugin: &str,
     base_dir: &Path,
-    textures: &mut Vec<Arc<dyn SpotTexture>>,
+    textures: &mut Vec<Arc<dyn LightTexture>>,
 ) -> Result<(u32, (u32, u32)), String> {
     if let TextureDesc::MeshAttribute { name, .. } = t {
         return Err(format!(

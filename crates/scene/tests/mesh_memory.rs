@@ -103,6 +103,7 @@ fn bytes_per_triangle_at_each_stage() {
             vec![Light::Area {
                 shape: 0,
                 radiance: Vec3::ONE,
+                texture: None,
             }],
             shapes.clone(),
             bounds,

@@ -257,6 +257,8 @@ const EVERYTHING: &str = r#"(
          emission: Some((10, 9, 8))),
         (geometry: Rectangle, to_world: [Translate((0, 0, -3))],
          material: Some(Inline(Diffuse(reflectance: (0.7, 0.7, 0.7)))), emission: Some((0.5, 0.5, 0.5))),
+        (geometry: Rectangle, to_world: [Translate((2, 0, -3))], emission: Some((1, 1, 1)),
+         emission_texture: Some(Checkerboard(color0: (3, 2, 1)))),
     ],
     lights: [
         Point(position: (1, 2, 1), intensity: (3, 2, 1)),
@@ -304,6 +306,7 @@ fn every_model_filter_camera_and_light_round_trips() {
         r#"<emitter type="projector">"#,
         r#"<texture type="bitmap" name="irradiance">"#,
         r#"<float name="scale" value="3"/>"#,
+        r#"<texture type="checkerboard" name="radiance">"#,
         r#"<string name="fov_axis" value="y"/>"#,
         r#"<boolean name="hide_emitters" value="true"/>"#,
         "<!-- output file: out.exr -->",
@@ -400,6 +403,19 @@ fn what_mitsuba_cannot_say_is_refused_by_name() {
     let e = write(&tinted);
     assert!(
         e.contains("a projector: Mitsuba's irradiance is a colour or a texture"),
+        "{e}"
+    );
+
+    let mut d = base.clone();
+    d.shapes[0].emission = Some([2.0, 1.0, 1.0]);
+    d.shapes[0].emission_texture = Some(restir_scene::TextureDesc::Checkerboard {
+        color0: [1.0; 3],
+        color1: [0.0; 3],
+        uv: Default::default(),
+    });
+    let e = write(&d);
+    assert!(
+        e.contains("shape 0: its emission texture has the factor [2.0, 1.0, 1.0]"),
         "{e}"
     );
 }

@@ -220,7 +220,7 @@ impl GBuffer {
                     continue;
                 };
                 if add_seen && let Some(light) = lights.light_on_shape(si.shape) {
-                    *l += lights.area_radiance(light, si.shading.n, -ray.d);
+                    *l += lights.area_radiance(light, &si, -ray.d);
                 }
                 if keep_hits {
                     recv[i] = Receiver::at_hit(scene, &si, -ray.d, si.t);

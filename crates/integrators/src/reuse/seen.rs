@@ -128,10 +128,7 @@ fn seen_id(scene: &Scene, film: Vec2, chains: Option<&DeltaChains>) -> ([(u32, f
         return ([seen; 2], rays);
     };
     if let Some(l) = lights.light_on_shape(si.shape) {
-        let seen = (
-            l + 1,
-            luminance(lights.area_radiance(l, si.shading.n, -ray.d)),
-        );
+        let seen = (l + 1, luminance(lights.area_radiance(l, &si, -ray.d)));
         return ([seen; 2], rays);
     }
     let Some(chains) = chains else {
@@ -607,7 +604,7 @@ impl SeenEmission {
         };
         let mut le = Vec3::ZERO;
         if let Some(light) = lights.light_on_shape(si.shape) {
-            le += lights.area_radiance(light, si.shading.n, -ray.d);
+            le += lights.area_radiance(light, &si, -ray.d);
         }
         if let Some(c) = chains {
             let r = Receiver::at_hit(scene, &si, -ray.d, si.t);

@@ -4,7 +4,7 @@
 #![allow(dead_code)] // each test file uses a different subset
 
 use glam::{Mat4, Vec2, Vec3};
-use restir_lights::{LightPoint, LightSet, Presampled, SpotTexture};
+use restir_lights::{LightPoint, LightSet, LightTexture, Presampled};
 use restir_sampling::{Pcg32, warp};
 
 /// Mitsuba's look-at frame from `position` towards a tilted axis (`z` along the axis,
@@ -25,7 +25,7 @@ pub fn tilted_frame(position: Vec3) -> Mat4 {
 #[derive(Debug)]
 pub struct UvRamp;
 
-impl SpotTexture for UvRamp {
+impl LightTexture for UvRamp {
     fn eval(&self, uv: Vec2) -> Vec3 {
         uv.extend(1.0)
     }

@@ -165,7 +165,8 @@ pub(super) struct ImageUse {
 
 /// Every image file the build of `desc` decodes, in the order it decodes them: the bitmap
 /// textures of the named materials, of the shapes' inline materials (each distinct texture
-/// once, as the build loads it), of spot lights and projectors, and the environment map.
+/// once, as the build loads it), of area emitters, of spot lights and projectors, and the
+/// environment map.
 /// A named material's texture is placed at the first shape that uses the material.
 pub(super) fn images(desc: &SceneDesc, base_dir: &Path) -> Vec<ImageUse> {
     let mut seen: Vec<&TextureDesc> = Vec::new();
@@ -207,6 +208,15 @@ pub(super) fn images(desc: &SceneDesc, base_dir: &Path) -> Vec<ImageUse> {
                     bitmap(&b.texture, &s.location, format!("shape {i}"), &mut out);
                 }
             }
+        }
+        // Each area emitter loads its own copy of its radiance texture.
+        if let Some(t) = &s.emission_texture {
+            bitmap(
+                t,
+                &s.location,
+                format!("shape {i}: emitter radiance texture"),
+                &mut out,
+            );
         }
     }
     for l in &desc.lights {

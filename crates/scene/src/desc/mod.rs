@@ -404,9 +404,14 @@ pub struct ShapeDesc {
     /// Material; a default diffuse (ρ = 0.5) when absent, black for an emitter without one.
     #[serde(default)]
     pub material: Option<MaterialRef>,
-    /// Radiance when the shape is an area light.
+    /// Radiance when the shape is an area light; with `emission_texture`, its factor.
     #[serde(default)]
     pub emission: Option<V3>,
+    /// The radiance as a texture over the shape's uv (Mitsuba's area emitter with a
+    /// `radiance` texture), times `emission`, which must be given (`(1, 1, 1)` for the
+    /// texture's values).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emission_texture: Option<TextureDesc>,
     /// Turn normals inside out.
     #[serde(default)]
     pub flip_normals: bool,

@@ -222,7 +222,7 @@ impl<'a> Importer<'a> {
 
     /// The nested (`<texture name=…>`) and referenced (`<ref name=… id=…>`) textures of emitter
     /// `node` (a `plugin` emitter, for messages): each element with its name and texture.
-    fn emitter_textures<'i>(
+    pub(super) fn emitter_textures<'i>(
         &self,
         node: Node<'a, 'i>,
         plugin: &str,

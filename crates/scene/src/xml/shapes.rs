@@ -140,6 +140,7 @@ impl<'a> Importer<'a> {
         let face_normals = props.bool("face_normals")?.unwrap_or(false);
         let mut material = None;
         let mut emission = None;
+        let mut emission_texture = None;
         for c in elements(node) {
             match c.tag_name().name() {
                 "bsdf" => {
@@ -168,23 +169,44 @@ impl<'a> Importer<'a> {
                     if emission.is_some() {
                         return Err(self.err(c, "a shape takes one emitter"));
                     }
-                    // A textured radiance varies over the surface, which the light tables and
-                    // samplers (one radiance per area light) cannot represent.
-                    if let Some(t) = elements(c).find(|t| {
-                        ["texture", "ref"].contains(&t.tag_name().name())
-                            && t.attribute("name").map(snake_case).as_deref() == Some("radiance")
-                    }) {
-                        return Err(self.err(
-                            t,
-                            "emitter 'area': a texture for 'radiance' is not supported (give the radiance as a colour: rgb, spectrum or float)",
-                        ));
+                    // `radiance` is a colour or a texture over the shape's uv.
+                    let mut texture = None;
+                    for (t, name, desc) in self.emitter_textures(c, "area")? {
+                        if snake_case(&name) != "radiance" {
+                            return Err(self.err(
+                                t,
+                                format!(
+                                    "emitter 'area': '{name}' cannot be a texture (only 'radiance' can)"
+                                ),
+                            ));
+                        }
+                        if texture.is_some() {
+                            return Err(self.err(t, "emitter 'area': a second 'radiance'"));
+                        }
+                        if let TextureDesc::MeshAttribute { name, .. } = &desc {
+                            return Err(self.err(
+                                t,
+                                format!(
+                                    "emitter 'area': a 'mesh_attribute' radiance (\"{name}\") is not supported (give a bitmap, a checkerboard or a colour)"
+                                ),
+                            ));
+                        }
+                        texture = Some(desc);
                     }
                     let ep = self.props(c, "emitter 'area'".into())?;
-                    let r = ep
-                        .color("radiance", ColorUse::Emission)?
-                        .unwrap_or(defaults::EMISSION);
+                    let colour = ep.color("radiance", ColorUse::Emission)?;
+                    if let (Some(_), Some(_)) = (&colour, &texture) {
+                        return Err(self.err(
+                            ep.node_or("radiance", c),
+                            "emitter 'area': 'radiance' is given both as a colour and as a texture (give one)",
+                        ));
+                    }
                     ep.finish();
-                    emission = Some(r);
+                    emission = Some(match texture {
+                        Some(_) => [1.0; 3],
+                        None => colour.unwrap_or(defaults::EMISSION),
+                    });
+                    emission_texture = texture;
                 }
                 t if PROPERTY_TAGS.contains(&t) => {}
                 t => return Err(self.err(c, format!("unexpected <{t}> inside a shape"))),
@@ -197,6 +219,7 @@ impl<'a> Importer<'a> {
             to_world,
             material,
             emission,
+            emission_texture,
             flip_normals,
             face_normals,
             location: self.loc(node),

@@ -125,7 +125,20 @@ impl Writer<'_> {
         if let Some(e) = &s.emission {
             finite(&item, "emission", e)?;
             self.open(r#"<emitter type="area">"#);
-            self.rgb("radiance", e);
+            match &s.emission_texture {
+                None => self.rgb("radiance", e),
+                // Mitsuba's area emitter takes a colour or a texture, not their product.
+                Some(_) if *e != [1.0; 3] => {
+                    return refuse(
+                        &item,
+                        format!(
+                            "its emission texture has the factor {e:?}, which Mitsuba's area \
+                             emitter cannot hold beside a texture (only (1, 1, 1))"
+                        ),
+                    );
+                }
+                Some(t) => self.texture(t, "radiance", &item)?,
+            }
             self.close("</emitter>");
         }
         self.close("</shape>");
