@@ -26,7 +26,9 @@
 //! Negative control: every image judged is also judged scaled by 1.03, and must then fail, so
 //! each budget is shown to detect a 3 % bias on every scene (counting only the pixel-channels
 //! whose reference is not black, where no scaling shows); on a scene where even Mitsuba's budget
-//! cannot (its variance images are that large), a 10 % bias, and the cell says so. What must hold for the test to pass:
+//! cannot (its variance images are that large), a 10 % bias, and the cell says so; where
+//! Mitsuba's budget cannot show even that (`various_emitters`), four times its budget. What must
+//! hold for the test to pass:
 //! at least [`MIN_LOADING`] scenes load, and every estimator passes every scene that loads and
 //! that it applies to, except those listed in [`KNOWN_FAILURES`] with the reason.
 //!
@@ -51,7 +53,7 @@ const PASS_FRACTION: f64 = 0.9975;
 /// The smallest variance the criterion divides by.
 const MIN_VARIANCE: f64 = 1e-4;
 /// Scenes that must load (of the 29).
-const MIN_LOADING: usize = 28;
+const MIN_LOADING: usize = 29;
 /// `(scene, estimator, reason)`: failures that are known and explained in docs/VALIDATION.md.
 const KNOWN_FAILURES: &[(&str, &str, &str)] = &[(
     "bsdf_spheres/test_constant_path.xml",
@@ -328,6 +330,12 @@ fn mitsuba_render_suite() {
                             let full = (MITSUBA_BUDGET / pixels).max(1) as u32;
                             if control.passes() && spp < full {
                                 spp = full;
+                                continue;
+                            }
+                            // Where Mitsuba's budget cannot show even 10 % (its variance image
+                            // is that large), four times its budget.
+                            if control.passes() && spp == full && scaled(1.10).passes() {
+                                spp = 4 * full;
                                 continue;
                             }
                             // Where Mitsuba's own budget cannot show 3 % (its variance is that

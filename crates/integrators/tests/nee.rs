@@ -95,15 +95,19 @@ fn hierarchy_nee_is_unbiased_and_weighing_against_the_power_density_is_caught() 
 
 /// `light_sampler = auto` (the default) gives the path tracer and ReSTIR PT the hierarchy for
 /// this scene's 18 small lights (rectangles and a sphere, at most two emitters each) and the
-/// power sampler to a scene whose one light is a tessellated box (12 triangles), and says
-/// which and why in the settings line; a named selection stays as named.
+/// power sampler to a scene whose one light is a tessellated box (12 triangles), and to one of
+/// two such boxes and a point light; the hierarchy again where two point lights join one box
+/// (most lights compact, though the box's triangles make the mean 4.7 a light); it says which
+/// and why in the settings line; a named selection stays as named.
 #[test]
 fn auto_decides_by_the_emitters_a_light_holds() {
     let s = scene(3);
     for name in ["path", "restir-pt"] {
         let line = make(&s, name, &[]).describe();
         assert!(
-            line.contains("light_sampler=bvh (auto: 35 emitters in 18 local lights)"),
+            line.contains(
+                "light_sampler=bvh (auto: 35 emitters in 18 local lights, the median light 2)"
+            ),
             "{line}"
         );
         let line = make(&s, name, &[("light_sampler", "power")]).describe();
@@ -162,4 +166,34 @@ fn auto_decides_by_the_emitters_a_light_holds() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("expected power, bvh or auto"), "{err}");
+
+    let point = |x: f32| format!("Point(position: ({x}, 1, 0), intensity: (1, 1, 1))");
+    let cube = |x: f32| {
+        format!(
+            "(geometry: Cube, to_world: [Scale((0.2, 0.2, 0.2)), Translate(({x}, 1.5, 0))], \
+             emission: Some((5, 5, 5)))"
+        )
+    };
+    for (shapes, lights, expected) in [
+        (
+            vec![cube(0.0)],
+            vec![point(1.0), point(-1.0)],
+            "light_sampler=bvh (auto: 14 emitters in 3 local lights, the median light 1)",
+        ),
+        (
+            vec![cube(0.0), cube(1.0)],
+            vec![point(-1.0)],
+            "light_sampler=power (auto: 25 emitters in 3 local lights, the median light 12)",
+        ),
+    ] {
+        let ron = format!(
+            "(camera: (fov: 45), integrator: (max_depth: 3), shapes: [{}], lights: [{}])",
+            shapes.join(", "),
+            lights.join(", ")
+        );
+        let desc = parse_ron(&ron, "mixed.ron".as_ref()).unwrap();
+        let mixed = common::build(&desc, ".".as_ref(), "mixed.ron".as_ref());
+        let line = make(&mixed, "path", &[]).describe();
+        assert!(line.contains(expected), "{line}");
+    }
 }

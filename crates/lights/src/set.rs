@@ -332,6 +332,27 @@ impl LightSet {
         self.table.len()
     }
 
+    /// The number of entries the typical local light holds: the lower median, over the lights
+    /// with entries, of each light's count (a mesh light's emissive triangles, 1 for any other
+    /// light); 0 without local lights. At most `n` means at least half of the lights hold at
+    /// most `n` entries.
+    pub fn median_emitters_per_light(&self) -> usize {
+        let mut counts = vec![0usize; self.lights.len()];
+        for e in self.table.entries() {
+            let light = match *e {
+                crate::table::Emitter::Triangle { light, .. }
+                | crate::table::Emitter::Whole { light } => light,
+            };
+            counts[light as usize] += 1;
+        }
+        counts.retain(|&c| c > 0);
+        counts.sort_unstable();
+        counts
+            .get(counts.len().saturating_sub(1) / 2)
+            .copied()
+            .unwrap_or(0)
+    }
+
     /// The lights.
     pub fn lights(&self) -> &[Light] {
         &self.lights

@@ -665,6 +665,7 @@ impl Scene {
             }),
             light_count: light_set.len(),
             emitter_count: light_set.emitter_count(),
+            median_light_emitters: light_set.median_emitters_per_light(),
             largest_light_share: 0.0,
             environment_share: None,
         };

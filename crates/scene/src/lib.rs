@@ -71,6 +71,9 @@ pub struct SceneFeatures {
     /// Entries of the emitter table (one per emissive triangle, one per other light with
     /// power; the environment aside): what a light selection chooses among.
     pub emitter_count: usize,
+    /// The entries the typical local light holds ([`restir_lights::LightSet::median_emitters_per_light`]:
+    /// the lower median over the lights; 0 without local lights).
+    pub median_light_emitters: usize,
     /// The largest probability with which a light selection picks one light (a mesh light with
     /// all its triangles; the environment with its share), after the environment share is
     /// decided; 0 without lights.
