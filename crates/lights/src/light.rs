@@ -114,6 +114,37 @@ impl LightSet {
         }
     }
 
+    /// A point `u` drawn uniformly on the triangle entry `e` of an area light: its light, the
+    /// point, and the radiance the light emits there; `None` for another entry.
+    #[inline]
+    pub(crate) fn triangle_entry_point(
+        &self,
+        e: &Emitter,
+        u: Vec2,
+    ) -> Option<(u32, PositionSample, Vec3)> {
+        let Emitter::Triangle {
+            light,
+            prim,
+            ref p,
+            ng,
+            shading,
+        } = *e
+        else {
+            return None;
+        };
+        let Light::Area {
+            shape,
+            radiance,
+            texture,
+        } = self.lights[light as usize]
+        else {
+            return None;
+        };
+        let ps = (self.table).triangle_point(p, ng, shading, &self.shapes[shape as usize], prim, u);
+        let le = self.area_le(shape, radiance, texture, prim, ps.param);
+        Some((light, ps, le))
+    }
+
     /// The radiance area light `light` (shape `shape`, radiance `radiance` and `texture` as
     /// [`Light::Area`] holds them) emits at the point `(prim, param)` of its shape.
     #[inline]

@@ -76,24 +76,8 @@ impl LightSet {
             None => return None,
         };
         let light = match picked {
-            Ok(&Emitter::Triangle {
-                light,
-                prim,
-                ref p,
-                ng,
-                shading,
-            }) => {
-                let Light::Area {
-                    shape: s,
-                    radiance,
-                    texture,
-                } = self.lights[light as usize]
-                else {
-                    return None;
-                };
-                let shape = &self.shapes[s as usize];
-                let ps = self.table.triangle_point(p, ng, shading, shape, prim, u);
-                let radiance = self.area_le(s, radiance, texture, prim, ps.param);
+            Ok(e @ &Emitter::Triangle { prim, .. }) => {
+                let (light, ps, radiance) = self.triangle_entry_point(e, u)?;
                 let pdf_area = self.area_pdf[light as usize];
                 return Some(Presampled::Fixed {
                     point: LightPoint {

@@ -10,7 +10,7 @@ use restir_geometry::area_to_solid_angle;
 use crate::bvh::LightBvh;
 use crate::light::area_light_sample;
 use crate::table::{Emitter, triangle_area};
-use crate::{EmitterGroups, Light, LightSample, LightSet};
+use crate::{EmitterGroups, LightSample, LightSet};
 
 impl LightSet {
     /// Picks a light: `(index, probability)`, the probability being [`LightSet::pmf`].
@@ -40,27 +40,7 @@ impl LightSet {
     /// density.
     #[inline]
     fn sample_triangle(&self, e: &Emitter, ref_p: Vec3, u: Vec2) -> Option<LightSample> {
-        let Emitter::Triangle {
-            light,
-            prim,
-            ref p,
-            ng,
-            shading,
-        } = *e
-        else {
-            return None;
-        };
-        let Light::Area {
-            shape: s,
-            radiance,
-            texture,
-        } = self.lights[light as usize]
-        else {
-            return None;
-        };
-        let shape = &self.shapes[s as usize];
-        let ps = self.table.triangle_point(p, ng, shading, shape, prim, u);
-        let radiance = self.area_le(s, radiance, texture, prim, ps.param);
+        let (light, ps, radiance) = self.triangle_entry_point(e, u)?;
         let pdf_sa = area_to_solid_angle(self.area_pdf[light as usize], ref_p, ps.p, ps.ng)?;
         area_light_sample(light, radiance, ref_p, ps, pdf_sa)
     }
@@ -141,24 +121,8 @@ impl LightSet {
             ));
         };
         match *e {
-            Emitter::Triangle {
-                light,
-                prim,
-                ref p,
-                ng,
-                shading,
-            } => {
-                let Light::Area {
-                    shape: s,
-                    radiance,
-                    texture,
-                } = self.lights[light as usize]
-                else {
-                    return None;
-                };
-                let shape = &self.shapes[s as usize];
-                let ps = self.table.triangle_point(p, ng, shading, shape, prim, u);
-                let radiance = self.area_le(s, radiance, texture, prim, ps.param);
+            Emitter::Triangle { ref p, .. } => {
+                let (light, ps, radiance) = self.triangle_entry_point(e, u)?;
                 let pdf_sa = area_to_solid_angle(pmf / triangle_area(p), ref_p, ps.p, ps.ng)?;
                 let power_pdf =
                     area_to_solid_angle(self.area_pdf[light as usize], ref_p, ps.p, ps.ng)?;
