@@ -158,7 +158,7 @@ impl PathSettings {
                 if emitters == 1 { "" } else { "s" },
                 if lights == 1 { "" } else { "s" },
                 if lights >= 2 {
-                    format!(", the median light {median}")
+                    format!("; the median light {median}")
                 } else {
                     String::new()
                 }

@@ -106,7 +106,7 @@ fn auto_decides_by_the_emitters_a_light_holds() {
         let line = make(&s, name, &[]).describe();
         assert!(
             line.contains(
-                "light_sampler=bvh (auto: 35 emitters in 18 local lights, the median light 2)"
+                "light_sampler=bvh (auto: 35 emitters in 18 local lights; the median light 2)"
             ),
             "{line}"
         );
@@ -178,12 +178,12 @@ fn auto_decides_by_the_emitters_a_light_holds() {
         (
             vec![cube(0.0)],
             vec![point(1.0), point(-1.0)],
-            "light_sampler=bvh (auto: 14 emitters in 3 local lights, the median light 1)",
+            "light_sampler=bvh (auto: 14 emitters in 3 local lights; the median light 1)",
         ),
         (
             vec![cube(0.0), cube(1.0)],
             vec![point(-1.0)],
-            "light_sampler=power (auto: 25 emitters in 3 local lights, the median light 12)",
+            "light_sampler=power (auto: 25 emitters in 3 local lights; the median light 12)",
         ),
     ] {
         let ron = format!(
