@@ -174,7 +174,12 @@ impl AutoIntegrator {
                 );
                 Box::new(RestirDiIntegrator::new(s))
             }
-            Choice::RestirPt => Box::new(RestirPtIntegrator::new(RestirPtSettings::new(path))),
+            Choice::RestirPt => {
+                let mut s = RestirPtSettings::new(path);
+                let (w, h) = scene.camera.resolution();
+                s.resolve(&scene.features, u64::from(w) * u64::from(h));
+                Box::new(RestirPtIntegrator::new(s))
+            }
         };
         Self {
             chosen,

@@ -255,7 +255,8 @@ pub fn make_integrator(
         "restir-pt" => {
             let mut s = RestirPtSettings::new(settings);
             let unused = s.apply(&params)?;
-            s.path.resolve_nee(&scene.features);
+            let (w, h) = scene.camera.resolution();
+            s.resolve(&scene.features, u64::from(w) * u64::from(h));
             notes.extend(s.reuse.pair_neighbors());
             (Box::new(RestirPtIntegrator::new(s)), unused)
         }

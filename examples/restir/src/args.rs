@@ -139,7 +139,8 @@ pub(crate) struct RestirArgs {
     #[arg(long, alias = "neighbours")]
     neighbors: Option<u32>,
     /// Spatial reuse radius in pixels [default: 2 for restir-di, widened by the filter's reach on
-    /// a film that splats it (4 with Mitsuba's Gaussian), 3 for restir-pt].
+    /// a film that splats it (4 with Mitsuba's Gaussian); 3 for restir-pt, 5 on a film of at
+    /// least 1280×720 pixels].
     #[arg(long)]
     radius: Option<f32>,
     /// Spatial reuse rounds [default: 1 for restir-di, 3 for restir-pt].

@@ -49,8 +49,7 @@ pub const TILE_CANDIDATES: u32 = 12;
 /// large films").
 pub const LARGE_FILM_NEIGHBORS: u32 = 12;
 
-/// The film size in pixels (1280×720) from which [`LARGE_FILM_NEIGHBORS`] neighbours are taken.
-pub const LARGE_FILM_PIXELS: u64 = 1280 * 720;
+pub use crate::reuse::params::LARGE_FILM_PIXELS;
 
 /// Where initial candidates' lights come from (`--light-sampler`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -36,7 +36,7 @@ use restir_scene::Scene;
 
 pub use pilot::{GLOSSY_VIEW_MIN, INDIRECT_VIEW_MIN, ViewPilot, view_pilot};
 pub use sample::{Kind, PathSample, Reconnection, ShiftKind};
-pub use settings::{DirectLight, RestirPtSettings, SHIFT_NAMES};
+pub use settings::{DirectLight, LARGE_FILM_RADIUS, RestirPtSettings, SHIFT_NAMES};
 use shift::PtReuse;
 pub use shift::{Frames, PtShift};
 
@@ -422,14 +422,14 @@ impl Integrator for RestirPtIntegrator {
     fn describe(&self) -> String {
         let s = &self.settings;
         format!(
-            "restir-pt max_depth={} {} candidates={} neighbors={} radius={} spatial_rounds={} \
+            "restir-pt max_depth={} {} candidates={} neighbors={} {} spatial_rounds={} \
              reciprocal={} mis={} mcap={} {} {} shift={} reconnection={} max_jacobian={} \
              direct={}{}{}",
             s.path.max_depth,
             s.path.nee_label(),
             s.candidates,
             s.reuse.neighbors,
-            s.reuse.radius,
+            s.radius_label(),
             s.reuse.spatial_rounds,
             s.reuse.reciprocal,
             mis_name(s.reuse.mis),

@@ -3,10 +3,11 @@
 
 use crate::params::{Param, ParamError, ParamProblem, ParamSet};
 use crate::path::PathSettings;
-use crate::reuse::params::ReuseParams;
+use crate::reuse::params::{LARGE_FILM_PIXELS, RADIUS_NAMES, ReuseParams};
 use crate::reuse::settings::ReuseSettings;
 
 use super::sample::{Reconnection, ShiftKind};
+use restir_scene::SceneFeatures;
 
 /// The shifts `--shift` accepts.
 pub const SHIFT_NAMES: &[&str] = &["reconnection", "replay", "hybrid"];
@@ -110,7 +111,23 @@ pub struct RestirPtSettings {
     /// Negative control only: the walks keep the emission seen through delta lobes that the
     /// silhouette stage adds too (counted twice; biased).
     pub delta_emission_twice: bool,
+    /// The radius was named (`radius`, `max_radius`, `spatial_radius`), so
+    /// [`RestirPtSettings::resolve`] keeps it.
+    pub radius_named: bool,
+    /// [`RestirPtSettings::resolve`] widened the radius to [`LARGE_FILM_RADIUS`] for a large
+    /// film (the settings line says why).
+    pub radius_widened: bool,
 }
+
+/// ReSTIR PT's spatial radius in pixels on a film of at least
+/// [`LARGE_FILM_PIXELS`] pixels (1280×720), where the radius was not named
+/// (else 3). Chosen on the PT training family at 1280×720 (4 passes, seeds 11 and 12, 1 thread,
+/// `scripts/pair_variance.py`): **1.24×** radius 3's efficiency at the median (1.13–1.35, every
+/// member gaining; MSE 1.19×, 1.03–1.24), where 8 neighbours in place of 4 were 1.18× (MSE
+/// 1.08×, 0.89–1.25); reported on the test family at 1280×720: 1.19× (1.10–1.42, MSE 1.11×).
+/// At 640×360, where the defaults were chosen, radius 5 gains little (`docs/RESTIR_PT.md`, "A
+/// wider radius on large films").
+pub const LARGE_FILM_RADIUS: f32 = 5.0;
 
 impl RestirPtSettings {
     /// The defaults: two candidate paths, three spatial rounds of four neighbours within 3
@@ -138,6 +155,33 @@ impl RestirPtSettings {
             shift: ShiftKind::Hybrid,
             skip_invertibility: false,
             delta_emission_twice: false,
+            radius_named: false,
+            radius_widened: false,
+        }
+    }
+
+    /// Decides the scene-dependent defaults: next-event estimation's light selection
+    /// ([`PathSettings::resolve_nee`]) and, on a film of `pixels` ≥
+    /// [`LARGE_FILM_PIXELS`] (the camera's whole film, so that the parts of a
+    /// split render agree), a radius that was not named becomes [`LARGE_FILM_RADIUS`].
+    pub fn resolve(&mut self, features: &SceneFeatures, pixels: u64) {
+        self.path.resolve_nee(features);
+        if !self.radius_named && pixels >= LARGE_FILM_PIXELS {
+            self.reuse.radius = LARGE_FILM_RADIUS;
+            self.radius_widened = true;
+        }
+    }
+
+    /// `radius=R`, with why when [`RestirPtSettings::resolve`] widened it, for the settings
+    /// line.
+    pub fn radius_label(&self) -> String {
+        if self.radius_widened {
+            format!(
+                "radius={} (auto: a film of at least 1280×720 pixels)",
+                self.reuse.radius
+            )
+        } else {
+            format!("radius={}", self.reuse.radius)
         }
     }
 
@@ -193,6 +237,10 @@ impl RestirPtSettings {
             "skip_invertibility" => self.skip_invertibility = p.boolean()?,
             "delta_emission_twice" => self.delta_emission_twice = p.boolean()?,
             _ if self.path.apply_one(key, p)? => {}
+            k if RADIUS_NAMES.contains(&k) => {
+                self.radius_named = true;
+                return self.reuse.apply(key, p);
+            }
             _ => return self.reuse.apply(key, p),
         }
         Ok(true)
@@ -267,5 +315,38 @@ mod tests {
         assert!(s.is_unbiased(), "no rejection: nothing one-sided");
         s.apply(&p("max_jacobian", "2")).unwrap();
         assert!(!s.is_unbiased());
+    }
+
+    /// A radius that was not named widens to [`LARGE_FILM_RADIUS`] on a film of at least
+    /// 1280×720 pixels (the settings line says why), not one pixel below; a named one stays,
+    /// under each of its names.
+    #[test]
+    fn auto_radius_follows_the_film_size() {
+        let path = PathSettings {
+            max_depth: 4,
+            rr_depth: 5,
+            hide_emitters: false,
+            sampler: restir_scene::SamplerKind::Independent,
+            nee: restir_lights::NeeSelection::Power,
+            nee_rule: crate::path::NeeRule::Named,
+        };
+        let features = SceneFeatures::default();
+        let radius = |params: &[(&str, &str)], pixels: u64| {
+            let mut s = RestirPtSettings::new(path);
+            s.apply(&ParamSet::from(params)).unwrap();
+            s.resolve(&features, pixels);
+            (s.reuse.radius, s.radius_label())
+        };
+        let auto = "radius=5 (auto: a film of at least 1280×720 pixels)".to_string();
+        assert_eq!(radius(&[], 1280 * 720), (LARGE_FILM_RADIUS, auto.clone()));
+        assert_eq!(radius(&[], 1800 * 1080), (LARGE_FILM_RADIUS, auto));
+        assert_eq!(radius(&[], 1280 * 720 - 1), (3.0, "radius=3".into()));
+        assert_eq!(radius(&[], 640 * 360), (3.0, "radius=3".into()));
+        for name in RADIUS_NAMES {
+            assert_eq!(
+                radius(&[(name, "3")], 1800 * 1080),
+                (3.0, "radius=3".into())
+            );
+        }
     }
 }

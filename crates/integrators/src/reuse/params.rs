@@ -13,6 +13,13 @@ impl Param {
     }
 }
 
+/// The film size in pixels (1280×720) from which the reuse's defaults for large films apply
+/// where the parameter was not named: ReSTIR DI's neighbours
+/// ([`crate::restir_di::LARGE_FILM_NEIGHBORS`]) and ReSTIR PT's radius
+/// ([`crate::restir_pt::LARGE_FILM_RADIUS`]). Smaller pixels see more alike surfaces within
+/// the same radius in pixels.
+pub const LARGE_FILM_PIXELS: u64 = 1280 * 720;
+
 /// The names of the spatial radius ([`ReuseSettings::radius`]).
 pub const RADIUS_NAMES: &[&str] = &["radius", "max_radius", "spatial_radius"];
 
