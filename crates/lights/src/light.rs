@@ -140,7 +140,9 @@ impl LightSet {
         else {
             return None;
         };
-        let ps = (self.table).triangle_point(p, ng, shading, &self.shapes[shape as usize], prim, u);
+        let ps = self
+            .table
+            .triangle_point(p, ng, shading, &self.shapes[shape as usize], prim, u);
         let le = self.area_le(shape, radiance, texture, prim, ps.param);
         Some((light, ps, le))
     }
