@@ -253,16 +253,21 @@ mod tests {
 
     use super::*;
 
-    #[test]
-    fn names_and_errors() {
-        let mut s = RestirPtSettings::new(PathSettings {
+    /// Paths of depth 4 with the power sampler, named.
+    fn path() -> PathSettings {
+        PathSettings {
             max_depth: 4,
             rr_depth: 5,
             hide_emitters: false,
             sampler: restir_scene::SamplerKind::Independent,
             nee: restir_lights::NeeSelection::Power,
             nee_rule: crate::path::NeeRule::Named,
-        });
+        }
+    }
+
+    #[test]
+    fn names_and_errors() {
+        let mut s = RestirPtSettings::new(path());
         let p = |a: &str, b: &str| ParamSet::from(&[(a, b)][..]);
         let unknown = s
             .apply(&ParamSet::from(
@@ -322,14 +327,7 @@ mod tests {
     /// under each of its names.
     #[test]
     fn auto_radius_follows_the_film_size() {
-        let path = PathSettings {
-            max_depth: 4,
-            rr_depth: 5,
-            hide_emitters: false,
-            sampler: restir_scene::SamplerKind::Independent,
-            nee: restir_lights::NeeSelection::Power,
-            nee_rule: crate::path::NeeRule::Named,
-        };
+        let path = path();
         let features = SceneFeatures::default();
         let radius = |params: &[(&str, &str)], pixels: u64| {
             let mut s = RestirPtSettings::new(path);
