@@ -483,6 +483,7 @@ impl Scene {
         let mut lights = Vec::new();
         // The textures lights emit (area lights) and project (spot lights, projectors).
         let mut light_textures = Vec::new();
+        let mut emission_textures = crate::spot::EmissionTextures::default();
         for (i, sd) in desc.shapes.iter().enumerate() {
             let (shape, dropped) = build_shape(sd, base_dir, &mut cache.budget)
                 .map_err(|e| at(&sd.location, format!("shape {i}: {e}")))?;
@@ -559,6 +560,7 @@ impl Scene {
                             radiance,
                             base_dir,
                             &mut light_textures,
+                            &mut emission_textures,
                         )
                         .map_err(|e| at(&sd.location, format!("shape {i}: {e}")))?;
                         (mean, Some(index))

@@ -93,27 +93,57 @@ pub(crate) fn spot_light(
     }
 }
 
+/// The radiance textures of area emitters loaded so far, by description: shapes that name the
+/// same texture share one copy of its image (and of its mean and brightest texel).
+#[derive(Debug, Default)]
+pub(crate) struct EmissionTextures {
+    /// Each description loaded: the unscaled texture's index, its mean and its largest value per
+    /// channel.
+    loaded: Vec<(TextureDesc, u32, Vec3, Vec3)>,
+}
+
 /// The radiance texture `t` of an area emitter, times `factor` (its `emission`), loaded into
-/// `textures`: its index there and its mean (what the light's selection weights count). Errors
-/// are the message without the location.
+/// `textures` unless `shared` holds it already: its index there and its mean (what the light's
+/// selection weights count). Errors are the message without the location.
 pub(crate) fn emission_texture(
     t: &TextureDesc,
     factor: Vec3,
     base_dir: &Path,
     textures: &mut Vec<Arc<dyn LightTexture>>,
+    shared: &mut EmissionTextures,
 ) -> Result<(u32, Vec3), String> {
-    let (index, _) = load(t, "area", base_dir, textures)?;
-    if factor != Vec3::ONE {
-        let texture = textures[index as usize].clone();
-        textures[index as usize] = Arc::new(Scaled { texture, factor });
-    }
-    let mean = textures[index as usize].mean();
+    let (index, mean, max) = match shared.loaded.iter().find(|(d, ..)| d == t) {
+        Some(&(_, index, mean, max)) => (index, mean, max),
+        None => {
+            let texture = read(t, "area", base_dir)?;
+            let (mean, max) = (texture.mean(), texture.max());
+            textures.push(Arc::new(texture));
+            let index = textures.len() as u32 - 1;
+            shared.loaded.push((t.clone(), index, mean, max));
+            (index, mean, max)
+        }
+    };
+    let (mean, max) = (mean * factor, max * factor);
     if !mean.is_finite() || mean.min_element() < 0.0 {
         return Err(format!(
             "area emitter texture: its mean radiance {mean} must be finite and non-negative"
         ));
     }
-    Ok((index, mean))
+    if max.max_element() > restir_lights::MAX_EMISSION {
+        return Err(format!(
+            "area emitter texture: its brightest texel, {:e} (times the emission), exceeds the \
+             largest emission this renderer computes with, {:e} (products with geometry terms \
+             and sample weights would overflow)",
+            max.max_element(),
+            restir_lights::MAX_EMISSION
+        ));
+    }
+    if factor == Vec3::ONE {
+        return Ok((index, mean));
+    }
+    let texture = textures[index as usize].clone();
+    textures.push(Arc::new(Scaled { texture, factor }));
+    Ok((textures.len() as u32 - 1, mean))
 }
 
 /// A light's texture times a constant factor.
@@ -141,17 +171,23 @@ fn load(
     base_dir: &Path,
     textures: &mut Vec<Arc<dyn LightTexture>>,
 ) -> Result<(u32, (u32, u32)), String> {
-    if let TextureDesc::MeshAttribute { name, .. } = t {
-        return Err(format!(
-            "{plugin} emitter texture: a 'mesh_attribute' texture (\"{name}\") reads the mesh a \
-             ray hits and cannot be projected by a light; use a bitmap or checkerboard"
-        ));
-    }
-    let t = Texture::load(t, base_dir).map_err(|e| format!("{plugin} emitter texture: {e}"))?;
+    let t = read(t, plugin, base_dir)?;
     let resolution = match &t {
         Texture::Bitmap { width, height, .. } => (*width as u32, *height as u32),
         Texture::Checkerboard { .. } | Texture::MeshAttribute(_) => (1, 1),
     };
     textures.push(Arc::new(t));
     Ok((textures.len() as u32 - 1, resolution))
+}
+
+/// Reads texture `t` of a `plugin` emitter: a bitmap or a checkerboard (a mesh attribute is
+/// refused: a light cannot project it).
+fn read(t: &TextureDesc, plugin: &str, base_dir: &Path) -> Result<Texture, String> {
+    if let TextureDesc::MeshAttribute { name, .. } = t {
+        return Err(format!(
+            "{plugin} emitter texture: a 'mesh_attribute' texture (\"{name}\") reads the mesh a \
+             ray hits and cannot be projected by a light; use a bitmap or checkerboard"
+        ));
+    }
+    Texture::load(t, base_dir).map_err(|e| format!("{plugin} emitter texture: {e}"))
 }

@@ -334,6 +334,18 @@ impl Texture {
         }
     }
 
+    /// The largest value per channel (of the texels, or the checkerboard's two colours); zero for
+    /// a mesh attribute, whose values are the meshes'.
+    pub fn max(&self) -> Vec3 {
+        match self {
+            Texture::MeshAttribute(_) => Vec3::ZERO,
+            Texture::Checkerboard { color0, color1, .. } => color0.max(*color1),
+            Texture::Bitmap { texels, .. } => {
+                (0..texels.len()).fold(Vec3::ZERO, |m, i| m.max(texels.get(i)))
+            }
+        }
+    }
+
     /// The mean texel value (the average reflectance of a bitmap, or the checkerboard's); zero
     /// for a mesh attribute, whose values are the meshes'.
     pub fn mean(&self) -> Vec3 {

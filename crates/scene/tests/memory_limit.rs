@@ -238,3 +238,39 @@ fn an_image_beyond_the_limit_is_located() {
     load(&scene, Some(60 << 20)).unwrap();
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Area emitters that name the same radiance texture share one copy of its image, and the
+/// limit counts it once: three rectangles lit by one 512² image load under a limit that one
+/// copy fits in (3 MiB kept, 7 MiB more while decoding) and three do not (6 + 3 + 7 MiB), which
+/// three different images of that size exceed (the negative control).
+#[test]
+fn emitters_sharing_a_radiance_texture_count_it_once() {
+    let dir = temp_dir("shared-radiance");
+    for k in 0..3 {
+        let img = image::RgbImage::from_fn(512, 512, |x, y| {
+            image::Rgb([(x % 256) as u8, (y % 256) as u8, 40 * k as u8])
+        });
+        img.save(dir.join(format!("tex{k}.png"))).unwrap();
+    }
+    let scene = |files: [&str; 3]| {
+        let shapes: String = files
+            .iter()
+            .enumerate()
+            .map(|(k, f)| {
+                format!(
+                    "(geometry: Rectangle, to_world: [Translate(({k}, 0, 0))], emission: \
+                     Some((1, 1, 1)), emission_texture: Some(Bitmap(filename: \"{f}\"))), "
+                )
+            })
+            .collect();
+        let path = dir.join(format!("{}.ron", files.join("-")));
+        std::fs::write(&path, format!("{HEAD}shapes: [{shapes}])")).unwrap();
+        path
+    };
+    let limit = 15 << 20;
+    load(&scene(["tex0.png"; 3]), Some(limit)).unwrap();
+    let err = load(&scene(["tex0.png", "tex1.png", "tex2.png"]), Some(limit)).unwrap_err();
+    assert!(err.contains("tex2.png"), "{err}");
+    assert!(err.contains("emitter radiance texture"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

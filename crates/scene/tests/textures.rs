@@ -332,3 +332,48 @@ fn textured_mask_opacity() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Area emitters that name the same radiance texture share one loaded copy: the lights name
+/// one texture, and one with another factor wraps that copy (a texture of its own, the image
+/// not read again). Each light's radiance is the texture's mean times its factor.
+#[test]
+fn area_emitters_share_their_radiance_texture() {
+    let dir = dir_with_png("shared-radiance");
+    let shape = |x: i32, factor: f32| {
+        format!(
+            "(geometry: Rectangle, to_world: [Translate(({x}, 0, 0))], emission: Some(({factor}, \
+             {factor}, {factor})), emission_texture: Some(Bitmap(filename: \"quad.png\", raw: \
+             true))), "
+        )
+    };
+    let path = dir.join("shared.ron");
+    std::fs::write(
+        &path,
+        format!(
+            "(camera: (fov: 45), film: (width: 4, height: 4), shapes: [{}{}{}])",
+            shape(0, 1.0),
+            shape(3, 1.0),
+            shape(6, 2.0)
+        ),
+    )
+    .unwrap();
+    let scene = load_scene(&path, &LoadOptions::default()).unwrap().scene;
+    let lights: Vec<(Vec3, Option<u32>)> = scene
+        .lights
+        .lights()
+        .iter()
+        .filter_map(|l| match *l {
+            restir_lights::Light::Area {
+                radiance, texture, ..
+            } => Some((radiance, texture)),
+            _ => None,
+        })
+        .collect();
+    // Red, green, blue and white: the mean is 0.5 in each channel.
+    let mean = Vec3::splat(0.5);
+    assert_eq!(
+        lights,
+        [(mean, Some(0)), (mean, Some(0)), (2.0 * mean, Some(1))]
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -165,11 +165,12 @@ pub(super) struct ImageUse {
 
 /// Every image file the build of `desc` decodes, in the order it decodes them: the bitmap
 /// textures of the named materials, of the shapes' inline materials (each distinct texture
-/// once, as the build loads it), of area emitters, of spot lights and projectors, and the
-/// environment map.
+/// once, as the build loads it), of area emitters (each distinct radiance texture once), of
+/// spot lights and projectors, and the environment map.
 /// A named material's texture is placed at the first shape that uses the material.
 pub(super) fn images(desc: &SceneDesc, base_dir: &Path) -> Vec<ImageUse> {
     let mut seen: Vec<&TextureDesc> = Vec::new();
+    let mut emission_seen: Vec<&TextureDesc> = Vec::new();
     let mut out = Vec::new();
     let bitmap = |t: &TextureDesc, location: &Location, what: String, out: &mut Vec<ImageUse>| {
         if let TextureDesc::Bitmap { filename, .. } = t {
@@ -209,8 +210,11 @@ pub(super) fn images(desc: &SceneDesc, base_dir: &Path) -> Vec<ImageUse> {
                 }
             }
         }
-        // Each area emitter loads its own copy of its radiance texture.
-        if let Some(t) = &s.emission_texture {
+        // Area emitters that name the same radiance texture share one copy.
+        if let Some(t) = &s.emission_texture
+            && !emission_seen.contains(&t)
+        {
+            emission_seen.push(t);
             bitmap(
                 t,
                 &s.location,
