@@ -11,7 +11,11 @@ its own variance to every configuration's relMSE and pulls their ratios towards 
 Per scene, every configuration renders `--passes` passes (its own count) with each of two seeds,
 interleaved seed-major; its relative variance is the mean over pixels and channels of
 `(a − b)² / 2 / (m² + 0.01)`, `m` the mean of all renders of the scene (the same denominator for
-every configuration, as `restir compare`'s relMSE uses the reference); its time is the child's
+every configuration, as `restir compare`'s relMSE uses the reference; a bright outlier of a
+render raises `m` where it falls and so weighs less, and two configurations that render alike
+from the same seeds, one estimator from two builds, say, count their shared outliers twice in
+`m` and favour themselves against a third: compare such a third in MSE, which has no
+denominator); its time is the child's
 user + system CPU time minus its load time (`--stats`' `load_seconds`); its efficiency is
 1 / (relative variance × CPU seconds), which does not depend on the pass count when a pass's
 cost does not. Prints, per scene and as the median over scenes, each configuration's efficiency
