@@ -237,8 +237,10 @@ def main():
             ratios_mse.setdefault(label, []).append(eff_mse[label] / eff_mse[base])
         print(name)
         for (label, _, _), cell in zip(rows, cells):
-            print(f"    {cell}  eff {eff[label] / eff[base]:.2f}x "
-                  f"(MSE {eff_mse[label] / eff_mse[base]:.2f}x)", flush=True)
+            # Three significant digits: a ratio far below 1 (Mitsuba against ReSTIR, say) keeps
+            # its precision for ratios taken from these lines.
+            print(f"    {cell}  eff {eff[label] / eff[base]:.3g}x "
+                  f"(MSE {eff_mse[label] / eff_mse[base]:.3g}x)", flush=True)
         if a.bias:
             for label, _, _ in configs[1:]:
                 parts = [mean_difference(images[label][k], images[base][k]) for k in range(2)]
@@ -256,7 +258,10 @@ def main():
               f"({a.mitsuba_variant}, {a.threads} thread(s)):")
         for label, r in ratios.items():
             rel = [x / y for x, y in zip(r, ratios["mitsuba"])]
-            print(f"    {label}: {statistics.median(rel):.2f}x ({min(rel):.2f}-{max(rel):.2f})")
+            rel_mse = [x / y for x, y in zip(ratios_mse[label], ratios_mse["mitsuba"])]
+            print(f"    {label}: {statistics.median(rel):.2f}x ({min(rel):.2f}-{max(rel):.2f}); "
+                  f"MSE {statistics.median(rel_mse):.2f}x "
+                  f"({min(rel_mse):.2f}-{max(rel_mse):.2f})")
 
 
 if __name__ == "__main__":
