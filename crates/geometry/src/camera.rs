@@ -189,6 +189,12 @@ impl Camera {
         self.resolution
     }
 
+    /// The film's pixel count, `width × height` (the whole film, also where a render covers a
+    /// part of it: what the estimators' film-size defaults ask about).
+    pub fn pixel_count(&self) -> u64 {
+        u64::from(self.resolution.0) * u64::from(self.resolution.1)
+    }
+
     /// The angle one pixel spans at the centre of the film, vertically (radians, small-angle):
     /// the spread of a primary ray's cone (for an orthographic camera, the pixel's width in
     /// camera units over a unit distance: its rays do not spread).

@@ -166,18 +166,16 @@ impl AutoIntegrator {
             Choice::Path => Box::new(PathIntegrator { settings: path }),
             Choice::RestirDi => {
                 let mut s = RestirDiSettings::new(path);
-                let (w, h) = scene.camera.resolution();
                 s.resolve(
                     &scene.features,
                     &crate::film::Reconstruction::decide(scene.filter),
-                    u64::from(w) * u64::from(h),
+                    scene.camera.pixel_count(),
                 );
                 Box::new(RestirDiIntegrator::new(s))
             }
             Choice::RestirPt => {
                 let mut s = RestirPtSettings::new(path);
-                let (w, h) = scene.camera.resolution();
-                s.resolve(&scene.features, u64::from(w) * u64::from(h));
+                s.resolve(&scene.features, scene.camera.pixel_count());
                 Box::new(RestirPtIntegrator::new(s))
             }
         };

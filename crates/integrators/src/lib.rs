@@ -243,11 +243,10 @@ pub fn make_integrator(
         "restir-di" => {
             let mut s = RestirDiSettings::new(settings);
             let unused = s.apply(&params)?;
-            let (w, h) = scene.camera.resolution();
             s.resolve(
                 &scene.features,
                 &film::Reconstruction::decide(scene.filter),
-                u64::from(w) * u64::from(h),
+                scene.camera.pixel_count(),
             );
             notes.extend(s.reuse.pair_neighbors());
             (Box::new(RestirDiIntegrator::new(s)), unused)
@@ -255,8 +254,7 @@ pub fn make_integrator(
         "restir-pt" => {
             let mut s = RestirPtSettings::new(settings);
             let unused = s.apply(&params)?;
-            let (w, h) = scene.camera.resolution();
-            s.resolve(&scene.features, u64::from(w) * u64::from(h));
+            s.resolve(&scene.features, scene.camera.pixel_count());
             notes.extend(s.reuse.pair_neighbors());
             (Box::new(RestirPtIntegrator::new(s)), unused)
         }

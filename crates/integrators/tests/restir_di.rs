@@ -415,11 +415,10 @@ fn raised_edge_rays_on_a_splatting_film_unbiased() {
     let mut settings = RestirDiSettings::new(restir_integrators::path::PathSettings::from_desc(
         &scene.integrator,
     ));
-    let (w, h) = scene.scene.camera.resolution();
     settings.resolve(
         &scene.scene.features,
         &restir_integrators::film::Reconstruction::decide(scene.scene.filter),
-        u64::from(w) * u64::from(h),
+        scene.scene.camera.pixel_count(),
     );
     let integrator = RestirDiIntegrator::new(settings);
     common::render_with(&scene, &integrator, 1, 0);

@@ -6,7 +6,7 @@
 //! to [`LEARN_MAX_EMITTERS`] emitters) and, from the source, the candidate count
 //! ([`TILE_CANDIDATES`] for the tiles' cuts).
 
-use crate::reuse::params::{NEIGHBOR_NAMES, RADIUS_NAMES, ReuseParams};
+use crate::reuse::params::{NEIGHBOR_NAMES, RADIUS_NAMES, ReuseParams, large_film_label};
 use restir_scene::SceneFeatures;
 
 use crate::film::Reconstruction;
@@ -493,14 +493,7 @@ impl RestirDiSettings {
     /// `neighbors=N`, with why when [`RestirDiSettings::resolve`] raised it, for the settings
     /// line.
     pub fn neighbors_label(&self) -> String {
-        if self.neighbors_raised {
-            format!(
-                "neighbors={} (auto: a film of at least 1280×720 pixels)",
-                self.reuse.neighbors
-            )
-        } else {
-            format!("neighbors={}", self.reuse.neighbors)
-        }
+        large_film_label("neighbors", self.reuse.neighbors, self.neighbors_raised)
     }
 
     /// `radius=R`, with why when [`RestirDiSettings::resolve`] widened it, for the settings

@@ -3,7 +3,7 @@
 
 use crate::params::{Param, ParamError, ParamProblem, ParamSet};
 use crate::path::PathSettings;
-use crate::reuse::params::{LARGE_FILM_PIXELS, RADIUS_NAMES, ReuseParams};
+use crate::reuse::params::{LARGE_FILM_PIXELS, RADIUS_NAMES, ReuseParams, large_film_label};
 use crate::reuse::settings::ReuseSettings;
 
 use super::sample::{Reconnection, ShiftKind};
@@ -175,14 +175,7 @@ impl RestirPtSettings {
     /// `radius=R`, with why when [`RestirPtSettings::resolve`] widened it, for the settings
     /// line.
     pub fn radius_label(&self) -> String {
-        if self.radius_widened {
-            format!(
-                "radius={} (auto: a film of at least 1280×720 pixels)",
-                self.reuse.radius
-            )
-        } else {
-            format!("radius={}", self.reuse.radius)
-        }
+        large_film_label("radius", self.reuse.radius, self.radius_widened)
     }
 
     /// Whether the estimator is unbiased with these settings.

@@ -20,6 +20,16 @@ impl Param {
 /// the same radius in pixels.
 pub const LARGE_FILM_PIXELS: u64 = 1280 * 720;
 
+/// `name=value` for the settings line, with why when a film of at least [`LARGE_FILM_PIXELS`]
+/// decided the value (`decided`).
+pub fn large_film_label(name: &str, value: impl std::fmt::Display, decided: bool) -> String {
+    if decided {
+        format!("{name}={value} (auto: a film of at least 1280×720 pixels)")
+    } else {
+        format!("{name}={value}")
+    }
+}
+
 /// The names of the spatial radius ([`ReuseSettings::radius`]).
 pub const RADIUS_NAMES: &[&str] = &["radius", "max_radius", "spatial_radius"];
 
