@@ -61,6 +61,17 @@ pub enum BsdfKind {
         /// Multiplier of transmission (default 1).
         specular_transmittance: Vec3,
     },
+    /// A sheet of glass too thin to offset what it transmits (Mitsuba `thindielectric`): delta
+    /// reflection with the reflectance of both faces and the light bounced between them, and
+    /// transmission straight through; the same from both sides.
+    ThinDielectric {
+        /// Relative IOR `int_ior / ext_ior`.
+        eta: f32,
+        /// Multiplier of reflection (default 1).
+        specular_reflectance: Vec3,
+        /// Multiplier of transmission (default 1).
+        specular_transmittance: Vec3,
+    },
     /// Rough dielectric interface (Mitsuba `roughdielectric`, Walter et al. 2007).
     RoughDielectric {
         /// Relative IOR `int_ior / ext_ior`.
@@ -95,6 +106,7 @@ impl BsdfKind {
     pub fn transmits(&self) -> bool {
         match self {
             BsdfKind::Dielectric { .. }
+            | BsdfKind::ThinDielectric { .. }
             | BsdfKind::RoughDielectric { .. }
             | BsdfKind::Null
             | BsdfKind::PrincipledThin(_) => true,
@@ -204,6 +216,20 @@ impl Bsdf {
         })
     }
 
+    /// A thin dielectric sheet with relative IOR `eta = int_ior / ext_ior` (Mitsuba
+    /// `thindielectric`).
+    pub fn thin_dielectric(
+        eta: f32,
+        specular_reflectance: Vec3,
+        specular_transmittance: Vec3,
+    ) -> Self {
+        one_sided(BsdfKind::ThinDielectric {
+            eta,
+            specular_reflectance,
+            specular_transmittance,
+        })
+    }
+
     /// A rough dielectric interface with relative IOR `eta = int_ior / ext_ior`.
     pub fn rough_dielectric(
         eta: f32,
@@ -307,6 +333,11 @@ impl Bsdf {
                 specular_reflectance: p.specular,
                 specular_transmittance: p.transmittance,
             },
+            BsdfKind::ThinDielectric { eta, .. } => BsdfKind::ThinDielectric {
+                eta,
+                specular_reflectance: p.specular,
+                specular_transmittance: p.transmittance,
+            },
             BsdfKind::RoughDielectric {
                 eta, microfacet, ..
             } => BsdfKind::RoughDielectric {
@@ -382,7 +413,9 @@ impl Bsdf {
             BsdfKind::Diffuse { .. } => REFLECT_DIFFUSE,
             BsdfKind::Conductor { .. } => REFLECT_DELTA,
             BsdfKind::RoughConductor { .. } => REFLECT_GLOSSY,
-            BsdfKind::Dielectric { .. } => REFLECT_DELTA | LobeFlags::TRANSMISSION,
+            BsdfKind::Dielectric { .. } | BsdfKind::ThinDielectric { .. } => {
+                REFLECT_DELTA | LobeFlags::TRANSMISSION
+            }
             BsdfKind::RoughDielectric { .. } => REFLECT_GLOSSY | LobeFlags::TRANSMISSION,
             BsdfKind::Plastic(_) => REFLECT_DELTA | LobeFlags::DIFFUSE,
             BsdfKind::RoughPlastic(_) => REFLECT_GLOSSY | LobeFlags::DIFFUSE,
@@ -479,6 +512,7 @@ impl Bsdf {
             BsdfKind::Blend(b) => blend::eval(b, v, l),
             BsdfKind::Conductor { .. }
             | BsdfKind::Dielectric { .. }
+            | BsdfKind::ThinDielectric { .. }
             | BsdfKind::Null
             | BsdfKind::Black => Vec3::ZERO,
         })
@@ -524,6 +558,7 @@ impl Bsdf {
             BsdfKind::Blend(b) => blend::pdf(b, v, l),
             BsdfKind::Conductor { .. }
             | BsdfKind::Dielectric { .. }
+            | BsdfKind::ThinDielectric { .. }
             | BsdfKind::Null
             | BsdfKind::Black => 0.0,
         })
@@ -604,6 +639,17 @@ impl Bsdf {
                 v,
                 u_lobe,
             ),
+            BsdfKind::ThinDielectric {
+                eta,
+                specular_reflectance,
+                specular_transmittance,
+            } => dielectric::sample_thin(
+                *eta,
+                *specular_reflectance,
+                *specular_transmittance,
+                v,
+                u_lobe,
+            ),
             BsdfKind::RoughDielectric {
                 eta,
                 specular_reflectance,
@@ -662,6 +708,10 @@ mod tests {
                     Bsdf::rough_conductor(eta, k, s1, mf),
                 ),
                 (Bsdf::dielectric(1.5, s0, t0), Bsdf::dielectric(1.5, s1, t1)),
+                (
+                    Bsdf::thin_dielectric(1.5, s0, t0),
+                    Bsdf::thin_dielectric(1.5, s1, t1),
+                ),
                 (
                     Bsdf::rough_dielectric(1.5, s0, t0, mf),
                     Bsdf::rough_dielectric(1.5, s1, t1, mf),

@@ -334,6 +334,14 @@ fn cases() -> Vec<Case> {
             eta: 1.333,
         });
     }
+    // Appended last, so the cases above keep their random streams.
+    v.push(Case {
+        name: "thin dielectric bk7",
+        bsdf: Bsdf::thin_dielectric(glass, Vec3::ONE, Vec3::ONE),
+        mass: Mass::AtMostOne,
+        albedo: Some(Vec3::ONE),
+        eta: 1.0,
+    });
     v
 }
 

@@ -354,6 +354,16 @@ fn bsdf_in(m: &MaterialDesc, spec_trans_textured: bool) -> Result<Bsdf> {
             unit_color("specular_reflectance", specular_reflectance)?,
             unit_color("specular_transmittance", specular_transmittance)?,
         ),
+        MaterialDesc::ThinDielectric {
+            int_ior,
+            ext_ior,
+            specular_reflectance,
+            specular_transmittance,
+        } => Bsdf::thin_dielectric(
+            relative_ior(*int_ior, *ext_ior)?,
+            unit_color("specular_reflectance", specular_reflectance)?,
+            unit_color("specular_transmittance", specular_transmittance)?,
+        ),
         MaterialDesc::RoughDielectric {
             int_ior,
             ext_ior,
@@ -525,7 +535,9 @@ pub(crate) fn color_params(m: &MaterialDesc) -> &'static [ColorParam] {
         MaterialDesc::Diffuse { .. } => &[Reflectance],
         MaterialDesc::Conductor { .. } => &[SpecularReflectance],
         MaterialDesc::RoughConductor { .. } => &[SpecularReflectance, Alpha, AlphaU, AlphaV],
-        MaterialDesc::Dielectric { .. } => &[SpecularReflectance, SpecularTransmittance],
+        MaterialDesc::Dielectric { .. } | MaterialDesc::ThinDielectric { .. } => {
+            &[SpecularReflectance, SpecularTransmittance]
+        }
         MaterialDesc::RoughDielectric { .. } => &[
             SpecularReflectance,
             SpecularTransmittance,
@@ -663,6 +675,11 @@ pub(crate) fn colors(m: &MaterialDesc) -> (ReflectanceParams, &[TextureBinding])
             ..
         } => p.specular = v3(specular_reflectance),
         MaterialDesc::Dielectric {
+            specular_reflectance,
+            specular_transmittance,
+            ..
+        }
+        | MaterialDesc::ThinDielectric {
             specular_reflectance,
             specular_transmittance,
             ..

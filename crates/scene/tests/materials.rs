@@ -65,6 +65,21 @@ fn defaults_are_mitsubas() {
         BsdfKind::Dielectric { eta, .. } => assert!((eta - 1.5046 / 1.000_277).abs() < 1e-6),
         k => panic!("{k:?}"),
     }
+    match built(
+        r#"<bsdf type="thindielectric" id="m"><string name="int_ior" value="water"/>
+           <rgb name="specular_transmittance" value="0.5, 0.6, 0.7"/></bsdf>"#,
+    ) {
+        BsdfKind::ThinDielectric {
+            eta,
+            specular_reflectance,
+            specular_transmittance,
+        } => {
+            assert!((eta - 1.333 / 1.000_277).abs() < 1e-6);
+            assert_eq!(specular_reflectance, glam::Vec3::ONE);
+            assert_eq!(specular_transmittance, glam::Vec3::new(0.5, 0.6, 0.7));
+        }
+        k => panic!("{k:?}"),
+    }
     match built(r#"<bsdf type="roughplastic" id="m"/>"#) {
         BsdfKind::RoughPlastic(p) => {
             assert!((p.eta - 1.49 / 1.000_277).abs() < 1e-6);
@@ -212,9 +227,14 @@ fn bad_values_are_errors_with_file_and_line() {
             "distribution",
         ),
         (
-            r#"<bsdf type="thindielectric" id="m"/>"#,
+            r#"<bsdf type="twosided" id="m"><bsdf type="thindielectric"/></bsdf>"#,
             "t.xml:3",
-            "not supported",
+            "twosided",
+        ),
+        (
+            r#"<bsdf type="thindielectric" id="m"><rgb name="specular_transmittance" value="1.5"/></bsdf>"#,
+            "t.xml:3",
+            "[0, 1]",
         ),
         (
             r#"<bsdf type="twosided" id="m"><bsdf type="dielectric"/></bsdf>"#,

@@ -84,6 +84,10 @@ fn as_written(desc: &SceneDesc) -> SceneDesc {
                                 specular_reflectance,
                                 ..
                             }
+                            | MaterialDesc::ThinDielectric {
+                                specular_reflectance,
+                                ..
+                            }
                             | MaterialDesc::RoughDielectric {
                                 specular_reflectance,
                                 ..
@@ -100,6 +104,10 @@ fn as_written(desc: &SceneDesc) -> SceneDesc {
                         ) => *specular_reflectance = default,
                         (
                             MaterialDesc::Dielectric {
+                                specular_transmittance,
+                                ..
+                            }
+                            | MaterialDesc::ThinDielectric {
                                 specular_transmittance,
                                 ..
                             }
@@ -223,6 +231,7 @@ const EVERYTHING: &str = r#"(
                                             roughness: (distribution: ggx, alpha_u: Some(0.05), alpha_v: Some(0.3)))),
         (name: "g", material: Dielectric(int_ior: 1.33, ext_ior: 1.0, specular_transmittance: (0.9, 1, 1))),
         (name: "rg", material: RoughDielectric(roughness: (alpha: 0.2))),
+        (name: "tg", material: ThinDielectric(int_ior: 1.33, specular_reflectance: (0.8, 0.9, 1))),
         (name: "p", material: Plastic(diffuse_reflectance: (0.1, 0.5, 0.2), nonlinear: true)),
         (name: "rp", material: RoughPlastic(int_ior: 1.6, roughness: (distribution: ggx, alpha: 0.3))),
         (name: "n", material: Null),
@@ -249,6 +258,7 @@ const EVERYTHING: &str = r#"(
         (geometry: Obj(filename: "textured/quad.obj"), to_world: [Translate((0, 1, -2))], material: Some(Ref("p")), face_normals: true),
         (geometry: Ply(filename: "textured/quad.ply"), to_world: [Translate((1, 1, -2))], material: Some(Ref("rp"))),
         (geometry: Rectangle, to_world: [Translate((0, 2, -2))], material: Some(Ref("n"))),
+        (geometry: Rectangle, to_world: [Translate((0, -2, -2))], material: Some(Ref("tg"))),
         (geometry: Rectangle, to_world: [Translate((2, 2, -2))], material: Some(Ref("b"))),
         (geometry: Rectangle, to_world: [Translate((-2, 2, -2))], material: Some(Ref("two"))),
         (geometry: Rectangle, to_world: [Translate((-2, 0, -2))], material: Some(Ref("c"))),

@@ -43,6 +43,50 @@ pub(crate) fn sample_smooth(
     }
 }
 
+/// The thin dielectric's reflectance: a sheet's two faces reflect `r` each, and the light bounced
+/// between them adds `t·r·t / (1 − r²)` (`t = 1 − r`), `2r / (1 + r)` in all, with `r` the
+/// Fresnel reflectance of the angle `v` makes with the sheet (from either side).
+#[inline]
+pub(crate) fn thin_reflectance(eta: f32, v: Vec3) -> f32 {
+    let r = fresnel_dielectric(v.z.abs(), eta).r;
+    r * 2.0 / (1.0 + r)
+}
+
+/// The thin dielectric's sample (Mitsuba `thindielectric`): a sheet of glass too thin to offset
+/// the light it lets through. Reflection with probability [`thin_reflectance`], else straight
+/// through (`−v`, no refraction and no radiance scale), each weighted by its multiplier alone.
+#[inline]
+pub(crate) fn sample_thin(
+    eta: f32,
+    specular_reflectance: Vec3,
+    specular_transmittance: Vec3,
+    v: Vec3,
+    u_lobe: f32,
+) -> Option<BsdfSample> {
+    if v.z == 0.0 {
+        return None;
+    }
+    let r = thin_reflectance(eta, v);
+    if u_lobe < r {
+        Some(delta(
+            mirror(v),
+            specular_reflectance * r,
+            r,
+            REFLECT_DELTA,
+            1.0,
+        ))
+    } else {
+        let t = 1.0 - r;
+        Some(delta(
+            -v,
+            specular_transmittance * t,
+            t,
+            TRANSMIT_DELTA,
+            1.0,
+        ))
+    }
+}
+
 /// The generalised half vector of a rough dielectric (Walter et al. 2007), in `+z`; `None` if
 /// degenerate. Returns `(m, reflect, η')` with `η'` the relative IOR seen from `v`'s side.
 #[inline]

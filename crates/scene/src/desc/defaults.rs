@@ -219,6 +219,7 @@ mod tests {
     fn ron_and_xml_share_the_defaults() {
         let ron = ron_materials(&[
             "Dielectric()",
+            "ThinDielectric()",
             "RoughDielectric()",
             "Plastic()",
             "RoughPlastic()",
@@ -226,7 +227,7 @@ mod tests {
             "RoughConductor()",
         ]);
         let xml = r#"<scene><sensor type="perspective"/>
-            <bsdf type="dielectric"/><bsdf type="roughdielectric"/><bsdf type="plastic"/>
+            <bsdf type="dielectric"/><bsdf type="thindielectric"/><bsdf type="roughdielectric"/><bsdf type="plastic"/>
             <bsdf type="roughplastic"/><bsdf type="conductor"/><bsdf type="roughconductor"/>
             </scene>"#;
         let (desc, _) = crate::xml::parse_xml(xml, "t.xml".as_ref(), &[]).unwrap();

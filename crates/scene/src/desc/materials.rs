@@ -117,6 +117,23 @@ pub enum MaterialDesc {
         #[serde(default = "defaults::specular")]
         specular_transmittance: V3,
     },
+    /// A sheet of glass too thin to offset what it transmits (Mitsuba `thindielectric`):
+    /// delta reflection with the reflectance of both faces and the light bounced between them,
+    /// transmission straight through, the same from both sides (windows modelled as one face).
+    ThinDielectric {
+        /// IOR inside (default 1.5046, `bk7`).
+        #[serde(default = "defaults::bk7_ior")]
+        int_ior: f32,
+        /// IOR outside (default 1.000277, `air`).
+        #[serde(default = "defaults::air_ior")]
+        ext_ior: f32,
+        /// Reflection multiplier in `[0, 1]` (default 1).
+        #[serde(default = "defaults::specular")]
+        specular_reflectance: V3,
+        /// Transmission multiplier in `[0, 1]` (default 1).
+        #[serde(default = "defaults::specular")]
+        specular_transmittance: V3,
+    },
     /// Rough dielectric interface (microfacet), from both sides.
     RoughDielectric {
         /// IOR inside (default 1.5046, `bk7`).

@@ -19,6 +19,7 @@ const BSDF_TYPES: &[&str] = &[
     "roughconductor",
     "dielectric",
     "roughdielectric",
+    "thindielectric",
     "plastic",
     "roughplastic",
     "null",
@@ -45,7 +46,7 @@ impl<'a> Importer<'a> {
             return self.blendbsdf(node, props);
         }
         // An unknown plugin is named before its parameters are looked at.
-        if !BSDF_TYPES.contains(&ty.as_str()) && ty != "thindielectric" {
+        if !BSDF_TYPES.contains(&ty.as_str()) {
             return Err(self.unknown_type(node, "bsdf", &ty, BSDF_TYPES));
         }
         let textured = self.texture_bindings(node, &ty, &props)?;
@@ -57,17 +58,13 @@ impl<'a> Importer<'a> {
             },
             "twosided" => self.twosided(node)?,
             "conductor" | "roughconductor" => self.conductor(node, &ty, &props)?,
-            "dielectric" | "roughdielectric" => self.dielectric(node, &ty, &props)?,
+            "dielectric" | "roughdielectric" | "thindielectric" => {
+                self.dielectric(node, &ty, &props)?
+            }
             "plastic" | "roughplastic" => self.plastic(node, &ty, &props)?,
             "null" => MaterialDesc::Null,
             "principled" | "principledthin" => self.principled(node, &ty, &props)?,
             "mask" => return self.mask(node, props, textured),
-            "thindielectric" => {
-                return Err(self.err(
-                    node,
-                    "bsdf 'thindielectric' is not supported yet (use 'dielectric' on a closed shape)",
-                ));
-            }
             other => return Err(self.unknown_type(node, "bsdf", other, BSDF_TYPES)),
         };
         let m = self.bind_textures(&ty, m, textured)?;
@@ -207,11 +204,12 @@ impl<'a> Importer<'a> {
             inner,
             MaterialDesc::Dielectric { .. }
                 | MaterialDesc::RoughDielectric { .. }
+                | MaterialDesc::ThinDielectric { .. }
                 | MaterialDesc::Null
         ) {
             return Err(self.err(
                 node,
-                "twosided cannot wrap a transmitting bsdf (dielectric, roughdielectric, null), as in Mitsuba",
+                "twosided cannot wrap a transmitting bsdf (dielectric, roughdielectric, thindielectric, null), as in Mitsuba",
             ));
         }
         Ok(MaterialDesc::TwoSided(Box::new(inner)))
@@ -305,7 +303,7 @@ impl<'a> Importer<'a> {
         })
     }
 
-    /// `dielectric` and `roughdielectric`.
+    /// `dielectric`, `roughdielectric` and `thindielectric`.
     fn dielectric(&self, node: Node, ty: &str, props: &Props) -> Result<MaterialDesc> {
         let int_ior = props.ior("int_ior", defaults::BK7_IOR)?;
         let ext_ior = props.ior("ext_ior", defaults::AIR_IOR)?;
@@ -317,6 +315,13 @@ impl<'a> Importer<'a> {
             .unwrap_or(defaults::SPECULAR);
         Ok(if ty == "dielectric" {
             MaterialDesc::Dielectric {
+                int_ior,
+                ext_ior,
+                specular_reflectance,
+                specular_transmittance,
+            }
+        } else if ty == "thindielectric" {
+            MaterialDesc::ThinDielectric {
                 int_ior,
                 ext_ior,
                 specular_reflectance,

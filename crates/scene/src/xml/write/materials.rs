@@ -201,6 +201,12 @@ impl Writer<'_> {
                 specular_reflectance,
                 specular_transmittance,
             }
+            | MaterialDesc::ThinDielectric {
+                int_ior,
+                ext_ior,
+                specular_reflectance,
+                specular_transmittance,
+            }
             | MaterialDesc::RoughDielectric {
                 int_ior,
                 ext_ior,
@@ -212,10 +218,10 @@ impl Writer<'_> {
                     MaterialDesc::RoughDielectric { roughness, .. } => Some(roughness),
                     _ => None,
                 };
-                let ty = if rough.is_some() {
-                    "roughdielectric"
-                } else {
-                    "dielectric"
+                let ty = match m {
+                    MaterialDesc::RoughDielectric { .. } => "roughdielectric",
+                    MaterialDesc::ThinDielectric { .. } => "thindielectric",
+                    _ => "dielectric",
                 };
                 self.open(&format!(r#"<bsdf type="{ty}"{id_attr}>"#));
                 self.float("int_ior", *int_ior);
