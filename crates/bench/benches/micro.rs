@@ -7,9 +7,9 @@
 //! evaluations per second for `bsdf` and `lights`.
 //!
 //! - `bvh`: closest-hit (`Accel::intersect`) and shadow (`Accel::occluded`) rays on the Cornell
-//!   box, on the indirect room and, when the scene corpus is next to the repository
-//!   (`../shared/corpus/restir_test_scene/test.xml`: PLY bunnies and 100+ sphere lights), on that
-//!   bigger scene. *Coherent* rays are the camera rays of a 64×64 image in raster order;
+//!   box, on the indirect room and, when the scene corpus is next to the repository, on two
+//!   bigger scenes (`../shared/corpus/restir_test_scene/test.xml`: PLY bunnies and 100+ sphere
+//!   lights; `../shared/corpus/lajolla/sponza/sponza.xml`: 66 000 triangles of architecture). *Coherent* rays are the camera rays of a 64×64 image in raster order;
 //!   *incoherent* rays start at those rays' primary hits and go in uniformly random directions;
 //!   *shadow* rays join random pairs of primary hits (finite `t_max`, any hit ends the
 //!   traversal).
@@ -132,10 +132,11 @@ mod bvh {
                 "restir_test_scene",
                 repo("../shared/corpus/restir_test_scene/test.xml"),
             ),
+            ("sponza", repo("../shared/corpus/lajolla/sponza/sponza.xml")),
         ]
     }
 
-    const SCENES: [&str; 3] = ["cornell-box", "indirect-room", "restir_test_scene"];
+    const SCENES: [&str; 4] = ["cornell-box", "indirect-room", "restir_test_scene", "sponza"];
 
     fn setup(name: &str) -> Option<Rays> {
         let (_, path) = scenes().into_iter().find(|(n, _)| *n == name)?;
