@@ -136,7 +136,12 @@ mod bvh {
         ]
     }
 
-    const SCENES: [&str; 4] = ["cornell-box", "indirect-room", "restir_test_scene", "sponza"];
+    const SCENES: [&str; 4] = [
+        "cornell-box",
+        "indirect-room",
+        "restir_test_scene",
+        "sponza",
+    ];
 
     fn setup(name: &str) -> Option<Rays> {
         let (_, path) = scenes().into_iter().find(|(n, _)| *n == name)?;
