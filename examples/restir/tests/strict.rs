@@ -53,8 +53,8 @@ fn unknown_plugin_types_list_the_valid_ones() {
         &["render", s(&sc), "-o", s(&dir.0.join("o.exr"))],
         &format!(
             "error: {}:2: unknown bsdf type 'velvet' (known: diffuse, twosided, conductor, \
-             roughconductor, dielectric, roughdielectric, plastic, roughplastic, null, mask, normalmap, \
-             principled, principledthin, bumpmap, blendbsdf)",
+             roughconductor, dielectric, roughdielectric, thindielectric, plastic, roughplastic, \
+             null, mask, normalmap, principled, principledthin, bumpmap, blendbsdf)",
             s(&sc)
         ),
     );
