@@ -16,10 +16,34 @@
 
 mod common;
 
-use std::sync::atomic::AtomicBool;
-
-use restir_integrators::{IntegratorOptions, RenderJob, make_integrator, render};
+use restir_integrators::{IntegratorOptions, make_integrator};
 use restir_scene::parse_ron;
+
+/// Mean and standard error over `pixels` of the scene `ron` rendered by its integrator (256
+/// passes, seed `seed`).
+fn pixel_mean(ron: &str, pixels: &[(u32, u32)], seed: u64) -> (f64, f64) {
+    let desc = parse_ron(ron, "furnace.ron".as_ref()).unwrap();
+    let scene = common::build(&desc, ".".as_ref(), "furnace.ron".as_ref());
+    let integrator = make_integrator(&scene, &scene.integrator, &IntegratorOptions::default())
+        .unwrap()
+        .integrator;
+    let image = common::render_with(&scene, integrator.as_ref(), 256, seed);
+    let vals: Vec<f64> = pixels
+        .iter()
+        .map(|&(x, y)| image.get(x, y).x as f64)
+        .collect();
+    let n = vals.len() as f64;
+    let mean = vals.iter().sum::<f64>() / n;
+    let var = vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
+/// The pixels `lo..hi` in both directions.
+fn square(lo: u32, hi: u32) -> Vec<(u32, u32)> {
+    (lo..hi)
+        .flat_map(|y| (lo..hi).map(move |x| (x, y)))
+        .collect()
+}
 
 /// Mean and standard error over the pixels covered by a unit sphere of `material` (RON), seen
 /// under a constant environment of radiance 1.
@@ -33,33 +57,8 @@ fn furnace(material: &str, max_depth: i32, seed: u64) -> (f64, f64) {
         lights: [Constant(radiance: (1, 1, 1))],
     )"#
     );
-    let desc = parse_ron(&ron, "furnace.ron".as_ref()).unwrap();
-    let scene = common::build(&desc, ".".as_ref(), "furnace.ron".as_ref());
-    let integrator = make_integrator(&scene, &scene.integrator, &IntegratorOptions::default())
-        .unwrap()
-        .integrator;
-    let settings = RenderJob {
-        spp: 256,
-        seed,
-        ..RenderJob::default()
-    };
-    let out = render(
-        &scene,
-        integrator.as_ref(),
-        &settings,
-        &AtomicBool::new(false),
-        &mut |_, _| {},
-    );
-    assert_eq!(out.nonfinite_pixels, 0);
     // The sphere (radius 1 at distance 5, fov 20°) covers the central 8×8 pixels entirely.
-    let vals: Vec<f64> = (4..12)
-        .flat_map(|y| (4..12).map(move |x| (x, y)))
-        .map(|(x, y)| out.image.get(x, y).x as f64)
-        .collect();
-    let n = vals.len() as f64;
-    let mean = vals.iter().sum::<f64>() / n;
-    let var = vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, (var / n).sqrt())
+    pixel_mean(&ron, &square(4, 12), seed)
 }
 
 #[test]
@@ -131,32 +130,7 @@ fn through_pane(material: &str, integrator: &str, seed: u64) -> (f64, f64) {
         lights: [Constant(radiance: (1, 1, 1))],
     )"#
     );
-    let desc = parse_ron(&ron, "pane.ron".as_ref()).unwrap();
-    let scene = common::build(&desc, ".".as_ref(), "pane.ron".as_ref());
-    let integrator = make_integrator(&scene, &scene.integrator, &IntegratorOptions::default())
-        .unwrap()
-        .integrator;
-    let settings = RenderJob {
-        spp: 256,
-        seed,
-        ..RenderJob::default()
-    };
-    let out = render(
-        &scene,
-        integrator.as_ref(),
-        &settings,
-        &AtomicBool::new(false),
-        &mut |_, _| {},
-    );
-    assert_eq!(out.nonfinite_pixels, 0);
-    let vals: Vec<f64> = (0..16)
-        .flat_map(|y| (0..16).map(move |x| (x, y)))
-        .map(|(x, y)| out.image.get(x, y).x as f64)
-        .collect();
-    let n = vals.len() as f64;
-    let mean = vals.iter().sum::<f64>() / n;
-    let var = vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    (mean, (var / n).sqrt())
+    pixel_mean(&ron, &square(0, 16), seed)
 }
 
 /// A thin pane that reflects nothing transmits `1 − 2r/(1 + r)` of what is behind it at

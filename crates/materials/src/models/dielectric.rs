@@ -12,6 +12,29 @@ use crate::fresnel::{fresnel_dielectric, reflect, refract};
 use crate::lobe::{REFLECT_DELTA, REFLECT_GLOSSY, TRANSMIT_DELTA, TRANSMIT_GLOSSY};
 use crate::microfacet::Microfacet;
 
+/// A smooth interface's sample: the mirror direction with probability `r` (weighted by `ks`),
+/// else the transmitted direction `wt` (weighted by `kt` times the radiance scale `scale`, and
+/// seen through relative IOR `eta_t`).
+#[inline]
+#[allow(clippy::too_many_arguments)] // the two lobes' directions, weights and IOR
+fn reflect_or_transmit(
+    u_lobe: f32,
+    r: f32,
+    v: Vec3,
+    ks: Vec3,
+    wt: Vec3,
+    kt: Vec3,
+    scale: f32,
+    eta_t: f32,
+) -> BsdfSample {
+    if u_lobe < r {
+        delta(mirror(v), ks * r, r, REFLECT_DELTA, 1.0)
+    } else {
+        let t = 1.0 - r;
+        delta(wt, kt * (scale * t), t, TRANSMIT_DELTA, eta_t)
+    }
+}
+
 /// The smooth dielectric's sample: reflection with probability `F`, else refraction (radiance
 /// scaled by `1/η'²`); `None` for a grazing `v`.
 #[inline]
@@ -26,21 +49,18 @@ pub(crate) fn sample_smooth(
         return None;
     }
     let fr = fresnel_dielectric(v.z, eta);
-    if u_lobe < fr.r {
-        Some(delta(
-            mirror(v),
-            specular_reflectance * fr.r,
-            fr.r,
-            REFLECT_DELTA,
-            1.0,
-        ))
-    } else {
-        let wi = Vec3::new(-fr.eta_ti * v.x, -fr.eta_ti * v.y, fr.cos_theta_t);
-        // Radiance scales by 1/η² across the interface (η_ti = 1/η_it).
-        let t = 1.0 - fr.r;
-        let f = specular_transmittance * (fr.eta_ti * fr.eta_ti * t);
-        Some(delta(wi, f, t, TRANSMIT_DELTA, fr.eta_it))
-    }
+    let wt = Vec3::new(-fr.eta_ti * v.x, -fr.eta_ti * v.y, fr.cos_theta_t);
+    // Radiance scales by 1/η² across the interface (η_ti = 1/η_it).
+    Some(reflect_or_transmit(
+        u_lobe,
+        fr.r,
+        v,
+        specular_reflectance,
+        wt,
+        specular_transmittance,
+        fr.eta_ti * fr.eta_ti,
+        fr.eta_it,
+    ))
 }
 
 /// The thin dielectric's reflectance: a sheet's two faces reflect `r` each, and the light bounced
@@ -66,25 +86,16 @@ pub(crate) fn sample_thin(
     if v.z == 0.0 {
         return None;
     }
-    let r = thin_reflectance(eta, v);
-    if u_lobe < r {
-        Some(delta(
-            mirror(v),
-            specular_reflectance * r,
-            r,
-            REFLECT_DELTA,
-            1.0,
-        ))
-    } else {
-        let t = 1.0 - r;
-        Some(delta(
-            -v,
-            specular_transmittance * t,
-            t,
-            TRANSMIT_DELTA,
-            1.0,
-        ))
-    }
+    Some(reflect_or_transmit(
+        u_lobe,
+        thin_reflectance(eta, v),
+        v,
+        specular_reflectance,
+        -v,
+        specular_transmittance,
+        1.0,
+        1.0,
+    ))
 }
 
 /// The generalised half vector of a rough dielectric (Walter et al. 2007), in `+z`; `None` if
