@@ -3,7 +3,8 @@
 //! is `1/eta`). The smooth one reflects and refracts as delta lobes chosen by the Fresnel
 //! reflectance; the rough one is Walter et al.'s (2007) microfacet BSDF with the generalised half
 //! vector, sampled from the visible normals. Transmitted radiance carries Mitsuba's radiance
-//! scale `1/η'²` (see the crate docs).
+//! scale `1/η'²` (see the crate docs). Mitsuba's `thindielectric` is a sheet of such glass too
+//! thin to offset what it transmits: delta reflection by both faces, the rest straight through.
 
 use glam::{Vec2, Vec3};
 
