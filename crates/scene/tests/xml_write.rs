@@ -200,6 +200,7 @@ fn the_shipped_scenes_round_trip() {
         "cornell-materials.xml",
         "glossy-still-life.xml",
         "envmap-spheres.xml",
+        "thin-pane.xml",
         "textured/textured-shapes.xml",
         "many-lights.ron",
         "indirect-room-glass.ron",
