@@ -1,6 +1,6 @@
 //! The AVX2 kernel: a node's eight child boxes and a block's eight triangles tested in one
-//! 256-bit pass each, with exactly the scalar kernel's float operations (multiply then add, no
-//! FMA; the same min/max operand order), so both give the same bits. Used only when the CPU
+//! 256-bit pass each, with exactly the scalar kernel's float operations (no FMA; the same
+//! operand order, min/max included), so both give the same bits. Used only when the CPU
 //! reports AVX2 (and the bit-counting POPCNT, BMI1 and LZCNT that come with it), checked once
 //! when the [`super::Accel`] is built.
 //!
@@ -14,7 +14,8 @@ use std::arch::x86_64::*;
 
 use super::prims::REL_T_MIN;
 use super::wide::{
-    Entries, Found, Kernel, NODE_EPSILON, Node, TRay, TriBlock, TriHit, Wide, any, closest,
+    EXIT_SCALE, Entries, Found, Kernel, NODE_EPSILON, Node, TRay, TriBlock, TriHit, Wide, any,
+    closest,
 };
 
 /// The AVX2 kernel (x86-64 only).
@@ -25,16 +26,6 @@ pub(super) struct Avx2;
 fn splat(x: f32) -> __m256 {
     // SAFETY: AVX is implied by AVX2, which the callers' `target_feature` guarantees.
     unsafe { _mm256_set1_ps(x) }
-}
-
-/// Eight `u8` grid coordinates as `f32` lanes.
-#[inline(always)]
-fn load_q(q: &[u8; 8]) -> __m256 {
-    // SAFETY: reads exactly the 8 bytes of `q`; AVX2 is guaranteed by the callers.
-    unsafe {
-        let b = _mm_loadl_epi64(q.as_ptr().cast());
-        _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(b))
-    }
 }
 
 #[inline(always)]
@@ -109,15 +100,15 @@ fn block_t(
 
 /// The entry and exit distances of the eight child slabs along `axis`.
 #[inline(always)]
-fn slab(n: &Node, r: &TRay, axis: usize, scale: f32, offset: f32) -> (__m256, __m256) {
-    let (lo, hi) = (load_q(&n.q[2 * axis]), load_q(&n.q[2 * axis + 1]));
+fn slab(n: &Node, r: &TRay, axis: usize, o: f32, inv: f32) -> (__m256, __m256) {
+    let (lo, hi) = (load(&n.b[2 * axis]), load(&n.b[2 * axis + 1]));
     let (near, far) = if r.neg[axis] { (hi, lo) } else { (lo, hi) };
-    let (s, o) = (splat(scale), splat(offset));
+    let (o, inv) = (splat(o), splat(inv));
     // SAFETY: arithmetic intrinsics only; AVX2 is guaranteed by the callers.
     unsafe {
         (
-            _mm256_add_ps(_mm256_mul_ps(near, s), o),
-            _mm256_add_ps(_mm256_mul_ps(far, s), o),
+            _mm256_mul_ps(_mm256_sub_ps(near, o), inv),
+            _mm256_mul_ps(_mm256_sub_ps(far, o), inv),
         )
     }
 }
@@ -125,19 +116,20 @@ fn slab(n: &Node, r: &TRay, axis: usize, scale: f32, offset: f32) -> (__m256, __
 impl Kernel for Avx2 {
     #[inline(always)]
     fn node_hits(n: &Node, r: &TRay, t_max: f32) -> (u32, [f32; 8]) {
-        let adj_inv = glam::Vec3A::from(n.extent) * r.inv_d;
-        let adj_o = (glam::Vec3A::from(n.p) - r.o) * r.inv_d;
-        let (ai, ao) = (adj_inv.to_array(), adj_o.to_array());
-        let (x0, x1) = slab(n, r, 0, ai[0], ao[0]);
-        let (y0, y1) = slab(n, r, 1, ai[1], ao[1]);
-        let (z0, z1) = slab(n, r, 2, ai[2], ao[2]);
+        let (o, inv) = (r.o.to_array(), r.inv_d.to_array());
+        let (x0, x1) = slab(n, r, 0, o[0], inv[0]);
+        let (y0, y1) = slab(n, r, 1, o[1], inv[1]);
+        let (z0, z1) = slab(n, r, 2, o[2], inv[2]);
         // SAFETY: arithmetic intrinsics only; AVX2 is guaranteed by the callers.
         unsafe {
             let tmin = _mm256_max_ps(
                 _mm256_max_ps(x0, _mm256_max_ps(y0, z0)),
                 splat(NODE_EPSILON),
             );
-            let tmax = _mm256_min_ps(_mm256_min_ps(x1, _mm256_min_ps(y1, z1)), splat(t_max));
+            let tmax = _mm256_mul_ps(
+                _mm256_min_ps(_mm256_min_ps(x1, _mm256_min_ps(y1, z1)), splat(t_max)),
+                splat(EXIT_SCALE),
+            );
             let mut entry = [0.0f32; 8];
             _mm256_storeu_ps(entry.as_mut_ptr(), tmin);
             (

@@ -385,3 +385,54 @@ fn analytic_shapes_in_the_bvh() {
     }
     assert!(seen.iter().all(|&n| n > 50), "{seen:?}");
 }
+
+/// The box test is conservative: rays aimed at the edge where two walls meet (each wall a flat
+/// box, the ray leaving one box's slab exactly where it enters the other's) find a wall whenever
+/// one of the walls' own triangle tests is hit. Without the exit distance's rounding allowance
+/// (`wide::EXIT_SCALE`) some of these boxes are culled and the ray escapes through the corner.
+#[test]
+fn rays_into_the_edge_of_two_walls_are_not_culled() {
+    // A Cornell box's ceiling (y = 2) and left wall (x = −1), 2 units across.
+    let mut ceiling = Shape::rectangle();
+    ceiling.transform(
+        &(glam::Affine3A::from_translation(Vec3::new(0.0, 2.0, 0.0))
+            * glam::Affine3A::from_rotation_x(std::f32::consts::FRAC_PI_2)),
+    );
+    let mut wall = Shape::rectangle();
+    wall.transform(
+        &(glam::Affine3A::from_translation(Vec3::new(-1.0, 1.0, 0.0))
+            * glam::Affine3A::from_rotation_y(std::f32::consts::FRAC_PI_2)),
+    );
+    let shapes = vec![Shape::Mesh(ceiling), Shape::Mesh(wall)];
+    for accel in [Accel::build(&shapes), {
+        let mut a = Accel::build(&shapes);
+        a.force_scalar();
+        a
+    }] {
+        let mut rng = Pcg32::new(11, 12);
+        let (mut posed, mut found) = (0, 0);
+        for _ in 0..20_000 {
+            // From around a camera in front of the box to a point on the shared edge.
+            let o = Vec3::new(
+                rng.next_f32() * 0.02 - 0.01,
+                1.0 + rng.next_f32() * 0.02 - 0.01,
+                3.6,
+            );
+            let target = Vec3::new(-1.0, 2.0, rng.next_f32() * 1.8 - 0.9);
+            let ray = Ray::new(o, (target - o).normalize());
+            let r = TRay::new(ray.o.into(), ray.d.into());
+            let brute = (0..accel.prims.len())
+                .map(|i| accel.intersect_prim(i, &r, f32::INFINITY))
+                .fold(f32::INFINITY, f32::min);
+            if brute.is_finite() {
+                posed += 1;
+                found += accel.intersect(&ray, f32::INFINITY).is_some() as u32;
+            }
+        }
+        assert!(posed > 10_000, "{posed}");
+        assert_eq!(
+            found, posed,
+            "rays that hit a wall's triangle but not its box"
+        );
+    }
+}
