@@ -14,8 +14,7 @@ use std::arch::x86_64::*;
 
 use super::prims::REL_T_MIN;
 use super::wide::{
-    EXIT_SCALE, Entries, Found, Kernel, NODE_EPSILON, Node, TRay, TriBlock, TriHit, Wide, any,
-    closest,
+    Entries, Found, Kernel, NODE_EPSILON, Node, TRay, TriBlock, TriHit, Wide, any, closest,
 };
 
 /// The AVX2 kernel (x86-64 only).
@@ -100,36 +99,34 @@ fn block_t(
 
 /// The entry and exit distances of the eight child slabs along `axis`.
 #[inline(always)]
-fn slab(n: &Node, r: &TRay, axis: usize, o: f32, inv: f32) -> (__m256, __m256) {
+fn slab(n: &Node, r: &TRay, axis: usize, o: f32, inv: f32, inv_far: f32) -> (__m256, __m256) {
     let (lo, hi) = (load(&n.b[2 * axis]), load(&n.b[2 * axis + 1]));
     let (near, far) = if r.neg[axis] { (hi, lo) } else { (lo, hi) };
-    let (o, inv) = (splat(o), splat(inv));
+    let (o, inv, inv_far) = (splat(o), splat(inv), splat(inv_far));
     // SAFETY: arithmetic intrinsics only; AVX2 is guaranteed by the callers.
     unsafe {
         (
             _mm256_mul_ps(_mm256_sub_ps(near, o), inv),
-            _mm256_mul_ps(_mm256_sub_ps(far, o), inv),
+            _mm256_mul_ps(_mm256_sub_ps(far, o), inv_far),
         )
     }
 }
 
 impl Kernel for Avx2 {
     #[inline(always)]
-    fn node_hits(n: &Node, r: &TRay, t_max: f32) -> (u32, [f32; 8]) {
-        let (o, inv) = (r.o.to_array(), r.inv_d.to_array());
-        let (x0, x1) = slab(n, r, 0, o[0], inv[0]);
-        let (y0, y1) = slab(n, r, 1, o[1], inv[1]);
-        let (z0, z1) = slab(n, r, 2, o[2], inv[2]);
+    fn node_hits(n: &Node, r: &TRay, t_lim: f32) -> (u32, [f32; 8]) {
+        let (o, inv, far) = (r.o.to_array(), r.inv_d.to_array(), r.inv_far.to_array());
+        let (x0, x1) = slab(n, r, 0, o[0], inv[0], far[0]);
+        let (y0, y1) = slab(n, r, 1, o[1], inv[1], far[1]);
+        let (z0, z1) = slab(n, r, 2, o[2], inv[2], far[2]);
         // SAFETY: arithmetic intrinsics only; AVX2 is guaranteed by the callers.
         unsafe {
+            // The scalar kernel's order: a NaN distance is always a first operand, passed over.
             let tmin = _mm256_max_ps(
-                _mm256_max_ps(x0, _mm256_max_ps(y0, z0)),
-                splat(NODE_EPSILON),
+                x0,
+                _mm256_max_ps(y0, _mm256_max_ps(z0, splat(NODE_EPSILON))),
             );
-            let tmax = _mm256_mul_ps(
-                _mm256_min_ps(_mm256_min_ps(x1, _mm256_min_ps(y1, z1)), splat(t_max)),
-                splat(EXIT_SCALE),
-            );
+            let tmax = _mm256_min_ps(x1, _mm256_min_ps(y1, _mm256_min_ps(z1, splat(t_lim))));
             let mut entry = [0.0f32; 8];
             _mm256_storeu_ps(entry.as_mut_ptr(), tmin);
             (

@@ -271,13 +271,23 @@ impl Accel {
             None => e..e + 1,
         };
         let is_mesh = |id: usize| matches!(shapes[ids[id].0 as usize], Shape::Mesh(_));
-        let wide = Wide::build(&bvh, |e| {
-            let m = members(e);
-            match prim_of(shapes, &slots, ids[m.start]) {
-                Prim::Triangle { v0, e1, e2 } if m.len() == 1 => Some([v0, e1, e2]),
-                _ => None,
-            }
-        });
+        let wide = Wide::build(
+            &bvh,
+            |e| {
+                let m = members(e);
+                match prim_of(shapes, &slots, ids[m.start]) {
+                    Prim::Triangle { v0, e1, e2 } if m.len() == 1 => Some([v0, e1, e2]),
+                    _ => None,
+                }
+            },
+            |e| {
+                members(e).fold([Vec3A::INFINITY, Vec3A::NEG_INFINITY], |[lo, hi], id| {
+                    let (shape, prim) = ids[id];
+                    let (a, b) = shapes[shape as usize].primitive_bounds(prim);
+                    [lo.min(a.into()), hi.max(b.into())]
+                })
+            },
+        );
         // The primitives tested one at a time: spheres and members of groups.
         let entry_count = groups.as_ref().map_or(ids.len(), |s| s.len() - 1);
         let scalar_ids: Vec<usize> = (0..entry_count)
