@@ -9,8 +9,9 @@ Each scene is written as Mitsuba 3 XML by `restir convert` (into a temporary dir
 both sides load that file, so they trace the same geometry. Mitsuba makes the rays, as the
 `bvh` micro-benchmarks do: the camera rays through the centres of a 64×64 image (`camera`),
 rays in uniformly random directions from those rays' hits (`incoherent`), and shadow rays
-between random pairs of hits (`shadow`, any hit ends the ray), each set repeated to
-`--rays` rays. Mitsuba traces them with `ray_intersect_preliminary` and `ray_test` (whole
+between random pairs of hits (`shadow`, any hit ends the ray; pairs whose segment lies in
+either surface's plane are left out, as rounding decides those), each set repeated to
+`--rays` rays (the shadow set a little fewer). Mitsuba traces them with `ray_intersect_preliminary` and `ray_test` (whole
 sets as one kernel, its packets as wide as the CPU allows), we with `Accel::intersect` and
 `Accel::occluded` one ray at a time (`crates/bench/examples/ray_file.rs`). Timings are
 wall-clock on one thread each, interleaved: every round times Mitsuba on each set (the
@@ -78,12 +79,15 @@ def rays_of(mi, dr, scene, n, rng):
         return at + eps * side_ * normal
 
     incoherent = (offset(p[k], nrm[k], dr_), dr_, np.full(n, np.inf))
-    q = p[rng.integers(0, m, n)]
-    to = q - p[k]
+    j = rng.integers(0, m, n)
+    to = p[j] - p[k]
     dist = np.linalg.norm(to, axis=1)
-    keep = dist > 1e-3 * max(1.0, float(np.abs(p).max()))
-    k, to, dist = k[keep], to[keep], dist[keep]
-    dirs = to / dist[:, None]
+    dirs = to / np.maximum(dist, 1e-30)[:, None]
+    # Pairs apart, the segment not in either surface's plane (a ray along a floor between two
+    # of its points is decided by rounding, and no renderer aims a shadow ray that way).
+    keep = (dist > 1e-3 * max(1.0, float(np.abs(p).max()))) \
+        & (np.abs(np.sum(dirs * nrm[k], 1)) > 1e-2) & (np.abs(np.sum(dirs * nrm[j], 1)) > 1e-2)
+    k, dirs, dist = k[keep], dirs[keep], dist[keep]
     shadow = (offset(p[k], nrm[k], dirs), dirs, dist * (1 - 1e-3))
     return {"camera": camera, "incoherent": incoherent, "shadow": shadow}
 
