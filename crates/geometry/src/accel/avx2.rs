@@ -29,7 +29,8 @@ fn splat(x: f32) -> __m256 {
 
 #[inline(always)]
 fn load(x: &[f32; 8]) -> __m256 {
-    // SAFETY: `TriBlock` rows are 32-byte aligned arrays of eight floats.
+    // SAFETY: the rows of a `TriBlock` (32-byte aligned) and of a `Node`'s boxes (at the start of
+    // a 64-byte aligned node, 32 bytes each) are 32-byte aligned arrays of eight floats.
     unsafe { _mm256_load_ps(x.as_ptr()) }
 }
 

@@ -3,30 +3,33 @@
 //! eight triangles at once), and the scalar kernel.
 //!
 //! The node test runs on each child's bounds in `f32`, computed at build from what the child
-//! holds (obvhs's quantized boxes exceed them by up to 1/255 of the node's extent per axis, so
-//! that a ray leaving a surface or ending at one entered that surface's leaf and tested its
-//! triangles in vain), and is conservative: with the exit distances scaled by [`EXIT_SCALE`] and
-//! the exact reciprocal of the direction, rounding cannot cull a box the ray passes through,
-//! flat boxes and axis-parallel rays included (tests
-//! `the_node_test_enters_every_box_the_ray_passes_through`, `rays_into_the_edge_of_two_walls_are_not_culled`).
-//! Against the traversal on obvhs's quantized boxes, decoded at each test, on the rays of
-//! `scripts/mitsuba_rays.py`: corpus Sponza 1.17–1.25× the rays per second, the indirect room's
-//! shadow rays 1.35×; a path-traced pass 1.11× on corpus Sponza, 1.06× on 400 emissive
-//! rectangles, 1.03× on the Cornell box (the same images). A node takes 256 bytes (128
-//! quantized). A node's
-//! leaf primitives are tested right after the node, the closest one kept with ties going to the
-//! highest primitive offset, as obvhs's sequential highest-bit-first loop does. The any-hit walk
-//! visits children in obvhs's order (the CWBVH's octant order: child slot `s` has priority
-//! `s ^ octant`, so the slots laid out towards the ray come first), so occlusion answers are
-//! those of obvhs's `ray_traverse_miss` except where its box test culls by rounding. The closest-hit walk visits the inner
-//! children nearest box first and drops waiting ones that lie behind the hit found meanwhile
-//! (on the corpus Sponza 15 % less time per path-traced pass than the octant order); it finds
-//! the distance obvhs's `ray_traverse` finds, bit for bit, except that among primitives hit at
-//! exactly the same distance it may name another one, and except where the order decides in
-//! both traversals (hits nearer than obvhs's node epsilon of 10⁻⁴, which ours does not have,
-//! rounding-noise hits of rays in a triangle's plane) or its box test culls by rounding. What changes is the layout: the triangles of a node sit inline in 8-wide
-//! SoA blocks (`v0`, `e1`, `e2` precomputed) in the node's own order, so a leaf test does no
-//! index indirection and one block test covers up to eight triangles.
+//! holds. (obvhs's quantized boxes exceed them by up to one cell of their 255-step grid per
+//! axis, so a ray leaving a surface or ending at one entered that surface's leaf and tested its
+//! triangles in vain.) It is conservative: with the direction's exact reciprocal and the exit
+//! distances scaled by [`EXIT_SCALE`], rounding cannot cull a box the ray passes through, flat
+//! boxes and axis-parallel rays included (tests
+//! `the_node_test_enters_every_box_the_ray_passes_through` and
+//! `rays_into_the_edge_of_two_walls_are_not_culled`). Against the traversal on obvhs's
+//! quantized boxes, decoded at each test, on the rays of `scripts/mitsuba_rays.py`: corpus Sponza
+//! 1.17–1.25× the rays per second, the indirect room's shadow rays 1.47×; a path-traced pass
+//! 1.11× on corpus Sponza, 1.06× on 400 emissive rectangles, 1.03× on the Cornell box, the
+//! images the same bits. A node takes 256 bytes (128 quantized).
+//!
+//! A node's leaf primitives are tested right after the node (testing them in distance order
+//! with its inner children was 0.74–0.95× on closest-hit rays), the closest one kept with ties
+//! going to the highest primitive offset, as obvhs's sequential highest-bit-first loop does. The
+//! any-hit walk visits children in obvhs's order (the CWBVH's octant order: child slot `s` has
+//! priority `s ^ octant`, so the slots laid out towards the ray come first), so occlusion
+//! answers are those of obvhs's `ray_traverse_miss` except where its box test culls by
+//! rounding. The closest-hit walk visits the inner children nearest box first and drops waiting
+//! ones that lie behind the hit found meanwhile (on the corpus Sponza 15 % less time per
+//! path-traced pass than the octant order); it finds the distance obvhs's `ray_traverse` finds,
+//! bit for bit, except that among primitives hit at exactly the same distance it may name
+//! another one, and except where the order decides in both traversals (hits nearer than
+//! obvhs's node epsilon of 10⁻⁴, which ours does not have, rounding-noise hits of rays in a
+//! triangle's plane) or obvhs's box test culls by rounding. The triangles of a node sit inline
+//! in 8-wide SoA blocks (`v0`, `e1`, `e2` precomputed) in the node's own order, so a leaf test
+//! does no index indirection and one block test covers up to eight triangles.
 
 use glam::Vec3A;
 use obvhs::cwbvh::CwBvh;
@@ -348,9 +351,7 @@ impl Wide {
 
 /// Replaces node `n`'s child boxes, and those below it, by the bounds of what they hold (the
 /// entries' boxes widened by one `f32` step, to cover the primitive tests' rounding), and
-/// returns the node's own box. The quantized boxes exceed these by up to a grid cell (1/255 of
-/// the node's extent per axis): a ray leaving a surface, or ending at one, enters that surface's
-/// leaf box and tests its triangles in vain.
+/// returns the node's own box.
 fn tighten(nodes: &mut [Node], n: usize, bounds: &impl Fn(usize) -> [Vec3A; 2]) -> [Vec3A; 2] {
     let node = nodes[n];
     let mut all = [Vec3A::INFINITY, Vec3A::NEG_INFINITY];
