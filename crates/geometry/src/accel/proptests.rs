@@ -174,6 +174,7 @@ fn check(shapes: &[Shape], ray: &Ray, t_max: f32) -> Result<(), TestCaseError> {
     // being at least `1e-4`), and the rounding-noise "hits" of a ray in a triangle's plane, which
     // can lie outside the triangle's box (found or culled depending on what was found first).
     let (ref_hit, ref_occ) = reference(&accel, ray, t_max);
+    let at_limit = |t: f32| t >= t_max * (1.0 - 1e-4);
     let posed = |t: f32, id: usize| {
         t >= OBVHS_NODE_EPSILON && well_posed(&accel.prims[id], tr.d, Vec3A::from(ray.at(t)))
     };
@@ -185,8 +186,10 @@ fn check(shapes: &[Shape], ray: &Ray, t_max: f32) -> Result<(), TestCaseError> {
     match (got.zip(ours_id), ref_hit) {
         (Some((h, i)), Some((t, r))) if !posed(h.t, i) || !posed(t, r as usize) => {}
         // Without obvhs's node epsilon ours also enters boxes flat in the ray's plane (exit
-        // distance 0), so it may see an in-plane triangle obvhs culls.
-        (Some((h, i)), None) if !posed(h.t, i) => {}
+        // distance 0), so it may see an in-plane triangle obvhs culls; and ours enters every
+        // box the ray reaches before `t_max` (a conservative test), where obvhs's may cull a
+        // box whose hit is within rounding of `t_max`.
+        (Some((h, i)), None) if !posed(h.t, i) || at_limit(h.t) => {}
         _ => prop_assert_eq!(
             got.map(|h| h.t),
             ref_hit.map(|(t, _)| t),
@@ -216,10 +219,11 @@ fn check(shapes: &[Shape], ray: &Ray, t_max: f32) -> Result<(), TestCaseError> {
         );
     }
     // obvhs culls boxes ending before its node epsilon (also boxes flat in the ray's plane),
-    // ours does not: an occluder that near, or in the ray's plane, may be seen by ours alone.
+    // ours does not: an occluder that near, or in the ray's plane, may be seen by ours alone;
+    // so may one within rounding of `t_max`, whose box obvhs's test may cull.
     let near_occluder = (0..accel.prims.len()).any(|i| {
         let t = accel.intersect_prim(i, &tr, t_max);
-        t < t_max && !posed(t, i)
+        t < t_max && (!posed(t, i) || at_limit(t))
     });
     if !(near_occluder && occluded && !ref_occ) {
         prop_assert_eq!(
