@@ -37,6 +37,8 @@ struct Stats<'a> {
     nonfinite_pixels: usize,
     seed: u64,
     threads: usize,
+    /// The ray-tracing structure the scene build made (its size and the CPU's kernel).
+    bvh: String,
     /// How light samples are drawn, as the scene build decided it.
     light_selection: String,
     /// The pixel filter and how the film uses it (sampled or splatted), and why.
@@ -141,6 +143,7 @@ impl Report<'_> {
             nonfinite_pixels: out.nonfinite_pixels,
             seed: self.seed,
             threads: self.threads,
+            bvh: scene.accel.describe(),
             light_selection: scene.light_selection(),
             film: Reconstruction::decide(scene.filter).describe(scene.filter),
             stage_seconds: integrator

@@ -410,6 +410,8 @@ fn tiny_render_writes_images_stats_and_compares() {
     assert_eq!(json["height"], 16);
     assert_eq!(json["integrator"], "path");
     assert_eq!(json["nonfinite_pixels"], 0);
+    let bvh = json["bvh"].as_str().unwrap();
+    assert!(bvh.contains("nodes") && bvh.contains("kernel"), "{bvh}");
     // At least a camera ray per pixel and pass.
     assert!(json["rays"].as_u64().unwrap() >= 16 * 16 * 2);
     assert!(json["seconds"].as_f64().unwrap() >= 0.0);

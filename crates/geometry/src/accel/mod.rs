@@ -345,6 +345,28 @@ impl Accel {
         self.avx2
     }
 
+    /// What the build made, for `--stats`: the tree's nodes and inline triangle blocks, the
+    /// bytes they take, and the kernel the CPU runs.
+    pub fn describe(&self) -> String {
+        let kernel = if self.avx2 { "AVX2" } else { "scalar" };
+        let Some(w) = &self.wide else {
+            return format!("empty (no primitives), {kernel} kernel");
+        };
+        let bytes =
+            std::mem::size_of_val(w.nodes.as_slice()) + std::mem::size_of_val(w.blocks.as_slice());
+        let size = if bytes < 1 << 20 {
+            format!("{:.1} KiB", bytes as f64 / 1024.0)
+        } else {
+            format!("{:.1} MiB", bytes as f64 / (1024.0 * 1024.0))
+        };
+        format!(
+            "{} nodes, {} blocks of 8 triangles, {} levels, {size}; {kernel} kernel",
+            w.nodes.len(),
+            w.blocks.len(),
+            w.depth,
+        )
+    }
+
     /// The scalar kernel from now on, whatever the CPU (to compare kernels).
     #[doc(hidden)]
     pub fn force_scalar(&mut self) {
