@@ -50,8 +50,8 @@ def parse():
     return p.parse_args()
 
 
-def rays_of(mi, dr, scene, n, rng):
-    """The three ray sets as (origins, directions, t_max) arrays of float32."""
+def rays_of(mi, scene, n, rng):
+    """The three ray sets, each (origins, directions, t_max) as numpy arrays."""
     side = 64
     sensor = scene.sensors()[0]
     idx = np.arange(side * side)
@@ -131,7 +131,7 @@ def main():
         dr.set_thread_count(os.cpu_count())
         scene = mi.load_file(xml, resx=64, resy=64)
         dr.set_thread_count(1)
-        sets = rays_of(mi, dr, scene, a.rays, rng)
+        sets = rays_of(mi, scene, a.rays, rng)
         raw = os.path.join(work, name + ".rays")
         with open(raw, "wb") as f:
             for key in ("camera", "incoherent", "shadow"):
