@@ -356,6 +356,18 @@ fn bounce<L: Lane>(
     (direct, dir, albedo)
 }
 
+/// [`bounce`] for one receiver with its numbers `u`.
+#[inline(always)]
+fn bounce_one(s: &Setup, r: &Receiver, u: [f32; 5]) -> [V3<f32>; 3] {
+    let v = |v: Vec3| V3 {
+        x: v.x,
+        y: v.y,
+        z: v.z,
+    };
+    let (d, dir, beta) = bounce(v(r.p), v(r.n), v(r.albedo), u, &s.light, s.area, Vec3::ONE);
+    [d, dir, beta]
+}
+
 #[divan::bench]
 fn general(bencher: Bencher) {
     let s = setup();
@@ -400,21 +412,7 @@ fn scalar(bencher: Bencher) {
         .bench_local(|| {
             let mut acc = Vec3::ZERO;
             for r in &s.receivers {
-                let v = |v: Vec3| V3 {
-                    x: v.x,
-                    y: v.y,
-                    z: v.z,
-                };
-                let (d, dir, beta) = bounce(
-                    v(r.p),
-                    v(r.n),
-                    v(r.albedo),
-                    r.u,
-                    &s.light,
-                    s.area,
-                    Vec3::ONE,
-                );
-                for x in [d, dir, beta] {
+                for x in bounce_one(&s, r, r.u) {
                     acc += Vec3::new(x.x, x.y, x.z);
                 }
             }
@@ -494,26 +492,12 @@ fn lanes(bencher: Bencher) {
 /// same direct light; within 4 standard errors of their difference).
 #[cfg(target_arch = "x86_64")]
 fn check(s: &Setup, g: &[Group]) {
-    let v = |v: Vec3| V3 {
-        x: v.x,
-        y: v.y,
-        z: v.z,
-    };
     for (k, group) in g.iter().enumerate() {
         // SAFETY: the caller detected AVX2 and FMA.
         let lanes = unsafe { run_lanes(std::slice::from_ref(group), &s.light, s.area) };
         for i in 0..8 {
             let r = &s.receivers[8 * k + i];
-            let (d, dir, beta) = bounce(
-                v(r.p),
-                v(r.n),
-                v(r.albedo),
-                r.u,
-                &s.light,
-                s.area,
-                Vec3::ONE,
-            );
-            let sum = [d, dir, beta]
+            let sum = bounce_one(s, r, r.u)
                 .iter()
                 .fold(0.0f32, |a, x| a + x.x + x.y + x.z);
             assert_eq!(lanes.0[i].to_bits(), sum.to_bits(), "group {k} lane {i}");
@@ -524,7 +508,7 @@ fn check(s: &Setup, g: &[Group]) {
     for r in &s.receivers {
         for _ in 0..16 {
             let u = [rng.next_f32(), rng.next_f32(), rng.next_f32(), 0.5, 0.5];
-            let (d, _, _) = bounce(v(r.p), v(r.n), v(r.albedo), u, &s.light, s.area, Vec3::ONE);
+            let [d, _, _] = bounce_one(s, r, u);
             let si = &r.si;
             let bsdf = s.scene.bsdf(si);
             let wo = si.shading.to_local(r.wo);
