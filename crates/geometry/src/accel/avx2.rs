@@ -203,3 +203,13 @@ pub(super) unsafe fn any_avx2(
 ) -> bool {
     any::<Avx2>(w, r, t_max, stack, entries)
 }
+
+/// The AVX2 node test alone, for the tests that hold it to the scalar one.
+///
+/// # Safety
+/// The CPU must support AVX2, POPCNT, BMI1 and LZCNT.
+#[cfg(test)]
+#[target_feature(enable = "avx2,popcnt,bmi1,lzcnt")]
+pub(super) unsafe fn node_hits_avx2(n: &Node, r: &TRay, t_lim: f32) -> (u32, [f32; 8]) {
+    Avx2::node_hits(n, r, t_lim)
+}

@@ -442,12 +442,15 @@ fn rays_into_the_edge_of_two_walls_are_not_culled() {
 /// around a point of the ray, its bounds rounded outward, so the point lies within an `f32` step
 /// of up to three faces, or on a flat face) is reported as entering it, for rays in every
 /// octant, grazing and axis-parallel ones included. Without [`wide::EXIT_SCALE`] rounding puts
-/// the entry after the exit for some of them.
+/// the entry after the exit for some of them. And a box the ray does not reach (the rounding
+/// hull of a point behind its origin) is reported missed, also when the ray is parallel to an
+/// axis and its origin lies on the box's faces there: the NaN that slab gives must be passed
+/// over, not let through in place of the other slabs' distances.
 #[test]
 fn the_node_test_enters_every_box_the_ray_passes_through() {
     use wide::{Kernel, Node};
     let mut rng = Pcg32::new(21, 22);
-    let mut missed = 0;
+    let (mut missed, mut entered) = (0, 0);
     let total = 200_000;
     for k in 0..total {
         let o = Vec3::new(
@@ -462,6 +465,7 @@ fn the_node_test_enters_every_box_the_ray_passes_through() {
         }
         let r = TRay::new(o.into(), d.into());
         let t = rng.next_f32() * 10.0;
+        let t_behind = -0.5 - rng.next_f32() * 10.0;
         let mut node = Node::default();
         for a in 0..3 {
             // The point at `t`, exactly (f64), and the box's bounds on either side of it.
@@ -481,15 +485,33 @@ fn the_node_test_enters_every_box_the_ray_passes_through() {
             node.b[2 * a + 1] = [f32::NEG_INFINITY; 8];
             node.b[2 * a][3] = lo;
             node.b[2 * a + 1][3] = hi;
+            let behind = o[a] as f64 + t_behind as f64 * d[a] as f64;
+            node.b[2 * a][5] = round_down(behind);
+            node.b[2 * a + 1][5] = round_up(behind);
         }
-        let (mask, _) = wide::Scalar::node_hits(&node, &r, f32::INFINITY);
-        if mask != 1 << 3 {
+        let (mask, entry) = wide::Scalar::node_hits(&node, &r, f32::INFINITY);
+        #[cfg(target_arch = "x86_64")]
+        if Accel::build(&[]).uses_avx2() {
+            // SAFETY: `uses_avx2` is set only when the CPU has AVX2, POPCNT, BMI1 and LZCNT.
+            #[allow(unsafe_code)]
+            let (m, e) = unsafe { super::avx2::node_hits_avx2(&node, &r, f32::INFINITY) };
+            assert_eq!(m, mask, "the AVX2 node test differs from the scalar one");
+            assert_eq!(e.map(f32::to_bits), entry.map(f32::to_bits));
+        }
+        if mask & 1 << 3 == 0 {
             missed += 1;
+        }
+        if mask & 1 << 5 != 0 {
+            entered += 1;
         }
     }
     assert_eq!(
         missed, 0,
         "boxes the ray passes through, reported missed (of {total})"
+    );
+    assert_eq!(
+        entered, 0,
+        "boxes behind the ray's origin, reported entered (of {total})"
     );
 }
 

@@ -146,11 +146,12 @@ impl TRay {
         let d = d + Vec3A::ZERO;
         let neg = [d.x < 0.0, d.y < 0.0, d.z < 0.0];
         let oct = (!neg[0] as u32) << 2 | (!neg[1] as u32) << 1 | !neg[2] as u32;
+        let inv_d = Vec3A::ONE / d;
         TRay {
             o,
             d,
-            inv_d: Vec3A::ONE / d,
-            inv_far: (Vec3A::ONE / d) * EXIT_SCALE,
+            inv_d,
+            inv_far: inv_d * EXIT_SCALE,
             neg,
             oct,
         }
@@ -349,9 +350,10 @@ impl Wide {
     }
 }
 
-/// Replaces node `n`'s child boxes, and those below it, by the bounds of what they hold (the
-/// entries' boxes widened by one `f32` step, to cover the primitive tests' rounding), and
-/// returns the node's own box.
+/// Replaces node `n`'s child boxes, and those below it, by the bounds of what they hold, and
+/// returns the node's own box. The entries' boxes are widened by one `f32` step: a sphere's
+/// `centre ± radius` and the analytic shapes' bounds are computed in `f32` and may round inward
+/// (a triangle's vertices bound it exactly; the step costs it nothing).
 fn tighten(nodes: &mut [Node], n: usize, bounds: &impl Fn(usize) -> [Vec3A; 2]) -> [Vec3A; 2] {
     let node = nodes[n];
     let mut all = [Vec3A::INFINITY, Vec3A::NEG_INFINITY];
