@@ -124,7 +124,7 @@ impl Sphere {
         let cos_alpha = sin2_theta * inv_sin_max
             + cos_theta * (1.0 - (sin2_theta * inv_sin_max * inv_sin_max).min(1.0)).sqrt();
         let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
-        let (sin_phi, cos_phi) = (2.0 * PI * u.y).sin_cos();
+        let (sin_phi, cos_phi) = warp::sincos_turns(u.y);
         let back = Frame::from_normal(to_c * (-1.0 / dist));
         let n = back.to_world(Vec3::new(
             sin_alpha * cos_phi,
