@@ -6,6 +6,8 @@
 //! - [`sequences`]: low-discrepancy sequences (Halton, R2).
 //! - [`warp`]: warps from the unit square with their pdfs, in triples (`sample_*`, `*_pdf`, and the
 //!   inverse where it exists).
+//! - [`lanes`]: eight `f32` lanes ([`lanes::F8`]) for lane-parallel estimators, with the warps
+//!   they need.
 //! - [`hash`]: FNV-1a, a stable hash for cache keys and checksums.
 //! - [`Distribution1D`], [`Distribution2D`]: piecewise-constant distributions; [`AliasTable`]: O(1)
 //!   discrete sampling.
@@ -28,6 +30,7 @@
 
 mod distribution;
 pub mod hash;
+pub mod lanes;
 pub mod owen;
 mod rng;
 pub mod sequences;

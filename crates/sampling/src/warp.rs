@@ -26,25 +26,42 @@ pub fn sample_concentric_disk(u: Vec2) -> Vec2 {
     }
 }
 
+/// The Taylor coefficients of `sin x / x − 1` in powers of `x²`, the highest first (Horner's
+/// order): `x²·(−1/3! + x²·(1/5! − …))`. With [`COS_TAYLOR`] the polynomials of
+/// [`sincos_quarter`] and of its lanes ([`crate::lanes::sincos_quarter`]).
+pub(crate) const SIN_TAYLOR: [f32; 5] = [
+    -1.0 / 39_916_800.0,
+    1.0 / 362_880.0,
+    -1.0 / 5040.0,
+    1.0 / 120.0,
+    -1.0 / 6.0,
+];
+
+/// The Taylor coefficients of `cos x − 1` in powers of `x²`, the highest first.
+pub(crate) const COS_TAYLOR: [f32; 6] = [
+    1.0 / 479_001_600.0,
+    -1.0 / 3_628_800.0,
+    1.0 / 40_320.0,
+    -1.0 / 720.0,
+    1.0 / 24.0,
+    -0.5,
+];
+
 /// `(sin x, cos x)` for `|x| ≤ π/4`: the Taylor polynomials of degree 11 and 12 (the first
 /// omitted terms are below 2·10⁻¹⁰ there, under `f32`'s resolution) by Horner's rule, within
 /// an `f32` step of the exact values and a few times cheaper than the library's `sin_cos`.
 #[inline(always)]
 pub fn sincos_quarter(x: f32) -> (f32, f32) {
     let x2 = x * x;
-    let s = ((((x2 * (-1.0 / 39_916_800.0) + 1.0 / 362_880.0) * x2 - 1.0 / 5040.0) * x2
-        + 1.0 / 120.0)
-        * x2
-        - 1.0 / 6.0)
-        * x2;
-    let c = (((((x2 * (1.0 / 479_001_600.0) - 1.0 / 3_628_800.0) * x2 + 1.0 / 40_320.0) * x2
-        - 1.0 / 720.0)
-        * x2
-        + 1.0 / 24.0)
-        * x2
-        - 0.5)
-        * x2;
-    (x + x * s, c + 1.0)
+    let mut s = 0.0;
+    for c in SIN_TAYLOR {
+        s = s * x2 + c;
+    }
+    let mut k = 0.0;
+    for c in COS_TAYLOR {
+        k = k * x2 + c;
+    }
+    (x + x * (s * x2), k * x2 + 1.0)
 }
 
 /// `(sin 2πt, cos 2πt)` for `t ∈ [0, 1]` (an angle in turns, as a uniform number gives it):

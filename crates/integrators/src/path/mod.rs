@@ -17,6 +17,8 @@ use crate::params::{Param, ParamError};
 use crate::pass::{Integrator, PassContext};
 use crate::shadow::{ShadowTarget, visible};
 
+mod lanes;
+
 /// Path tracer settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathSettings {
@@ -446,6 +448,24 @@ impl Integrator for PathIntegrator {
         let w = w as usize;
         let settings = self.settings.resolved(&scene.features);
         let bands = Bands::new(w);
+        if std::env::var_os("RESTIR_PATH_SCALAR").is_none() {
+            return bands.run(accum, |first, chunk| match settings.sampler {
+                SamplerKind::Independent => {
+                    lanes::render_pixels(scene, &settings, w, first, chunk, |index, xy| {
+                        let mut rng = ctx.pixel_rng(index);
+                        let film = ctx.pixel_film_position(index, xy, &mut rng);
+                        (rng, film)
+                    })
+                }
+                SamplerKind::Sobol => {
+                    lanes::render_pixels(scene, &settings, w, first, chunk, |index, (x, y)| {
+                        let mut rng = ctx.pixel_sequence(index);
+                        let film = ctx.film_position(x, y, &mut rng);
+                        (rng, film)
+                    })
+                }
+            });
+        }
         bands.run(accum, |first, chunk| {
             let mut rays = 0;
             for (i, px) in chunk.iter_mut().enumerate() {
