@@ -25,6 +25,7 @@ mod attribute;
 mod camera;
 mod cylinder;
 mod frame;
+pub mod lanes;
 mod mesh;
 mod ray;
 mod sdfgrid;

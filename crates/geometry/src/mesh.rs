@@ -329,6 +329,13 @@ impl TriangleMesh {
         self.faces[i].ng
     }
 
+    /// The `dp/du` of triangle `i` that shading frames take their first tangent from
+    /// ([`TriangleMesh::surface_at`]).
+    #[inline]
+    pub fn face_dpdu(&self, i: usize) -> Vec3 {
+        self.faces[i].dpdu
+    }
+
     /// Triangle `i`'s geometric normal and `dp/du`, computed from its corners.
     fn face(&self, i: usize) -> Face {
         let [ia, ib, ic] = self.indices[i];

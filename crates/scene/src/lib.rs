@@ -178,6 +178,18 @@ impl Scene {
         self.bsdf_bumped(bsdf, &TexturePoint::of(si), self.bump_at(si))
     }
 
+    /// The BSDF of every point of shape `shape` when it is the same everywhere (its material
+    /// reads no texture and has no bump map): [`Scene::bsdf`] of any hit on it, without the
+    /// hit. `None` when it varies over the shape.
+    #[inline]
+    pub fn uniform_bsdf(&self, shape: u32) -> Option<Bsdf> {
+        let bsdf = self.shape_bsdf[shape as usize] as usize;
+        if self.features.has_textures && self.bsdf_textures[bsdf].is_some() {
+            return None;
+        }
+        Some(self.bsdfs[bsdf])
+    }
+
     /// The normal-map texel a bump map gives at `si` (from the height's gradient, the
     /// surface's derivatives and its shading frame there: [`restir_materials::bump_normal`]),
     /// or `None` when the material of `si`'s shape has no bump map. With the hit's

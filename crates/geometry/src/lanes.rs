@@ -1,0 +1,244 @@
+//! Surface data of eight mesh hits at once: a hit's corners, vertex normals, face normal and
+//! `dp/du` gathered lane by lane ([`MeshHits::set`]), then the point and shading frame computed
+//! in lanes ([`MeshHits::surface`]) with the arithmetic of [`TriangleMesh::surface_at`] and
+//! [`Frame::from_normal_tangent`] (whose square roots and divisions, latency for one hit at a
+//! time, are one instruction for eight).
+
+use glam::{Vec2, Vec3};
+use restir_sampling::lanes::{F8, M8, V3};
+
+use crate::{Frame, TriangleMesh};
+
+/// Eight mesh hits, gathered.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct MeshHits {
+    corners: [V3; 3],
+    normals: [V3; 3],
+    smooth: M8,
+    flip: M8,
+    ng: V3,
+    dpdu: V3,
+    b1: F8,
+    b2: F8,
+}
+
+/// A point and shading frame per lane.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SurfaceLanes {
+    /// Position.
+    pub p: V3,
+    /// Geometric normal.
+    pub ng: V3,
+    /// The shading frame's first tangent.
+    pub s: V3,
+    /// Its second tangent, `n × s`.
+    pub t: V3,
+    /// The shading normal.
+    pub n: V3,
+}
+
+impl SurfaceLanes {
+    /// Lane `i`'s frame.
+    #[inline(always)]
+    pub fn frame(&self, i: usize) -> Frame {
+        Frame {
+            s: self.s.get(i),
+            t: self.t.get(i),
+            n: self.n.get(i),
+        }
+    }
+
+    /// Sets lane `i` to a point and frame computed elsewhere.
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, p: Vec3, ng: Vec3, f: &Frame) {
+        self.p.set(i, p);
+        self.ng.set(i, ng);
+        self.s.set(i, f.s);
+        self.t.set(i, f.t);
+        self.n.set(i, f.n);
+    }
+
+    /// `v` in every lane's frame ([`Frame::to_local`]).
+    #[inline(always)]
+    pub fn to_local(&self, v: V3) -> V3 {
+        V3 {
+            x: v.dot(self.s),
+            y: v.dot(self.t),
+            z: v.dot(self.n),
+        }
+    }
+
+    /// Every lane's local `v` in world space ([`Frame::to_world`]).
+    #[inline(always)]
+    pub fn to_world(&self, v: V3) -> V3 {
+        self.s.scale(v.x) + self.t.scale(v.y) + self.n.scale(v.z)
+    }
+}
+
+impl MeshHits {
+    /// Gathers lane `i`: triangle `prim` of `mesh` at barycentrics `bary` (the traversal's).
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, mesh: &TriangleMesh, prim: usize, bary: Vec2) {
+        let [ia, ib, ic] = mesh.indices()[prim];
+        let ps = mesh.positions();
+        for (c, k) in self.corners.iter_mut().zip([ia, ib, ic]) {
+            c.set(i, ps[k as usize]);
+        }
+        let smooth = match mesh.normals() {
+            Some(ns) => {
+                for (c, k) in self.normals.iter_mut().zip([ia, ib, ic]) {
+                    c.set(i, ns[k as usize]);
+                }
+                true
+            }
+            None => false,
+        };
+        self.smooth.set(i, smooth);
+        self.flip.set(i, mesh.flip_normals());
+        self.ng.set(i, mesh.face_normal(prim));
+        self.dpdu.set(i, mesh.face_dpdu(prim));
+        self.b1.0[i] = bary.x;
+        self.b2.0[i] = bary.y;
+    }
+
+    /// The points and shading frames of the gathered hits: [`crate::surface_at`]'s for a mesh,
+    /// lane by lane (the barycentrics clamped into the triangle as
+    /// [`crate::Accel::surface_interaction`] does).
+    #[inline(always)]
+    pub fn surface(&self) -> SurfaceLanes {
+        let (zero, one) = (F8::splat(0.0), F8::splat(1.0));
+        let u = self.b1.max(zero).min(one);
+        let v = self.b2.max(zero).min(one - u);
+        let b0 = one - u - v;
+        let [p0, p1, p2] = self.corners;
+        let p = p0.scale(b0) + p1.scale(u) + p2.scale(v);
+        let [n0, n1, n2] = self.normals;
+        let ni = n0.scale(b0) + n1.scale(u) + n2.scale(v);
+        // glam's `normalize_or_zero`: the reciprocal length where it is finite and positive.
+        let rcp = one / ni.dot(ni).sqrt();
+        let unit = rcp.is_finite() & rcp.gt(zero);
+        let ni = ni.scale(rcp);
+        let ns = (self.smooth & unit).select3(self.flip.select3(-ni, ni), self.ng);
+        let (s, t) = tangents(ns, self.dpdu);
+        SurfaceLanes {
+            p,
+            ng: self.ng,
+            s,
+            t,
+            n: ns,
+        }
+    }
+}
+
+/// [`Frame::from_normal_tangent`]'s tangents in every lane: `tangent` made orthogonal to `n`,
+/// or [`Frame::from_normal`]'s where it is (nearly) parallel to `n`.
+#[inline(always)]
+pub fn tangents(n: V3, tangent: V3) -> (V3, V3) {
+    let s = tangent - n.scale(n.dot(tangent));
+    let len2 = s.dot(s);
+    let fallback = len2.lt(F8::splat(1e-12)) | !len2.is_finite();
+    let s = s / len2.sqrt();
+    let t = n.cross(s);
+    // Duff et al.'s basis.
+    let one = F8::splat(1.0);
+    let sign = one.copysign(n.z);
+    let a = -one / (sign + n.z);
+    let b = n.x * n.y * a;
+    let ds = V3 {
+        x: one + sign * n.x * n.x * a,
+        y: sign * b,
+        z: -sign * n.x,
+    };
+    let dt = V3 {
+        x: b,
+        y: sign + n.y * n.y * a,
+        z: -n.y,
+    };
+    (fallback.select3(ds, s), fallback.select3(dt, t))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use restir_sampling::Pcg32;
+
+    /// [`MeshHits::surface`] gives [`crate::surface_at`]'s point and frame to the bit: meshes
+    /// with and without vertex normals, texture coordinates and flipped normals, a shading
+    /// normal along dp/du (Duff et al.'s frame instead), barycentrics outside the triangle
+    /// (clamped).
+    #[test]
+    fn lanes_give_surface_ats_bits() {
+        let mut rng = Pcg32::new(3, 8);
+        let mut r = |s: f32| (rng.next_f32() * 2.0 - 1.0) * s;
+        let positions: Vec<Vec3> = (0..30).map(|_| Vec3::new(r(3.0), r(3.0), r(3.0))).collect();
+        let normals: Vec<Vec3> = (0..30)
+            .map(|k| match k {
+                // Along the first triangle's dp/du: the tangent has nothing left.
+                0..3 => Vec3::X,
+                _ => Vec3::new(r(1.0), r(1.0), r(1.0)).normalize(),
+            })
+            .collect();
+        let uvs: Vec<Vec2> = (0..30).map(|_| Vec2::new(r(1.0), r(1.0))).collect();
+        let indices: Vec<[u32; 3]> = (0..10).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]).collect();
+        let mut meshes = Vec::new();
+        for (n, uv, flip) in [
+            (true, true, false),
+            (true, false, true),
+            (false, true, false),
+            (false, false, true),
+        ] {
+            let mut p = positions.clone();
+            // A triangle in the plane z = 0: without uvs its dp/du is along x.
+            p[0..3].copy_from_slice(&[Vec3::ZERO, Vec3::X, Vec3::Y]);
+            meshes.push(
+                TriangleMesh::new(
+                    p,
+                    n.then(|| normals.clone()),
+                    uv.then(|| uvs.clone()),
+                    indices.clone(),
+                    flip,
+                )
+                .unwrap(),
+            );
+        }
+        let shapes: Vec<crate::Shape> = meshes.into_iter().map(crate::Shape::Mesh).collect();
+        let mut checked = 0;
+        for _ in 0..500 {
+            let mut hits = MeshHits::default();
+            let picks: [(u32, usize, Vec2); restir_sampling::lanes::LANES] =
+                core::array::from_fn(|_| {
+                    let shape = (rng.next_f32() * 4.0) as u32 % 4;
+                    let prim = (rng.next_f32() * 10.0) as usize % 10;
+                    let b = Vec2::new(rng.next_f32() * 1.2 - 0.1, rng.next_f32() * 1.2 - 0.1);
+                    (shape, prim, b)
+                });
+            for (i, &(shape, prim, b)) in picks.iter().enumerate() {
+                let crate::Shape::Mesh(m) = &shapes[shape as usize] else {
+                    unreachable!()
+                };
+                hits.set(i, m, prim, b);
+            }
+            let got = hits.surface();
+            for (i, &(shape, prim, b)) in picks.iter().enumerate() {
+                let u = b.x.clamp(0.0, 1.0);
+                let b = Vec2::new(u, b.y.clamp(0.0, 1.0 - u));
+                let want = crate::surface_at(&shapes, shape, prim as u32, b);
+                let f = got.frame(i);
+                let bits = |v: [Vec3; 5]| v.map(|v| v.to_array().map(f32::to_bits));
+                assert_eq!(
+                    bits([got.p.get(i), got.ng.get(i), f.s, f.t, f.n]),
+                    bits([
+                        want.p,
+                        want.ng,
+                        want.shading.s,
+                        want.shading.t,
+                        want.shading.n
+                    ]),
+                    "shape {shape}, triangle {prim}, barycentrics {b}"
+                );
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 500 * restir_sampling::lanes::LANES);
+    }
+}
