@@ -237,6 +237,10 @@ impl Integrator for AutoIntegrator {
         self.chosen.light_cuts()
     }
 
+    fn lanes(&self, scene: &Scene) -> Option<String> {
+        self.chosen.lanes(scene)
+    }
+
     fn next_frame(&self, motion: Arc<FrameMotion>) {
         self.chosen.next_frame(motion);
     }

@@ -347,6 +347,13 @@ pub trait Integrator: Sync + Send + std::fmt::Debug {
     fn light_cuts(&self) -> Option<String> {
         None
     }
+    /// What the estimator runs in SIMD lanes for `scene` (the path tracer: how many paths at a
+    /// time, with which instructions, on which of the scene's shapes), one line; `None` (the
+    /// default) when it runs nothing in lanes.
+    fn lanes(&self, scene: &Scene) -> Option<String> {
+        let _ = scene;
+        None
+    }
     /// Why this estimator renders when the `auto` estimator chose it (what its rules measured
     /// of the scene, one line); `None` (the default) when it was asked for by name.
     fn auto_choice(&self) -> Option<&str> {

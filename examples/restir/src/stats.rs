@@ -56,6 +56,9 @@ struct Stats<'a> {
     /// How screen tiles cut the light hierarchy (ReSTIR DI with `--light-sampler tiles`).
     #[serde(skip_serializing_if = "Option::is_none")]
     light_cuts: Option<String>,
+    /// What the estimator runs in SIMD lanes (the path tracer).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    lanes: Option<String>,
     /// The part of a split render this process rendered (--chain, --crop).
     #[serde(skip_serializing_if = "Option::is_none")]
     part: Option<cluster::PartStats>,
@@ -154,6 +157,7 @@ impl Report<'_> {
             learned: integrator.learned(),
             silhouettes: integrator.silhouettes(),
             light_cuts: integrator.light_cuts(),
+            lanes: integrator.lanes(scene),
             part: self.plan.map(|p| p.stats(integrator, scene)),
         };
         let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;

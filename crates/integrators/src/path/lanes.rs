@@ -1,52 +1,54 @@
 //! The path tracer over eight paths at once ([`trace_camera_paths`]): the estimator of
-//! [`super::trace_path`], each lane one pixel's path with that pixel's numbers drawn in the same
-//! order, so that lane `i` follows the path the scalar walk would (to within the rounding of
-//! [`lanes::sample_cosine_hemisphere`]'s sine and cosine).
+//! [`super::trace_path`], each lane one pixel's path drawing that pixel's numbers in the same
+//! order and doing the same arithmetic, so that every lane's estimate is the scalar walk's, to
+//! the bit.
 //!
-//! What every lane does alike runs in lanes: the shading frame's changes of basis, the diffuse
-//! model's value, density and cosine-weighted sampling, the power heuristic, the throughput and
-//! Russian roulette. What differs per lane stays scalar, one lane after the other: traversal,
-//! the surface data of a hit, light sampling, shadow rays, emission, and every material but a
-//! plain diffuse one (its lanes call the general [`Bsdf`] methods and write their results
-//! into the lanes).
+//! The lanes carry paths across diffuse surfaces of meshes (Mitsuba's `diffuse`, no mask or
+//! normal map, its reflectance the same over the shape) and absorbers: the surface data of a
+//! hit, light sampling from triangles of uniform radiance, the diffuse model's value, density
+//! and cosine-weighted sampling, the power heuristic, the throughput and Russian roulette run
+//! in lanes ([`F8`]); traversal, shadow rays and emission lane by lane. A path that meets any
+//! other surface (another material, a textured one, a sphere) leaves its lane there and the
+//! scalar walk finishes it from that hit ([`super::trace_path_from`]).
 
 use glam::Vec3;
-use restir_geometry::{Ray, SurfaceInteraction, offset_ray_origin};
-use restir_lights::LightSample;
+use restir_geometry::lanes::{MeshHits, SurfaceLanes};
+use restir_geometry::{Ray, Shape, SurfaceInteraction, offset_ray_origin};
 use restir_materials::{Bsdf, BsdfKind};
 use restir_sampling::Sampler;
 use restir_sampling::lanes::{self, F8, LANES, M8, V3};
 use restir_scene::Scene;
 
-use super::{EmissionMis, PathSettings, PrevVertex, rr_survival};
+use super::{EmissionMis, PathSettings, PrevVertex, rr_survival, trace_path_from};
 use crate::shadow::{ShadowTarget, visible};
 
 const FRAC_1_PI: f32 = core::f32::consts::FRAC_1_PI;
 
-/// A lane's material at a vertex.
-#[derive(Clone, Copy)]
-enum Material {
-    /// Mitsuba's `diffuse` with nothing around it (no mask, no normal map): computed in lanes.
-    Diffuse { two_sided: bool },
-    /// Anything else: the general methods, one lane at a time.
-    General(Bsdf),
+/// What a lane does at a surface.
+#[derive(Clone, Copy, PartialEq)]
+enum Surface {
+    /// A plain diffuse surface of reflectance `albedo`, mirrored to the front when `two_sided`.
+    Diffuse { albedo: Vec3, two_sided: bool },
+    /// An absorber (an emitter without a material): the path ends after its emission.
+    Black,
+    /// Anything else: the scalar walk takes the path over.
+    Other,
 }
 
-impl Material {
+impl Surface {
+    /// The class of a mesh surface whose BSDF is `bsdf` everywhere.
     #[inline(always)]
-    fn of(bsdf: Bsdf) -> (Self, Vec3) {
-        match bsdf.kind {
-            BsdfKind::Diffuse { reflectance }
-                if !bsdf.is_masked() && bsdf.normal_map.is_none() =>
-            {
-                (
-                    Material::Diffuse {
-                        two_sided: bsdf.two_sided,
-                    },
-                    reflectance,
-                )
-            }
-            _ => (Material::General(bsdf), Vec3::ZERO),
+    fn of(bsdf: Option<Bsdf>) -> Self {
+        match bsdf {
+            Some(b) if !b.is_masked() && b.normal_map.is_none() => match b.kind {
+                BsdfKind::Diffuse { reflectance } => Surface::Diffuse {
+                    albedo: reflectance,
+                    two_sided: b.two_sided,
+                },
+                BsdfKind::Black => Surface::Black,
+                _ => Surface::Other,
+            },
+            _ => Surface::Other,
         }
     }
 }
@@ -59,16 +61,6 @@ fn power_heuristic(pdf_a: F8, pdf_b: F8) -> F8 {
     let w = a2 / (a2 + b2);
     let w = w.is_finite().select(w, F8::splat(0.0));
     pdf_a.is_infinite().select(F8::splat(1.0), w)
-}
-
-/// `v` in the frame `(s, t, n)` of every lane ([`restir_geometry::Frame::to_local`]).
-#[inline(always)]
-fn to_local(v: V3, s: V3, t: V3, n: V3) -> V3 {
-    V3 {
-        x: v.dot(s),
-        y: v.dot(t),
-        z: v.dot(n),
-    }
 }
 
 /// Radiance along the camera rays `rays` (one a lane, at most [`LANES`]), each estimated with one
@@ -84,7 +76,6 @@ pub(crate) fn trace_camera_paths<S: Sampler>(
 ) -> u64 {
     let n = rays.len();
     debug_assert!(n <= LANES && rngs.len() == n && out.len() == n);
-    let mut traced = 0u64;
     let max_depth = settings.max_segments();
     if max_depth == 0 {
         out.fill(Vec3::ZERO);
@@ -92,87 +83,134 @@ pub(crate) fn trace_camera_paths<S: Sampler>(
     }
     let lights = &scene.lights;
     let has_env = scene.features.has_environment;
+    let mut traced = 0u64;
     let mut ray: [Ray; LANES] = core::array::from_fn(|i| rays[i.min(n - 1)]);
-    let mut active = M8(core::array::from_fn(|i| i < n));
+    let mut active = M8::from_fn(|i| i < n);
     let mut beta = V3::splat(Vec3::ONE);
     let mut radiance = V3::ZERO;
-    let mut eta_scale = F8::splat(1.0);
     let mut prev: [Option<PrevVertex>; LANES] = [None; LANES];
-    let mut si: [Option<SurfaceInteraction>; LANES] = [None; LANES];
     let mut depth = 0u32;
     loop {
-        // The hits and what they emit, lane by lane.
+        // The hits, lane by lane: what they emit, the surface data of mesh hits gathered for
+        // the lanes (of emitters computed here, as their emission needs it), paths on other
+        // surfaces handed to the scalar walk.
         let hide = depth == 0 && settings.hide_emitters;
+        let mut gather = MeshHits::default();
+        let mut computed = [None::<SurfaceInteraction>; LANES];
+        let mut albedo = V3::ZERO;
+        let mut two_sided = M8::default();
         for i in 0..n {
-            si[i] = None;
-            if !active.0[i] {
+            if !active.get(i) {
                 continue;
             }
-            let r = &ray[i];
-            let (hit, k) = scene.camera_intersect(r, hide);
-            traced += k;
-            let mut add = Vec3::ZERO;
-            match hit {
-                None => {
-                    active.0[i] = false;
-                    if has_env && !hide {
-                        let le = lights.environment_radiance(r.d);
+            let r = ray[i];
+            let hit = if hide {
+                let (si, k) = scene.intersect_past_emitters(&r);
+                traced += k;
+                si.map(Err)
+            } else {
+                traced += 1;
+                scene.accel.intersect(&r, r.t_max).map(Ok)
+            };
+            let Some(hit) = hit else {
+                active.set(i, false);
+                if has_env && !hide {
+                    let le = lights.environment_radiance(r.d);
+                    let w = match prev[i] {
+                        Some(pv) if !pv.delta => {
+                            let env = lights
+                                .environment()
+                                .expect("feature summary says there is one");
+                            let em_pdf =
+                                pv.light_pdf(lights, settings.nee, (env, 0), pv.p + r.d, -r.d);
+                            pv.emission_weight(em_pdf)
+                        }
+                        _ => 1.0,
+                    };
+                    radiance.set(i, radiance.get(i) + beta.get(i) * le * w);
+                }
+                continue;
+            };
+            let shape = match &hit {
+                Ok(h) => h.shape,
+                Err(si) => si.shape,
+            };
+            let surface = match &scene.shapes[shape as usize] {
+                Shape::Mesh(_) => Surface::of(scene.uniform_bsdf(shape)),
+                _ => Surface::Other,
+            };
+            let light = lights.light_on_shape(shape).filter(|_| !hide);
+            if let (Ok(h), None, Surface::Diffuse { .. }, Shape::Mesh(m)) =
+                (&hit, light, surface, &scene.shapes[shape as usize])
+            {
+                gather.set(i, m, h.prim as usize, h.bary);
+            } else {
+                let s = match hit {
+                    Ok(h) => scene.accel.surface_interaction(&scene.shapes, &h, &r),
+                    Err(si) => si,
+                };
+                if surface == Surface::Other {
+                    let (l, k) = trace_path_from(
+                        scene,
+                        settings,
+                        r,
+                        Some(Some(s)),
+                        depth,
+                        beta.get(i),
+                        prev[i],
+                        radiance.get(i),
+                        &mut rngs[i],
+                    );
+                    radiance.set(i, l);
+                    traced += k;
+                    active.set(i, false);
+                    continue;
+                }
+                if let Some(light) = light {
+                    let le = lights.area_radiance(light, &s, -r.d);
+                    if le != Vec3::ZERO {
                         let w = match prev[i] {
                             Some(pv) if !pv.delta => {
-                                let env = lights
-                                    .environment()
-                                    .expect("feature summary says there is one");
                                 let em_pdf =
-                                    pv.light_pdf(lights, settings.nee, (env, 0), pv.p + r.d, -r.d);
+                                    pv.light_pdf(lights, settings.nee, (light, s.prim), s.p, s.ng);
                                 pv.emission_weight(em_pdf)
                             }
                             _ => 1.0,
                         };
-                        add = beta.get(i) * le * w;
+                        radiance.set(i, radiance.get(i) + beta.get(i) * le * w);
                     }
                 }
-                Some(s) => {
-                    if let Some(light) = lights.light_on_shape(s.shape)
-                        && !hide
-                    {
-                        let le = lights.area_radiance(light, &s, -r.d);
-                        if le != Vec3::ZERO {
-                            let w = match prev[i] {
-                                Some(pv) if !pv.delta => {
-                                    let em_pdf = pv.light_pdf(
-                                        lights,
-                                        settings.nee,
-                                        (light, s.prim),
-                                        s.p,
-                                        s.ng,
-                                    );
-                                    pv.emission_weight(em_pdf)
-                                }
-                                _ => 1.0,
-                            };
-                            add = beta.get(i) * le * w;
-                        }
-                    }
-                    si[i] = Some(s);
+                if surface == Surface::Black {
+                    active.set(i, false);
+                    continue;
                 }
+                computed[i] = Some(s);
             }
-            if add != Vec3::ZERO {
-                radiance.set(i, radiance.get(i) + add);
+            if let Surface::Diffuse {
+                albedo: a,
+                two_sided: t,
+            } = surface
+            {
+                albedo.set(i, a);
+                two_sided.set(i, t);
             }
         }
         if !active.any() || depth + 1 >= max_depth {
             break;
         }
+        let mut surf: SurfaceLanes = gather.surface();
+        for (i, s) in computed.iter().enumerate() {
+            if let Some(s) = s {
+                surf.set(i, s.p, s.ng, &s.shading);
+            }
+        }
 
-        // The fixed per-bounce budget of numbers, the surfaces and their materials.
+        // The fixed per-bounce budget of numbers.
         let mut u = [[0.0f32; 7]; LANES];
-        let mut mat = [Material::Diffuse { two_sided: false }; LANES];
-        let (mut p, mut ng) = (V3::ZERO, V3::ZERO);
-        let (mut fs, mut ft, mut fn_) = (V3::ZERO, V3::ZERO, V3::ZERO);
-        let mut albedo = V3::ZERO;
-        let mut d = V3::ZERO;
         for i in 0..n {
-            let Some(s) = &si[i] else { continue };
+            if !active.get(i) {
+                continue;
+            }
             let rng = &mut rngs[i];
             let u_select = rng.next_1d();
             let u_light = rng.next_2d();
@@ -182,153 +220,79 @@ pub(crate) fn trace_camera_paths<S: Sampler>(
             u[i] = [
                 u_select, u_light.x, u_light.y, u_lobe, u_bsdf.x, u_bsdf.y, u_rr,
             ];
-            let (m, a) = Material::of(scene.bsdf(s));
-            mat[i] = m;
-            albedo.set(i, a);
-            p.set(i, s.p);
-            ng.set(i, s.ng);
-            fs.set(i, s.shading.s);
-            ft.set(i, s.shading.t);
-            fn_.set(i, s.shading.n);
-            d.set(i, ray[i].d);
         }
         let lane = |k: usize| F8::from_fn(|i| u[i][k]);
-        let wo = to_local(-d, fs, ft, fn_);
-        // Two-sided diffuse seen from behind: mirrored to the front.
-        let flip = M8(core::array::from_fn(|i| {
-            matches!(mat[i], Material::Diffuse { two_sided: true })
-        })) & wo.z.lt(F8::splat(0.0));
-        let vz = flip.select(-wo.z, wo.z);
         let zero = F8::splat(0.0);
-        let front = vz.gt(zero);
+        let d = V3::from_fn(|i| ray[i].d);
+        let wo = surf.to_local(-d);
+        // A two-sided surface seen from behind is mirrored to the front.
+        let flip = two_sided & wo.z.lt(zero);
+        let front = flip.select(-wo.z, wo.z).gt(zero);
 
-        // Next-event estimation: the light sample lane by lane, the material's value and
-        // density in lanes for the diffuse lanes.
-        let mut ls: [Option<LightSample>; LANES] = [None; LANES];
-        let (mut l_wi, mut l_le) = (V3::ZERO, V3::ZERO);
-        let (mut l_pdf, mut l_delta) = (F8::splat(1.0), M8::default());
-        let (mut g_f, mut g_pdf) = (V3::ZERO, zero);
-        for i in 0..n {
-            let Some(s) = &si[i] else { continue };
-            let smooth = match &mat[i] {
-                Material::Diffuse { .. } => true,
-                Material::General(b) => b.has_smooth_lobe(),
-            };
-            if !smooth {
-                continue;
-            }
-            let Some(l) = lights.sample_nee(
-                settings.nee,
-                s.p,
-                s.shading.n,
-                (u[i][0], u[i][6]),
-                glam::Vec2::new(u[i][1], u[i][2]),
-            ) else {
-                continue;
-            };
-            l_wi.set(i, l.wi);
-            l_le.set(i, l.le);
-            l_pdf.0[i] = l.pdf_sa;
-            l_delta.0[i] = l.delta;
-            ls[i] = Some(l);
-            if let Material::General(b) = &mat[i] {
-                let (wo_i, wi_i) = (s.shading.to_local(-ray[i].d), s.shading.to_local(l.wi));
-                g_f.set(i, b.eval(wo_i, wi_i));
-                g_pdf.0[i] = b.pdf_sa(wo_i, wi_i);
-            }
-        }
-        let wi = to_local(l_wi, fs, ft, fn_);
+        // Next-event estimation.
+        let nee_u = core::array::from_fn(|i| [u[i][0], u[i][6], u[i][1], u[i][2]]);
+        let ls = lights.sample_nee_lanes(settings.nee, surf.p, surf.n, &nee_u, active);
+        let wi = surf.to_local(ls.wi);
         let lz = flip.select(-wi.z, wi.z);
         let reach = front & lz.gt(zero);
-        let diffuse = M8(core::array::from_fn(|i| {
-            matches!(mat[i], Material::Diffuse { .. })
-        }));
-        let f = diffuse.select3(
-            reach.select3(albedo.scale(F8::splat(FRAC_1_PI) * lz), V3::ZERO),
-            g_f,
-        );
-        let b_pdf = diffuse.select(reach.select(lz * FRAC_1_PI, zero), g_pdf);
-        let w = l_delta.select(F8::splat(1.0), power_heuristic(l_pdf, b_pdf));
-        let direct = (beta * f * l_le).scale(w / l_pdf);
+        let f = reach.select3(albedo.scale(F8::splat(FRAC_1_PI) * lz), V3::ZERO);
+        let b_pdf = reach.select(lz * FRAC_1_PI, zero);
+        let w = ls
+            .delta
+            .select(F8::splat(1.0), power_heuristic(ls.pdf_sa, b_pdf));
+        let direct = (beta * f * ls.le).scale(w / ls.pdf_sa);
         for i in 0..n {
-            let (Some(l), Some(s)) = (&ls[i], &si[i]) else {
+            let Some(l) = ls.get(i) else {
                 continue;
             };
             if f.get(i) == Vec3::ZERO {
                 continue;
             }
             traced += 1;
-            if visible(scene, s.p, s.ng, ShadowTarget::of_sample(l)) {
+            if visible(
+                scene,
+                surf.p.get(i),
+                surf.ng.get(i),
+                ShadowTarget::of_sample(&l),
+            ) {
                 radiance.set(i, radiance.get(i) + direct.get(i));
             }
         }
 
-        // The continuation: cosine-weighted in lanes for the diffuse lanes.
+        // The continuation, cosine-weighted.
         let cos = lanes::sample_cosine_hemisphere(lane(4), lane(5));
-        let pdf_c = cos.z.gt(zero).select(cos.z * FRAC_1_PI, zero);
+        let pdf = cos.z.gt(zero).select(cos.z * FRAC_1_PI, zero);
         let f_c = albedo.scale(F8::splat(FRAC_1_PI) * cos.z);
-        let valid_c = front
-            & pdf_c.gt(zero)
-            & pdf_c.is_finite()
-            & f_c.is_finite()
-            & cos.is_finite();
-        let mut b_wi = V3 {
+        let ok = front & pdf.gt(zero) & pdf.is_finite() & f_c.is_finite() & cos.is_finite();
+        active = active & ok;
+        beta = beta * (f_c / pdf);
+        let local = V3 {
             x: cos.x,
             y: cos.y,
             z: flip.select(-cos.z, cos.z),
         };
-        let mut b_weight = f_c / pdf_c;
-        let mut b_pdf = pdf_c;
-        let mut b_eta = F8::splat(1.0);
-        let mut ok = valid_c;
-        let mut delta = M8::default();
+        let dir = surf.to_world(local);
         for i in 0..n {
-            if si[i].is_none() {
-                ok.0[i] = false;
+            if !active.get(i) {
                 continue;
             }
-            let Material::General(b) = &mat[i] else {
-                continue;
-            };
-            let s = si[i].as_ref().expect("checked above");
-            let wo_i = s.shading.to_local(-ray[i].d);
-            match b.sample(wo_i, u[i][3], glam::Vec2::new(u[i][4], u[i][5])) {
-                None => ok.0[i] = false,
-                Some(bs) => {
-                    ok.0[i] = true;
-                    b_wi.set(i, bs.wi);
-                    b_weight.set(i, bs.f / bs.pdf_sa);
-                    b_pdf.0[i] = bs.pdf_sa;
-                    b_eta.0[i] = bs.eta;
-                    delta.0[i] = bs.lobe.is_delta();
-                }
-            }
-        }
-        active = active & ok;
-        beta = beta * b_weight;
-        eta_scale = eta_scale * b_eta;
-        let dir = fs.scale(b_wi.x) + ft.scale(b_wi.y) + fn_.scale(b_wi.z);
-        for i in 0..n {
-            if !active.0[i] {
-                continue;
-            }
-            let (pi, ngi, di) = (p.get(i), ng.get(i), dir.get(i));
+            let (p, di) = (surf.p.get(i), dir.get(i));
             prev[i] = Some(PrevVertex {
-                p: pi,
-                n: fn_.get(i),
-                pdf_sa: b_pdf.0[i],
-                delta: delta.0[i],
+                p,
+                n: surf.n.get(i),
+                pdf_sa: pdf.0[i],
+                delta: false,
                 mis: EmissionMis::Power,
             });
-            ray[i] = Ray::new(offset_ray_origin(pi, ngi, di), di);
+            ray[i] = Ray::new(offset_ray_origin(p, surf.ng.get(i), di), di);
         }
         depth += 1;
 
-        // Russian roulette.
+        // Russian roulette (diffuse surfaces leave the relative index of refraction at 1).
         let bmax = beta.max_element();
         active = active & bmax.gt(zero) & beta.is_finite();
         if depth >= settings.rr_depth {
-            let q = F8::from_fn(|i| rr_survival(bmax.0[i], eta_scale.0[i]));
+            let q = F8::from_fn(|i| rr_survival(bmax.0[i], 1.0));
             active = active & lane(6).lt(q);
             beta = beta / q;
         }
@@ -340,6 +304,35 @@ pub(crate) fn trace_camera_paths<S: Sampler>(
         *o = radiance.get(i);
     }
     traced
+}
+
+/// Whether this CPU runs the lanes with AVX2 and FMA (else with the baseline's SSE2).
+fn avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// What runs in lanes for `scene`, for `--stats`: the lane count and instructions, and how many
+/// of its shapes the lanes carry paths across.
+pub(crate) fn describe(scene: &Scene) -> String {
+    let carried = (0..scene.shapes.len() as u32)
+        .filter(|&s| {
+            matches!(scene.shapes[s as usize], Shape::Mesh(_))
+                && Surface::of(scene.uniform_bsdf(s)) != Surface::Other
+        })
+        .count();
+    format!(
+        "{LANES} paths at a time ({}); {carried} of {} shapes (diffuse or absorbing meshes) in \
+         lanes, paths reaching the others finished one at a time",
+        if avx2() { "AVX2 and FMA" } else { "SSE2" },
+        scene.shapes.len()
+    )
 }
 
 /// The path tracer's estimates for the pixels `first..first + out.len()` of a film `width`
@@ -355,7 +348,7 @@ pub(crate) fn render_pixels<S: Sampler>(
     start: impl Fn(usize, (u32, u32)) -> (S, glam::Vec2),
 ) -> u64 {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+    if avx2() {
         // SAFETY: the CPU reported AVX2 and FMA, the features the function is compiled with.
         #[allow(unsafe_code)]
         return unsafe { render_pixels_avx2(scene, settings, width, first, out, start) };

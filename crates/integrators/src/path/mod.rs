@@ -6,7 +6,7 @@
 //! `min(max(β)·η², 0.95)`.
 
 use glam::{DVec3, Vec2, Vec3};
-use restir_geometry::{Ray, offset_ray_origin};
+use restir_geometry::{Ray, SurfaceInteraction, offset_ray_origin};
 use restir_lights::{LightSet, NeeSelection};
 use restir_sampling::Sampler;
 use restir_sampling::warp::{power_heuristic, power_share};
@@ -286,13 +286,42 @@ pub fn rr_survival(beta_max: f32, eta_scale: f32) -> f32 {
 pub fn trace_path<S: Sampler>(
     scene: &Scene,
     settings: &PathSettings,
+    ray: Ray,
+    depth: u32,
+    beta: Vec3,
+    prev: Option<PrevVertex>,
+    rng: &mut S,
+) -> (Vec3, u64) {
+    trace_path_from(
+        scene,
+        settings,
+        ray,
+        None,
+        depth,
+        beta,
+        prev,
+        Vec3::ZERO,
+        rng,
+    )
+}
+
+/// [`trace_path`] when the closest hit of `ray` is already known: `first` is what
+/// [`Scene::camera_intersect`] returned for it (its rays already counted by the caller), or
+/// `None` to trace it. The estimate adds to `radiance`, what the path gathered before `ray`
+/// (so that it is summed in the order [`trace_path`] sums it).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(crate) fn trace_path_from<S: Sampler>(
+    scene: &Scene,
+    settings: &PathSettings,
     mut ray: Ray,
+    mut first: Option<Option<SurfaceInteraction>>,
     mut depth: u32,
     mut beta: Vec3,
     mut prev: Option<PrevVertex>,
+    mut radiance: Vec3,
     rng: &mut S,
 ) -> (Vec3, u64) {
-    let mut radiance = Vec3::ZERO;
     let mut rays = 0u64;
     let max_depth = settings.max_segments();
     if depth >= max_depth {
@@ -303,8 +332,14 @@ pub fn trace_path<S: Sampler>(
     let mut eta_scale = 1.0f32;
     loop {
         // With hidden emitters the camera sees through area lights (as in Mitsuba 3).
-        let (hit, n) = scene.camera_intersect(&ray, depth == 0 && settings.hide_emitters);
-        rays += n;
+        let hit = match first.take() {
+            Some(hit) => hit,
+            None => {
+                let (hit, n) = scene.camera_intersect(&ray, depth == 0 && settings.hide_emitters);
+                rays += n;
+                hit
+            }
+        };
         let Some(si) = hit else {
             if has_env && !(depth == 0 && settings.hide_emitters) {
                 let le = lights.environment_radiance(ray.d);
@@ -448,46 +483,27 @@ impl Integrator for PathIntegrator {
         let w = w as usize;
         let settings = self.settings.resolved(&scene.features);
         let bands = Bands::new(w);
-        if std::env::var_os("RESTIR_PATH_SCALAR").is_none() {
-            return bands.run(accum, |first, chunk| match settings.sampler {
-                SamplerKind::Independent => {
-                    lanes::render_pixels(scene, &settings, w, first, chunk, |index, xy| {
-                        let mut rng = ctx.pixel_rng(index);
-                        let film = ctx.pixel_film_position(index, xy, &mut rng);
-                        (rng, film)
-                    })
-                }
-                SamplerKind::Sobol => {
-                    lanes::render_pixels(scene, &settings, w, first, chunk, |index, (x, y)| {
-                        let mut rng = ctx.pixel_sequence(index);
-                        let film = ctx.film_position(x, y, &mut rng);
-                        (rng, film)
-                    })
-                }
-            });
-        }
-        bands.run(accum, |first, chunk| {
-            let mut rays = 0;
-            for (i, px) in chunk.iter_mut().enumerate() {
-                let index = first + i;
-                let (x, y) = ((index % w) as u32, (index / w) as u32);
-                let (l, r) = match settings.sampler {
-                    SamplerKind::Independent => {
-                        let mut rng = ctx.pixel_rng(index);
-                        let film = ctx.pixel_film_position(index, (x, y), &mut rng);
-                        trace_camera_path(scene, &settings, film, &mut rng)
-                    }
-                    SamplerKind::Sobol => {
-                        let mut rng = ctx.pixel_sequence(index);
-                        let film = ctx.film_position(x, y, &mut rng);
-                        trace_camera_path(scene, &settings, film, &mut rng)
-                    }
-                };
-                *px += l.as_dvec3();
-                rays += r;
+        // Eight pixels at a time, each lane the path `trace_camera_path` draws for its pixel.
+        bands.run(accum, |first, chunk| match settings.sampler {
+            SamplerKind::Independent => {
+                lanes::render_pixels(scene, &settings, w, first, chunk, |index, xy| {
+                    let mut rng = ctx.pixel_rng(index);
+                    let film = ctx.pixel_film_position(index, xy, &mut rng);
+                    (rng, film)
+                })
             }
-            rays
+            SamplerKind::Sobol => {
+                lanes::render_pixels(scene, &settings, w, first, chunk, |index, (x, y)| {
+                    let mut rng = ctx.pixel_sequence(index);
+                    let film = ctx.film_position(x, y, &mut rng);
+                    (rng, film)
+                })
+            }
         })
+    }
+
+    fn lanes(&self, scene: &Scene) -> Option<String> {
+        Some(lanes::describe(scene))
     }
 }
 

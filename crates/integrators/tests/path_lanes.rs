@@ -1,0 +1,123 @@
+//! The path tracer's passes run eight paths at a time in SIMD lanes; each lane must give the
+//! estimate of the scalar walk (`trace_camera_path`) for its pixel, to the bit, and the same
+//! ray count: on diffuse meshes (in lanes), on every other material, sphere lights and an
+//! environment (handed to the scalar walk mid-path), with both samplers, hidden emitters, short
+//! and unbounded depths, and films whose width is not a multiple of eight.
+
+mod common;
+
+use glam::{DVec3, Vec3};
+use restir_integrators::film::Filter;
+use restir_integrators::path::{PathIntegrator, PathSettings, trace_camera_path};
+use restir_integrators::{Integrator, PassContext};
+use restir_scene::{SamplerKind, Scene};
+
+/// The scalar walk's estimates for every pixel of one pass, and its ray count.
+fn scalar_pass(scene: &Scene, settings: &PathSettings, ctx: &PassContext) -> (Vec<Vec3>, u64) {
+    let (w, h) = ctx.resolution(scene);
+    let settings = settings.resolved(&scene.features);
+    let mut rays = 0;
+    let image = (0..(w * h) as usize)
+        .map(|index| {
+            let (x, y) = ((index % w as usize) as u32, (index / w as usize) as u32);
+            let (l, r) = match settings.sampler {
+                SamplerKind::Independent => {
+                    let mut rng = ctx.pixel_rng(index);
+                    let film = ctx.pixel_film_position(index, (x, y), &mut rng);
+                    trace_camera_path(scene, &settings, film, &mut rng)
+                }
+                SamplerKind::Sobol => {
+                    let mut rng = ctx.pixel_sequence(index);
+                    let film = ctx.film_position(x, y, &mut rng);
+                    trace_camera_path(scene, &settings, film, &mut rng)
+                }
+            };
+            rays += r;
+            l
+        })
+        .collect();
+    (image, rays)
+}
+
+/// Renders passes of `file` (at 37 × 21) with the lanes and with the scalar walk and requires
+/// the same bits and ray counts; returns how many pixels were not black.
+fn check(file: &str, edit: impl Fn(&mut PathSettings)) -> usize {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(file);
+    let (mut desc, _) = restir_scene::load_desc(&path, &[]).unwrap();
+    desc.film.width = 37;
+    desc.film.height = 21;
+    let scene = common::build(&desc, path.parent().unwrap(), &path);
+    let mut settings = PathSettings::from_desc(&scene.integrator);
+    edit(&mut settings);
+    let integrator = PathIntegrator { settings };
+    let filter = Filter::new(scene.filter);
+    let mut lit = 0;
+    for pass in 0..3 {
+        let ctx = PassContext {
+            seed: 11,
+            pass,
+            filter: &filter,
+            shared_offset: None,
+            samples: None,
+            crop: None,
+        };
+        let mut lanes = vec![DVec3::ZERO; 37 * 21];
+        let lane_rays = integrator.render_pass(&scene, &ctx, &mut lanes);
+        let (scalar, scalar_rays) = scalar_pass(&scene, &settings, &ctx);
+        for (i, (a, b)) in lanes.iter().zip(&scalar).enumerate() {
+            assert_eq!(
+                a.as_vec3().to_array().map(f32::to_bits),
+                b.to_array().map(f32::to_bits),
+                "{file}, pass {pass}, pixel {i}: lanes {a} against the scalar walk's {b}"
+            );
+            lit += usize::from(*b != Vec3::ZERO);
+        }
+        assert_eq!(lane_rays, scalar_rays, "{file}, pass {pass}: rays traced");
+    }
+    lit
+}
+
+/// Diffuse meshes and a rectangle light: every path in lanes, both samplers, every depth
+/// from emitters alone to unbounded, emitters hidden.
+#[test]
+fn lanes_give_the_scalar_walks_bits_on_diffuse_meshes() {
+    for sampler in [SamplerKind::Independent, SamplerKind::Sobol] {
+        for depth in [1, 2, 3, 6, -1] {
+            let lit = check("cornell-box.xml", |s| {
+                s.sampler = sampler;
+                s.max_depth = depth;
+            });
+            // Depth 1 is the emitters alone, which this camera does not see.
+            assert!(
+                depth == 1 || lit > 37 * 21,
+                "{sampler:?}, depth {depth}: {lit} lit"
+            );
+        }
+    }
+    check("cornell-box.xml", |s| s.hide_emitters = true);
+    check("cornell-box.xml", |s| s.rr_depth = 1);
+}
+
+/// Paths that leave the lanes: conductors, dielectrics, plastics and textures (the scalar walk
+/// finishes them from the hit), sphere lights under the light hierarchy's selection, an
+/// environment map, a thin pane.
+#[test]
+fn lanes_give_the_scalar_walks_bits_where_paths_leave_them() {
+    for file in [
+        "cornell-materials.xml",
+        "envmap-spheres.xml",
+        "many-lights.ron",
+        "thin-pane.xml",
+        "textured/textured-shapes.xml",
+        "glossy-still-life.xml",
+    ] {
+        let lit = check(file, |_| {});
+        assert!(lit > 0, "{file}: black");
+        check(file, |s| {
+            s.sampler = SamplerKind::Sobol;
+            s.hide_emitters = !s.hide_emitters;
+        });
+    }
+}
