@@ -157,6 +157,30 @@ pub fn tangents(n: V3, tangent: V3) -> (V3, V3) {
     (fallback.select3(ds, s), fallback.select3(dt, t))
 }
 
+/// [`crate::offset_ray_origin`] in every lane: `p` moved off its surface along `ng`, to the
+/// side `d` leaves towards.
+#[inline(always)]
+pub fn offset_ray_origins(p: V3, ng: V3, d: V3) -> V3 {
+    let one = F8::splat(1.0);
+    let side = ng.dot(d).ge(F8::splat(0.0)).select(one, -one);
+    let a = V3 {
+        x: p.x.abs(),
+        y: p.y.abs(),
+        z: p.z.abs(),
+    };
+    p + ng.scale(side * (a.max_element() * crate::RAY_EPSILON))
+}
+
+/// [`crate::shadow_ray_between`] in every lane: the shadow rays' origins, unit directions and
+/// the distances to test.
+#[inline(always)]
+pub fn shadow_rays_between(p: V3, ng: V3, target: V3) -> (V3, V3, F8) {
+    let o = offset_ray_origins(p, ng, target - p);
+    let to = target - o;
+    let dist = to.dot(to).sqrt();
+    (o, to / dist, dist * (1.0 - crate::SHADOW_EPSILON))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -240,5 +264,31 @@ mod tests {
             }
         }
         assert_eq!(checked, 500 * restir_sampling::lanes::LANES);
+    }
+
+    /// [`offset_ray_origins`] and [`shadow_rays_between`] give the scalar functions' bits, on
+    /// either side of the surface and at points far from the origin.
+    #[test]
+    fn lanes_give_the_ray_offsets_bits() {
+        let mut rng = Pcg32::new(6, 2);
+        for k in 0..2000 {
+            let scale = if k % 2 == 0 { 1.0 } else { 1e4 };
+            let mut r = || (rng.next_f32() * 2.0 - 1.0) * scale;
+            let p = V3::from_fn(|_| Vec3::new(r(), r(), r()));
+            let q = V3::from_fn(|_| Vec3::new(r(), r(), r()));
+            let ng = V3::from_fn(|_| Vec3::new(r(), r(), r()).normalize());
+            let o = offset_ray_origins(p, ng, q - p);
+            let (so, sd, st) = shadow_rays_between(p, ng, q);
+            for i in 0..restir_sampling::lanes::LANES {
+                let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                let want = crate::offset_ray_origin(p.get(i), ng.get(i), q.get(i) - p.get(i));
+                assert_eq!(bits(o.get(i)), bits(want));
+                let (ray, t) = crate::shadow_ray_between(p.get(i), ng.get(i), q.get(i));
+                assert_eq!(
+                    (bits(so.get(i)), bits(sd.get(i)), st.0[i].to_bits()),
+                    (bits(ray.o), bits(ray.d), t.to_bits())
+                );
+            }
+        }
     }
 }

@@ -410,17 +410,23 @@ impl TriangleMesh {
     /// triangle `i`.
     #[inline(always)]
     pub fn surface_at(&self, i: usize, b: Vec2) -> (Vec3, Vec3, Vec3, Vec2, Vec3) {
-        let [ia, ib, ic] = self.indices[i];
-        let b0 = 1.0 - b.x - b.y;
         let (p, ng, ns) = self.point_at(i, b);
-        let uv = match &self.uvs {
+        (p, ng, ns, self.uv_at(i, b), self.faces[i].dpdu)
+    }
+
+    /// The texture coordinates at barycentrics `b` of triangle `i` (the barycentrics themselves
+    /// for a mesh without texture coordinates).
+    #[inline(always)]
+    pub fn uv_at(&self, i: usize, b: Vec2) -> Vec2 {
+        match &self.uvs {
             Some(uvs) => {
+                let [ia, ib, ic] = self.indices[i];
                 let (t0, t1, t2) = (uvs[ia as usize], uvs[ib as usize], uvs[ic as usize]);
+                let b0 = 1.0 - b.x - b.y;
                 b0 * t0 + b.x * t1 + b.y * t2
             }
             None => b,
-        };
-        (p, ng, ns, uv, self.faces[i].dpdu)
+        }
     }
 
     /// Picks a triangle proportionally to area and a uniform point on it. Returns the triangle,

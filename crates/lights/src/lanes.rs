@@ -24,7 +24,7 @@ pub struct NeeLanes {
     /// Lanes whose light is a delta light.
     pub delta: M8,
     /// The points on the lights.
-    p: V3,
+    pub p: V3,
     /// The lights' shading normals there.
     n: V3,
     /// The lights' geometric normals there.

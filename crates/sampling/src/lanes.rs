@@ -338,7 +338,7 @@ impl V3 {
     /// The largest component in every lane (as glam's `max_element`).
     #[inline(always)]
     pub fn max_element(self) -> F8 {
-        F8::from_fn(|i| self.get(i).max_element())
+        self.x.max(self.y.max(self.z))
     }
 
     /// Lanes whose three components are finite.

@@ -190,6 +190,22 @@ impl Scene {
         Some(self.bsdfs[bsdf])
     }
 
+    /// The BSDF at the point `at` names on a shape, without the hit: [`Scene::bsdf`] of a hit
+    /// there, or `None` when the shape's material has a bump map (whose normal needs the
+    /// hit's derivatives).
+    #[inline]
+    pub fn bsdf_at_point(&self, at: &TexturePoint) -> Option<Bsdf> {
+        let bsdf = self.shape_bsdf[at.shape as usize];
+        if self.features.has_textures
+            && self.bsdf_textures[bsdf as usize]
+                .as_ref()
+                .is_some_and(|t| t.bump.is_some())
+        {
+            return None;
+        }
+        Some(self.bsdf_at(bsdf, at))
+    }
+
     /// The normal-map texel a bump map gives at `si` (from the height's gradient, the
     /// surface's derivatives and its shading frame there: [`restir_materials::bump_normal`]),
     /// or `None` when the material of `si`'s shape has no bump map. With the hit's
