@@ -1,4 +1,4 @@
-//! What paths in SIMD lanes would gain on a bounce's work besides its rays, one thread.
+//! What SIMD lanes gain on a bounce's work besides its rays, one thread.
 //!
 //! Run with `cargo bench -p restir-bench --bench lanes`. At the Cornell box's camera-ray hits
 //! (`scenes/cornell-box.xml`, 64×64, all diffuse, one rectangle light), each benchmark does what
@@ -11,8 +11,9 @@
 //! - `scalar`: the same mathematics written for this scene alone (two emissive triangles, a
 //!   diffuse albedo per receiver), one receiver at a time: what the general code's dispatch and
 //!   data layout cost.
-//! - `lanes`: that code again over eight receivers at once (`F8`, eight `f32` lanes that the
-//!   compiler maps to AVX2 registers; only where the CPU has AVX2 and FMA): what lanes gain.
+//! - `lanes`: that code again over eight receivers at once (`restir_sampling::lanes::F8`, eight
+//!   `f32` lanes that the compiler maps to AVX2 registers; only where the CPU has AVX2 and FMA):
+//!   what lanes gain.
 //!
 //! Both specialised versions are one generic function ([`bounce`]) instantiated for `f32` and
 //! for `F8`; its sine and cosine are one polynomial for both. Items are receivers.
@@ -27,6 +28,7 @@ use divan::{Bencher, black_box};
 use glam::{Vec2, Vec3};
 use restir_lights::NeeSelection;
 use restir_sampling::Pcg32;
+use restir_sampling::lanes::F8;
 use restir_sampling::warp::power_heuristic;
 use restir_scene::{Scene, load_desc};
 
@@ -149,59 +151,22 @@ impl Lane for f32 {
     }
 }
 
-/// Eight `f32` lanes.
-#[derive(Clone, Copy, Debug, Default)]
-#[repr(C, align(32))]
-struct F8([f32; 8]);
-
-macro_rules! lanewise {
-    ($tr:ident, $f:ident, $op:tt) => {
-        impl $tr for F8 {
-            type Output = F8;
-            #[inline(always)]
-            fn $f(self, o: F8) -> F8 {
-                let mut r = [0.0; 8];
-                for i in 0..8 {
-                    r[i] = self.0[i] $op o.0[i];
-                }
-                F8(r)
-            }
-        }
-    };
-}
-lanewise!(Add, add, +);
-lanewise!(Sub, sub, -);
-lanewise!(Mul, mul, *);
-lanewise!(Div, div, /);
-
 impl Lane for F8 {
     #[inline(always)]
     fn splat(x: f32) -> Self {
-        F8([x; 8])
+        F8::splat(x)
     }
     #[inline(always)]
     fn sqrt(self) -> Self {
-        F8(self.0.map(f32::sqrt))
+        F8::sqrt(self)
     }
     #[inline(always)]
     fn max(self, o: Self) -> Self {
-        let mut r = [0.0; 8];
-        for (i, x) in r.iter_mut().enumerate() {
-            *x = if self.0[i] > o.0[i] {
-                self.0[i]
-            } else {
-                o.0[i]
-            };
-        }
-        F8(r)
+        F8::max(self, o)
     }
     #[inline(always)]
     fn lt_select(a: Self, b: Self, x: Self, y: Self) -> Self {
-        let mut r = [0.0; 8];
-        for (i, v) in r.iter_mut().enumerate() {
-            *v = if a.0[i] < b.0[i] { x.0[i] } else { y.0[i] };
-        }
-        F8(r)
+        a.lt(b).select(x, y)
     }
 }
 
@@ -433,15 +398,15 @@ fn groups(receivers: &[Receiver]) -> Vec<Group> {
         .chunks_exact(8)
         .map(|c| {
             let v = |f: &dyn Fn(&Receiver) -> Vec3| V3 {
-                x: F8(std::array::from_fn(|i| f(&c[i]).x)),
-                y: F8(std::array::from_fn(|i| f(&c[i]).y)),
-                z: F8(std::array::from_fn(|i| f(&c[i]).z)),
+                x: F8::from_fn(|i| f(&c[i]).x),
+                y: F8::from_fn(|i| f(&c[i]).y),
+                z: F8::from_fn(|i| f(&c[i]).z),
             };
             Group {
                 p: v(&|r| r.p),
                 n: v(&|r| r.n),
                 albedo: v(&|r| r.albedo),
-                u: std::array::from_fn(|k| F8(std::array::from_fn(|i| c[i].u[k]))),
+                u: std::array::from_fn(|k| F8::from_fn(|i| c[i].u[k])),
             }
         })
         .collect()

@@ -39,16 +39,22 @@ fn scalar_pass(scene: &Scene, settings: &PathSettings, ctx: &PassContext) -> (Ve
     (image, rays)
 }
 
-/// Renders passes of `file` (at 37 × 21) with the lanes and with the scalar walk and requires
-/// the same bits and ray counts; returns how many pixels were not black.
+/// Renders passes of `file` (in the repository's `scenes/`, at 37 × 21) with the lanes and with
+/// the scalar walk and requires the same bits and ray counts; returns how many pixels were not
+/// black.
 fn check(file: &str, edit: impl Fn(&mut PathSettings)) -> usize {
     let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../scenes")
         .join(file);
-    let (mut desc, _) = restir_scene::load_desc(&path, &[]).unwrap();
+    check_file(&path, edit)
+}
+
+fn check_file(path: &std::path::Path, edit: impl Fn(&mut PathSettings)) -> usize {
+    let file = path.display();
+    let (mut desc, _) = restir_scene::load_desc(path, &[]).unwrap();
     desc.film.width = 37;
     desc.film.height = 21;
-    let scene = common::build(&desc, path.parent().unwrap(), &path);
+    let scene = common::build(&desc, path.parent().unwrap(), path);
     let mut settings = PathSettings::from_desc(&scene.integrator);
     edit(&mut settings);
     let integrator = PathIntegrator { settings };
@@ -119,5 +125,14 @@ fn lanes_give_the_scalar_walks_bits_where_paths_leave_them() {
             s.sampler = SamplerKind::Sobol;
             s.hide_emitters = !s.hide_emitters;
         });
+    }
+}
+
+restir_testkit::corpus_test! {
+    /// Corpus Sponza: textured diffuse meshes (in lanes, each texture looked up at its hit), a
+    /// `phong` material and a sphere light (paths leave the lanes there).
+    fn lanes_give_the_scalar_walks_bits_on_corpus_sponza() {
+        let path = restir_testkit::corpus::corpus_dir().join("lajolla/sponza/sponza.xml");
+        assert!(check_file(&path, |_| {}) > 37 * 21);
     }
 }

@@ -11,13 +11,13 @@
 //! other surface (another material, a textured one, a sphere) leaves its lane there and the
 //! scalar walk finishes it from that hit ([`super::trace_path_from`]).
 
-use glam::Vec3;
-use restir_geometry::lanes::{MeshHits, SurfaceLanes};
-use restir_geometry::{Ray, Shape, SurfaceInteraction, offset_ray_origin};
+use glam::{Vec2, Vec3};
+use restir_geometry::lanes::{MeshHits, SurfaceLanes, offset_ray_origins, shadow_rays_between};
+use restir_geometry::{Ray, Shape, SurfaceInteraction};
 use restir_materials::{Bsdf, BsdfKind};
 use restir_sampling::Sampler;
 use restir_sampling::lanes::{self, F8, LANES, M8, V3};
-use restir_scene::Scene;
+use restir_scene::{Scene, TexturePoint};
 
 use super::{EmissionMis, PathSettings, PrevVertex, rr_survival, trace_path_from};
 use crate::shadow::{ShadowTarget, visible};
@@ -26,7 +26,7 @@ const FRAC_1_PI: f32 = core::f32::consts::FRAC_1_PI;
 
 /// What a lane does at a surface.
 #[derive(Clone, Copy, PartialEq)]
-enum Surface {
+pub(crate) enum Surface {
     /// A plain diffuse surface of reflectance `albedo`, mirrored to the front when `two_sided`.
     Diffuse { albedo: Vec3, two_sided: bool },
     /// An absorber (an emitter without a material): the path ends after its emission.
@@ -53,6 +53,44 @@ impl Surface {
     }
 }
 
+/// What the lanes do at a hit on a shape, decided once for the scene ([`shape_classes`]).
+#[derive(Clone, Copy, PartialEq)]
+pub(crate) enum Class {
+    /// A mesh whose BSDF is the same everywhere.
+    Uniform(Surface),
+    /// A mesh of a diffuse or absorbing material with textures (none of them a mask, a normal
+    /// map or a bump map): its BSDF is looked up at each hit.
+    Textured,
+    /// Anything else: paths that reach it are handed to the scalar walk.
+    Other,
+}
+
+/// Each shape's [`Class`].
+pub(crate) fn shape_classes(scene: &Scene) -> Vec<Class> {
+    (0..scene.shapes.len())
+        .map(|s| {
+            if !matches!(scene.shapes[s], Shape::Mesh(_)) {
+                return Class::Other;
+            }
+            if let Some(b) = scene.uniform_bsdf(s as u32) {
+                return match Surface::of(Some(b)) {
+                    Surface::Other => Class::Other,
+                    surface => Class::Uniform(surface),
+                };
+            }
+            let b = scene.shape_bsdf()[s] as usize;
+            let plain = scene.bsdf_textures()[b]
+                .as_ref()
+                .is_none_or(|t| t.opacity.is_none() && t.normal.is_none() && t.bump.is_none());
+            if plain && Surface::of(Some(scene.bsdfs()[b])) != Surface::Other {
+                Class::Textured
+            } else {
+                Class::Other
+            }
+        })
+        .collect()
+}
+
 /// Lanes where `pdf_a` wins by the power heuristic against `pdf_b`
 /// ([`restir_sampling::warp::power_heuristic`] in every lane).
 #[inline(always)]
@@ -70,6 +108,7 @@ fn power_heuristic(pdf_a: F8, pdf_b: F8) -> F8 {
 pub(crate) fn trace_camera_paths<S: Sampler>(
     scene: &Scene,
     settings: &PathSettings,
+    classes: &[Class],
     rays: &[Ray],
     rngs: &mut [S],
     out: &mut [Vec3],
@@ -135,8 +174,22 @@ pub(crate) fn trace_camera_paths<S: Sampler>(
                 Ok(h) => h.shape,
                 Err(si) => si.shape,
             };
-            let surface = match &scene.shapes[shape as usize] {
-                Shape::Mesh(_) => Surface::of(scene.uniform_bsdf(shape)),
+            let surface = match (classes[shape as usize], &hit, &scene.shapes[shape as usize]) {
+                (Class::Uniform(surface), ..) => surface,
+                (Class::Textured, Ok(h), Shape::Mesh(m)) => {
+                    // Looked up at the hit (the barycentrics clamped into the triangle as
+                    // `Accel::surface_interaction` clamps them).
+                    let u = h.bary.x.clamp(0.0, 1.0);
+                    let bary = Vec2::new(u, h.bary.y.clamp(0.0, 1.0 - u));
+                    let uv = m.uv_at(h.prim as usize, bary);
+                    Surface::of(scene.bsdf_at_point(&TexturePoint {
+                        uv,
+                        shape,
+                        prim: h.prim,
+                        bary,
+                    }))
+                }
+                (Class::Textured, Err(si), _) => Surface::of(Some(scene.bsdf(si))),
                 _ => Surface::Other,
             };
             let light = lights.light_on_shape(shape).filter(|_| !hide);
@@ -241,6 +294,8 @@ pub(crate) fn trace_camera_paths<S: Sampler>(
             .delta
             .select(F8::splat(1.0), power_heuristic(ls.pdf_sa, b_pdf));
         let direct = (beta * f * ls.le).scale(w / ls.pdf_sa);
+        // The shadow rays toward points (`visible`'s, `shadow_ray_between` in lanes).
+        let (s_o, s_d, s_t) = shadow_rays_between(surf.p, surf.ng, ls.p);
         for i in 0..n {
             let Some(l) = ls.get(i) else {
                 continue;
@@ -249,12 +304,18 @@ pub(crate) fn trace_camera_paths<S: Sampler>(
                 continue;
             }
             traced += 1;
-            if visible(
-                scene,
-                surf.p.get(i),
-                surf.ng.get(i),
-                ShadowTarget::of_sample(&l),
-            ) {
+            let ray = Ray::new(s_o.get(i), s_d.get(i));
+            let seen = match ShadowTarget::of_sample(&l) {
+                ShadowTarget::OnLight { p, ng, light, prim } => {
+                    let end = lights.shadow_end(light, prim, ray.o, ray.d, s_t.0[i], p, ng);
+                    !scene.occluded(&ray, end)
+                }
+                ShadowTarget::Point(_) => !scene.occluded(&ray, s_t.0[i]),
+                target @ ShadowTarget::Direction(_) => {
+                    visible(scene, surf.p.get(i), surf.ng.get(i), target)
+                }
+            };
+            if seen {
                 radiance.set(i, radiance.get(i) + direct.get(i));
             }
         }
@@ -272,19 +333,19 @@ pub(crate) fn trace_camera_paths<S: Sampler>(
             z: flip.select(-cos.z, cos.z),
         };
         let dir = surf.to_world(local);
+        let origin = offset_ray_origins(surf.p, surf.ng, dir);
         for i in 0..n {
             if !active.get(i) {
                 continue;
             }
-            let (p, di) = (surf.p.get(i), dir.get(i));
             prev[i] = Some(PrevVertex {
-                p,
+                p: surf.p.get(i),
                 n: surf.n.get(i),
                 pdf_sa: pdf.0[i],
                 delta: false,
                 mis: EmissionMis::Power,
             });
-            ray[i] = Ray::new(offset_ray_origin(p, surf.ng.get(i), di), di);
+            ray[i] = Ray::new(origin.get(i), dir.get(i));
         }
         depth += 1;
 
@@ -321,15 +382,13 @@ fn avx2() -> bool {
 /// What runs in lanes for `scene`, for `--stats`: the lane count and instructions, and how many
 /// of its shapes the lanes carry paths across.
 pub(crate) fn describe(scene: &Scene) -> String {
-    let carried = (0..scene.shapes.len() as u32)
-        .filter(|&s| {
-            matches!(scene.shapes[s as usize], Shape::Mesh(_))
-                && Surface::of(scene.uniform_bsdf(s)) != Surface::Other
-        })
+    let carried = shape_classes(scene)
+        .iter()
+        .filter(|&&c| c != Class::Other)
         .count();
     format!(
-        "{LANES} paths at a time ({}); {carried} of {} shapes (diffuse or absorbing meshes) in \
-         lanes, paths reaching the others finished one at a time",
+        "{LANES} paths at a time ({}); {carried} of {} shapes (diffuse or absorbing meshes, textured \
+         or not) in lanes, paths reaching the others finished one at a time",
         if avx2() { "AVX2 and FMA" } else { "SSE2" },
         scene.shapes.len()
     )
@@ -342,6 +401,7 @@ pub(crate) fn describe(scene: &Scene) -> String {
 pub(crate) fn render_pixels<S: Sampler>(
     scene: &Scene,
     settings: &PathSettings,
+    classes: &[Class],
     width: usize,
     first: usize,
     out: &mut [glam::DVec3],
@@ -351,9 +411,9 @@ pub(crate) fn render_pixels<S: Sampler>(
     if avx2() {
         // SAFETY: the CPU reported AVX2 and FMA, the features the function is compiled with.
         #[allow(unsafe_code)]
-        return unsafe { render_pixels_avx2(scene, settings, width, first, out, start) };
+        return unsafe { render_pixels_avx2(scene, settings, classes, width, first, out, start) };
     }
-    render_pixels_with(scene, settings, width, first, out, start)
+    render_pixels_with(scene, settings, classes, width, first, out, start)
 }
 
 /// [`render_pixels`] compiled for AVX2 and FMA.
@@ -363,18 +423,20 @@ pub(crate) fn render_pixels<S: Sampler>(
 unsafe fn render_pixels_avx2<S: Sampler>(
     scene: &Scene,
     settings: &PathSettings,
+    classes: &[Class],
     width: usize,
     first: usize,
     out: &mut [glam::DVec3],
     start: impl Fn(usize, (u32, u32)) -> (S, glam::Vec2),
 ) -> u64 {
-    render_pixels_with(scene, settings, width, first, out, start)
+    render_pixels_with(scene, settings, classes, width, first, out, start)
 }
 
 #[inline(always)]
 fn render_pixels_with<S: Sampler>(
     scene: &Scene,
     settings: &PathSettings,
+    classes: &[Class],
     width: usize,
     first: usize,
     out: &mut [glam::DVec3],
@@ -395,7 +457,14 @@ fn render_pixels_with<S: Sampler>(
             rng
         });
         let mut est = [Vec3::ZERO; LANES];
-        traced += trace_camera_paths(scene, settings, &rays[..n], &mut rngs[..n], &mut est[..n]);
+        traced += trace_camera_paths(
+            scene,
+            settings,
+            classes,
+            &rays[..n],
+            &mut rngs[..n],
+            &mut est[..n],
+        );
         for (o, e) in group.iter_mut().zip(est) {
             *o += e.as_dvec3();
         }

@@ -484,21 +484,29 @@ impl Integrator for PathIntegrator {
         let settings = self.settings.resolved(&scene.features);
         let bands = Bands::new(w);
         // Eight pixels at a time, each lane the path `trace_camera_path` draws for its pixel.
+        let classes = lanes::shape_classes(scene);
+        let classes = classes.as_slice();
         bands.run(accum, |first, chunk| match settings.sampler {
             SamplerKind::Independent => {
-                lanes::render_pixels(scene, &settings, w, first, chunk, |index, xy| {
+                lanes::render_pixels(scene, &settings, classes, w, first, chunk, |index, xy| {
                     let mut rng = ctx.pixel_rng(index);
                     let film = ctx.pixel_film_position(index, xy, &mut rng);
                     (rng, film)
                 })
             }
-            SamplerKind::Sobol => {
-                lanes::render_pixels(scene, &settings, w, first, chunk, |index, (x, y)| {
+            SamplerKind::Sobol => lanes::render_pixels(
+                scene,
+                &settings,
+                classes,
+                w,
+                first,
+                chunk,
+                |index, (x, y)| {
                     let mut rng = ctx.pixel_sequence(index);
                     let film = ctx.film_position(x, y, &mut rng);
                     (rng, film)
-                })
-            }
+                },
+            ),
         })
     }
 
