@@ -19,14 +19,17 @@ use restir_sampling::Sampler;
 use restir_sampling::lanes::{self, F8, LANES, M8, V3};
 use restir_scene::{Scene, TexturePoint};
 
-use super::{EmissionMis, PathSettings, PrevVertex, rr_survival, trace_path_from};
+use super::{
+    EmissionMis, PathSettings, PrevVertex, emission_mis, environment_mis, rr_survival,
+    trace_path_from,
+};
 use crate::shadow::{ShadowTarget, visible};
 
 const FRAC_1_PI: f32 = core::f32::consts::FRAC_1_PI;
 
 /// What a lane does at a surface.
 #[derive(Clone, Copy, PartialEq)]
-pub(crate) enum Surface {
+enum Surface {
     /// A plain diffuse surface of reflectance `albedo`, mirrored to the front when `two_sided`.
     Diffuse { albedo: Vec3, two_sided: bool },
     /// An absorber (an emitter without a material): the path ends after its emission.
@@ -55,7 +58,7 @@ impl Surface {
 
 /// What the lanes do at a hit on a shape, decided once for the scene ([`shape_classes`]).
 #[derive(Clone, Copy, PartialEq)]
-pub(crate) enum Class {
+enum Class {
     /// A mesh whose BSDF is the same everywhere.
     Uniform(Surface),
     /// A mesh of a diffuse or absorbing material with textures (none of them a mask, a normal
@@ -66,7 +69,7 @@ pub(crate) enum Class {
 }
 
 /// Each shape's [`Class`].
-pub(crate) fn shape_classes(scene: &Scene) -> Vec<Class> {
+fn shape_classes(scene: &Scene) -> Vec<Class> {
     (0..scene.shapes.len())
         .map(|s| {
             if !matches!(scene.shapes[s], Shape::Mesh(_)) {
@@ -105,7 +108,7 @@ fn power_heuristic(pdf_a: F8, pdf_b: F8) -> F8 {
 /// path drawing its numbers from the same lane of `rngs`: [`super::trace_path`] from depth 0, lane
 /// by lane. Writes the estimates to `out` and returns the number of rays traced.
 #[inline(always)]
-pub(crate) fn trace_camera_paths<S: Sampler>(
+fn trace_camera_paths<S: Sampler>(
     scene: &Scene,
     settings: &PathSettings,
     classes: &[Class],
@@ -155,17 +158,7 @@ pub(crate) fn trace_camera_paths<S: Sampler>(
                 active.set(i, false);
                 if has_env && !hide {
                     let le = lights.environment_radiance(r.d);
-                    let w = match prev[i] {
-                        Some(pv) if !pv.delta => {
-                            let env = lights
-                                .environment()
-                                .expect("feature summary says there is one");
-                            let em_pdf =
-                                pv.light_pdf(lights, settings.nee, (env, 0), pv.p + r.d, -r.d);
-                            pv.emission_weight(em_pdf)
-                        }
-                        _ => 1.0,
-                    };
+                    let w = environment_mis(prev[i], lights, settings.nee, r.d);
                     radiance.set(i, radiance.get(i) + beta.get(i) * le * w);
                 }
                 continue;
@@ -222,14 +215,8 @@ pub(crate) fn trace_camera_paths<S: Sampler>(
                 if let Some(light) = light {
                     let le = lights.area_radiance(light, &s, -r.d);
                     if le != Vec3::ZERO {
-                        let w = match prev[i] {
-                            Some(pv) if !pv.delta => {
-                                let em_pdf =
-                                    pv.light_pdf(lights, settings.nee, (light, s.prim), s.p, s.ng);
-                                pv.emission_weight(em_pdf)
-                            }
-                            _ => 1.0,
-                        };
+                        let w =
+                            emission_mis(prev[i], lights, settings.nee, (light, s.prim), s.p, s.ng);
                         radiance.set(i, radiance.get(i) + beta.get(i) * le * w);
                     }
                 }
@@ -394,80 +381,91 @@ pub(crate) fn describe(scene: &Scene) -> String {
     )
 }
 
-/// The path tracer's estimates for the pixels `first..first + out.len()` of a film `width`
-/// pixels wide, added to `out`, eight pixels at a time: `start` gives a pixel's numbers and its
-/// film position (the caller's pixel sampler). Returns the rays traced. Runs with AVX2 and FMA
-/// where the CPU has them (the same bits as without).
-pub(crate) fn render_pixels<S: Sampler>(
-    scene: &Scene,
-    settings: &PathSettings,
-    classes: &[Class],
-    width: usize,
-    first: usize,
-    out: &mut [glam::DVec3],
-    start: impl Fn(usize, (u32, u32)) -> (S, glam::Vec2),
-) -> u64 {
-    #[cfg(target_arch = "x86_64")]
-    if avx2() {
-        // SAFETY: the CPU reported AVX2 and FMA, the features the function is compiled with.
-        #[allow(unsafe_code)]
-        return unsafe { render_pixels_avx2(scene, settings, classes, width, first, out, start) };
-    }
-    render_pixels_with(scene, settings, classes, width, first, out, start)
+/// A pass of the path tracer in lanes over a scene, with what it decided about the scene's
+/// shapes.
+pub(crate) struct LanePass<'a> {
+    scene: &'a Scene,
+    settings: &'a PathSettings,
+    classes: Vec<Class>,
 }
 
-/// [`render_pixels`] compiled for AVX2 and FMA.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-#[allow(unsafe_code)]
-unsafe fn render_pixels_avx2<S: Sampler>(
-    scene: &Scene,
-    settings: &PathSettings,
-    classes: &[Class],
-    width: usize,
-    first: usize,
-    out: &mut [glam::DVec3],
-    start: impl Fn(usize, (u32, u32)) -> (S, glam::Vec2),
-) -> u64 {
-    render_pixels_with(scene, settings, classes, width, first, out, start)
-}
-
-#[inline(always)]
-fn render_pixels_with<S: Sampler>(
-    scene: &Scene,
-    settings: &PathSettings,
-    classes: &[Class],
-    width: usize,
-    first: usize,
-    out: &mut [glam::DVec3],
-    start: impl Fn(usize, (u32, u32)) -> (S, glam::Vec2),
-) -> u64 {
-    let mut traced = 0;
-    for (g, group) in out.chunks_mut(LANES).enumerate() {
-        let base = first + g * LANES;
-        let n = group.len();
-        let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); LANES];
-        // Lanes past the end of a short group repeat its last pixel and are not traced.
-        let mut rngs: [S; LANES] = core::array::from_fn(|i| {
-            let index = base + i.min(n - 1);
-            let (mut rng, film) = start(index, ((index % width) as u32, (index / width) as u32));
-            // The lens sample comes first, as in `trace_camera_path`.
-            let u_lens = rng.next_2d();
-            rays[i] = scene.camera.generate_ray(film, u_lens);
-            rng
-        });
-        let mut est = [Vec3::ZERO; LANES];
-        traced += trace_camera_paths(
+impl<'a> LanePass<'a> {
+    /// The pass over `scene` with `settings` (next-event estimation decided).
+    pub(crate) fn new(scene: &'a Scene, settings: &'a PathSettings) -> Self {
+        Self {
             scene,
             settings,
-            classes,
-            &rays[..n],
-            &mut rngs[..n],
-            &mut est[..n],
-        );
-        for (o, e) in group.iter_mut().zip(est) {
-            *o += e.as_dvec3();
+            classes: shape_classes(scene),
         }
     }
-    traced
+
+    /// The path tracer's estimates for the pixels `first..first + out.len()` of a film `width`
+    /// pixels wide, added to `out`, eight pixels at a time: `start` gives a pixel's numbers and
+    /// its film position (the caller's pixel sampler). Returns the rays traced. Runs with AVX2
+    /// and FMA where the CPU has them (the same bits as without).
+    pub(crate) fn render_pixels<S: Sampler>(
+        &self,
+        (width, first): (usize, usize),
+        out: &mut [glam::DVec3],
+        start: &impl Fn(usize, (u32, u32)) -> (S, glam::Vec2),
+    ) -> u64 {
+        #[cfg(target_arch = "x86_64")]
+        if avx2() {
+            // SAFETY: the CPU reported AVX2 and FMA, the features the function is compiled with.
+            #[allow(unsafe_code)]
+            return unsafe { self.render_pixels_avx2((width, first), out, start) };
+        }
+        self.render_pixels_with((width, first), out, start)
+    }
+
+    /// [`LanePass::render_pixels`] compiled for AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    #[allow(unsafe_code)]
+    unsafe fn render_pixels_avx2<S: Sampler>(
+        &self,
+        at: (usize, usize),
+        out: &mut [glam::DVec3],
+        start: &impl Fn(usize, (u32, u32)) -> (S, glam::Vec2),
+    ) -> u64 {
+        self.render_pixels_with(at, out, start)
+    }
+
+    #[inline(always)]
+    fn render_pixels_with<S: Sampler>(
+        &self,
+        (width, first): (usize, usize),
+        out: &mut [glam::DVec3],
+        start: &impl Fn(usize, (u32, u32)) -> (S, glam::Vec2),
+    ) -> u64 {
+        let mut traced = 0;
+        for (g, group) in out.chunks_mut(LANES).enumerate() {
+            let base = first + g * LANES;
+            let n = group.len();
+            let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); LANES];
+            // Lanes past the end of a short group repeat its last pixel and are not traced.
+            let mut rngs: [S; LANES] = core::array::from_fn(|i| {
+                let index = base + i.min(n - 1);
+                let (mut rng, film) =
+                    start(index, ((index % width) as u32, (index / width) as u32));
+                // The lens sample comes first, as in `trace_camera_path`.
+                let u_lens = rng.next_2d();
+                rays[i] = self.scene.camera.generate_ray(film, u_lens);
+                rng
+            });
+            let mut est = [Vec3::ZERO; LANES];
+            traced += trace_camera_paths(
+                self.scene,
+                self.settings,
+                &self.classes,
+                &rays[..n],
+                &mut rngs[..n],
+                &mut est[..n],
+            );
+            for (o, e) in group.iter_mut().zip(est) {
+                *o += e.as_dvec3();
+            }
+        }
+        traced
+    }
 }

@@ -255,6 +255,43 @@ impl PrevVertex {
     }
 }
 
+/// The MIS weight of emission from the point `p` (geometric normal `ng`) of primitive `prim` of
+/// area light `light`, reached from `prev` (`None`: a camera ray; behind a delta lobe: 1).
+#[inline]
+pub(crate) fn emission_mis(
+    prev: Option<PrevVertex>,
+    lights: &LightSet,
+    nee: NeeSelection,
+    light: (u32, u32),
+    p: Vec3,
+    ng: Vec3,
+) -> f32 {
+    match prev {
+        Some(pv) if !pv.delta => pv.emission_weight(pv.light_pdf(lights, nee, light, p, ng)),
+        _ => 1.0,
+    }
+}
+
+/// The MIS weight of the environment's emission along the unit direction `d` from `prev`
+/// (`None`: a camera ray; behind a delta lobe: 1). The scene must have an environment.
+#[inline]
+pub(crate) fn environment_mis(
+    prev: Option<PrevVertex>,
+    lights: &LightSet,
+    nee: NeeSelection,
+    d: Vec3,
+) -> f32 {
+    match prev {
+        Some(pv) if !pv.delta => {
+            let env = lights
+                .environment()
+                .expect("feature summary says there is one");
+            pv.emission_weight(pv.light_pdf(lights, nee, (env, 0), pv.p + d, -d))
+        }
+        _ => 1.0,
+    }
+}
+
 /// The weight `m_B / N_b` of one of `N_b` BSDF samples of density `p_b` against `N_l` light
 /// samples of density `p_l`, `m_B` their power-heuristic share ([`power_share`]): the sample
 /// contributes `f·L_e·m_B / (N_b·p_b)` (0 when there are no BSDF samples).
@@ -343,18 +380,7 @@ pub(crate) fn trace_path_from<S: Sampler>(
         let Some(si) = hit else {
             if has_env && !(depth == 0 && settings.hide_emitters) {
                 let le = lights.environment_radiance(ray.d);
-                let w = match prev {
-                    Some(pv) if !pv.delta => {
-                        let env = lights
-                            .environment()
-                            .expect("feature summary says there is one");
-                        let em_pdf =
-                            pv.light_pdf(lights, settings.nee, (env, 0), pv.p + ray.d, -ray.d);
-                        pv.emission_weight(em_pdf)
-                    }
-                    _ => 1.0,
-                };
-                radiance += beta * le * w;
+                radiance += beta * le * environment_mis(prev, lights, settings.nee, ray.d);
             }
             break;
         };
@@ -365,14 +391,7 @@ pub(crate) fn trace_path_from<S: Sampler>(
         {
             let le = lights.area_radiance(light, &si, -ray.d);
             if le != Vec3::ZERO {
-                let w = match prev {
-                    Some(pv) if !pv.delta => {
-                        let em_pdf =
-                            pv.light_pdf(lights, settings.nee, (light, si.prim), si.p, si.ng);
-                        pv.emission_weight(em_pdf)
-                    }
-                    _ => 1.0,
-                };
+                let w = emission_mis(prev, lights, settings.nee, (light, si.prim), si.p, si.ng);
                 radiance += beta * le * w;
             }
         }
@@ -484,29 +503,18 @@ impl Integrator for PathIntegrator {
         let settings = self.settings.resolved(&scene.features);
         let bands = Bands::new(w);
         // Eight pixels at a time, each lane the path `trace_camera_path` draws for its pixel.
-        let classes = lanes::shape_classes(scene);
-        let classes = classes.as_slice();
+        let pass = lanes::LanePass::new(scene, &settings);
         bands.run(accum, |first, chunk| match settings.sampler {
-            SamplerKind::Independent => {
-                lanes::render_pixels(scene, &settings, classes, w, first, chunk, |index, xy| {
-                    let mut rng = ctx.pixel_rng(index);
-                    let film = ctx.pixel_film_position(index, xy, &mut rng);
-                    (rng, film)
-                })
-            }
-            SamplerKind::Sobol => lanes::render_pixels(
-                scene,
-                &settings,
-                classes,
-                w,
-                first,
-                chunk,
-                |index, (x, y)| {
-                    let mut rng = ctx.pixel_sequence(index);
-                    let film = ctx.film_position(x, y, &mut rng);
-                    (rng, film)
-                },
-            ),
+            SamplerKind::Independent => pass.render_pixels((w, first), chunk, &|index, xy| {
+                let mut rng = ctx.pixel_rng(index);
+                let film = ctx.pixel_film_position(index, xy, &mut rng);
+                (rng, film)
+            }),
+            SamplerKind::Sobol => pass.render_pixels((w, first), chunk, &|index, (x, y)| {
+                let mut rng = ctx.pixel_sequence(index);
+                let film = ctx.film_position(x, y, &mut rng);
+                (rng, film)
+            }),
         })
     }
 
