@@ -1,15 +1,17 @@
-//! The path tracer over eight paths at once ([`trace_camera_paths`]): the estimator of
+//! The path tracer over eight paths at once ([`LanePass`]): the estimator of
 //! [`super::trace_path`], each lane one pixel's path drawing that pixel's numbers in the same
 //! order and doing the same arithmetic, so that every lane's estimate is the scalar walk's, to
 //! the bit.
 //!
-//! The lanes carry paths across diffuse surfaces of meshes (Mitsuba's `diffuse`, no mask or
-//! normal map, its reflectance the same over the shape) and absorbers: the surface data of a
-//! hit, light sampling from triangles of uniform radiance, the diffuse model's value, density
-//! and cosine-weighted sampling, the power heuristic, the throughput and Russian roulette run
-//! in lanes ([`F8`]); traversal, shadow rays and emission lane by lane. A path that meets any
-//! other surface (another material, a textured one, a sphere) leaves its lane there and the
-//! scalar walk finishes it from that hit ([`super::trace_path_from`]).
+//! The lanes carry paths across diffuse surfaces of meshes (Mitsuba's `diffuse` without a mask,
+//! normal map or bump map, textured or not) and absorbers. In lanes ([`F8`]): the hit's point
+//! and shading frame, light samples on triangles of uniform radiance, the diffuse model's
+//! value, density and cosine-weighted sampling, the power heuristic, the shadow rays and
+//! continuations off the surface, the throughput and Russian roulette. Lane by lane: traversal,
+//! each hit's material and emission, other lights' samples, the random numbers. A path that
+//! meets any other surface (another material, a mask, normal or bump map, an analytic shape)
+//! leaves its lane there and the scalar walk finishes it from that hit
+//! ([`super::trace_path_from`]).
 
 use glam::{Vec2, Vec3};
 use restir_geometry::lanes::{MeshHits, SurfaceLanes, offset_ray_origins, shadow_rays_between};
@@ -94,8 +96,8 @@ fn shape_classes(scene: &Scene) -> Vec<Class> {
         .collect()
 }
 
-/// Lanes where `pdf_a` wins by the power heuristic against `pdf_b`
-/// ([`restir_sampling::warp::power_heuristic`] in every lane).
+/// The power heuristic's weight of `pdf_a` against `pdf_b` in every lane
+/// ([`restir_sampling::warp::power_heuristic`]).
 #[inline(always)]
 fn power_heuristic(pdf_a: F8, pdf_b: F8) -> F8 {
     let (a2, b2) = (pdf_a * pdf_a, pdf_b * pdf_b);
