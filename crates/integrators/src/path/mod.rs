@@ -4,6 +4,9 @@
 //! path segments from the camera (1 = directly visible emitters, 2 = direct lighting, -1 =
 //! unbounded); Russian roulette starts once `depth ≥ rr_depth` with survival probability
 //! `min(max(β)·η², 0.95)`.
+//!
+//! This file is the walk one path at a time ([`trace_path`]); the integrator's passes run it
+//! eight paths at a time in SIMD lanes (`lanes.rs`), every lane giving this walk's bits.
 
 use glam::{DVec3, Vec2, Vec3};
 use restir_geometry::{Ray, SurfaceInteraction, offset_ray_origin};
