@@ -1,8 +1,8 @@
 //! The path tracer's passes run eight paths at a time in SIMD lanes; each lane must give the
 //! estimate of the scalar walk (`trace_camera_path`) for its pixel, to the bit, and the same
 //! ray count: on diffuse meshes (in lanes), on every other material, sphere lights and an
-//! environment (handed to the scalar walk mid-path), with both samplers, hidden emitters, short
-//! and unbounded depths, and films whose width is not a multiple of eight.
+//! environment (the scalar walk's bounce there, then lanes again), with both samplers, hidden
+//! emitters, short and unbounded depths, and films whose width is not a multiple of eight.
 
 mod common;
 
@@ -106,11 +106,11 @@ fn lanes_give_the_scalar_walks_bits_on_diffuse_meshes() {
     check("cornell-box.xml", |s| s.rr_depth = 1);
 }
 
-/// Paths that leave the lanes: conductors, dielectrics, plastics and textures (the scalar walk
-/// finishes them from the hit), sphere lights under the light hierarchy's selection, an
-/// environment map, a thin pane.
+/// Surfaces the lanes do not bounce on: conductors, dielectrics, plastics, masks and spheres
+/// (the scalar walk's bounce there, and the path back in lanes after it), textures, sphere
+/// lights under the light hierarchy's selection, an environment map, a thin pane.
 #[test]
-fn lanes_give_the_scalar_walks_bits_where_paths_leave_them() {
+fn lanes_give_the_scalar_walks_bits_where_paths_bounce_one_lane_at_a_time() {
     for file in [
         "cornell-materials.xml",
         "envmap-spheres.xml",
@@ -130,7 +130,7 @@ fn lanes_give_the_scalar_walks_bits_where_paths_leave_them() {
 
 restir_testkit::corpus_test! {
     /// Corpus Sponza: textured diffuse meshes (in lanes, each texture looked up at its hit), a
-    /// `phong` material and a sphere light (paths leave the lanes there).
+    /// `phong` material and a sphere light (the scalar walk's bounces there).
     fn lanes_give_the_scalar_walks_bits_on_corpus_sponza() {
         let path = restir_testkit::corpus::corpus_dir().join("lajolla/sponza/sponza.xml");
         assert!(check_file(&path, |_| {}) > 37 * 21);

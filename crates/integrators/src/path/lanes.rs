@@ -8,10 +8,9 @@
 //! and shading frame, light samples on triangles of uniform radiance, the diffuse model's
 //! value, density and cosine-weighted sampling, the power heuristic, the shadow rays and
 //! continuations off the surface, the throughput and Russian roulette. Lane by lane: traversal,
-//! each hit's material and emission, other lights' samples, the random numbers. A path that
-//! meets any other surface (another material, a mask, normal or bump map, an analytic shape)
-//! leaves its lane there and the scalar walk finishes it from that hit
-//! ([`super::trace_path_from`]).
+//! each hit's material and emission, other lights' samples, the random numbers. At any other
+//! surface (another material, a mask, normal or bump map, an analytic shape) a lane makes the
+//! scalar walk's bounce ([`super::scatter`]) and its path goes on in the lanes from there.
 
 use glam::{Vec2, Vec3};
 use restir_geometry::lanes::{MeshHits, SurfaceLanes, offset_ray_origins, shadow_rays_between};
@@ -22,8 +21,8 @@ use restir_sampling::lanes::{self, F8, LANES, M8, V3};
 use restir_scene::{Scene, TexturePoint};
 
 use super::{
-    EmissionMis, PathSettings, PrevVertex, emission_mis, environment_mis, rr_survival,
-    trace_path_from,
+    EmissionMis, PathSettings, PrevVertex, Walk, emission_mis, environment_mis, rr_survival,
+    scatter,
 };
 use crate::shadow::{ShadowTarget, visible};
 
@@ -36,7 +35,7 @@ enum Surface {
     Diffuse { albedo: Vec3, two_sided: bool },
     /// An absorber (an emitter without a material): the path ends after its emission.
     Black,
-    /// Anything else: the scalar walk takes the path over.
+    /// Anything else: the scalar walk's bounce there.
     Other,
 }
 
@@ -66,7 +65,7 @@ enum Class {
     /// A mesh of a diffuse or absorbing material with textures (none of them a mask, a normal
     /// map or a bump map): its BSDF is looked up at each hit.
     Textured,
-    /// Anything else: paths that reach it are handed to the scalar walk.
+    /// Anything else: a path that reaches it bounces there as the scalar walk does.
     Other,
 }
 
@@ -133,16 +132,21 @@ fn trace_camera_paths<S: Sampler>(
     let mut beta = V3::splat(Vec3::ONE);
     let mut radiance = V3::ZERO;
     let mut prev: [Option<PrevVertex>; LANES] = [None; LANES];
+    // The squared product of the relative indices of refraction crossed (by the scalar walk's
+    // bounces on other surfaces).
+    let mut eta = F8::splat(1.0);
     let mut depth = 0u32;
     loop {
         // The hits, lane by lane: what they emit, the surface data of mesh hits gathered for
-        // the lanes (of emitters computed here, as their emission needs it), paths on other
-        // surfaces handed to the scalar walk.
+        // the lanes (computed here for emitters, whose emission needs it, and for other
+        // surfaces, where the scalar walk's bounce needs it).
         let hide = depth == 0 && settings.hide_emitters;
         let mut gather = MeshHits::default();
         let mut computed = [None::<SurfaceInteraction>; LANES];
         let mut albedo = V3::ZERO;
         let mut two_sided = M8::default();
+        // Lanes whose surface this bounce is not for the lanes: the walk's own bounce there.
+        let mut one_lane = M8::default();
         for i in 0..n {
             if !active.get(i) {
                 continue;
@@ -197,23 +201,6 @@ fn trace_camera_paths<S: Sampler>(
                     Ok(h) => scene.accel.surface_interaction(&scene.shapes, &h, &r),
                     Err(si) => si,
                 };
-                if surface == Surface::Other {
-                    let (l, k) = trace_path_from(
-                        scene,
-                        settings,
-                        r,
-                        Some(Some(s)),
-                        depth,
-                        beta.get(i),
-                        prev[i],
-                        radiance.get(i),
-                        &mut rngs[i],
-                    );
-                    radiance.set(i, l);
-                    traced += k;
-                    active.set(i, false);
-                    continue;
-                }
                 if let Some(light) = light {
                     let le = lights.area_radiance(light, &s, -r.d);
                     if le != Vec3::ZERO {
@@ -226,6 +213,7 @@ fn trace_camera_paths<S: Sampler>(
                     active.set(i, false);
                     continue;
                 }
+                one_lane.set(i, surface == Surface::Other);
                 computed[i] = Some(s);
             }
             if let Surface::Diffuse {
@@ -242,15 +230,34 @@ fn trace_camera_paths<S: Sampler>(
         }
         let mut surf: SurfaceLanes = gather.surface();
         for (i, s) in computed.iter().enumerate() {
-            if let Some(s) = s {
+            let Some(s) = s else { continue };
+            if one_lane.get(i) {
+                // Any other surface: the scalar walk's bounce, its numbers included.
+                let mut w = Walk {
+                    ray: ray[i],
+                    depth,
+                    beta: beta.get(i),
+                    eta_scale: eta.0[i],
+                    prev: prev[i],
+                    radiance: radiance.get(i),
+                    rays: 0,
+                };
+                active.set(i, scatter(scene, settings, s, &mut w, &mut rngs[i]));
+                (ray[i], prev[i], eta.0[i]) = (w.ray, w.prev, w.eta_scale);
+                beta.set(i, w.beta);
+                radiance.set(i, w.radiance);
+                traced += w.rays;
+            } else {
                 surf.set(i, s.p, s.ng, &s.shading);
             }
         }
+        // The lanes that bounce in lanes.
+        let here = active & !one_lane;
 
         // The fixed per-bounce budget of numbers.
         let mut u = [[0.0f32; 7]; LANES];
         for i in 0..n {
-            if !active.get(i) {
+            if !here.get(i) {
                 continue;
             }
             let rng = &mut rngs[i];
@@ -273,7 +280,7 @@ fn trace_camera_paths<S: Sampler>(
 
         // Next-event estimation.
         let nee_u = core::array::from_fn(|i| [u[i][0], u[i][6], u[i][1], u[i][2]]);
-        let ls = lights.sample_nee_lanes(settings.nee, surf.p, surf.n, &nee_u, active);
+        let ls = lights.sample_nee_lanes(settings.nee, surf.p, surf.n, &nee_u, here);
         let wi = surf.to_local(ls.wi);
         let lz = flip.select(-wi.z, wi.z);
         let reach = front & lz.gt(zero);
@@ -314,8 +321,8 @@ fn trace_camera_paths<S: Sampler>(
         let pdf = cos.z.gt(zero).select(cos.z * FRAC_1_PI, zero);
         let f_c = albedo.scale(F8::splat(FRAC_1_PI) * cos.z);
         let ok = front & pdf.gt(zero) & pdf.is_finite() & f_c.is_finite() & cos.is_finite();
-        active = active & ok;
-        beta = beta * (f_c / pdf);
+        let mut go_on = here & ok;
+        beta = here.select3(beta * (f_c / pdf), beta);
         let local = V3 {
             x: cos.x,
             y: cos.y,
@@ -324,7 +331,7 @@ fn trace_camera_paths<S: Sampler>(
         let dir = surf.to_world(local);
         let origin = offset_ray_origins(surf.p, surf.ng, dir);
         for i in 0..n {
-            if !active.get(i) {
+            if !go_on.get(i) {
                 continue;
             }
             prev[i] = Some(PrevVertex {
@@ -338,14 +345,15 @@ fn trace_camera_paths<S: Sampler>(
         }
         depth += 1;
 
-        // Russian roulette (diffuse surfaces leave the relative index of refraction at 1).
+        // Russian roulette (a diffuse bounce leaves the relative index of refraction as it was).
         let bmax = beta.max_element();
-        active = active & bmax.gt(zero) & beta.is_finite();
+        go_on = go_on & bmax.gt(zero) & beta.is_finite();
         if depth >= settings.rr_depth {
-            let q = F8::from_fn(|i| rr_survival(bmax.0[i], 1.0));
-            active = active & lane(6).lt(q);
-            beta = beta / q;
+            let q = F8::from_fn(|i| rr_survival(bmax.0[i], eta.0[i]));
+            beta = here.select3(beta / q, beta);
+            go_on = go_on & lane(6).lt(q);
         }
+        active = (active & one_lane) | go_on;
         if !active.any() {
             break;
         }
@@ -377,7 +385,7 @@ pub(crate) fn describe(scene: &Scene) -> String {
         .count();
     format!(
         "{LANES} paths at a time ({}); {carried} of {} shapes (diffuse or absorbing meshes, textured \
-         or not) in lanes, paths reaching the others finished one at a time",
+         or not) bounce in lanes, the others one lane at a time",
         if avx2() { "AVX2 and FMA" } else { "SSE2" },
         scene.shapes.len()
     )

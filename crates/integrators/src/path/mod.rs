@@ -332,137 +332,144 @@ pub fn trace_path<S: Sampler>(
     prev: Option<PrevVertex>,
     rng: &mut S,
 ) -> (Vec3, u64) {
-    trace_path_from(
-        scene,
-        settings,
-        ray,
-        None,
-        depth,
-        beta,
-        prev,
-        Vec3::ZERO,
-        rng,
-    )
-}
-
-/// [`trace_path`] when the closest hit of `ray` is already known: `first` is what
-/// [`Scene::camera_intersect`] returned for it (its rays already counted by the caller), or
-/// `None` to trace it. The estimate adds to `radiance`, what the path gathered before `ray`
-/// (so that it is summed in the order [`trace_path`] sums it).
-#[allow(clippy::too_many_arguments)]
-#[inline]
-pub(crate) fn trace_path_from<S: Sampler>(
-    scene: &Scene,
-    settings: &PathSettings,
-    mut ray: Ray,
-    mut first: Option<Option<SurfaceInteraction>>,
-    mut depth: u32,
-    mut beta: Vec3,
-    mut prev: Option<PrevVertex>,
-    mut radiance: Vec3,
-    rng: &mut S,
-) -> (Vec3, u64) {
-    let mut rays = 0u64;
     let max_depth = settings.max_segments();
     if depth >= max_depth {
-        return (radiance, rays);
+        return (Vec3::ZERO, 0);
     }
     let lights = &scene.lights;
     let has_env = scene.features.has_environment;
-    let mut eta_scale = 1.0f32;
+    let mut w = Walk {
+        ray,
+        depth,
+        beta,
+        eta_scale: 1.0,
+        prev,
+        radiance: Vec3::ZERO,
+        rays: 0,
+    };
     loop {
         // With hidden emitters the camera sees through area lights (as in Mitsuba 3).
-        let hit = match first.take() {
-            Some(hit) => hit,
-            None => {
-                let (hit, n) = scene.camera_intersect(&ray, depth == 0 && settings.hide_emitters);
-                rays += n;
-                hit
-            }
-        };
+        let hide = w.depth == 0 && settings.hide_emitters;
+        let (hit, n) = scene.camera_intersect(&w.ray, hide);
+        w.rays += n;
         let Some(si) = hit else {
-            if has_env && !(depth == 0 && settings.hide_emitters) {
-                let le = lights.environment_radiance(ray.d);
-                radiance += beta * le * environment_mis(prev, lights, settings.nee, ray.d);
+            if has_env && !hide {
+                let le = lights.environment_radiance(w.ray.d);
+                w.radiance += w.beta * le * environment_mis(w.prev, lights, settings.nee, w.ray.d);
             }
             break;
         };
 
         // Emission from the surface the ray hit.
         if let Some(light) = lights.light_on_shape(si.shape)
-            && !(depth == 0 && settings.hide_emitters)
+            && !hide
         {
-            let le = lights.area_radiance(light, &si, -ray.d);
+            let le = lights.area_radiance(light, &si, -w.ray.d);
             if le != Vec3::ZERO {
-                let w = emission_mis(prev, lights, settings.nee, (light, si.prim), si.p, si.ng);
-                radiance += beta * le * w;
+                let mis = emission_mis(w.prev, lights, settings.nee, (light, si.prim), si.p, si.ng);
+                w.radiance += w.beta * le * mis;
             }
         }
 
-        if depth + 1 >= max_depth {
+        if w.depth + 1 >= max_depth || !scatter(scene, settings, &si, &mut w, rng) {
             break;
-        }
-
-        // The fixed per-bounce budget of random numbers.
-        let u_select = rng.next_1d();
-        let u_light = rng.next_2d();
-        let u_lobe = rng.next_1d();
-        let u_bsdf = rng.next_2d();
-        let u_rr = rng.next_1d();
-
-        let bsdf = scene.bsdf(&si);
-        let wo = si.shading.to_local(-ray.d);
-
-        // Next-event estimation.
-        if bsdf.has_smooth_lobe()
-            && let Some(ls) =
-                lights.sample_nee(settings.nee, si.p, si.shading.n, (u_select, u_rr), u_light)
-        {
-            let wi = si.shading.to_local(ls.wi);
-            let f = bsdf.eval(wo, wi);
-            if f != Vec3::ZERO {
-                rays += 1;
-                if visible(scene, si.p, si.ng, ShadowTarget::of_sample(&ls)) {
-                    let w = if ls.delta {
-                        1.0
-                    } else {
-                        power_heuristic(ls.pdf_sa, bsdf.pdf_sa(wo, wi))
-                    };
-                    radiance += beta * f * ls.le * (w / ls.pdf_sa);
-                }
-            }
-        }
-
-        // BSDF sampling.
-        let Some(bs) = bsdf.sample(wo, u_lobe, u_bsdf) else {
-            break;
-        };
-        beta *= bs.f / bs.pdf_sa;
-        eta_scale *= bs.eta;
-        let d = si.shading.to_world(bs.wi);
-        prev = Some(PrevVertex {
-            p: si.p,
-            n: si.shading.n,
-            pdf_sa: bs.pdf_sa,
-            delta: bs.lobe.is_delta(),
-            mis: EmissionMis::Power,
-        });
-        ray = Ray::new(offset_ray_origin(si.p, si.ng, d), d);
-        depth += 1;
-
-        let bmax = beta.max_element();
-        if bmax <= 0.0 || !beta.is_finite() {
-            break;
-        }
-        if depth >= settings.rr_depth {
-            let q = rr_survival(bmax, eta_scale);
-            if u_rr >= q {
-                break;
-            }
-            beta /= q;
         }
     }
-    (radiance, rays)
+    (w.radiance, w.rays)
+}
+
+/// What a path carries from one vertex to the next.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Walk {
+    /// The ray to trace next.
+    pub ray: Ray,
+    /// Segments traced before `ray`.
+    pub depth: u32,
+    /// Throughput.
+    pub beta: Vec3,
+    /// The squared product of the relative indices of refraction crossed, for Russian roulette
+    /// ([`rr_survival`]).
+    pub eta_scale: f32,
+    /// The vertex `ray` leaves, for the MIS weight of emission it reaches.
+    pub prev: Option<PrevVertex>,
+    /// The estimate so far.
+    pub radiance: Vec3,
+    /// Rays traced so far.
+    pub rays: u64,
+}
+
+/// The bounce at `si`, the hit of `w.ray` (its emission already counted; the depth below the
+/// limit): the bounce's fixed budget of numbers, next-event estimation, the BSDF's continuation
+/// and Russian roulette. Updates the walk (`w.ray` becomes the continuation) and returns whether
+/// the path goes on.
+#[inline]
+pub(crate) fn scatter<S: Sampler>(
+    scene: &Scene,
+    settings: &PathSettings,
+    si: &SurfaceInteraction,
+    w: &mut Walk,
+    rng: &mut S,
+) -> bool {
+    // The fixed per-bounce budget of random numbers.
+    let u_select = rng.next_1d();
+    let u_light = rng.next_2d();
+    let u_lobe = rng.next_1d();
+    let u_bsdf = rng.next_2d();
+    let u_rr = rng.next_1d();
+
+    let lights = &scene.lights;
+    let bsdf = scene.bsdf(si);
+    let wo = si.shading.to_local(-w.ray.d);
+
+    // Next-event estimation.
+    if bsdf.has_smooth_lobe()
+        && let Some(ls) =
+            lights.sample_nee(settings.nee, si.p, si.shading.n, (u_select, u_rr), u_light)
+    {
+        let wi = si.shading.to_local(ls.wi);
+        let f = bsdf.eval(wo, wi);
+        if f != Vec3::ZERO {
+            w.rays += 1;
+            if visible(scene, si.p, si.ng, ShadowTarget::of_sample(&ls)) {
+                let mis = if ls.delta {
+                    1.0
+                } else {
+                    power_heuristic(ls.pdf_sa, bsdf.pdf_sa(wo, wi))
+                };
+                w.radiance += w.beta * f * ls.le * (mis / ls.pdf_sa);
+            }
+        }
+    }
+
+    // BSDF sampling.
+    let Some(bs) = bsdf.sample(wo, u_lobe, u_bsdf) else {
+        return false;
+    };
+    w.beta *= bs.f / bs.pdf_sa;
+    w.eta_scale *= bs.eta;
+    let d = si.shading.to_world(bs.wi);
+    w.prev = Some(PrevVertex {
+        p: si.p,
+        n: si.shading.n,
+        pdf_sa: bs.pdf_sa,
+        delta: bs.lobe.is_delta(),
+        mis: EmissionMis::Power,
+    });
+    w.ray = Ray::new(offset_ray_origin(si.p, si.ng, d), d);
+    w.depth += 1;
+
+    let bmax = w.beta.max_element();
+    if bmax <= 0.0 || !w.beta.is_finite() {
+        return false;
+    }
+    if w.depth >= settings.rr_depth {
+        let q = rr_survival(bmax, w.eta_scale);
+        if u_rr >= q {
+            return false;
+        }
+        w.beta /= q;
+    }
+    true
 }
 
 /// One path-traced estimate for the camera ray through `film` (pixel coordinates).
