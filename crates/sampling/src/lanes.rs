@@ -1,9 +1,9 @@
 //! Eight `f32` lanes: the types estimators write lane-parallel mathematics in.
 //!
 //! [`F8`] is eight numbers in an aligned array, [`M8`] eight conditions, [`V3`] a vector of
-//! lanes. Every operation is written lane by lane; inside a function compiled with AVX2 and FMA
-//! enabled (`#[target_feature(enable = "avx2,fma")]`) the compiler keeps each in one 256-bit
-//! register and one instruction, elsewhere in two SSE registers. Neither contracts `a·b + c`
+//! lanes. Every operation is written lane by lane, as a loop the compiler vectorises: inside a
+//! function compiled with AVX2 and FMA (`#[target_feature(enable = "avx2,fma")]`) into 256-bit
+//! instructions, elsewhere into SSE2 ones. Neither contracts `a·b + c`
 //! into a fused multiply-add, so both give the bits of the same arithmetic on `f32`, lane by
 //! lane: lane `i` of any expression equals the scalar expression on lane `i`'s inputs.
 
@@ -123,7 +123,7 @@ impl F8 {
         lanes1(self, f32::abs)
     }
 
-    /// The larger of the two in every lane; `o`'s lane where either is NaN ( `x > o ? x : o`).
+    /// The larger of the two in every lane; `o`'s lane where either is NaN (`x > o ? x : o`).
     #[inline(always)]
     pub fn max(self, o: F8) -> Self {
         M8::select(self.gt(o), self, o)
