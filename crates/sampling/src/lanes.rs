@@ -424,6 +424,16 @@ pub fn sincos_quarter(x: F8) -> (F8, F8) {
     (x + x * (s * x2), k * x2 + 1.0)
 }
 
+/// [`crate::warp::power_heuristic`] in every lane: the weight of `pdf_a` against `pdf_b`, 1
+/// where `pdf_a` is infinite, 0 where the ratio is not finite.
+#[inline(always)]
+pub fn power_heuristic(pdf_a: F8, pdf_b: F8) -> F8 {
+    let (a2, b2) = (pdf_a * pdf_a, pdf_b * pdf_b);
+    let w = a2 / (a2 + b2);
+    let w = w.is_finite().select(w, F8::splat(0.0));
+    pdf_a.is_infinite().select(F8::splat(1.0), w)
+}
+
 /// [`crate::warp::sample_cosine_hemisphere`] in every lane (Malley's method over Shirley and
 /// Chiu's concentric map): the same direction to within rounding, the angle's sine and cosine
 /// from [`sincos_quarter`] (either branch of the map needs them only on `[−π/4, π/4]`).
@@ -501,6 +511,20 @@ mod tests {
                     d.get(i).to_array().map(f32::to_bits),
                     want.to_array().map(f32::to_bits)
                 );
+            }
+        }
+    }
+
+    /// The lanes' power heuristic is the scalar one's bits, infinite, zero and huge densities
+    /// included.
+    #[test]
+    fn power_heuristic_gives_the_scalar_bits() {
+        let values = [0.0, 1e-30, 0.3, 1.0, 7.5, 1e20, 3e38, f32::INFINITY];
+        for &a in &values {
+            let w = power_heuristic(F8::splat(a), F8::from_fn(|i| values[i]));
+            for (i, &b) in values.iter().enumerate() {
+                let want = crate::warp::power_heuristic(a, b);
+                assert_eq!(w.0[i].to_bits(), want.to_bits(), "{a} against {b}");
             }
         }
     }

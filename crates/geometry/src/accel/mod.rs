@@ -38,6 +38,16 @@ pub struct Hit {
     pub bary: Vec2,
 }
 
+impl Hit {
+    /// A triangle's barycentrics kept inside the triangle despite the test's rounding: the
+    /// point [`Accel::surface_interaction`] names on it ([`SurfaceInteraction::param`]).
+    #[inline(always)]
+    pub fn triangle_param(&self) -> Vec2 {
+        let u = self.bary.x.clamp(0.0, 1.0);
+        Vec2::new(u, self.bary.y.clamp(0.0, 1.0 - u))
+    }
+}
+
 /// Everything about a surface point that shading needs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SurfaceInteraction {
@@ -485,12 +495,7 @@ impl Accel {
     ) -> SurfaceInteraction {
         let shape = &shapes[hit.shape as usize];
         let param = match shape {
-            Shape::Mesh(_) => {
-                // The traversal's barycentrics, kept inside the triangle despite rounding.
-                let u = hit.bary.x.clamp(0.0, 1.0);
-                let v = hit.bary.y.clamp(0.0, 1.0 - u);
-                Vec2::new(u, v)
-            }
+            Shape::Mesh(_) => hit.triangle_param(),
             Shape::Sphere(s) => {
                 let n = (ray.at(hit.t) - s.center).normalize();
                 crate::Sphere::param_of(n)

@@ -12,7 +12,7 @@
 //! surface (another material, a mask, normal or bump map, an analytic shape) a lane makes the
 //! scalar walk's bounce ([`super::scatter`]) and its path goes on in the lanes from there.
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use restir_geometry::lanes::{MeshHits, SurfaceLanes, offset_ray_origins, shadow_rays_between};
 use restir_geometry::{Ray, Shape, SurfaceInteraction};
 use restir_materials::{Bsdf, BsdfKind};
@@ -95,16 +95,6 @@ fn shape_classes(scene: &Scene) -> Vec<Class> {
         .collect()
 }
 
-/// The power heuristic's weight of `pdf_a` against `pdf_b` in every lane
-/// ([`restir_sampling::warp::power_heuristic`]).
-#[inline(always)]
-fn power_heuristic(pdf_a: F8, pdf_b: F8) -> F8 {
-    let (a2, b2) = (pdf_a * pdf_a, pdf_b * pdf_b);
-    let w = a2 / (a2 + b2);
-    let w = w.is_finite().select(w, F8::splat(0.0));
-    pdf_a.is_infinite().select(F8::splat(1.0), w)
-}
-
 /// Radiance along the camera rays `rays` (one a lane, at most [`LANES`]), each estimated with one
 /// path drawing its numbers from the same lane of `rngs`: [`super::trace_path`] from depth 0, lane
 /// by lane. Writes the estimates to `out` and returns the number of rays traced.
@@ -176,10 +166,8 @@ fn trace_camera_paths<S: Sampler>(
             let surface = match (classes[shape as usize], &hit, &scene.shapes[shape as usize]) {
                 (Class::Uniform(surface), ..) => surface,
                 (Class::Textured, Ok(h), Shape::Mesh(m)) => {
-                    // Looked up at the hit (the barycentrics clamped into the triangle as
-                    // `Accel::surface_interaction` clamps them).
-                    let u = h.bary.x.clamp(0.0, 1.0);
-                    let bary = Vec2::new(u, h.bary.y.clamp(0.0, 1.0 - u));
+                    // Looked up at the point the hit names.
+                    let bary = h.triangle_param();
                     let uv = m.uv_at(h.prim as usize, bary);
                     Surface::of(scene.bsdf_at_point(&TexturePoint {
                         uv,
@@ -288,7 +276,7 @@ fn trace_camera_paths<S: Sampler>(
         let b_pdf = reach.select(lz * FRAC_1_PI, zero);
         let w = ls
             .delta
-            .select(F8::splat(1.0), power_heuristic(ls.pdf_sa, b_pdf));
+            .select(F8::splat(1.0), lanes::power_heuristic(ls.pdf_sa, b_pdf));
         let direct = (beta * f * ls.le).scale(w / ls.pdf_sa);
         // The shadow rays toward points (`visible`'s, `shadow_ray_between` in lanes).
         let (s_o, s_d, s_t) = shadow_rays_between(surf.p, surf.ng, ls.p);
