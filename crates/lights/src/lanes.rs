@@ -4,7 +4,7 @@
 //! point, direction and density in lanes, with the arithmetic of [`LightSet::sample_nee`];
 //! every other lane (another light, another selection) is [`LightSet::sample_nee`]'s own.
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use restir_sampling::lanes::{F8, LANES, M8, V3};
 
 use crate::table::Emitter;
@@ -75,6 +75,19 @@ impl NeeLanes {
     }
 }
 
+/// A lane's triangle pick: the triangle, its normals and radiance, the density by area of the
+/// selection and the point, and the numbers for the point.
+#[derive(Clone, Copy, Default)]
+struct Picked {
+    p: [Vec3; 3],
+    n: Vec3,
+    ng: Vec3,
+    le: Vec3,
+    area_pdf: f32,
+    u: Vec2,
+    tri: bool,
+}
+
 impl LightSet {
     /// [`LightSet::sample_nee`] for the receivers at `ref_p` (shading normals `ref_n`) of the
     /// lanes in `lanes`, lane `i` with the numbers `u[i] = [u_select, u_fine, u.x, u.y]`: the
@@ -102,10 +115,8 @@ impl LightSet {
             prim: [0; LANES],
             param: [Vec2::ZERO; LANES],
         };
-        // The triangles picked, gathered.
-        let mut tri = M8::default();
-        let (mut c0, mut c1, mut c2) = (V3::ZERO, V3::ZERO, V3::ZERO);
-        let (mut area_pdf, mut ux, mut uy) = (F8::splat(0.0), F8::splat(0.0), F8::splat(0.0));
+        // The triangles picked, one lane at a time, each as a whole record; then gathered.
+        let mut picked = [Picked::default(); LANES];
         for (i, &[u_select, u_fine, u0, u1]) in u.iter().enumerate() {
             if !lanes.get(i) {
                 continue;
@@ -125,16 +136,15 @@ impl LightSet {
                 } = self.lights[light as usize]
                 && let Some(n) = self.table.constant_normal(ng, shading)
             {
-                tri.set(i, true);
-                c0.set(i, p[0]);
-                c1.set(i, p[1]);
-                c2.set(i, p[2]);
-                out.n.set(i, n);
-                out.ng.set(i, ng);
-                out.le.set(i, radiance);
-                area_pdf.0[i] = self.area_pdf[light as usize];
-                ux.0[i] = u0;
-                uy.0[i] = u1;
+                picked[i] = Picked {
+                    p,
+                    n,
+                    ng,
+                    le: radiance,
+                    area_pdf: self.area_pdf[light as usize],
+                    u: Vec2::new(u0, u1),
+                    tri: true,
+                };
                 out.light[i] = light;
                 out.prim[i] = prim;
                 continue;
@@ -144,9 +154,19 @@ impl LightSet {
             });
             out.set(i, s);
         }
+        let tri = M8::from_fn(|i| picked[i].tri);
         if !tri.any() {
             return out;
         }
+        let c0 = V3::from_fn(|i| picked[i].p[0]);
+        let c1 = V3::from_fn(|i| picked[i].p[1]);
+        let c2 = V3::from_fn(|i| picked[i].p[2]);
+        let area_pdf = F8::from_fn(|i| picked[i].area_pdf);
+        let ux = F8::from_fn(|i| picked[i].u.x);
+        let uy = F8::from_fn(|i| picked[i].u.y);
+        out.n = tri.select3(V3::from_fn(|i| picked[i].n), out.n);
+        out.ng = tri.select3(V3::from_fn(|i| picked[i].ng), out.ng);
+        out.le = tri.select3(V3::from_fn(|i| picked[i].le), out.le);
         // `warp::sample_uniform_triangle` and the point `TriangleMesh::point_at` computes.
         let (zero, one) = (F8::splat(0.0), F8::splat(1.0));
         let su0 = ux.sqrt();
@@ -168,10 +188,10 @@ impl LightSet {
         out.wi = tri.select3(wi, out.wi);
         out.dist = tri.select(dist, out.dist);
         out.pdf_sa = tri.select(pdf, out.pdf_sa);
+        out.valid = (tri & ok) | (!tri & out.valid);
+        out.delta = !tri & out.delta;
         for i in 0..LANES {
             if tri.get(i) {
-                out.valid.set(i, ok.get(i));
-                out.delta.set(i, false);
                 out.param[i] = Vec2::new(b1.0[i], b2.0[i]);
             }
         }

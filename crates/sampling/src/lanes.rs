@@ -198,7 +198,10 @@ impl M8 {
     pub fn select(self, a: F8, b: F8) -> F8 {
         let mut r = [0.0; LANES];
         for (i, v) in r.iter_mut().enumerate() {
-            *v = if self.0[i] != 0 { a.0[i] } else { b.0[i] };
+            // Bitwise, not a branch: a branch would let the compiler compute the chosen
+            // lane's operand alone, one lane at a time.
+            let m = self.0[i] as u32;
+            *v = f32::from_bits((a.0[i].to_bits() & m) | (b.0[i].to_bits() & !m));
         }
         F8(r)
     }

@@ -117,7 +117,11 @@ fn trace_camera_paths<S: Sampler>(
     let lights = &scene.lights;
     let has_env = scene.features.has_environment;
     let mut traced = 0u64;
-    let mut ray: [Ray; LANES] = core::array::from_fn(|i| rays[i.min(n - 1)]);
+    // The rays in lanes: a bounce in lanes selects its continuations into them whole.
+    let pick = |i: usize| rays[i.min(n - 1)];
+    let mut ray_o = V3::from_fn(|i| pick(i).o);
+    let mut ray_d = V3::from_fn(|i| pick(i).d);
+    let mut t_max = F8::from_fn(|i| pick(i).t_max);
     let mut active = M8::from_fn(|i| i < n);
     let mut beta = V3::splat(Vec3::ONE);
     let mut radiance = V3::ZERO;
@@ -141,7 +145,11 @@ fn trace_camera_paths<S: Sampler>(
             if !active.get(i) {
                 continue;
             }
-            let r = ray[i];
+            let r = Ray {
+                o: ray_o.get(i),
+                d: ray_d.get(i),
+                t_max: t_max.0[i],
+            };
             let hit = if hide {
                 let (si, k) = scene.intersect_past_emitters(&r);
                 traced += k;
@@ -222,7 +230,11 @@ fn trace_camera_paths<S: Sampler>(
             if one_lane.get(i) {
                 // Any other surface: the scalar walk's bounce, its numbers included.
                 let mut w = Walk {
-                    ray: ray[i],
+                    ray: Ray {
+                        o: ray_o.get(i),
+                        d: ray_d.get(i),
+                        t_max: t_max.0[i],
+                    },
                     depth,
                     beta: beta.get(i),
                     eta_scale: eta.0[i],
@@ -231,7 +243,9 @@ fn trace_camera_paths<S: Sampler>(
                     rays: 0,
                 };
                 active.set(i, scatter(scene, settings, s, &mut w, &mut rngs[i]));
-                (ray[i], prev[i], eta.0[i]) = (w.ray, w.prev, w.eta_scale);
+                (prev[i], eta.0[i], t_max.0[i]) = (w.prev, w.eta_scale, w.ray.t_max);
+                ray_o.set(i, w.ray.o);
+                ray_d.set(i, w.ray.d);
                 beta.set(i, w.beta);
                 radiance.set(i, w.radiance);
                 traced += w.rays;
@@ -260,8 +274,7 @@ fn trace_camera_paths<S: Sampler>(
         }
         let lane = |k: usize| F8::from_fn(|i| u[i][k]);
         let zero = F8::splat(0.0);
-        let d = V3::from_fn(|i| ray[i].d);
-        let wo = surf.to_local(-d);
+        let wo = surf.to_local(-ray_d);
         // A two-sided surface seen from behind is mirrored to the front.
         let flip = two_sided & wo.z.lt(zero);
         let front = flip.select(-wo.z, wo.z).gt(zero);
@@ -318,19 +331,21 @@ fn trace_camera_paths<S: Sampler>(
         };
         let dir = surf.to_world(local);
         let origin = offset_ray_origins(surf.p, surf.ng, dir);
-        for i in 0..n {
+        for (i, prev) in prev.iter_mut().enumerate().take(n) {
             if !go_on.get(i) {
                 continue;
             }
-            prev[i] = Some(PrevVertex {
+            *prev = Some(PrevVertex {
                 p: surf.p.get(i),
                 n: surf.n.get(i),
                 pdf_sa: pdf.0[i],
                 delta: false,
                 mis: EmissionMis::Power,
             });
-            ray[i] = Ray::new(origin.get(i), dir.get(i));
         }
+        ray_o = go_on.select3(origin, ray_o);
+        ray_d = go_on.select3(dir, ray_d);
+        t_max = go_on.select(F8::splat(f32::INFINITY), t_max);
         depth += 1;
 
         // Russian roulette (a diffuse bounce leaves the relative index of refraction as it was).
