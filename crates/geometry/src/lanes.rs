@@ -2,7 +2,9 @@
 //! `dp/du` gathered lane by lane ([`MeshHits::set`]), then the point and shading frame computed
 //! in lanes ([`MeshHits::surface`]) with the arithmetic of [`TriangleMesh::surface_at`] and
 //! [`Frame::from_normal_tangent`] (whose square roots and divisions, latency for one hit at a
-//! time, are one instruction for eight).
+//! time, are one instruction for eight). Also in lanes: Duff et al.'s frame around a normal,
+//! the octahedral encoding of unit vectors, and points drawn on spheres in the cones they
+//! subtend ([`sphere_cone_samples`]).
 
 use glam::{Vec2, Vec3};
 use restir_sampling::lanes::{F8, M8, V3};
@@ -139,22 +141,94 @@ pub fn tangents(n: V3, tangent: V3) -> (V3, V3) {
     let fallback = len2.lt(F8::splat(1e-12)) | !len2.is_finite();
     let s = s / len2.sqrt();
     let t = n.cross(s);
-    // Duff et al.'s basis.
+    let (ds, dt) = normal_tangents(n);
+    (fallback.select3(ds, s), fallback.select3(dt, t))
+}
+
+/// [`Frame::from_normal`]'s tangents in every lane (Duff et al.'s basis around unit `n`).
+#[inline(always)]
+pub fn normal_tangents(n: V3) -> (V3, V3) {
     let one = F8::splat(1.0);
     let sign = one.copysign(n.z);
     let a = -one / (sign + n.z);
     let b = n.x * n.y * a;
-    let ds = V3 {
+    let s = V3 {
         x: one + sign * n.x * n.x * a,
         y: sign * b,
         z: -sign * n.x,
     };
-    let dt = V3 {
+    let t = V3 {
         x: b,
         y: sign + n.y * n.y * a,
         z: -n.y,
     };
-    (fallback.select3(ds, s), fallback.select3(dt, t))
+    (s, t)
+}
+
+/// The octahedral encoding of unit vectors ([`crate::Sphere::param_of`]) in every lane.
+#[inline(always)]
+pub fn octahedral_encode(n: V3) -> (F8, F8) {
+    let (zero, one, half) = (F8::splat(0.0), F8::splat(1.0), F8::splat(0.5));
+    let l1 = n.x.abs() + n.y.abs() + n.z.abs();
+    let (x, y) = (n.x / l1, n.y / l1);
+    let sign = |v: F8| v.ge(zero).select(one, -one);
+    let lower = n.z.lt(zero);
+    let fx = lower.select((one - y.abs()) * sign(x), x);
+    let fy = lower.select((one - x.abs()) * sign(y), y);
+    (half * fx + half, half * fy + half)
+}
+
+/// The unit vectors [`octahedral_encode`] maps to `(ex, ey)`, as [`crate::Sphere::point_at`]
+/// decodes them, in every lane.
+#[inline(always)]
+pub fn octahedral_decode(ex: F8, ey: F8) -> V3 {
+    let (zero, one, two) = (F8::splat(0.0), F8::splat(1.0), F8::splat(2.0));
+    let (x, y) = (two * ex - one, two * ey - one);
+    let z = one - x.abs() - y.abs();
+    let t = (-z).max(zero);
+    let x = x + x.ge(zero).select(-t, t);
+    let y = y + y.ge(zero).select(-t, t);
+    let v = V3 { x, y, z };
+    v.scale(one / v.dot(v).sqrt())
+}
+
+/// Points on spheres (centres `center`, radii `radius`) drawn uniformly in the cones of
+/// directions they subtend from receivers `ref_p` outside them, with [`crate::Sphere::sample_from`]'s
+/// arithmetic (its cone branch) on the numbers `(ux, uy)`: the points, their outward normals,
+/// their parameters ([`crate::Sphere::param_of`]) and the solid-angle densities, zero where
+/// [`crate::Sphere::sample_from`] has no sample.
+#[inline(always)]
+pub fn sphere_cone_samples(
+    center: V3,
+    radius: F8,
+    ref_p: V3,
+    (ux, uy): (F8, F8),
+) -> (V3, V3, (F8, F8), F8) {
+    let (zero, one, two) = (F8::splat(0.0), F8::splat(1.0), F8::splat(2.0));
+    let to_c = center - ref_p;
+    let d2 = to_c.dot(to_c);
+    let r2 = radius * radius;
+    let dist = d2.sqrt();
+    // `one_minus_cos_max` and `uniform_cone_pdf_of`.
+    let sin2_max = r2 / d2;
+    let omc_max = sin2_max / (one + (one - sin2_max).max(zero).sqrt());
+    let solid_angle = F8::splat(2.0 * core::f32::consts::PI) * omc_max;
+    let pdf = one / solid_angle;
+    let pdf = (solid_angle.gt(zero) & pdf.is_finite()).select(pdf, zero);
+    let omc = ux * omc_max;
+    let cos_theta = one - omc;
+    let sin2_theta = omc * (two - omc);
+    let inv_sin_max = dist / radius;
+    let cos_alpha = sin2_theta * inv_sin_max
+        + cos_theta * (one - (sin2_theta * inv_sin_max * inv_sin_max).min(one)).sqrt();
+    let sin_alpha = (one - cos_alpha * cos_alpha).max(zero).sqrt();
+    let (sin_phi, cos_phi) = restir_sampling::lanes::sincos_turns(uy);
+    let back = to_c.scale(-one / dist);
+    let (bs, bt) = normal_tangents(back);
+    let n = bs.scale(sin_alpha * cos_phi) + bt.scale(sin_alpha * sin_phi) + back.scale(cos_alpha);
+    let param = octahedral_encode(n);
+    let n = octahedral_decode(param.0, param.1);
+    (center + n.scale(radius), n, param, pdf)
 }
 
 /// [`crate::offset_ray_origin`] in every lane: `p` moved off its surface along `ng`, to the
@@ -185,6 +259,7 @@ pub fn shadow_rays_between(p: V3, ng: V3, target: V3) -> (V3, V3, F8) {
 mod tests {
     use super::*;
     use restir_sampling::Pcg32;
+    use restir_sampling::lanes::LANES;
 
     /// [`MeshHits::surface`] gives [`crate::surface_at`]'s point and frame to the bit: meshes
     /// with and without vertex normals, texture coordinates and flipped normals, a shading
@@ -268,6 +343,47 @@ mod tests {
 
     /// [`offset_ray_origins`] and [`shadow_rays_between`] give the scalar functions' bits, on
     /// either side of the surface and at points far from the origin.
+    /// The octahedral encoding and decoding in lanes give the scalar bits: the axes, the
+    /// equator, both hemispheres, random directions.
+    #[test]
+    fn lanes_give_the_octahedral_maps_bits() {
+        let mut rng = Pcg32::new(21, 2);
+        let mut dirs = vec![
+            Vec3::X,
+            -Vec3::X,
+            Vec3::Y,
+            -Vec3::Y,
+            Vec3::Z,
+            -Vec3::Z,
+            Vec3::new(1.0, 1.0, 0.0).normalize(),
+            Vec3::new(-1.0, 0.5, 0.0).normalize(),
+        ];
+        dirs.extend((0..4000).map(|_| {
+            let mut c = || rng.next_f32() * 2.0 - 1.0;
+            Vec3::new(c(), c(), c()).normalize()
+        }));
+        for chunk in dirs.chunks_exact(LANES) {
+            let n = V3::from_fn(|i| chunk[i]);
+            let (ex, ey) = octahedral_encode(n);
+            let back = octahedral_decode(ex, ey);
+            for (i, &d) in chunk.iter().enumerate() {
+                let e = crate::shape::octahedral_encode(d);
+                assert_eq!(
+                    [ex.0[i], ey.0[i]].map(f32::to_bits),
+                    e.to_array().map(f32::to_bits),
+                    "{d}"
+                );
+                assert_eq!(
+                    back.get(i).to_array().map(f32::to_bits),
+                    crate::shape::octahedral_decode(e)
+                        .to_array()
+                        .map(f32::to_bits),
+                    "{d}"
+                );
+            }
+        }
+    }
+
     #[test]
     fn lanes_give_the_ray_offsets_bits() {
         let mut rng = Pcg32::new(6, 2);

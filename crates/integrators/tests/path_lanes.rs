@@ -8,8 +8,9 @@ mod common;
 
 use glam::{DVec3, Vec3};
 use restir_integrators::film::Filter;
-use restir_integrators::path::{PathIntegrator, PathSettings, trace_camera_path};
+use restir_integrators::path::{NeeRule, PathIntegrator, PathSettings, trace_camera_path};
 use restir_integrators::{Integrator, PassContext};
+use restir_lights::NeeSelection;
 use restir_scene::{SamplerKind, Scene};
 
 /// The scalar walk's estimates for every pixel of one pass, and its ray count.
@@ -104,6 +105,19 @@ fn lanes_give_the_scalar_walks_bits_on_diffuse_meshes() {
     }
     check("cornell-box.xml", |s| s.hide_emitters = true);
     check("cornell-box.xml", |s| s.rr_depth = 1);
+}
+
+/// Sphere lights picked by power: sampled in lanes.
+#[test]
+fn lanes_give_the_scalar_walks_bits_under_sphere_lights_picked_by_power() {
+    for sampler in [SamplerKind::Independent, SamplerKind::Sobol] {
+        let lit = check("many-lights.ron", |s| {
+            s.sampler = sampler;
+            s.nee = NeeSelection::Power;
+            s.nee_rule = NeeRule::Named;
+        });
+        assert!(lit > 37 * 21, "{sampler:?}: {lit} lit");
+    }
 }
 
 /// Surfaces the lanes do not bounce on: conductors, dielectrics, plastics, masks and spheres

@@ -427,6 +427,26 @@ pub fn sincos_quarter(x: F8) -> (F8, F8) {
     (x + x * (s * x2), k * x2 + 1.0)
 }
 
+/// [`crate::warp::sincos_turns`] in every lane: `(sin 2πt, cos 2πt)` for `t ∈ [0, 1]`, reduced
+/// to the nearest quarter turn, the same bits.
+#[inline(always)]
+pub fn sincos_turns(t: F8) -> (F8, F8) {
+    // The nearest quarter `k` (truncation is the floor of `t·4 + ½ ≥ ½`) and its bits.
+    let mut k = [0.0; LANES];
+    let mut odd = M8::default();
+    let mut half = M8::default();
+    for (i, k) in k.iter_mut().enumerate() {
+        let q = (t.0[i] * 4.0 + 0.5) as u32;
+        *k = q as f32;
+        odd.0[i] = -((q & 1) as i32);
+        half.0[i] = -((q >> 1 & 1) as i32);
+    }
+    let (s, c) = sincos_quarter((t - F8(k) * 0.25) * (2.0 * core::f32::consts::PI));
+    // Quarters 0 and 1 give (s, c) and (c, −s); 2 and 3 their negatives.
+    let (a, b) = (odd.select(c, s), odd.select(-s, c));
+    (half.select(-a, a), half.select(-b, b))
+}
+
 /// [`crate::warp::power_heuristic`] in every lane: the weight of `pdf_a` against `pdf_b`, 1
 /// where `pdf_a` is infinite, 0 where the ratio is not finite.
 #[inline(always)]
@@ -474,6 +494,26 @@ mod tests {
                 assert_eq!(
                     (s.0[i].to_bits(), c.0[i].to_bits()),
                     (ws.to_bits(), wc.to_bits())
+                );
+            }
+        }
+    }
+
+    /// The lanes' sine and cosine of turns are the warp's bits, in all four quarters and on
+    /// their boundaries.
+    #[test]
+    fn sincos_turns_gives_the_warps_bits() {
+        let n = 40_000;
+        for k in (0..=n).step_by(LANES) {
+            let t = F8::from_fn(|i| ((k + i).min(n) as f32 / n as f32).min(1.0));
+            let (s, c) = sincos_turns(t);
+            for i in 0..LANES {
+                let (ws, wc) = crate::warp::sincos_turns(t.0[i]);
+                assert_eq!(
+                    (s.0[i].to_bits(), c.0[i].to_bits()),
+                    (ws.to_bits(), wc.to_bits()),
+                    "t = {}",
+                    t.0[i]
                 );
             }
         }
