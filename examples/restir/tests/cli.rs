@@ -412,6 +412,12 @@ fn tiny_render_writes_images_stats_and_compares() {
     assert_eq!(json["nonfinite_pixels"], 0);
     let bvh = json["bvh"].as_str().unwrap();
     assert!(bvh.contains("nodes") && bvh.contains("kernel"), "{bvh}");
+    // The Cornell box's one light is picked by power: its samples are drawn in lanes.
+    let lanes = json["lanes"].as_str().unwrap();
+    assert!(
+        lanes.contains("paths at a time") && lanes.contains("light samples in lanes"),
+        "{lanes}"
+    );
     // At least a camera ray per pixel and pass.
     assert!(json["rays"].as_u64().unwrap() >= 16 * 16 * 2);
     assert!(json["seconds"].as_f64().unwrap() >= 0.0);

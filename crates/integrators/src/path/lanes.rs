@@ -15,6 +15,7 @@
 use glam::Vec3;
 use restir_geometry::lanes::{MeshHits, SurfaceLanes, offset_ray_origins, shadow_rays_between};
 use restir_geometry::{Ray, Shape, SurfaceInteraction};
+use restir_lights::NeeSelection;
 use restir_materials::{Bsdf, BsdfKind};
 use restir_sampling::Sampler;
 use restir_sampling::lanes::{self, F8, LANES, M8, V3};
@@ -379,18 +380,26 @@ fn avx2() -> bool {
     }
 }
 
-/// What runs in lanes for `scene`, for `--stats`: the lane count and instructions, and how many
-/// of its shapes the lanes carry paths across.
-pub(crate) fn describe(scene: &Scene) -> String {
+/// What runs in lanes for `scene`, for `--stats`: the lane count and instructions, how many of
+/// its shapes the lanes carry paths across, and whether light samples (selected as `nee`) are
+/// drawn in lanes.
+pub(crate) fn describe(scene: &Scene, nee: NeeSelection) -> String {
     let carried = shape_classes(scene)
         .iter()
         .filter(|&&c| c != Class::Other)
         .count();
     format!(
         "{LANES} paths at a time ({}); {carried} of {} shapes (diffuse or absorbing meshes, textured \
-         or not) bounce in lanes, the others one lane at a time",
+         or not) bounce in lanes, the others one lane at a time; {}",
         if avx2() { "AVX2 and FMA" } else { "SSE2" },
-        scene.shapes.len()
+        scene.shapes.len(),
+        match nee {
+            NeeSelection::Power => {
+                "light samples in lanes on triangles and spheres of uniform radiance, on other \
+                 lights one lane at a time"
+            }
+            _ => "light samples one lane at a time (the light hierarchy picks them)",
+        }
     )
 }
 

@@ -529,7 +529,10 @@ impl Integrator for PathIntegrator {
     }
 
     fn lanes(&self, scene: &Scene) -> Option<String> {
-        Some(lanes::describe(scene))
+        Some(lanes::describe(
+            scene,
+            self.settings.resolved(&scene.features).nee,
+        ))
     }
 }
 
