@@ -143,8 +143,8 @@ fn lanes_give_the_scalar_walks_bits_where_paths_bounce_one_lane_at_a_time() {
 }
 
 restir_testkit::corpus_test! {
-    /// Corpus Sponza: textured diffuse meshes (in lanes, each texture looked up at its hit), a
-    /// `phong` material and a sphere light (the scalar walk's bounces there).
+    /// Corpus Sponza: textured diffuse meshes (in lanes, each texture looked up at its hit) and
+    /// a sphere light (its samples in lanes, the scalar walk's bounce where a path meets it).
     fn lanes_give_the_scalar_walks_bits_on_corpus_sponza() {
         let path = restir_testkit::corpus::corpus_dir().join("lajolla/sponza/sponza.xml");
         assert!(check_file(&path, |_| {}) > 37 * 21);

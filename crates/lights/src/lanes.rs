@@ -249,7 +249,8 @@ impl LightSet {
         let facing = n.dot(wi);
         let tri_ok =
             d2.gt(zero) & tri_pdf.is_finite() & tri_pdf.gt(zero) & dist.gt(zero) & facing.lt(zero);
-        // (The scalar tests reject; a NaN passes them.)
+        // Written as `Sphere::sample_from`'s and `area_light_sample`'s rejections (a NaN passes
+        // them there too).
         let sph_ok = !cone_pdf.eq(zero) & !dist.le(zero) & !facing.ge(zero);
         out.p = mine.select3(p, out.p);
         out.n = mine.select3(n, out.n);
