@@ -193,10 +193,10 @@ pub fn octahedral_decode(ex: F8, ey: F8) -> V3 {
 }
 
 /// Points on spheres (centres `center`, radii `radius`) drawn uniformly in the cones of
-/// directions they subtend from receivers `ref_p` outside them, with [`crate::Sphere::sample_from`]'s
-/// arithmetic (its cone branch) on the numbers `(ux, uy)`: the points, their outward normals,
-/// their parameters ([`crate::Sphere::param_of`]) and the solid-angle densities, zero where
-/// [`crate::Sphere::sample_from`] has no sample.
+/// directions they subtend from receivers `ref_p` outside them, with the arithmetic of
+/// [`crate::Sphere::sample_from`] (its cone branch) on the numbers `(ux, uy)`: the points,
+/// their outward normals, their parameters ([`crate::Sphere::param_of`]) and the solid-angle
+/// densities, zero where [`crate::Sphere::sample_from`] has no sample.
 #[inline(always)]
 pub fn sphere_cone_samples(
     center: V3,
