@@ -9,7 +9,7 @@
 use glam::{Vec2, Vec3};
 use restir_sampling::lanes::{F8, M8, V3};
 
-use crate::{Frame, TriangleMesh};
+use crate::{Frame, Ray, TriangleMesh};
 
 /// Eight mesh hits, gathered.
 #[derive(Clone, Copy, Debug, Default)]
@@ -243,6 +243,55 @@ pub fn offset_ray_origins(p: V3, ng: V3, d: V3) -> V3 {
         z: p.z.abs(),
     };
     p + ng.scale(side * (a.max_element() * crate::RAY_EPSILON))
+}
+
+/// Eight rays: origins, directions and ends in lanes.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RayLanes {
+    /// Origins.
+    pub o: V3,
+    /// Directions.
+    pub d: V3,
+    /// Ends ([`Ray::t_max`]).
+    pub t_max: F8,
+}
+
+impl RayLanes {
+    /// Lane `i` is `f(i)`.
+    #[inline(always)]
+    pub fn from_fn(mut f: impl FnMut(usize) -> Ray) -> Self {
+        let mut r = RayLanes::default();
+        for i in 0..restir_sampling::lanes::LANES {
+            r.set(i, f(i));
+        }
+        r
+    }
+
+    /// Lane `i`.
+    #[inline(always)]
+    pub fn get(&self, i: usize) -> Ray {
+        Ray {
+            o: self.o.get(i),
+            d: self.d.get(i),
+            t_max: self.t_max.0[i],
+        }
+    }
+
+    /// Sets lane `i`.
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, r: Ray) {
+        self.o.set(i, r.o);
+        self.d.set(i, r.d);
+        self.t_max.0[i] = r.t_max;
+    }
+
+    /// Where `m` holds, the unbounded ray from `o` along `d` ([`Ray::new`]).
+    #[inline(always)]
+    pub fn set_where(&mut self, m: M8, o: V3, d: V3) {
+        self.o = m.select3(o, self.o);
+        self.d = m.select3(d, self.d);
+        self.t_max = m.select(F8::splat(f32::INFINITY), self.t_max);
+    }
 }
 
 /// [`crate::shadow_ray_between`] in every lane: the shadow rays' origins, unit directions and

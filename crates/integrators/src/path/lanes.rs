@@ -13,7 +13,9 @@
 //! scalar walk's bounce ([`super::scatter`]) and its path goes on in the lanes from there.
 
 use glam::Vec3;
-use restir_geometry::lanes::{MeshHits, SurfaceLanes, offset_ray_origins, shadow_rays_between};
+use restir_geometry::lanes::{
+    MeshHits, RayLanes, SurfaceLanes, offset_ray_origins, shadow_rays_between,
+};
 use restir_geometry::{Ray, Shape, SurfaceInteraction};
 use restir_lights::NeeSelection;
 use restir_materials::{Bsdf, BsdfKind};
@@ -119,10 +121,7 @@ fn trace_camera_paths<S: Sampler>(
     let has_env = scene.features.has_environment;
     let mut traced = 0u64;
     // The rays in lanes: a bounce in lanes selects its continuations into them whole.
-    let pick = |i: usize| rays[i.min(n - 1)];
-    let mut ray_o = V3::from_fn(|i| pick(i).o);
-    let mut ray_d = V3::from_fn(|i| pick(i).d);
-    let mut t_max = F8::from_fn(|i| pick(i).t_max);
+    let mut ray = RayLanes::from_fn(|i| rays[i.min(n - 1)]);
     let mut active = M8::from_fn(|i| i < n);
     let mut beta = V3::splat(Vec3::ONE);
     let mut radiance = V3::ZERO;
@@ -146,11 +145,7 @@ fn trace_camera_paths<S: Sampler>(
             if !active.get(i) {
                 continue;
             }
-            let r = Ray {
-                o: ray_o.get(i),
-                d: ray_d.get(i),
-                t_max: t_max.0[i],
-            };
+            let r = ray.get(i);
             let hit = if hide {
                 let (si, k) = scene.intersect_past_emitters(&r);
                 traced += k;
@@ -231,11 +226,7 @@ fn trace_camera_paths<S: Sampler>(
             if one_lane.get(i) {
                 // Any other surface: the scalar walk's bounce, its numbers included.
                 let mut w = Walk {
-                    ray: Ray {
-                        o: ray_o.get(i),
-                        d: ray_d.get(i),
-                        t_max: t_max.0[i],
-                    },
+                    ray: ray.get(i),
                     depth,
                     beta: beta.get(i),
                     eta_scale: eta.0[i],
@@ -244,9 +235,8 @@ fn trace_camera_paths<S: Sampler>(
                     rays: 0,
                 };
                 active.set(i, scatter(scene, settings, s, &mut w, &mut rngs[i]));
-                (prev[i], eta.0[i], t_max.0[i]) = (w.prev, w.eta_scale, w.ray.t_max);
-                ray_o.set(i, w.ray.o);
-                ray_d.set(i, w.ray.d);
+                (prev[i], eta.0[i]) = (w.prev, w.eta_scale);
+                ray.set(i, w.ray);
                 beta.set(i, w.beta);
                 radiance.set(i, w.radiance);
                 traced += w.rays;
@@ -275,7 +265,7 @@ fn trace_camera_paths<S: Sampler>(
         }
         let lane = |k: usize| F8::from_fn(|i| u[i][k]);
         let zero = F8::splat(0.0);
-        let wo = surf.to_local(-ray_d);
+        let wo = surf.to_local(-ray.d);
         // A two-sided surface seen from behind is mirrored to the front.
         let flip = two_sided & wo.z.lt(zero);
         let front = flip.select(-wo.z, wo.z).gt(zero);
@@ -302,13 +292,13 @@ fn trace_camera_paths<S: Sampler>(
                 continue;
             }
             traced += 1;
-            let ray = Ray::new(s_o.get(i), s_d.get(i));
+            let shadow = Ray::new(s_o.get(i), s_d.get(i));
             let seen = match ShadowTarget::of_sample(&l) {
                 ShadowTarget::OnLight { p, ng, light, prim } => {
-                    let end = lights.shadow_end(light, prim, ray.o, ray.d, s_t.0[i], p, ng);
-                    !scene.occluded(&ray, end)
+                    let end = lights.shadow_end(light, prim, shadow.o, shadow.d, s_t.0[i], p, ng);
+                    !scene.occluded(&shadow, end)
                 }
-                ShadowTarget::Point(_) => !scene.occluded(&ray, s_t.0[i]),
+                ShadowTarget::Point(_) => !scene.occluded(&shadow, s_t.0[i]),
                 target @ ShadowTarget::Direction(_) => {
                     visible(scene, surf.p.get(i), surf.ng.get(i), target)
                 }
@@ -344,9 +334,7 @@ fn trace_camera_paths<S: Sampler>(
                 mis: EmissionMis::Power,
             });
         }
-        ray_o = go_on.select3(origin, ray_o);
-        ray_d = go_on.select3(dir, ray_d);
-        t_max = go_on.select(F8::splat(f32::INFINITY), t_max);
+        ray.set_where(go_on, origin, dir);
         depth += 1;
 
         // Russian roulette (a diffuse bounce leaves the relative index of refraction as it was).
