@@ -206,6 +206,20 @@ impl Scene {
         Some(self.bsdf_at(bsdf, at))
     }
 
+    /// The diffuse reflectance of material `bsdf` at the point `at` names, its textures looked
+    /// up ([`TexturedParams::diffuse_at`]): for a diffuse model whose other textures change
+    /// nothing it holds (no mask, normal or bump map), [`Scene::bsdf_at`]'s `reflectance` there,
+    /// without building the rest of the BSDF. `None` when the material's textures are not looked
+    /// up (it has none, or the scene has none: [`SceneFeatures::has_textures`]).
+    #[inline]
+    pub fn textured_diffuse_at(&self, bsdf: u32, at: &TexturePoint) -> Option<Vec3> {
+        if !self.features.has_textures {
+            return None;
+        }
+        let t = self.bsdf_textures[bsdf as usize].as_ref()?;
+        Some(t.diffuse_at(&self.textures, &self.shapes, at))
+    }
+
     /// The normal-map texel a bump map gives at `si` (from the height's gradient, the
     /// surface's derivatives and its shading frame there: [`restir_materials::bump_normal`]),
     /// or `None` when the material of `si`'s shape has no bump map. With the hit's
@@ -331,14 +345,10 @@ impl TexturedParams {
         shapes: &[Shape],
         at: &TexturePoint,
     ) -> ReflectanceParams {
-        let look = |slot: Option<u32>, constant: Vec3| match slot {
-            Some(i) => textures[i as usize]
-                .eval_at(shapes, at)
-                .clamp(Vec3::ZERO, Vec3::ONE),
-            None => constant,
-        };
+        let look =
+            |slot: Option<u32>, constant: Vec3| colour_at(textures, shapes, at, slot, constant);
         ReflectanceParams {
-            diffuse: look(self.diffuse, self.base.diffuse),
+            diffuse: self.diffuse_at(textures, shapes, at),
             specular: look(self.specular, self.base.specular),
             transmittance: look(self.transmittance, self.base.transmittance),
             nonlinear: self.base.nonlinear,
@@ -362,5 +372,29 @@ impl TexturedParams {
                 }
             },
         }
+    }
+
+    /// The diffuse reflectance at `at`: [`TexturedParams::eval`]'s `diffuse` alone.
+    #[inline]
+    pub fn diffuse_at(&self, textures: &[Texture], shapes: &[Shape], at: &TexturePoint) -> Vec3 {
+        colour_at(textures, shapes, at, self.diffuse, self.base.diffuse)
+    }
+}
+
+/// A colour parameter at `at`: texture `slot`'s value clamped to `[0, 1]`, or `constant` where
+/// the parameter has no texture.
+#[inline]
+fn colour_at(
+    textures: &[Texture],
+    shapes: &[Shape],
+    at: &TexturePoint,
+    slot: Option<u32>,
+    constant: Vec3,
+) -> Vec3 {
+    match slot {
+        Some(i) => textures[i as usize]
+            .eval_at(shapes, at)
+            .clamp(Vec3::ZERO, Vec3::ONE),
+        None => constant,
     }
 }

@@ -65,9 +65,10 @@ impl Surface {
 enum Class {
     /// A mesh whose BSDF is the same everywhere.
     Uniform(Surface),
-    /// A mesh of a diffuse or absorbing material with textures (none of them a mask, a normal
-    /// map or a bump map): its BSDF is looked up at each hit.
-    Textured,
+    /// A mesh of material `bsdf`, a diffuse model with textures that change only its colours
+    /// (no mask, normal map or bump map, blend weight or principled parameters): its
+    /// reflectance alone is looked up at each hit.
+    TexturedDiffuse { bsdf: u32, two_sided: bool },
     /// Anything else: a path that reaches it bounces there as the scalar walk does.
     Other,
 }
@@ -85,14 +86,21 @@ fn shape_classes(scene: &Scene) -> Vec<Class> {
                     surface => Class::Uniform(surface),
                 };
             }
-            let b = scene.shape_bsdf()[s] as usize;
-            let plain = scene.bsdf_textures()[b]
-                .as_ref()
-                .is_none_or(|t| t.opacity.is_none() && t.normal.is_none() && t.bump.is_none());
-            if plain && Surface::of(Some(scene.bsdfs()[b])) != Surface::Other {
-                Class::Textured
-            } else {
-                Class::Other
+            let b = scene.shape_bsdf()[s];
+            let colours_only = scene.bsdf_textures()[b as usize].as_ref().is_none_or(|t| {
+                t.opacity.is_none()
+                    && t.normal.is_none()
+                    && t.bump.is_none()
+                    && t.weight.is_none()
+                    && !t.principled.any()
+            });
+            match Surface::of(Some(scene.bsdfs()[b as usize])) {
+                // An absorber stays one whatever its textures.
+                Surface::Black if colours_only => Class::Uniform(Surface::Black),
+                Surface::Diffuse { two_sided, .. } if colours_only => {
+                    Class::TexturedDiffuse { bsdf: b, two_sided }
+                }
+                _ => Class::Other,
             }
         })
         .collect()
@@ -169,18 +177,21 @@ fn trace_camera_paths<S: Sampler>(
             };
             let surface = match (classes[shape as usize], &hit, &scene.shapes[shape as usize]) {
                 (Class::Uniform(surface), ..) => surface,
-                (Class::Textured, Ok(h), Shape::Mesh(m)) => {
+                (Class::TexturedDiffuse { bsdf, two_sided }, Ok(h), Shape::Mesh(m)) => {
                     // Looked up at the point the hit names.
                     let bary = h.triangle_param();
-                    let uv = m.uv_at(h.prim as usize, bary);
-                    Surface::of(scene.bsdf_at_point(&TexturePoint {
-                        uv,
+                    let at = TexturePoint {
+                        uv: m.uv_at(h.prim as usize, bary),
                         shape,
                         prim: h.prim,
                         bary,
-                    }))
+                    };
+                    match scene.textured_diffuse_at(bsdf, &at) {
+                        Some(albedo) => Surface::Diffuse { albedo, two_sided },
+                        None => Surface::of(scene.bsdf_at_point(&at)),
+                    }
                 }
-                (Class::Textured, Err(si), _) => Surface::of(Some(scene.bsdf(si))),
+                (Class::TexturedDiffuse { .. }, Err(si), _) => Surface::of(Some(scene.bsdf(si))),
                 _ => Surface::Other,
             };
             let light = lights.light_on_shape(shape).filter(|_| !hide);
