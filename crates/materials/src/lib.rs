@@ -89,6 +89,7 @@
 mod bsdf;
 pub mod fresnel;
 pub mod ior;
+pub mod lanes;
 mod lobe;
 pub mod microfacet;
 mod models;

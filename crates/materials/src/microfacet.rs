@@ -288,7 +288,7 @@ pub(crate) fn beckmann_slope_y(u: f32) -> f32 {
 /// it is added to, so the result is within 3·10⁻⁷ (relative) of the `f64` formula's
 /// (`beckmann_g1_matches_f64`); beyond `a = 9` Λ is far below `f32`'s resolution of 1.
 #[inline]
-fn beckmann_g1(a: f32) -> f32 {
+pub(crate) fn beckmann_g1(a: f32) -> f32 {
     if a > 9.0 {
         return 1.0;
     }

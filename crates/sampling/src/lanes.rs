@@ -221,6 +221,12 @@ impl M8 {
     pub fn any(self) -> bool {
         self.0.iter().fold(0, |a, &b| a | b) != 0
     }
+
+    /// Whether every lane holds.
+    #[inline(always)]
+    pub fn all(self) -> bool {
+        self.0.iter().fold(-1, |a, &b| a & b) != 0
+    }
 }
 
 impl BitAnd for M8 {
@@ -462,6 +468,17 @@ pub fn power_heuristic(pdf_a: F8, pdf_b: F8) -> F8 {
 /// from [`sincos_quarter`] (either branch of the map needs them only on `[−π/4, π/4]`).
 #[inline(always)]
 pub fn sample_cosine_hemisphere(ux: F8, uy: F8) -> V3 {
+    let (x, y) = sample_concentric_disk(ux, uy);
+    let z = (F8::splat(1.0) - (x * x + y * y))
+        .max(F8::splat(0.0))
+        .sqrt();
+    V3 { x, y, z }
+}
+
+/// [`crate::warp::sample_concentric_disk`] in every lane (Shirley and Chiu's map), the angle's
+/// sine and cosine from [`sincos_quarter`]: the same bits.
+#[inline(always)]
+pub fn sample_concentric_disk(ux: F8, uy: F8) -> (F8, F8) {
     let (ox, oy) = (ux * 2.0 - 1.0, uy * 2.0 - 1.0);
     let wide = ox.abs().gt(oy.abs());
     let q = wide.select(oy / ox, ox / oy);
@@ -471,8 +488,7 @@ pub fn sample_cosine_hemisphere(ux: F8, uy: F8) -> V3 {
     let zero = F8::splat(0.0);
     let x = centre.select(zero, r * wide.select(c, s));
     let y = centre.select(zero, r * wide.select(s, c));
-    let z = (F8::splat(1.0) - (x * x + y * y)).max(zero).sqrt();
-    V3 { x, y, z }
+    (x, y)
 }
 
 #[cfg(test)]
