@@ -107,6 +107,68 @@ fn lanes_give_the_scalar_walks_bits_on_diffuse_meshes() {
     check("cornell-box.xml", |s| s.rr_depth = 1);
 }
 
+/// Rough conductors on meshes, in lanes: the Cornell box with its walls made GGX gold (two
+/// sided), anisotropic Beckmann copper (one sided) and near-mirror GGX aluminium (two sided), the
+/// back wall turned away from the camera (its back seen, mirrored to the front), both samplers.
+#[test]
+fn lanes_give_the_scalar_walks_bits_on_rough_conductors() {
+    let conductor = |material: &str, distribution: &str, alphas: &str| {
+        format!(
+            r#"<bsdf type="roughconductor"><string name="material" value="{material}"/><string name="distribution" value="{distribution}"/>{alphas}</bsdf>"#
+        )
+    };
+    let mut xml = std::fs::read_to_string(
+        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml"),
+    )
+    .unwrap();
+    for (id, old, new) in [
+        (
+            "white",
+            r#"<rgb name="reflectance" value="0.725, 0.71, 0.68"/>"#,
+            format!(
+                r#"<bsdf type="twosided" id="white">{}</bsdf>"#,
+                conductor("Au", "ggx", r#"<float name="alpha" value="0.3"/>"#)
+            ),
+        ),
+        (
+            "red",
+            r#"<rgb name="reflectance" value="0.63, 0.065, 0.05"/>"#,
+            conductor(
+                "Cu",
+                "beckmann",
+                r#"<float name="alpha_u" value="0.05"/><float name="alpha_v" value="0.4"/>"#,
+            )
+            .replacen("<bsdf ", r#"<bsdf id="red" "#, 1),
+        ),
+        (
+            "green",
+            r#"<rgb name="reflectance" value="0.14, 0.45, 0.091"/>"#,
+            format!(
+                r#"<bsdf type="twosided" id="green">{}</bsdf>"#,
+                conductor("Al", "ggx", r#"<float name="alpha" value="0.01"/>"#)
+            ),
+        ),
+    ] {
+        let diffuse = format!("<bsdf type=\"diffuse\" id=\"{id}\">\n        {old}\n    </bsdf>");
+        assert!(xml.contains(&diffuse), "{id}");
+        xml = xml.replace(&diffuse, &new);
+    }
+    let back = r#"<translate x="0" y="1" z="-1"/>
+        </transform>"#;
+    assert!(xml.contains(back));
+    xml = xml.replace(
+        back,
+        &format!(r#"{back}<boolean name="flip_normals" value="true"/>"#),
+    );
+    let dir = restir_testkit::TempDir::new("path-lanes", "conductors");
+    let path = dir.join("conductors.xml");
+    std::fs::write(&path, xml).unwrap();
+    for sampler in [SamplerKind::Independent, SamplerKind::Sobol] {
+        let lit = check_file(&path, |s| s.sampler = sampler);
+        assert!(lit > 37 * 21 / 2, "{sampler:?}: {lit} lit");
+    }
+}
+
 /// Sphere lights picked by power: sampled in lanes.
 #[test]
 fn lanes_give_the_scalar_walks_bits_under_sphere_lights_picked_by_power() {

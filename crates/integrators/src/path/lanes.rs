@@ -4,13 +4,15 @@
 //! the bit.
 //!
 //! The lanes carry paths across diffuse surfaces of meshes (Mitsuba's `diffuse` without a mask,
-//! normal map or bump map, textured or not) and absorbers. In lanes ([`F8`]): the hit's point
-//! and shading frame, light samples on triangles of uniform radiance, the diffuse model's
-//! value, density and cosine-weighted sampling, the power heuristic, the shadow rays and
-//! continuations off the surface, the throughput and Russian roulette. Lane by lane: traversal,
-//! each hit's material and emission, other lights' samples, the random numbers. At any other
-//! surface (another material, a mask, normal or bump map, an analytic shape) a lane makes the
-//! scalar walk's bounce ([`super::scatter`]) and its path goes on in the lanes from there.
+//! normal map or bump map, textured or not), rough conductors of meshes (`roughconductor`,
+//! untextured) and absorbers. In lanes ([`F8`]): the hit's point and shading frame, light
+//! samples on triangles and spheres of uniform radiance, the diffuse model's and the rough
+//! conductor's values, densities and sampling ([`RoughConductorLanes`]), the power heuristic,
+//! the shadow rays and continuations off the surface, the throughput and Russian roulette. Lane
+//! by lane: traversal, each hit's material and emission, other lights' samples, the Beckmann
+//! distribution's transcendental functions, the random numbers. At any other surface (another
+//! material, a mask, normal or bump map, an analytic shape) a lane makes the scalar walk's
+//! bounce ([`super::scatter`]) and its path goes on in the lanes from there.
 
 use glam::Vec3;
 use restir_geometry::lanes::{
@@ -18,7 +20,8 @@ use restir_geometry::lanes::{
 };
 use restir_geometry::{Ray, Shape, SurfaceInteraction};
 use restir_lights::NeeSelection;
-use restir_materials::{Bsdf, BsdfKind};
+use restir_materials::lanes::RoughConductorLanes;
+use restir_materials::{Bsdf, BsdfKind, Microfacet};
 use restir_sampling::Sampler;
 use restir_sampling::lanes::{self, F8, LANES, M8, V3};
 use restir_scene::{Scene, TexturePoint};
@@ -36,6 +39,15 @@ const FRAC_1_PI: f32 = core::f32::consts::FRAC_1_PI;
 enum Surface {
     /// A plain diffuse surface of reflectance `albedo`, mirrored to the front when `two_sided`.
     Diffuse { albedo: Vec3, two_sided: bool },
+    /// A plain rough conductor (Mitsuba's `roughconductor`), mirrored to the front when
+    /// `two_sided`.
+    RoughConductor {
+        eta: Vec3,
+        k: Vec3,
+        specular: Vec3,
+        microfacet: Microfacet,
+        two_sided: bool,
+    },
     /// An absorber (an emitter without a material): the path ends after its emission.
     Black,
     /// Anything else: the scalar walk's bounce there.
@@ -50,6 +62,18 @@ impl Surface {
             Some(b) if !b.is_masked() && b.normal_map.is_none() => match b.kind {
                 BsdfKind::Diffuse { reflectance } => Surface::Diffuse {
                     albedo: reflectance,
+                    two_sided: b.two_sided,
+                },
+                BsdfKind::RoughConductor {
+                    eta,
+                    k,
+                    specular_reflectance,
+                    microfacet,
+                } => Surface::RoughConductor {
+                    eta,
+                    k,
+                    specular: specular_reflectance,
+                    microfacet,
                     two_sided: b.two_sided,
                 },
                 BsdfKind::Black => Surface::Black,
@@ -146,6 +170,8 @@ fn trace_camera_paths<S: Sampler>(
         let mut gather = MeshHits::default();
         let mut computed = [None::<SurfaceInteraction>; LANES];
         let mut albedo = V3::ZERO;
+        let mut conductor = RoughConductorLanes::default();
+        let mut conducts = M8::default();
         let mut two_sided = M8::default();
         // Lanes whose surface this bounce is not for the lanes: the walk's own bounce there.
         let mut one_lane = M8::default();
@@ -195,8 +221,12 @@ fn trace_camera_paths<S: Sampler>(
                 _ => Surface::Other,
             };
             let light = lights.light_on_shape(shape).filter(|_| !hide);
-            if let (Ok(h), None, Surface::Diffuse { .. }, Shape::Mesh(m)) =
-                (&hit, light, surface, &scene.shapes[shape as usize])
+            if let (
+                Ok(h),
+                None,
+                Surface::Diffuse { .. } | Surface::RoughConductor { .. },
+                Shape::Mesh(m),
+            ) = (&hit, light, surface, &scene.shapes[shape as usize])
             {
                 gather.set(i, m, h.prim as usize, h.bary);
             } else {
@@ -219,13 +249,26 @@ fn trace_camera_paths<S: Sampler>(
                 one_lane.set(i, surface == Surface::Other);
                 computed[i] = Some(s);
             }
-            if let Surface::Diffuse {
-                albedo: a,
-                two_sided: t,
-            } = surface
-            {
-                albedo.set(i, a);
-                two_sided.set(i, t);
+            match surface {
+                Surface::Diffuse {
+                    albedo: a,
+                    two_sided: t,
+                } => {
+                    albedo.set(i, a);
+                    two_sided.set(i, t);
+                }
+                Surface::RoughConductor {
+                    eta,
+                    k,
+                    specular,
+                    microfacet,
+                    two_sided: t,
+                } => {
+                    conductor.set(i, eta, k, specular, &microfacet);
+                    conducts.set(i, true);
+                    two_sided.set(i, t);
+                }
+                _ => {}
             }
         }
         if !active.any() || depth + 1 >= max_depth {
@@ -279,7 +322,12 @@ fn trace_camera_paths<S: Sampler>(
         let wo = surf.to_local(-ray.d);
         // A two-sided surface seen from behind is mirrored to the front.
         let flip = two_sided & wo.z.lt(zero);
-        let front = flip.select(-wo.z, wo.z).gt(zero);
+        let v = V3 {
+            x: wo.x,
+            y: wo.y,
+            z: flip.select(-wo.z, wo.z),
+        };
+        let front = v.z.gt(zero);
 
         // Next-event estimation.
         let nee_u = core::array::from_fn(|i| [u[i][0], u[i][6], u[i][1], u[i][2]]);
@@ -287,8 +335,18 @@ fn trace_camera_paths<S: Sampler>(
         let wi = surf.to_local(ls.wi);
         let lz = flip.select(-wi.z, wi.z);
         let reach = front & lz.gt(zero);
-        let f = reach.select3(albedo.scale(F8::splat(FRAC_1_PI) * lz), V3::ZERO);
-        let b_pdf = reach.select(lz * FRAC_1_PI, zero);
+        let mut f = reach.select3(albedo.scale(F8::splat(FRAC_1_PI) * lz), V3::ZERO);
+        let mut b_pdf = reach.select(lz * FRAC_1_PI, zero);
+        if conducts.any() {
+            let l = V3 {
+                x: wi.x,
+                y: wi.y,
+                z: lz,
+            };
+            let (f_l, pdf_l) = conductor.eval_pdf(v, l);
+            f = conducts.select3(f_l, f);
+            b_pdf = conducts.select(pdf_l, b_pdf);
+        }
         let w = ls
             .delta
             .select(F8::splat(1.0), lanes::power_heuristic(ls.pdf_sa, b_pdf));
@@ -319,17 +377,24 @@ fn trace_camera_paths<S: Sampler>(
             }
         }
 
-        // The continuation, cosine-weighted.
-        let cos = lanes::sample_cosine_hemisphere(lane(4), lane(5));
-        let pdf = cos.z.gt(zero).select(cos.z * FRAC_1_PI, zero);
-        let f_c = albedo.scale(F8::splat(FRAC_1_PI) * cos.z);
-        let ok = front & pdf.gt(zero) & pdf.is_finite() & f_c.is_finite() & cos.is_finite();
+        // The continuation: cosine-weighted, or about a visible normal of a rough conductor.
+        let mut sampled = lanes::sample_cosine_hemisphere(lane(4), lane(5));
+        let mut pdf = sampled.z.gt(zero).select(sampled.z * FRAC_1_PI, zero);
+        let mut f_c = albedo.scale(F8::splat(FRAC_1_PI) * sampled.z);
+        let mut ok = front & pdf.gt(zero) & pdf.is_finite() & f_c.is_finite() & sampled.is_finite();
+        if conducts.any() {
+            let (l, f, p, some) = conductor.sample(v, lane(4), lane(5));
+            sampled = conducts.select3(l, sampled);
+            f_c = conducts.select3(f, f_c);
+            pdf = conducts.select(p, pdf);
+            ok = (conducts & some) | (!conducts & ok);
+        }
         let mut go_on = here & ok;
         beta = here.select3(beta * (f_c / pdf), beta);
         let local = V3 {
-            x: cos.x,
-            y: cos.y,
-            z: flip.select(-cos.z, cos.z),
+            x: sampled.x,
+            y: sampled.y,
+            z: flip.select(-sampled.z, sampled.z),
         };
         let dir = surf.to_world(local);
         let origin = offset_ray_origins(surf.p, surf.ng, dir);
@@ -348,7 +413,7 @@ fn trace_camera_paths<S: Sampler>(
         ray.set_where(go_on, origin, dir);
         depth += 1;
 
-        // Russian roulette (a diffuse bounce leaves the relative index of refraction as it was).
+        // Russian roulette (a reflection leaves the relative index of refraction as it was).
         let bmax = beta.max_element();
         go_on = go_on & bmax.gt(zero) & beta.is_finite();
         if depth >= settings.rr_depth {
@@ -388,8 +453,9 @@ pub(crate) fn describe(scene: &Scene, nee: NeeSelection) -> String {
         .filter(|&&c| c != Class::Other)
         .count();
     format!(
-        "{LANES} paths at a time ({}); {carried} of {} shapes (diffuse or absorbing meshes, textured \
-         or not) bounce in lanes, the others one lane at a time; {}",
+        "{LANES} paths at a time ({}); {carried} of {} shapes (meshes of diffuse materials, \
+         textured or not, of rough conductors and absorbers) bounce in lanes, the others one lane \
+         at a time; {}",
         if avx2() { "AVX2 and FMA" } else { "SSE2" },
         scene.shapes.len(),
         match nee {
