@@ -256,8 +256,8 @@ mod tests {
 
     /// Lane by lane, the bits of the scalar model's `eval`, `pdf_sa` and `sample` (its
     /// direction, value and density, and whether there is a sample): both distributions,
-    /// isotropic and anisotropic, smooth to very rough, three metals and a perfect mirror, each lane its own
-    /// material; directions above, below and along the surface.
+    /// isotropic and anisotropic, smooth to very rough, three metals and a perfect mirror, each
+    /// lane its own material; directions above, below and along the surface.
     #[test]
     fn lanes_give_the_rough_conductors_bits() {
         let mut rng = Pcg32::new(7, 3);
