@@ -8,6 +8,7 @@ use restir_geometry::Shape;
 use restir_lights::Light;
 use restir_scene::animation::{build_at, frame_time, interpolate};
 use restir_scene::{Interpolation, LoadOptions, load_scene, parse_ron};
+use restir_testkit::TempDir;
 
 const SCENE: &str = r#"(
     camera: (fov: 40, to_world: [LookAt(origin: (0, 0, 4), target: (0, 0, 0), up: (0, 1, 0))]),
@@ -30,11 +31,9 @@ const SCENE: &str = r#"(
     )),
 )"#;
 
-/// A fresh directory for one test's files.
-fn temp_dir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("restir-anim-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh directory for one test's files, removed when the test ends.
+fn temp_dir(name: &str) -> TempDir {
+    TempDir::new("anim", name)
 }
 
 fn write_scene(dir: &std::path::Path) -> std::path::PathBuf {

@@ -9,12 +9,12 @@
 
 use glam::Vec2;
 use restir_scene::{LoadOptions, load_scene};
+use restir_testkit::TempDir;
 
 /// What the camera sees through the film's centre and its top-left corner: the depth of the
 /// surface hit, or `None` for a miss.
 fn seen(sensor: &str, props: &str) -> [Option<f32>; 2] {
-    let dir = std::env::temp_dir().join(format!("restir-camera-clip-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("camera-clip", sensor);
     let path = dir.join(format!("{sensor}-{}.xml", props.len()));
     let fov = if sensor == "orthographic" {
         ""

@@ -96,10 +96,8 @@ fn textured_corpus_scenes_load() {
 }
 }
 
-/// A scene around one shape, written next to the test's temporary files.
-fn shape_scene(name: &str, shape: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("restir-corpus-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+/// A scene around one shape, written into the test's temporary directory `dir`.
+fn shape_scene(dir: &Path, name: &str, shape: &str) -> PathBuf {
     let path = dir.join(name);
     let xml = format!(
         r#"<scene version="0.6.0">
@@ -119,6 +117,7 @@ fn serialized_meshes_of_the_corpus() {
     let dir = restir_testkit::corpus_dir();
     let mp = dir.join("lajolla/matpreview/matpreview.serialized");
     let sp = dir.join("lajolla/sponza/sponza.serialized");
+    let tmp = restir_testkit::TempDir::new("corpus", "serialized");
     let mut shapes = String::new();
     for i in 0..3 {
         shapes += &format!(
@@ -130,7 +129,7 @@ fn serialized_meshes_of_the_corpus() {
         "<shape type=\"serialized\"><string name=\"filename\" value=\"{}\"/><integer name=\"shape_index\" value=\"5\"/><boolean name=\"flip_normals\" value=\"true\"/></shape>\n",
         sp.display()
     );
-    let path = shape_scene("serialized.xml", &shapes);
+    let path = shape_scene(&tmp, "serialized.xml", &shapes);
     let s = load_scene(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(s.scene.shapes.len(), 4);
 
@@ -139,7 +138,7 @@ fn serialized_meshes_of_the_corpus() {
         "<shape type=\"serialized\">\n<string name=\"filename\" value=\"{}\"/><integer name=\"shape_index\" value=\"99\"/></shape>",
         mp.display()
     );
-    let e = load_scene(&shape_scene("bad-index.xml", &bad), &LoadOptions::default())
+    let e = load_scene(&shape_scene(&tmp, "bad-index.xml", &bad), &LoadOptions::default())
         .unwrap_err()
         .to_string();
     assert!(
@@ -149,6 +148,7 @@ fn serialized_meshes_of_the_corpus() {
     // A missing file.
     let e = load_scene(
         &shape_scene(
+            &tmp,
             "missing.xml",
             "<shape type=\"ply\"><string name=\"filename\" value=\"nope.ply\"/></shape>",
         ),

@@ -2,14 +2,15 @@
 //! scene files with their `<default>`s, and relative names resolved through both. (The errors
 //! are cases of `tests/bad_scenes/`.)
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use restir_scene::{GeometryDesc, LightDesc, LoadOptions, load_desc, load_scene};
+use restir_testkit::TempDir;
 
-/// A fresh directory tree: `scene/`, `scene/parts/`, `common/meshes/`, `common/textures/`.
-fn tree(tag: &str) -> PathBuf {
-    let root = std::env::temp_dir().join(format!("restir-xml-files-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&root);
+/// A fresh directory tree: `scene/`, `scene/parts/`, `common/meshes/`, `common/textures/`,
+/// removed when dropped.
+fn tree(tag: &str) -> TempDir {
+    let root = TempDir::new("xml-files", tag);
     for d in ["scene/parts", "common/meshes", "common/textures"] {
         std::fs::create_dir_all(root.join(d)).unwrap();
     }
@@ -85,7 +86,6 @@ fn path_and_include_resolve_like_mitsuba() {
     // And the whole scene builds from another working directory's point of view.
     let loaded = load_scene(&scene, &LoadOptions::default()).unwrap();
     assert_eq!(loaded.scene.camera.resolution(), (32, 16));
-    let _ = std::fs::remove_dir_all(&root);
 }
 
 /// A name beside the scene file stays as written (so written scenes keep relative names); the
@@ -127,7 +127,6 @@ fn names_beside_the_scene_stay_relative_and_newer_paths_win() {
         .collect();
     assert!(names[0].ends_with("other/meshes/tri.obj"), "{names:?}");
     assert_eq!(names[1], "meshes/own.obj");
-    let _ = std::fs::remove_dir_all(&root);
 }
 
 /// A sensor's `<sampler>` decides where the path tracer's numbers come from: `independent` (and
