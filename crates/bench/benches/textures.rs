@@ -65,8 +65,7 @@ fn interleaved(budget: f64, mut run: impl FnMut(usize) -> u64) -> [(f64, u64, us
 }
 
 fn bsdf_at_costs(budget: f64) {
-    let dir = std::env::temp_dir().join(format!("restir-bench-tex-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = restir_testkit::TempDir::new("bench-tex", "bsdf-at");
     let img = image::RgbImage::from_fn(256, 256, |x, y| {
         image::Rgb([(x ^ y) as u8, (x * 7) as u8, (y * 3) as u8])
     });
@@ -83,7 +82,7 @@ fn bsdf_at_costs(budget: f64) {
     )"#;
     let desc = parse_ron(ron, "b.ron".as_ref()).unwrap();
     let mut scene = Scene::build(&desc, &dir, "b.ron".as_ref()).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
+    drop(dir);
     let uvs: Vec<TexturePoint> = (0..4096)
         .map(|i| {
             TexturePoint::at_uv(Vec2::new(

@@ -292,10 +292,8 @@ impl Image {
 mod tests {
     use super::*;
 
-    fn temp_dir(tag: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("restir-image-{tag}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    fn temp_dir(tag: &str) -> restir_testkit::TempDir {
+        restir_testkit::TempDir::new("image", tag)
     }
 
     #[test]
@@ -325,7 +323,6 @@ mod tests {
             Err(ImageError::ChannelsNeedExr { .. })
         ));
         assert!(!png.exists());
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     /// PNG output is 8-bit sRGB; reading it back decodes it (or not, when raw).
@@ -342,7 +339,6 @@ mod tests {
         let back = Image::read(&path, IntegerEncoding::Srgb).unwrap();
         assert!(back.pixels[0].abs_diff_eq(Vec3::new(0.0, 0.5, 1.0), 0.01));
         assert!(back.pixels[1].abs_diff_eq(Vec3::new(1.0, 0.0, 0.25), 0.01));
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     /// BMP textures (Mitsuba reads them; its test scenes use one) are 8-bit sRGB like PNG, and
@@ -361,7 +357,6 @@ mod tests {
         assert_eq!(raw.pixels[1], Vec3::new(1.0, 0.0, 64.0 / 255.0));
         let back = Image::read(&path, IntegerEncoding::Srgb).unwrap();
         assert!(back.pixels[0].abs_diff_eq(Vec3::new(0.0, 0.5, 1.0), 0.01));
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     /// An EXR whose header claims 65536×65536 pixels (a few hundred bytes on disk) is refused
@@ -385,7 +380,6 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains(want), "{e}");
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     /// The messages name the file, as the scene loader and the command line report them.
@@ -418,6 +412,5 @@ mod tests {
         );
         std::fs::write(dir.join("bad.png"), b"not a png").unwrap();
         assert!(Image::read(&dir.join("bad.png"), IntegerEncoding::Srgb).is_err());
-        std::fs::remove_dir_all(&dir).ok();
     }
 }

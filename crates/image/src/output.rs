@@ -342,11 +342,8 @@ pub fn write_file_atomically(path: &Path, bytes: &[u8]) -> Result<(), ImageError
 mod tests {
     use super::*;
 
-    fn temp_dir(tag: &str) -> PathBuf {
-        let dir =
-            std::env::temp_dir().join(format!("restir-image-out-{tag}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    fn temp_dir(tag: &str) -> restir_testkit::TempDir {
+        restir_testkit::TempDir::new("image-out", tag)
     }
 
     /// A failing write leaves the old file and no temporary file; a good one replaces it.
@@ -372,8 +369,7 @@ mod tests {
         assert!(!temp_path(&path).exists());
         write_file_atomically(&path, b"new").unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"new");
-        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
-        std::fs::remove_dir_all(&dir).ok();
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     /// /dev/full accepts the file but fails every write: the error surfaces at the flush that
@@ -395,7 +391,7 @@ mod tests {
         let dir = temp_dir("check");
         check_writable(&dir.join("ok.exr")).unwrap();
         assert_eq!(
-            std::fs::read_dir(&dir).unwrap().count(),
+            std::fs::read_dir(dir.path()).unwrap().count(),
             0,
             "the probe is removed"
         );
@@ -412,7 +408,6 @@ mod tests {
         let slash = PathBuf::from(format!("{}/out.exr/", dir.display()));
         let e = check_writable(&slash).unwrap_err().to_string();
         assert!(e.ends_with("ends in '/': it names a directory"), "{e}");
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     /// A device is written in place, never replaced by a regular file (as root the rename
@@ -447,7 +442,6 @@ mod tests {
         for stdout in ["-", "/dev/stdout"] {
             assert_eq!(destination(Path::new(stdout)).unwrap(), Destination::Stdout);
         }
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     /// A FIFO is opened and written (a reader gets the bytes) and stays a FIFO; the check
@@ -477,11 +471,10 @@ mod tests {
         assert_eq!(reader.join().unwrap(), "through the pipe");
         assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
         assert_eq!(
-            std::fs::read_dir(&dir).unwrap().count(),
+            std::fs::read_dir(dir.path()).unwrap().count(),
             1,
             "no temporary left"
         );
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     /// A link is followed: its target is replaced and the link stays a link; a dangling link
@@ -518,7 +511,6 @@ mod tests {
                 .file_type()
                 .is_symlink()
         );
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     /// A socket (or anything that is neither a file, a character device nor a FIFO) is an
@@ -535,7 +527,6 @@ mod tests {
             "{e}"
         );
         assert!(write_file_atomically(&sock, b"x").is_err());
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     /// A valid name of 250 bytes has a temporary name within the 255-byte limit.
@@ -550,7 +541,6 @@ mod tests {
         assert_eq!(std::fs::read(&path).unwrap(), b"long");
         let temp = temp_path(&path);
         assert!(temp.file_name().unwrap().len() <= 255);
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     /// Two spellings of one file are one destination; different files are not.
@@ -566,6 +556,5 @@ mod tests {
         assert!(same_destination(&a, &dir.join(".").join("a.exr")));
         assert!(!same_destination(&a, &dir.join("b.exr")));
         assert!(same_destination(Path::new("-"), Path::new("/dev/stdout")));
-        std::fs::remove_dir_all(&dir).ok();
     }
 }

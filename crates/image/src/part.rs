@@ -176,8 +176,7 @@ mod tests {
     /// Pixels, offset, film size and attributes survive a round trip.
     #[test]
     fn part_roundtrip() {
-        let dir = std::env::temp_dir().join(format!("restir-image-part-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = restir_testkit::TempDir::new("image-part", "roundtrip");
         let path = dir.join("part.exr");
         let mut image = Image::new(3, 2);
         for (i, p) in image.pixels.iter_mut().enumerate() {
@@ -202,7 +201,6 @@ mod tests {
         let (_, plain) = Image::read_exr_part(&path).unwrap();
         assert_eq!((plain.film, plain.offset), ((3, 2), (0, 0)));
         assert!(plain.attribute("restir:passes").is_none());
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     /// A part whose display window claims more pixels than any image read may have, or whose
@@ -210,8 +208,7 @@ mod tests {
     /// block).
     #[test]
     fn bad_part_headers_are_refused() {
-        let dir = std::env::temp_dir().join(format!("restir-image-badpart-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = restir_testkit::TempDir::new("image-part", "bad");
         let path = dir.join("huge.exr");
         let image = Image::new(2, 2);
         let part = |film| ExrPart {
@@ -241,6 +238,5 @@ mod tests {
             let e = Image::read_exr_part(&fifo).unwrap_err().to_string();
             assert!(e.contains("not a regular file"), "{e}");
         }
-        std::fs::remove_dir_all(&dir).ok();
     }
 }

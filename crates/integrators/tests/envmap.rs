@@ -16,15 +16,14 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use restir_integrators::Image;
 use restir_scene::parse_ron;
+use restir_testkit::TempDir;
 
 mod common;
 use common::{block_statistics, max_z, render_image};
 
-/// A fresh directory per test (tests run in parallel and each removes its own).
-fn temp_dir(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("restir-envmap-int-{}-{test}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh directory per test (tests run in parallel), removed when the test ends.
+fn temp_dir(test: &str) -> TempDir {
+    TempDir::new("envmap-int", test)
 }
 
 /// Writes a `w × h` EXR with texel `f(x, y)` (row 0 at the top).
@@ -127,7 +126,6 @@ fn furnace_constant_envmap_equals_constant_emitter() {
         z > 2.0 * FURNACE_Z,
         "a 3 % error went unnoticed: max |z| = {z:.2}"
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 // ------------------------------------------------------------------------------------------
@@ -232,7 +230,6 @@ fn restir_di_and_pt_with_envmap_match_path_tracer() {
     let z = max_z(&pt, &reference);
     eprintln!("restir-pt: max |z| = {z:.2}");
     assert!(z < Z_MAX, "restir-pt: max |z| = {z:.2}");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// The sky scene with two small bright area lights beside the envmap: the scene build picks the
@@ -281,7 +278,6 @@ fn environment_share_beside_area_lights_is_unbiased() {
         );
         assert!(z < Z_MAX, "{name}: max |z| = {z:.2}");
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 // ------------------------------------------------------------------------------------------
@@ -322,6 +318,5 @@ fn matpreview_renders() {
         let mean = img.pixels.iter().map(|p| p.x + p.y + p.z).sum::<f32>();
         assert!(mean > 0.0, "{name}: black image");
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 }

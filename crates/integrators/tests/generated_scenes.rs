@@ -6,7 +6,6 @@
 
 mod common;
 
-use std::path::PathBuf;
 use std::time::Instant;
 
 use restir_families::{
@@ -14,16 +13,16 @@ use restir_families::{
     Split, generate, members,
 };
 use restir_scene::{LoadOptions, load_scene};
+use restir_testkit::TempDir;
 
-/// A fresh directory for one test's files.
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("restir-generated-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+/// A fresh directory for one test's files, removed when dropped.
+fn temp_dir(name: &str) -> TempDir {
+    TempDir::new("generated", name)
 }
 
-/// Writes `generated` into a fresh directory and loads it at `width`×`height`.
-fn load(generated: &Generated, name: &str, width: u32, height: u32) -> (common::Built, PathBuf) {
+/// Writes `generated` into a fresh directory and loads it at `width`×`height`; the directory
+/// goes when the returned guard is dropped.
+fn load(generated: &Generated, name: &str, width: u32, height: u32) -> (common::Built, TempDir) {
     let dir = temp_dir(name);
     let path = generated.write(&dir, name).unwrap();
     let options = LoadOptions {
@@ -119,7 +118,7 @@ fn every_kind_builds_and_renders_finite_and_lit() {
     for (name, params, restir) in cases {
         for seed in [1, 2] {
             let generated = generate(&params, seed).unwrap();
-            let (scene, dir) = load(&generated, &format!("{name}-{seed}"), 32, 24);
+            let (scene, _dir) = load(&generated, &format!("{name}-{seed}"), 32, 24);
             if let Params::Di(_, options) = &params {
                 assert_eq!(
                     emissive_primitives(&generated),
@@ -158,7 +157,6 @@ fn every_kind_builds_and_renders_finite_and_lit() {
                     "{name} seed {seed} {estimator}: black image (mean {mean})"
                 );
             }
-            let _ = std::fs::remove_dir_all(dir);
         }
     }
 }
@@ -282,7 +280,7 @@ fn hundred_thousand_light_members_build() {
         let generated = member.generate().unwrap();
         let made = start.elapsed();
         let start = Instant::now();
-        let (scene, dir) = load(&generated, &member.name(), 32, 24);
+        let (scene, _dir) = load(&generated, &member.name(), 32, 24);
         let loaded = start.elapsed();
         eprintln!(
             "{}: generated in {:.2} s, written, parsed and built in {:.2} s, {} light-set entries",
@@ -298,7 +296,6 @@ fn hundred_thousand_light_members_build() {
             member.name()
         );
         assert!(scene.features.light_count >= 8, "{}", member.name());
-        let _ = std::fs::remove_dir_all(dir);
     }
 }
 
@@ -346,7 +343,6 @@ fn added_lamps_sit_in_free_space_and_the_written_scene_loads() {
     assert!((flux / (0.2 * area) - 1.0).abs() < 1e-3, "{flux} W");
 
     let dir = temp_dir("added-lamps");
-    std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("lamps.xml");
     let text = restir_families::added_lamps_xml(host.to_str().unwrap(), &lamps, "a test");
     std::fs::write(&path, text).unwrap();
@@ -362,5 +358,4 @@ fn added_lamps_sit_in_free_space_and_the_written_scene_loads() {
     );
     let image = common::render_image(&with, "restir-di", &[], 2, 7);
     assert!(image.mean().max_element() > 1e-3);
-    let _ = std::fs::remove_dir_all(dir);
 }

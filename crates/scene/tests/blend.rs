@@ -10,6 +10,7 @@ use restir_scene::{
     ColorParam, LoadOptions, MaterialDesc, load_scene, parse_ron,
     xml::{XmlWriteOptions, parse_xml, to_mitsuba_xml},
 };
+use restir_testkit::TempDir;
 
 mod common;
 use common::scene_text;
@@ -44,8 +45,7 @@ fn inline_and_referenced_bsdfs_in_order() {
 /// A checkerboard weight of 0 and 1 picks one component on each square, at every hit.
 #[test]
 fn textured_weight_reaches_the_bsdf() {
-    let dir = std::env::temp_dir().join(format!("restir-blend-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("blend", "weight");
     let path = dir.join("s.xml");
     std::fs::write(
         &path,
@@ -91,7 +91,6 @@ fn textured_weight_reaches_the_bsdf() {
         unreachable!()
     };
     assert_eq!(b.parts()[0], Bsdf::diffuse(Vec3::splat(0.2)));
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// What the XML writer makes of blends (constant and textured weights, nested in a mask,

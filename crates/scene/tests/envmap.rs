@@ -5,12 +5,11 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use restir_scene::{LoadOptions, load_scene};
+use restir_testkit::TempDir;
 
-/// A fresh directory per test (tests run in parallel and each removes its own).
-fn temp_dir(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("restir-envmap-{}-{test}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh directory per test (tests run in parallel), removed when the test ends.
+fn temp_dir(test: &str) -> TempDir {
+    TempDir::new("envmap", test)
 }
 
 /// Writes a scene whose only emitter is `emitter` (starting on line 5).
@@ -108,7 +107,6 @@ fn envmap_formats_orientation_and_scale() {
     let s = load_scene(&path, &LoadOptions::default()).unwrap();
     let l = s.scene.lights.environment_radiance(Vec3::Z);
     assert!((l.x - 0.5029).abs() < 1e-3, "{l}");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -165,5 +163,4 @@ fn envmap_bad_input_names_file_and_line() {
         };
         assert!(e.contains(want), "{name}: got \"{e}\", want \"{want}\"");
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }

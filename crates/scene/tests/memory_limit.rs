@@ -3,15 +3,14 @@
 //! before it is built, each emitter's tables before they are made, and the one that crosses the
 //! limit is named where the scene declares it.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use restir_scene::desc::limits;
 use restir_scene::{LoadOptions, load_scene};
+use restir_testkit::TempDir;
 
-fn temp_dir(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("restir-memlimit-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn temp_dir(tag: &str) -> TempDir {
+    TempDir::new("memlimit", tag)
 }
 
 fn load(scene: &Path, max_memory: Option<u64>) -> Result<(), String> {
@@ -69,7 +68,6 @@ fn textures_are_bounded_together() {
     // under a limit a little higher, and without one.
     load(&scene, Some(20 << 20)).unwrap();
     load(&scene, None).unwrap();
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A 40 × 40 quad grid (3200 triangles, 1681 vertices) as an OBJ file in `dir`.
@@ -116,7 +114,6 @@ fn meshes_are_bounded_before_the_build() {
     assert!(err.contains("shape 1: mesh '"), "{err}");
     assert!(err.contains("grid.obj' (3200 triangles)"), "{err}");
     load(&scene, Some(mesh + 50_000)).unwrap();
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// An emissive mesh's light tables (one entry per triangle, and the light hierarchy over them)
@@ -153,7 +150,6 @@ fn emitters_are_counted() {
     );
     assert!(err.contains("raise --max-memory"), "{err}");
     load(&scene(true), Some(limit + 3200 * 300)).unwrap();
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A PNG whose header says 64 × 64 but whose pixel data is cut off: its size is known, its
@@ -203,7 +199,6 @@ fn images_are_counted_before_any_is_decoded() {
     let err = load(&scene, None).unwrap_err();
     assert!(err.contains("broken.png"), "{err}");
     assert!(!err.contains("--max-memory"), "{err}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// In an XML scene the error is at the line of the shape that uses the named material whose
@@ -236,7 +231,6 @@ fn an_image_beyond_the_limit_is_located() {
     assert!(err.contains("material 'wall'"), "{err}");
     assert!(err.contains("big.png' (1024×1024 texels)"), "{err}");
     load(&scene, Some(60 << 20)).unwrap();
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Area emitters that name the same radiance texture share one copy of its image, and the
@@ -272,5 +266,4 @@ fn emitters_sharing_a_radiance_texture_count_it_once() {
     let err = load(&scene(["tex0.png", "tex1.png", "tex2.png"]), Some(limit)).unwrap_err();
     assert!(err.contains("tex2.png"), "{err}");
     assert!(err.contains("emitter radiance texture"), "{err}");
-    std::fs::remove_dir_all(&dir).ok();
 }

@@ -10,6 +10,7 @@ use restir_geometry::Ray;
 use restir_materials::BsdfKind;
 use restir_scene::xml::{XmlWriteOptions, to_mitsuba_xml};
 use restir_scene::{LoadOptions, Scene, TextureDesc, load_desc, load_scene};
+use restir_testkit::TempDir;
 
 /// Two triangles in the `z = 0` plane: the left one `x < 0`, the right one `x > 0`, both facing
 /// `+z`. Vertex colours (8-bit, sRGB-coded) red at the bottom-left corner, green at the top,
@@ -38,10 +39,8 @@ end_header
 3 0 2 1 0.6 0.5 0.4 0.75
 ";
 
-fn dir(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("restir-meshattr-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+fn dir(tag: &str) -> TempDir {
+    let dir = TempDir::new("meshattr", tag);
     std::fs::write(dir.join("m.ply"), PLY).unwrap();
     dir
 }
@@ -115,7 +114,6 @@ fn face_attributes_are_constant_per_triangle() {
     let scene = load(&path);
     assert_eq!(reflectance(&scene, -0.9, 0.5), Vec3::splat(0.125));
     assert_eq!(reflectance(&scene, 0.5, -0.5), Vec3::splat(0.375));
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
@@ -140,7 +138,6 @@ fn vertex_attributes_are_interpolated() {
     assert!(c.z > 0.97 && c.x < 0.02, "{c}");
     let c = reflectance(&scene, -0.99, 0.98);
     assert!(c.min_element() > 0.97, "{c}");
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 #[test]
@@ -194,7 +191,6 @@ fn a_missing_attribute_is_an_error_with_what_the_mesh_has() {
         e.contains("s.xml:3:") && e.contains("3 channels") && e.contains("opacity"),
         "{e}"
     );
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// A RON scene uses the texture as `MeshAttribute(name: …)`; `restir convert` writes it as
@@ -248,7 +244,6 @@ fn ron_and_the_xml_writer() {
     }
     let e = to_mitsuba_xml(&bad, &XmlWriteOptions::default()).unwrap_err();
     assert!(e.to_string().contains("face_$x"), "{e}");
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// Giving a shape a material whose mesh attribute it lacks is refused; giving it to a mesh that
@@ -271,7 +266,6 @@ fn editing_a_shape_material_checks_its_attributes() {
     assert!(e.to_string().contains("shape 1") && e.to_string().contains("face_color"));
     scene.set_shape_material(2, m).unwrap();
     assert_eq!(reflectance(&scene, -5.9, 0.5), Vec3::new(0.1, 0.2, 0.3));
-    let _ = std::fs::remove_dir_all(&d);
 }
 
 /// Attributes count against `--max-memory` with their mesh: the limit that holds the mesh's
@@ -297,5 +291,4 @@ fn attributes_count_against_the_memory_limit() {
         Ok(_) => panic!("loads within {} bytes", need - 1),
         Err(e) => assert!(e.to_string().contains("m.ply"), "{e}"),
     }
-    let _ = std::fs::remove_dir_all(&d);
 }

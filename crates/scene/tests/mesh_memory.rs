@@ -15,7 +15,7 @@ use glam::Vec3;
 use restir_geometry::{Accel, Shape, TriangleMesh};
 use restir_lights::{Light, LightSet};
 use restir_scene::{LoadOptions, load_scene};
-use restir_testkit::{CountingAllocator, measure};
+use restir_testkit::{CountingAllocator, TempDir, measure};
 
 #[global_allocator]
 static GLOBAL: CountingAllocator = CountingAllocator;
@@ -114,8 +114,7 @@ fn bytes_per_triangle_at_each_stage() {
     drop((lights, accel, shapes));
 
     // The whole pipeline from a binary PLY file.
-    let dir = std::env::temp_dir().join(format!("restir-mesh-memory-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("mesh-memory", "ply");
     let (positions, indices) = grid(N);
     write_ply(&dir.join("grid.ply"), &positions, &indices);
     drop((positions, indices));
@@ -154,7 +153,7 @@ fn bytes_per_triangle_at_each_stage() {
         emissive_peak,
     ));
     drop(loaded);
-    std::fs::remove_dir_all(&dir).ok();
+    drop(dir);
 
     println!("{:<34} {:>12} {:>12}", "stage", "kept B/tri", "peak B/tri");
     for (name, kept, peak) in &rows {

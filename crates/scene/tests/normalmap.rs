@@ -2,21 +2,22 @@
 //! nesting rules with `mask` and `twosided`, what the BSDF at a hit holds, the XML writer's
 //! round trip, and errors with `file:line`.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::Vec3;
 use restir_scene::{
     ColorParam, LoadOptions, MaterialDesc, load_scene, parse_ron,
     xml::{XmlWriteOptions, parse_xml, to_mitsuba_xml},
 };
+use restir_testkit::TempDir;
 
 mod common;
 use common::scene_text;
 
-/// A fresh directory with a 2×1 raw PNG normal map: left texel tilted towards +x, right flat.
-fn dir_with_map(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("restir-normalmap-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+/// A fresh directory with a 2×1 raw PNG normal map: left texel tilted towards +x, right flat;
+/// removed when dropped.
+fn dir_with_map(tag: &str) -> TempDir {
+    let dir = TempDir::new("normalmap", tag);
     image::RgbImage::from_raw(2, 1, vec![204, 128, 230, 128, 128, 255])
         .unwrap()
         .save(dir.join("n.png"))
@@ -111,7 +112,6 @@ fn bitmap_map_reaches_the_bsdf() {
     assert!((n - want).length() < 1e-3, "{n} {want}");
     let flat = (Vec3::new(128.0, 128.0, 255.0) / 255.0 * 2.0 - Vec3::ONE).normalize();
     assert!((right.normal_map.unwrap().normal() - flat).length() < 1e-3);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// What the XML writer makes of a normal map reads back the same.

@@ -22,8 +22,7 @@ fn load_within(path: &Path, limit: Duration) -> Result<String, String> {
 
 #[test]
 fn fifos_are_refused_without_blocking() {
-    let dir = std::env::temp_dir().join(format!("restir-fifo-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = restir_testkit::TempDir::new("fifo", "refused");
     let fifo = |name: &str| {
         let p = dir.join(name);
         let ok = std::process::Command::new("mkfifo")
@@ -61,5 +60,4 @@ fn fifos_are_refused_without_blocking() {
         e.contains("cannot read scene: it is not a regular file"),
         "{e}"
     );
-    std::fs::remove_dir_all(&dir).ok();
 }

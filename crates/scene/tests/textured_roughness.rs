@@ -10,6 +10,7 @@ use restir_scene::{
     ColorParam, LoadOptions, MaterialDesc, load_scene,
     xml::{XmlWriteOptions, parse_xml, to_mitsuba_xml},
 };
+use restir_testkit::TempDir;
 
 mod common;
 use common::scene_text;
@@ -22,8 +23,7 @@ const CHECKER_U: &str = r#"<texture name="alpha_u" type="checkerboard">
 /// fractional parts of `u`, `v` exceeds ½) and the constant along `v`.
 #[test]
 fn checkerboard_alpha_u_reaches_the_bsdf() {
-    let dir = std::env::temp_dir().join(format!("restir-alpha-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("alpha", "checkerboard");
     let path = dir.join("s.xml");
     std::fs::write(
         &path,
@@ -55,7 +55,6 @@ fn checkerboard_alpha_u_reaches_the_bsdf() {
         assert_eq!(au, if one_above { 0.05 } else { 0.3 }, "uv {uv}");
         assert_eq!(av, 0.2);
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

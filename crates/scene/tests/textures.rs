@@ -11,11 +11,12 @@ use restir_scene::{
     ColorParam, LoadOptions, MaterialDesc, Scene, TextureDesc, load_scene, parse_ron,
     xml::parse_xml,
 };
+use restir_testkit::TempDir;
 
-/// A fresh directory with a 2×2 raw PNG: row 0 (top) red, green; row 1 blue, white.
-fn dir_with_png(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("restir-textures-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+/// A fresh directory with a 2×2 raw PNG: row 0 (top) red, green; row 1 blue, white; removed
+/// when dropped.
+fn dir_with_png(tag: &str) -> TempDir {
+    let dir = TempDir::new("textures", tag);
     image::RgbImage::from_raw(2, 2, vec![255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255])
         .unwrap()
         .save(dir.join("quad.png"))
@@ -101,7 +102,6 @@ fn xml_nested_and_referenced_textures() {
         },
         m => panic!("{m:?}"),
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -121,7 +121,6 @@ fn untextured_scenes_take_the_constant_path() {
         diffuse_reflectance(seen_at(&scene, 0.3, 0.2)),
         Vec3::splat(0.25)
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -143,7 +142,6 @@ fn obj_texture_coordinates_count_v_from_the_bottom() {
     // Mitsuba 3 reads this OBJ's (vt 0 0) corner as uv (0, 1): the image's bottom-left texel.
     assert_eq!(diffuse_reflectance(seen_at(&scene, -0.5, -0.5)), Vec3::Z);
     assert_eq!(diffuse_reflectance(seen_at(&scene, -0.5, 0.5)), Vec3::X);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -210,7 +208,6 @@ fn ron_textured_materials() {
         e.contains("material 'floor'") && e.contains("nope.png"),
         "{e}"
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -257,7 +254,6 @@ fn xml_texture_errors_name_file_and_line() {
         };
         assert!(e.contains(want), "got \"{e}\", want \"{want}\"");
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Texture coordinates reach the material on every built-in shape: a sphere's are Mitsuba's
@@ -330,7 +326,6 @@ fn textured_mask_opacity() {
         }
         m => panic!("{m:?}"),
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Area emitters that name the same radiance texture share one loaded copy: the lights name
@@ -375,5 +370,4 @@ fn area_emitters_share_their_radiance_texture() {
         lights,
         [(mean, Some(0)), (mean, Some(0)), (2.0 * mean, Some(1))]
     );
-    std::fs::remove_dir_all(&dir).ok();
 }

@@ -9,13 +9,11 @@ use std::path::{Path, PathBuf};
 use restir_families::{Family, Params, Split, members};
 use restir_scene::xml::{XmlWriteOptions, to_mitsuba_xml};
 use restir_scene::{ColorParam, MaterialDesc, MaterialRef, Scene, SceneDesc, defaults, load_desc};
+use restir_testkit::TempDir;
 
-/// A fresh directory per test (tests run in parallel and each removes its own).
-fn temp_dir(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("restir-xmlwrite-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh directory per test (tests run in parallel), removed when the test ends.
+fn temp_dir(test: &str) -> TempDir {
+    TempDir::new("xmlwrite", test)
 }
 
 /// The built scene and its integrator settings as text, without where the integrator was
@@ -188,7 +186,6 @@ fn the_static_families_round_trip() {
             assert!(text.starts_with("<?xml"), "{text}");
         }
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -215,7 +212,6 @@ fn the_shipped_scenes_round_trip() {
         let prefix = source.parent().unwrap().to_str().unwrap().to_string();
         round_trip(&desc, &source, &xml, Some(&prefix));
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// Every material model, texture, filter, camera and light kind the description has.
@@ -329,7 +325,6 @@ fn every_model_filter_camera_and_light_round_trips() {
     assert!(text.contains(r#"<rotate x="0" y="1" z="1""#), "{text}");
     // A shape with a file only takes face_normals (Mitsuba rejects it elsewhere).
     assert_eq!(text.matches("face_normals").count(), 1, "{text}");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// Clip planes other than Mitsuba's defaults are written and read back; the defaults are left
@@ -348,7 +343,6 @@ fn clip_planes_round_trip() {
             assert_eq!(text.contains("far_clip"), !clips.is_empty(), "{text}");
         }
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -512,5 +506,4 @@ fn cylinders_and_sdfgrids_round_trip() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("sdfgrid cannot be an area emitter"), "{e}");
-    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -10,8 +10,7 @@ fn repo() -> PathBuf {
 
 #[test]
 fn renders_the_cornell_box_through_the_library() {
-    let dir = std::env::temp_dir().join(format!("library-render-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = restir_testkit::TempDir::new("library-render", "cbox");
     let output = dir.join("cbox.exr");
     let run = Command::new(env!("CARGO_BIN_EXE_library-render"))
         .arg(repo().join("scenes/cornell-box.xml"))
@@ -40,7 +39,6 @@ fn renders_the_cornell_box_through_the_library() {
         .collect();
     assert!(mean.iter().all(|&m| m > 0.01 && m.is_finite()), "{mean:?}");
     assert!(std::fs::metadata(&output).unwrap().len() > 0);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

@@ -127,7 +127,7 @@ mod tests {
 
     #[test]
     fn prefixes_lead_from_the_output_to_the_scene() {
-        let tmp = std::env::temp_dir().join(format!("restir-convert-{}", std::process::id()));
+        let tmp = restir_testkit::TempDir::new("convert", "prefixes");
         let (a, b, c) = (tmp.join("a"), tmp.join("a/b"), tmp.join("c/d"));
         let root = std::path::Path::new("/");
         for d in [&a, &b, &c] {
@@ -140,6 +140,5 @@ mod tests {
         if cfg!(unix) {
             assert_eq!(file_prefix(&a, root), Some(a.canonicalize().unwrap()));
         }
-        std::fs::remove_dir_all(&tmp).unwrap();
     }
 }

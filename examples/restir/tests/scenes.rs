@@ -8,6 +8,8 @@
 use std::path::{Component, Path, PathBuf};
 use std::process::Command;
 
+use restir_testkit::TempDir;
+
 const RESTIR: &str = env!("CARGO_BIN_EXE_restir");
 
 fn scenes_dir() -> PathBuf {
@@ -84,8 +86,7 @@ fn stays_inside(scene_dir: &Path, rel: &str) -> bool {
 fn every_shipped_scene_loads_from_the_repository_alone() {
     let root = scenes_dir();
     // Nothing beside the copy: a path leaving it finds no file.
-    let sandbox = std::env::temp_dir().join(format!("restir-scenes-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&sandbox);
+    let sandbox = TempDir::new("scenes", "sandbox");
     let copy = sandbox.join("repo/scenes");
     copy_tree(&root, &copy);
 
@@ -159,7 +160,7 @@ fn every_shipped_scene_loads_from_the_repository_alone() {
         }
         scenes += 1;
     }
-    let _ = std::fs::remove_dir_all(&sandbox);
+    drop(sandbox);
     assert!(scenes >= 8, "only {scenes} scenes found");
     assert!(suites >= 2, "only {suites} suites found");
     assert!(animated >= 2, "only {animated} animated scenes found");
@@ -184,8 +185,7 @@ fn paths_leaving_the_scenes_directory_are_caught() {
 /// platform's sin/cos), so the asset can be remade.
 #[test]
 fn the_committed_sky_is_the_generated_one() {
-    let dir = std::env::temp_dir().join(format!("restir-sky-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("scenes", "sky");
     let out = dir.join("sky.exr");
     let o = Command::new(RESTIR)
         .args(["generate", "envmap", "-o", out.to_str().unwrap()])
@@ -201,14 +201,12 @@ fn the_committed_sky_is_the_generated_one() {
     for (a, b) in made.pixels.iter().zip(&committed.pixels) {
         assert!((*a - *b).abs().max_element() <= 1e-5 * b.max_element().max(1.0));
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `scenes/textured/tex.png` is what `restir generate uv-pattern` writes (8-bit, so exact).
 #[test]
 fn the_committed_uv_pattern_is_the_generated_one() {
-    let dir = std::env::temp_dir().join(format!("restir-uv-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = TempDir::new("scenes", "uv");
     let out = dir.join("tex.png");
     let o = Command::new(RESTIR)
         .args(["generate", "uv-pattern", "-o", out.to_str().unwrap()])
@@ -219,5 +217,4 @@ fn the_committed_uv_pattern_is_the_generated_one() {
     let made = restir_image::Image::read(&out, raw).unwrap();
     let committed = restir_image::Image::read(&scenes_dir().join("textured/tex.png"), raw).unwrap();
     assert_eq!(made, committed);
-    let _ = std::fs::remove_dir_all(&dir);
 }

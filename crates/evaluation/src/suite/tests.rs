@@ -31,7 +31,8 @@ fn families_expand_into_scenes() {
         budgets: [0.5],
     )"#;
     let mut s = Suite::parse(text, Path::new("f.ron")).unwrap();
-    let dir = std::env::temp_dir().join(format!("restir-families-{}", std::process::id()));
+    let tmp = restir_testkit::TempDir::new("suite", "families");
+    let dir = tmp.join("families");
     s.expand_families(&dir).unwrap();
     assert!(s.families.is_empty());
     assert_eq!(s.scenes.len(), 1);
@@ -49,7 +50,7 @@ fn families_expand_into_scenes() {
         .modified()
         .unwrap();
     assert_eq!(written, kept);
-    std::fs::remove_dir_all(&dir).unwrap();
+    drop(tmp);
 
     for (bad, says) in [
         (r#"kind: "dj""#, "family kind 'dj': expected di or pt"),

@@ -49,14 +49,14 @@ fn a_hall_has_its_triangles_in_tens_of_garlands_and_builds() {
         assert!(!a.desc.integrator.hide_emitters);
         assert_eq!(a.desc.integrator.max_depth, 2);
         // The RON text reads back and builds (OBJ meshes and sky written beside it).
-        let dir = std::env::temp_dir().join(format!("restir-hall-{}-{seed}", std::process::id()));
+        let tmp = restir_testkit::TempDir::new("hall", &seed.to_string());
+        let dir = tmp.join("hall");
         let path = a.write(&dir, "hall").unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         let desc = restir_scene::parse_ron(&text, &path).unwrap();
         assert_eq!(desc, a.desc);
         let scene = restir_scene::Scene::build(&desc, &dir, &path).unwrap();
         assert_eq!(scene.features.light_count, meshes + 1);
-        std::fs::remove_dir_all(&dir).unwrap();
     }
     let other = generate(&Params::Di(Kind::Hall, options(4_000, true, true)), 12).unwrap();
     let first = generate(&Params::Di(Kind::Hall, options(4_000, true, true)), 11).unwrap();

@@ -358,7 +358,8 @@ mod tests {
 
     #[test]
     fn every_moving_member_generates_parses_builds_and_moves_the_shapes_it_names() {
-        let dir = std::env::temp_dir().join(format!("restir-motion-{}", std::process::id()));
+        let tmp = restir_testkit::TempDir::new("motion", "members");
+        let dir = tmp.join("motion");
         for family in [Family::DiMotion, Family::PtMotion] {
             for split in [Split::Train, Split::Test] {
                 for member in members(family, split) {
@@ -429,7 +430,6 @@ mod tests {
                 }
             }
         }
-        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

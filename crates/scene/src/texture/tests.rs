@@ -54,10 +54,8 @@ fn checkerboard_pattern_and_scale() {
     assert_eq!(t.mean(), Vec3::splat(0.5));
 }
 
-fn temp_dir(tag: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("restir-tex-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn temp_dir(tag: &str) -> restir_testkit::TempDir {
+    restir_testkit::TempDir::new("tex", tag)
 }
 
 /// Checkerboard values agree with Mitsuba 3's at points read off its `checkerboard` (also for
@@ -135,7 +133,6 @@ fn bitmap_orientation_scale_offset_and_wrap() {
     let offset = load(Vec2::ONE, Vec2::new(0.5, 0.5));
     assert_eq!(offset.eval(Vec2::new(0.25, 0.25)), Vec3::ONE);
     assert_eq!(offset.eval(Vec2::new(0.75, 0.75)), red);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `wrap_mode` mirror and clamp, and `filter_type` nearest, on the same 2×2 image.
@@ -174,7 +171,6 @@ fn bitmap_mirror_clamp_and_nearest() {
     assert_eq!(n.eval(Vec2::new(1.51, -0.49)), Vec3::ONE);
     let r = load(WrapMode::Repeat, FilterType::Bilinear);
     assert_ne!(r.eval(Vec2::new(1.0, 0.25)), green);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// 8-bit values go through the exact sRGB curve (both branches), unless `raw`.
@@ -208,7 +204,6 @@ fn srgb_decoding_of_8_bit_values() {
         );
     }
     assert!((srgb_to_linear(0.5) - 0.214_041).abs() < 1e-5);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -243,8 +238,7 @@ fn bad_texture_parameters_are_errors() {
 
 #[test]
 fn png_is_srgb_decoded_and_bilinear() {
-    let dir = std::env::temp_dir().join(format!("restir-tex-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("png");
     // 2×1 image: black | sRGB 188 (≈ linear 0.5).
     let img = image::RgbImage::from_raw(2, 1, vec![0, 0, 0, 188, 188, 188]).unwrap();
     img.save(dir.join("t.png")).unwrap();
@@ -296,5 +290,4 @@ fn png_is_srgb_decoded_and_bilinear() {
         filter: FilterType::default(),
     };
     assert!(Texture::load(&bad, &dir).is_err());
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -191,8 +191,8 @@ mod tests {
     /// caller) rather than used.
     #[test]
     fn store_and_load_through_a_directory() {
-        let dir = std::env::temp_dir().join(format!("restir-plastic-cache-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
+        let tmp = restir_testkit::TempDir::new("plastic-cache", "store");
+        let dir = tmp.join("cache");
         let previous = cache_dir();
         set_cache_dir(Some(dir.clone()));
         let (d, a, e) = (Distribution::Ggx, 0.123f32, 1.777f32);
@@ -207,7 +207,6 @@ mod tests {
         drop(big);
         assert!(load(d, a, e).is_none());
         set_cache_dir(previous);
-        let _ = std::fs::remove_dir_all(&dir);
     }
 
     /// A table with a valid checksum but values no integration gives is refused by the
