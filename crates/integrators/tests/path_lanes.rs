@@ -107,65 +107,81 @@ fn lanes_give_the_scalar_walks_bits_on_diffuse_meshes() {
     check("cornell-box.xml", |s| s.rr_depth = 1);
 }
 
-/// Rough conductors on meshes, in lanes: the Cornell box with its walls made GGX gold (two
-/// sided), anisotropic Beckmann copper (one sided) and near-mirror GGX aluminium (two sided), the
-/// back wall turned away from the camera (its back seen, mirrored to the front), both samplers.
+/// Rough conductors and rough plastics on meshes, in lanes: the Cornell box with its white
+/// surfaces made GGX gold, GGX plastic or nonlinear Beckmann plastic (two sided), its red wall
+/// anisotropic Beckmann copper (one sided) and its green wall near-mirror GGX aluminium (two
+/// sided), the back wall turned away from the camera (its back seen, mirrored to the front),
+/// both samplers.
 #[test]
-fn lanes_give_the_scalar_walks_bits_on_rough_conductors() {
+fn lanes_give_the_scalar_walks_bits_on_rough_conductors_and_plastics() {
     let conductor = |material: &str, distribution: &str, alphas: &str| {
-        format!(
-            r#"<bsdf type="roughconductor"><string name="material" value="{material}"/><string name="distribution" value="{distribution}"/>{alphas}</bsdf>"#
-        )
+        format!(r#"<bsdf type="roughconductor"><string name="material" value="{material}"/>"#)
+            + &format!(r#"<string name="distribution" value="{distribution}"/>{alphas}</bsdf>"#)
     };
-    let mut xml = std::fs::read_to_string(
+    let plastic = |distribution: &str, alpha: f32, nonlinear: bool| {
+        format!(r#"<bsdf type="roughplastic"><string name="distribution" value="{distribution}"/>"#)
+            + &format!(
+                r#"<float name="alpha" value="{alpha}"/><boolean name="nonlinear" value="{nonlinear}"/>"#
+            )
+            + r#"<rgb name="diffuse_reflectance" value="0.6, 0.5, 0.3"/></bsdf>"#
+    };
+    let original = std::fs::read_to_string(
         std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.xml"),
     )
     .unwrap();
-    for (id, old, new) in [
-        (
-            "white",
-            r#"<rgb name="reflectance" value="0.725, 0.71, 0.68"/>"#,
-            format!(
-                r#"<bsdf type="twosided" id="white">{}</bsdf>"#,
-                conductor("Au", "ggx", r#"<float name="alpha" value="0.3"/>"#)
+    let dir = restir_testkit::TempDir::new("path-lanes", "glossy");
+    for (n, white) in [
+        conductor("Au", "ggx", r#"<float name="alpha" value="0.3"/>"#),
+        plastic("ggx", 0.1, false),
+        plastic("beckmann", 0.2, true),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut xml = original.clone();
+        for (id, old, new) in [
+            (
+                "white",
+                r#"<rgb name="reflectance" value="0.725, 0.71, 0.68"/>"#,
+                format!(r#"<bsdf type="twosided" id="white">{white}</bsdf>"#),
             ),
-        ),
-        (
-            "red",
-            r#"<rgb name="reflectance" value="0.63, 0.065, 0.05"/>"#,
-            conductor(
-                "Cu",
-                "beckmann",
-                r#"<float name="alpha_u" value="0.05"/><float name="alpha_v" value="0.4"/>"#,
-            )
-            .replacen("<bsdf ", r#"<bsdf id="red" "#, 1),
-        ),
-        (
-            "green",
-            r#"<rgb name="reflectance" value="0.14, 0.45, 0.091"/>"#,
-            format!(
-                r#"<bsdf type="twosided" id="green">{}</bsdf>"#,
-                conductor("Al", "ggx", r#"<float name="alpha" value="0.01"/>"#)
+            (
+                "red",
+                r#"<rgb name="reflectance" value="0.63, 0.065, 0.05"/>"#,
+                conductor(
+                    "Cu",
+                    "beckmann",
+                    r#"<float name="alpha_u" value="0.05"/><float name="alpha_v" value="0.4"/>"#,
+                )
+                .replacen("<bsdf ", r#"<bsdf id="red" "#, 1),
             ),
-        ),
-    ] {
-        let diffuse = format!("<bsdf type=\"diffuse\" id=\"{id}\">\n        {old}\n    </bsdf>");
-        assert!(xml.contains(&diffuse), "{id}");
-        xml = xml.replace(&diffuse, &new);
-    }
-    let back = r#"<translate x="0" y="1" z="-1"/>
+            (
+                "green",
+                r#"<rgb name="reflectance" value="0.14, 0.45, 0.091"/>"#,
+                format!(
+                    r#"<bsdf type="twosided" id="green">{}</bsdf>"#,
+                    conductor("Al", "ggx", r#"<float name="alpha" value="0.01"/>"#)
+                ),
+            ),
+        ] {
+            let diffuse =
+                format!("<bsdf type=\"diffuse\" id=\"{id}\">\n        {old}\n    </bsdf>");
+            assert!(xml.contains(&diffuse), "{id}");
+            xml = xml.replace(&diffuse, &new);
+        }
+        let back = r#"<translate x="0" y="1" z="-1"/>
         </transform>"#;
-    assert!(xml.contains(back));
-    xml = xml.replace(
-        back,
-        &format!(r#"{back}<boolean name="flip_normals" value="true"/>"#),
-    );
-    let dir = restir_testkit::TempDir::new("path-lanes", "conductors");
-    let path = dir.join("conductors.xml");
-    std::fs::write(&path, xml).unwrap();
-    for sampler in [SamplerKind::Independent, SamplerKind::Sobol] {
-        let lit = check_file(&path, |s| s.sampler = sampler);
-        assert!(lit > 37 * 21 / 2, "{sampler:?}: {lit} lit");
+        assert!(xml.contains(back));
+        xml = xml.replace(
+            back,
+            &format!(r#"{back}<boolean name="flip_normals" value="true"/>"#),
+        );
+        let path = dir.join(format!("glossy-{n}.xml"));
+        std::fs::write(&path, xml).unwrap();
+        for sampler in [SamplerKind::Independent, SamplerKind::Sobol] {
+            let lit = check_file(&path, |s| s.sampler = sampler);
+            assert!(lit > 37 * 21 / 2, "{n}, {sampler:?}: {lit} lit");
+        }
     }
 }
 

@@ -4,15 +4,16 @@
 //! the bit.
 //!
 //! The lanes carry paths across diffuse surfaces of meshes (Mitsuba's `diffuse` without a mask,
-//! normal map or bump map, textured or not), rough conductors of meshes (`roughconductor`,
-//! untextured) and absorbers. In lanes ([`F8`]): the hit's point and shading frame, light
-//! samples on triangles and spheres of uniform radiance, the diffuse model's and the rough
-//! conductor's values, densities and sampling ([`RoughConductorLanes`]), the power heuristic,
-//! the shadow rays and continuations off the surface, the throughput and Russian roulette. Lane
-//! by lane: traversal, each hit's material and emission, other lights' samples, the Beckmann
-//! distribution's transcendental functions, the random numbers. At any other surface (another
-//! material, a mask, normal or bump map, an analytic shape) a lane makes the scalar walk's
-//! bounce ([`super::scatter`]) and its path goes on in the lanes from there.
+//! normal map or bump map, textured or not), rough conductors and rough plastics of meshes
+//! (`roughconductor`, `roughplastic`, untextured) and absorbers. In lanes ([`F8`]): the hit's
+//! point and shading frame, light samples on triangles and spheres of uniform radiance, the
+//! diffuse and microfacet models' values, densities and sampling ([`GlossyLanes`]), the power
+//! heuristic, the shadow rays and continuations off the surface, the throughput and Russian
+//! roulette. Lane by lane: traversal, each hit's material and emission, other lights' samples,
+//! the Beckmann distribution's transcendental functions and the plastic's coating tables, the
+//! random numbers. At any other surface (another material, a mask, normal or bump map, an
+//! analytic shape) a lane makes the scalar walk's bounce ([`super::scatter`]) and its path goes
+//! on in the lanes from there.
 
 use glam::Vec3;
 use restir_geometry::lanes::{
@@ -20,8 +21,8 @@ use restir_geometry::lanes::{
 };
 use restir_geometry::{Ray, Shape, SurfaceInteraction};
 use restir_lights::NeeSelection;
-use restir_materials::lanes::RoughConductorLanes;
-use restir_materials::{Bsdf, BsdfKind, Microfacet};
+use restir_materials::lanes::GlossyLanes;
+use restir_materials::{Bsdf, BsdfKind, Microfacet, RoughPlastic};
 use restir_sampling::Sampler;
 use restir_sampling::lanes::{self, F8, LANES, M8, V3};
 use restir_scene::{Scene, TexturePoint};
@@ -46,6 +47,12 @@ enum Surface {
         k: Vec3,
         specular: Vec3,
         microfacet: Microfacet,
+        two_sided: bool,
+    },
+    /// A plain rough plastic (Mitsuba's `roughplastic`), mirrored to the front when
+    /// `two_sided`.
+    RoughPlastic {
+        plastic: RoughPlastic,
         two_sided: bool,
     },
     /// An absorber (an emitter without a material): the path ends after its emission.
@@ -74,6 +81,10 @@ impl Surface {
                     k,
                     specular: specular_reflectance,
                     microfacet,
+                    two_sided: b.two_sided,
+                },
+                BsdfKind::RoughPlastic(plastic) => Surface::RoughPlastic {
+                    plastic,
                     two_sided: b.two_sided,
                 },
                 BsdfKind::Black => Surface::Black,
@@ -170,8 +181,8 @@ fn trace_camera_paths<S: Sampler>(
         let mut gather = MeshHits::default();
         let mut computed = [None::<SurfaceInteraction>; LANES];
         let mut albedo = V3::ZERO;
-        let mut conductor = RoughConductorLanes::default();
-        let mut conducts = M8::default();
+        let mut glossy = GlossyLanes::default();
+        let mut glossy_here = M8::default();
         let mut two_sided = M8::default();
         // Lanes whose surface this bounce is not for the lanes: the walk's own bounce there.
         let mut one_lane = M8::default();
@@ -224,7 +235,9 @@ fn trace_camera_paths<S: Sampler>(
             if let (
                 Ok(h),
                 None,
-                Surface::Diffuse { .. } | Surface::RoughConductor { .. },
+                Surface::Diffuse { .. }
+                | Surface::RoughConductor { .. }
+                | Surface::RoughPlastic { .. },
                 Shape::Mesh(m),
             ) = (&hit, light, surface, &scene.shapes[shape as usize])
             {
@@ -264,8 +277,16 @@ fn trace_camera_paths<S: Sampler>(
                     microfacet,
                     two_sided: t,
                 } => {
-                    conductor.set(i, eta, k, specular, &microfacet);
-                    conducts.set(i, true);
+                    glossy.set_rough_conductor(i, eta, k, specular, &microfacet);
+                    glossy_here.set(i, true);
+                    two_sided.set(i, t);
+                }
+                Surface::RoughPlastic {
+                    plastic,
+                    two_sided: t,
+                } => {
+                    glossy.set_rough_plastic(i, &plastic);
+                    glossy_here.set(i, true);
                     two_sided.set(i, t);
                 }
                 _ => {}
@@ -337,15 +358,15 @@ fn trace_camera_paths<S: Sampler>(
         let reach = front & lz.gt(zero);
         let mut f = reach.select3(albedo.scale(F8::splat(FRAC_1_PI) * lz), V3::ZERO);
         let mut b_pdf = reach.select(lz * FRAC_1_PI, zero);
-        if conducts.any() {
+        if glossy_here.any() {
             let l = V3 {
                 x: wi.x,
                 y: wi.y,
                 z: lz,
             };
-            let (f_l, pdf_l) = conductor.eval_pdf(v, l);
-            f = conducts.select3(f_l, f);
-            b_pdf = conducts.select(pdf_l, b_pdf);
+            let (f_l, pdf_l) = glossy.eval_pdf(v, l);
+            f = glossy_here.select3(f_l, f);
+            b_pdf = glossy_here.select(pdf_l, b_pdf);
         }
         let w = ls
             .delta
@@ -377,17 +398,17 @@ fn trace_camera_paths<S: Sampler>(
             }
         }
 
-        // The continuation: cosine-weighted, or about a visible normal of a rough conductor.
+        // The continuation: cosine-weighted, or the microfacet models' sample.
         let mut sampled = lanes::sample_cosine_hemisphere(lane(4), lane(5));
         let mut pdf = sampled.z.gt(zero).select(sampled.z * FRAC_1_PI, zero);
         let mut f_c = albedo.scale(F8::splat(FRAC_1_PI) * sampled.z);
         let mut ok = front & pdf.gt(zero) & pdf.is_finite() & f_c.is_finite() & sampled.is_finite();
-        if conducts.any() {
-            let (l, f, p, some) = conductor.sample(v, lane(4), lane(5));
-            sampled = conducts.select3(l, sampled);
-            f_c = conducts.select3(f, f_c);
-            pdf = conducts.select(p, pdf);
-            ok = (conducts & some) | (!conducts & ok);
+        if glossy_here.any() {
+            let (l, f, p, some) = glossy.sample(v, lane(3), lane(4), lane(5));
+            sampled = glossy_here.select3(l, sampled);
+            f_c = glossy_here.select3(f, f_c);
+            pdf = glossy_here.select(p, pdf);
+            ok = (glossy_here & some) | (!glossy_here & ok);
         }
         let mut go_on = here & ok;
         beta = here.select3(beta * (f_c / pdf), beta);
@@ -454,8 +475,8 @@ pub(crate) fn describe(scene: &Scene, nee: NeeSelection) -> String {
         .count();
     format!(
         "{LANES} paths at a time ({}); {carried} of {} shapes (meshes of diffuse materials, \
-         textured or not, of rough conductors and absorbers) bounce in lanes, the others one lane \
-         at a time; {}",
+         textured or not, of rough conductors, rough plastics and absorbers) bounce in lanes, \
+         the others one lane at a time; {}",
         if avx2() { "AVX2 and FMA" } else { "SSE2" },
         scene.shapes.len(),
         match nee {
