@@ -1,12 +1,12 @@
 //! The microfacet models in SIMD lanes ([`GlossyLanes`]): Mitsuba's `roughconductor` and
-//! `roughplastic` of [`crate::models`], each lane its own material, direction and numbers, for an
-//! integrator that
-//! carries eight paths at once. Every function gives, lane by lane, the bits of the model's own
-//! [`crate::Bsdf::eval`], [`crate::Bsdf::pdf_sa`] and [`crate::Bsdf::sample`] on oriented
-//! directions (the lanes' caller mirrors a two-sided surface seen from behind, as
-//! [`crate::Bsdf`] does): the same operations in the same order ([`restir_sampling::lanes`]),
-//! the Beckmann distribution's exponentials, error functions and slope sampling and the
-//! plastic's coating tables computed one lane at a time by the scalar functions themselves.
+//! `roughplastic` as [`crate::Bsdf`] holds them, each lane its own material, direction and
+//! numbers, for an integrator that carries eight paths at once. Every function gives, lane by
+//! lane, the bits of the model's own [`crate::Bsdf::eval`], [`crate::Bsdf::pdf_sa`] and
+//! [`crate::Bsdf::sample`] on oriented directions (the lanes' caller mirrors a two-sided surface
+//! seen from behind, as [`crate::Bsdf`] does): the same operations in the same order
+//! ([`restir_sampling::lanes`]), the Beckmann distribution's exponentials, error functions and
+//! slope sampling and the plastic's coating tables computed one lane at a time by the scalar
+//! functions themselves.
 
 use core::f32::consts::{FRAC_1_PI, PI};
 use glam::Vec3;
