@@ -188,8 +188,7 @@ pub fn octahedral_decode(ex: F8, ey: F8) -> V3 {
     let t = (-z).max(zero);
     let x = x + x.ge(zero).select(-t, t);
     let y = y + y.ge(zero).select(-t, t);
-    let v = V3 { x, y, z };
-    v.scale(one / v.dot(v).sqrt())
+    V3 { x, y, z }.normalize()
 }
 
 /// Points on spheres (centres `center`, radii `radius`) drawn uniformly in the cones of

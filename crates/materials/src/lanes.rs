@@ -114,7 +114,7 @@ impl GlossyLanes {
     #[inline(always)]
     pub fn eval_pdf(&self, v: V3, l: V3) -> (V3, F8) {
         let zero = F8::splat(0.0);
-        let h = normalize(v + l);
+        let h = (v + l).normalize();
         let (vh, lh) = (v.dot(h), l.dot(h));
         let d = self.d(h);
         let above = !v.z.le(zero) & !l.z.le(zero);
@@ -171,16 +171,17 @@ impl GlossyLanes {
         }
         // Where the scalar model samples a visible normal (`Microfacet::stretched_view`).
         let seen = up & v.is_finite();
-        let vs = normalize(V3 {
+        let vs = V3 {
             x: au * v.x,
             y: av * v.y,
             z: v.z,
-        });
+        }
+        .normalize();
         let sin2 = vs.x * vs.x + vs.y * vs.y;
         let inv = one / sin2.sqrt();
         let tilted = sin2.gt(zero);
-        let sin_phi = tilted.select(clamp_unit(vs.y * inv), zero);
-        let cos_phi = tilted.select(clamp_unit(vs.x * inv), one);
+        let sin_phi = tilted.select((vs.y * inv).clamp(-1.0, 1.0), zero);
+        let cos_phi = tilted.select((vs.x * inv).clamp(-1.0, 1.0), one);
         let cos_theta = vs.z;
         // Unit-roughness slopes: GGX's from the concentric disk, Beckmann's one lane at a time.
         let (px, py) = lanes::sample_concentric_disk(ux, uy);
@@ -202,11 +203,12 @@ impl GlossyLanes {
             }
         }
         // `StretchedView::normal`, and the reflection about it.
-        let m = normalize(V3 {
+        let m = V3 {
             x: -((cos_phi * sx - sin_phi * sy) * au),
             y: -((sin_phi * sx + cos_phi * sy) * av),
             z: one,
-        });
+        }
+        .normalize();
         let reflected = m.scale(F8::splat(2.0) * v.dot(m)) - v;
         // The plastic's diffuse lobe: the concentric disk lifted to the hemisphere.
         let lifted = V3 {
@@ -229,7 +231,7 @@ impl GlossyLanes {
         let (qx, qy) = (m.x / au, m.y / av);
         let norm = F8::splat(PI) * au * av;
         let t = qx * qx + qy * qy + cos2;
-        let ggx = one_over(norm * t * t);
+        let ggx = F8::splat(1.0) / (norm * t * t);
         let r = if self.beckmann.any() {
             let e = (qx * qx + qy * qy) / cos2;
             let mut exp = F8::splat(0.0);
@@ -282,24 +284,6 @@ impl GlossyLanes {
     }
 }
 
-/// `v / |v|` in every lane, as glam's `normalize` (times the reciprocal of the length).
-#[inline(always)]
-fn normalize(v: V3) -> V3 {
-    v.scale(one_over(v.dot(v).sqrt()))
-}
-
-/// `1 / x` in every lane.
-#[inline(always)]
-fn one_over(x: F8) -> F8 {
-    F8::splat(1.0) / x
-}
-
-/// `x.clamp(−1, 1)` in every lane (NaN stays NaN).
-#[inline(always)]
-fn clamp_unit(x: F8) -> F8 {
-    F8::from_fn(|i| x.0[i].clamp(-1.0, 1.0))
-}
-
 /// [`crate::fresnel::fresnel_dielectric`]'s reflectance in every lane, for `cos θi`
 /// `cos_theta_i` and relative IOR `eta`.
 #[inline(always)]
@@ -320,7 +304,7 @@ fn fresnel_dielectric(cos_theta_i: F8, eta: F8) -> F8 {
 #[inline(always)]
 fn fresnel_conductor(cos_theta_i: F8, eta: V3, k: V3) -> V3 {
     let (zero, one) = (F8::splat(0.0), F8::splat(1.0));
-    let c = F8::from_fn(|i| cos_theta_i.0[i].clamp(0.0, 1.0));
+    let c = cos_theta_i.clamp(0.0, 1.0);
     let c2 = c * c;
     let s2 = one - c2;
     let s4 = s2 * s2;
@@ -331,8 +315,7 @@ fn fresnel_conductor(cos_theta_i: F8, eta: V3, k: V3) -> V3 {
         let rs = (b + c2 - a * 2.0 * c) / (b + c2 + a * 2.0 * c);
         let rp = rs * (b * c2 + s4 - a * 2.0 * c * s2) / (b * c2 + s4 + a * 2.0 * c * s2);
         let f = (rs + rp) * 0.5;
-        let clamped = F8::from_fn(|i| f.0[i].clamp(0.0, 1.0));
-        f.is_finite().select(clamped, one)
+        f.is_finite().select(f.clamp(0.0, 1.0), one)
     };
     V3 {
         x: channel(eta.x, k.x),

@@ -123,6 +123,12 @@ impl F8 {
         lanes1(self, f32::abs)
     }
 
+    /// `f32::clamp` of every lane to `[lo, hi]` (NaN stays NaN).
+    #[inline(always)]
+    pub fn clamp(self, lo: f32, hi: f32) -> Self {
+        lanes1(self, |x| x.clamp(lo, hi))
+    }
+
     /// The larger of the two in every lane; `o`'s lane where either is NaN (`x > o ? x : o`).
     #[inline(always)]
     pub fn max(self, o: F8) -> Self {
@@ -220,12 +226,6 @@ impl M8 {
     #[inline(always)]
     pub fn any(self) -> bool {
         self.0.iter().fold(0, |a, &b| a | b) != 0
-    }
-
-    /// Whether every lane holds.
-    #[inline(always)]
-    pub fn all(self) -> bool {
-        self.0.iter().fold(-1, |a, &b| a & b) != 0
     }
 }
 
@@ -332,6 +332,13 @@ impl V3 {
     #[inline(always)]
     pub fn dot(self, o: V3) -> F8 {
         self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    /// The unit vector in every lane, as glam's `normalize` (times the reciprocal of the
+    /// length).
+    #[inline(always)]
+    pub fn normalize(self) -> V3 {
+        self.scale(F8::splat(1.0) / self.dot(self).sqrt())
     }
 
     /// The cross product in every lane (glam's order of operations).

@@ -190,22 +190,6 @@ impl Scene {
         Some(self.bsdfs[bsdf])
     }
 
-    /// The BSDF at the point `at` names on a shape, without the hit: [`Scene::bsdf`] of a hit
-    /// there, or `None` when the shape's material has a bump map (whose normal needs the
-    /// hit's derivatives).
-    #[inline]
-    pub fn bsdf_at_point(&self, at: &TexturePoint) -> Option<Bsdf> {
-        let bsdf = self.shape_bsdf[at.shape as usize];
-        if self.features.has_textures
-            && self.bsdf_textures[bsdf as usize]
-                .as_ref()
-                .is_some_and(|t| t.bump.is_some())
-        {
-            return None;
-        }
-        Some(self.bsdf_at(bsdf, at))
-    }
-
     /// The diffuse reflectance of material `bsdf` at the point `at` names, its textures looked
     /// up ([`TexturedParams::diffuse_at`]): for a diffuse model whose other textures change
     /// nothing it holds (no mask, normal or bump map), [`Scene::bsdf_at`]'s `reflectance` there,

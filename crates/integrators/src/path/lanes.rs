@@ -223,9 +223,10 @@ fn trace_camera_paths<S: Sampler>(
                         prim: h.prim,
                         bary,
                     };
+                    // (Always a value: the class is given only where textures are looked up.)
                     match scene.textured_diffuse_at(bsdf, &at) {
                         Some(albedo) => Surface::Diffuse { albedo, two_sided },
-                        None => Surface::of(scene.bsdf_at_point(&at)),
+                        None => Surface::Other,
                     }
                 }
                 (Class::TexturedDiffuse { .. }, Err(si), _) => Surface::of(Some(scene.bsdf(si))),
