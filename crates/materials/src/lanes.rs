@@ -303,25 +303,29 @@ fn fresnel_dielectric(cos_theta_i: F8, eta: F8) -> F8 {
 /// [`crate::fresnel::fresnel_conductor`] in every lane, for `cos θi` `cos_theta_i`.
 #[inline(always)]
 fn fresnel_conductor(cos_theta_i: F8, eta: V3, k: V3) -> V3 {
-    let (zero, one) = (F8::splat(0.0), F8::splat(1.0));
     let c = cos_theta_i.clamp(0.0, 1.0);
+    V3 {
+        x: fresnel_conductor_channel(c, eta.x, k.x),
+        y: fresnel_conductor_channel(c, eta.y, k.y),
+        z: fresnel_conductor_channel(c, eta.z, k.z),
+    }
+}
+
+/// One channel of [`fresnel_conductor`] for the clamped `cos θi` `c`. (A function, not a
+/// closure: a closure is compiled apart from its caller's target features and called.)
+#[inline(always)]
+fn fresnel_conductor_channel(c: F8, n: F8, k: F8) -> F8 {
+    let (zero, one) = (F8::splat(0.0), F8::splat(1.0));
     let c2 = c * c;
     let s2 = one - c2;
     let s4 = s2 * s2;
-    let channel = |n: F8, k: F8| {
-        let a_ = n * n - k * k - s2;
-        let b = (a_ * a_ + n * 4.0 * n * k * k).sqrt();
-        let a = ((b + a_) * 0.5).max(zero).sqrt();
-        let rs = (b + c2 - a * 2.0 * c) / (b + c2 + a * 2.0 * c);
-        let rp = rs * (b * c2 + s4 - a * 2.0 * c * s2) / (b * c2 + s4 + a * 2.0 * c * s2);
-        let f = (rs + rp) * 0.5;
-        f.is_finite().select(f.clamp(0.0, 1.0), one)
-    };
-    V3 {
-        x: channel(eta.x, k.x),
-        y: channel(eta.y, k.y),
-        z: channel(eta.z, k.z),
-    }
+    let a_ = n * n - k * k - s2;
+    let b = (a_ * a_ + n * 4.0 * n * k * k).sqrt();
+    let a = ((b + a_) * 0.5).max(zero).sqrt();
+    let rs = (b + c2 - a * 2.0 * c) / (b + c2 + a * 2.0 * c);
+    let rp = rs * (b * c2 + s4 - a * 2.0 * c * s2) / (b * c2 + s4 + a * 2.0 * c * s2);
+    let f = (rs + rp) * 0.5;
+    f.is_finite().select(f.clamp(0.0, 1.0), one)
 }
 
 #[cfg(test)]
