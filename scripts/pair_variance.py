@@ -21,8 +21,15 @@ user + system CPU time minus its load time (`--stats`' `load_seconds`); its effi
 cost does not. Prints, per scene and as the median over scenes, each configuration's efficiency
 relative to the first, also in plain squared error (MSE: `(a − b)² / 2` without the denominator,
 which weighs bright pixels as a viewer does), and the share of its squared error in the 1 % of
-pixels where it is largest (how concentrated the noise is; from two renders, so it reads a little
-high for every configuration alike). A configuration is `label=passes=flags`; flags that start
+pixels where it is largest (how concentrated the noise is; from two renders, so it reads high,
+the more so the heavier the tail of a configuration's per-pixel errors).
+
+With four seeds (`--seeds 11,12,13,14`) each configuration renders two independent pairs: the
+variances are their mean, and the hardest pixels' figures are also given held out: the top 1 %
+and the worst 1 % chosen from one pair's 3×3 means and read from the other pair, both ways,
+averaged. Chosen and read from the same pair, the hardest 1 % is partly pixels whose estimate
+is high by chance, which inflates the share and lowers the worst-1 % efficiency of whichever
+configuration chose them; held out, they estimate the share of the expected squared error. A configuration is `label=passes=flags`; flags that start
 with `@PATH` render with the binary at PATH instead of `--bin` (two builds in one run). Renders are kept in `--out` and
 reused when their stats file exists, so an interrupted run resumes.
 
@@ -108,7 +115,8 @@ def render(a, scene, flags, passes, seed, out):
 
 
 def mitsuba_renders(a, scene, name, seeds):
-    """Two renders of `scene` by Mitsuba 3 (module documentation): images and CPU seconds."""
+    """One render of `scene` by Mitsuba 3 per seed (module documentation): images and CPU
+    seconds."""
     import tempfile
     import drjit as dr
     import mitsuba as mi
@@ -121,7 +129,9 @@ def mitsuba_renders(a, scene, name, seeds):
     if os.path.exists(stats):
         with open(stats) as f:
             cpu = json.load(f)
-        return [read_rgb(o) for o in outs], cpu
+        if len(cpu) == len(seeds):
+            return [read_rgb(o) for o in outs], cpu
+        cpu = []
     w, h = a.size.split("x")
     a.work = tempfile.mkdtemp(prefix="pair-variance-")
     a.convert, a.max_depth, a.mi_integrator = True, None, a.mitsuba
@@ -162,14 +172,42 @@ def box3(a):
     return sum(p[i:i + h, j:j + w] for i in range(3) for j in range(3)) / 9.0
 
 
-def worst_share_efficiency(sq, t, sq_base, t_base):
+def worst_share_efficiency(sq, t, sq_base, t_base, held=None):
     """Equal-time squared-error efficiency against the first configuration within this
     configuration's own worst 1 % of pixels (by the 3×3 means of the squared error times CPU
-    time): > 1 where even its hardest pixels are better than the first configuration's there."""
-    e, e_base = box3(sq.sum(-1)) * t, box3(sq_base.sum(-1)) * t_base
+    time): > 1 where even its hardest pixels are better than the first configuration's there.
+
+    `sq` and `sq_base` are per-pixel squared errors (summed over channels). With `held`, a
+    second independent pair `(sq2, sq2_base)`, the pixels are chosen from `sq` and the
+    efficiency read from the held-out pair, so the choice does not favour pixels whose
+    estimate is high by chance (see `held_out`)."""
+    e = box3(sq) * t
     k = max(1, e.size // 100)
     worst = np.argsort(e.ravel())[-k:]
+    num, den = (held[1], held[0]) if held else (sq_base, sq)
+    e_base, e = box3(num) * t_base, box3(den) * t
     return float(e_base.ravel()[worst].sum() / max(e.ravel()[worst].sum(), 1e-30))
+
+
+def top_share(sq, held=None):
+    """The share of the squared error in the 1 % of pixels where it is largest; with `held`,
+    the share of the held-out pair's squared error in the 1 % of pixels where `sq`'s 3×3 means
+    are largest."""
+    k = max(1, sq.size // 100)
+    if held is None:
+        per_pixel = np.sort(sq.ravel())[::-1]
+        return float(per_pixel[:k].sum() / max(per_pixel.sum(), 1e-30))
+    top = np.argsort(box3(sq).ravel())[-k:]
+    return float(held.ravel()[top].sum() / max(held.sum(), 1e-30))
+
+
+def held_out(f, first, second):
+    """`f(first, held=second)` and `f(second, held=first)` averaged: a statistic of the hardest
+    pixels chosen from one pair of renders and read from the other. From the pair that chose
+    them, the hardest 1 % is partly the pixels whose one-degree chi-square estimate is high by
+    chance, which inflates the share of the configuration with fewer, heavier-tailed samples
+    per pixel; held out, it is the share of the expected squared error."""
+    return (f(first, second) + f(second, first)) / 2
 
 
 def main():
@@ -177,7 +215,9 @@ def main():
     ap.add_argument("--bin", default="target/release/restir")
     ap.add_argument("--size", default="640x360")
     ap.add_argument("--threads", type=int, default=1)
-    ap.add_argument("--seeds", default="11,12", help="two seeds, comma-separated")
+    ap.add_argument("--seeds", default="11,12",
+                    help="two seeds, or four for held-out figures of the hardest pixels, "
+                         "comma-separated")
     ap.add_argument("--out", required=True, help="directory for the renders")
     ap.add_argument("--config", action="append", required=True, help="label=passes=flags")
     ap.add_argument("--mitsuba", help="also render with this Mitsuba 3 integrator (e.g. direct)")
@@ -188,8 +228,8 @@ def main():
     ap.add_argument("scenes", nargs="+")
     a = ap.parse_args()
     seeds = [int(s) for s in a.seeds.split(",")]
-    if len(seeds) != 2:
-        sys.exit("--seeds takes two seeds")
+    if len(seeds) not in (2, 4) or len(set(seeds)) != len(seeds):
+        sys.exit("--seeds takes two or four different seeds")
     configs = parse_configs(a.config)
     os.makedirs(a.out, exist_ok=True)
     base = configs[0][0]
@@ -215,22 +255,35 @@ def main():
         denom = m * m + 1e-2
         eff, eff_mse = {}, {}
         cells = []
-        xb, yb = images[base]
-        sq_base, t_base = (xb - yb) ** 2 / 2, statistics.mean(cpu[base])
+        def pairs(imgs):
+            """Per pixel and channel, each pair of renders' squared error `(a − b)² / 2`."""
+            return [(imgs[i] - imgs[i + 1]) ** 2 / 2 for i in range(0, len(imgs), 2)]
+
+        sq_base, t_base = pairs(images[base]), statistics.mean(cpu[base])
         for label, passes, _ in rows:
-            x, y = images[label]
-            sq = (x - y) ** 2 / 2
+            sqs = pairs(images[label])
+            sq = np.mean(sqs, axis=0)
             rel_var = float(np.mean(sq / denom))
             mse = float(np.mean(sq))
-            per_pixel = np.sort(sq.sum(-1).ravel())[::-1]
-            top = float(per_pixel[: max(1, per_pixel.size // 100)].sum() / max(per_pixel.sum(), 1e-30))
+            pixel = [q.sum(-1) for q in sqs]
+            top = f"top-1% {100 * top_share(sq.sum(-1)):.0f}%"
+            if len(pixel) == 2:
+                top += f" (held out {100 * held_out(top_share, *pixel):.0f}%)"
             t = statistics.mean(cpu[label])
             eff[label] = 1.0 / (rel_var * t) if rel_var > 0 and t > 0 else float("inf")
             eff_mse[label] = 1.0 / (mse * t) if mse > 0 and t > 0 else float("inf")
             worst = ""
-            if label != base and label != "mitsuba" and sq.shape == sq_base.shape:
-                worst = f" (MSE in its worst 1% {worst_share_efficiency(sq, t, sq_base, t_base):.2f}x)"
-            cells.append(f"{label}: relvar {rel_var:.3g} mse {mse:.3g} top-1% {100 * top:.0f}%"
+            if label != base and label != "mitsuba" and sq.shape == sq_base[0].shape:
+                base_pixel = [q.sum(-1) for q in sq_base]
+                w = worst_share_efficiency(pixel[0], t, base_pixel[0], t_base)
+                worst = f" (MSE in its worst 1% {w:.2f}x"
+                if len(pixel) == 2:
+                    w = held_out(
+                        lambda a, held: worst_share_efficiency(a[0], t, a[1], t_base, held),
+                        (pixel[0], base_pixel[0]), (pixel[1], base_pixel[1]))
+                    worst += f", held out {w:.2f}x"
+                worst += ")"
+            cells.append(f"{label}: relvar {rel_var:.3g} mse {mse:.3g} {top}"
                          f"{worst} cpu {t:.2f}s ({t / passes:.3f}/pass)")
         for label in eff:
             ratios.setdefault(label, []).append(eff[label] / eff[base])
@@ -243,7 +296,8 @@ def main():
                   f"(MSE {eff_mse[label] / eff_mse[base]:.3g}x)", flush=True)
         if a.bias:
             for label, _, _ in configs[1:]:
-                parts = [mean_difference(images[label][k], images[base][k]) for k in range(2)]
+                parts = [mean_difference(images[label][k], images[base][k])
+                         for k in range(len(seeds))]
                 print(f"    {label} - {base}, image sum: " + ", ".join(
                     f"seed {seed} {100 * rel:+.2f} % ({z:+.1f} s.e.)"
                     for seed, (rel, z) in zip(seeds, parts)))
