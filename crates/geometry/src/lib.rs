@@ -36,7 +36,7 @@ pub use attribute::{AttributeError, AttributeRate, MeshAttribute};
 pub use camera::{Camera, CameraError, FovAxis};
 pub use cylinder::Cylinder;
 pub use frame::Frame;
-pub use mesh::{MeshError, TriangleMesh};
+pub use mesh::{MeshError, TriangleMesh, angle_weighted_normals};
 pub use ray::{Ray, offset_ray_origin, ray_epsilon, shadow_ray_between, shadow_ray_towards};
 pub use sdfgrid::{SdfGrid, SdfNormals};
 pub use shape::{PositionSample, Shape, Sphere, area_to_solid_angle};

@@ -214,6 +214,15 @@ impl TriangleMesh {
         self.update_tables();
     }
 
+    /// Gives a mesh read without normals smooth ones, as Mitsuba 3 and Lajolla do for a mesh
+    /// file that has none (unless it asks for face normals): [`angle_weighted_normals`] of the
+    /// positions as they are now, so called on world-space meshes, after
+    /// [`TriangleMesh::transform`]. A vertex that no triangle with an area meets gets a zero
+    /// normal, which a lookup replaces by the face normal.
+    pub fn compute_vertex_normals(&mut self) {
+        self.normals = Some(angle_weighted_normals(&self.positions, &self.indices));
+    }
+
     /// Removes the triangles of zero area (collinear or coincident corners: they can never be
     /// sampled and are hit only through rounding), returning how many there were. Called on
     /// world-space meshes, after [`TriangleMesh::transform`]; a mesh with nothing else is an error.
@@ -437,5 +446,142 @@ impl TriangleMesh {
         let (tri, _pmf, ux) = dist.sample_discrete(u.x);
         let b = restir_sampling::warp::sample_uniform_triangle(Vec2::new(ux, u.y));
         Some((tri, b, 1.0 / self.area))
+    }
+}
+
+/// Vertex normals from the faces: each triangle's unit normal (its winding's, `(p1 − p0) ×
+/// (p2 − p0)`), weighted by the triangle's angle at the vertex, summed and normalised
+/// (Thürmer and Wüthrich, "Computing vertex normals from polygonal facets", JGT 1998, the
+/// weighting Mitsuba 3 uses). Triangles of zero area add nothing; a vertex that only they
+/// meet gets a zero normal.
+pub fn angle_weighted_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec<Vec3> {
+    let mut normals = vec![Vec3::ZERO; positions.len()];
+    for tri in indices {
+        let p = tri.map(|i| positions[i as usize]);
+        let n = (p[1] - p[0]).cross(p[2] - p[0]);
+        let len2 = n.length_squared();
+        if !(len2 > 0.0 && len2.is_finite()) {
+            continue;
+        }
+        let n = n / len2.sqrt();
+        for k in 0..3 {
+            let a = (p[(k + 1) % 3] - p[k]).normalize_or_zero();
+            let b = (p[(k + 2) % 3] - p[k]).normalize_or_zero();
+            normals[tri[k] as usize] += n * unit_angle(a, b);
+        }
+    }
+    for n in &mut normals {
+        *n = n.normalize_or_zero();
+    }
+    normals
+}
+
+/// The angle between unit vectors `a` and `b`, accurate near 0 and π (from the chord `|a ∓ b|`
+/// rather than the cosine, whose `acos` loses digits there).
+fn unit_angle(a: Vec3, b: Vec3) -> f32 {
+    if a.dot(b) < 0.0 {
+        std::f32::consts::PI - 2.0 * (0.5 * (a + b).length()).min(1.0).asin()
+    } else {
+        2.0 * (0.5 * (a - b).length()).min(1.0).asin()
+    }
+}
+
+#[cfg(test)]
+mod normal_tests {
+    use super::*;
+
+    /// A fan around the origin in the plane z = 0 and one face tilted out of it.
+    fn fan() -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let p = vec![
+            Vec3::ZERO,
+            Vec3::X,
+            Vec3::Y,
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::new(0.0, -1.0, 1.0),
+        ];
+        (p, vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]])
+    }
+
+    #[test]
+    fn planar_faces_keep_their_normal() {
+        let (p, idx) = fan();
+        let n = angle_weighted_normals(&p, &idx[..2]);
+        for (i, n) in n[..4].iter().enumerate() {
+            assert_eq!(*n, Vec3::Z, "vertex {i}");
+        }
+        // A vertex no triangle uses.
+        assert_eq!(n[4], Vec3::ZERO);
+    }
+
+    #[test]
+    fn faces_weigh_by_their_angle_at_the_vertex() {
+        let (p, idx) = fan();
+        let n = angle_weighted_normals(&p, &idx);
+        // At the centre: two right angles of +z and the tilted face's angle (between −x and
+        // (0, −1, 1)/√2: 90°) of its normal.
+        let tilted = (p[3] - p[0]).cross(p[4] - p[0]).normalize();
+        let expected =
+            (Vec3::Z * std::f32::consts::PI + tilted * std::f32::consts::FRAC_PI_2).normalize();
+        assert!((n[0] - expected).length() < 1e-6, "{} vs {expected}", n[0]);
+        // The corner at (−1, 0, 0): the second face's 45° and the tilted face's acos(1/√3)
+        // (between (1, 0, 0) and (1, −1, 1)).
+        let w2 = std::f32::consts::FRAC_PI_4;
+        let w3 = (1.0 / 3f32.sqrt()).acos();
+        let expected = (Vec3::Z * w2 + tilted * w3).normalize();
+        assert!((n[3] - expected).length() < 1e-6, "{} vs {expected}", n[3]);
+    }
+
+    #[test]
+    fn zero_area_triangles_add_nothing() {
+        let (mut p, mut idx) = fan();
+        p.push(Vec3::new(2.0, 0.0, 0.0));
+        idx.push([0, 1, 5]);
+        let with = angle_weighted_normals(&p, &idx);
+        let without = angle_weighted_normals(&p, &idx[..3]);
+        assert_eq!(with[..5], without[..5]);
+        assert_eq!(with[5], Vec3::ZERO);
+    }
+
+    #[test]
+    fn unit_angle_is_accurate_at_both_ends() {
+        let a = Vec3::X;
+        let tiny = Vec3::new(1.0, 1e-4, 0.0).normalize();
+        assert!((unit_angle(a, tiny) - 1e-4).abs() < 1e-9);
+        let opposite = Vec3::new(-1.0, 1e-4, 0.0).normalize();
+        assert!((unit_angle(a, opposite) - (std::f32::consts::PI - 1e-4)).abs() < 1e-6);
+        assert!((unit_angle(a, Vec3::Y) - std::f32::consts::FRAC_PI_2).abs() < 4e-7);
+    }
+
+    #[test]
+    fn a_sphere_gets_its_radial_normals() {
+        // A UV sphere of 16 × 8 quads with shared vertices: the computed normals are close to
+        // the radial direction (exact for the sphere the facets approximate).
+        let (rings, segments) = (8u32, 16u32);
+        let mut p = vec![Vec3::Y, -Vec3::Y];
+        for r in 1..rings {
+            let theta = std::f32::consts::PI * r as f32 / rings as f32;
+            for s in 0..segments {
+                let phi = std::f32::consts::TAU * s as f32 / segments as f32;
+                p.push(Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.cos(),
+                    theta.sin() * phi.sin(),
+                ));
+            }
+        }
+        let v = |r: u32, s: u32| 2 + (r - 1) * segments + s % segments;
+        let mut idx = Vec::new();
+        for s in 0..segments {
+            idx.push([0, v(1, s + 1), v(1, s)]);
+            idx.push([1, v(rings - 1, s), v(rings - 1, s + 1)]);
+            for r in 1..rings - 1 {
+                idx.push([v(r, s), v(r, s + 1), v(r + 1, s)]);
+                idx.push([v(r, s + 1), v(r + 1, s + 1), v(r + 1, s)]);
+            }
+        }
+        let n = angle_weighted_normals(&p, &idx);
+        for (i, (n, p)) in n.iter().zip(&p).enumerate() {
+            assert!(n.dot(*p) > 0.995, "vertex {i}: {n} against {p}");
+        }
     }
 }

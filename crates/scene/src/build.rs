@@ -18,8 +18,9 @@ use crate::transform_matrix;
 use crate::{Scene, SceneError, SceneFeatures, SceneWarning, TexturedParams};
 
 mod budget;
+mod mesh_file;
 
-use budget::{Budget, vertex_bytes};
+use budget::Budget;
 
 fn affine(m: Mat4) -> Result<Affine3A, String> {
     let row3 = m.row(3);
@@ -206,6 +207,8 @@ fn build_shape(
         dropped.set(mesh.drop_degenerate().map_err(|e| e.to_string())?);
         Ok(Shape::Mesh(mesh))
     };
+    // A mesh file without normals gets smooth ones (in world space), as in Mitsuba 3.
+    let mut smooth = false;
     let mut shape = match &desc.geometry {
         GeometryDesc::Rectangle => mesh(Shape::rectangle())?,
         GeometryDesc::Cube => mesh(Shape::cube())?,
@@ -253,51 +256,10 @@ fn build_shape(
             )?;
             Shape::SdfGrid(grid)
         }
-        GeometryDesc::Obj { filename } => {
-            let path = base_dir.join(filename);
-            let (p, n, uv, idx) = crate::meshio::load_obj(&path).map_err(|e| e.to_string())?;
-            budget.take_mesh(idx.len(), vertex_bytes(&p, &n, &uv), || {
-                format!("mesh '{}'", path.display())
-            })?;
-            let n = if desc.face_normals { None } else { n };
-            mesh(
-                TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
-                    .map_err(|e| format!("mesh '{}': {e}", path.display()))?,
-            )?
-        }
-        GeometryDesc::Ply { filename } => {
-            let path = base_dir.join(filename);
-            let ((p, n, uv, idx), attributes) =
-                crate::meshio::load_ply(&path).map_err(|e| e.to_string())?;
-            let attribute_bytes: usize = attributes.iter().map(|a| a.bytes()).sum();
-            budget.take_mesh(
-                idx.len(),
-                vertex_bytes(&p, &n, &uv) + attribute_bytes,
-                || format!("mesh '{}'", path.display()),
-            )?;
-            let n = if desc.face_normals { None } else { n };
-            mesh(
-                TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
-                    .map_err(|e| e.to_string())
-                    .and_then(|m| m.with_attributes(attributes).map_err(|e| e.to_string()))
-                    .map_err(|e| format!("mesh '{}': {e}", path.display()))?,
-            )?
-        }
-        GeometryDesc::Serialized {
-            filename,
-            shape_index,
-        } => {
-            let path = base_dir.join(filename);
-            let (p, n, uv, idx) = crate::meshio::load_serialized(&path, *shape_index as usize)
-                .map_err(|e| e.to_string())?;
-            budget.take_mesh(idx.len(), vertex_bytes(&p, &n, &uv), || {
-                format!("mesh '{}'", path.display())
-            })?;
-            let n = if desc.face_normals { None } else { n };
-            mesh(
-                TriangleMesh::new(p, n, uv, idx, desc.flip_normals)
-                    .map_err(|e| format!("mesh '{}': {e}", path.display()))?,
-            )?
+        GeometryDesc::Obj { .. } | GeometryDesc::Ply { .. } | GeometryDesc::Serialized { .. } => {
+            let (m, computed_normals) = mesh_file::read(desc, base_dir, budget)?;
+            smooth = computed_normals;
+            mesh(m)?
         }
         GeometryDesc::Mesh {
             positions,
@@ -320,6 +282,9 @@ fn build_shape(
             )?
         }
     };
+    if let (Shape::Mesh(m), true) = (&mut shape, smooth) {
+        m.compute_vertex_normals();
+    }
     if let (Shape::Mesh(m), true) = (&mut shape, desc.flip_normals) {
         // Built-in meshes are made unflipped; rebuild with the flag.
         if !m.flip_normals() {

@@ -148,9 +148,17 @@ fn size(b: u64) -> String {
     }
 }
 
-/// The bytes of a mesh's positions, normals and uvs.
-pub(super) fn vertex_bytes(p: &[Vec3], n: &Option<Vec<Vec3>>, uv: &Option<Vec<Vec2>>) -> usize {
-    12 * p.len() + n.as_ref().map_or(0, |n| 12 * n.len()) + uv.as_ref().map_or(0, |u| 8 * u.len())
+/// The bytes of a mesh's positions, normals (read, or `computed_normals` for a mesh given
+/// them at load) and uvs.
+pub(super) fn vertex_bytes(
+    p: &[Vec3],
+    n: &Option<Vec<Vec3>>,
+    uv: &Option<Vec<Vec2>>,
+    computed_normals: bool,
+) -> usize {
+    let normals =
+        n.as_ref().map_or(0, |n| 12 * n.len()) + if computed_normals { 12 * p.len() } else { 0 };
+    12 * p.len() + normals + uv.as_ref().map_or(0, |u| 8 * u.len())
 }
 
 /// An image file the build decodes: its path, where the scene names it and how the error says
