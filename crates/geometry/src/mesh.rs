@@ -554,8 +554,8 @@ mod normal_tests {
 
     #[test]
     fn a_sphere_gets_its_radial_normals() {
-        // A UV sphere of 16 × 8 quads with shared vertices: the computed normals are close to
-        // the radial direction (exact for the sphere the facets approximate).
+        // A UV sphere of 16 × 8 quads with shared vertices: each computed normal lies within
+        // six degrees of the radial direction, the normal of the sphere the facets approximate.
         let (rings, segments) = (8u32, 16u32);
         let mut p = vec![Vec3::Y, -Vec3::Y];
         for r in 1..rings {
