@@ -556,29 +556,7 @@ mod normal_tests {
     fn a_sphere_gets_its_radial_normals() {
         // A UV sphere of 16 × 8 quads with shared vertices: each computed normal lies within
         // six degrees of the radial direction, the normal of the sphere the facets approximate.
-        let (rings, segments) = (8u32, 16u32);
-        let mut p = vec![Vec3::Y, -Vec3::Y];
-        for r in 1..rings {
-            let theta = std::f32::consts::PI * r as f32 / rings as f32;
-            for s in 0..segments {
-                let phi = std::f32::consts::TAU * s as f32 / segments as f32;
-                p.push(Vec3::new(
-                    theta.sin() * phi.cos(),
-                    theta.cos(),
-                    theta.sin() * phi.sin(),
-                ));
-            }
-        }
-        let v = |r: u32, s: u32| 2 + (r - 1) * segments + s % segments;
-        let mut idx = Vec::new();
-        for s in 0..segments {
-            idx.push([0, v(1, s + 1), v(1, s)]);
-            idx.push([1, v(rings - 1, s), v(rings - 1, s + 1)]);
-            for r in 1..rings - 1 {
-                idx.push([v(r, s), v(r, s + 1), v(r + 1, s)]);
-                idx.push([v(r, s + 1), v(r + 1, s + 1), v(r + 1, s)]);
-            }
-        }
+        let (p, idx) = restir_testkit::meshes::uv_sphere(Vec3::ZERO, 1.0, 16, 8);
         let n = angle_weighted_normals(&p, &idx);
         for (i, (n, p)) in n.iter().zip(&p).enumerate() {
             assert!(n.dot(*p) > 0.995, "vertex {i}: {n} against {p}");

@@ -16,6 +16,7 @@
 //!   renders ([`block_statistics`], [`max_z`]), for comparing two estimators of the same image.
 //! - [`tempdir`]: a fresh temporary directory per test, removed when dropped ([`TempDir`]).
 //! - [`alloc`]: a counting global allocator and [`measure`] for tests of memory ([`CountingAllocator`]).
+//! - [`meshes`]: a UV sphere of triangles ([`meshes::uv_sphere`]) for tests of meshes and lights.
 //!
 //! # Chi-square tests of samplers
 //!
@@ -68,6 +69,7 @@ pub mod blocks;
 pub mod chi2;
 pub mod corpus;
 pub mod grid;
+pub mod meshes;
 pub mod running;
 pub mod special;
 pub mod tempdir;
