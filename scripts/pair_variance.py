@@ -29,9 +29,12 @@ variances are their mean, and the hardest pixels' figures are also given held ou
 and the worst 1 % chosen from one pair's 3×3 means and read from the other pair, both ways,
 averaged. Chosen and read from the same pair, the hardest 1 % is partly pixels whose estimate
 is high by chance, which inflates the share and lowers the worst-1 % efficiency of whichever
-configuration chose them; held out, they estimate the share of the expected squared error. A configuration is `label=passes=flags`; flags that start
-with `@PATH` render with the binary at PATH instead of `--bin` (two builds in one run). Renders are kept in `--out` and
-reused when their stats file exists, so an interrupted run resumes.
+configuration chose them; held out, they estimate the share of the expected squared error. The
+figures not marked held out come from the first pair, as a run with two seeds gives them.
+
+A configuration is `label=passes=flags`; flags that start with `@PATH` render with the binary
+at PATH instead of `--bin` (two builds in one run). Renders are kept in `--out` and reused when
+their stats file exists, so an interrupted run resumes.
 
     python3 scripts/pair_variance.py --bin target/release/restir --size 640x360 --threads 1 \\
         --out /tmp/pv --config 'path=16=--integrator path' \\
@@ -210,6 +213,11 @@ def held_out(f, first, second):
     return (f(first, second) + f(second, first)) / 2
 
 
+def pairs(imgs):
+    """Per pixel and channel, each pair of renders' squared error `(a − b)² / 2`."""
+    return [(imgs[i] - imgs[i + 1]) ** 2 / 2 for i in range(0, len(imgs), 2)]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--bin", default="target/release/restir")
@@ -255,10 +263,6 @@ def main():
         denom = m * m + 1e-2
         eff, eff_mse = {}, {}
         cells = []
-        def pairs(imgs):
-            """Per pixel and channel, each pair of renders' squared error `(a − b)² / 2`."""
-            return [(imgs[i] - imgs[i + 1]) ** 2 / 2 for i in range(0, len(imgs), 2)]
-
         sq_base, t_base = pairs(images[base]), statistics.mean(cpu[base])
         for label, passes, _ in rows:
             sqs = pairs(images[label])
@@ -266,7 +270,7 @@ def main():
             rel_var = float(np.mean(sq / denom))
             mse = float(np.mean(sq))
             pixel = [q.sum(-1) for q in sqs]
-            top = f"top-1% {100 * top_share(sq.sum(-1)):.0f}%"
+            top = f"top-1% {100 * top_share(pixel[0]):.0f}%"
             if len(pixel) == 2:
                 top += f" (held out {100 * held_out(top_share, *pixel):.0f}%)"
             t = statistics.mean(cpu[label])
