@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use restir_geometry::{Shape, TriangleMesh, angle_weighted_normals};
+use restir_geometry::{Ray, Shape, TriangleMesh, angle_weighted_normals};
 use restir_scene::{LoadOptions, load_scene};
 use restir_testkit::TempDir;
 
@@ -101,4 +101,31 @@ fn face_normals_and_a_files_own_normals_are_kept() {
     }
     let m = mesh(&scene_file(&d, "obj", "vn.obj", ""));
     assert!(m.normals().unwrap().iter().all(|n| *n == Vec3::Z));
+}
+
+/// The computed normals are stored as the winding gives them and turned at lookup with the
+/// shape, as a file's own normals are: under `flip_normals` a hit near the apex shades with
+/// the interpolated normal reversed.
+#[test]
+fn flip_normals_turns_computed_normals() {
+    let d = dir("flip");
+    let shading = |props: &str| {
+        let path = scene_file(&d, "obj", "p.obj", props);
+        let scene = load_scene(&path, &LoadOptions::default())
+            .unwrap_or_else(|e| panic!("{e}"))
+            .scene;
+        let si = scene
+            .intersect(&Ray::new(Vec3::new(0.1, 0.05, 5.0), -Vec3::Z))
+            .expect("hit");
+        (si.shading.n, si.ng)
+    };
+    let (n, ng) = shading("");
+    let (flipped, flipped_ng) = shading(r#"<boolean name="flip_normals" value="true"/>"#);
+    // Smooth: near the apex the shading normal leans towards +z, away from the face's.
+    assert!(n.z > ng.z + 0.1, "{n} against the face's {ng}");
+    assert!((flipped + n).length() < 1e-6, "{flipped} against {n}");
+    assert!(
+        (flipped_ng + ng).length() < 1e-6,
+        "{flipped_ng} against {ng}"
+    );
 }
