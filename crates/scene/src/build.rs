@@ -207,8 +207,6 @@ fn build_shape(
         dropped.set(mesh.drop_degenerate().map_err(|e| e.to_string())?);
         Ok(Shape::Mesh(mesh))
     };
-    // A mesh file without normals gets smooth ones (in world space), as in Mitsuba 3.
-    let mut smooth = false;
     let mut shape = match &desc.geometry {
         GeometryDesc::Rectangle => mesh(Shape::rectangle())?,
         GeometryDesc::Cube => mesh(Shape::cube())?,
@@ -258,8 +256,12 @@ fn build_shape(
         }
         GeometryDesc::Obj { .. } | GeometryDesc::Ply { .. } | GeometryDesc::Serialized { .. } => {
             let (m, computed_normals) = mesh_file::read(desc, base_dir, budget)?;
-            smooth = computed_normals;
-            mesh(m)?
+            let mut shape = mesh(m)?;
+            // A file without normals gets smooth ones, in world space, as in Mitsuba 3.
+            if let (Shape::Mesh(m), true) = (&mut shape, computed_normals) {
+                m.compute_vertex_normals();
+            }
+            shape
         }
         GeometryDesc::Mesh {
             positions,
@@ -282,9 +284,6 @@ fn build_shape(
             )?
         }
     };
-    if let (Shape::Mesh(m), true) = (&mut shape, smooth) {
-        m.compute_vertex_normals();
-    }
     if let (Shape::Mesh(m), true) = (&mut shape, desc.flip_normals) {
         // Built-in meshes are made unflipped; rebuild with the flag.
         if !m.flip_normals() {
